@@ -1,0 +1,169 @@
+// pybind11 binding: a thin layer that names the core's types for Python. No logic lives here
+// beyond converting poses (3-sequences) and batching checks for the benchmarks.
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <array>
+
+#include "stablepush/cross_section.hpp"
+#include "stablepush/friction_cone.hpp"
+#include "stablepush/gripper.hpp"
+#include "stablepush/pusher.hpp"
+#include "stablepush/rigid_body.hpp"
+#include "stablepush/stable_push.hpp"
+
+namespace py = pybind11;
+using namespace stablepush;
+
+namespace {
+Pose to_pose(const std::array<double, 3>& q) { return Pose{q[0], q[1], q[2]}; }
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "stablepush C++ core: contact models, generalized friction cones and the stable-push test (SI units)";
+  m.attr("CERTIFICATION_BAND") = kCertificationBand;
+  m.attr("STICKING_SPEED_RATIO") = kStickingSpeedRatio;
+
+  py::class_<CrossSection>(m, "CrossSection", "The object's cross-section in O: a simple polygon [m].")
+      .def(py::init<std::vector<Vec2>>(), py::arg("vertices"))
+      .def_static("box", &CrossSection::box, py::arg("length_x"), py::arg("height_z"))
+      .def_static("defect", &CrossSection::defect, py::arg("vertices"),
+                  "Why the vertices are not a usable cross-section ('' when they are).")
+      .def_property_readonly("vertices", &CrossSection::vertices)
+      .def_property_readonly("area", &CrossSection::area)
+      .def_property_readonly("centroid", &CrossSection::centroid)
+      .def_property_readonly("polar_moment_about_centroid", &CrossSection::polar_moment_about_centroid)
+      .def_property_readonly("circumradius", &CrossSection::circumradius)
+      .def("contains_disc", &CrossSection::contains_disc, py::arg("center"), py::arg("radius"))
+      .def("distance_to_boundary", &CrossSection::distance_to_boundary, py::arg("point"))
+      .def("edges_holding", &CrossSection::edges_holding, py::arg("a"), py::arg("b"), py::arg("tolerance"))
+      .def("inward_normal", &CrossSection::inward_normal, py::arg("edge"));
+
+  py::class_<RigidBody>(m, "RigidBody", "Mass [kg], centre of mass in O [m], inertia about it [kg m^2].")
+      .def(py::init([](double mass, const Vec2& com, double inertia) { return RigidBody{mass, com, inertia}; }),
+           py::arg("mass"), py::arg("com"), py::arg("inertia"))
+      .def_static("uniform", &RigidBody::uniform, py::arg("section"), py::arg("mass"))
+      .def_readonly("mass", &RigidBody::mass)
+      .def_readonly("com", &RigidBody::com)
+      .def_readonly("inertia", &RigidBody::inertia);
+
+  py::class_<Pad>(m, "Pad", "A finger pad: a disc in G (centre [m], radius [m]).")
+      .def(py::init([](const Vec2& center, double radius) { return Pad{center, radius}; }), py::arg("center"),
+           py::arg("radius"))
+      .def_readonly("center", &Pad::center)
+      .def_readonly("radius", &Pad::radius);
+
+  py::class_<Gripper>(m, "Gripper")
+      .def(py::init<std::vector<Pad>, double, double, int>(), py::arg("pads"), py::arg("grip_force"), py::arg("mu"),
+           py::arg("pad_rings"))
+      .def_property_readonly("pads", &Gripper::pads)
+      .def_property_readonly("point_positions", [](const Gripper& g) {
+        std::vector<Vec2> out;
+        for (const PadPoint& p : g.points()) out.push_back(p.position);
+        return out;
+      })
+      .def_property_readonly("point_friction_limits", [](const Gripper& g) {
+        std::vector<double> out;
+        for (const PadPoint& p : g.points()) out.push_back(p.friction_limit);
+        return out;
+      })
+      .def("pads_inside", [](const Gripper& g, const CrossSection& s, const std::array<double, 3>& q) {
+        return g.pads_inside(s, to_pose(q));
+      }, py::arg("section"), py::arg("pose"));
+
+  py::class_<Pusher>(m, "Pusher")
+      .def_static("on_boundary", &Pusher::on_boundary, py::arg("section"), py::arg("name"), py::arg("a"),
+                  py::arg("b"), py::arg("mu"), py::arg("n_points"))
+      .def_readonly("name", &Pusher::name)
+      .def_readonly("points", &Pusher::points)
+      .def_readonly("inward_normal", &Pusher::inward_normal)
+      .def_readonly("mu", &Pusher::mu)
+      .def("cone_generators", &Pusher::cone_generators);
+
+  py::class_<WrenchCone>(m, "WrenchCone", "A pointed polyhedral wrench cone with its exact H-representation.")
+      .def(py::init<std::vector<Wrench>, double>(), py::arg("generators"), py::arg("torque_length"))
+      .def_property_readonly("dimension", &WrenchCone::dimension)
+      .def_property_readonly("generators", &WrenchCone::generators)
+      .def_property_readonly("facet_rows", &WrenchCone::facet_rows)
+      .def_property_readonly("equality_rows", &WrenchCone::equality_rows)
+      .def_property_readonly("torque_length", &WrenchCone::torque_length);
+
+  py::enum_<ContactCase>(m, "ContactCase")
+      .value("all_sliding", ContactCase::AllSliding)
+      .value("sticking", ContactCase::Sticking);
+
+  py::class_<PushResult>(m, "PushResult")
+      .def_readonly("feasible", &PushResult::feasible)
+      .def_readonly("contact_case", &PushResult::contact_case)
+      .def_readonly("margin", &PushResult::margin, "How deep inside the cone [N]")
+      .def_readonly("witness", &PushResult::witness, "Pusher wrench in O [N, N, N m]")
+      .def_readonly("exact", &PushResult::exact, "Decided in exact arithmetic")
+      .def_readonly("sticking_points", &PushResult::sticking_points)
+      .def("__repr__", [](const PushResult& r) {
+        return std::string("<PushResult feasible=") + (r.feasible ? "True" : "False") + " case=" +
+               (r.contact_case == ContactCase::Sticking ? "sticking" : "all_sliding") +
+               " margin=" + std::to_string(r.margin) + ">";
+      });
+
+  py::class_<MotionWrench>(m, "MotionWrench")
+      .def_readonly("required", &MotionWrench::required, "M xi/dt - w_sliding - w_gravity in O [N, N, N m]")
+      .def_property_readonly("sticking", [](const MotionWrench& w) {
+        std::vector<std::pair<Vec2, double>> out;
+        for (const StickingGroup& g : w.sticking) out.emplace_back(g.arm, g.friction_limit);
+        return out;
+      }, "(arm in G from O's origin [m], friction disc radius [N]) per sticking location")
+      .def_readonly("sticking_points", &MotionWrench::sticking_points)
+      .def_readonly("scale", &MotionWrench::scale);
+
+  py::class_<StablePushModel>(m, "StablePushModel")
+      .def(py::init<CrossSection, RigidBody, Gripper, std::vector<Pusher>, const Vec2&, double, int>(),
+           py::arg("section"), py::arg("body"), py::arg("gripper"), py::arg("pushers"), py::arg("gravity"),
+           py::arg("step_time"), py::arg("friction_polygon_sides") = 16)
+      .def_property_readonly("section", &StablePushModel::section)
+      .def_property_readonly("body", &StablePushModel::body)
+      .def_property_readonly("gripper", &StablePushModel::gripper)
+      .def_property_readonly("pushers", &StablePushModel::pushers)
+      .def_property_readonly("pusher_cones", &StablePushModel::pusher_cones)
+      .def_property_readonly("torque_length", &StablePushModel::torque_length)
+      .def("motion_wrench", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq) {
+        return m.motion_wrench(to_pose(q), to_pose(dq));
+      }, py::arg("q"), py::arg("dq"))
+      .def("check", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq,
+                       int pusher) { return m.check(to_pose(q), to_pose(dq), pusher); },
+           py::arg("q"), py::arg("dq"), py::arg("pusher"))
+      .def("check_all", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq) {
+        return m.check_all(to_pose(q), to_pose(dq));
+      }, py::arg("q"), py::arg("dq"))
+      .def("grasp_maintained", [](const StablePushModel& m, const std::array<double, 3>& q) {
+        return m.grasp_maintained(to_pose(q));
+      }, py::arg("q"))
+      .def("check_batch",
+           [](const StablePushModel& m, py::array_t<double, py::array::c_style | py::array::forcecast> q,
+              py::array_t<double, py::array::c_style | py::array::forcecast> dq, int pusher) {
+             if (q.ndim() != 2 || q.shape(1) != 3 || dq.ndim() != 2 || dq.shape(1) != 3 || q.shape(0) != dq.shape(0))
+               throw std::invalid_argument("q and dq must be arrays of shape (n, 3)");
+             const py::ssize_t n = q.shape(0);
+             py::array_t<bool> feasible(n);
+             py::array_t<double> margin(n);
+             py::array_t<bool> exact(n);
+             auto Q = q.unchecked<2>();
+             auto D = dq.unchecked<2>();
+             auto F = feasible.mutable_unchecked<1>();
+             auto M = margin.mutable_unchecked<1>();
+             auto E = exact.mutable_unchecked<1>();
+             {
+               py::gil_scoped_release release;
+               for (py::ssize_t i = 0; i < n; ++i) {
+                 const PushResult r = m.check(Pose{Q(i, 0), Q(i, 1), Q(i, 2)}, Pose{D(i, 0), D(i, 1), D(i, 2)}, pusher);
+                 F(i) = r.feasible;
+                 M(i) = r.margin;
+                 E(i) = r.exact;
+               }
+             }
+             return py::make_tuple(feasible, margin, exact);
+           },
+           py::arg("q"), py::arg("dq"), py::arg("pusher"),
+           "Check many (q, dq) rows for one pusher without Python overhead per row: (feasible, margin, exact).");
+}

@@ -1,0 +1,57 @@
+// The object's cross-section in its own frame O: a simple polygon (concave allowed).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "stablepush/types.hpp"
+
+namespace stablepush {
+
+class CrossSection {
+ public:
+  /// vertices: the polygon in O [m]. Counterclockwise with x right and z up is the contract;
+  /// a clockwise list is reversed. Throws std::invalid_argument with defect() as the message.
+  explicit CrossSection(std::vector<Vec2> vertices);
+
+  /// The box of MODEL.md section 4: length along x, height along z [m], centred on O.
+  static CrossSection box(double length_x, double height_z);
+
+  /// Why these vertices are not a usable cross-section ("" when they are): fewer than three
+  /// vertices, non-finite coordinates, repeated vertices, zero area, self-intersection.
+  static std::string defect(const std::vector<Vec2>& vertices);
+
+  const std::vector<Vec2>& vertices() const { return vertices_; }
+  /// Area [m^2].
+  double area() const { return area_; }
+  /// Centroid in O [m].
+  const Vec2& centroid() const { return centroid_; }
+  /// Polar second moment of area about the centroid, integral of |p - centroid|^2 dA [m^4].
+  double polar_moment_about_centroid() const { return polar_moment_centroid_; }
+  /// Largest distance from O's origin to the boundary [m]; the length that turns torques into forces
+  /// when wrench components are compared (margins in newtons).
+  double circumradius() const { return circumradius_; }
+
+  /// Whether the closed disc (centre in O [m], radius [m]) lies inside the closed polygon.
+  /// Decided in double unless the answer is within rounding of tangency; then with CGAL's exact kernel.
+  bool contains_disc(const Vec2& center, double radius) const;
+
+  /// Euclidean distance from a point of O to the boundary [m].
+  double distance_to_boundary(const Vec2& p) const;
+
+  /// Indices of the edges (edge i runs from vertex i to vertex i+1) that hold the segment a-b
+  /// within `tolerance` [m]; for a point (a == b) on a vertex this names both edges.
+  std::vector<int> edges_holding(const Vec2& a, const Vec2& b, double tolerance) const;
+
+  /// Unit normal of edge i pointing into the object.
+  Vec2 inward_normal(int edge) const;
+
+ private:
+  std::vector<Vec2> vertices_;
+  double area_ = 0.0;
+  Vec2 centroid_ = Vec2::Zero();
+  double polar_moment_centroid_ = 0.0;
+  double circumradius_ = 0.0;
+};
+
+}  // namespace stablepush

@@ -1,0 +1,125 @@
+// The stable prehensile push test (paper section V, MODEL.md section 2).
+//
+// Quasi-dynamic balance over one step from rest (paper eq. 5, rearranged as eqs. 6 and 7):
+//     w_pusher = M xi / dt - w_sliding fingers - w_gravity - w_sticking fingers,
+// all in O about O's origin. The push is stable for a pusher when some w_sticking in the
+// sticking points' friction polytope puts w_pusher in the relative interior of that pusher's
+// generalized friction cone.
+//
+// Fast and exact together: the decision is made in double precision and accepted when it is
+// more than a certification band (kCertificationBand times the sum of the magnitudes of the
+// terms) away from the cone's boundary; otherwise it is re-made in exact arithmetic from the
+// same doubles (CGAL Gmpzf sums and products, CGAL's exact LP solver for the sticking case).
+#pragma once
+
+#include <boost/container/small_vector.hpp>
+#include <string>
+#include <vector>
+
+#include "stablepush/cross_section.hpp"
+#include "stablepush/friction_cone.hpp"
+#include "stablepush/gripper.hpp"
+#include "stablepush/pusher.hpp"
+#include "stablepush/rigid_body.hpp"
+#include "stablepush/types.hpp"
+
+namespace stablepush {
+
+/// Relative width of the band around a cone boundary inside which a double answer is re-made exactly.
+inline constexpr double kCertificationBand = 1e-9;
+/// A pad point sticks when its slip speed is below this fraction of |v| + |omega| r_pad (MODEL.md section 2).
+inline constexpr double kStickingSpeedRatio = 1e-9;
+
+enum class ContactCase { AllSliding, Sticking };
+
+/// Pad points at one location that stick during the motion; their friction discs add up.
+struct StickingGroup {
+  Vec2 arm;               ///< from O's origin to the points, in G [m]
+  double friction_limit;  ///< radius of the summed friction disc, sum of mu N / k [N]
+};
+
+/// The paper's net motion wrench: everything in eq. 7 that the motion fixes.
+struct MotionWrench {
+  /// M xi / dt - w_sliding - w_gravity in O about O's origin [N, N, N m].
+  Wrench required = Wrench::Zero();
+  /// Sticking pad points, grouped by location; empty in the all-sliding case.
+  boost::container::small_vector<StickingGroup, 2> sticking;
+  int sticking_points = 0;
+  /// Sum of the magnitudes of the terms [N] (torques divided by the model's torque length).
+  double scale = 0.0;
+  Rotation2 rotation;  ///< R(theta) at the pose
+};
+
+/// The answer of the stable-push test for one pusher.
+struct PushResult {
+  bool feasible = false;
+  ContactCase contact_case = ContactCase::AllSliding;
+  /// How deep inside the cone [N]: the largest t such that w_pusher has every facet row at most -t,
+  /// over the admissible sticking forces (rows normalized as in WrenchCone). Positive iff feasible
+  /// outside the certification band; off the cone's span it is minus the distance to the span.
+  double margin = 0.0;
+  /// The pusher wrench that realizes `margin` (in O about O's origin) [N, N, N m].
+  Wrench witness = Wrench::Zero();
+  /// True when the decision was made in exact arithmetic.
+  bool exact = false;
+  int sticking_points = 0;
+};
+
+class StablePushModel {
+ public:
+  /// gravity: acceleration in G's grasp plane [m/s^2]; step_time: dt of one unit step [s];
+  /// friction_polygon_sides: facets of the polygon inscribed in a sticking point's friction disc.
+  StablePushModel(CrossSection section, RigidBody body, Gripper gripper, std::vector<Pusher> pushers,
+                  const Vec2& gravity, double step_time, int friction_polygon_sides = 16);
+
+  const CrossSection& section() const { return section_; }
+  const RigidBody& body() const { return body_; }
+  const Gripper& gripper() const { return gripper_; }
+  const std::vector<Pusher>& pushers() const { return pushers_; }
+  const std::vector<WrenchCone>& pusher_cones() const { return cones_; }
+  const Vec2& gravity() const { return gravity_; }
+  double step_time() const { return step_time_; }
+  /// Length that converts torques to forces in margins and bands [m]: the cross-section's circumradius.
+  double torque_length() const { return torque_length_; }
+  int friction_polygon_sides() const { return polygon_sides_; }
+
+  /// The motion wrench of a unit motion dq from pose q (twist xi = dq / dt, constant over the step).
+  MotionWrench motion_wrench(const Pose& q, const Motion& dq) const;
+
+  /// The stable-push test of dq from q for pusher `pusher` (an index into pushers()).
+  PushResult check(const Pose& q, const Motion& dq, int pusher) const;
+  /// The test for every pusher, sharing one motion wrench.
+  std::vector<PushResult> check_all(const Pose& q, const Motion& dq) const;
+  /// The test against a motion wrench already computed for (q, dq).
+  PushResult check(const MotionWrench& load, const Pose& q, const Motion& dq, int pusher) const;
+
+  /// Every pad disc inside the cross-section at q.
+  bool grasp_maintained(const Pose& q) const { return gripper_.grasp_maintained(section_, q); }
+
+  /// Walks the terms of the motion wrench in G: loads.force(f, arm) for a force f [N] at arm [m]
+  /// from O's origin, loads.torque(t) for a pure torque [N m], loads.sticking(arm, limit) for a
+  /// sticking pad point. Shared by the double and the exact evaluations so both see the same doubles.
+  template <class Loads>
+  void visit_motion_terms(const Pose& q, const Motion& dq, Loads& loads) const;
+
+ private:
+  PushResult all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq) const;
+  PushResult with_sticking(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq) const;
+  PushResult exact_all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq,
+                               PushResult double_answer) const;
+  PushResult exact_sticking(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq) const;
+
+  CrossSection section_;
+  RigidBody body_;
+  Gripper gripper_;
+  std::vector<Pusher> pushers_;
+  std::vector<WrenchCone> cones_;
+  Vec2 gravity_;
+  double step_time_;
+  double torque_length_;
+  int polygon_sides_;
+  std::vector<Vec2> polygon_normals_;  ///< outward edge normals of the unit friction polygon (in G)
+  double polygon_inradius_;            ///< cos(pi / sides): edge offset of the unit polygon
+};
+
+}  // namespace stablepush

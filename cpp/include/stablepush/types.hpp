@@ -1,0 +1,51 @@
+// Small value types shared by the whole core. Everything inside the core is SI:
+// metres, radians, kilograms, newtons, seconds (MODEL.md section 1).
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+
+namespace stablepush {
+
+/// A vector in a grasp plane, (x, z). In G or in O as the name says.
+using Vec2 = Eigen::Vector2d;
+
+/// A planar wrench (f_x [N], f_z [N], tau_y [N m]) with tau_y = r_z f_x - r_x f_z.
+using Wrench = Eigen::Vector3d;
+
+/// Pose of the object frame O seen from the gripper frame G: (x [m], z [m], theta [rad]),
+/// theta a right-handed rotation about +y (the paper's theta_y).
+struct Pose {
+  double x = 0.0;
+  double z = 0.0;
+  double theta = 0.0;
+};
+
+/// A unit motion Delta q over one step: (dx [m], dz [m], dtheta [rad]).
+using Motion = Pose;
+
+/// y-component of r x f for r, f in a grasp plane: tau_y = r_z f_x - r_x f_z.
+inline double cross_y(const Vec2& r, const Vec2& f) { return r.y() * f.x() - r.x() * f.y(); }
+
+/// omega x r for an angular velocity omega about +y and r in the grasp plane: (omega r_z, -omega r_x).
+inline Vec2 omega_cross(double omega, const Vec2& r) { return Vec2(omega * r.y(), -omega * r.x()); }
+
+/// The rotation R(theta) of MODEL.md section 1: p_G = c + R p_O, R = [[cos, sin], [-sin, cos]].
+struct Rotation2 {
+  double c = 1.0;
+  double s = 0.0;
+  Rotation2() = default;
+  explicit Rotation2(double theta) : c(std::cos(theta)), s(std::sin(theta)) {}
+  /// R p: a vector of O expressed in G.
+  Vec2 apply(const Vec2& p) const { return Vec2(c * p.x() + s * p.y(), -s * p.x() + c * p.y()); }
+  /// R^T v: a vector of G expressed in O.
+  Vec2 apply_inverse(const Vec2& v) const { return Vec2(c * v.x() - s * v.y(), s * v.x() + c * v.y()); }
+};
+
+/// The point at angle 2 pi j / n on the unit circle, with the eight symmetries of the square
+/// holding bit for bit (mirror images are exact negations or swaps). Pad rings and friction
+/// polygons are built from it, so a symmetric task gives sums that cancel exactly, which the
+/// exact re-check of a lower-dimensional cone relies on.
+Vec2 unit_circle_point(long j, long n);
+
+}  // namespace stablepush

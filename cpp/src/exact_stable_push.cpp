@@ -1,0 +1,131 @@
+// The exact re-check of a stable-push decision that the double evaluation could not certify.
+// Every input is the double the fast path used; sums and products are exact in CGAL::Gmpzf, and
+// the sticking case is CGAL's exact LP solver (about 50 us, so it stays off the common path).
+#include <CGAL/QP_functions.h>
+#include <CGAL/QP_models.h>
+
+#include <limits>
+
+#include "motion_terms.hpp"
+#include "stablepush/exact.hpp"
+
+namespace stablepush {
+namespace {
+
+struct ExactLoads {
+  ExactFT fx = 0, fz = 0, tau = 0;
+  boost::container::small_vector<StickingGroup, 2> groups;
+
+  void force(const Vec2& f, const Vec2& arm) {
+    const ExactFT f_x(f.x()), f_z(f.y());
+    fx += f_x;
+    fz += f_z;
+    tau += ExactFT(arm.y()) * f_x - ExactFT(arm.x()) * f_z;
+  }
+  void torque(double t) { tau += ExactFT(t); }
+  void sticking(const Vec2& arm, double friction_limit) { add_sticking_point(groups, arm, friction_limit); }
+};
+
+/// The motion wrench in O, exactly, from the same doubles (R^T applied with the same cos and sin).
+ExactWrench exact_required(const ExactLoads& loads, const Rotation2& R) {
+  const ExactFT c(R.c), s(R.s);
+  return ExactWrench(c * loads.fx - s * loads.fz, s * loads.fx + c * loads.fz, loads.tau);
+}
+
+/// row^T L_g: the covector a wrench row induces on a sticking group's force (f in G).
+std::pair<ExactFT, ExactFT> exact_pull_back(const ExactWrench& row, const Rotation2& R, const Vec2& arm) {
+  const ExactFT c(R.c), s(R.s);
+  return {row.x() * c + row.y() * s + row.z() * ExactFT(arm.y()),
+          -(row.x() * s) + row.y() * c - row.z() * ExactFT(arm.x())};
+}
+
+}  // namespace
+
+PushResult StablePushModel::exact_all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q,
+                                              const Motion& dq, PushResult answer) const {
+  ExactLoads loads;
+  visit_motion_terms(q, dq, loads);
+  const ExactWrench required = exact_required(loads, load.rotation);
+  answer.exact = true;
+  answer.feasible = cone.contains_in_relative_interior(required);
+  for (const ExactWrench& e : cone.exact_equalities())
+    if (!CGAL::is_zero(e * required)) {  // off the span by less than the band
+      double off_span = 0.0;
+      for (const Wrench& row : cone.equality_rows()) off_span = std::max(off_span, std::abs(row.dot(load.required)));
+      answer.margin = -off_span;
+      break;
+    }
+  return answer;
+}
+
+// maximize t  s.t.  t - sum_g (k_i a_i^T L_g) f_g <= -k_i a_i . w   (facets, k_i > 0 their scales)
+//                      - sum_g (e_j^T L_g) f_g  = -e_j . w        (equalities of a lower-dimensional cone)
+//                      n_k . f_g <= rho_g cos(pi / sides)          (friction polygons)
+PushResult StablePushModel::exact_sticking(const WrenchCone& cone, const MotionWrench& load, const Pose& q,
+                                           const Motion& dq) const {
+  ExactLoads loads;
+  visit_motion_terms(q, dq, loads);
+  const ExactWrench required = exact_required(loads, load.rotation);
+  const int groups = static_cast<int>(loads.groups.size());
+  const int t_var = 2 * groups;
+
+  using Program = CGAL::Quadratic_program<ExactFT>;
+  Program lp(CGAL::SMALLER, false, 0, false, 0);  // free variables, rows "<=" unless set
+  int row = 0;
+  for (std::size_t i = 0; i < cone.exact_facets().size(); ++i, ++row) {
+    const ExactFT k(cone.facet_scales()[i]);
+    const ExactWrench a = cone.exact_facets()[i];
+    for (int g = 0; g < groups; ++g) {
+      const auto [u, v] = exact_pull_back(a, load.rotation, loads.groups[g].arm);
+      lp.set_a(2 * g, row, -(k * u));
+      lp.set_a(2 * g + 1, row, -(k * v));
+    }
+    lp.set_a(t_var, row, ExactFT(1));
+    lp.set_b(row, -(k * (a * required)));
+  }
+  for (const ExactWrench& e : cone.exact_equalities()) {
+    for (int g = 0; g < groups; ++g) {
+      const auto [u, v] = exact_pull_back(e, load.rotation, loads.groups[g].arm);
+      lp.set_a(2 * g, row, -u);
+      lp.set_a(2 * g + 1, row, -v);
+    }
+    lp.set_r(row, CGAL::EQUAL);
+    lp.set_b(row, -(e * required));
+    ++row;
+  }
+  for (int g = 0; g < groups; ++g)
+    for (int k = 0; k < polygon_sides_; ++k, ++row) {
+      lp.set_a(2 * g, row, ExactFT(polygon_normals_[k].x()));
+      lp.set_a(2 * g + 1, row, ExactFT(polygon_normals_[k].y()));
+      lp.set_b(row, ExactFT(loads.groups[g].friction_limit * polygon_inradius_));
+    }
+  lp.set_c(t_var, ExactFT(-1));
+  const auto solution = CGAL::solve_linear_program(lp, ExactFT());
+
+  PushResult result;
+  result.contact_case = ContactCase::Sticking;
+  result.sticking_points = load.sticking_points;
+  result.exact = true;
+  if (solution.is_infeasible()) {
+    // No admissible sticking force brings w_pusher onto the cone's span.
+    double off_span = 0.0;
+    for (const Wrench& e : cone.equality_rows()) off_span = std::max(off_span, std::abs(e.dot(load.required)));
+    result.feasible = false;
+    result.margin = -off_span;
+    result.witness = load.required;
+    return result;
+  }
+  std::vector<double> x;
+  for (auto it = solution.variable_values_begin(); it != solution.variable_values_end(); ++it)
+    x.push_back(CGAL::to_double(*it));
+  const auto t = -solution.objective_value();
+  result.feasible = CGAL::is_positive(t);
+  result.margin = CGAL::to_double(t);
+  result.witness = load.required;
+  for (int g = 0; g < groups; ++g) {
+    result.witness -= sticking_wrench(load.rotation, loads.groups[g].arm, Vec2(x[2 * g], x[2 * g + 1]));
+  }
+  return result;
+}
+
+}  // namespace stablepush

@@ -1,0 +1,130 @@
+#include "stablepush/friction_cone.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace stablepush {
+namespace {
+
+ExactWrench to_exact(const Wrench& w) { return ExactWrench(ExactFT(w.x()), ExactFT(w.y()), ExactFT(w.z())); }
+
+bool is_zero(const ExactWrench& v) { return CGAL::is_zero(v.x()) && CGAL::is_zero(v.y()) && CGAL::is_zero(v.z()); }
+
+bool same_direction(const ExactWrench& a, const ExactWrench& b) {
+  return is_zero(CGAL::cross_product(a, b)) && CGAL::is_positive(a * b);
+}
+
+Wrench to_double(const ExactWrench& v) { return Wrench(CGAL::to_double(v.x()), CGAL::to_double(v.y()), CGAL::to_double(v.z())); }
+
+}  // namespace
+
+double WrenchCone::row_scale(const ExactWrench& row) const {
+  const Wrench r = to_double(row);
+  return 1.0 / std::sqrt(r.x() * r.x() + r.y() * r.y() + torque_length_ * torque_length_ * r.z() * r.z());
+}
+
+void WrenchCone::add_facet(const ExactWrench& outward) {
+  for (const ExactWrench& f : exact_facets_)
+    if (same_direction(f, outward)) return;
+  const double scale = row_scale(outward);
+  exact_facets_.push_back(outward);
+  facet_scales_.push_back(scale);
+  facet_rows_.push_back(scale * to_double(outward));
+}
+
+void WrenchCone::add_equality(const ExactWrench& row) {
+  const double scale = row_scale(row);
+  exact_equalities_.push_back(row);
+  equality_scales_.push_back(scale);
+  equality_rows_.push_back(scale * to_double(row));
+}
+
+WrenchCone::WrenchCone(std::vector<Wrench> generators, double torque_length)
+    : generators_(std::move(generators)), torque_length_(torque_length) {
+  if (generators_.empty()) throw std::invalid_argument("a wrench cone needs at least one generator");
+  if (!(torque_length_ > 0.0)) throw std::invalid_argument("torque_length must be > 0");
+  std::vector<ExactWrench> g;
+  for (const Wrench& w : generators_) {
+    if (!w.allFinite()) throw std::invalid_argument("a cone generator is not finite");
+    g.push_back(to_exact(w));
+    if (is_zero(g.back())) throw std::invalid_argument("a cone generator is zero");
+  }
+  const std::size_t m = g.size();
+
+  // Rank of the generators, exactly: a non-parallel pair (a, b), then a third off their plane.
+  std::size_t a = 0, b = m;
+  for (std::size_t j = 1; j < m && b == m; ++j)
+    if (!is_zero(CGAL::cross_product(g[0], g[j]))) b = j;
+  if (b == m) {
+    // Dimension 1: the ray through g[0] (every generator is a positive multiple of it).
+    for (std::size_t j = 1; j < m; ++j)
+      if (!CGAL::is_positive(g[0] * g[j])) throw std::invalid_argument("the cone is not pointed");
+    dimension_ = 1;
+    add_facet(-g[0]);
+    const ExactWrench axes[3] = {ExactWrench(1, 0, 0), ExactWrench(0, 1, 0), ExactWrench(0, 0, 1)};
+    for (const ExactWrench& axis : axes) {
+      const ExactWrench row = CGAL::cross_product(g[0], axis);
+      if (is_zero(row)) continue;
+      if (!exact_equalities_.empty() && is_zero(CGAL::cross_product(exact_equalities_[0], row))) continue;
+      add_equality(row);
+      if (exact_equalities_.size() == 2) break;
+    }
+    return;
+  }
+  const ExactWrench plane_normal = CGAL::cross_product(g[a], g[b]);
+  bool full = false;
+  for (std::size_t k = 0; k < m && !full; ++k) full = !CGAL::is_zero(plane_normal * g[k]);
+
+  if (!full) {
+    // Dimension 2: a wedge in the plane with normal plane_normal, bounded by its two extreme rays.
+    dimension_ = 2;
+    add_equality(plane_normal);
+    for (std::size_t r = 0; r < m; ++r) {
+      bool any_pos = false, any_neg = false;
+      for (std::size_t k = 0; k < m; ++k) {
+        const CGAL::Sign s = CGAL::sign(CGAL::cross_product(g[r], g[k]) * plane_normal);
+        any_pos |= (s == CGAL::POSITIVE);
+        any_neg |= (s == CGAL::NEGATIVE);
+      }
+      if (any_pos && any_neg) continue;  // not an extreme ray
+      ExactWrench outward = CGAL::cross_product(plane_normal, g[r]);
+      for (std::size_t k = 0; k < m; ++k)
+        if (CGAL::is_positive(outward * g[k])) {
+          outward = -outward;
+          break;
+        }
+      add_facet(outward);
+    }
+    return;
+  }
+
+  // Dimension 3: every facet of a pointed cone is spanned by two of its extreme rays, so a pair
+  // whose plane has all generators on one side gives a facet (duplicates collapse in add_facet).
+  dimension_ = 3;
+  for (std::size_t i = 0; i < m; ++i)
+    for (std::size_t j = i + 1; j < m; ++j) {
+      const ExactWrench n = CGAL::cross_product(g[i], g[j]);
+      if (is_zero(n)) continue;
+      bool any_pos = false, any_neg = false;
+      for (std::size_t k = 0; k < m; ++k) {
+        const CGAL::Sign s = CGAL::sign(n * g[k]);
+        any_pos |= (s == CGAL::POSITIVE);
+        any_neg |= (s == CGAL::NEGATIVE);
+      }
+      if (any_pos && any_neg) continue;
+      if (any_pos && !any_neg) add_facet(-n);
+      else if (any_neg && !any_pos) add_facet(n);
+      else throw std::invalid_argument("the cone is not pointed");
+    }
+  if (exact_facets_.size() < 3) throw std::invalid_argument("the cone is not pointed");
+}
+
+bool WrenchCone::contains_in_relative_interior(const ExactWrench& w) const {
+  for (const ExactWrench& e : exact_equalities_)
+    if (!CGAL::is_zero(e * w)) return false;
+  for (const ExactWrench& f : exact_facets_)
+    if (!CGAL::is_negative(f * w)) return false;
+  return true;
+}
+
+}  // namespace stablepush
