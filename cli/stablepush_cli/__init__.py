@@ -1,0 +1,1 @@
+"""The `stablepush` command line: click commands over the stablepush Python API."""

@@ -1,0 +1,40 @@
+"""The stable-push test in file units: the Python face of the core's feasibility test."""
+from __future__ import annotations
+
+from typing import Dict, Optional, Sequence
+
+from stablepush import _core
+from stablepush.task import Task, TaskError, pose_to_si
+
+CASE_NAMES = {_core.ContactCase.all_sliding: "all_sliding", _core.ContactCase.sticking: "sticking"}
+
+
+def result_to_dict(result: "_core.PushResult") -> dict:
+    """A PushResult as plain data: margin in N, witness (f_x N, f_z N, tau_y N m) in O."""
+    return {
+        "feasible": bool(result.feasible),
+        "case": CASE_NAMES[result.contact_case],
+        "margin": float(result.margin),
+        "witness": [float(v) for v in result.witness],
+        "exact": bool(result.exact),
+        "sticking_points": int(result.sticking_points),
+    }
+
+
+def check_push(
+    task: Task,
+    at: Sequence[float],
+    move: Sequence[float],
+    pusher: Optional[str] = None,
+    model: "Optional[_core.StablePushModel]" = None,
+) -> Dict[str, dict]:
+    """Is the unit motion `move` (dx mm, dz mm, dtheta deg) from pose `at` (x mm, z mm, theta deg)
+    a stable push? One entry per pusher (or only `pusher`), keyed by pusher name."""
+    if all(v == 0 for v in move):
+        raise TaskError("move", "the motion is zero; give a non-zero (dx, dz, dtheta)")
+    model = model or task.build_model()
+    q, dq = pose_to_si(at), pose_to_si(move)
+    if pusher is not None:
+        index = task.pusher_index(pusher)
+        return {pusher: result_to_dict(model.check(q, dq, index))}
+    return {name: result_to_dict(r) for name, r in zip(task.pusher_names, model.check_all(q, dq))}

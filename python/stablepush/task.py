@@ -1,0 +1,364 @@
+"""Task files (MODEL.md section 4): load, validate, convert to SI, build the core model.
+
+Files use mm, degrees, grams and newtons; the core is SI. Every bad input is refused with a
+`TaskError` that names the field and the reason, before anything reaches the C++ core.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Dict, List, Optional, Sequence, Tuple
+
+import yaml
+
+from stablepush import _core
+
+MM = 1e-3  # m per mm
+G = 1e-3  # kg per g
+
+DEFAULT_PAD_RADIUS_MM = 5.0
+DEFAULT_GRAVITY = (0.0, -9.81)
+DEFAULT_STEP_TIME = 0.1
+DEFAULT_POLYGON_SIDES = 16
+DEFAULT_PUSHER_POINTS = 3
+PLANNER_DEFAULTS: Dict[str, Any] = {
+    "time_limit": 10.0,
+    "seed": 1,
+    "max_switches": 1,
+    "step": [1.0, 1.0],
+    "tolerance": [1.0, 1.0],
+}
+
+
+class TaskError(ValueError):
+    """A task that cannot be used; `field` is the dotted path of the offending key."""
+
+    def __init__(self, field: str, reason: str, source: Optional[str] = None):
+        self.field = field
+        self.reason = reason
+        self.source = source
+        where = f"{source}: " if source else ""
+        super().__init__(f"{where}{field}: {reason}" if field else f"{where}{reason}")
+
+
+# ---------------------------------------------------------------------------------------------
+# YAML with duplicate keys refused (PyYAML silently keeps the last one).
+
+
+class _StrictLoader(yaml.SafeLoader):
+    pass
+
+
+def _construct_mapping(loader: _StrictLoader, node: yaml.MappingNode, deep: bool = False) -> dict:
+    seen = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise TaskError(str(key), f"duplicate key (line {key_node.start_mark.line + 1})")
+        seen[key] = True
+    return loader.construct_mapping(node, deep=deep)
+
+
+_StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+
+
+# ---------------------------------------------------------------------------------------------
+# Field checkers: each takes the dotted path for its message.
+
+
+def _mapping(path: str, value: Any, required: Sequence[str], optional: Sequence[str]) -> dict:
+    if not isinstance(value, dict):
+        raise TaskError(path, f"must be a mapping, got {type(value).__name__}")
+    for key in value:
+        if key not in required and key not in optional:
+            allowed = ", ".join(list(required) + list(optional))
+            raise TaskError(_join(path, str(key)), f"unknown key (allowed here: {allowed})")
+    for key in required:
+        if key not in value:
+            raise TaskError(_join(path, key), "missing")
+    return value
+
+
+def _join(path: str, key: str) -> str:
+    return f"{path}.{key}" if path else key
+
+
+def _number(path: str, value: Any, *, positive: bool = False, nonnegative: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise TaskError(path, f"must be a number, got {value!r}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise TaskError(path, f"must be finite, got {value!r}")
+    if positive and not x > 0:
+        raise TaskError(path, f"must be > 0, got {value!r}")
+    if nonnegative and not x >= 0:
+        raise TaskError(path, f"must be >= 0, got {value!r}")
+    return x
+
+
+def _integer(path: str, value: Any, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise TaskError(path, f"must be an integer, got {value!r}")
+    if value < minimum:
+        raise TaskError(path, f"must be >= {minimum}, got {value}")
+    return value
+
+
+def _vector(path: str, value: Any, n: int, **kw) -> Tuple[float, ...]:
+    if not isinstance(value, (list, tuple)) or len(value) != n:
+        raise TaskError(path, f"must be a list of {n} numbers, got {value!r}")
+    return tuple(_number(f"{path}[{i}]", v, **kw) for i, v in enumerate(value))
+
+
+def _name(path: str, value: Any) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise TaskError(path, f"must be a non-empty string, got {value!r}")
+    return value
+
+
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PusherSpec:
+    """A pusher as the task gives it, in O [mm]; `a == b` for a point pusher."""
+
+    name: str
+    a: Tuple[float, float]
+    b: Tuple[float, float]
+    mu: float
+    points: int
+
+    @property
+    def is_point(self) -> bool:
+        return self.a == self.b
+
+
+@dataclass(frozen=True)
+class Task:
+    """A validated task, in file units (mm, deg, g, N); `build_model` converts to SI."""
+
+    name: str
+    vertices: Tuple[Tuple[float, float], ...]  # cross-section in O, mm, counterclockwise
+    thickness: float  # mm along y
+    mass: float  # g
+    com: Optional[Tuple[float, float]]  # mm in O; None: the centroid
+    inertia: Optional[float]  # kg m^2 about the com; None: uniform body
+    grip_force: float  # N per pad
+    mu: float  # pad-object friction
+    pad_rings: int
+    pads: Tuple[Tuple[Tuple[float, float], float], ...]  # (centre mm in G, radius mm)
+    gravity: Tuple[float, float]  # m/s^2 in G
+    step_time: float  # s
+    friction_polygon_sides: int
+    pushers: Tuple[PusherSpec, ...]
+    start: Tuple[float, float, float]  # mm, mm, deg
+    goal: Tuple[float, float, float]
+    planner: Dict[str, Any] = field(default_factory=dict)
+    source: Optional[str] = None
+
+    @property
+    def pusher_names(self) -> List[str]:
+        return [p.name for p in self.pushers]
+
+    def pusher_index(self, name: str) -> int:
+        try:
+            return self.pusher_names.index(name)
+        except ValueError:
+            raise TaskError("pusher", f"no pusher named {name!r} (the task has {', '.join(self.pusher_names)})")
+
+    def section(self) -> "_core.CrossSection":
+        return _core.CrossSection([(x * MM, z * MM) for x, z in self.vertices])
+
+    def build_model(self) -> "_core.StablePushModel":
+        """The core's stable-push model of this task, in SI units."""
+        section = self.section()
+        if self.com is None and self.inertia is None:
+            body = _core.RigidBody.uniform(section, self.mass * G)
+        else:
+            uniform = _core.RigidBody.uniform(section, self.mass * G)
+            com = (self.com[0] * MM, self.com[1] * MM) if self.com is not None else uniform.com
+            body = _core.RigidBody(self.mass * G, com, self.inertia if self.inertia is not None else uniform.inertia)
+        gripper = _make_gripper(self.pads, self.grip_force, self.mu, self.pad_rings)
+        pushers = [
+            _core.Pusher.on_boundary(section, p.name, _mm2(p.a), _mm2(p.b), p.mu, p.points) for p in self.pushers
+        ]
+        return _core.StablePushModel(
+            section, body, gripper, pushers, self.gravity, self.step_time, self.friction_polygon_sides
+        )
+
+
+def _mm2(p: Tuple[float, float]) -> Tuple[float, float]:
+    return (p[0] * MM, p[1] * MM)
+
+
+def _make_gripper(pads, grip_force: float, mu: float, pad_rings: int) -> "_core.Gripper":
+    return _core.Gripper([_core.Pad(_mm2(c), r * MM) for c, r in pads], grip_force, mu, pad_rings)
+
+
+def pose_to_si(q: Sequence[float]) -> Tuple[float, float, float]:
+    """(x mm, z mm, theta deg) -> (x m, z m, theta rad)."""
+    return (q[0] * MM, q[1] * MM, math.radians(q[2]))
+
+
+def pose_from_si(q: Sequence[float]) -> Tuple[float, float, float]:
+    """(x m, z m, theta rad) -> (x mm, z mm, theta deg)."""
+    return (q[0] / MM, q[1] / MM, math.degrees(q[2]))
+
+
+# ---------------------------------------------------------------------------------------------
+
+
+def load_task(path: "str | Path") -> Task:
+    """Read and validate a task file; raises TaskError naming the field on any problem."""
+    source = str(path)
+    try:
+        text = Path(path).read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise TaskError("", f"cannot read the task file ({exc.__class__.__name__}: {exc})", source) from None
+    try:
+        return parse_task(text, source)
+    except TaskError as exc:
+        if exc.source is None:
+            raise TaskError(exc.field, exc.reason, source) from None
+        raise
+
+
+def parse_task(text: str, source: Optional[str] = None) -> Task:
+    try:
+        data = yaml.load(text, Loader=_StrictLoader)
+    except TaskError:
+        raise
+    except yaml.YAMLError as exc:
+        raise TaskError("", f"not valid YAML ({exc})".replace("\n", " "), source) from None
+    if data is None:
+        raise TaskError("", "the task file is empty", source)
+    return _validate(data, source)
+
+
+def _validate(data: Any, source: Optional[str]) -> Task:
+    top = _mapping(
+        "", data, ["name", "object", "gripper", "pushers", "start", "goal"], ["gravity", "dynamics", "planner"]
+    )
+    name = _name("name", top["name"])
+    vertices, thickness, mass, com, inertia = _validate_object(top["object"])
+
+    section_defect = _core.CrossSection.defect([(x * MM, z * MM) for x, z in vertices])
+    if section_defect:
+        raise TaskError("object.polygon", section_defect)
+    section = _core.CrossSection([(x * MM, z * MM) for x, z in vertices])
+
+    grip = _mapping("gripper", top["gripper"], ["grip_force", "mu"], ["pad_rings", "pads"])
+    grip_force = _number("gripper.grip_force", grip["grip_force"], positive=True)
+    mu = _number("gripper.mu", grip["mu"], nonnegative=True)
+    pad_rings = _integer("gripper.pad_rings", grip.get("pad_rings", 1), 0)
+    if "pads" in grip:
+        if not isinstance(grip["pads"], list) or not grip["pads"]:
+            raise TaskError("gripper.pads", "must be a non-empty list of {center: [x, z], radius: r}")
+        pads = []
+        for i, pad in enumerate(grip["pads"]):
+            path = f"gripper.pads[{i}]"
+            pad = _mapping(path, pad, ["center", "radius"], [])
+            pads.append((_vector(f"{path}.center", pad["center"], 2), _number(f"{path}.radius", pad["radius"], positive=True)))
+        pads = tuple(pads)
+    else:
+        pads = (((0.0, 0.0), DEFAULT_PAD_RADIUS_MM), ((0.0, 0.0), DEFAULT_PAD_RADIUS_MM))
+
+    gravity = _vector("gravity", top.get("gravity", list(DEFAULT_GRAVITY)), 2)
+    dyn = _mapping("dynamics", top.get("dynamics", {}), [], ["step_time", "friction_polygon_sides"])
+    step_time = _number("dynamics.step_time", dyn.get("step_time", DEFAULT_STEP_TIME), positive=True)
+    sides = _integer("dynamics.friction_polygon_sides", dyn.get("friction_polygon_sides", DEFAULT_POLYGON_SIDES), 3)
+
+    pushers = _validate_pushers(top["pushers"], section)
+    start = _vector("start", top["start"], 3)
+    goal = _vector("goal", top["goal"], 3)
+    for label, q in (("start", start), ("goal", goal)):
+        inside = _make_gripper(pads, grip_force, mu, pad_rings).pads_inside(section, pose_to_si(q))
+        for i, ok in enumerate(inside):
+            if not ok:
+                where = f"gripper.pads[{i}]" if "pads" in grip else "gripper (default pads)"
+                raise TaskError(label, f"{where} does not lie inside the object at the {label} pose {list(q)}")
+
+    planner = _validate_planner(top.get("planner", {}))
+    return Task(
+        name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
+        grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
+        friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner, source=source,
+    )
+
+
+def _validate_object(obj: Any):
+    obj = _mapping("object", obj, ["shape", "mass"], ["size", "polygon", "thickness", "com", "inertia"])
+    shape = obj["shape"]
+    if shape == "box":
+        if "polygon" in obj:
+            raise TaskError("object.polygon", "only for shape: polygon (a box takes size)")
+        if "thickness" in obj:
+            raise TaskError("object.thickness", "only for shape: polygon (a box's thickness is size[1])")
+        if "size" not in obj:
+            raise TaskError("object.size", "missing (a box needs [L along x, B along y, H along z] in mm)")
+        length, thickness, height = _vector("object.size", obj["size"], 3, positive=True)
+        vertices = ((-length / 2, -height / 2), (length / 2, -height / 2), (length / 2, height / 2), (-length / 2, height / 2))
+    elif shape == "polygon":
+        if "size" in obj:
+            raise TaskError("object.size", "only for shape: box (a polygon takes polygon and thickness)")
+        if "polygon" not in obj:
+            raise TaskError("object.polygon", "missing (a list of [x, z] vertices in mm)")
+        poly = obj["polygon"]
+        if not isinstance(poly, list) or len(poly) < 3:
+            raise TaskError("object.polygon", "must be a list of at least 3 [x, z] vertices")
+        vertices = tuple(_vector(f"object.polygon[{i}]", v, 2) for i, v in enumerate(poly))
+        thickness = _number("object.thickness", obj.get("thickness", 25.0), positive=True)
+    else:
+        raise TaskError("object.shape", f"must be box or polygon, got {shape!r}")
+    mass = _number("object.mass", obj["mass"], positive=True)
+    com = _vector("object.com", obj["com"], 2) if "com" in obj else None
+    inertia = _number("object.inertia", obj["inertia"], positive=True) if "inertia" in obj else None
+    return vertices, thickness, mass, com, inertia
+
+
+def _validate_pushers(value: Any, section: "_core.CrossSection") -> Tuple[PusherSpec, ...]:
+    if not isinstance(value, list) or not value:
+        raise TaskError("pushers", "must be a non-empty list")
+    specs: List[PusherSpec] = []
+    for i, raw in enumerate(value):
+        path = f"pushers[{i}]"
+        if isinstance(raw, dict) and "at" in raw:
+            raw = _mapping(path, raw, ["name", "at", "mu"], [])
+            if "from" in raw or "to" in raw:
+                raise TaskError(path, "give either at (a point pusher) or from/to (a segment), not both")
+            a = b = _vector(f"{path}.at", raw["at"], 2)
+            points = 1
+        else:
+            raw = _mapping(path, raw, ["name", "from", "to", "mu"], ["points"])
+            a = _vector(f"{path}.from", raw["from"], 2)
+            b = _vector(f"{path}.to", raw["to"], 2)
+            if a == b:
+                raise TaskError(f"{path}.to", "equals from; a point pusher is written at: [x, z]")
+            points = _integer(f"{path}.points", raw.get("points", DEFAULT_PUSHER_POINTS), 2)
+        name = _name(f"{path}.name", raw["name"])
+        if any(s.name == name for s in specs):
+            raise TaskError(f"{path}.name", f"duplicate pusher name {name!r}")
+        mu = _number(f"{path}.mu", raw["mu"], nonnegative=True)
+        try:
+            _core.Pusher.on_boundary(section, name, _mm2(a), _mm2(b), mu, points)
+        except ValueError as exc:
+            raise TaskError(path, str(exc)) from None
+        specs.append(PusherSpec(name=name, a=a, b=b, mu=mu, points=points))
+    return tuple(specs)
+
+
+def _validate_planner(value: Any) -> Dict[str, Any]:
+    planner = _mapping("planner", value, [], list(PLANNER_DEFAULTS))
+    out = dict(PLANNER_DEFAULTS)
+    if "time_limit" in planner:
+        out["time_limit"] = _number("planner.time_limit", planner["time_limit"], positive=True)
+    if "seed" in planner:
+        out["seed"] = _integer("planner.seed", planner["seed"], 0)
+    if "max_switches" in planner:
+        out["max_switches"] = _integer("planner.max_switches", planner["max_switches"], 0)
+    for key in ("step", "tolerance"):
+        if key in planner:
+            out[key] = list(_vector(f"planner.{key}", planner[key], 2, positive=True))
+    return out
