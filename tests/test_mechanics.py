@@ -1,0 +1,190 @@
+"""Hand-derived mechanics cases (MODEL.md section 2, paper section V)."""
+import math
+
+import numpy as np
+import pytest
+from conftest import shipped, task_with
+
+from stablepush.task import pose_to_si
+
+MM = 1e-3
+
+
+def horizontal(task_name="horizontal-offset-low-mu", **edits):
+    def edit(d):
+        d["gravity"] = [0, 0]
+        for key, value in edits.items():
+            d["gripper"][key] = value
+
+    return task_with(task_name, edit)
+
+
+def test_pure_translation_pad_friction_is_mu_N_per_pad_opposite_the_motion():
+    task = horizontal()
+    model = task.build_model()
+    for direction_deg in (0, 30, 90, 145, 270):
+        u = np.array([math.cos(math.radians(direction_deg)), math.sin(math.radians(direction_deg))])
+        dq = (u[0] * MM, u[1] * MM, 0.0)
+        load = model.motion_wrench((0, 0, 0), dq)
+        assert load.sticking_points == 0
+        # Two pads, each pressed with N: sliding friction 2 mu N opposite the motion, so the
+        # pusher must supply +2 mu N along u, plus the momentum m v / dt (v = 1 mm / 0.1 s).
+        inertial = task.mass * 1e-3 * (1e-3 / task.step_time) / task.step_time
+        expected = (2 * task.mu * task.grip_force + inertial) * u
+        np.testing.assert_allclose(load.required[:2], expected, rtol=1e-12)
+        assert abs(load.required[2]) < 1e-12  # symmetric pads: no torque about the centre
+
+
+def test_pure_rotation_about_pad_centre_friction_torque_and_sticking_centre():
+    task = horizontal()
+    model = task.build_model()
+    dtheta = math.radians(1.0)
+    load = model.motion_wrench((0, 0, 0), (0, 0, dtheta))
+    # The centre point of each pad sticks; the 6 ring points of each pad slide tangentially.
+    assert load.sticking_points == 2
+    [(arm, disc_radius)] = load.sticking
+    np.testing.assert_array_equal(arm, [0.0, 0.0])
+    k = 7  # points per pad with one ring
+    assert disc_radius == pytest.approx(2 * task.mu * task.grip_force / k, rel=1e-15)
+    r = 5 * MM
+    friction_torque = 2 * 6 * (task.mu * task.grip_force / k) * r  # 12 points at radius r
+    inertia = model.body.inertia
+    omega = dtheta / task.step_time
+    expected_tau = friction_torque + inertia * omega / task.step_time
+    assert load.required[2] == pytest.approx(expected_tau, rel=1e-12)
+    np.testing.assert_allclose(load.required[:2], [0, 0], atol=1e-12)
+
+
+def test_uniform_box_inertia():
+    task = horizontal()
+    body = task.build_model().body
+    m, L, H = 0.202, 0.1, 0.025
+    assert body.inertia == pytest.approx(m * (L * L + H * H) / 12, rel=1e-12)
+
+
+def test_gravity_load_the_pusher_must_carry():
+    task = shipped("horizontal-offset-low-mu")
+    model = task.build_model()
+    m = task.mass * 1e-3
+    load = model.motion_wrench((0, 0, 0), (0, 1 * MM, 0))
+    inertial = m * (1e-3 / task.step_time) / task.step_time
+    assert load.required[1] == pytest.approx(2 * task.mu * task.grip_force + inertial + m * 9.81, rel=1e-12)
+    # With the centre of mass 10 mm off along x, the force m (a - g) acting there adds the torque
+    # r_z f_x - r_x f_z = -r_x m (a_z - g_z) about O's origin, which the pusher must supply.
+    off = task_with("horizontal-offset-low-mu", lambda d: d["object"].update(com=[10, 0]))
+    load_off = off.build_model().motion_wrench((0, 0, 0), (0, 1 * MM, 0))
+    a_z = 1e-3 / task.step_time / task.step_time
+    assert load_off.required[2] - load.required[2] == pytest.approx(-0.010 * m * (a_z + 9.81), rel=1e-9)
+
+
+def test_paper_low_mu_horizontal_push_unstable_and_stable_at_mu_0_6():
+    low = shipped("horizontal-offset-low-mu")
+    high = shipped("horizontal-offset-high-mu")
+    dq = pose_to_si((1, 0, 0))
+    left_low = low.build_model().check((0, 0, 0), dq, low.pusher_index("left"))
+    left_high = high.build_model().check((0, 0, 0), dq, high.pusher_index("left"))
+    assert not left_low.feasible and left_low.margin < 0
+    assert left_high.feasible and left_high.margin > 0
+    # Hand check of the boundary: the side pusher carries the weight by friction, so the push is
+    # stable iff m g / (2 mu N + m a) < mu_p (and < 0.25 for the torque, face half-height / 50 mm).
+    ratio = 0.202 * 9.81 / (2 * 0.45 * 10 + 0.0202)
+    assert 0.2 < ratio < 0.25 < 0.6
+
+
+def test_pivot_is_feasible_only_through_the_sticking_pad_centre():
+    task = shipped("pivoting")
+    model = task.build_model()
+    left = task.pusher_index("left")
+    q, dq = (0, 0, 0), (0, 0, math.radians(1))
+    result = model.check(q, dq, left)
+    assert result.feasible and result.contact_case.name == "sticking" and result.sticking_points == 2
+    # Without the sticking centre's friction the same motion wrench lies outside the cone (fig. 8, left).
+    required = model.motion_wrench(q, dq).required
+    cone = model.pusher_cones[left]
+    assert max(row @ required for row in cone.facet_rows) > 0
+    # Rotating about a point 0.5 mm away: every pad point slides, and the push is not stable.
+    off_centre = model.check((0.5 * MM, 0, 0), dq, left)
+    assert off_centre.contact_case.name == "all_sliding" and not off_centre.feasible
+    # The witness balances the motion wrench with a sticking force inside its friction disc.
+    [(arm, disc)] = model.motion_wrench(q, dq).sticking
+    stick = required - np.asarray(result.witness)
+    assert abs(stick[2]) < 1e-12 and np.hypot(stick[0], stick[1]) <= disc * (1 + 1e-9)
+
+
+def point_pusher_task(at, mu=0.5):
+    def edit(d):
+        d["gravity"] = [0, 0]
+        d["pushers"] = [{"name": "tip", "at": at, "mu": mu}]
+
+    return task_with("horizontal-offset-low-mu", edit)
+
+
+def test_point_pusher_cone_is_a_wedge_and_in_plane_pushes_are_decided_exactly():
+    task = point_pusher_task([-50, 0])
+    model = task.build_model()
+    assert model.pusher_cones[0].dimension == 2
+    # Pushing along x through the centre: the motion wrench (F, 0, 0) lies exactly in the wedge's
+    # plane only in exact arithmetic (the pad points' torques cancel by symmetry).
+    r = model.check((0, 0, 0), (1 * MM, 0, 0), 0)
+    assert r.feasible and r.exact
+    # The same pusher 5 mm off the axis would need torque 5 mm x F: not stable, and certain.
+    off = point_pusher_task([-50, 5]).build_model().check((0, 0, 0), (1 * MM, 0, 0), 0)
+    assert not off.feasible and off.margin < 0
+    # mu = 0: the cone is a ray.
+    assert point_pusher_task([-50, 0], mu=0.0).build_model().pusher_cones[0].dimension == 1
+
+
+def test_point_pusher_pivot_uses_the_exact_lp():
+    # Paper fig. 7-8: a point pusher and the sticking pad centre. A point pusher's wedge has no
+    # interior in wrench space, so the sticking case needs the equality-constrained exact LP.
+    task = point_pusher_task([-50, 0], mu=0.6)
+    model = task.build_model()
+    r = model.check((0, 0, 0), (0, 0, math.radians(-1)), 0)
+    assert r.exact and r.contact_case.name == "sticking"
+
+
+def mirror_task(name):
+    """The task mirrored through the gripper's z axis (x -> -x)."""
+
+    def edit(d):
+        obj = d["object"]
+        if obj["shape"] == "polygon":
+            obj["polygon"] = [[-x, z] for x, z in reversed(obj["polygon"])]
+        for p in d["pushers"]:
+            for key in ("from", "to", "at"):
+                if key in p:
+                    p[key] = [-p[key][0], p[key][1]]
+        d["gravity"] = [-d.get("gravity", [0, -9.81])[0], d.get("gravity", [0, -9.81])[1]]
+        d["start"] = [-d["start"][0], d["start"][1], -d["start"][2]]
+        d["goal"] = [-d["goal"][0], d["goal"][1], -d["goal"][2]]
+
+    return task_with(name, edit)
+
+
+@pytest.mark.parametrize("name", ["horizontal-offset-low-mu", "pivoting", "large-manipulation", "t-shaped"])
+def test_mirror_the_task_mirror_the_answer(name):
+    task, mirrored = shipped(name), mirror_task(name)
+    model, mirror_model = task.build_model(), mirrored.build_model()
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        q = (rng.uniform(-3, 3) * MM, rng.uniform(-3, 3) * MM, math.radians(rng.uniform(-20, 20)))
+        if rng.random() < 0.3:  # rotation about the pad centre: the sticking case
+            w = math.radians(rng.choice([-1, 1]))
+            dq = (-w * (-q[1]), w * (-q[0]), w)  # v = -omega x (p - c) with p = 0
+        else:
+            dq = (rng.uniform(-1, 1) * MM, rng.uniform(-1, 1) * MM, math.radians(rng.uniform(-1, 1)))
+        qm, dqm = (-q[0], q[1], -q[2]), (-dq[0], dq[1], -dq[2])
+        for p in range(len(task.pushers)):
+            a, b = model.check(q, dq, p), mirror_model.check(qm, dqm, p)
+            assert a.contact_case == b.contact_case
+            assert a.margin == pytest.approx(b.margin, abs=1e-9 * (1 + abs(a.margin)))
+            if abs(a.margin) > 1e-9:
+                assert a.feasible == b.feasible
+            # The mirrored witness: f_x and tau change sign.
+            np.testing.assert_allclose(np.asarray(b.witness) * [-1, 1, -1], a.witness, atol=1e-7)
+
+
+def test_zero_motion_is_refused():
+    model = shipped("pivoting").build_model()
+    with pytest.raises(ValueError, match="zero"):
+        model.check((0, 0, 0), (0, 0, 0), 0)

@@ -1,0 +1,150 @@
+"""Every bad task is refused through the CLI with exit status 2 and one message naming the field."""
+import subprocess
+import sys
+
+import pytest
+import yaml
+from click.testing import CliRunner
+from conftest import TASKS, task_text
+
+from stablepush_cli.main import cli
+
+BASE = yaml.safe_load(task_text("horizontal-offset-low-mu"))
+
+
+def edited(edit):
+    data = yaml.safe_load(task_text("horizontal-offset-low-mu"))
+    edit(data)
+    return yaml.safe_dump(data)
+
+
+def run_check(tmp_path, text):
+    path = tmp_path / "task.yaml"
+    path.write_text(text)
+    result = CliRunner().invoke(cli, ["check", str(path), "--move", "1", "0", "0"])
+    return result
+
+
+def _set(path, value):
+    def edit(d):
+        *parents, last = path
+        for key in parents:
+            d = d[key]
+        d[last] = value
+
+    return edit
+
+
+def _delete(path):
+    def edit(d):
+        *parents, last = path
+        for key in parents:
+            d = d[key]
+        del d[last]
+
+    return edit
+
+
+BAD = [
+    ("missing key", _delete(["object", "mass"]), "object.mass", "missing"),
+    ("missing top key", _delete(["goal"]), "goal", "missing"),
+    ("unknown key", _set(["object", "colour"], "red"), "object.colour", "unknown key"),
+    ("unknown top key", _set(["speed"], 3), "speed", "unknown key"),
+    ("wrong type", _set(["gripper", "grip_force"], "strong"), "gripper.grip_force", "must be a number"),
+    ("bool as number", _set(["object", "mass"], True), "object.mass", "must be a number"),
+    ("wrong length", _set(["start"], [0, 0]), "start", "list of 3"),
+    ("negative mass", _set(["object", "mass"], -1), "object.mass", "> 0"),
+    ("zero mass", _set(["object", "mass"], 0), "object.mass", "> 0"),
+    ("zero grip force", _set(["gripper", "grip_force"], 0), "gripper.grip_force", "> 0"),
+    ("zero size", _set(["object", "size"], [100, 0, 25]), "object.size[1]", "> 0"),
+    ("negative pad mu", _set(["gripper", "mu"], -0.1), "gripper.mu", ">= 0"),
+    ("negative pusher mu", lambda d: d["pushers"][1].update(mu=-0.5), "pushers[1].mu", ">= 0"),
+    ("unknown shape", _set(["object", "shape"], "sphere"), "object.shape", "box or polygon"),
+    ("duplicate pusher", lambda d: d["pushers"][1].update(name="left"), "pushers[1].name", "duplicate"),
+    ("pusher off boundary", lambda d: d["pushers"][0].update({"from": [-40, -12.5], "to": [-40, 12.5]}), "pushers[0]", "not on the object's boundary"),
+    ("point pusher on vertex", lambda d: d["pushers"].append({"name": "corner", "at": [50, 12.5], "mu": 0.3}), "pushers[3]", "vertex"),
+    ("pad outside at start", _set(["start"], [0, 10, 0]), "start", "does not lie inside"),
+    ("pad outside at goal", _set(["goal"], [60, 0, 0]), "goal", "does not lie inside"),
+    ("bad pad radius", _set(["gripper", "pads"], [{"center": [0, 0], "radius": -5}]), "gripper.pads[0].radius", "> 0"),
+    ("negative step time", _set(["dynamics", "step_time"], -0.1), "dynamics.step_time", "> 0"),
+    ("planner unknown", _set(["planner", "speed"], 1), "planner.speed", "unknown key"),
+    ("planner seed", _set(["planner", "seed"], -3), "planner.seed", ">= 0"),
+    ("self-intersecting polygon",
+     lambda d: d.update(object={"shape": "polygon", "polygon": [[-50, -12.5], [50, 12.5], [50, -12.5], [-50, 12.5]], "mass": 100}),
+     "object.polygon", "self-intersecting"),
+    ("degenerate polygon",
+     lambda d: d.update(object={"shape": "polygon", "polygon": [[-50, 0], [0, 0], [50, 0]], "mass": 100}),
+     "object.polygon", "degenerate"),
+    ("repeated vertex",
+     lambda d: d.update(object={"shape": "polygon", "polygon": [[-50, -12.5], [-50, -12.5], [50, -12.5], [50, 12.5]], "mass": 100}),
+     "object.polygon", "coincide"),
+]
+
+
+@pytest.mark.parametrize("label,edit,field,reason", BAD, ids=[b[0] for b in BAD])
+def test_bad_task_is_refused_naming_the_field(tmp_path, label, edit, field, reason):
+    result = run_check(tmp_path, edited(edit))
+    assert result.exit_code == 2, result.output
+    message = result.stderr.strip()
+    assert message.count("\n") == 0, message
+    assert f"{field}:" in message and reason in message, message
+    assert "Traceback" not in result.output
+
+
+@pytest.mark.parametrize(
+    "text,reason",
+    [
+        ("name: x\nname: y\n", "duplicate key"),
+        ("object: [unclosed\n", "not valid YAML"),
+        ("", "empty"),
+        ("- just\n- a list\n", "must be a mapping"),
+        (task_text("horizontal-offset-low-mu").replace("mass: 202", "mass: .nan"), "finite"),
+        (task_text("horizontal-offset-low-mu").replace("mass: 202", "mass: .inf"), "finite"),
+    ],
+)
+def test_bad_yaml_is_refused(tmp_path, text, reason):
+    result = run_check(tmp_path, text)
+    assert result.exit_code == 2 and reason in result.stderr, result.stderr
+
+
+def test_unreadable_file_is_refused(tmp_path):
+    result = CliRunner().invoke(cli, ["check", str(tmp_path / "missing.yaml"), "--move", "1", "0", "0"])
+    assert result.exit_code == 2 and "cannot read the task file" in result.stderr
+
+
+def test_no_traceback_from_the_installed_command(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text(edited(_set(["object", "mass"], -1)))
+    proc = subprocess.run([sys.executable, "-m", "stablepush_cli.main", "check", str(path), "--move", "1", "0", "0"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr and "object.mass" in proc.stderr
+
+
+def test_check_json_output_keys():
+    import json
+
+    result = CliRunner().invoke(cli, ["check", str(TASKS / "pivoting.yaml"), "--move", "0", "0", "1", "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)
+    assert set(data) == {"left", "right", "bottom"}
+    for entry in data.values():
+        assert {"feasible", "case", "margin"} <= set(entry)
+        assert entry["case"] == "sticking"
+    assert data["left"]["feasible"] is True
+
+
+def test_check_one_pusher_and_unknown_pusher():
+    ok = CliRunner().invoke(cli, ["check", str(TASKS / "horizontal-offset-high-mu.yaml"), "--move", "1", "0", "0", "--pusher", "left"])
+    assert ok.exit_code == 0 and ok.stdout.startswith("left") and "stable" in ok.stdout
+    bad = CliRunner().invoke(cli, ["check", str(TASKS / "horizontal-offset-high-mu.yaml"), "--move", "1", "0", "0", "--pusher", "nope"])
+    assert bad.exit_code == 2 and "no pusher named 'nope'" in bad.stderr
+
+
+def test_every_shipped_task_loads(tasks_dir):
+    from stablepush.task import load_task
+
+    names = sorted(p.stem for p in tasks_dir.glob("*.yaml"))
+    assert names == ["horizontal-offset-high-mu", "horizontal-offset-low-mu", "large-manipulation", "pivoting", "t-shaped"]
+    for name in names:
+        task = load_task(tasks_dir / f"{name}.yaml")
+        assert task.build_model().grasp_maintained((0, 0, 0))
