@@ -61,6 +61,39 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
         click.echo(f"{name:<{width}}  {verdict:<10}  {r['case']:<11}  margin {r['margin']:+.4f} N")
 
 
+@cli.command()
+@click.argument("task_files", metavar="TASK.yaml...", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.option("--checks", "checks_only", is_flag=True, help="Benchmark the stable-push test (median time per check).")
+@click.option("-n", "--count", default=200_000, show_default=True, help="Checks per contact case and task.")
+@click.option("--seed", default=0, show_default=True, help="Seed of the random queries.")
+def bench(task_files, checks_only: bool, count: int, seed: int) -> None:
+    """Benchmark stablepush on task files.
+
+    --checks times the stable-push test itself: random poses and unit motions, all-sliding
+    (generic motions) and sticking (rotations about a pad centre), single thread, the median
+    over batches of 2,000 checks.
+
+    \b
+    Example:
+      stablepush bench --checks data/tasks/horizontal-offset-low-mu.yaml
+    """
+    from stablepush.benchmark import bench_checks
+
+    if not checks_only:
+        _fail("choose what to benchmark: --checks (planning benchmarks come with the planner)")
+    try:
+        tasks = [load_task(path) for path in task_files]
+    except TaskError as exc:
+        _fail(str(exc))
+    click.echo(f"{'task':<28} {'case':<12} {'median us':>10} {'min us':>8} {'checks':>8} {'feasible':>9} {'exact':>7}")
+    for task in tasks:
+        with click.progressbar(length=2 * count, label=f"{task.name}", file=sys.stderr) as bar:
+            timings = bench_checks(task, checks=count, seed=seed, progress=bar.update)
+        for t in timings.values():
+            click.echo(f"{task.name:<28} {t.case:<12} {t.median_us:>10.3f} {t.min_us:>8.3f} {t.checks:>8d} "
+                       f"{t.feasible_fraction:>8.1%} {t.exact_fraction:>7.3%}")
+
+
 def main() -> None:  # pragma: no cover - console entry
     cli()
 
