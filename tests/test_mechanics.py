@@ -188,3 +188,10 @@ def test_zero_motion_is_refused():
     model = shipped("pivoting").build_model()
     with pytest.raises(ValueError, match="zero"):
         model.check((0, 0, 0), (0, 0, 0), 0)
+
+
+def test_default_inertia_about_a_given_com_uses_parallel_axes():
+    base = shipped("horizontal-offset-low-mu").build_model().body
+    off = task_with("horizontal-offset-low-mu", lambda d: d["object"].update(com=[10, 0])).build_model().body
+    assert off.inertia == pytest.approx(base.inertia + 0.202 * 0.010**2, rel=1e-12)
+    np.testing.assert_allclose(off.com, [0.010, 0.0])

@@ -50,9 +50,7 @@ PushResult StablePushModel::exact_all_sliding(const WrenchCone& cone, const Moti
   answer.feasible = cone.contains_in_relative_interior(required);
   for (const ExactWrench& e : cone.exact_equalities())
     if (!CGAL::is_zero(e * required)) {  // off the span by less than the band
-      double off_span = 0.0;
-      for (const Wrench& row : cone.equality_rows()) off_span = std::max(off_span, std::abs(row.dot(load.required)));
-      answer.margin = -off_span;
+      answer.margin = -cone.distance_to_span(load.required);
       break;
     }
   return answer;
@@ -108,10 +106,8 @@ PushResult StablePushModel::exact_sticking(const WrenchCone& cone, const MotionW
   result.exact = true;
   if (solution.is_infeasible()) {
     // No admissible sticking force brings w_pusher onto the cone's span.
-    double off_span = 0.0;
-    for (const Wrench& e : cone.equality_rows()) off_span = std::max(off_span, std::abs(e.dot(load.required)));
     result.feasible = false;
-    result.margin = -off_span;
+    result.margin = -cone.distance_to_span(load.required);
     result.witness = load.required;
     return result;
   }

@@ -1,5 +1,6 @@
 #include "stablepush/friction_cone.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -117,6 +118,12 @@ WrenchCone::WrenchCone(std::vector<Wrench> generators, double torque_length)
       else throw std::invalid_argument("the cone is not pointed");
     }
   if (exact_facets_.size() < 3) throw std::invalid_argument("the cone is not pointed");
+}
+
+double WrenchCone::distance_to_span(const Wrench& w) const {
+  double distance = 0.0;
+  for (const Wrench& e : equality_rows_) distance = std::max(distance, std::abs(e.dot(w)));
+  return distance;
 }
 
 bool WrenchCone::contains_in_relative_interior(const ExactWrench& w) const {

@@ -113,8 +113,7 @@ PushResult StablePushModel::all_sliding(const WrenchCone& cone, const MotionWren
   result.contact_case = ContactCase::AllSliding;
   result.witness = load.required;
   const double band = kCertificationBand * load.scale;
-  double off_span = 0.0;
-  for (const Wrench& e : cone.equality_rows()) off_span = std::max(off_span, std::abs(e.dot(load.required)));
+  const double off_span = cone.distance_to_span(load.required);
   if (off_span > band) {  // certainly off a lower-dimensional cone's span
     result.margin = -off_span;
     return result;

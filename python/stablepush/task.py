@@ -174,12 +174,14 @@ class Task:
     def build_model(self) -> "_core.StablePushModel":
         """The core's stable-push model of this task, in SI units."""
         section = self.section()
-        if self.com is None and self.inertia is None:
-            body = _core.RigidBody.uniform(section, self.mass * G)
-        else:
-            uniform = _core.RigidBody.uniform(section, self.mass * G)
-            com = (self.com[0] * MM, self.com[1] * MM) if self.com is not None else uniform.com
-            body = _core.RigidBody(self.mass * G, com, self.inertia if self.inertia is not None else uniform.inertia)
+        uniform = _core.RigidBody.uniform(section, self.mass * G)
+        com = _mm2(self.com) if self.com is not None else tuple(uniform.com)
+        if self.inertia is not None:
+            inertia = self.inertia
+        else:  # the uniform body's inertia about the given com (parallel axes)
+            offset2 = (com[0] - uniform.com[0]) ** 2 + (com[1] - uniform.com[1]) ** 2
+            inertia = uniform.inertia + self.mass * G * offset2
+        body = _core.RigidBody(self.mass * G, com, inertia)
         gripper = _make_gripper(self.pads, self.grip_force, self.mu, self.pad_rings)
         pushers = [
             _core.Pusher.on_boundary(section, p.name, _mm2(p.a), _mm2(p.b), p.mu, p.points) for p in self.pushers

@@ -32,6 +32,9 @@ class WrenchCone {
   const std::vector<ExactWrench>& exact_equalities() const { return exact_equalities_; }
   const std::vector<double>& equality_scales() const { return equality_scales_; }
 
+  /// Distance [N] from w to the cone's linear span (largest |e . w| over the equality rows; 0 in 3-D).
+  double distance_to_span(const Wrench& w) const;
+
   /// Exact test: w lies in the relative interior of the cone (all facets strict, equalities exact).
   bool contains_in_relative_interior(const ExactWrench& w) const;
 
