@@ -57,7 +57,14 @@ def test_core_agrees_with_independent_lp(name, n):
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     compared = near = sticking = feasible = 0
     disagreements = []
-    for q, dq, p in random_queries(task, rng, n):
+    queries = list(random_queries(task, rng, n))
+    if name == "point-pushers":
+        # A point pusher's stable pushes are measure-zero among generic motions: add pushes along
+        # the left tip's line of action (pad centre on the line), exactly in its wedge's plane.
+        for _ in range(100):
+            q = (rng.uniform(-4, 4) * MM, 0.0, 0.0)
+            queries.append((q, (rng.uniform(0.2, 1.0) * MM, 0.0, 0.0), 0))
+    for q, dq, p in queries:
         core = model.check(q, dq, p)
         ref_feasible, ref_s = reference.stable(q, dq, p)
         sticking += core.contact_case.name == "sticking"
