@@ -140,7 +140,6 @@ class IndependentModel:
                 fo = R.T @ f
                 # A sticking force f moves to the other side of the balance: sum lambda g = w - W(f).
                 cols.append(np.array([-fo[0], -fo[1], -torque(arm, f)]))
-        n_beta = len(cols) - m
         n = len(cols) + 1  # ..., s
         A_eq = np.zeros((3 + len(sticking), n))
         A_eq[:3, : len(cols)] = np.array(cols).T
@@ -155,7 +154,6 @@ class IndependentModel:
             A_ub[k, k] = -1.0
             A_ub[k, -1] = 1.0
         bounds = [(0, None)] * len(cols) + [(None, 1.0)]
-        del n_beta
         c = np.zeros(n)
         c[-1] = -1.0
         res = linprog(c, A_ub=A_ub, b_ub=np.zeros(m), A_eq=A_eq, b_eq=b_eq, bounds=bounds, method="highs")

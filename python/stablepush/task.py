@@ -169,7 +169,7 @@ class Task:
             raise TaskError("pusher", f"no pusher named {name!r} (the task has {', '.join(self.pusher_names)})")
 
     def section(self) -> "_core.CrossSection":
-        return _core.CrossSection([(x * MM, z * MM) for x, z in self.vertices])
+        return _core.CrossSection([_mm2(v) for v in self.vertices])
 
     def build_model(self) -> "_core.StablePushModel":
         """The core's stable-push model of this task, in SI units."""
@@ -246,10 +246,11 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     name = _name("name", top["name"])
     vertices, thickness, mass, com, inertia = _validate_object(top["object"])
 
-    section_defect = _core.CrossSection.defect([(x * MM, z * MM) for x, z in vertices])
+    vertices_m = [_mm2(v) for v in vertices]
+    section_defect = _core.CrossSection.defect(vertices_m)
     if section_defect:
         raise TaskError("object.polygon", section_defect)
-    section = _core.CrossSection([(x * MM, z * MM) for x, z in vertices])
+    section = _core.CrossSection(vertices_m)
 
     grip = _mapping("gripper", top["gripper"], ["grip_force", "mu"], ["pad_rings", "pads"])
     grip_force = _number("gripper.grip_force", grip["grip_force"], positive=True)
