@@ -10,6 +10,7 @@
 #include "stablepush/cross_section.hpp"
 #include "stablepush/friction_cone.hpp"
 #include "stablepush/gripper.hpp"
+#include "stablepush/planning.hpp"
 #include "stablepush/pusher.hpp"
 #include "stablepush/rigid_body.hpp"
 #include "stablepush/stable_push.hpp"
@@ -19,6 +20,7 @@ using namespace stablepush;
 
 namespace {
 Pose to_pose(const std::array<double, 3>& q) { return Pose{q[0], q[1], q[2]}; }
+StepSize to_step(const std::array<double, 2>& s) { return StepSize{s[0], s[1]}; }
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -166,4 +168,62 @@ PYBIND11_MODULE(_core, m) {
            },
            py::arg("q"), py::arg("dq"), py::arg("pusher"),
            "Check many (q, dq) rows for one pusher without Python overhead per row: (feasible, margin, exact).");
+
+  py::enum_<PlanOutcome>(m, "PlanOutcome")
+      .value("goal_reached", PlanOutcome::GoalReached)
+      .value("goal_over_switch_limit", PlanOutcome::GoalOverSwitchLimit)
+      .value("time_limit", PlanOutcome::TimeLimit);
+
+  py::class_<PlanStats>(m, "PlanStats")
+      .def_readonly("planning_time_s", &PlanStats::planning_time_s)
+      .def_readonly("iterations", &PlanStats::iterations)
+      .def_readonly("nodes", &PlanStats::nodes)
+      .def_readonly("feasibility_checks", &PlanStats::feasibility_checks)
+      .def_readonly("switches", &PlanStats::switches)
+      .def_readonly("length", &PlanStats::length, "[unit steps]");
+
+  py::class_<Plan>(m, "Plan", "Waypoints after each unit push, start first (SI units).")
+      .def_readonly("outcome", &Plan::outcome)
+      .def_readonly("stats", &Plan::stats)
+      .def_readonly("goal_distance", &Plan::goal_distance, "from the last waypoint [unit steps]")
+      .def_property_readonly("poses", [](const Plan& p) {
+        py::array_t<double> out({static_cast<py::ssize_t>(p.waypoints.size()), py::ssize_t{3}});
+        auto o = out.mutable_unchecked<2>();
+        for (std::size_t i = 0; i < p.waypoints.size(); ++i) {
+          o(i, 0) = p.waypoints[i].pose.x;
+          o(i, 1) = p.waypoints[i].pose.z;
+          o(i, 2) = p.waypoints[i].pose.theta;
+        }
+        return out;
+      }, "(n, 3): x [m], z [m], theta [rad]")
+      .def_property_readonly("pushers", [](const Plan& p) {
+        std::vector<int> out;
+        for (const PlanStep& s : p.waypoints) out.push_back(s.pusher);
+        return out;
+      }, "pusher index of the push into each waypoint (-1 at the start)")
+      .def_property_readonly("margins", [](const Plan& p) {
+        std::vector<double> out;
+        for (const PlanStep& s : p.waypoints) out.push_back(s.margin);
+        return out;
+      }, "[N]; NaN at the start")
+      .def_property_readonly("contact_cases", [](const Plan& p) {
+        std::vector<ContactCase> out;
+        for (const PlanStep& s : p.waypoints) out.push_back(s.contact_case);
+        return out;
+      });
+
+  m.def("plan", [](const StablePushModel& model, const std::array<double, 3>& start, const std::array<double, 3>& goal,
+                   const std::array<double, 2>& step, const std::array<double, 2>& tolerance, double time_limit,
+                   double min_margin, double sampling_margin, const std::map<std::string, std::string>& parameters) {
+          PlannerSettings settings{to_pose(start), to_pose(goal), to_step(step), to_step(tolerance), time_limit,
+                                   min_margin, sampling_margin, parameters};
+          py::gil_scoped_release release;
+          return plan_stable_pushes(model, settings);
+        },
+        py::arg("model"), py::arg("start"), py::arg("goal"), py::arg("step"), py::arg("tolerance"),
+        py::arg("time_limit"), py::arg("min_margin"), py::arg("sampling_margin"), py::arg("parameters"),
+        "Plan stable pushes with TRRTstar. start, goal: (x m, z m, theta rad); step, tolerance: (m, rad);\n"
+        "time_limit [s]; min_margin [N]; sampling_margin [unit steps]; parameters: TRRTstar's declared\n"
+        "parameters by name, as text.");
+  m.attr("TRRT_STAR_PARAMETERS") = trrt_star_parameters();
 }

@@ -115,27 +115,46 @@ CrossSection CrossSection::box(double length_x, double height_z) {
 }
 
 bool CrossSection::contains_disc(const Vec2& center, double radius) const {
+  return contains_capsule(center, center, radius);
+}
+
+bool CrossSection::contains_capsule(const Vec2& a, const Vec2& b, double radius) const {
   const auto points = to_cgal(vertices_);
-  // Exact predicate (filtered by CGAL): is the centre inside the closed polygon?
-  if (CGAL::bounded_side_2(points.begin(), points.end(), Epick::Point_2(center.x(), center.y()), Epick()) ==
+  // Exact predicate (filtered by CGAL): is the spine's start inside the closed polygon?
+  if (CGAL::bounded_side_2(points.begin(), points.end(), Epick::Point_2(a.x(), a.y()), Epick()) ==
       CGAL::ON_UNBOUNDED_SIDE)
     return false;
+  // The capsule is inside iff its spine stays at least `radius` from every edge (a spine that
+  // crosses an edge is at distance 0 from it). Crossings are an exact predicate; distances
+  // are computed in double and re-made exactly only within rounding of tangency.
+  const bool is_point = a == b;
+  const Epick::Segment_2 spine(Epick::Point_2(a.x(), a.y()), Epick::Point_2(b.x(), b.y()));
   double min_d2 = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < vertices_.size(); ++i)
-    min_d2 = std::min(min_d2, squared_distance_to_segment(center, vertices_[i], vertices_[(i + 1) % vertices_.size()]));
+  for (std::size_t i = 0; i < vertices_.size(); ++i) {
+    const Vec2& p = vertices_[i];
+    const Vec2& q = vertices_[(i + 1) % vertices_.size()];
+    if (!is_point && CGAL::do_intersect(spine, Epick::Segment_2(points[i], points[(i + 1) % points.size()])))
+      return false;
+    double d2 = squared_distance_to_segment(a, p, q);
+    if (!is_point)
+      d2 = std::min({d2, squared_distance_to_segment(b, p, q), squared_distance_to_segment(p, a, b),
+                     squared_distance_to_segment(q, a, b)});
+    min_d2 = std::min(min_d2, d2);
+  }
   const double r2 = radius * radius;
   // The double distance is good to a few ulps of the coordinates' squared magnitude.
-  const double band = 1e-12 * (circumradius_ * circumradius_ + center.squaredNorm() + r2);
+  const double band = 1e-12 * (circumradius_ * circumradius_ + a.squaredNorm() + b.squaredNorm() + r2);
   if (min_d2 - r2 > band) return true;
   if (r2 - min_d2 > band) return false;
   // Within rounding of tangency: decide with exact constructions.
-  const Epeck::Point_2 c(center.x(), center.y());
+  const Epeck::Point_2 ea(a.x(), a.y()), eb(b.x(), b.y());
   const Epeck::FT exact_r2 = Epeck::FT(radius) * Epeck::FT(radius);
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
-    const Vec2& a = vertices_[i];
-    const Vec2& b = vertices_[(i + 1) % vertices_.size()];
-    const Epeck::Segment_2 edge(Epeck::Point_2(a.x(), a.y()), Epeck::Point_2(b.x(), b.y()));
-    if (CGAL::squared_distance(c, edge) < exact_r2) return false;
+    const Vec2& p = vertices_[i];
+    const Vec2& q = vertices_[(i + 1) % vertices_.size()];
+    const Epeck::Segment_2 edge(Epeck::Point_2(p.x(), p.y()), Epeck::Point_2(q.x(), q.y()));
+    const Epeck::FT d2 = is_point ? CGAL::squared_distance(ea, edge) : CGAL::squared_distance(Epeck::Segment_2(ea, eb), edge);
+    if (d2 < exact_r2) return false;
   }
   return true;
 }

@@ -1,5 +1,7 @@
 #include "stablepush/gripper.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace stablepush {
@@ -40,6 +42,24 @@ bool Gripper::grasp_maintained(const CrossSection& section, const Pose& q) const
   const Vec2 origin(q.x, q.z);
   for (const Pad& pad : pads_)
     if (!section.contains_disc(rotation.apply_inverse(pad.center - origin), pad.radius)) return false;
+  return true;
+}
+
+bool Gripper::grasp_maintained_along(const CrossSection& section, const Pose& from, const Pose& to) const {
+  const Rotation2 r0(from.theta), r1(to.theta);
+  const Vec2 c0(from.x, from.z), c1(to.x, to.z);
+  const double dtheta = std::abs(to.theta - from.theta);
+  const double dc = (c1 - c0).norm();
+  for (const Pad& pad : pads_) {
+    // The pad centre in O, f(t) = R(theta(t))^T (p - c(t)), bows away from its chord by at most
+    // max|f''| / 8 with |f''| <= dtheta^2 |p - c| + 2 dtheta |dc|; the swept disc therefore lies in
+    // the capsule around the chord with its radius grown by that bow.
+    const double reach = std::max((pad.center - c0).norm(), (pad.center - c1).norm());
+    const double bow = (dtheta * dtheta * reach + 2.0 * dtheta * dc) / 8.0;
+    if (!section.contains_capsule(r0.apply_inverse(pad.center - c0), r1.apply_inverse(pad.center - c1),
+                                  pad.radius + bow))
+      return false;
+  }
   return true;
 }
 

@@ -36,6 +36,10 @@ class CrossSection {
   /// Decided in double unless the answer is within rounding of tangency; then with CGAL's exact kernel.
   bool contains_disc(const Vec2& center, double radius) const;
 
+  /// Whether the capsule swept by a disc of `radius` [m] whose centre moves along the segment a-b
+  /// (in O [m]) lies inside the closed polygon. contains_capsule(c, c, r) == contains_disc(c, r).
+  bool contains_capsule(const Vec2& a, const Vec2& b, double radius) const;
+
   /// Euclidean distance from a point of O to the boundary [m].
   double distance_to_boundary(const Vec2& p) const;
 

@@ -39,6 +39,10 @@ class Gripper {
   std::vector<bool> pads_inside(const CrossSection& section, const Pose& q) const;
   /// The grasp is maintained when every pad disc lies inside the cross-section (MODEL.md section 3).
   bool grasp_maintained(const CrossSection& section, const Pose& q) const;
+  /// The grasp is maintained throughout the motion that interpolates (x, z, theta) linearly from
+  /// `from` to `to`: every pad disc stays inside the cross-section at every instant, not only at
+  /// the ends (so a step cannot cut a concave corner).
+  bool grasp_maintained_along(const CrossSection& section, const Pose& from, const Pose& to) const;
 
  private:
   std::vector<Pad> pads_;

@@ -1,0 +1,122 @@
+// The planning problem as OMPL sees it (paper section VI, MODEL.md section 3), kept apart from
+// the search: the space of grasp poses q = (x, z, theta), its metric in unit steps, the state
+// validity (grasp maintained), the motion validity (a stable push by some pusher, the grasp kept
+// throughout) and the goal region.
+#pragma once
+
+#include <ompl/base/MotionValidator.h>
+#include <ompl/base/StateValidityChecker.h>
+#include <ompl/base/goals/GoalSampleableRegion.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "stablepush/stable_push.hpp"
+#include "stablepush/types.hpp"
+
+namespace stablepush {
+
+/// One unit step of the planner: a translation of `length` [m] or a rotation of `angle` [rad]
+/// (the task's planner.step). Distances in the planner are counted in these units.
+struct StepSize {
+  double length = 1e-3;
+  double angle = M_PI / 180.0;
+};
+
+/// Pushers as a set: bit i stands for pusher i. At most kMaxPushers pushers per task.
+using PusherSet = std::uint32_t;
+inline constexpr int kMaxPushers = 32;
+inline constexpr int kNoPusher = -1;
+inline bool contains(PusherSet set, int pusher) { return pusher >= 0 && ((set >> pusher) & 1u); }
+
+/// The grasp poses (x [m], z [m], theta [rad]) with the metric
+///     d(q1, q2) = sqrt((dx^2 + dz^2) / length^2 + dtheta^2 / angle^2)   [unit steps],
+/// so that a unit step is a step of length 1. theta is not wrapped: a plan turns the object
+/// through the angles it passes, and the bounds decide how far it may turn.
+class GraspPoseSpace : public ompl::base::RealVectorStateSpace {
+ public:
+  GraspPoseSpace(StepSize step, const ompl::base::RealVectorBounds& bounds);
+
+  const StepSize& step() const { return step_; }
+  double distance(const ompl::base::State* a, const ompl::base::State* b) const override;
+  double distance(const Pose& a, const Pose& b) const;
+  double getMaximumExtent() const override;
+
+  static Pose pose(const ompl::base::State* s);
+  static void set_pose(ompl::base::State* s, const Pose& q);
+
+  /// The motion a -> b cut into n equal pushes of at most one unit step each (n >= 1);
+  /// returns the n + 1 poses, a first and b last. Planning and the plan's waypoints share it.
+  std::vector<Pose> unit_pushes(const Pose& a, const Pose& b) const;
+
+ private:
+  StepSize step_;
+};
+
+/// Uniform samples of the pose space from a generator seeded by the planner, so that a seed
+/// gives the same samples in any process (OMPL's default samplers draw from a global seed).
+class SeededPoseSampler : public ompl::base::RealVectorStateSampler {
+ public:
+  SeededPoseSampler(const ompl::base::StateSpace* space, std::uint_fast32_t seed);
+};
+
+/// A pose is valid when the grasp is maintained: every pad disc inside the cross-section.
+class GraspValidityChecker : public ompl::base::StateValidityChecker {
+ public:
+  GraspValidityChecker(const ompl::base::SpaceInformationPtr& si, const StablePushModel& model);
+  bool isValid(const ompl::base::State* s) const override;
+
+ private:
+  const StablePushModel& model_;
+};
+
+/// A motion a -> b is valid when, for one same pusher, each of its unit pushes
+/// (GraspPoseSpace::unit_pushes) is a stable push with a margin of at least `min_margin` [N],
+/// and the grasp is maintained throughout (swept pads, Gripper::grasp_maintained_along).
+class StablePushValidator : public ompl::base::MotionValidator {
+ public:
+  StablePushValidator(const ompl::base::SpaceInformationPtr& si, const StablePushModel& model,
+                      double min_margin);
+
+  /// The pushers among `candidates` that make every unit push of a -> b stable; 0 when the
+  /// grasp is lost on the way.
+  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const;
+  PusherSet all_pushers() const { return all_; }
+
+  bool checkMotion(const ompl::base::State* a, const ompl::base::State* b) const override;
+  bool checkMotion(const ompl::base::State* a, const ompl::base::State* b,
+                   std::pair<ompl::base::State*, double>& last_valid) const override;
+
+  /// Stable-push tests made so far (one per pusher and unit push).
+  std::uint64_t feasibility_checks() const { return checks_; }
+  void reset_feasibility_checks() { checks_ = 0; }
+
+ private:
+  const StablePushModel& model_;
+  const GraspPoseSpace& space_;
+  double min_margin_;
+  PusherSet all_;
+  mutable std::uint64_t checks_ = 0;
+};
+
+/// The goal: every coordinate within its tolerance of the goal pose (|dx|, |dz| <= tolerance.length,
+/// |dtheta| <= tolerance.angle). distanceGoal is the distance in unit steps.
+class PoseGoal : public ompl::base::GoalSampleableRegion {
+ public:
+  PoseGoal(const ompl::base::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance);
+
+  const Pose& pose() const { return goal_; }
+  bool isSatisfied(const ompl::base::State* s) const override;
+  bool isSatisfied(const ompl::base::State* s, double* distance) const override;
+  double distanceGoal(const ompl::base::State* s) const override;
+  void sampleGoal(ompl::base::State* s) const override;
+  unsigned int maxSampleCount() const override { return 1; }
+
+ private:
+  const GraspPoseSpace& space_;
+  Pose goal_;
+  StepSize tolerance_;
+};
+
+}  // namespace stablepush

@@ -1,0 +1,61 @@
+// From a stable-push model, a start and a goal to a plan: the OMPL problem set up around
+// TRRTstar, solved, and the tree path cut into the unit pushes a robot executes.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "stablepush/grasp_space.hpp"
+#include "stablepush/stable_push.hpp"
+#include "stablepush/trrt_star.hpp"
+
+namespace stablepush {
+
+struct PlannerSettings {
+  Pose start;                   ///< [m, m, rad]
+  Pose goal;                    ///< [m, m, rad]
+  StepSize step;                ///< one unit step
+  StepSize tolerance;           ///< per coordinate, around the goal
+  double time_limit = 10.0;     ///< [s]
+  double min_margin = 1e-3;     ///< least depth inside the pusher's cone for a push to count [N]
+  /// Samples are drawn from the box spanned by start and goal, grown by this many unit steps.
+  double sampling_margin = 5.0;
+  /// TRRTstar's declared parameters by name (seed, max_switches, goal_bias, ...); values as text.
+  std::map<std::string, std::string> parameters;
+};
+
+/// One waypoint: the pose after a unit push, the pusher that made it, and the test's verdict
+/// on that push. The first waypoint is the start: pusher kNoPusher, margin NaN.
+struct PlanStep {
+  Pose pose;
+  int pusher = kNoPusher;
+  double margin = 0.0;  ///< [N]
+  ContactCase contact_case = ContactCase::AllSliding;
+};
+
+struct PlanStats {
+  double planning_time_s = 0.0;
+  std::uint64_t iterations = 0;
+  std::size_t nodes = 0;
+  std::uint64_t feasibility_checks = 0;  ///< stable-push tests, one per pusher and unit push
+  int switches = 0;
+  double length = 0.0;  ///< [unit steps]
+};
+
+struct Plan {
+  PlanOutcome outcome = PlanOutcome::TimeLimit;
+  std::vector<PlanStep> waypoints;
+  PlanStats stats;
+  double goal_distance = 0.0;  ///< from the last waypoint [unit steps]
+};
+
+/// Plan stable pushes from settings.start to settings.goal. Throws std::invalid_argument for a
+/// parameter that TRRTstar does not declare or cannot take.
+Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& settings);
+
+/// TRRTstar's declared parameters and their default values (as text).
+std::map<std::string, std::string> trrt_star_parameters();
+
+}  // namespace stablepush

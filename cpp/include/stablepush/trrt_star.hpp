@@ -1,0 +1,159 @@
+// T-RRT* over grasp poses with the pusher in the search state (paper section VI, Algorithm 1).
+//
+// Each tree node is a grasp pose q together with the pusher that made the push into it, so that
+// the path cost (switch-overs first, then length in unit steps) is a sum over edges and RRT*'s
+// choose-parent (the paper's optimEdge) and rewiring count switch-overs exactly.
+//
+// One iteration: sample q_rand (the goal with probability goal_bias); from the nearest node that
+// needs at most max_switches switch-overs (a node beyond the budget cannot start a plan that
+// meets it unless a rewiring lowers its count, so it is kept but not extended), step
+// toward q_rand one unit step at a time while
+//   1. the T-RRT transition test accepts the step on the configuration cost c(q) = distance to
+//      the goal [unit steps] (Jaillet, Cortes and Simeon, T-RRT, 2008):
+//        c_new <= c_parent: accept; otherwise accept with probability exp(-(dc / d) / T), where
+//        the temperature T falls by temp_change_factor after an accepted climb and rises by it
+//        after max_transition_failures refused climbs in a row;
+//   2. the grasp is maintained at the new pose (the space's validity checker);
+//   3. some pusher makes the step a stable push (StablePushValidator);
+// then connect the new pose to the cheapest near node whose push to it is stable, and rewire
+// the near nodes through it when that is cheaper (Karaman and Frazzoli, RRT*, 2011).
+//
+// The planner stops when a node within the goal tolerance costs at most max_switches
+// switch-overs, or when the termination condition (time) fires; outcome() says which.
+#pragma once
+
+#include <ompl/base/Planner.h>
+#include <ompl/datastructures/NearestNeighbors.h>
+#include <ompl/util/RandomNumbers.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "stablepush/grasp_space.hpp"
+
+namespace stablepush {
+
+/// Path cost: switch-overs first, then length [unit steps]. The first push is not a switch-over.
+struct PathCost {
+  int switches = 0;
+  double length = 0.0;
+
+  /// Lexicographic; lengths within 1e-9 unit steps count as equal.
+  bool operator<(const PathCost& other) const {
+    if (switches != other.switches) return switches < other.switches;
+    return length < other.length - 1e-9;
+  }
+  PathCost operator+(const PathCost& other) const { return {switches + other.switches, length + other.length}; }
+  PathCost operator-(const PathCost& other) const { return {switches - other.switches, length - other.length}; }
+};
+
+/// How a solve ended.
+enum class PlanOutcome {
+  GoalReached,          ///< a node within the goal tolerance with at most max_switches switch-overs
+  GoalOverSwitchLimit,  ///< time ran out; the goal was reached, but only with more switch-overs
+  TimeLimit,            ///< time ran out before the goal was reached; the path ends closest to it
+};
+
+/// One node of a solution path: the pose and the pusher of the push into it (kNoPusher at the start).
+struct PathNode {
+  Pose pose;
+  int pusher = kNoPusher;
+};
+
+class TRRTstar : public ompl::base::Planner {
+ public:
+  explicit TRRTstar(const ompl::base::SpaceInformationPtr& si);
+  ~TRRTstar() override;
+
+  void setup() override;
+  ompl::base::PlannerStatus solve(const ompl::base::PlannerTerminationCondition& ptc) override;
+  void clear() override;
+  void getPlannerData(ompl::base::PlannerData& data) const override;
+
+  // Declared parameters (Planner::params()), settable by name from the task's planner section.
+  void setGoalBias(double p) { goal_bias_ = p; }
+  double getGoalBias() const { return goal_bias_; }
+  void setRewireRadius(double steps) { rewire_radius_ = steps; }
+  double getRewireRadius() const { return rewire_radius_; }
+  void setInitTemperature(double t) { init_temperature_ = t; }
+  double getInitTemperature() const { return init_temperature_; }
+  void setTempChangeFactor(double f) { temp_change_factor_ = f; }
+  double getTempChangeFactor() const { return temp_change_factor_; }
+  void setMaxTransitionFailures(unsigned n) { max_transition_failures_ = n; }
+  unsigned getMaxTransitionFailures() const { return max_transition_failures_; }
+  void setMaxSwitches(unsigned k) { max_switches_ = k; }
+  unsigned getMaxSwitches() const { return max_switches_; }
+  /// Largest deviation from the straight step toward the goal tried when that step is not a
+  /// stable push [deg]; 0 keeps to straight steps.
+  void setSteerAngle(double degrees) { steer_angle_ = degrees; }
+  double getSteerAngle() const { return steer_angle_; }
+  void setSeed(unsigned seed) { seed_ = seed; }
+  unsigned getSeed() const { return seed_; }
+
+  // The last solve.
+  PlanOutcome outcome() const { return outcome_; }
+  /// The best path of the last solve, start first: to the cheapest goal node, or, when the goal
+  /// was not reached, to the node closest to the goal.
+  std::vector<PathNode> solution() const;
+  PathCost solution_cost() const;
+  std::uint64_t iterations() const { return iterations_; }
+  std::size_t node_count() const { return nodes_.size(); }
+  double temperature() const { return temperature_; }
+
+ private:
+  struct Node;
+  struct Candidate;
+
+  void free_tree();
+  /// Connect q_new (stable from `from` by `stable`) through the cheapest near parent, rewire,
+  /// and note a goal; returns the first node added.
+  Node* connect(Node* from, const Pose& q_new, PusherSet stable);
+  /// Unit steps from `from` straight toward `target` while each is accepted (Algorithm 1).
+  void extend(Node* from, const ompl::base::State* target, const ompl::base::PlannerTerminationCondition& ptc);
+  /// Unit steps from `from` toward the goal, each the straight step or the nearest deviation
+  /// from it within steer_angle that a pusher allowed by the switch-over budget makes stable.
+  void extend_toward_goal(Node* from, const ompl::base::PlannerTerminationCondition& ptc);
+  Node* add_node(const Pose& q, int pusher, Node* parent, const PathCost& cost);
+  /// optimEdge: the cheapest stable connection to q_new among the near nodes; `via` is the node
+  /// the extension came from, `via_pushers` the pushers stable along via -> q_new.
+  Candidate choose_parent(const Pose& q_new, const std::vector<Node*>& near, Node* via, PusherSet via_pushers) const;
+  void rewire(Node* node, const std::vector<Node*>& near);
+  void shift_subtree_cost(Node* node, const PathCost& delta);
+  bool transition_test(double cost_from, double cost_to, double step);
+  /// The node nearest to q among those within the switch-over budget (max_switches).
+  Node* nearest_extendable(const Pose& q) const;
+  /// Among the nodes within the budget not yet extended toward the goal, the one with the least
+  /// cost plus distance to the goal; nullptr when there is none.
+  Node* most_promising_toward_goal() const;
+  void note_goal_candidate(Node* node);
+  Node* best_goal() const;
+
+  StablePushValidator* validator_ = nullptr;
+  const GraspPoseSpace* space_ = nullptr;
+  std::shared_ptr<ompl::NearestNeighbors<Node*>> nn_;
+  std::vector<Node*> nodes_;
+  std::vector<Node*> goal_nodes_;
+  std::vector<Node*> near_;  ///< scratch for near-node queries
+  Node* closest_ = nullptr;
+  std::unique_ptr<ompl::RNG> rng_;
+  ompl::base::StateSamplerPtr sampler_;
+
+  double goal_bias_ = 0.2;
+  double rewire_radius_ = 2.0;
+  double init_temperature_ = 0.1;
+  double temp_change_factor_ = 2.0;
+  double steer_angle_ = 45.0;
+  unsigned max_transition_failures_ = 10;
+  unsigned max_switches_ = 1;
+  unsigned seed_ = 1;
+
+  double temperature_ = 0.0;
+  unsigned transition_failures_ = 0;
+  double min_goal_distance_ = 0.0;
+  double max_goal_distance_ = 0.0;
+  std::uint64_t iterations_ = 0;
+  PlanOutcome outcome_ = PlanOutcome::TimeLimit;
+};
+
+}  // namespace stablepush

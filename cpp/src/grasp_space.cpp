@@ -1,0 +1,159 @@
+#include "stablepush/grasp_space.hpp"
+
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/util/Exception.h>
+
+#include <cmath>
+
+namespace stablepush {
+
+namespace ob = ompl::base;
+
+GraspPoseSpace::GraspPoseSpace(StepSize step, const ob::RealVectorBounds& bounds)
+    : ob::RealVectorStateSpace(3), step_(step) {
+  if (!(step_.length > 0.0) || !(step_.angle > 0.0)) throw std::invalid_argument("unit steps must be > 0");
+  setName("GraspPose");
+  setDimensionName(0, "x");
+  setDimensionName(1, "z");
+  setDimensionName(2, "theta");
+  setBounds(bounds);
+}
+
+double GraspPoseSpace::distance(const ob::State* a, const ob::State* b) const { return distance(pose(a), pose(b)); }
+
+double GraspPoseSpace::distance(const Pose& a, const Pose& b) const {
+  const double dx = (b.x - a.x) / step_.length;
+  const double dz = (b.z - a.z) / step_.length;
+  const double dt = (b.theta - a.theta) / step_.angle;
+  return std::sqrt(dx * dx + dz * dz + dt * dt);
+}
+
+double GraspPoseSpace::getMaximumExtent() const {
+  const double dx = (bounds_.high[0] - bounds_.low[0]) / step_.length;
+  const double dz = (bounds_.high[1] - bounds_.low[1]) / step_.length;
+  const double dt = (bounds_.high[2] - bounds_.low[2]) / step_.angle;
+  return std::sqrt(dx * dx + dz * dz + dt * dt);
+}
+
+Pose GraspPoseSpace::pose(const ob::State* s) {
+  const double* v = s->as<StateType>()->values;
+  return Pose{v[0], v[1], v[2]};
+}
+
+void GraspPoseSpace::set_pose(ob::State* s, const Pose& q) {
+  double* v = s->as<StateType>()->values;
+  v[0] = q.x;
+  v[1] = q.z;
+  v[2] = q.theta;
+}
+
+std::vector<Pose> GraspPoseSpace::unit_pushes(const Pose& a, const Pose& b) const {
+  const double steps = distance(a, b);
+  // A hair of slack so that a motion of exactly k unit steps is k pushes, not k + 1.
+  const int n = std::max(1, static_cast<int>(std::ceil(steps - 1e-9)));
+  std::vector<Pose> poses;
+  poses.reserve(n + 1);
+  for (int i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) / n;
+    poses.push_back(Pose{a.x + t * (b.x - a.x), a.z + t * (b.z - a.z), a.theta + t * (b.theta - a.theta)});
+  }
+  poses.push_back(b);
+  return poses;
+}
+
+SeededPoseSampler::SeededPoseSampler(const ob::StateSpace* space, std::uint_fast32_t seed)
+    : ob::RealVectorStateSampler(space) {
+  rng_ = ompl::RNG(seed);
+}
+
+GraspValidityChecker::GraspValidityChecker(const ob::SpaceInformationPtr& si, const StablePushModel& model)
+    : ob::StateValidityChecker(si), model_(model) {}
+
+bool GraspValidityChecker::isValid(const ob::State* s) const {
+  return model_.grasp_maintained(GraspPoseSpace::pose(s));
+}
+
+StablePushValidator::StablePushValidator(const ob::SpaceInformationPtr& si, const StablePushModel& model,
+                                         double min_margin)
+    : ob::MotionValidator(si),
+      model_(model),
+      space_(*si->getStateSpace()->as<GraspPoseSpace>()),
+      min_margin_(min_margin) {
+  const int n = static_cast<int>(model_.pushers().size());
+  if (n < 1 || n > kMaxPushers) throw std::invalid_argument("a task has between 1 and 32 pushers");
+  all_ = n == kMaxPushers ? ~PusherSet{0} : ((PusherSet{1} << n) - 1u);
+}
+
+PusherSet StablePushValidator::stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const {
+  const std::vector<Pose> poses = space_.unit_pushes(a, b);
+  for (std::size_t i = 0; i + 1 < poses.size() && candidates != 0; ++i) {
+    const Pose& from = poses[i];
+    const Pose& to = poses[i + 1];
+    if (!model_.gripper().grasp_maintained_along(model_.section(), from, to)) return 0;
+    const Motion dq{to.x - from.x, to.z - from.z, to.theta - from.theta};
+    const MotionWrench load = model_.motion_wrench(from, dq);
+    for (int p = 0; p < kMaxPushers; ++p) {
+      if (!contains(candidates, p)) continue;
+      ++checks_;
+      const PushResult r = model_.check(load, from, dq, p);
+      if (!(r.feasible && r.margin >= min_margin_)) candidates &= ~(PusherSet{1} << p);
+    }
+  }
+  return candidates;
+}
+
+bool StablePushValidator::checkMotion(const ob::State* a, const ob::State* b) const {
+  const bool ok = stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_) != 0;
+  (ok ? valid_ : invalid_)++;
+  return ok;
+}
+
+bool StablePushValidator::checkMotion(const ob::State* a, const ob::State* b,
+                                      std::pair<ob::State*, double>& last_valid) const {
+  // The longest prefix of whole unit pushes that one pusher makes stable.
+  const std::vector<Pose> poses = space_.unit_pushes(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b));
+  const std::size_t n = poses.size() - 1;
+  PusherSet alive = all_;
+  std::size_t done = 0;
+  for (; done < n; ++done) {
+    const PusherSet next = stable_pushers(poses[done], poses[done + 1], alive);
+    if (next == 0) break;
+    alive = next;
+  }
+  if (done == n) {
+    valid_++;
+    return true;
+  }
+  if (last_valid.first != nullptr) GraspPoseSpace::set_pose(last_valid.first, poses[done]);
+  last_valid.second = static_cast<double>(done) / n;
+  invalid_++;
+  return false;
+}
+
+PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance)
+    : ob::GoalSampleableRegion(si),
+      space_(*si->getStateSpace()->as<GraspPoseSpace>()),
+      goal_(goal),
+      tolerance_(tolerance) {
+  // OMPL's threshold: no state farther than this (unit steps) from the goal pose satisfies it.
+  const double x = tolerance_.length / space_.step().length;
+  const double t = tolerance_.angle / space_.step().angle;
+  setThreshold(std::sqrt(2.0 * x * x + t * t));
+}
+
+bool PoseGoal::isSatisfied(const ob::State* s) const {
+  const Pose q = GraspPoseSpace::pose(s);
+  return std::abs(q.x - goal_.x) <= tolerance_.length && std::abs(q.z - goal_.z) <= tolerance_.length &&
+         std::abs(q.theta - goal_.theta) <= tolerance_.angle;
+}
+
+bool PoseGoal::isSatisfied(const ob::State* s, double* distance) const {
+  if (distance != nullptr) *distance = distanceGoal(s);
+  return isSatisfied(s);
+}
+
+double PoseGoal::distanceGoal(const ob::State* s) const { return space_.distance(GraspPoseSpace::pose(s), goal_); }
+
+void PoseGoal::sampleGoal(ob::State* s) const { GraspPoseSpace::set_pose(s, goal_); }
+
+}  // namespace stablepush

@@ -1,0 +1,120 @@
+#include "stablepush/planning.hpp"
+
+#include <ompl/base/ProblemDefinition.h>
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/util/Console.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+namespace stablepush {
+
+namespace ob = ompl::base;
+
+namespace {
+
+/// The region the planner samples: the box spanned by the start and the goal, grown by
+/// settings.sampling_margin unit steps on every side, and cut to where some pad can still hold the object
+/// (a pad centre p in G lies in the cross-section, so |p - c| <= circumradius and each of x, z
+/// is within circumradius + |p| of 0).
+ob::RealVectorBounds sampling_region(const StablePushModel& model, const PlannerSettings& settings) {
+  double reach = 0.0;
+  for (const Pad& pad : model.gripper().pads()) reach = std::max(reach, pad.center.norm());
+  reach += model.section().circumradius();
+  const Pose& a = settings.start;
+  const Pose& b = settings.goal;
+  const double grow = settings.sampling_margin * settings.step.length;
+  const double turn = settings.sampling_margin * settings.step.angle;
+  ob::RealVectorBounds bounds(3);
+  bounds.setLow(0, std::max(-reach, std::min(a.x, b.x) - grow));
+  bounds.setHigh(0, std::min(reach, std::max(a.x, b.x) + grow));
+  bounds.setLow(1, std::max(-reach, std::min(a.z, b.z) - grow));
+  bounds.setHigh(1, std::min(reach, std::max(a.z, b.z) + grow));
+  bounds.setLow(2, std::min(a.theta, b.theta) - turn);
+  bounds.setHigh(2, std::max(a.theta, b.theta) + turn);
+  return bounds;
+}
+
+void apply_parameters(ob::Planner& planner, const std::map<std::string, std::string>& parameters) {
+  ob::ParamSet& declared = planner.params();
+  for (const auto& [name, value] : parameters) {
+    if (!declared.hasParam(name)) {
+      std::vector<std::string> names;
+      declared.getParamNames(names);
+      std::string known;
+      for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+      throw std::invalid_argument("unknown planner parameter '" + name + "' (TRRTstar declares " + known + ")");
+    }
+    if (!declared.setParam(name, value))
+      throw std::invalid_argument("planner parameter '" + name + "' cannot take the value '" + value + "'");
+  }
+}
+
+}  // namespace
+
+Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& settings) {
+  const auto started = std::chrono::steady_clock::now();
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+
+  auto space = std::make_shared<GraspPoseSpace>(settings.step, sampling_region(model, settings));
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  si->setStateValidityChecker(std::make_shared<GraspValidityChecker>(si, model));
+  auto validator = std::make_shared<StablePushValidator>(si, model, settings.min_margin);
+  si->setMotionValidator(validator);
+  si->setup();
+
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  ob::ScopedState<GraspPoseSpace> start(space);
+  GraspPoseSpace::set_pose(start.get(), settings.start);
+  pdef->addStartState(start);
+  pdef->setGoal(std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance));
+
+  TRRTstar planner(si);
+  apply_parameters(planner, settings.parameters);
+  planner.setProblemDefinition(pdef);
+  planner.setup();
+  planner.solve(ob::timedPlannerTerminationCondition(settings.time_limit));
+
+  Plan plan;
+  plan.outcome = planner.outcome();
+  const std::vector<PathNode> nodes = planner.solution();
+  plan.waypoints.push_back({nodes.front().pose, kNoPusher, std::numeric_limits<double>::quiet_NaN(),
+                            ContactCase::AllSliding});
+  for (std::size_t i = 1; i < nodes.size(); ++i) {
+    // The same cut into unit pushes as the validator made, so each waypoint is a checked push.
+    const std::vector<Pose> poses = space->unit_pushes(nodes[i - 1].pose, nodes[i].pose);
+    for (std::size_t k = 1; k < poses.size(); ++k) {
+      const Pose& from = poses[k - 1];
+      const Pose& to = poses[k];
+      const PushResult r =
+          model.check(from, Motion{to.x - from.x, to.z - from.z, to.theta - from.theta}, nodes[i].pusher);
+      plan.waypoints.push_back({to, nodes[i].pusher, r.margin, r.contact_case});
+    }
+  }
+  const PathCost cost = planner.solution_cost();
+  plan.stats.iterations = planner.iterations();
+  plan.stats.nodes = planner.node_count();
+  plan.stats.feasibility_checks = validator->feasibility_checks();
+  plan.stats.switches = cost.switches;
+  plan.stats.length = cost.length;
+  plan.goal_distance = space->distance(plan.waypoints.back().pose, settings.goal);
+  plan.stats.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return plan;
+}
+
+std::map<std::string, std::string> trrt_star_parameters() {
+  ob::RealVectorBounds bounds(3);
+  bounds.setLow(-1.0);
+  bounds.setHigh(1.0);
+  auto si = std::make_shared<ob::SpaceInformation>(std::make_shared<GraspPoseSpace>(StepSize{}, bounds));
+  TRRTstar planner(si);
+  std::map<std::string, std::string> out;
+  planner.params().getParams(out);
+  return out;
+}
+
+}  // namespace stablepush

@@ -1,0 +1,445 @@
+#include "stablepush/trrt_star.hpp"
+
+#include <ompl/base/PlannerData.h>
+#include <ompl/base/goals/GoalSampleableRegion.h>
+#include <ompl/datastructures/NearestNeighborsLinear.h>
+#include <ompl/geometric/PathGeometric.h>
+#include <ompl/util/Exception.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+
+namespace stablepush {
+
+namespace ob = ompl::base;
+
+struct TRRTstar::Node {
+  ob::State* state = nullptr;
+  Pose pose;
+  int pusher = kNoPusher;  ///< the pusher of the push into this node
+  Node* parent = nullptr;
+  std::vector<Node*> children;
+  PathCost cost;
+  double goal_distance = 0.0;  ///< T-RRT configuration cost [unit steps]
+  bool extended_to_goal = false;  ///< a goal sample has already been extended from here
+};
+
+/// A way to connect a new pose: from `parent`, at `cost`, by any pusher of `pushers`.
+struct TRRTstar::Candidate {
+  Node* parent = nullptr;
+  PathCost cost;
+  PusherSet pushers = 0;
+};
+
+namespace {
+/// Edges shorter than this [unit steps] are not pushes (co-located nodes differ only by pusher).
+constexpr double kMinEdge = 1e-9;
+
+PusherSet single(int pusher) { return pusher < 0 ? 0u : (1u << pusher); }
+}  // namespace
+
+TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTstar") {
+  specs_.approximateSolutions = true;
+  specs_.optimizingPaths = true;
+  specs_.directed = true;
+  declareParam<double>("goal_bias", this, &TRRTstar::setGoalBias, &TRRTstar::getGoalBias, "0.:.05:1.");
+  declareParam<double>("rewire_radius", this, &TRRTstar::setRewireRadius, &TRRTstar::getRewireRadius, "0.:.5:10.");
+  declareParam<double>("init_temperature", this, &TRRTstar::setInitTemperature, &TRRTstar::getInitTemperature,
+                       "0.:.01:10.");
+  declareParam<double>("temp_change_factor", this, &TRRTstar::setTempChangeFactor, &TRRTstar::getTempChangeFactor,
+                       "1.:.1:10.");
+  declareParam<unsigned>("max_transition_failures", this, &TRRTstar::setMaxTransitionFailures,
+                         &TRRTstar::getMaxTransitionFailures, "1:1:1000");
+  declareParam<unsigned>("max_switches", this, &TRRTstar::setMaxSwitches, &TRRTstar::getMaxSwitches, "0:1:20");
+  declareParam<double>("steer_angle", this, &TRRTstar::setSteerAngle, &TRRTstar::getSteerAngle, "0.:5.:90.");
+  declareParam<unsigned>("seed", this, &TRRTstar::setSeed, &TRRTstar::getSeed, "0:1:1000000");
+}
+
+TRRTstar::~TRRTstar() { free_tree(); }
+
+void TRRTstar::setup() {
+  ob::Planner::setup();
+  space_ = dynamic_cast<const GraspPoseSpace*>(si_->getStateSpace().get());
+  validator_ = dynamic_cast<StablePushValidator*>(si_->getMotionValidator().get());
+  if (space_ == nullptr || validator_ == nullptr)
+    throw ompl::Exception(getName(), "needs a GraspPoseSpace and a StablePushValidator");
+  if (!nn_) {
+    // Linear search: exact and deterministic (tie-breaking by insertion order). GNAT draws its
+    // pivots from OMPL's global seed, which would make plans depend on the process's history.
+    nn_ = std::make_shared<ompl::NearestNeighborsLinear<Node*>>();
+    nn_->setDistanceFunction([this](const Node* a, const Node* b) { return si_->distance(a->state, b->state); });
+  }
+}
+
+void TRRTstar::free_tree() {
+  for (Node* n : nodes_) {
+    si_->freeState(n->state);
+    delete n;
+  }
+  nodes_.clear();
+  goal_nodes_.clear();
+  closest_ = nullptr;
+  if (nn_) nn_->clear();
+}
+
+void TRRTstar::clear() {
+  ob::Planner::clear();
+  free_tree();
+  iterations_ = 0;
+  outcome_ = PlanOutcome::TimeLimit;
+}
+
+TRRTstar::Node* TRRTstar::add_node(const Pose& q, int pusher, Node* parent, const PathCost& cost) {
+  auto* node = new Node;
+  node->state = si_->allocState();
+  GraspPoseSpace::set_pose(node->state, q);
+  node->pose = q;
+  node->pusher = pusher;
+  node->parent = parent;
+  node->cost = cost;
+  const auto* goal = pdef_->getGoal()->as<ob::GoalRegion>();
+  node->goal_distance = goal->distanceGoal(node->state);
+  if (parent != nullptr) parent->children.push_back(node);
+  nodes_.push_back(node);
+  nn_->add(node);
+  if (nodes_.size() == 1) min_goal_distance_ = max_goal_distance_ = node->goal_distance;
+  min_goal_distance_ = std::min(min_goal_distance_, node->goal_distance);
+  max_goal_distance_ = std::max(max_goal_distance_, node->goal_distance);
+  return node;
+}
+
+bool TRRTstar::transition_test(double cost_from, double cost_to, double step) {
+  if (cost_to <= cost_from) return true;  // downhill toward the goal: always
+  const double slope = (cost_to - cost_from) / step;
+  if (rng_->uniform01() < std::exp(-slope / temperature_)) {
+    temperature_ /= temp_change_factor_;  // an accepted climb cools the search
+    transition_failures_ = 0;
+    return true;
+  }
+  if (++transition_failures_ >= max_transition_failures_) {  // stuck below climbs: heat up
+    temperature_ *= temp_change_factor_;
+    transition_failures_ = 0;
+  }
+  return false;
+}
+
+TRRTstar::Node* TRRTstar::nearest_extendable(const Pose& q) const {
+  Node* best = nullptr;
+  double best_d = 0.0;
+  for (Node* n : nodes_) {
+    if (n->cost.switches > static_cast<int>(max_switches_)) continue;
+    const double d = space_->distance(n->pose, q);
+    if (best == nullptr || d < best_d) {
+      best = n;
+      best_d = d;
+    }
+  }
+  return best;
+}
+
+TRRTstar::Node* TRRTstar::most_promising_toward_goal() const {
+  Node* best = nullptr;
+  PathCost best_estimate;
+  for (Node* n : nodes_) {
+    if (n->extended_to_goal || n->cost.switches > static_cast<int>(max_switches_)) continue;
+    const PathCost estimate = n->cost + PathCost{0, n->goal_distance};
+    if (best == nullptr || estimate < best_estimate) {
+      best = n;
+      best_estimate = estimate;
+    }
+  }
+  return best;
+}
+
+TRRTstar::Candidate TRRTstar::choose_parent(const Pose& q_new, const std::vector<Node*>& near, Node* via,
+                                            PusherSet via_pushers) const {
+  // Near nodes in order of their cost if no switch-over were needed: a candidate cannot do
+  // better than that, so the scan stops at the first one that cannot beat the best found.
+  struct Option {
+    Node* node;
+    double distance;
+    PathCost optimistic;
+  };
+  std::vector<Option> options;
+  options.reserve(near.size() + 1);
+  bool via_listed = false;
+  for (Node* m : near) {
+    const double d = space_->distance(m->pose, q_new);
+    if (d < kMinEdge) continue;
+    options.push_back({m, d, m->cost + PathCost{0, d}});
+    via_listed = via_listed || m == via;
+  }
+  if (!via_listed) {
+    const double d = space_->distance(via->pose, q_new);
+    options.push_back({via, d, via->cost + PathCost{0, d}});
+  }
+  std::stable_sort(options.begin(), options.end(),
+                   [](const Option& a, const Option& b) { return a.optimistic < b.optimistic; });
+
+  Candidate best;
+  for (const Option& o : options) {
+    if (best.parent != nullptr && !(o.optimistic < best.cost)) break;
+    Node* m = o.node;
+    const PusherSet all = validator_->all_pushers();
+    PusherSet stable;
+    if (m == via) {
+      stable = via_pushers;
+    } else if (m->pusher != kNoPusher) {
+      // The parent's own pusher first: if it works there is no switch-over to pay.
+      stable = validator_->stable_pushers(m->pose, q_new, single(m->pusher));
+      if (stable == 0 && (best.parent == nullptr || m->cost + PathCost{1, o.distance} < best.cost))
+        stable = validator_->stable_pushers(m->pose, q_new, all & ~single(m->pusher));
+    } else {
+      stable = validator_->stable_pushers(m->pose, q_new, all);
+    }
+    if (stable == 0) continue;
+    Candidate c;
+    c.parent = m;
+    if (m->pusher == kNoPusher) {  // the first push is not a switch-over
+      c.cost = o.optimistic;
+      c.pushers = stable;
+    } else if (contains(stable, m->pusher)) {
+      c.cost = o.optimistic;
+      c.pushers = single(m->pusher);
+    } else {
+      c.cost = m->cost + PathCost{1, o.distance};
+      c.pushers = stable;
+    }
+    if (best.parent == nullptr || c.cost < best.cost) best = c;
+  }
+  return best;
+}
+
+void TRRTstar::shift_subtree_cost(Node* node, const PathCost& delta) {
+  std::vector<Node*> stack{node};
+  while (!stack.empty()) {
+    Node* n = stack.back();
+    stack.pop_back();
+    n->cost = n->cost + delta;
+    stack.insert(stack.end(), n->children.begin(), n->children.end());
+  }
+}
+
+void TRRTstar::rewire(Node* node, const std::vector<Node*>& near) {
+  for (Node* m : near) {
+    if (m == node->parent || m->parent == nullptr) continue;
+    const double d = si_->distance(node->state, m->state);
+    if (d < kMinEdge) continue;
+    const int switches = node->pusher != m->pusher ? 1 : 0;
+    const PathCost via = node->cost + PathCost{switches, d};
+    if (!(via < m->cost)) continue;
+    // m keeps its pusher, so the costs below m stay exact; only the push into m is new.
+    if (validator_->stable_pushers(node->pose, m->pose, single(m->pusher)) == 0) continue;
+    auto& siblings = m->parent->children;
+    siblings.erase(std::find(siblings.begin(), siblings.end(), m));
+    m->parent = node;
+    node->children.push_back(m);
+    shift_subtree_cost(m, via - m->cost);
+  }
+}
+
+void TRRTstar::note_goal_candidate(Node* node) {
+  if (pdef_->getGoal()->isSatisfied(node->state)) goal_nodes_.push_back(node);
+  if (closest_ == nullptr || node->goal_distance < closest_->goal_distance ||
+      (node->goal_distance == closest_->goal_distance && node->cost < closest_->cost))
+    closest_ = node;
+}
+
+TRRTstar::Node* TRRTstar::best_goal() const {
+  Node* best = nullptr;
+  for (Node* g : goal_nodes_)
+    if (best == nullptr || g->cost < best->cost) best = g;
+  return best;
+}
+
+TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stable) {
+  ob::State* probe_state = si_->allocState();
+  GraspPoseSpace::set_pose(probe_state, q_new);
+  Node probe;
+  probe.state = probe_state;
+  nn_->nearestR(&probe, rewire_radius_, near_);
+  si_->freeState(probe_state);
+  const Candidate best = choose_parent(q_new, near_, from, stable);
+  // One node per pusher that can make the push when it starts a new contact (or is the first
+  // push), so that any of them can be continued without a further switch-over.
+  Node* first = nullptr;
+  for (int p = 0; p < kMaxPushers; ++p) {
+    if (!contains(best.pushers, p)) continue;
+    Node* node = add_node(q_new, p, best.parent, best.cost);
+    rewire(node, near_);
+    note_goal_candidate(node);
+    if (first == nullptr) first = node;
+  }
+  const Node* reached = best_goal();
+  if (reached != nullptr && reached->cost.switches <= static_cast<int>(max_switches_))
+    outcome_ = PlanOutcome::GoalReached;
+  return first;
+}
+
+void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerminationCondition& ptc) {
+  // Algorithm 1's inner loop: unit steps toward the target while each is accepted.
+  const auto* goal = pdef_->getGoal()->as<ob::GoalRegion>();
+  ob::State* step_state = si_->allocState();
+  while (outcome_ != PlanOutcome::GoalReached && !ptc) {
+    const double d = si_->distance(from->state, target);
+    if (d < kMinEdge) break;
+    const bool last = d <= 1.0;
+    if (last)
+      si_->copyState(step_state, target);
+    else
+      si_->getStateSpace()->interpolate(from->state, target, 1.0 / d, step_state);
+    const double step = last ? d : si_->distance(from->state, step_state);
+    if (!transition_test(from->goal_distance, goal->distanceGoal(step_state), step)) break;
+    if (!si_->isValid(step_state)) break;  // the grasp is lost at the new pose
+    const Pose q_new = GraspPoseSpace::pose(step_state);
+    const PusherSet stable = validator_->stable_pushers(from->pose, q_new, validator_->all_pushers());
+    if (stable == 0) break;
+    Node* next = connect(from, q_new, stable);
+    if (last || next->cost.switches > static_cast<int>(max_switches_)) break;
+    from = next;
+  }
+  si_->freeState(step_state);
+}
+
+void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
+  const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
+  const StepSize unit = space_->step();
+  ob::State* step_state = si_->allocState();
+  while (outcome_ != PlanOutcome::GoalReached && !ptc) {
+    // The step in unit-step coordinates, u toward the goal.
+    const Eigen::Vector3d to_goal((goal.x - from->pose.x) / unit.length, (goal.z - from->pose.z) / unit.length,
+                                  (goal.theta - from->pose.theta) / unit.angle);
+    const double d = to_goal.norm();
+    if (d < kMinEdge) break;
+    const double length = std::min(1.0, d);
+    const Eigen::Vector3d u = to_goal / d;
+    // Two directions square to u, from the coordinate axis least aligned with it.
+    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+    Eigen::Index least;
+    u.cwiseAbs().minCoeff(&least);
+    axis[least] = 1.0;
+    const Eigen::Vector3d e1 = u.cross(axis).normalized();
+    const Eigen::Vector3d e2 = u.cross(e1);
+    // Pushers this node may use without exceeding the switch-over budget.
+    const PusherSet allowed = from->pusher == kNoPusher || from->cost.switches < static_cast<int>(max_switches_)
+                                  ? validator_->all_pushers()
+                                  : single(from->pusher);
+    // The step toward the goal, or the nearest deviation from it (in rings of growing angle up
+    // to steer_angle, eight directions per ring) that some allowed pusher makes stable.
+    PusherSet stable = 0;
+    Pose q_new;
+    const int rings = steer_angle_ > 0.0 ? 4 : 0;
+    for (int ring = 0; ring <= rings && stable == 0; ++ring) {
+      const double alpha = steer_angle_ * M_PI / 180.0 * ring / std::max(rings, 1);
+      for (int k = 0; k < (ring == 0 ? 1 : 8) && stable == 0; ++k) {
+        const double phi = 2.0 * M_PI * k / 8.0;
+        const Eigen::Vector3d dir =
+            std::cos(alpha) * u + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
+        const Eigen::Vector3d delta = length * dir;
+        q_new = Pose{from->pose.x + delta[0] * unit.length, from->pose.z + delta[1] * unit.length,
+                     from->pose.theta + delta[2] * unit.angle};
+        GraspPoseSpace::set_pose(step_state, q_new);
+        if (!si_->isValid(step_state)) continue;
+        stable = validator_->stable_pushers(from->pose, q_new, allowed);
+      }
+    }
+    if (stable == 0) break;
+    if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state),
+                         length))
+      break;
+    Node* next = connect(from, q_new, stable);
+    // Nodes on this descent would only repeat it: none of them is tried toward the goal again.
+    for (Node* sibling : next->parent->children)
+      if (sibling->pose.x == q_new.x && sibling->pose.z == q_new.z && sibling->pose.theta == q_new.theta)
+        sibling->extended_to_goal = true;
+    if (next->cost.switches > static_cast<int>(max_switches_)) break;
+    from = next;
+  }
+  si_->freeState(step_state);
+}
+
+ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
+  checkValidity();
+  auto* goal = dynamic_cast<PoseGoal*>(pdef_->getGoal().get());
+  if (goal == nullptr) throw ompl::Exception(getName(), "needs a PoseGoal");
+  const ob::State* start = pis_.nextStart();
+  if (start == nullptr) return ob::PlannerStatus::INVALID_START;
+
+  free_tree();
+  iterations_ = 0;
+  rng_ = std::make_unique<ompl::RNG>(2u * seed_ + 1u);
+  sampler_ = std::make_shared<SeededPoseSampler>(si_->getStateSpace().get(), 2u * seed_);
+  temperature_ = init_temperature_;
+  transition_failures_ = 0;
+  validator_->reset_feasibility_checks();
+  outcome_ = PlanOutcome::TimeLimit;
+
+  Node* root = add_node(GraspPoseSpace::pose(start), kNoPusher, nullptr, PathCost{});
+  note_goal_candidate(root);
+  if (best_goal() != nullptr) outcome_ = PlanOutcome::GoalReached;  // already there
+
+  ob::State* sample = si_->allocState();
+  while (outcome_ != PlanOutcome::GoalReached && !ptc) {
+    ++iterations_;
+    // A goal sample extends from the node that promises the cheapest plan, cost so far plus
+    // the straight distance left (an A* estimate), among those not yet extended toward the
+    // goal: the steps of such an extension all go downhill, so the transition test passes them
+    // and the mechanics alone decide how far it gets; a second try would repeat the first.
+    Node* from = nullptr;
+    if (rng_->uniform01() < goal_bias_ && (from = most_promising_toward_goal()) != nullptr) {
+      from->extended_to_goal = true;
+      extend_toward_goal(from, ptc);
+    } else {
+      sampler_->sampleUniform(sample);
+      extend(nearest_extendable(GraspPoseSpace::pose(sample)), sample, ptc);
+    }
+  }
+  si_->freeState(sample);
+
+  if (outcome_ != PlanOutcome::GoalReached)
+    outcome_ = best_goal() != nullptr ? PlanOutcome::GoalOverSwitchLimit : PlanOutcome::TimeLimit;
+  auto path = std::make_shared<ompl::geometric::PathGeometric>(si_);
+  for (const PathNode& n : solution()) {
+    ob::State* s = si_->allocState();
+    GraspPoseSpace::set_pose(s, n.pose);
+    path->append(s);
+    si_->freeState(s);
+  }
+  const bool exact = outcome_ == PlanOutcome::GoalReached;
+  const Node* end = best_goal() ? best_goal() : closest_;
+  pdef_->addSolutionPath(path, !exact, exact ? 0.0 : end->goal_distance, getName());
+  return {true, !exact};
+}
+
+std::vector<PathNode> TRRTstar::solution() const {
+  std::vector<PathNode> path;
+  const Node* end = best_goal();
+  if (end == nullptr) end = closest_;
+  for (const Node* n = end; n != nullptr; n = n->parent) path.push_back({n->pose, n->pusher});
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+PathCost TRRTstar::solution_cost() const {
+  const Node* end = best_goal();
+  if (end == nullptr) end = closest_;
+  return end ? end->cost : PathCost{};
+}
+
+void TRRTstar::getPlannerData(ob::PlannerData& data) const {
+  ob::Planner::getPlannerData(data);
+  // Vertex tags carry the pusher of the push into the vertex (kNoPusher at the start).
+  for (const Node* n : nodes_) {
+    if (n->parent == nullptr)
+      data.addStartVertex(ob::PlannerDataVertex(n->state, n->pusher));
+    else
+      data.addEdge(ob::PlannerDataVertex(n->parent->state, n->parent->pusher), ob::PlannerDataVertex(n->state, n->pusher));
+  }
+  if (const Node* g = best_goal()) data.addGoalVertex(ob::PlannerDataVertex(g->state, g->pusher));
+}
+
+}  // namespace stablepush
