@@ -39,6 +39,8 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("polar_moment_about_centroid", &CrossSection::polar_moment_about_centroid)
       .def_property_readonly("circumradius", &CrossSection::circumradius)
       .def("contains_disc", &CrossSection::contains_disc, py::arg("center"), py::arg("radius"))
+      .def("contains_capsule", &CrossSection::contains_capsule, py::arg("a"), py::arg("b"), py::arg("radius"),
+           "Whether the disc of `radius` swept along the segment a-b lies inside the polygon.")
       .def("distance_to_boundary", &CrossSection::distance_to_boundary, py::arg("point"))
       .def("edges_holding", &CrossSection::edges_holding, py::arg("a"), py::arg("b"), py::arg("tolerance"))
       .def("inward_normal", &CrossSection::inward_normal, py::arg("edge"));
@@ -73,7 +75,12 @@ PYBIND11_MODULE(_core, m) {
       })
       .def("pads_inside", [](const Gripper& g, const CrossSection& s, const std::array<double, 3>& q) {
         return g.pads_inside(s, to_pose(q));
-      }, py::arg("section"), py::arg("pose"));
+      }, py::arg("section"), py::arg("pose"))
+      .def("grasp_maintained_along", [](const Gripper& g, const CrossSection& s, const std::array<double, 3>& a,
+                                        const std::array<double, 3>& b) {
+        return g.grasp_maintained_along(s, to_pose(a), to_pose(b));
+      }, py::arg("section"), py::arg("start"), py::arg("end"),
+      "Every pad disc inside the cross-section throughout the linear motion start -> end.");
 
   py::class_<Pusher>(m, "Pusher")
       .def_static("on_boundary", &Pusher::on_boundary, py::arg("section"), py::arg("name"), py::arg("a"),

@@ -1,7 +1,9 @@
-"""Benchmarks of the stable-push test: median time per check, by contact case.
+"""Benchmarks: the stable-push test (median time per check, by contact case) and planning
+(the paper's Table II: planning time over seeds, success, switch-overs, path length).
 
-Queries run through `StablePushModel.check_batch` (one C++ loop, no Python per check) in batches;
-each batch gives a time per check, and the median over batches is reported.
+Check queries run through `StablePushModel.check_batch` (one C++ loop, no Python per check) in
+batches; each batch gives a time per check, and the median over batches is reported. Planning
+trials run the task with seeds seed, seed + 1, ...; the time is the core's own (model built once).
 """
 from __future__ import annotations
 
@@ -12,7 +14,17 @@ from typing import Callable, Dict, Optional
 
 import numpy as np
 
+from stablepush.planning import plan_task
 from stablepush.task import MM, Task
+
+# Paper Table II (median planning time over 10 trials, s): this paper's planner in MATLAB on an
+# i7 2.8 GHz, and the earlier complementarity-based planner (Chavan-Dafle and Rodriguez 2017).
+PAPER_TABLE_II = {
+    "horizontal-offset-low-mu": (2.83, 592.8),
+    "pivoting": (1.6, 128.4),
+    "large-manipulation": (2.54, 17684.0),
+    "t-shaped": (0.82, 32657.0),
+}
 
 
 @dataclass
@@ -72,3 +84,60 @@ def bench_checks(
             exact_fraction=exact / done,
         )
     return out
+
+
+@dataclass
+class PlanningTrial:
+    task: str
+    seed: int
+    solved: bool
+    outcome: str
+    planning_time_s: float
+    switches: int
+    pushes: int
+    path_length_steps: float
+    feasibility_checks: int
+    nodes: int
+    pusher_sequence: str
+
+
+def bench_planning(task: Task, trials: int, seed: int = 1, time_limit: Optional[float] = None,
+                   progress: Optional[Callable[[int], None]] = None) -> "list[PlanningTrial]":
+    """Plan `task` with seeds seed .. seed + trials - 1."""
+    model = task.build_model()
+    out = []
+    for k in range(trials):
+        plan = plan_task(task, seed=seed + k, time_limit=time_limit, model=model)
+        s = plan.stats
+        out.append(PlanningTrial(
+            task=task.name, seed=seed + k, solved=plan.solved, outcome=plan.outcome,
+            planning_time_s=s["planning_time_s"], switches=s["switches"], pushes=s["pushes"],
+            path_length_steps=s["path_length_steps"], feasibility_checks=s["feasibility_checks"], nodes=s["nodes"],
+            pusher_sequence="-".join(plan.pusher_sequence),
+        ))
+        if progress is not None:
+            progress(1)
+    return out
+
+
+def summarize_planning(trials: "list[PlanningTrial]") -> dict:
+    """One Table II row: times in s over all trials (a failed trial counts its time limit)."""
+    times = sorted(t.planning_time_s for t in trials)
+    solved = [t for t in trials if t.solved]
+    name = trials[0].task
+    paper, earlier = PAPER_TABLE_II.get(name, (None, None))
+    total_time = sum(t.planning_time_s for t in trials)
+    return {
+        "task": name,
+        "trials": len(trials),
+        "success_rate": len(solved) / len(trials),
+        "median_time_s": float(np.median(times)),
+        "min_time_s": times[0],
+        "max_time_s": times[-1],
+        "median_switches": float(np.median([t.switches for t in solved])) if solved else None,
+        "median_path_length_steps": float(np.median([t.path_length_steps for t in solved])) if solved else None,
+        "checks_per_s": sum(t.feasibility_checks for t in trials) / total_time if total_time > 0 else 0.0,
+        "paper_time_s": paper,
+        "earlier_planner_time_s": earlier,
+    }
+

@@ -23,11 +23,23 @@ DEFAULT_STEP_TIME = 0.1
 DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 PLANNER_DEFAULTS: Dict[str, Any] = {
-    "time_limit": 10.0,
+    "time_limit": 10.0,  # s
     "seed": 1,
     "max_switches": 1,
-    "step": [1.0, 1.0],
-    "tolerance": [1.0, 1.0],
+    "step": [1.0, 1.0],  # mm, deg per unit step
+    "tolerance": [1.0, 1.0],  # mm, deg
+    "min_margin": 1e-3,  # N: least depth inside the pusher's cone for a push to count
+    "sampling_margin": 5.0,  # unit steps around the start-goal box
+}
+# TRRTstar's tuning parameters (declared OMPL parameters; their defaults live in the C++ planner,
+# _core.TRRT_STAR_PARAMETERS): key -> (kind, lowest, highest).
+PLANNER_TUNING: Dict[str, Tuple[str, float, float]] = {
+    "goal_bias": ("number", 0.0, 1.0),
+    "rewire_radius": ("number", 0.0, 100.0),  # unit steps
+    "steer_angle": ("number", 0.0, 90.0),  # deg
+    "init_temperature": ("number", 1e-12, 1e6),
+    "temp_change_factor": ("number", 1.0, 1e3),
+    "max_transition_failures": ("integer", 1, 1_000_000),
 }
 
 
@@ -353,7 +365,8 @@ def _validate_pushers(value: Any, section: "_core.CrossSection") -> Tuple[Pusher
 
 
 def _validate_planner(value: Any) -> Dict[str, Any]:
-    planner = _mapping("planner", value, [], list(PLANNER_DEFAULTS))
+    """The planner section with defaults filled in; tuning keys appear only when given."""
+    planner = _mapping("planner", value, [], list(PLANNER_DEFAULTS) + list(PLANNER_TUNING))
     out = dict(PLANNER_DEFAULTS)
     if "time_limit" in planner:
         out["time_limit"] = _number("planner.time_limit", planner["time_limit"], positive=True)
@@ -364,4 +377,15 @@ def _validate_planner(value: Any) -> Dict[str, Any]:
     for key in ("step", "tolerance"):
         if key in planner:
             out[key] = list(_vector(f"planner.{key}", planner[key], 2, positive=True))
+    for key in ("min_margin", "sampling_margin"):
+        if key in planner:
+            out[key] = _number(f"planner.{key}", planner[key], nonnegative=True)
+    for key, (kind, lowest, highest) in PLANNER_TUNING.items():
+        if key not in planner:
+            continue
+        path = f"planner.{key}"
+        v = _integer(path, planner[key], int(lowest)) if kind == "integer" else _number(path, planner[key])
+        if not lowest <= v <= highest:
+            raise TaskError(path, f"must be between {lowest:g} and {highest:g}, got {v:g}")
+        out[key] = v
     return out

@@ -1,0 +1,143 @@
+"""Planning a task with the core's T-RRT* (MODEL.md section 3), in file units.
+
+`plan_task` turns a validated Task into a `PlanResult`: waypoints in mm and degrees, the pusher
+of each push, the test's verdict on it, and the pusher's contact seen from the gripper, which is
+what a robot executes (the pusher is fixed in the world and in O during a push, so in G it moves
+with the object).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Tuple
+
+from stablepush import _core
+from stablepush.mechanics import CASE_NAMES
+from stablepush.task import MM, PLANNER_TUNING, Task, pose_from_si, pose_to_si
+
+OUTCOME_NAMES = {
+    _core.PlanOutcome.goal_reached: "goal_reached",
+    _core.PlanOutcome.goal_over_switch_limit: "goal_over_switch_limit",
+    _core.PlanOutcome.time_limit: "time_limit",
+}
+
+
+@dataclass(frozen=True)
+class PusherContact:
+    """A pusher's contact in the gripper frame G: the segment from-to (mm; equal for a point
+    pusher) and the unit normal pointing into the object."""
+
+    start: Tuple[float, float]
+    end: Tuple[float, float]
+    normal: Tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Waypoint:
+    """The pose after a unit push (x mm, z mm, theta deg), the pusher that made the push and the
+    test's verdict on it; the first waypoint is the start and has no pusher."""
+
+    x: float
+    z: float
+    theta: float
+    pusher: Optional[str] = None
+    margin: Optional[float] = None  # N, depth inside the pusher's cone
+    case: Optional[str] = None  # all_sliding | sticking
+    contact: Optional[PusherContact] = None  # the pusher's contact in G at this pose
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    task: str
+    solved: bool  # the goal is reached within tolerance with at most max_switches switch-overs
+    outcome: str  # goal_reached | goal_over_switch_limit | time_limit
+    message: str
+    waypoints: List[Waypoint]
+    stats: Dict[str, float] = field(default_factory=dict)
+
+    @property
+    def pusher_sequence(self) -> List[str]:
+        """The pushers in the order they are used, one entry per contact."""
+        out: List[str] = []
+        for w in self.waypoints[1:]:
+            if not out or out[-1] != w.pusher:
+                out.append(w.pusher)
+        return out
+
+
+def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, pose_mm_deg) -> PusherContact:
+    """Where pusher `pusher` touches the object, seen from G, when the object is at the pose."""
+    x, z, theta = pose_mm_deg
+    c, s = math.cos(math.radians(theta)), math.sin(math.radians(theta))
+
+    def to_g(p):  # p_G = (x, z) + R(theta) p_O  (MODEL.md section 1)
+        return (x + c * p[0] + s * p[1], z - s * p[0] + c * p[1])
+
+    spec = task.pushers[pusher]
+    n = [float(v) for v in model.pushers[pusher].inward_normal]
+    return PusherContact(start=to_g(spec.a), end=to_g(spec.b), normal=(c * n[0] + s * n[1], -s * n[0] + c * n[1]))
+
+
+def plan_task(
+    task: Task,
+    *,
+    seed: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    max_switches: Optional[int] = None,
+    model: "Optional[_core.StablePushModel]" = None,
+) -> PlanResult:
+    """Plan stable pushes from the task's start to its goal. Arguments left as None take the
+    task's planner section (which has defaults for every key)."""
+    settings = dict(task.planner)
+    for key, value in (("seed", seed), ("time_limit", time_limit), ("max_switches", max_switches)):
+        if value is not None:
+            settings[key] = value
+    model = model or task.build_model()
+    step = (settings["step"][0] * MM, math.radians(settings["step"][1]))
+    tolerance = (settings["tolerance"][0] * MM, math.radians(settings["tolerance"][1]))
+    parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}
+    parameters.update({key: repr(settings[key]) for key in PLANNER_TUNING if key in settings})
+    raw = _core.plan(
+        model, pose_to_si(task.start), pose_to_si(task.goal), step, tolerance, float(settings["time_limit"]),
+        float(settings["min_margin"]), float(settings["sampling_margin"]), parameters,
+    )
+
+    names = task.pusher_names
+    waypoints: List[Waypoint] = []
+    for q, p, margin, case in zip(raw.poses, raw.pushers, raw.margins, raw.contact_cases):
+        pose = tuple(float(v) for v in pose_from_si(q))
+        if p < 0:
+            waypoints.append(Waypoint(*pose))
+        else:
+            waypoints.append(Waypoint(*pose, pusher=names[p], margin=float(margin), case=CASE_NAMES[case],
+                                      contact=contact_in_gripper(task, model, p, pose)))
+
+    outcome = OUTCOME_NAMES[raw.outcome]
+    s = raw.stats
+    stats = {
+        "planning_time_s": s.planning_time_s,
+        "iterations": int(s.iterations),
+        "nodes": int(s.nodes),
+        "feasibility_checks": int(s.feasibility_checks),
+        "switches": int(s.switches),
+        "seed": int(settings["seed"]),
+        "max_switches": int(settings["max_switches"]),
+        "time_limit_s": float(settings["time_limit"]),
+        "pushes": len(waypoints) - 1,
+        "path_length_steps": s.length,
+        "goal_distance_steps": raw.goal_distance,
+    }
+    return PlanResult(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
+                      message=_message(outcome, stats), waypoints=waypoints, stats=stats)
+
+
+def _message(outcome: str, stats: dict) -> str:
+    if outcome == "goal_reached":
+        return (f"solved in {stats['planning_time_s'] * 1e3:.1f} ms: {stats['pushes']} pushes, "
+                f"{stats['switches']} switch-over(s)")
+    if outcome == "goal_over_switch_limit":
+        return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out with the goal reached only with "
+                f"{stats['switches']} switch-overs (max_switches {stats['max_switches']}); the plan written is that "
+                f"one; allow it with --max-switches {stats['switches']}")
+    return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out before the goal was reached; "
+            f"the best partial path ends {stats['goal_distance_steps']:.1f} unit steps from the goal")

@@ -1,0 +1,85 @@
+"""`stablepush plan` and `stablepush bench` as a user runs them: files, exit codes, messages."""
+import csv
+import json
+import subprocess
+import sys
+
+import yaml
+from conftest import TASKS, task_text
+
+LOW_MU = str(TASKS / "horizontal-offset-low-mu.yaml")
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "stablepush_cli.main", *args], capture_output=True, text=True, cwd=cwd)
+
+
+def test_plan_writes_json_and_csv(tmp_path):
+    out, table = tmp_path / "p.json", tmp_path / "p.csv"
+    r = run("plan", LOW_MU, "-o", str(out), "--csv", str(table), "--seed", "2")
+    assert r.returncode == 0, r.stderr
+    assert "solved" in r.stdout and "bottom -> left" in r.stdout
+    plan = json.loads(out.read_text())
+    assert plan["format"] == "stablepush.plan/1" and plan["task"] == "horizontal-offset-low-mu"
+    assert plan["solved"] is True and plan["stats"]["seed"] == 2
+    for key in ("planning_time_s", "iterations", "nodes", "feasibility_checks", "switches"):
+        assert key in plan["stats"]
+    first, second = plan["waypoints"][0], plan["waypoints"][1]
+    assert first == {"x": 0.0, "z": 0.0, "theta": 0.0, "pusher": None, "margin": None, "case": None,
+                     "pusher_in_gripper": None}
+    assert second["pusher"] == "bottom" and second["margin"] > 0
+    contact = second["pusher_in_gripper"]
+    assert set(contact) == {"from", "to", "normal"} and abs(contact["normal"][1]) > 0.99  # bottom faces up
+    rows = list(csv.DictReader(table.open()))
+    assert list(rows[0])[:5] == ["step", "x", "z", "theta", "pusher"]
+    assert len(rows) == len(plan["waypoints"])
+    assert [float(rows[-1][k]) for k in ("x", "z", "theta")] == [plan["waypoints"][-1][k] for k in ("x", "z", "theta")]
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]  # atomic writes leave nothing behind
+
+
+def test_same_seed_same_file(tmp_path):
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    assert run("plan", LOW_MU, "-o", str(a), "--seed", "4").returncode == 0
+    assert run("plan", LOW_MU, "-o", str(b), "--seed", "4").returncode == 0
+    wa, wb = json.loads(a.read_text())["waypoints"], json.loads(b.read_text())["waypoints"]
+    assert wa == wb
+
+
+def test_unsolved_plan_exits_1_and_still_writes_the_partial_plan(tmp_path):
+    out = tmp_path / "p.json"
+    r = run("plan", LOW_MU, "-o", str(out), "--max-switches", "0", "--time-limit", "0.2")
+    assert r.returncode == 1
+    assert "not solved" in r.stderr and "time limit" in r.stderr
+    plan = json.loads(out.read_text())
+    assert plan["solved"] is False and plan["outcome"] in ("time_limit", "goal_over_switch_limit")
+    assert len(plan["waypoints"]) >= 1
+
+
+def test_plan_refuses_a_bad_planner_key(tmp_path):
+    data = yaml.safe_load(task_text("horizontal-offset-low-mu"))
+    data["planner"]["goal_bias"] = 1.5
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(yaml.safe_dump(data))
+    r = run("plan", str(bad), "-o", str(tmp_path / "p.json"))
+    assert r.returncode == 2 and "planner.goal_bias" in r.stderr
+    data["planner"].pop("goal_bias")
+    data["planner"]["temperature"] = 1
+    bad.write_text(yaml.safe_dump(data))
+    r = run("plan", str(bad), "-o", str(tmp_path / "p.json"))
+    assert r.returncode == 2 and "planner.temperature" in r.stderr and "unknown key" in r.stderr
+    assert not (tmp_path / "p.json").exists()
+
+
+def test_bench_prints_table_ii_and_writes_trials(tmp_path):
+    out = tmp_path / "bench.csv"
+    r = run("bench", LOW_MU, str(TASKS / "pivoting.yaml"), "--trials", "2", "--out", str(out))
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0].split()[:3] == ["task", "success", "median"]
+    low = next(line for line in lines if line.startswith("horizontal-offset-low-mu"))
+    assert "100%" in low and "2.83" in low and "592.8" in low  # the paper's times beside ours
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == 4 and {r["seed"] for r in rows} == {"1", "2"}
+    js = tmp_path / "bench.json"
+    assert run("bench", LOW_MU, "--trials", "1", "--out", str(js)).returncode == 0
+    assert json.loads(js.read_text())["summary"][0]["task"] == "horizontal-offset-low-mu"

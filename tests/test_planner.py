@@ -1,0 +1,245 @@
+"""The planner: the paper's behaviours (MODEL.md section 6) on the shipped tasks, every step of
+every plan re-checked independently, determinism, limits and the swept grasp test."""
+import math
+import time
+
+import numpy as np
+import pytest
+from conftest import shipped, task_with
+from independent_lp import IndependentModel
+
+from stablepush.planning import plan_task
+from stablepush.task import MM, pose_to_si
+
+SEEDS = range(1, 6)
+_plans = {}
+
+
+def planned(name, seed, **kw):
+    key = (name, seed, tuple(sorted(kw.items())))
+    if key not in _plans:
+        _plans[key] = plan_task(shipped(name), seed=seed, **kw)
+    return _plans[key]
+
+
+# ---------------------------------------------------------------------------------------------
+# Independent re-checks: the HiGHS LP of the core's tests, and a pure-Python grasp test.
+
+
+def _point_in_polygon(p, v):
+    inside = False
+    for i in range(len(v)):
+        a, b = v[i], v[(i + 1) % len(v)]
+        if (a[1] > p[1]) != (b[1] > p[1]):
+            x = a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1])
+            if x > p[0]:
+                inside = not inside
+    return inside
+
+
+def _distance_to_boundary(p, v):
+    best = math.inf
+    for i in range(len(v)):
+        a, b = np.asarray(v[i]), np.asarray(v[(i + 1) % len(v)])
+        t = np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0)
+        best = min(best, np.linalg.norm(p - (a + t * (b - a))))
+    return best
+
+
+def pads_inside(task, pose_mm_deg, slack_mm=1e-9):
+    """Every pad disc inside the cross-section (mm), by point-in-polygon and edge distances."""
+    x, z, th = pose_mm_deg
+    c, s = math.cos(math.radians(th)), math.sin(math.radians(th))
+    for center, radius in task.pads:
+        d = np.array(center) - np.array([x, z])
+        p_o = np.array([c * d[0] - s * d[1], s * d[0] + c * d[1]])  # R^T (p - c)
+        if not _point_in_polygon(p_o, task.vertices) or _distance_to_boundary(p_o, task.vertices) < radius - slack_mm:
+            return False
+    return True
+
+
+def recheck(task, plan):
+    """Every push stable by the independent LP, the grasp kept at and between waypoints, and the
+    switch count as stated. Returns the LP's s* per push."""
+    lp = IndependentModel(task)
+    names = task.pusher_names
+    margins = []
+    for prev, w in zip(plan.waypoints, plan.waypoints[1:]):
+        q0 = np.array(pose_to_si((prev.x, prev.z, prev.theta)))
+        q1 = np.array(pose_to_si((w.x, w.z, w.theta)))
+        feasible, s = lp.stable(q0, q1 - q0, names.index(w.pusher))
+        assert feasible and s > 0, f"push to {w} is not stable by the independent LP (s* = {s})"
+        margins.append(s)
+        for t in np.linspace(0.0, 1.0, 11):  # the pads stay inside along the push
+            pose = (1 - t) * np.array([prev.x, prev.z, prev.theta]) + t * np.array([w.x, w.z, w.theta])
+            assert pads_inside(task, pose), f"grasp lost between {prev} and {w}"
+    switches = sum(1 for a, b in zip(plan.waypoints[1:], plan.waypoints[2:]) if a.pusher != b.pusher)
+    assert switches == plan.stats["switches"]
+    assert plan.waypoints[0].pusher is None
+    assert (plan.waypoints[0].x, plan.waypoints[0].z, plan.waypoints[0].theta) == tuple(task.start)
+    return margins
+
+
+def reaches_goal(task, plan):
+    end = plan.waypoints[-1]
+    tol_mm, tol_deg = task.planner["tolerance"]
+    gx, gz, gt = task.goal
+    return abs(end.x - gx) <= tol_mm and abs(end.z - gz) <= tol_mm and abs(end.theta - gt) <= tol_deg
+
+
+def unit_steps(task, plan):
+    step_mm, step_deg = task.planner["step"]
+    for a, b in zip(plan.waypoints, plan.waypoints[1:]):
+        d = math.sqrt(((b.x - a.x) / step_mm) ** 2 + ((b.z - a.z) / step_mm) ** 2 + ((b.theta - a.theta) / step_deg) ** 2)
+        assert 0 < d <= 1 + 1e-9
+
+
+# ---------------------------------------------------------------------------------------------
+# The paper's behaviours.
+
+
+def test_low_mu_straight_push_is_not_stable_but_lift_then_drag_is():
+    task = shipped("horizontal-offset-low-mu")
+    model = task.build_model()
+    for pusher in range(len(task.pushers)):
+        assert not model.check(task.start, pose_to_si((1, 0, 0)), pusher).feasible
+    for seed in SEEDS:
+        plan = planned("horizontal-offset-low-mu", seed)
+        assert plan.solved and reaches_goal(task, plan)
+        assert plan.pusher_sequence == ["bottom", "left"], plan.pusher_sequence
+        lift = [w for w in plan.waypoints[1:] if w.pusher == "bottom"]
+        assert lift[-1].z > plan.waypoints[0].z  # the bottom pusher pushed the object up
+        drag = [w for w in plan.waypoints[1:] if w.pusher == "left"]
+        assert drag[-1].x - drag[0].x > 15  # then the side pusher dragged it along
+        recheck(task, plan)
+        unit_steps(task, plan)
+
+
+def test_high_mu_uses_one_side_pusher_and_no_switch_over():
+    task = shipped("horizontal-offset-high-mu")
+    for seed in SEEDS:
+        plan = planned("horizontal-offset-high-mu", seed)
+        assert plan.solved and reaches_goal(task, plan)
+        assert plan.pusher_sequence == ["left"] and plan.stats["switches"] == 0
+        recheck(task, plan)
+
+
+def test_pivot_turns_the_object_with_a_side_pusher_through_sticking_steps():
+    task = shipped("pivoting")
+    for seed in SEEDS:
+        plan = planned("pivoting", seed)
+        assert plan.solved and reaches_goal(task, plan)
+        assert len(plan.pusher_sequence) == 1 and plan.pusher_sequence[0] in ("left", "right")
+        sticking = [w for w in plan.waypoints[1:] if w.case == "sticking"]
+        # The turn is made about the pad centre, which sticks (paper fig. 8).
+        turned_sticking = sum(abs(b.theta - a.theta) for a, b in zip(plan.waypoints, plan.waypoints[1:]) if b.case == "sticking")
+        assert turned_sticking >= 0.9 * abs(task.goal[2] - task.start[2]), (len(sticking), turned_sticking)
+        recheck(task, plan)
+
+
+def test_large_manipulation_reaches_a_zero_switch_plan_for_nine_of_ten_seeds():
+    task = shipped("large-manipulation")
+    assert task.planner["max_switches"] == 0
+    zero_switch = 0
+    for seed in range(1, 11):
+        plan = planned("large-manipulation", seed)
+        if plan.solved:
+            assert plan.stats["switches"] == 0 and reaches_goal(task, plan)
+            recheck(task, plan)
+            zero_switch += 1
+    assert zero_switch >= 9
+
+
+def test_t_shape_straight_path_loses_the_grasp_and_the_plan_goes_around():
+    task = shipped("t-shaped")
+    straight = [np.array(task.start) + t * (np.array(task.goal) - np.array(task.start)) for t in np.linspace(0, 1, 51)]
+    assert not all(pads_inside(task, q) for q in straight)
+    for seed in SEEDS:
+        plan = planned("t-shaped", seed)
+        assert plan.solved and reaches_goal(task, plan)
+        recheck(task, plan)  # includes the grasp along every push
+        # Going around: the path strays well off the straight line (the pads go down the web
+        # before they go along the flange), and is longer than it.
+        s0, s1 = np.array(task.start[:2]), np.array(task.goal[:2])
+        u = (s1 - s0) / np.linalg.norm(s1 - s0)
+        off_line = max(abs(u[0] * (w.z - s0[1]) - u[1] * (w.x - s0[0])) for w in plan.waypoints)
+        assert off_line > 5.0
+        assert plan.stats["path_length_steps"] > np.linalg.norm(s1 - s0) + 5
+
+
+# ---------------------------------------------------------------------------------------------
+# Determinism, limits, budgets.
+
+
+def test_same_seed_same_plan_and_seeds_matter():
+    task = shipped("horizontal-offset-low-mu")
+    a = plan_task(task, seed=3)
+    b = plan_task(task, seed=3)
+    assert a.waypoints == b.waypoints and a.stats["iterations"] == b.stats["iterations"]
+    others = [plan_task(task, seed=s).waypoints for s in (4, 5, 6)]
+    assert any(o != a.waypoints for o in others)
+
+
+def test_unreachable_goal_ends_unsolved_at_the_time_limit():
+    # Only the right pusher, which can push the object toward -x: the +x goal is out of reach.
+    def only_right(d):
+        d["pushers"] = [p for p in d["pushers"] if p["name"] == "right"]
+
+    task = task_with("horizontal-offset-high-mu", only_right)
+    started = time.perf_counter()
+    plan = plan_task(task, time_limit=0.3)
+    elapsed = time.perf_counter() - started
+    assert not plan.solved and plan.outcome == "time_limit"
+    assert elapsed < 0.3 + 1.0  # the limit is respected (generous slack for a loaded machine)
+    assert "time limit" in plan.message
+    assert plan.stats["goal_distance_steps"] > 0
+    if len(plan.waypoints) > 1:
+        recheck(task, plan)  # the partial path is still physically valid
+
+
+def test_switch_budget_is_a_hard_stop_criterion():
+    task = shipped("horizontal-offset-low-mu")
+    plan = plan_task(task, max_switches=0, time_limit=0.3)  # the lift needs a switch-over
+    assert not plan.solved
+    for w in plan.waypoints[1:]:
+        assert w.pusher == plan.waypoints[1].pusher or plan.outcome == "goal_over_switch_limit"
+
+
+def test_planner_parameters_reach_the_ompl_planner():
+    from stablepush import _core
+
+    declared = set(_core.TRRT_STAR_PARAMETERS)
+    assert {"goal_bias", "rewire_radius", "steer_angle", "init_temperature", "temp_change_factor",
+            "max_transition_failures", "max_switches", "seed"} <= declared
+    task = task_with("horizontal-offset-high-mu", lambda d: d["planner"].update(goal_bias=0.0, steer_angle=0.0))
+    assert plan_task(task).stats["iterations"] != plan_task(shipped("horizontal-offset-high-mu")).stats["iterations"]
+
+
+# ---------------------------------------------------------------------------------------------
+# The swept grasp test (robust geometry, concave shapes).
+
+
+def test_a_step_that_cuts_a_concave_corner_loses_the_grasp():
+    task = shipped("t-shaped")
+    model = task.build_model()
+    a, b = (4.0, 4.0, 0.0), (12.0, 17.0, 0.0)  # pads at (-4, -4) in the web, (-12, -17) in the flange
+    assert model.grasp_maintained(pose_to_si(a)) and model.grasp_maintained(pose_to_si(b))
+    assert pads_inside(task, a) and pads_inside(task, b)
+    assert not model.gripper.grasp_maintained_along(model.section, pose_to_si(a), pose_to_si(b))
+    assert not all(pads_inside(task, np.array(a) + t * (np.array(b) - np.array(a))) for t in np.linspace(0, 1, 101))
+    # Down the web first, then along the flange: each leg keeps the grasp.
+    c = (0.0, 17.0, 0.0)
+    assert model.gripper.grasp_maintained_along(model.section, pose_to_si(a), pose_to_si((4.0, 17.0, 0.0)))
+    assert model.gripper.grasp_maintained_along(model.section, pose_to_si(c), pose_to_si(b))
+
+
+def test_capsule_reduces_to_disc_and_matches_sampling():
+    section = shipped("t-shaped").section()
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        a = rng.uniform(-40, 40, 2) * MM
+        b = a + rng.uniform(-3, 3, 2) * MM
+        r = rng.uniform(1, 8) * MM
+        assert section.contains_capsule(a, a, r) == section.contains_disc(a, r)
+        if section.contains_capsule(a, b, r):  # sampled discs along the spine are all inside
+            assert all(section.contains_disc(a + t * (b - a), r) for t in np.linspace(0, 1, 21))
