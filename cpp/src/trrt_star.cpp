@@ -2,7 +2,6 @@
 
 #include <ompl/base/PlannerData.h>
 #include <ompl/base/goals/GoalSampleableRegion.h>
-#include <ompl/datastructures/NearestNeighborsLinear.h>
 #include <ompl/geometric/PathGeometric.h>
 #include <ompl/util/Exception.h>
 
@@ -67,12 +66,6 @@ void TRRTstar::setup() {
   validator_ = dynamic_cast<StablePushValidator*>(si_->getMotionValidator().get());
   if (space_ == nullptr || validator_ == nullptr)
     throw ompl::Exception(getName(), "needs a GraspPoseSpace and a StablePushValidator");
-  if (!nn_) {
-    // Linear search: exact and deterministic (tie-breaking by insertion order). GNAT draws its
-    // pivots from OMPL's global seed, which would make plans depend on the process's history.
-    nn_ = std::make_shared<ompl::NearestNeighborsLinear<Node*>>();
-    nn_->setDistanceFunction([this](const Node* a, const Node* b) { return si_->distance(a->state, b->state); });
-  }
 }
 
 void TRRTstar::free_tree() {
@@ -83,7 +76,7 @@ void TRRTstar::free_tree() {
   nodes_.clear();
   goal_nodes_.clear();
   closest_ = nullptr;
-  if (nn_) nn_->clear();
+  unit_coords_.clear();
 }
 
 void TRRTstar::clear() {
@@ -105,7 +98,7 @@ TRRTstar::Node* TRRTstar::add_node(const Pose& q, int pusher, Node* parent, cons
   node->goal_distance = goal->distanceGoal(node->state);
   if (parent != nullptr) parent->children.push_back(node);
   nodes_.push_back(node);
-  nn_->add(node);
+  unit_coords_.push_back(in_unit_steps(q));
   if (nodes_.size() == 1) min_goal_distance_ = max_goal_distance_ = node->goal_distance;
   min_goal_distance_ = std::min(min_goal_distance_, node->goal_distance);
   max_goal_distance_ = std::max(max_goal_distance_, node->goal_distance);
@@ -127,15 +120,38 @@ bool TRRTstar::transition_test(double cost_from, double cost_to, double step) {
   return false;
 }
 
+Eigen::Vector3d TRRTstar::in_unit_steps(const Pose& q) const {
+  const StepSize& unit = space_->step();
+  return Eigen::Vector3d(q.x / unit.length, q.z / unit.length, q.theta / unit.angle);
+}
+
+// Neighbour queries scan the nodes' coordinates in unit steps, kept contiguous: exact, and
+// deterministic (ties go to the older node). Tree sizes here are thousands of nodes, where a
+// tight linear scan beats tree structures; OMPL's GNAT would also draw its pivots from OMPL's
+// global seed and make plans depend on the process's history.
+void TRRTstar::near(const Pose& q, double radius, std::vector<Node*>& out) const {
+  const Eigen::Vector3d u = in_unit_steps(q);
+  const double r2 = radius * radius;
+  std::vector<std::pair<double, std::size_t>> hits;
+  for (std::size_t i = 0; i < unit_coords_.size(); ++i) {
+    const double d2 = (unit_coords_[i] - u).squaredNorm();
+    if (d2 <= r2) hits.emplace_back(d2, i);
+  }
+  std::stable_sort(hits.begin(), hits.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  out.clear();
+  for (const auto& hit : hits) out.push_back(nodes_[hit.second]);
+}
+
 TRRTstar::Node* TRRTstar::nearest_extendable(const Pose& q) const {
+  const Eigen::Vector3d u = in_unit_steps(q);
   Node* best = nullptr;
-  double best_d = 0.0;
-  for (Node* n : nodes_) {
-    if (n->cost.switches > static_cast<int>(max_switches_)) continue;
-    const double d = space_->distance(n->pose, q);
-    if (best == nullptr || d < best_d) {
-      best = n;
-      best_d = d;
+  double best_d2 = 0.0;
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    if (nodes_[i]->cost.switches > static_cast<int>(max_switches_)) continue;
+    const double d2 = (unit_coords_[i] - u).squaredNorm();
+    if (best == nullptr || d2 < best_d2) {
+      best = nodes_[i];
+      best_d2 = d2;
     }
   }
   return best;
@@ -257,12 +273,7 @@ TRRTstar::Node* TRRTstar::best_goal() const {
 }
 
 TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stable) {
-  ob::State* probe_state = si_->allocState();
-  GraspPoseSpace::set_pose(probe_state, q_new);
-  Node probe;
-  probe.state = probe_state;
-  nn_->nearestR(&probe, rewire_radius_, near_);
-  si_->freeState(probe_state);
+  near(q_new, rewire_radius_, near_);
   const Candidate best = choose_parent(q_new, near_, from, stable);
   // One node per pusher that can make the push when it starts a new contact (or is the first
   // push), so that any of them can be continued without a further switch-over.

@@ -23,7 +23,6 @@
 #pragma once
 
 #include <ompl/base/Planner.h>
-#include <ompl/datastructures/NearestNeighbors.h>
 #include <ompl/util/RandomNumbers.h>
 
 #include <cstdint>
@@ -121,6 +120,9 @@ class TRRTstar : public ompl::base::Planner {
   void rewire(Node* node, const std::vector<Node*>& near);
   void shift_subtree_cost(Node* node, const PathCost& delta);
   bool transition_test(double cost_from, double cost_to, double step);
+  Eigen::Vector3d in_unit_steps(const Pose& q) const;
+  /// The nodes within `radius` unit steps of q, nearest first.
+  void near(const Pose& q, double radius, std::vector<Node*>& out) const;
   /// The node nearest to q among those within the switch-over budget (max_switches).
   Node* nearest_extendable(const Pose& q) const;
   /// Among the nodes within the budget not yet extended toward the goal, the one with the least
@@ -131,8 +133,8 @@ class TRRTstar : public ompl::base::Planner {
 
   StablePushValidator* validator_ = nullptr;
   const GraspPoseSpace* space_ = nullptr;
-  std::shared_ptr<ompl::NearestNeighbors<Node*>> nn_;
   std::vector<Node*> nodes_;
+  std::vector<Eigen::Vector3d> unit_coords_;  ///< nodes_[i]'s pose in unit steps
   std::vector<Node*> goal_nodes_;
   std::vector<Node*> near_;  ///< scratch for near-node queries
   Node* closest_ = nullptr;
