@@ -5,8 +5,9 @@ import sys
 import pytest
 import yaml
 from click.testing import CliRunner
-from conftest import TASKS, task_text
+from conftest import TASKS, task_text, task_with
 
+from stablepush.task import TaskError
 from stablepush_cli.main import cli
 
 BASE = yaml.safe_load(task_text("horizontal-offset-low-mu"))
@@ -148,3 +149,12 @@ def test_every_shipped_task_loads(tasks_dir):
     for name in names:
         task = load_task(tasks_dir / f"{name}.yaml")
         assert task.build_model().grasp_maintained((0, 0, 0))
+
+
+def test_too_many_pushers_is_refused():
+    def many(d):
+        d["pushers"] = [{"name": f"p{i}", "from": [-50, -12.5], "to": [-50, 12.5], "mu": 0.2} for i in range(33)]
+
+    with pytest.raises(TaskError) as err:
+        task_with("horizontal-offset-low-mu", many)
+    assert err.value.field == "pushers" and "at most 32" in err.value.reason

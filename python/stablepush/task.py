@@ -22,6 +22,7 @@ DEFAULT_GRAVITY = (0.0, -9.81)
 DEFAULT_STEP_TIME = 0.1
 DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
+MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
 PLANNER_DEFAULTS: Dict[str, Any] = {
     "time_limit": 10.0,  # s
     "seed": 1,
@@ -336,6 +337,8 @@ def _validate_object(obj: Any):
 def _validate_pushers(value: Any, section: "_core.CrossSection") -> Tuple[PusherSpec, ...]:
     if not isinstance(value, list) or not value:
         raise TaskError("pushers", "must be a non-empty list")
+    if len(value) > MAX_PUSHERS:
+        raise TaskError("pushers", f"at most {MAX_PUSHERS} pushers, got {len(value)}")
     specs: List[PusherSpec] = []
     for i, raw in enumerate(value):
         path = f"pushers[{i}]"
