@@ -22,10 +22,8 @@ GraspPoseSpace::GraspPoseSpace(StepSize step, const ob::RealVectorBounds& bounds
 double GraspPoseSpace::distance(const ob::State* a, const ob::State* b) const { return distance(pose(a), pose(b)); }
 
 double GraspPoseSpace::distance(const Pose& a, const Pose& b) const {
-  const double dx = (b.x - a.x) / step_.length;
-  const double dz = (b.z - a.z) / step_.length;
-  const double dt = (b.theta - a.theta) / step_.angle;
-  return std::sqrt(dx * dx + dz * dz + dt * dt);
+  const Eigen::Vector3d d = in_unit_steps(Motion{b.x - a.x, b.z - a.z, b.theta - a.theta});
+  return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
 }
 
 double GraspPoseSpace::getMaximumExtent() const {

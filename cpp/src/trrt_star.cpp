@@ -98,7 +98,7 @@ TRRTstar::Node* TRRTstar::add_node(const Pose& q, int pusher, Node* parent, cons
   node->goal_distance = goal->distanceGoal(node->state);
   if (parent != nullptr) parent->children.push_back(node);
   nodes_.push_back(node);
-  unit_coords_.push_back(in_unit_steps(q));
+  unit_coords_.push_back(space_->in_unit_steps(q));
   if (nodes_.size() == 1) min_goal_distance_ = max_goal_distance_ = node->goal_distance;
   min_goal_distance_ = std::min(min_goal_distance_, node->goal_distance);
   max_goal_distance_ = std::max(max_goal_distance_, node->goal_distance);
@@ -120,17 +120,12 @@ bool TRRTstar::transition_test(double cost_from, double cost_to, double step) {
   return false;
 }
 
-Eigen::Vector3d TRRTstar::in_unit_steps(const Pose& q) const {
-  const StepSize& unit = space_->step();
-  return Eigen::Vector3d(q.x / unit.length, q.z / unit.length, q.theta / unit.angle);
-}
-
 // Neighbour queries scan the nodes' coordinates in unit steps, kept contiguous: exact, and
 // deterministic (ties go to the older node). Tree sizes here are thousands of nodes, where a
 // tight linear scan beats tree structures; OMPL's GNAT would also draw its pivots from OMPL's
 // global seed and make plans depend on the process's history.
 void TRRTstar::near(const Pose& q, double radius, std::vector<Node*>& out) const {
-  const Eigen::Vector3d u = in_unit_steps(q);
+  const Eigen::Vector3d u = space_->in_unit_steps(q);
   const double r2 = radius * radius;
   std::vector<std::pair<double, std::size_t>> hits;
   for (std::size_t i = 0; i < unit_coords_.size(); ++i) {
@@ -143,7 +138,7 @@ void TRRTstar::near(const Pose& q, double radius, std::vector<Node*>& out) const
 }
 
 TRRTstar::Node* TRRTstar::nearest_extendable(const Pose& q) const {
-  const Eigen::Vector3d u = in_unit_steps(q);
+  const Eigen::Vector3d u = space_->in_unit_steps(q);
   Node* best = nullptr;
   double best_d2 = 0.0;
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
@@ -318,12 +313,11 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
 
 void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
   const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
-  const StepSize unit = space_->step();
   ob::State* step_state = si_->allocState();
   while (outcome_ != PlanOutcome::GoalReached && !ptc) {
     // The step in unit-step coordinates, u toward the goal.
-    const Eigen::Vector3d to_goal((goal.x - from->pose.x) / unit.length, (goal.z - from->pose.z) / unit.length,
-                                  (goal.theta - from->pose.theta) / unit.angle);
+    const Eigen::Vector3d to_goal =
+        space_->in_unit_steps(Motion{goal.x - from->pose.x, goal.z - from->pose.z, goal.theta - from->pose.theta});
     const double d = to_goal.norm();
     if (d < kMinEdge) break;
     const double length = std::min(1.0, d);
@@ -350,9 +344,8 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
         const double phi = 2.0 * M_PI * k / 8.0;
         const Eigen::Vector3d dir =
             std::cos(alpha) * u + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
-        const Eigen::Vector3d delta = length * dir;
-        q_new = Pose{from->pose.x + delta[0] * unit.length, from->pose.z + delta[1] * unit.length,
-                     from->pose.theta + delta[2] * unit.angle};
+        const Motion delta = space_->from_unit_steps(length * dir);
+        q_new = Pose{from->pose.x + delta.x, from->pose.z + delta.z, from->pose.theta + delta.theta};
         GraspPoseSpace::set_pose(step_state, q_new);
         if (!si_->isValid(step_state)) continue;
         stable = validator_->stable_pushers(from->pose, q_new, allowed);

@@ -41,6 +41,14 @@ class GraspPoseSpace : public ompl::base::RealVectorStateSpace {
   const StepSize& step() const { return step_; }
   double distance(const ompl::base::State* a, const ompl::base::State* b) const override;
   double distance(const Pose& a, const Pose& b) const;
+  /// A motion (or a pose, as the motion from the origin) in unit steps: (dx, dz) / length, dtheta / angle.
+  Eigen::Vector3d in_unit_steps(const Motion& d) const {
+    return Eigen::Vector3d(d.x / step_.length, d.z / step_.length, d.theta / step_.angle);
+  }
+  /// The inverse of in_unit_steps.
+  Motion from_unit_steps(const Eigen::Vector3d& u) const {
+    return Motion{u[0] * step_.length, u[1] * step_.length, u[2] * step_.angle};
+  }
   double getMaximumExtent() const override;
 
   static Pose pose(const ompl::base::State* s);

@@ -120,7 +120,6 @@ class TRRTstar : public ompl::base::Planner {
   void rewire(Node* node, const std::vector<Node*>& near);
   void shift_subtree_cost(Node* node, const PathCost& delta);
   bool transition_test(double cost_from, double cost_to, double step);
-  Eigen::Vector3d in_unit_steps(const Pose& q) const;
   /// The nodes within `radius` unit steps of q, nearest first.
   void near(const Pose& q, double radius, std::vector<Node*>& out) const;
   /// The node nearest to q among those within the switch-over budget (max_switches).
