@@ -1,0 +1,189 @@
+"""Figures of plans and pusher cones (matplotlib, headless): `stablepush show` and `stablepush cone`.
+
+`plan_figure` draws, as the paper's fig. 1 does, snapshots of the object in the grasp along the
+plan (outline, pads, the active pusher thick and coloured, switch-overs marked) above x, z and
+theta against the step. `cone_figure` draws a pusher's generalized friction cone in wrench space
+(f_x, f_z, tau_y / l), as the paper's figs. 5-6 do; l is the torque length of the margin metric.
+"""
+from __future__ import annotations
+
+import math
+from typing import List, Optional, Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib import animation  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+
+from stablepush.execution import PlanStep, contacts_of  # noqa: E402
+from stablepush.task import Task  # noqa: E402
+
+MAX_SNAPSHOTS = 6
+PUSHER_COLOURS = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+
+
+def _in_gripper(task: Task, pose: Sequence[float], points) -> np.ndarray:
+    """Points of O (mm) seen from G at pose (x mm, z mm, theta deg): p_G = (x, z) + R(theta) p_O."""
+    c, s = math.cos(math.radians(pose[2])), math.sin(math.radians(pose[2]))
+    p = np.asarray(points, float)
+    return np.column_stack([pose[0] + c * p[:, 0] + s * p[:, 1], pose[1] - s * p[:, 0] + c * p[:, 1]])
+
+
+def _colour(task: Task, pusher: str) -> str:
+    return PUSHER_COLOURS[task.pusher_index(pusher) % len(PUSHER_COLOURS)]
+
+
+def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits) -> None:
+    outline = _in_gripper(task, pose, list(task.vertices) + [task.vertices[0]])
+    ax.fill(outline[:, 0], outline[:, 1], color="0.85", zorder=1)
+    ax.plot(outline[:, 0], outline[:, 1], color="0.25", lw=1.2, zorder=2)
+    for (cx, cz), r in task.pads:
+        ax.add_patch(plt.Circle((cx, cz), r, fill=False, ec="0.1", lw=1.0, ls="--", zorder=3))
+    ax.plot([0], [0], "+", color="0.1", ms=6, zorder=3)
+    for spec in task.pushers:
+        seg = _in_gripper(task, pose, [spec.a, spec.b])
+        active = spec.name == pusher
+        ax.plot(seg[:, 0], seg[:, 1], color=_colour(task, spec.name) if active else "0.6",
+                lw=5 if active else 1.5, solid_capstyle="butt", zorder=4 if active else 2)
+    ax.set_title(title, fontsize=9)
+    ax.set_aspect("equal")
+    ax.set_xlim(*limits[0])
+    ax.set_ylim(*limits[1])
+    ax.tick_params(labelsize=7)
+
+
+def _limits(task: Task, steps: Sequence[PlanStep]):
+    pts = np.vstack([_in_gripper(task, s.pose, task.vertices) for s in steps])
+    pad = 5.0
+    return ((pts[:, 0].min() - pad, pts[:, 0].max() + pad), (pts[:, 1].min() - pad, pts[:, 1].max() + pad))
+
+
+def _snapshots(steps: Sequence[PlanStep]) -> List[int]:
+    """The start, the first pose of every contact (where switch-overs happen), the goal, and evenly
+    spread poses in between, at most MAX_SNAPSHOTS."""
+    keys = [0] + [c.first for c in contacts_of(steps)[1:]] + [len(steps) - 1]
+    keys = sorted(set(keys))
+    while len(keys) < min(MAX_SNAPSHOTS, len(steps)):
+        gaps = [(b - a, a, b) for a, b in zip(keys, keys[1:])]
+        size, a, b = max(gaps)
+        if size < 2:
+            break
+        keys.append((a + b) // 2)
+        keys.sort()
+    return keys[:MAX_SNAPSHOTS] if len(keys) <= MAX_SNAPSHOTS else keys[:MAX_SNAPSHOTS - 1] + [keys[-1]]
+
+
+def plan_figure(task: Task, steps: Sequence[PlanStep], title: str = ""):
+    """The plan in the grasp: snapshots above, x, z, theta against step below."""
+    keys = _snapshots(steps)
+    switches = {c.first for c in contacts_of(steps)[1:]}
+    fig = plt.figure(figsize=(2.3 * len(keys) + 0.5, 6.2))
+    grid = fig.add_gridspec(2, len(keys), height_ratios=[1.1, 1.0], hspace=0.35)
+    limits = _limits(task, steps)
+    for k, i in enumerate(keys):
+        ax = fig.add_subplot(grid[0, k])
+        pusher = steps[i + 1].pusher if i + 1 < len(steps) else steps[i].pusher
+        label = "start" if i == 0 else ("goal" if i == len(steps) - 1 else f"step {i}")
+        if i in switches:
+            label += f"\nswitch to {pusher}"
+        elif pusher:
+            label += f"\n{pusher}"
+        _draw_grasp(ax, task, steps[i].pose, pusher, label, limits)
+        if k == 0:
+            ax.set_ylabel("z in G (mm)", fontsize=8)
+        ax.set_xlabel("x in G (mm)", fontsize=8)
+    ax = fig.add_subplot(grid[1, :])
+    n = np.arange(len(steps))
+    poses = np.array([s.pose for s in steps])
+    ax.plot(n, poses[:, 0], label="x (mm)")
+    ax.plot(n, poses[:, 1], label="z (mm)")
+    ax2 = ax.twinx()
+    ax2.plot(n, poses[:, 2], color="C3", label="theta (deg)")
+    ax2.set_ylabel("theta (deg)", color="C3")
+    for c in contacts_of(steps):
+        ax.axvspan(c.first, c.last, color=_colour(task, c.pusher), alpha=0.12, lw=0)
+        ax.text((c.first + c.last) / 2, 1.01, c.pusher, transform=ax.get_xaxis_transform(), ha="center",
+                va="bottom", fontsize=8, color=_colour(task, c.pusher))
+    for i in switches:
+        ax.axvline(i, color="0.3", ls="--", lw=1)
+    ax.set_xlabel("step")
+    ax.set_ylabel("mm")
+    lines = ax.get_legend_handles_labels()
+    lines2 = ax2.get_legend_handles_labels()
+    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="best", fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.suptitle(title or task.name, fontsize=11)
+    return fig
+
+
+def save_plan_gif(task: Task, steps: Sequence[PlanStep], path: str, max_frames: int = 80) -> None:
+    """The plan animated, one frame per step (thinned to at most `max_frames`)."""
+    fig, ax = plt.subplots(figsize=(4, 4))
+    limits = _limits(task, steps)
+    frames = sorted(set(np.linspace(0, len(steps) - 1, min(max_frames, len(steps))).round().astype(int)))
+
+    def draw(i):
+        ax.clear()
+        pusher = steps[i].pusher or (steps[1].pusher if len(steps) > 1 else None)
+        _draw_grasp(ax, task, steps[i].pose, pusher, f"{task.name}: step {i}/{len(steps) - 1} ({pusher})", limits)
+
+    anim = animation.FuncAnimation(fig, draw, frames=frames)
+    anim.save(path, writer=animation.PillowWriter(fps=10))
+    plt.close(fig)
+
+
+def cone_figure(task: Task, pusher: str):
+    """The generalized friction cone of `pusher` in O: the edges n +- mu t of every contact point's
+    cone as wrenches (f_x, f_z, tau_y / l), unit length, and the cone's surface."""
+    model = task.build_model()
+    index = task.pusher_index(pusher)
+    cone = model.pusher_cones[index]
+    length = cone.torque_length
+    gens = np.array([[g[0], g[1], g[2] / length] for g in cone.generators], float)
+    gens /= np.linalg.norm(gens, axis=1, keepdims=True)
+    fig = plt.figure(figsize=(6, 5.5))
+    ax = fig.add_subplot(projection="3d")
+    for g in gens:
+        ax.plot([0, g[0]], [0, g[1]], [0, g[2]], color="0.3", lw=1)
+    ax.scatter(gens[:, 0], gens[:, 1], gens[:, 2], color="C0", s=15, depthshade=False)
+    ring = _cone_ring(gens)
+    if len(ring) >= 3:
+        faces = [[np.zeros(3), ring[i], ring[(i + 1) % len(ring)]] for i in range(len(ring))]
+        ax.add_collection3d(Poly3DCollection(faces, facecolor=_colour(task, pusher), alpha=0.25, edgecolor="0.4", lw=0.5))
+    elif len(ring) == 2:
+        ax.add_collection3d(Poly3DCollection([[np.zeros(3), ring[0], ring[1]]], facecolor=_colour(task, pusher), alpha=0.3))
+    ax.set_xlabel("f_x (N)")
+    ax.set_ylabel("f_z (N)")
+    ax.set_zlabel(f"tau_y / l (N), l = {length * 1e3:.1f} mm")
+    for set_lim in (ax.set_xlim, ax.set_ylim, ax.set_zlim):
+        set_lim(-1, 1)
+    spec = task.pushers[index]
+    kind = "point" if spec.is_point else f"segment of {spec.points} points"
+    ax.set_title(f"{task.name}: pusher {pusher!r} ({kind}, mu {spec.mu:g})\n"
+                 f"generalized friction cone in O, dimension {cone.dimension}", fontsize=10)
+    return fig
+
+
+def _cone_ring(gens: np.ndarray) -> List[np.ndarray]:
+    """The extreme generators of a pointed cone in cyclic order (its cross-section's convex hull)."""
+    axis = gens.mean(axis=0)
+    axis /= np.linalg.norm(axis)
+    u = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(axis, u)
+    pts = [(float(np.dot(g, u) / np.dot(g, axis)), float(np.dot(g, v) / np.dot(g, axis)), i) for i, g in enumerate(gens)]
+    pts.sort()
+    def half(points):
+        out = []
+        for p in points:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 1e-12:
+                out.pop()
+            out.append(p)
+        return out
+    lower, upper = half(pts), half(pts[::-1])
+    hull = lower[:-1] + upper[:-1]
+    return [gens[p[2]] for p in hull]
