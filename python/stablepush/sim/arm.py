@@ -1,0 +1,203 @@
+"""The simulated arm: a MuJoCo scene (scene.py) whose joint servos track end-effector poses by
+damped least-squares IK. It knows nothing of sockets; `stablepush.sim.server` puts it on one.
+
+Poses are (x, y, z, qw, qx, qy, qz) in the world [m]; the end effector is the gripper frame G,
+midway between the pads.
+"""
+from __future__ import annotations
+
+import math
+import time
+from typing import Dict, Optional, Sequence
+
+import mujoco
+import numpy as np
+
+from stablepush.sim import scene as scene_mod
+
+IK_DAMPING = 1e-4  # DLS damping lambda^2 [m^2]
+IK_ITERATIONS = 50
+IK_TOLERANCE = 1e-9  # m (and rad) of pose error
+POSTURE_GAIN = 0.05  # null-space pull toward the home posture per IK iteration
+HOME_GUESS = np.array([0.0, 0.35, 0.0, 1.9, 0.0, 0.89, 0.0])  # rad, hand pointing down in front of the base
+SETTLE_TIME = 0.3  # s of simulation after the grasp closes, before the first waypoint
+
+
+def pose_matrix(pose: Sequence[float]) -> np.ndarray:
+    """4x4 homogeneous transform of (x, y, z, qw, qx, qy, qz)."""
+    T = np.eye(4)
+    mat = np.zeros(9)
+    mujoco.mju_quat2Mat(mat, np.asarray(pose[3:], float))
+    T[:3, :3] = mat.reshape(3, 3)
+    T[:3, 3] = pose[:3]
+    return T
+
+
+def matrix_pose(T: np.ndarray) -> list:
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
+    if quat[0] < 0:
+        quat = -quat
+    return [*map(float, T[:3, 3]), *map(float, quat)]
+
+
+def in_grasp(T_world_gripper: np.ndarray, T_world_object: np.ndarray) -> Dict[str, float]:
+    """The object's pose in the grasp as MODEL.md section 1 defines it (x, z mm; theta deg), with the
+    out-of-plane parts (y mm, tilt deg) that the planar model assumes to be zero."""
+    T = np.linalg.inv(T_world_gripper) @ T_world_object
+    R = T[:3, :3]
+    tilt = math.degrees(math.acos(max(-1.0, min(1.0, R[1, 1]))))
+    return {"x": T[0, 3] * 1e3, "z": T[2, 3] * 1e3, "theta": math.degrees(math.atan2(R[0, 2], R[0, 0])),
+            "y": T[1, 3] * 1e3, "tilt": tilt}
+
+
+class SimArm:
+    """The arm, the grasp and the world of one scene description."""
+
+    def __init__(self, scene: dict):
+        self.scene = scene
+        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene))
+        self.data = mujoco.MjData(self.model)
+        m = self.model
+        self._arm_qpos = np.array([m.jnt_qposadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
+        self._arm_dof = np.array([m.jnt_dofadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
+        self._arm_act = np.array([m.actuator(j).id for j in scene_mod.ARM_JOINTS])
+        self._finger_qpos = np.array([m.jnt_qposadr[m.joint(j).id] for j in scene_mod.FINGER_JOINTS])
+        self._finger_act = np.array([m.actuator(j).id for j in scene_mod.FINGER_JOINTS])
+        self._site = m.site(scene_mod.GRIPPER_SITE).id
+        self._object = m.body(scene_mod.OBJECT_BODY).id
+        self._object_qpos = m.jnt_qposadr[m.joint(scene_mod.OBJECT_BODY).id]
+        self._scratch = mujoco.MjData(m)
+        self.steps = 0
+        self.step_wall_time = 0.0
+
+        home = np.asarray(scene["gripper_pose"], float)
+        self.home_posture = HOME_GUESS.copy()
+        self.home_posture = self.solve_ik(home, HOME_GUESS, strict=True, iterations=1000)
+        self.target = self.home_posture.copy()
+        self.data.qpos[self._arm_qpos] = self.home_posture
+        self.data.qpos[self._finger_qpos] = scene["object"]["thickness"] / 2
+        self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene["object_pose"]
+        self.data.ctrl[self._arm_act] = self.home_posture
+        self.data.ctrl[self._finger_act] = 0.0  # close: the servos saturate at the grip force
+        mujoco.mj_forward(m, self.data)
+        self.advance(SETTLE_TIME)
+
+    # -- kinematics ---------------------------------------------------------------------------
+
+    def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, strict: bool = False,
+                 iterations: int = IK_ITERATIONS) -> np.ndarray:
+        """Joint angles [rad] that put G at `pose`, by damped least squares from `q_start`, with a
+        null-space pull toward the home posture (the arm has one joint more than the pose needs)."""
+        d = self._scratch
+        target = pose_matrix(pose)
+        q = np.array(q_start, float)
+        lo = self.model.jnt_range[[self.model.joint(j).id for j in scene_mod.ARM_JOINTS], 0]
+        hi = self.model.jnt_range[[self.model.joint(j).id for j in scene_mod.ARM_JOINTS], 1]
+        jacp = np.zeros((3, self.model.nv))
+        jacr = np.zeros((3, self.model.nv))
+        error = np.inf
+        for _ in range(iterations):
+            d.qpos[self._arm_qpos] = q
+            mujoco.mj_kinematics(self.model, d)
+            mujoco.mj_comPos(self.model, d)
+            R = d.site_xmat[self._site].reshape(3, 3)
+            e_pos = target[:3, 3] - d.site_xpos[self._site]
+            e_rot = _rotation_vector(target[:3, :3] @ R.T)
+            e = np.concatenate([e_pos, e_rot])
+            error = float(np.linalg.norm(e))
+            if error < IK_TOLERANCE:
+                break
+            mujoco.mj_jacSite(self.model, d, jacp, jacr, self._site)
+            J = np.vstack([jacp, jacr])[:, self._arm_dof]
+            JJt = J @ J.T + IK_DAMPING * np.eye(6)
+            dq = J.T @ np.linalg.solve(JJt, e)
+            null_space = np.eye(7) - np.linalg.pinv(J, rcond=1e-6) @ J
+            dq += null_space @ (POSTURE_GAIN * (self.home_posture - q))
+            q = np.clip(q + dq, lo, hi)
+        if strict and error > 1e-6:
+            raise ValueError(f"the arm cannot reach the pose {[round(float(v), 4) for v in pose]} (IK error {error:.2e})")
+        self.ik_error = error
+        return q
+
+    # -- simulation ---------------------------------------------------------------------------
+
+    def advance(self, duration: float, target: Optional[np.ndarray] = None) -> None:
+        """Step the physics for `duration` s while the joint servo set-points move linearly from the
+        current target to `target` (the servos interpolate between streamed waypoints)."""
+        n = max(1, int(round(duration / self.model.opt.timestep)))
+        start = self.target.copy()
+        end = start if target is None else np.asarray(target, float)
+        t0 = time.perf_counter()
+        for i in range(1, n + 1):
+            self.data.ctrl[self._arm_act] = start + (end - start) * (i / n)
+            mujoco.mj_step(self.model, self.data)
+        self.step_wall_time += time.perf_counter() - t0
+        self.steps += n
+        self.target = end.copy()
+
+    def move_to(self, pose: Sequence[float], duration: float) -> None:
+        """Track G toward `pose` over `duration` s (one streamed waypoint period)."""
+        self.advance(duration, self.solve_ik(pose, self.target))
+
+    def stop(self) -> None:
+        """Hold the joints where they are now."""
+        self.target = self.data.qpos[self._arm_qpos].copy()
+        self.data.ctrl[self._arm_act] = self.target
+        self.data.qvel[self._arm_dof] = 0.0
+
+    # -- state --------------------------------------------------------------------------------
+
+    def gripper_matrix(self) -> np.ndarray:
+        T = np.eye(4)
+        T[:3, :3] = self.data.site_xmat[self._site].reshape(3, 3)
+        T[:3, 3] = self.data.site_xpos[self._site]
+        return T
+
+    def object_matrix(self) -> np.ndarray:
+        T = np.eye(4)
+        T[:3, :3] = self.data.xmat[self._object].reshape(3, 3)
+        T[:3, 3] = self.data.xpos[self._object]
+        return T
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.steps / self.step_wall_time if self.step_wall_time > 0 else 0.0
+
+    def state(self) -> dict:
+        """What the arm reports: G's pose and the joints; as a simulation it also reports the object's
+        world pose and its pose in the grasp (a real arm would not know these)."""
+        T_g, T_o = self.gripper_matrix(), self.object_matrix()
+        return {
+            "time": float(self.data.time),
+            "ee_pose": matrix_pose(T_g),
+            "joints": [float(v) for v in self.data.qpos[self._arm_qpos]],
+            "object_pose": matrix_pose(T_o),
+            "object_in_grasp": in_grasp(T_g, T_o),
+            "steps_per_s": round(self.steps_per_second, 1),
+        }
+
+    def contact_force_on_object(self, geom_name: str) -> np.ndarray:
+        """Total force [N, world frame] that geom `geom_name` exerts on the object now."""
+        geom = self.model.geom(geom_name).id
+        total = np.zeros(3)
+        f6 = np.zeros(6)
+        for i in range(self.data.ncon):
+            c = self.data.contact[i]
+            if geom not in (c.geom1, c.geom2):
+                continue
+            mujoco.mj_contactForce(self.model, self.data, i, f6)
+            frame = c.frame.reshape(3, 3)  # rows: normal, tangents; force acts on geom2
+            f = frame.T @ f6[:3]
+            total += f if c.geom1 == geom else -f
+        return total
+
+
+def _rotation_vector(R: np.ndarray) -> np.ndarray:
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(R).ravel())
+    if quat[0] < 0:
+        quat = -quat
+    v = np.zeros(3)
+    mujoco.mju_quat2Vel(v, quat, 1.0)
+    return v

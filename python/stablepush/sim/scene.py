@@ -1,0 +1,242 @@
+"""The MuJoCo scene of the simulated arm: the shipped arm (arm.xml) plus the held object, the
+multi-point finger pads and the fixed features, built from a scene description (a plain dict,
+SI units, as the executor sends it in its `hello`; see `stablepush.arm_protocol`).
+
+Contact settings that keep friction honest (the simulation's results rest on them):
+- elliptic friction cones with impratio 10, so sticking contacts do not creep;
+- noslip iterations, which remove the residual slip of MuJoCo's soft constraints;
+- a small solref time constant (stiff contacts, 4 time steps);
+- each pad is a disc of point contacts (centre and two rings), so it resists torque by friction
+  the way the model's discretized pad does (MODEL.md section 2);
+- only the object touches pads and features (explicit contact pairs with the task's friction);
+  the fingers are driven by force-capped joint servos, not as mocap bodies, so the pads press
+  with exactly the task's grip force and friction can drag the object.
+"""
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import List, Sequence, Tuple
+
+import numpy as np
+
+ARM_XML = Path(__file__).with_name("arm.xml")
+ARM_JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6", "j7")
+FINGER_JOINTS = ("finger_pos", "finger_neg")
+GRIPPER_SITE = "G"
+OBJECT_BODY = "object"
+
+TIMESTEP = 0.00025  # s
+CONTACT_SOLREF = (0.001, 1.0)  # time constant s (4 time steps), damping ratio
+CONTACT_SOLIMP = (0.95, 0.99, 0.0005)
+IMPRATIO = 10.0
+NOSLIP_ITERATIONS = 20
+PAD_POINT_RADIUS = 0.0005  # m, radius of each pad contact sphere
+PAD_RINGS = 2  # pad points: the centre and rings of 6, 12 points
+FEATURE_DEPTH = 0.01  # m, how far a feature extends behind its contact face
+FEATURE_CLEARANCE = 0.002  # m, a feature is this much narrower than the object along y on each side
+
+
+def pad_points(center: Sequence[float], radius: float, rings: int) -> List[Tuple[float, float]]:
+    """The points of a pad disc in G's xz-plane [m]: the centre, and ring i of 6i points at radius
+    i r / rings, the first on +x (the same layout as the model's, MODEL.md section 2)."""
+    points = [(center[0], center[1])]
+    for i in range(1, rings + 1):
+        rho = radius * i / rings
+        for k in range(6 * i):
+            a = 2.0 * math.pi * k / (6 * i)
+            points.append((center[0] + rho * math.cos(a), center[1] + rho * math.sin(a)))
+    return points
+
+
+def convex_pieces(polygon: Sequence[Sequence[float]]) -> List[List[Tuple[float, float]]]:
+    """A simple counterclockwise polygon as convex counterclockwise pieces: ear-clipping
+    triangulation, then adjacent pieces merged while their union stays convex (Hertel-Mehlhorn)."""
+    pts = [tuple(map(float, p)) for p in polygon]
+    if _is_convex(pts):
+        return [pts]
+    index = list(range(len(pts)))
+    triangles = []
+    while len(index) > 3:
+        for k in range(len(index)):
+            i, j, l = index[k - 1], index[k], index[(k + 1) % len(index)]
+            if _cross(pts[i], pts[j], pts[l]) <= 0:
+                continue
+            if any(_in_triangle(pts[m], pts[i], pts[j], pts[l]) for m in index if m not in (i, j, l)):
+                continue
+            triangles.append([i, j, l])
+            index.pop(k)
+            break
+        else:
+            raise ValueError("polygon could not be triangulated (is it simple and counterclockwise?)")
+    triangles.append(index)
+    pieces = [list(t) for t in triangles]
+    merged = True
+    while merged:
+        merged = False
+        for a in range(len(pieces)):
+            for b in range(a + 1, len(pieces)):
+                union = _merge(pieces[a], pieces[b])
+                if union is not None and _is_convex([pts[i] for i in union]):
+                    pieces[a] = union
+                    pieces.pop(b)
+                    merged = True
+                    break
+            if merged:
+                break
+    return [_drop_collinear([pts[i] for i in piece]) for piece in pieces]
+
+
+def _cross(a, b, c) -> float:
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+
+def _in_triangle(p, a, b, c) -> bool:
+    return _cross(a, b, p) >= 0 and _cross(b, c, p) >= 0 and _cross(c, a, p) >= 0
+
+
+def _is_convex(pts) -> bool:
+    n = len(pts)
+    return all(_cross(pts[i - 1], pts[i], pts[(i + 1) % n]) >= -1e-15 for i in range(n))
+
+
+def _merge(p: List[int], q: List[int]):
+    """The union of two pieces sharing an edge (as a vertex cycle), or None."""
+    for i in range(len(p)):
+        a, b = p[i], p[(i + 1) % len(p)]
+        for j in range(len(q)):
+            if q[j] == b and q[(j + 1) % len(q)] == a:
+                rest = [q[(j + 2 + k) % len(q)] for k in range(len(q) - 2)]
+                return p[: i + 1] + rest + p[i + 1:]
+    return None
+
+
+def _drop_collinear(pts):
+    n = len(pts)
+    return [pts[i] for i in range(n) if abs(_cross(pts[i - 1], pts[i], pts[(i + 1) % n])) > 1e-15]
+
+
+def _axis_aligned_rectangle(piece) -> bool:
+    if len(piece) != 4:
+        return False
+    xs = sorted({round(p[0], 12) for p in piece})
+    zs = sorted({round(p[1], 12) for p in piece})
+    return len(xs) == 2 and len(zs) == 2
+
+
+def _prism_inertia(polygon, thickness: float, mass: float, com) -> np.ndarray:
+    """Inertia tensor [kg m^2] about `com` (x, z in O) of a uniform prism, axes of O (y = thickness)."""
+    pts = np.asarray(polygon, float) - np.asarray(com, float)
+    area = sxx = szz = sxz = 0.0
+    for (x0, z0), (x1, z1) in zip(pts, np.roll(pts, -1, axis=0)):
+        c = x0 * z1 - x1 * z0
+        area += c / 2
+        sxx += c * (x0 * x0 + x0 * x1 + x1 * x1) / 12  # integral of x^2 dA
+        szz += c * (z0 * z0 + z0 * z1 + z1 * z1) / 12
+        sxz += c * (x0 * z1 + 2 * x0 * z0 + 2 * x1 * z1 + x1 * z0) / 24
+    density = mass / area
+    mx, mz, mxz = density * sxx, density * szz, density * sxz
+    my = mass * thickness**2 / 12
+    return np.array([[my + mz, 0.0, -mxz], [0.0, mx + mz, 0.0], [-mxz, 0.0, mx + my]])
+
+
+def quat_about_y(angle: float) -> Tuple[float, float, float, float]:
+    """(w, x, y, z) of a right-handed rotation by `angle` rad about +y."""
+    return (math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0)
+
+
+def _fmt(values) -> str:
+    return " ".join(repr(float(v)) for v in values)
+
+
+def build_mjcf(scene: dict) -> str:
+    """The complete MJCF of a scene description (see `stablepush.arm_protocol.Scene`)."""
+    root = ET.parse(ARM_XML).getroot()
+    gx, gz = scene["gravity"]
+    ET.SubElement(root, "option", timestep=repr(TIMESTEP), gravity=_fmt((gx, 0.0, gz)), cone="elliptic",
+                  impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS), integrator="implicitfast")
+    root.find("option").append(ET.Element("flag", multiccd="enable"))
+    worldbody = root.find("worldbody")
+    obj = scene["object"]
+    gripper = scene["gripper"]
+    half_thickness = obj["thickness"] / 2
+
+    # The pads: point spheres on the inner side of each finger, in G's xz-plane.
+    pad_names = []
+    # Pad i sits on finger i mod 2 (the task lists the opposed pads in pairs).
+    for f, (finger, side) in enumerate(zip(FINGER_JOINTS, (1.0, -1.0))):
+        body = root.find(f".//body[@name='{finger}']")
+        for p, pad in list(enumerate(gripper["pads"]))[f::2]:
+            for k, (px, pz) in enumerate(pad_points(pad["center"], pad["radius"], PAD_RINGS)):
+                name = f"{finger}_pad{p}_{k}"
+                ET.SubElement(body, "geom", name=name, type="sphere", size=repr(PAD_POINT_RADIUS),
+                              pos=_fmt((px, side * PAD_POINT_RADIUS, pz)), mass="0.0001", rgba="0.2 0.2 0.2 1")
+                pad_names.append(name)
+
+    # The held object: a free body of convex prisms in O.
+    x, y, z, w, qx, qy, qz = scene["object_pose"]
+    body = ET.SubElement(worldbody, "body", name=OBJECT_BODY, pos=_fmt((x, y, z)), quat=_fmt((w, qx, qy, qz)))
+    ET.SubElement(body, "freejoint", name=OBJECT_BODY)
+    com = obj["com"]
+    inertia = _prism_inertia(obj["polygon"], obj["thickness"], obj["mass"], com)
+    inertia[1, 1] = obj["inertia"]  # the task's moment about y (MODEL.md section 4)
+    ET.SubElement(body, "inertial", pos=_fmt((com[0], 0.0, com[1])), mass=repr(obj["mass"]),
+                  fullinertia=_fmt((inertia[0, 0], inertia[1, 1], inertia[2, 2], 0.0, inertia[0, 2], 0.0)))
+    piece_names = []
+    assets = root.find("asset")
+    if assets is None:
+        assets = ET.SubElement(root, "asset")
+    for i, piece in enumerate(convex_pieces(obj["polygon"])):
+        name = f"object_piece{i}"
+        if _axis_aligned_rectangle(piece):
+            xs = [p[0] for p in piece]
+            zs = [p[1] for p in piece]
+            ET.SubElement(body, "geom", name=name, type="box", mass="0",
+                          pos=_fmt(((min(xs) + max(xs)) / 2, 0.0, (min(zs) + max(zs)) / 2)),
+                          size=_fmt(((max(xs) - min(xs)) / 2, half_thickness, (max(zs) - min(zs)) / 2)),
+                          rgba="0.85 0.55 0.25 1")
+        else:
+            vertices = [(px, sy * half_thickness, pz) for sy in (-1, 1) for px, pz in piece]
+            ET.SubElement(assets, "mesh", name=name, vertex=_fmt(np.ravel(vertices)))
+            ET.SubElement(body, "geom", name=name, type="mesh", mesh=name, mass="0", rgba="0.85 0.55 0.25 1")
+        piece_names.append(name)
+
+    # The features: fixed boxes whose contact face is the pusher's segment (a thin rod for a point).
+    feature_half_y = max(half_thickness - FEATURE_CLEARANCE, 0.001)
+    contact = ET.SubElement(root, "contact")
+    for feature in scene["features"]:
+        a = np.asarray(feature["from"], float)
+        b = np.asarray(feature["to"], float)
+        n = np.asarray(feature["normal"], float)
+        name = f"feature_{feature['pusher']}"
+        length = float(np.linalg.norm(b - a))
+        if length > 0:
+            t = (b - a) / length
+            angle = math.atan2(-t[2], t[0])
+            center = (a + b) / 2 - n * FEATURE_DEPTH / 2
+            ET.SubElement(worldbody, "geom", name=name, type="box", pos=_fmt(center), quat=_fmt(quat_about_y(angle)),
+                          size=_fmt((length / 2, feature_half_y, FEATURE_DEPTH / 2)), rgba="0.3 0.5 0.8 1")
+        else:
+            rod = 0.001
+            center = a - n * rod
+            ET.SubElement(worldbody, "geom", name=name, type="capsule", size=repr(rod),
+                          fromto=_fmt((*(center - [0, feature_half_y, 0]), *(center + [0, feature_half_y, 0]))),
+                          rgba="0.3 0.5 0.8 1")
+        for piece in piece_names:
+            _pair(contact, name, piece, feature["mu"])
+    for pad in pad_names:
+        for piece in piece_names:
+            _pair(contact, pad, piece, gripper["mu"])
+
+    # The finger servos close toward y = 0 and press with at most the grip force.
+    for finger in FINGER_JOINTS:
+        act = root.find(f".//actuator/position[@name='{finger}']")
+        act.set("forcerange", _fmt((-gripper["grip_force"], gripper["grip_force"])))
+        act.set("forcelimited", "true")
+    return ET.tostring(root, encoding="unicode")
+
+
+def _pair(contact: ET.Element, geom1: str, geom2: str, mu: float) -> None:
+    ET.SubElement(contact, "pair", geom1=geom1, geom2=geom2, condim="3",
+                  friction=_fmt((mu, mu, 0.0, 0.0, 0.0)), solref=_fmt(CONTACT_SOLREF), solimp=_fmt(CONTACT_SOLIMP))
