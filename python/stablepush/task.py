@@ -23,6 +23,15 @@ DEFAULT_STEP_TIME = 0.1
 DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
+# Where the arm works (stablepush.execution): mm in the world frame (x forward, y along the
+# gripping axis at home, z up).
+ENVIRONMENT_DEFAULTS: Dict[str, Any] = {
+    "home": [450.0, 0.0, 300.0],  # G's position at the start; G's axes are the world's there
+    "retract": 20.0,  # how far the object backs off a feature before moving to the next
+    "station_spacing": 150.0,  # default features sit this far apart along y
+    "lane_offset": 75.0,  # moves between features run this far along y from a feature
+}
+
 PLANNER_DEFAULTS: Dict[str, Any] = {
     "time_limit": 10.0,  # s
     "seed": 1,
@@ -169,6 +178,7 @@ class Task:
     start: Tuple[float, float, float]  # mm, mm, deg
     goal: Tuple[float, float, float]
     planner: Dict[str, Any] = field(default_factory=dict)
+    environment: Dict[str, Any] = field(default_factory=dict)  # the world around the arm, see ENVIRONMENT_DEFAULTS
     source: Optional[str] = None
 
     @property
@@ -254,7 +264,7 @@ def parse_task(text: str, source: Optional[str] = None) -> Task:
 
 def _validate(data: Any, source: Optional[str]) -> Task:
     top = _mapping(
-        "", data, ["name", "object", "gripper", "pushers", "start", "goal"], ["gravity", "dynamics", "planner"]
+        "", data, ["name", "object", "gripper", "pushers", "start", "goal"], ["gravity", "dynamics", "planner", "environment"]
     )
     name = _name("name", top["name"])
     vertices, thickness, mass, com, inertia = _validate_object(top["object"])
@@ -297,10 +307,12 @@ def _validate(data: Any, source: Optional[str]) -> Task:
                 raise TaskError(label, f"{where} does not lie inside the object at the {label} pose {list(q)}")
 
     planner = _validate_planner(top.get("planner", {}))
+    environment = _validate_environment(top.get("environment", {}), [p.name for p in pushers])
     return Task(
         name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
         grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
-        friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner, source=source,
+        friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner,
+        environment=environment, source=source,
     )
 
 
@@ -365,6 +377,26 @@ def _validate_pushers(value: Any, section: "_core.CrossSection") -> Tuple[Pusher
             raise TaskError(path, str(exc)) from None
         specs.append(PusherSpec(name=name, a=a, b=b, mu=mu, points=points))
     return tuple(specs)
+
+
+def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Dict[str, Any]:
+    """The environment section with defaults filled in. `features` maps a pusher's name to the
+    object's world pose [x, y, z mm, theta deg about world y] while it rests on that pusher's
+    feature; pushers not listed get a feature placed by the executor (stablepush.execution)."""
+    env = _mapping("environment", value, [], list(ENVIRONMENT_DEFAULTS) + ["features"])
+    out: Dict[str, Any] = {key: env.get(key, default) for key, default in ENVIRONMENT_DEFAULTS.items()}
+    out["home"] = list(_vector("environment.home", out["home"], 3))
+    for key in ("retract", "lane_offset", "station_spacing"):
+        out[key] = _number(f"environment.{key}", out[key], positive=True)
+    features = env.get("features", {})
+    if not isinstance(features, dict):
+        raise TaskError("environment.features", "must map pusher names to [x, y, z, theta] (mm, deg)")
+    out["features"] = {}
+    for name, pose in features.items():
+        if name not in pusher_names:
+            raise TaskError(f"environment.features.{name}", f"no pusher named {name!r} (the task has {', '.join(pusher_names)})")
+        out["features"][name] = list(_vector(f"environment.features.{name}", pose, 4))
+    return out
 
 
 def _validate_planner(value: Any) -> Dict[str, Any]:

@@ -1,0 +1,319 @@
+"""From a plan to arm motions: where the features that act as pushers sit in the world, and the
+end-effector waypoints that carry the plan out (issue 4). No sockets here (`executor.py` streams
+these waypoints) and no simulation (`sim/`).
+
+World frame W: x forward, z up, y along the gripping axis at the home pose, where G's axes are
+W's. During a push the pusher sticks to the object (that is what the plan guarantees), so the
+object rests on its feature, fixed in W, while the gripper moves: with T_GO(q) the object's pose in
+the grasp (MODEL.md section 1), G's world pose is
+
+    T_WG(t) = T_WO · T_GO(q(t))^-1.
+
+Between two contacts the gripper retracts the object from the feature along the pusher's inward
+normal, moves it along y into a lane between features (lifting it over everything first when the
+lanes differ), brings it opposite the next feature and approaches until the pusher's segment
+touches. Poses are (x, y, z, qw, qx, qy, qz) in W [m].
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from stablepush.task import MM, Task, TaskError
+
+MOVE_SPEED = 0.1  # m/s of G between contacts
+TURN_SPEED = math.radians(60)  # rad/s of G between contacts
+SETTLE_TIME = 0.2  # s held still at the end of the last push, before the final retract
+LIFT_MARGIN = 0.02  # m above every feature when the object changes lanes
+
+
+@dataclass(frozen=True)
+class PlanStep:
+    """Plan waypoint i: the object's pose in the grasp (x mm, z mm, theta deg) after the push by
+    `pusher` (None for the start)."""
+
+    pose: Tuple[float, float, float]
+    pusher: Optional[str]
+
+
+@dataclass(frozen=True)
+class Feature:
+    """A fixed feature of the world acting as pusher `pusher`: it touches the object along the
+    segment from-to (W, m) when the object is at `object_pose` (T_WO, 4x4); `normal` is the
+    pusher's inward normal in W (pointing into the object, away from the feature)."""
+
+    pusher: str
+    object_pose: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    normal: np.ndarray
+    mu: float
+
+    def as_dict(self) -> dict:
+        return {"pusher": self.pusher, "from": self.start.tolist(), "to": self.end.tolist(),
+                "normal": self.normal.tolist(), "mu": self.mu, "object_pose": matrix_to_pose(self.object_pose)}
+
+
+@dataclass(frozen=True)
+class ArmWaypoint:
+    """One streamed end-effector set-point. `step` is the plan step the motion is heading for
+    (during a push) or the last one reached (otherwise); when `completes` is set, the arm's
+    acknowledgement of this waypoint confirms that plan step."""
+
+    seq: int
+    t: float  # s from the start of the stream
+    step: int
+    completes: bool
+    phase: str  # push | settle | retract | move | approach
+    pose: Tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Plan pushes first+1 .. last, all by `pusher` (one stay on one feature)."""
+
+    pusher: str
+    first: int
+    last: int
+
+
+# -- frames ------------------------------------------------------------------------------------
+
+
+def rot_y(angle: float) -> np.ndarray:
+    """Right-handed rotation by `angle` rad about +y (MODEL.md section 1: R(theta) in xz)."""
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def grasp_transform(pose_mm_deg: Sequence[float]) -> np.ndarray:
+    """T_GO(q) = Trans(x, 0, z) · Rot_y(theta), for q in mm and degrees."""
+    T = np.eye(4)
+    T[:3, :3] = rot_y(math.radians(pose_mm_deg[2]))
+    T[0, 3], T[2, 3] = pose_mm_deg[0] * MM, pose_mm_deg[1] * MM
+    return T
+
+
+def translation(p: Sequence[float]) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, 3] = p
+    return T
+
+
+def matrix_to_pose(T: np.ndarray) -> List[float]:
+    """(x, y, z, qw, qx, qy, qz) of a 4x4 transform."""
+    R = T[:3, :3]
+    w = math.sqrt(max(0.0, 1.0 + R[0, 0] + R[1, 1] + R[2, 2])) / 2
+    if w > 1e-6:
+        q = [w, (R[2, 1] - R[1, 2]) / (4 * w), (R[0, 2] - R[2, 0]) / (4 * w), (R[1, 0] - R[0, 1]) / (4 * w)]
+    else:  # a half turn: the axis from the largest diagonal term
+        i = int(np.argmax(np.diag(R)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        v = math.sqrt(max(0.0, 1.0 + R[i, i] - R[j, j] - R[k, k])) / 2
+        q = [0.0, 0.0, 0.0, 0.0]
+        q[1 + i] = v
+        q[1 + j] = (R[j, i] + R[i, j]) / (4 * v)
+        q[1 + k] = (R[k, i] + R[i, k]) / (4 * v)
+        q[0] = (R[k, j] - R[j, k]) / (4 * v)
+    norm = math.sqrt(sum(c * c for c in q))
+    return [float(v) for v in T[:3, 3]] + [c / norm for c in q]
+
+
+def pose_to_matrix(pose: Sequence[float]) -> np.ndarray:
+    w, x, y, z = pose[3:]
+    T = np.eye(4)
+    T[:3, :3] = np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+    T[:3, 3] = pose[:3]
+    return T
+
+
+def _slerp(q0: np.ndarray, q1: np.ndarray, s: float) -> np.ndarray:
+    dot = float(np.dot(q0, q1))
+    if dot < 0:
+        q1, dot = -q1, -dot
+    if dot > 0.9995:
+        q = q0 + s * (q1 - q0)
+        return q / np.linalg.norm(q)
+    a = math.acos(dot)
+    return (math.sin((1 - s) * a) * q0 + math.sin(s * a) * q1) / math.sin(a)
+
+
+# -- the plan in the world ---------------------------------------------------------------------
+
+
+def contacts_of(steps: Sequence[PlanStep]) -> List[Contact]:
+    """The plan's pushes grouped into contacts: runs of consecutive pushes by one pusher."""
+    out: List[Contact] = []
+    for i, step in enumerate(steps[1:], start=1):
+        if out and out[-1].pusher == step.pusher and out[-1].last == i - 1:
+            out[-1] = Contact(step.pusher, out[-1].first, i)
+        else:
+            out.append(Contact(step.pusher, i - 1, i))
+    return out
+
+
+def place_features(task: Task, steps: Sequence[PlanStep]) -> Dict[str, Feature]:
+    """One feature per pusher the plan uses. The task's `environment.features` gives the object's
+    world pose on a feature; otherwise pusher k (in order of first use) gets a station k
+    `station_spacing` mm along +y from home, and the feature is placed where the pusher touches the
+    object at the start of its first contact with G at that station, axes aligned with W (so the
+    task's gravity, given in G, is W's there)."""
+    env = task.environment
+    model = task.build_model()
+    home = np.asarray(env["home"], float) * MM
+    features: Dict[str, Feature] = {}
+    for contact in contacts_of(steps):
+        name = contact.pusher
+        if name in features:
+            continue
+        if name in env["features"]:
+            x, y, z, theta = env["features"][name]
+            T_WO = translation(np.array([x, y, z]) * MM)
+            T_WO[:3, :3] = rot_y(math.radians(theta))
+        else:
+            station = home + np.array([0.0, len(features) * env["station_spacing"] * MM, 0.0])
+            T_WO = translation(station) @ grasp_transform(steps[contact.first].pose)
+        index = task.pusher_index(name)
+        spec = task.pushers[index]
+        n_O = np.array(model.pushers[index].inward_normal, float)
+        to_w = lambda p: (T_WO @ np.array([p[0] * MM, 0.0, p[1] * MM, 1.0]))[:3]  # noqa: E731
+        features[name] = Feature(pusher=name, object_pose=T_WO, start=to_w(spec.a), end=to_w(spec.b),
+                                 normal=T_WO[:3, :3] @ np.array([n_O[0], 0.0, n_O[1]]), mu=spec.mu)
+    return features
+
+
+def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float]) -> dict:
+    """What a simulated arm needs to build the world (SI units): the object, the gripper, gravity,
+    the features, G's home pose and the object's pose when the run starts (`in_grasp`, mm/deg)."""
+    model = task.build_model()
+    home = translation(np.asarray(task.environment["home"], float) * MM)
+    return {
+        "task": task.name,
+        "gravity": list(task.gravity),
+        "object": {"polygon": [[x * MM, z * MM] for x, z in task.vertices], "thickness": task.thickness * MM,
+                   "mass": model.body.mass, "com": list(model.body.com), "inertia": model.body.inertia},
+        "gripper": {"grip_force": task.grip_force, "mu": task.mu,
+                    "pads": [{"center": [c[0] * MM, c[1] * MM], "radius": r * MM} for c, r in task.pads]},
+        "features": [f.as_dict() for f in features.values()],
+        "gripper_pose": matrix_to_pose(home),
+        "object_pose": matrix_to_pose(home @ grasp_transform(in_grasp)),
+        "object_in_grasp": list(in_grasp),
+    }
+
+
+class _Stream:
+    """Accumulates waypoints at a fixed rate."""
+
+    def __init__(self, rate_hz: float, start_pose: np.ndarray, step: int):
+        self.period = 1.0 / rate_hz
+        self.points: List[ArmWaypoint] = []
+        self.pose = start_pose
+        self.step = step
+
+    def _emit(self, T: np.ndarray, phase: str, step: int, completes: bool = False) -> None:
+        self.points.append(ArmWaypoint(seq=len(self.points), t=(len(self.points) + 1) * self.period, step=step,
+                                       completes=completes, phase=phase, pose=tuple(matrix_to_pose(T))))
+        self.pose = T
+
+    def move(self, target: np.ndarray, phase: str) -> None:
+        """A straight move of G to `target` with smooth (3s^2 - 2s^3) timing."""
+        start = self.pose
+        distance = float(np.linalg.norm(target[:3, 3] - start[:3, 3]))
+        q0 = np.array(matrix_to_pose(start)[3:])
+        q1 = np.array(matrix_to_pose(target)[3:])
+        angle = 2 * math.acos(min(1.0, abs(float(np.dot(q0, q1)))))
+        duration = max(distance / MOVE_SPEED, angle / TURN_SPEED)
+        if duration < 1e-9:
+            return
+        n = max(1, math.ceil(duration / self.period))
+        for i in range(1, n + 1):
+            s = i / n
+            s = s * s * (3 - 2 * s)
+            T = pose_to_matrix([*(start[:3, 3] + s * (target[:3, 3] - start[:3, 3])), *_slerp(q0, q1, s)])
+            self._emit(T, phase, self.step)
+
+    def push(self, T_WO: np.ndarray, q0, q1, duration: float, step: int) -> None:
+        """One unit push: q moves linearly from q0 to q1 over `duration` while the object stays at T_WO."""
+        n = max(1, round(duration / self.period))
+        for i in range(1, n + 1):
+            q = [a + (b - a) * i / n for a, b in zip(q0, q1)]
+            self._emit(T_WO @ np.linalg.inv(grasp_transform(q)), "push", step, completes=i == n)
+        self.step = step
+
+    def hold(self, duration: float, phase: str) -> None:
+        for _ in range(max(1, round(duration / self.period))):
+            self._emit(self.pose, phase, self.step)
+
+
+def arm_trajectory(
+    task: Task,
+    steps: Sequence[PlanStep],
+    features: Dict[str, Feature],
+    rate_hz: float,
+    start_pose: Sequence[float],
+    resume_from: int = 0,
+) -> List[ArmWaypoint]:
+    """The end-effector waypoints that carry out plan steps resume_from+1 .. end, starting with
+    G at `start_pose` holding the object at plan pose `resume_from`."""
+    if not 0 <= resume_from < len(steps) - 1:
+        raise TaskError("--resume-from", f"must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} pushes)")
+    env = task.environment
+    retract = env["retract"] * MM
+    home = np.asarray(env["home"], float) * MM
+    lane_of = {name: f.object_pose[1, 3] + env["lane_offset"] * MM for name, f in features.items()}
+    reach = max(math.hypot(x, z) for x, z in task.vertices) * MM
+    top = max(max(f.start[2], f.end[2]) for f in features.values())
+
+    stream = _Stream(rate_hz, pose_to_matrix(start_pose), resume_from)
+    # On a resume the object may still rest on the feature of the last confirmed push: back off first.
+    current: Optional[Feature] = features.get(steps[resume_from].pusher) if resume_from > 0 else None
+    lane = home[1] + env["lane_offset"] * MM
+    for contact in contacts_of(steps):
+        if contact.last <= resume_from:
+            continue
+        first = max(contact.first, resume_from)
+        feature = features[contact.pusher]
+        q_first = steps[first].pose
+        touching = feature.object_pose @ np.linalg.inv(grasp_transform(q_first))
+        if _near(stream.pose, touching):
+            stream.move(touching, "approach")  # already there, up to the arm's tracking error
+        else:
+            approach = translation(feature.normal * retract) @ touching
+            if current is not None:
+                stream.move(translation(current.normal * retract) @ stream.pose, "retract")
+                lane = lane_of[current.pusher]
+            target_lane = lane_of[feature.pusher]
+            stream.move(_with(stream.pose, y=lane), "move")
+            if abs(target_lane - lane) > 1e-9:
+                clear_z = top + math.hypot(*q_first[:2]) * MM + reach + LIFT_MARGIN
+                stream.move(_with(stream.pose, z=max(clear_z, stream.pose[2, 3])), "move")
+                stream.move(_with(stream.pose, y=target_lane), "move")
+            stream.move(_with(approach, y=target_lane), "move")
+            stream.move(approach, "approach")
+            stream.move(touching, "approach")
+        for i in range(first + 1, contact.last + 1):
+            stream.push(feature.object_pose, steps[i - 1].pose, steps[i].pose, task.step_time, i)
+        current = feature
+    stream.hold(SETTLE_TIME, "settle")
+    if current is not None:
+        stream.move(translation(current.normal * retract) @ stream.pose, "retract")
+    return stream.points
+
+
+def _near(a: np.ndarray, b: np.ndarray, distance: float = 1e-3, angle: float = math.radians(0.5)) -> bool:
+    cos = (np.trace(a[:3, :3].T @ b[:3, :3]) - 1) / 2
+    return np.linalg.norm(a[:3, 3] - b[:3, 3]) < distance and cos > math.cos(angle)
+
+
+def _with(T: np.ndarray, **coordinate) -> np.ndarray:
+    out = T.copy()
+    for axis, value in coordinate.items():
+        out["xyz".index(axis), 3] = value
+    return out

@@ -1,0 +1,272 @@
+"""The executor: streams a plan's end-effector waypoints (execution.py) to an arm server over the
+arm protocol (arm_protocol.py), lock-step, and reports what the arm confirmed.
+
+Any fault (the server gone, a malformed or out-of-order reply, an error from the server, no reply
+in time) ends the run with `ExecutionFault`: the arm is told to stop when it can still be
+reached, and the fault names the last plan step the arm confirmed, from which `resume_from`
+continues.
+"""
+from __future__ import annotations
+
+import math
+import socket
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Dict, List, Optional, Sequence
+
+import numpy as np
+
+from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
+from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, place_features, pose_to_matrix,
+                                  scene_description)
+from stablepush.task import MM, Task, TaskError, pose_to_si
+
+DEFAULT_ACK_TIMEOUT = 5.0  # s to wait for any reply
+
+
+class ExecutionFault(RuntimeError):
+    """The run stopped early. `last_confirmed_step` is the last plan step the arm acknowledged."""
+
+    def __init__(self, reason: str, last_confirmed_step: int, arm_stopped: Optional[bool]):
+        self.reason = reason
+        self.last_confirmed_step = last_confirmed_step
+        self.arm_stopped = arm_stopped  # None: the arm could not be reached to stop it
+        super().__init__(reason)
+
+
+@dataclass
+class ContactRecord:
+    """How one stay on a feature went: the object's motion in the world while the pusher pushed
+    (zero when the pusher stuck), measured at the middle of the pusher's segment."""
+
+    pusher: str
+    first_step: int
+    last_step: int
+    slip_mm: Optional[float] = None
+    slip_deg: Optional[float] = None
+
+
+@dataclass
+class ExecutionReport:
+    task: str
+    resumed_from: int
+    last_confirmed_step: int
+    total_steps: int
+    waypoints: int
+    planned_final: Sequence[float]  # x mm, z mm, theta deg
+    # The object in the grasp as the arm reports it (a simulator does): at the end of the last push,
+    # still resting on the pusher, and after the gripper has backed it off the feature.
+    final_in_grasp: Optional[Dict[str, float]]
+    released_in_grasp: Optional[Dict[str, float]] = None
+    contacts: List[ContactRecord] = field(default_factory=list)
+    features: List[dict] = field(default_factory=list)
+    wall_time_s: float = 0.0
+    sim_steps_per_s: Optional[float] = None
+
+    @property
+    def final_error(self) -> Optional[Dict[str, float]]:
+        """Final pose in the grasp minus the plan's: x, z mm, theta deg, and the distance mm."""
+        if self.final_in_grasp is None:
+            return None
+        dx = self.final_in_grasp["x"] - self.planned_final[0]
+        dz = self.final_in_grasp["z"] - self.planned_final[1]
+        dth = self.final_in_grasp["theta"] - self.planned_final[2]
+        return {"x": dx, "z": dz, "theta": dth, "distance": math.hypot(dx, dz)}
+
+    @property
+    def release_change(self) -> Optional[Dict[str, float]]:
+        """How the object moved in the grasp when the last feature let go (x, z mm, theta deg): nonzero
+        when the grasp alone cannot hold the final pose against gravity."""
+        if self.final_in_grasp is None or self.released_in_grasp is None:
+            return None
+        return {k: self.released_in_grasp[k] - self.final_in_grasp[k] for k in ("x", "z", "theta")}
+
+    def as_dict(self) -> dict:
+        return {
+            "task": self.task, "resumed_from": self.resumed_from, "last_confirmed_step": self.last_confirmed_step,
+            "total_steps": self.total_steps, "waypoints": self.waypoints, "planned_final": list(self.planned_final),
+            "final_in_grasp": self.final_in_grasp, "final_error": self.final_error,
+            "released_in_grasp": self.released_in_grasp, "release_change": self.release_change,
+            "contacts": [c.__dict__ for c in self.contacts], "features": self.features,
+            "wall_time_s": self.wall_time_s, "sim_steps_per_s": self.sim_steps_per_s,
+        }
+
+
+def plan_steps(task: Task, plan: dict) -> List[PlanStep]:
+    """The plan's waypoints, once they are shown to belong to `task`: same task name and start,
+    pushers the task has, and every push a stable push of this task with the pads inside the object
+    (so a plan made for another version of the file is refused). TaskError names what differs."""
+    if plan.get("task") != task.name:
+        raise TaskError("plan.task", f"the plan is for task {plan.get('task')!r}, not {task.name!r}")
+    if not plan.get("solved"):
+        raise TaskError("plan.solved", f"the plan does not reach the goal ({plan.get('message', 'not solved')})")
+    raw = plan.get("waypoints")
+    if not isinstance(raw, list) or len(raw) < 2:
+        raise TaskError("plan.waypoints", "needs the start and at least one push")
+    steps = []
+    for i, w in enumerate(raw):
+        try:
+            pose = (float(w["x"]), float(w["z"]), float(w["theta"]))
+            pusher = w["pusher"]
+        except (KeyError, TypeError, ValueError):
+            raise TaskError(f"plan.waypoints[{i}]", "needs numbers x, z, theta and a pusher (null for the start)") from None
+        if (pusher is None) != (i == 0):
+            raise TaskError(f"plan.waypoints[{i}].pusher", "only the first waypoint (the start) has no pusher")
+        if pusher is not None and pusher not in task.pusher_names:
+            raise TaskError(f"plan.waypoints[{i}].pusher", f"the task has no pusher {pusher!r}")
+        steps.append(PlanStep(pose, pusher))
+    if max(abs(a - b) for a, b in zip(steps[0].pose, task.start)) > 1e-6:
+        raise TaskError("plan.waypoints[0]", f"the plan starts at {list(steps[0].pose)}, the task at {list(task.start)}")
+    model = task.build_model()
+    for i in range(1, len(steps)):
+        q0, q1 = pose_to_si(steps[i - 1].pose), pose_to_si(steps[i].pose)
+        dq = tuple(b - a for a, b in zip(q0, q1))
+        verdict = model.check(q0, dq, task.pusher_index(steps[i].pusher))
+        if not verdict.feasible:
+            raise TaskError(f"plan.waypoints[{i}]", f"the push by {steps[i].pusher!r} is not a stable push for this task "
+                                                    f"(margin {verdict.margin:+.4f} N); was the plan made for another version of it?")
+        if not model.grasp_maintained(q1):
+            raise TaskError(f"plan.waypoints[{i}]", "the pads leave the object at this pose")
+    return steps
+
+
+class _Link:
+    """The socket to the arm server, reading one JSON line at a time with a timeout."""
+
+    def __init__(self, host: str, port: int, timeout: float):
+        self.where = f"{host}:{port}"
+        try:
+            self.sock = socket.create_connection((host, port), timeout=timeout)
+        except OSError as exc:
+            raise ConnectionError(f"cannot reach the arm server at {self.where} ({exc.strerror or exc})") from None
+        self.sock.settimeout(timeout)
+        self.reader = self.sock.makefile("rb")
+
+    def send(self, message: dict) -> None:
+        self.sock.sendall(encode(message))
+
+    def receive(self) -> dict:
+        try:
+            line = self.reader.readline()
+        except socket.timeout:
+            raise TimeoutError(f"no reply from the arm server at {self.where} within {self.sock.gettimeout():g} s") from None
+        if not line:
+            raise ConnectionError(f"the arm server at {self.where} closed the connection")
+        return decode(line, "server")
+
+    def close(self) -> None:
+        try:
+            self.sock.close()
+        except OSError:
+            pass
+
+
+def execute_plan(
+    task: Task,
+    steps: Sequence[PlanStep],
+    host: str,
+    port: int,
+    *,
+    rate_hz: float,
+    resume_from: int = 0,
+    pace: bool = True,
+    reset: bool = False,
+    ack_timeout: float = DEFAULT_ACK_TIMEOUT,
+    progress: Optional[Callable[[ArmWaypoint, int], None]] = None,
+) -> ExecutionReport:
+    """Stream the plan from step `resume_from` to the arm server at host:port. `pace` holds the
+    stream to rate_hz in wall-clock time (a real arm); without it waypoints go as fast as they are
+    acknowledged (a simulator keeps its own clock). `progress(waypoint, n)` is called per ack."""
+    features = place_features(task, steps)
+    scene = scene_description(task, features, steps[resume_from].pose)
+    started = time.perf_counter()
+    last_confirmed = resume_from
+    link = None
+    try:
+        link = _Link(host, port, ack_timeout)
+        link.send({"type": "hello", "protocol": PROTOCOL, "rate_hz": rate_hz, "scene": scene, "reset": reset})
+        ready = _expect(link.receive(), "ready")
+        waypoints = arm_trajectory(task, steps, features, rate_hz, ready["state"]["ee_pose"], resume_from)
+        contacts: Dict[int, ContactRecord] = {}
+        touch_state: Optional[dict] = None
+        state = ready["state"]
+        settled: Optional[dict] = None
+        next_time = time.perf_counter()
+        for w in waypoints:
+            if pace:
+                next_time += 1.0 / rate_hz
+                time.sleep(max(0.0, next_time - time.perf_counter()))
+            link.send({"type": "waypoint", "seq": w.seq, "t": w.t, "step": w.step, "phase": w.phase, "pose": list(w.pose)})
+            reply = _expect(link.receive(), "ack")
+            if reply["seq"] != w.seq:
+                raise ProtocolError(f"out-of-order acknowledgement: expected seq {w.seq}, got {reply['seq']}")
+            if w.phase == "push" and state is not None and touch_state is None:
+                touch_state = state  # the object as it came to rest on the feature
+            state = reply["state"]
+            if w.completes:
+                last_confirmed = w.step
+                _record(contacts, task, steps, features, w.step, touch_state, state)
+            if w.phase != "push":
+                touch_state = None
+            if w.phase == "settle":
+                settled = state
+            if progress is not None:
+                progress(w, last_confirmed)
+        link.send({"type": "bye"})
+    except (ConnectionError, TimeoutError, ProtocolError, OSError, KeyError) as exc:
+        stopped = _stop(link) if link is not None else None
+        reason = str(exc) if not isinstance(exc, KeyError) else f"a reply lacks {exc}"
+        raise ExecutionFault(reason, last_confirmed, stopped) from None
+    finally:
+        if link is not None:
+            link.close()
+    return ExecutionReport(
+        task=task.name, resumed_from=resume_from, last_confirmed_step=last_confirmed, total_steps=len(steps) - 1,
+        waypoints=len(waypoints), planned_final=steps[-1].pose,
+        final_in_grasp=(settled or state).get("object_in_grasp"), released_in_grasp=state.get("object_in_grasp"),
+        contacts=list(contacts.values()), features=[f.as_dict() for f in features.values()],
+        wall_time_s=time.perf_counter() - started, sim_steps_per_s=state.get("steps_per_s"),
+    )
+
+
+def _expect(message: dict, kind: str) -> dict:
+    if message["type"] == "error":
+        raise ProtocolError(f"the arm server reported: {message['message']}")
+    if message["type"] != kind:
+        raise ProtocolError(f"expected {kind!r} from the arm server, got {message['type']!r}")
+    return message
+
+
+def _stop(link: _Link) -> Optional[bool]:
+    """Tell the arm to hold still; True when it confirmed, None when it could not be reached."""
+    try:
+        link.sock.settimeout(2.0)
+        link.send({"type": "stop"})
+        while True:
+            reply = link.receive()
+            if reply["type"] == "stopped":
+                return True
+            if reply["type"] == "error":  # the server stops the arm itself before reporting an error
+                return True
+    except (ConnectionError, TimeoutError, ProtocolError, OSError):
+        return None
+
+
+def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[PlanStep], features: Dict[str, Feature],
+            step: int, touch_state: Optional[dict], state: dict) -> None:
+    """Update the record of the contact that plan step `step` belongs to with the object's motion in
+    the world since it came to rest on the feature (when the arm reports the object)."""
+    pusher = steps[step].pusher
+    first = step
+    while first > 1 and steps[first - 1].pusher == pusher:
+        first -= 1
+    record = contacts.setdefault(first, ContactRecord(pusher, first, step))
+    record.last_step = step
+    if touch_state is None or "object_pose" not in state or "object_pose" not in touch_state:
+        return
+    spec = task.pushers[task.pusher_index(pusher)]
+    mid = np.array([(spec.a[0] + spec.b[0]) / 2 * MM, 0.0, (spec.a[1] + spec.b[1]) / 2 * MM, 1.0])
+    T0, T1 = pose_to_matrix(touch_state["object_pose"]), pose_to_matrix(state["object_pose"])
+    record.slip_mm = float(np.linalg.norm((T1 @ mid - T0 @ mid)[:3])) / MM
+    R = T0[:3, :3].T @ T1[:3, :3]
+    record.slip_deg = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(R) - 1) / 2))))
