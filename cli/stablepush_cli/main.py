@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 
 import click
@@ -211,6 +212,239 @@ def _write_bench(path: str, trials, rows) -> None:
     writer.writeheader()
     writer.writerows(records)
     write_atomically(path, buffer.getvalue())
+
+
+EXIT_ARM_FAULT = 3
+
+
+def _load_plan_and_task(plan_file: str, task_file: str):
+    """The task and the plan's steps, once the plan is shown to belong to the task (exit 2 if not)."""
+    from stablepush.executor import plan_steps
+    from stablepush.plan_io import read_plan
+
+    try:
+        task = load_task(task_file)
+        plan = read_plan(plan_file)
+        return task, plan, plan_steps(task, plan)
+    except TaskError as exc:
+        _fail(f"{plan_file}: {exc}" if str(exc).startswith("plan") else str(exc))
+    except (OSError, ValueError) as exc:
+        _fail(f"{plan_file}: {exc}")
+
+
+@cli.command()
+@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
+@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
+              help="The task the plan was made for (checked against the plan).")
+@click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,
+              help="PNG to write. Default: PLAN.png beside the plan file.")
+@click.option("--gif", "gif_path", type=click.Path(dir_okay=False), default=None, help="Also write an animated GIF.")
+def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
+    """Draw a plan: snapshots of the object in the grasp and x, z, theta against step.
+
+    The snapshots (as in the paper's fig. 1) show the object's outline in the gripper frame G, the
+    pads (dashed), every pusher (grey) and the active one (thick, coloured); switch-overs are named
+    above the snapshot where they happen and dashed in the lower plot.
+
+    \b
+    Example:
+      stablepush plan data/tasks/t-shaped.yaml -o t.plan.json
+      stablepush show t.plan.json --task data/tasks/t-shaped.yaml -o t.png --gif t.gif
+    """
+    from pathlib import Path
+
+    from stablepush import figures
+
+    task, plan, steps = _load_plan_and_task(plan_file, task_file)
+    png_path = png_path or str(Path(plan_file).with_suffix("").with_suffix(".png"))
+    stats = plan.get("stats", {})
+    title = f"{task.name}: {len(steps) - 1} pushes, {stats.get('switches', '?')} switch-over(s), seed {stats.get('seed', '?')}"
+    fig = figures.plan_figure(task, steps, title)
+    fig.savefig(png_path, dpi=110, bbox_inches="tight")
+    click.echo(f"figure written to {png_path}")
+    if gif_path:
+        figures.save_plan_gif(task, steps, gif_path)
+        click.echo(f"animation written to {gif_path}")
+
+
+@cli.command()
+@click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
+@click.option("--pusher", required=True, metavar="NAME", help="The pusher whose cone to draw.")
+@click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,
+              help="PNG to write. Default: <task name>.<pusher>.cone.png.")
+def cone(task_file: str, pusher: str, png_path) -> None:
+    """Draw a pusher's generalized friction cone in wrench space (paper figs. 5-6).
+
+    The cone is the conic hull of the wrenches of the edges n +- mu t of each of the pusher's contact
+    points, in the object frame O; axes f_x, f_z (N) and tau_y / l (N), with l the torque length that
+    the stable-push margin uses. A point pusher's cone is a flat wedge (dimension 2).
+
+    \b
+    Example:
+      stablepush cone data/tasks/pivoting.yaml --pusher left -o left-cone.png
+    """
+    from stablepush import figures
+
+    try:
+        task = load_task(task_file)
+        task.pusher_index(pusher)
+    except TaskError as exc:
+        _fail(str(exc))
+    png_path = png_path or f"{task.name}.{pusher}.cone.png"
+    figures.cone_figure(task, pusher).savefig(png_path, dpi=110, bbox_inches="tight")
+    click.echo(f"figure written to {png_path}")
+
+
+def _host_port(value: str):
+    host, sep, port = value.rpartition(":")
+    if not sep or not port.isdigit():
+        raise click.BadParameter(f"expected HOST:PORT, got {value!r}")
+    return host or "127.0.0.1", int(port)
+
+
+@cli.command()
+@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
+@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
+              help="The task the plan was made for (checked against the plan before anything moves).")
+@click.option("--arm", "arm", default=None, metavar="HOST:PORT",
+              help="The arm server (stablepush.arm/1 protocol, see README). Default: with --sim a simulated arm "
+                   "started in this process, else 127.0.0.1:47100.")
+@click.option("--sim", is_flag=True, help="Start a simulated arm (MuJoCo) here and run the plan on it.")
+@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
+              metavar="HZ", help="Waypoints per second of motion.")
+@click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
+              help="Continue after plan step STEP (the last confirmed step a fault reported).")
+@click.option("--pace/--no-pace", default=None,
+              help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
+@click.option("--reset", is_flag=True, help="Ask a simulated arm to rebuild its world instead of keeping it.")
+@click.option("--ack-timeout", default=5.0, show_default=True, type=click.FloatRange(min=0.01), metavar="S",
+              help="Give up when the arm does not reply within S seconds.")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+              help="Write the run's report (final pose in the grasp, slip per contact, features) as JSON.")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resume_from: int, pace, reset: bool,
+            ack_timeout: float, json_path, quiet: bool) -> None:
+    """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
+
+    Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
+    places them, else one station per pusher 150 mm apart along y). During a push the object rests on
+    its feature while the gripper moves; between pushes the gripper retracts, moves and approaches.
+    Waypoints (G's pose in the world, m and a quaternion) go out at --rate as JSON lines over TCP and
+    each is acknowledged with the arm's state.
+
+    On a fault (the arm server gone, a malformed or out-of-order reply, an error from the arm) the arm
+    is told to stop, the last confirmed plan step is printed, and the exit status is 3; run again with
+    --resume-from STEP to continue. A plan that does not belong to the task exits 2 before anything moves.
+
+    \b
+    Examples:
+      stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --sim
+      stablepush sim-arm --port 47100 &     # or your robot's bridge
+      stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
+    """
+    import json as json_module
+
+    from stablepush.arm_protocol import DEFAULT_PORT
+    from stablepush.executor import ExecutionFault, execute_plan
+    from stablepush.plan_io import write_atomically
+
+    task, plan, steps = _load_plan_and_task(plan_file, task_file)
+    if resume_from >= len(steps) - 1:
+        _fail(f"--resume-from: must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} pushes)")
+    server = None
+    if sim and arm is None:
+        from stablepush.sim.server import SimArmServer
+
+        server = SimArmServer(log=(lambda text: None) if quiet else None)
+        server.start_in_thread()
+        host, port = server.host, server.port
+    else:
+        host, port = _host_port(arm) if arm else ("127.0.0.1", DEFAULT_PORT)
+    pace = (not sim) if pace is None else pace
+
+    bar = None
+    if not quiet:
+        bar = click.progressbar(length=len(steps) - 1 - resume_from, label=f"{task.name}: step {resume_from}",
+                                file=sys.stderr, show_pos=True)
+        bar.__enter__()
+    seen = [resume_from]
+
+    def progress(waypoint, confirmed):
+        if bar is not None and confirmed > seen[0]:
+            bar.label = f"{task.name}: step {confirmed} ({waypoint.phase})"
+            bar.update(confirmed - seen[0])
+            seen[0] = confirmed
+
+    try:
+        report = execute_plan(task, steps, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
+                              reset=reset, ack_timeout=ack_timeout, progress=progress)
+    except ExecutionFault as fault:
+        if bar is not None:
+            bar.__exit__(None, None, None)
+        stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
+        click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
+                   f"{len(steps) - 1}", err=True)
+        click.echo(f"continue with: stablepush execute {plan_file} --task {task_file} "
+                   f"{'--arm ' + arm + ' ' if arm else ''}{'--sim ' if sim else ''}--resume-from {fault.last_confirmed_step}",
+                   err=True)
+        sys.exit(EXIT_ARM_FAULT)
+    finally:
+        if server is not None:
+            server.close()
+    if bar is not None:
+        bar.__exit__(None, None, None)
+    _print_report(report)
+    if json_path:
+        write_atomically(json_path, json_module.dumps(report.as_dict(), indent=1) + "\n")
+        click.echo(f"report written to {json_path}")
+
+
+def _print_report(report) -> None:
+    click.echo(f"{report.task}: steps {report.resumed_from + 1}-{report.last_confirmed_step} of {report.total_steps} "
+               f"confirmed, {report.waypoints} waypoints in {report.wall_time_s:.1f} s"
+               + (f" ({report.sim_steps_per_s:.0f} simulation steps/s)" if report.sim_steps_per_s else ""))
+    err = report.final_error
+    if err is None:
+        click.echo("the arm does not report the object, so the final pose in the grasp is not measured")
+        return
+    x, z, th = report.planned_final
+    f = report.final_in_grasp
+    click.echo(f"final pose in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
+               f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg")
+    for c in report.contacts:
+        if c.slip_mm is not None:
+            click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} slip at the pusher "
+                       f"{c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
+    change = report.release_change
+    if change and (math.hypot(change["x"], change["z"]) > 0.5 or abs(change["theta"]) > 0.5):
+        click.echo(f"note: when the last feature let go the object moved in the grasp by {math.hypot(change['x'], change['z']):.2f} mm, "
+                   f"{change['theta']:+.2f} deg: the grasp alone does not hold the final pose against gravity")
+
+
+@cli.command("sim-arm")
+@click.option("--host", default="127.0.0.1", show_default=True, help="Address to listen on.")
+@click.option("--port", default=47100, show_default=True, type=click.IntRange(min=0, max=65535),
+              help="Port to listen on (0: any free port, printed).")
+@click.option("--exit-after", type=click.IntRange(min=1), default=None, metavar="N", hidden=False,
+              help="Fault injection for testing executors: die abruptly after N waypoints.")
+def sim_arm(host: str, port: int, exit_after) -> None:
+    """Serve a simulated arm (MuJoCo) over the arm protocol, until interrupted.
+
+    A 7-joint arm of simple shapes (shipped MJCF) with a parallel-jaw gripper whose pads press with
+    the task's grip force; the executor's hello carries the object, the features and the friction.
+    Joint servos track the streamed waypoints by IK; the simulation steps in lock-step with the stream
+    (one waypoint period per waypoint), headless, and reports its steps/s.
+    """
+    from stablepush.sim.server import SimArmServer
+
+    server = SimArmServer(host, port, exit_after=exit_after)
+    click.echo(f"sim-arm: listening on {server.host}:{server.port}", err=True)
+    try:
+        server.serve_forever()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.close()
 
 
 def main() -> None:  # pragma: no cover - console entry
