@@ -1,0 +1,132 @@
+"""The simulated arm's physics and the plan's geometry in the world.
+
+The friction test is what the measured results rest on: a ledge pushing the held object along the
+pads must need 2 mu N + m g (both pads slide; the weight is lifted), Coulomb's law, within 5%.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from conftest import shipped, task_with
+from stablepush.execution import (PlanStep, arm_trajectory, grasp_transform, place_features, pose_to_matrix,
+                                  scene_description)
+from stablepush.sim.arm import SimArm
+from stablepush.sim.scene import convex_pieces
+
+G0 = 9.81
+
+
+def _ledge_force(task, speed=0.01, duration=1.0):
+    """Hold the object above the task's bottom pusher, made a ledge, and lower the gripper onto it at
+    `speed` m/s: the mean ledge force on the object (N, world z) once the pads slide steadily."""
+    start = task.start
+    steps = [PlanStep(start, None), PlanStep(start, "bottom")]
+    features = place_features(task, steps)
+    arm = SimArm(scene_description(task, features, start))
+    pose = list(arm.state()["ee_pose"])
+    z0 = pose[2]
+    period = 0.01
+    forces = []
+    for k in range(int(duration / period)):
+        pose[2] = z0 - speed * period * (k + 1)
+        arm.move_to(pose, period)
+        if k * period >= 0.3:  # past the start-up transient
+            forces.append(arm.contact_force_on_object("feature_bottom")[2])
+    slid = arm.state()["object_in_grasp"]["z"] - start[1]
+    return float(np.mean(forces)), slid
+
+
+@pytest.mark.parametrize("grip_force, mu", [
+    (10.0, 0.425), (10.0, 0.6), (5.0, 0.3),
+    # Known limit: at 16 N of sliding friction per pad the jaws chatter and the pads press ~16% harder
+    # than the servo cap on average (README, "The simulated arm"). Strict: it fails once fixed.
+    pytest.param(20.0, 0.8, marks=pytest.mark.xfail(strict=True, reason="jaw chatter at high friction load")),
+])
+def test_ledge_force_to_slide_the_held_object_is_coulombs(grip_force, mu):
+    def edit(data):
+        data["gripper"]["grip_force"] = grip_force
+        data["gripper"]["mu"] = mu
+
+    task = task_with("horizontal-offset-low-mu", edit)
+    force, slid = _ledge_force(task)
+    expected = 2 * mu * grip_force + task.mass * 1e-3 * G0
+    assert force == pytest.approx(expected, rel=0.05), (force, expected)
+    assert slid > 5.0  # mm: the object really slid up between the pads while the force was measured
+
+
+def test_a_held_object_stays_put_under_gravity_alone():
+    """Static friction: 2 mu N = 8.5 N holds the 2 N prism; it must not creep over a second."""
+    task = shipped("horizontal-offset-low-mu")
+    arm = SimArm(scene_description(task, {}, task.start))
+    before = arm.state()["object_in_grasp"]
+    arm.advance(1.0)
+    after = arm.state()["object_in_grasp"]
+    assert abs(after["z"] - before["z"]) < 0.02 and abs(after["x"] - before["x"]) < 0.02
+
+
+def test_ik_tracks_a_rotation_about_the_pads():
+    task = shipped("pivoting")
+    arm = SimArm(scene_description(task, {}, task.start))
+    home = pose_to_matrix(arm.state()["ee_pose"])
+    for deg in range(0, 91, 10):
+        target = home.copy()
+        target[:3, :3] = grasp_transform((0, 0, -deg))[:3, :3]
+        q = arm.solve_ik(_pose(target), arm.target)
+        assert arm.ik_error < 1e-6, deg
+        arm.target = q
+
+
+def _pose(T):
+    from stablepush.execution import matrix_to_pose
+
+    return matrix_to_pose(T)
+
+
+def test_during_a_push_the_object_stays_on_its_feature():
+    """T_WG(t) · T_GO(q(t)) is the feature's object pose at every push waypoint (the pusher sticks)."""
+    task = shipped("t-shaped")
+    from stablepush.planning import plan_task
+
+    plan = plan_task(task, seed=2)
+    steps = [PlanStep((w.x, w.z, w.theta), w.pusher) for w in plan.waypoints]
+    features = place_features(task, steps)
+    home = scene_description(task, features, task.start)["gripper_pose"]
+    waypoints = arm_trajectory(task, steps, features, 100.0, home)
+    pushes = [w for w in waypoints if w.phase == "push"]
+    assert sum(w.completes for w in pushes) == len(steps) - 1
+    for w in pushes:
+        if not w.completes:
+            continue
+        T_WO = pose_to_matrix(w.pose) @ grasp_transform(steps[w.step].pose)
+        np.testing.assert_allclose(T_WO, features[steps[w.step].pusher].object_pose, atol=1e-9)
+    # Waypoints are one period apart and the steps confirmed only go up.
+    assert all(b.t - a.t == pytest.approx(0.01) for a, b in zip(waypoints, waypoints[1:]))
+    confirmed = [w.step for w in waypoints if w.completes]
+    assert confirmed == sorted(confirmed) == list(range(1, len(steps)))
+
+
+def test_features_from_the_task_environment():
+    def edit(data):
+        data["environment"] = {"features": {"left": [400, 50, 250, 10]}}
+
+    task = task_with("horizontal-offset-high-mu", edit)
+    steps = [PlanStep(task.start, None), PlanStep((1.0, 0.0, 0.0), "left")]
+    feature = place_features(task, steps)["left"]
+    np.testing.assert_allclose(feature.object_pose[:3, 3], [0.4, 0.05, 0.25])
+    # The left face, 50 mm left of O, rotated 10 deg about y; its inward normal is O's +x.
+    c, s = math.cos(math.radians(10)), math.sin(math.radians(10))
+    np.testing.assert_allclose(feature.normal, [c, 0, -s], atol=1e-12)
+    np.testing.assert_allclose((feature.start + feature.end) / 2, [0.4 - 0.05 * c, 0.05, 0.25 + 0.05 * s], atol=1e-12)
+
+
+def test_convex_pieces_of_the_t_cover_its_area():
+    t = shipped("t-shaped")
+    pieces = convex_pieces(t.vertices)
+    area = lambda p: 0.5 * sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(p, p[1:] + p[:1]))  # noqa: E731
+    assert len(pieces) <= 3
+    assert sum(area(p) for p in pieces) == pytest.approx(area(list(t.vertices)))
+    for p in pieces:
+        n = len(p)
+        assert all((p[i][0] - p[i - 1][0]) * (p[(i + 1) % n][1] - p[i - 1][1])
+                   - (p[i][1] - p[i - 1][1]) * (p[(i + 1) % n][0] - p[i - 1][0]) > 0 for i in range(n))
