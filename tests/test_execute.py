@@ -1,0 +1,247 @@
+"""`stablepush execute` on the simulated arm over the socket, its faults and resume, and the
+figures of `stablepush show` / `cone`."""
+import json
+import re
+import socket
+import subprocess
+import sys
+import threading
+
+import pytest
+from click.testing import CliRunner
+
+from conftest import TASKS, shipped, task_with
+from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
+from stablepush.executor import ExecutionFault, execute_plan, plan_steps
+from stablepush.plan_io import plan_to_dict, write_plan_json
+from stablepush.planning import plan_task
+from stablepush.sim.server import SimArmServer
+from stablepush_cli.main import cli
+
+# The bound the end-to-end test holds the simulated run to (the paper's robot: 0.5 mm, 0.5 deg).
+FINAL_BOUND_MM = 0.5
+FINAL_BOUND_DEG = 0.5
+
+
+@pytest.fixture(scope="module")
+def high_mu_plan(tmp_path_factory):
+    task = shipped("horizontal-offset-high-mu")
+    path = tmp_path_factory.mktemp("plans") / "high-mu.plan.json"
+    write_plan_json(plan_task(task, seed=1), path)
+    return str(path), str(TASKS / "horizontal-offset-high-mu.yaml")
+
+
+def test_end_to_end_plan_execute_on_the_sim_arm(high_mu_plan, tmp_path):
+    plan, task = high_mu_plan
+    report_path = tmp_path / "run.json"
+    result = CliRunner().invoke(cli, ["execute", plan, "--task", task, "--sim", "--quiet", "--json", str(report_path)])
+    assert result.exit_code == 0, result.output
+    report = json.loads(report_path.read_text())
+    assert report["last_confirmed_step"] == report["total_steps"] == 20
+    err = report["final_error"]
+    assert err["distance"] < FINAL_BOUND_MM and abs(err["theta"]) < FINAL_BOUND_DEG, err
+    (contact,) = report["contacts"]
+    assert contact["pusher"] == "left" and contact["slip_mm"] < FINAL_BOUND_MM
+    assert "final pose in the grasp" in result.output
+
+
+def test_t_shape_end_to_end_through_two_switch_overs():
+    task = shipped("t-shaped")
+    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    server = SimArmServer(log=lambda text: None)
+    server.start_in_thread()
+    try:
+        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
+    finally:
+        server.close()
+    assert [c.pusher for c in report.contacts] == ["left", "under-web", "left"]
+    assert report.final_error["distance"] < 1.0 and abs(report.final_error["theta"]) < FINAL_BOUND_DEG
+
+
+# -- a plan that does not belong to its task ----------------------------------------------------
+
+
+def test_a_plan_for_another_task_is_refused_before_anything_moves(high_mu_plan):
+    plan, _ = high_mu_plan
+    result = CliRunner().invoke(cli, ["execute", plan, "--task", str(TASKS / "pivoting.yaml"), "--sim"])
+    assert result.exit_code == 2
+    assert "plan.task" in result.output and "'horizontal-offset-high-mu'" in result.output
+
+
+def test_a_plan_for_another_version_of_the_task_is_refused(high_mu_plan, tmp_path):
+    import yaml
+
+    plan, task_file = high_mu_plan
+    data = yaml.safe_load(open(task_file))
+    for p in data["pushers"]:
+        p["mu"] = 0.2  # the low-mu pushers: the straight push is no longer stable
+    edited = tmp_path / "edited.yaml"
+    edited.write_text(yaml.safe_dump(data))
+    result = CliRunner().invoke(cli, ["execute", plan, "--task", str(edited), "--sim"])
+    assert result.exit_code == 2
+    assert "plan.waypoints[1]" in result.output and "not a stable push" in result.output
+
+
+# -- faults -------------------------------------------------------------------------------------
+
+
+def _start_sim_arm(*args):
+    process = subprocess.Popen([sys.executable, "-m", "stablepush_cli.main", "sim-arm", "--port", "0", *args],
+                               stderr=subprocess.PIPE, text=True)
+    line = process.stderr.readline()
+    port = int(re.search(r"listening on [\d.]+:(\d+)", line).group(1))
+    threading.Thread(target=process.stderr.read, daemon=True).start()  # keep its log from blocking it
+    return process, port
+
+
+def test_server_gone_mid_plan_names_the_last_step_and_resume_finishes(high_mu_plan):
+    plan, task = high_mu_plan
+    runner = CliRunner()
+    process, port = _start_sim_arm("--exit-after", "100")
+    try:
+        result = runner.invoke(cli, ["execute", plan, "--task", task, "--arm", f"127.0.0.1:{port}", "--no-pace", "--quiet"])
+    finally:
+        process.wait(timeout=30)
+    assert result.exit_code == 3, result.output
+    assert "closed the connection" in result.output
+    assert "could not be reached to stop it" in result.output
+    # 99 waypoints were acknowledged: the approach, then 10 per push: 9 pushes confirmed.
+    step = int(re.search(r"last confirmed step: (\d+) of 20", result.output).group(1))
+    assert step == 9
+    assert f"--resume-from {step}" in result.output
+
+    process, port = _start_sim_arm()
+    try:
+        resumed = runner.invoke(cli, ["execute", plan, "--task", task, "--arm", f"127.0.0.1:{port}", "--no-pace",
+                                      "--quiet", "--resume-from", str(step)])
+    finally:
+        process.terminate()
+        process.wait(timeout=30)
+    assert resumed.exit_code == 0, resumed.output
+    assert f"steps {step + 1}-20 of 20 confirmed" in resumed.output
+    final = re.search(r"error ([\d.]+) mm, ([-+][\d.]+) deg", resumed.output)
+    assert float(final.group(1)) < 1.0 and abs(float(final.group(2))) < FINAL_BOUND_DEG
+
+
+def test_nothing_listening_is_a_clear_fault(high_mu_plan):
+    plan, task = high_mu_plan
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]  # closed again when the block ends: nothing listens there
+    result = CliRunner().invoke(cli, ["execute", plan, "--task", task, "--arm", f"127.0.0.1:{port}", "--quiet"])
+    assert result.exit_code == 3
+    assert "cannot reach the arm server" in result.output and "last confirmed step: 0 of 20" in result.output
+
+
+class FakeArm:
+    """An arm server that misbehaves after `good` acknowledgements, and records whether it was
+    told to stop."""
+
+    def __init__(self, good: int, bad_reply):
+        self.good, self.bad_reply = good, bad_reply
+        self.stopped = False
+        self.sock = socket.create_server(("127.0.0.1", 0))
+        self.port = self.sock.getsockname()[1]
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        conn, _ = self.sock.accept()
+        with conn:
+            reader = conn.makefile("rb")
+            state = None
+            for line in reader:
+                msg = json.loads(line)
+                if msg["type"] == "hello":
+                    state = {"ee_pose": msg["scene"]["gripper_pose"], "joints": [0.0] * 7}
+                    conn.sendall(encode({"type": "ready", "protocol": PROTOCOL, "arm": "fake", "state": state}))
+                elif msg["type"] == "waypoint":
+                    state = {"ee_pose": msg["pose"], "joints": [0.0] * 7}
+                    if msg["seq"] < self.good:
+                        conn.sendall(encode({"type": "ack", "seq": msg["seq"], "state": state}))
+                    else:
+                        conn.sendall(self.bad_reply(msg))
+                elif msg["type"] == "stop":
+                    self.stopped = True
+                    conn.sendall(encode({"type": "stopped", "state": state}))
+                    return
+
+
+@pytest.mark.parametrize("bad_reply, says", [
+    (lambda msg: b"ack, but not JSON\n", "not a JSON line"),
+    (lambda msg: encode({"type": "ack", "seq": msg["seq"] + 1, "state": {}}), "out-of-order acknowledgement"),
+    (lambda msg: encode({"type": "ack", "seq": msg["seq"]}), "field 'state' missing"),
+    (lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "joint 4 over its torque limit"}), "torque limit"),
+])
+def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
+    task = shipped("horizontal-offset-high-mu")
+    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    arm = FakeArm(good=41, bad_reply=bad_reply)  # the approach and 4 pushes
+    with pytest.raises(ExecutionFault) as fault:
+        execute_plan(task, steps, "127.0.0.1", arm.port, rate_hz=100.0, pace=False, ack_timeout=5.0)
+    assert says in fault.value.reason
+    assert fault.value.last_confirmed_step == 4
+    assert fault.value.arm_stopped is True and arm.stopped
+
+
+def test_the_sim_arm_refuses_malformed_and_out_of_order_waypoints_and_stops():
+    task = shipped("horizontal-offset-high-mu")
+    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    from stablepush.execution import place_features, scene_description
+
+    scene = scene_description(task, place_features(task, steps), task.start)
+    server = SimArmServer(log=lambda text: None)
+    server.start_in_thread()
+    try:
+        for bad, says in ((b"{not json\n", "not a JSON line"),
+                          (encode({"type": "waypoint", "seq": 5, "t": 0.0, "step": 0, "phase": "push",
+                                   "pose": scene["gripper_pose"]}), "out-of-order waypoint: expected seq 0, got 5"),
+                          (encode({"type": "waypoint", "seq": 0, "t": 0.0, "step": 0, "phase": "push",
+                                   "pose": [0, 0, 0, 2, 0, 0, 0]}), "not of unit length")):
+            with socket.create_connection((server.host, server.port), timeout=30) as conn:
+                reader = conn.makefile("rb")
+                conn.sendall(encode({"type": "hello", "protocol": PROTOCOL, "rate_hz": 100, "scene": scene}))
+                assert decode(reader.readline(), "server")["type"] == "ready"
+                conn.sendall(bad)
+                reply = decode(reader.readline(), "server")
+                assert reply["type"] == "error" and says in reply["message"], reply
+                assert reader.readline() == b""  # the server closed the connection
+            arm = server.arm
+            assert list(arm.target) == list(arm.data.qpos[arm._arm_qpos])  # held where it was
+    finally:
+        server.close()
+
+
+def test_protocol_decoding_names_what_is_wrong():
+    with pytest.raises(ProtocolError, match="unknown message type 'dance'"):
+        decode(b'{"type": "dance"}\n', "client")
+    with pytest.raises(ProtocolError, match="field 'seq' missing"):
+        decode(b'{"type": "waypoint", "t": 0, "step": 1, "phase": "push", "pose": [0,0,0,1,0,0,0]}\n', "client")
+    with pytest.raises(ProtocolError, match="protocol 'other/1'"):
+        decode(b'{"type": "hello", "protocol": "other/1", "rate_hz": 100, "scene": {}}\n', "client")
+    assert decode(encode({"type": "stop"}), "client") == {"type": "stop"}
+
+
+# -- figures ------------------------------------------------------------------------------------
+
+
+def test_show_writes_a_png_and_a_gif_of_the_plan(high_mu_plan, tmp_path):
+    from PIL import Image
+    import numpy as np
+
+    plan, task = high_mu_plan
+    png, gif = tmp_path / "plan.png", tmp_path / "plan.gif"
+    result = CliRunner().invoke(cli, ["show", plan, "--task", task, "-o", str(png), "--gif", str(gif)])
+    assert result.exit_code == 0, result.output
+    image = np.asarray(Image.open(png).convert("L"), float)
+    assert image.shape[0] > 400 and image.shape[1] > 800
+    assert image.std() > 10  # not a blank canvas
+    with Image.open(gif) as animation:
+        assert animation.n_frames == 21  # the start and one frame per push
+
+
+def test_cone_draws_the_pushers_cone_and_names_a_bad_pusher(tmp_path):
+    png = tmp_path / "cone.png"
+    ok = CliRunner().invoke(cli, ["cone", str(TASKS / "pivoting.yaml"), "--pusher", "left", "-o", str(png)])
+    assert ok.exit_code == 0 and png.stat().st_size > 10_000
+    bad = CliRunner().invoke(cli, ["cone", str(TASKS / "pivoting.yaml"), "--pusher", "nope"])
+    assert bad.exit_code == 2 and "no pusher named 'nope'" in bad.output
