@@ -1,0 +1,45 @@
+"""Plan every shipped task (seed 1) and run it on the simulated arm over the socket: the final
+pose in the grasp against the plan's, and the slip at the pusher per contact (README table).
+
+    python3 benchmarks/execute_shipped.py [--seed 1]
+"""
+import argparse
+import math
+from pathlib import Path
+
+from stablepush.executor import execute_plan, plan_steps
+from stablepush.plan_io import plan_to_dict
+from stablepush.planning import plan_task
+from stablepush.sim.server import SimArmServer
+from stablepush.task import load_task
+
+TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--seed", type=int, default=1)
+    args = parser.parse_args()
+    print("| task | pushes | contacts | final error mm | final error deg | max slip at pusher mm (deg) "
+          "| release moves it mm / deg | sim steps/s | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for path in sorted(TASKS.glob("*.yaml")):
+        task = load_task(path)
+        steps = plan_steps(task, plan_to_dict(plan_task(task, seed=args.seed)))
+        server = SimArmServer(log=lambda text: None)
+        server.start_in_thread()
+        try:
+            report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
+        finally:
+            server.close()
+        err = report.final_error
+        slip = max(report.contacts, key=lambda c: c.slip_mm)
+        release = report.release_change
+        print(f"| {task.name} | {len(steps) - 1} | {' → '.join(c.pusher for c in report.contacts)} "
+              f"| {err['distance']:.2f} | {err['theta']:+.2f} | {slip.slip_mm:.2f} ({slip.slip_deg:.2f}) "
+              f"| {math.hypot(release['x'], release['z']):.2f} / {release['theta']:+.2f} "
+              f"| {report.sim_steps_per_s:.0f} | {report.wall_time_s:.1f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
