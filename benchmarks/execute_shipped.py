@@ -10,7 +10,7 @@ from pathlib import Path
 from stablepush.executor import execute_plan, plan_steps
 from stablepush.plan_io import plan_to_dict
 from stablepush.planning import plan_task
-from stablepush.sim.server import SimArmServer
+from stablepush.sim.server import running_sim_arm
 from stablepush.task import load_task
 
 TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
@@ -26,12 +26,8 @@ def main() -> None:
     for path in sorted(TASKS.glob("*.yaml")):
         task = load_task(path)
         steps = plan_steps(task, plan_to_dict(plan_task(task, seed=args.seed)))
-        server = SimArmServer(log=lambda text: None)
-        server.start_in_thread()
-        try:
+        with running_sim_arm(log=lambda text: None) as server:
             report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
-        finally:
-            server.close()
         err = report.final_error
         slip = max(report.contacts, key=lambda c: c.slip_mm)
         release = report.release_change

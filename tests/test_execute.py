@@ -10,12 +10,12 @@ import threading
 import pytest
 from click.testing import CliRunner
 
-from conftest import TASKS, shipped, task_with
+from conftest import TASKS, shipped
 from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
 from stablepush.executor import ExecutionFault, execute_plan, plan_steps
 from stablepush.plan_io import plan_to_dict, write_plan_json
 from stablepush.planning import plan_task
-from stablepush.sim.server import SimArmServer
+from stablepush.sim.server import running_sim_arm
 from stablepush_cli.main import cli
 
 # The bound the end-to-end test holds the simulated run to (the paper's robot: 0.5 mm, 0.5 deg).
@@ -48,12 +48,8 @@ def test_end_to_end_plan_execute_on_the_sim_arm(high_mu_plan, tmp_path):
 def test_t_shape_end_to_end_through_two_switch_overs():
     task = shipped("t-shaped")
     steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
-    server = SimArmServer(log=lambda text: None)
-    server.start_in_thread()
-    try:
+    with running_sim_arm(log=lambda text: None) as server:
         report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
-    finally:
-        server.close()
     assert [c.pusher for c in report.contacts] == ["left", "under-web", "left"]
     assert report.final_error["distance"] < 1.0 and abs(report.final_error["theta"]) < FINAL_BOUND_DEG
 
@@ -189,9 +185,7 @@ def test_the_sim_arm_refuses_malformed_and_out_of_order_waypoints_and_stops():
     from stablepush.execution import place_features, scene_description
 
     scene = scene_description(task, place_features(task, steps), task.start)
-    server = SimArmServer(log=lambda text: None)
-    server.start_in_thread()
-    try:
+    with running_sim_arm(log=lambda text: None) as server:
         for bad, says in ((b"{not json\n", "not a JSON line"),
                           (encode({"type": "waypoint", "seq": 5, "t": 0.0, "step": 0, "phase": "push",
                                    "pose": scene["gripper_pose"]}), "out-of-order waypoint: expected seq 0, got 5"),
@@ -207,8 +201,6 @@ def test_the_sim_arm_refuses_malformed_and_out_of_order_waypoints_and_stops():
                 assert reader.readline() == b""  # the server closed the connection
             arm = server.arm
             assert list(arm.target) == list(arm.data.qpos[arm._arm_qpos])  # held where it was
-    finally:
-        server.close()
 
 
 def test_protocol_decoding_names_what_is_wrong():

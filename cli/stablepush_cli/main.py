@@ -1,6 +1,7 @@
 """`stablepush` commands. The CLI parses arguments and prints; the mechanics live in the core."""
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import sys
@@ -351,12 +352,11 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
     task, plan, steps = _load_plan_and_task(plan_file, task_file)
     if resume_from >= len(steps) - 1:
         _fail(f"--resume-from: must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} pushes)")
-    server = None
+    sim_arm = contextlib.ExitStack()
     if sim and arm is None:
-        from stablepush.sim.server import SimArmServer
+        from stablepush.sim.server import running_sim_arm
 
-        server = SimArmServer(log=(lambda text: None) if quiet else None)
-        server.start_in_thread()
+        server = sim_arm.enter_context(running_sim_arm(log=(lambda text: None) if quiet else None))
         host, port = server.host, server.port
     else:
         host, port = _host_port(arm) if arm else ("127.0.0.1", DEFAULT_PORT)
@@ -389,8 +389,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
                    err=True)
         sys.exit(EXIT_ARM_FAULT)
     finally:
-        if server is not None:
-            server.close()
+        sim_arm.close()
     if bar is not None:
         bar.__exit__(None, None, None)
     _print_report(report)
@@ -425,7 +424,7 @@ def _print_report(report) -> None:
 @click.option("--host", default="127.0.0.1", show_default=True, help="Address to listen on.")
 @click.option("--port", default=47100, show_default=True, type=click.IntRange(min=0, max=65535),
               help="Port to listen on (0: any free port, printed).")
-@click.option("--exit-after", type=click.IntRange(min=1), default=None, metavar="N", hidden=False,
+@click.option("--exit-after", type=click.IntRange(min=1), default=None, metavar="N",
               help="Fault injection for testing executors: die abruptly after N waypoints.")
 def sim_arm(host: str, port: int, exit_after) -> None:
     """Serve a simulated arm (MuJoCo) over the arm protocol, until interrupted.

@@ -9,7 +9,8 @@ import os
 import socket
 import sys
 import threading
-from typing import Callable, Optional
+from contextlib import contextmanager
+from typing import Callable, Iterator, Optional
 
 from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
 from stablepush.sim.arm import SimArm
@@ -113,3 +114,15 @@ class SimArmServer:
                      f"{self.arm.model.npair} contact pairs)")
         else:
             self.log("world kept from the previous connection")
+
+
+@contextmanager
+def running_sim_arm(log: Optional[Callable[[str], None]] = None) -> Iterator[SimArmServer]:
+    """A simulated arm served from a thread of this process on a free localhost port, for the
+    length of the `with` block (`execute --sim`, the tests, the benchmark)."""
+    server = SimArmServer(log=log)
+    server.start_in_thread()
+    try:
+        yield server
+    finally:
+        server.close()
