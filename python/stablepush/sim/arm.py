@@ -13,6 +13,7 @@ from typing import Dict, Optional, Sequence
 import mujoco
 import numpy as np
 
+from stablepush.execution import matrix_to_pose, pose_to_matrix
 from stablepush.sim import scene as scene_mod
 
 IK_DAMPING = 1e-4  # DLS damping lambda^2 [m^2]
@@ -21,24 +22,6 @@ IK_TOLERANCE = 1e-9  # m (and rad) of pose error
 POSTURE_GAIN = 0.05  # null-space pull toward the home posture per IK iteration
 HOME_GUESS = np.array([0.0, 0.35, 0.0, 1.9, 0.0, 0.89, 0.0])  # rad, hand pointing down in front of the base
 SETTLE_TIME = 0.3  # s of simulation after the grasp closes, before the first waypoint
-
-
-def pose_matrix(pose: Sequence[float]) -> np.ndarray:
-    """4x4 homogeneous transform of (x, y, z, qw, qx, qy, qz)."""
-    T = np.eye(4)
-    mat = np.zeros(9)
-    mujoco.mju_quat2Mat(mat, np.asarray(pose[3:], float))
-    T[:3, :3] = mat.reshape(3, 3)
-    T[:3, 3] = pose[:3]
-    return T
-
-
-def matrix_pose(T: np.ndarray) -> list:
-    quat = np.zeros(4)
-    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(T[:3, :3]).ravel())
-    if quat[0] < 0:
-        quat = -quat
-    return [*map(float, T[:3, 3]), *map(float, quat)]
 
 
 def in_grasp(T_world_gripper: np.ndarray, T_world_object: np.ndarray) -> Dict[str, float]:
@@ -90,7 +73,7 @@ class SimArm:
         """Joint angles [rad] that put G at `pose`, by damped least squares from `q_start`, with a
         null-space pull toward the home posture (the arm has one joint more than the pose needs)."""
         d = self._scratch
-        target = pose_matrix(pose)
+        target = pose_to_matrix(pose)
         q = np.array(q_start, float)
         lo = self.model.jnt_range[[self.model.joint(j).id for j in scene_mod.ARM_JOINTS], 0]
         hi = self.model.jnt_range[[self.model.joint(j).id for j in scene_mod.ARM_JOINTS], 1]
@@ -170,9 +153,9 @@ class SimArm:
         T_g, T_o = self.gripper_matrix(), self.object_matrix()
         return {
             "time": float(self.data.time),
-            "ee_pose": matrix_pose(T_g),
+            "ee_pose": matrix_to_pose(T_g),
             "joints": [float(v) for v in self.data.qpos[self._arm_qpos]],
-            "object_pose": matrix_pose(T_o),
+            "object_pose": matrix_to_pose(T_o),
             "object_in_grasp": in_grasp(T_g, T_o),
             "steps_per_s": round(self.steps_per_second, 1),
         }
