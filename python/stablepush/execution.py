@@ -199,7 +199,7 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequen
         "gravity": list(task.gravity),
         "object": {"polygon": [[x * MM, z * MM] for x, z in task.vertices], "thickness": task.thickness * MM,
                    "mass": model.body.mass, "com": list(model.body.com), "inertia": model.body.inertia},
-        "gripper": {"grip_force": task.grip_force, "mu": task.mu,
+        "gripper": {"grip_force": task.grip_force, "mu": task.mu, "pad_rings": task.pad_rings,
                     "pads": [{"center": [c[0] * MM, c[1] * MM], "radius": r * MM} for c, r in task.pads]},
         "features": [f.as_dict() for f in features.values()],
         "gripper_pose": matrix_to_pose(home),

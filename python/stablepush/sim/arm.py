@@ -15,6 +15,7 @@ import numpy as np
 
 from stablepush.execution import matrix_to_pose, pose_to_matrix
 from stablepush.sim import scene as scene_mod
+from stablepush.sim.friction import SlipSwitchedPadFriction
 
 IK_DAMPING = 1e-4  # DLS damping lambda^2 [m^2]
 IK_ITERATIONS = 50
@@ -51,6 +52,7 @@ class SimArm:
         self._object = m.body(scene_mod.OBJECT_BODY).id
         self._object_qpos = m.jnt_qposadr[m.joint(scene_mod.OBJECT_BODY).id]
         self._scratch = mujoco.MjData(m)
+        self.pad_friction = SlipSwitchedPadFriction(m, scene_mod.pad_geoms(m))
         self.steps = 0
         self.step_wall_time = 0.0
 
@@ -114,6 +116,7 @@ class SimArm:
         t0 = time.perf_counter()
         for i in range(1, n + 1):
             self.data.ctrl[self._arm_act] = start + (end - start) * (i / n)
+            self.pad_friction.update(self.data)
             mujoco.mj_step(self.model, self.data)
         self.step_wall_time += time.perf_counter() - t0
         self.steps += n
@@ -160,20 +163,24 @@ class SimArm:
             "steps_per_s": round(self.steps_per_second, 1),
         }
 
-    def contact_force_on_object(self, geom_name: str) -> np.ndarray:
-        """Total force [N, world frame] that geom `geom_name` exerts on the object now."""
-        geom = self.model.geom(geom_name).id
-        total = np.zeros(3)
-        f6 = np.zeros(6)
-        for i in range(self.data.ncon):
-            c = self.data.contact[i]
-            if geom not in (c.geom1, c.geom2):
-                continue
-            mujoco.mj_contactForce(self.model, self.data, i, f6)
-            frame = c.frame.reshape(3, 3)  # rows: normal, tangents; force acts on geom2
-            f = frame.T @ f6[:3]
-            total += f if c.geom1 == geom else -f
-        return total
+    def contact_force_on_object(self, pusher: str) -> np.ndarray:
+        """Total force [N, world frame] that pusher `pusher`'s feature exerts on the object now."""
+        return force_on_object(self.model, self.data, [self.model.geom(scene_mod.feature_geom(pusher)).id])
+
+
+def force_on_object(model, data, geoms) -> np.ndarray:
+    """Total force [N, world frame] that the geoms `geoms` exert on whatever they touch now."""
+    geoms = set(geoms)
+    total = np.zeros(3)
+    f6 = np.zeros(6)
+    for i in range(data.ncon):
+        c = data.contact[i]
+        if c.geom1 not in geoms and c.geom2 not in geoms:
+            continue
+        mujoco.mj_contactForce(model, data, i, f6)
+        f = c.frame.reshape(3, 3).T @ f6[:3]  # rows of frame: normal, tangents; the force acts on geom2
+        total += f if c.geom1 in geoms else -f
+    return total
 
 
 def _rotation_vector(R: np.ndarray) -> np.ndarray:

@@ -2,12 +2,15 @@
 multi-point finger pads and the fixed features, built from a scene description (a plain dict,
 SI units, as the executor sends it in its `hello`; see `stablepush.arm_protocol`).
 
-Contact settings that keep friction honest (the simulation's results rest on them):
-- elliptic friction cones with impratio 10, so sticking contacts do not creep;
+Contact settings that keep friction honest (the simulation's results rest on them, and
+`stablepush.sim.fidelity` measures them):
+- elliptic friction cones with impratio 100, so sticking contacts do not creep;
 - noslip iterations, which remove the residual slip of MuJoCo's soft constraints;
 - a small solref time constant (stiff contacts, 4 time steps);
-- each pad is a disc of point contacts (centre and two rings), so it resists torque by friction
-  the way the model's discretized pad does (MODEL.md section 2);
+- pad friction whose reference is switched per pad point by its own slip (`friction.py`): stiff
+  while it sticks, soft while it slides, which removes the pads' drop-outs while they slide;
+- each pad is a disc of point contacts laid out as the task's `pad_rings` says, so the simulated
+  pad's force acts where the model's does (docs/model.md, "Contacts");
 - only the object touches pads and features (explicit contact pairs with the task's friction);
   the fingers are driven by force-capped joint servos, not as mocap bodies, so the pads press
   with exactly the task's grip force and friction can drag the object.
@@ -26,14 +29,16 @@ ARM_JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6", "j7")
 FINGER_JOINTS = ("finger_pos", "finger_neg")
 GRIPPER_SITE = "G"
 OBJECT_BODY = "object"
+PAD_PREFIX = "pad_"  # pad point geoms are named pad_<finger>_<pad>_<point>
+HAND_JOINTS = ("hand_x", "hand_z", "hand_theta")  # the kinematic hand's slide x, slide z, hinge y
 
 TIMESTEP = 0.00025  # s
 CONTACT_SOLREF = (0.001, 1.0)  # time constant s (4 time steps), damping ratio
 CONTACT_SOLIMP = (0.95, 0.99, 0.0005)
-IMPRATIO = 10.0
+IMPRATIO = 100.0
 NOSLIP_ITERATIONS = 20
+NOSLIP_TOLERANCE = 1e-6  # MuJoCo's default
 PAD_POINT_RADIUS = 0.0005  # m, radius of each pad contact sphere
-PAD_RINGS = 2  # pad points: the centre and rings of 6, 12 points
 FEATURE_DEPTH = 0.01  # m, how far a feature extends behind its contact face
 FEATURE_CLEARANCE = 0.002  # m, a feature is this much narrower than the object along y on each side
 
@@ -150,12 +155,18 @@ def _fmt(values) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
-def build_mjcf(scene: dict) -> str:
-    """The complete MJCF of a scene description (see `stablepush.arm_protocol.Scene`)."""
+def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
+    """The complete MJCF of a scene description (see `stablepush.arm_protocol.Scene`). With
+    `kinematic_hand` the arm is replaced by a hand at the scene's gripper pose that moves in G's
+    plane through three joints (HAND_JOINTS) whose motion the caller prescribes: the same fingers,
+    pads and contacts without the arm, for measuring friction alone (`fidelity.py`)."""
     root = ET.parse(ARM_XML).getroot()
+    if kinematic_hand:
+        _replace_arm_by_kinematic_hand(root, scene["gripper_pose"])
     gx, gz = scene["gravity"]
     ET.SubElement(root, "option", timestep=repr(TIMESTEP), gravity=_fmt((gx, 0.0, gz)), cone="elliptic",
-                  impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS), integrator="implicitfast")
+                  impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS),
+                  noslip_tolerance=repr(NOSLIP_TOLERANCE), integrator="implicitfast")
     root.find("option").append(ET.Element("flag", multiccd="enable"))
     worldbody = root.find("worldbody")
     obj = scene["object"]
@@ -168,8 +179,8 @@ def build_mjcf(scene: dict) -> str:
     for f, (finger, side) in enumerate(zip(FINGER_JOINTS, (1.0, -1.0))):
         body = root.find(f".//body[@name='{finger}']")
         for p, pad in list(enumerate(gripper["pads"]))[f::2]:
-            for k, (px, pz) in enumerate(pad_points(pad["center"], pad["radius"], PAD_RINGS)):
-                name = f"{finger}_pad{p}_{k}"
+            for k, (px, pz) in enumerate(pad_points(pad["center"], pad["radius"], gripper["pad_rings"])):
+                name = f"{PAD_PREFIX}{finger}_{p}_{k}"
                 ET.SubElement(body, "geom", name=name, type="sphere", size=repr(PAD_POINT_RADIUS),
                               pos=_fmt((px, side * PAD_POINT_RADIUS, pz)), mass="0.0001", rgba="0.2 0.2 0.2 1")
                 pad_names.append(name)
@@ -209,7 +220,7 @@ def build_mjcf(scene: dict) -> str:
         a = np.asarray(feature["from"], float)
         b = np.asarray(feature["to"], float)
         n = np.asarray(feature["normal"], float)
-        name = f"feature_{feature['pusher']}"
+        name = feature_geom(feature["pusher"])
         length = float(np.linalg.norm(b - a))
         if length > 0:
             t = (b - a) / length
@@ -235,6 +246,39 @@ def build_mjcf(scene: dict) -> str:
         act.set("forcerange", _fmt((-gripper["grip_force"], gripper["grip_force"])))
         act.set("forcelimited", "true")
     return ET.tostring(root, encoding="unicode")
+
+
+def feature_geom(pusher: str) -> str:
+    """The name of the geom of pusher `pusher`'s feature in a model built by `build_mjcf`."""
+    return f"feature_{pusher}"
+
+
+def pad_geoms(model) -> List[int]:
+    """The ids of the pad point geoms of a model built by `build_mjcf`."""
+    return [g for g in range(model.ngeom) if model.geom(g).name.startswith(PAD_PREFIX)]
+
+
+def _replace_arm_by_kinematic_hand(root: ET.Element, gripper_pose: Sequence[float]) -> None:
+    """Swap the arm for a body at G's pose with HAND_JOINTS and the arm's own fingers, finger
+    servos and jaw coupling (so the grasp is the arm's, without the arm's dynamics)."""
+    worldbody = root.find("worldbody")
+    arm_base = worldbody.find("body")
+    fingers = [root.find(f".//body[@name='{f}']") for f in FINGER_JOINTS]
+    worldbody.remove(arm_base)
+    x, y, z, w, qx, qy, qz = gripper_pose
+    hand = ET.SubElement(worldbody, "body", name="hand", pos=_fmt((x, y, z)), quat=_fmt((w, qx, qy, qz)))
+    for name, kind, axis in zip(HAND_JOINTS, ("slide", "slide", "hinge"), ((1, 0, 0), (0, 0, 1), (0, 1, 0))):
+        ET.SubElement(hand, "joint", name=name, type=kind, axis=_fmt(axis), armature="1e4", damping="0")
+    ET.SubElement(hand, "geom", type="box", size="0.01 0.01 0.01", pos="0 0 -0.1", mass="1")
+    ET.SubElement(hand, "site", name=GRIPPER_SITE, size="0.004")
+    for finger in fingers:  # in the arm they sit at G's pose in the hand; here the hand is G
+        finger.set("pos", "0 0 0")
+        finger.set("quat", "1 0 0 0")
+        hand.append(finger)
+    actuators = root.find("actuator")
+    for act in list(actuators):
+        if act.get("name") not in FINGER_JOINTS:
+            actuators.remove(act)
 
 
 def _pair(contact: ET.Element, geom1: str, geom2: str, mu: float) -> None:

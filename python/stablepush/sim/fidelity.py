@@ -1,0 +1,232 @@
+"""The friction-fidelity contract of the simulated arm (issue 9): what any engine or contact setting
+that runs plans must reproduce before its results mean anything.
+
+Every experiment uses the arm's own grasp (fingers, force-capped jaw servos, pad points, contact
+pairs, solver options and the pad friction switch of `scene.py` and `friction.py`) on a hand that
+moves as prescribed in G's plane (`build_mjcf(..., kinematic_hand=True)`), so what is measured is
+friction, not the arm's tracking:
+
+- `wall_creep`: a box held by two pads that slide over it at a given speed while a fixed wall
+  holds it; the pads' friction (2 mu N) presses the box into the wall and the wall's friction
+  carries the weight at `load` of its cone (wall mu = m g / (load 2 mu N)). Coulomb: the box does
+  not move. Measured: its creep along the wall per mm of pad travel (um/mm), the wall's normal
+  force over 2 mu N (the sliding pads' friction), and the steps in which a pad point lost contact.
+- `static_hold`: the box hanging in the pads by friction alone at `load` of their cone, the
+  hand still: it must not move.
+- `pivot`: the pivoting task's side push: the hand turns about the pad centre while the side
+  pusher, a fixed feature, holds the prism. The model says the pad centre sticks and the pusher
+  sticks; the prism must stay where it is in the world and the pose in the grasp follow the turn.
+
+Units: SI inside; results in mm, um, deg and N as their names say.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Optional, Sequence
+
+import mujoco
+import numpy as np
+import yaml
+
+from stablepush.execution import PlanStep, place_features, scene_description
+from stablepush.sim import scene as scene_mod
+from stablepush.sim.arm import force_on_object, in_grasp
+from stablepush.sim.friction import SlipSwitchedPadFriction
+from stablepush.task import Task, parse_task
+
+G0 = 9.81  # m/s^2
+SETTLE_TIME = 0.2  # s with the grasp closed before anything moves
+RAMP_TIME = 0.02  # s over which the hand's speed ramps up smoothly
+
+# The contract (issue 9): creep per mm of pad travel at 50% and 90% of the wall's cone, the sliding
+# pads' friction against mu N, a still hold, and the pivot through the sticking pad centre.
+CREEP_LIMIT_UM_PER_MM = {0.5: 1.0, 0.9: 5.0}
+PAD_FRICTION_TOLERANCE = 0.03
+HOLD_LIMIT_UM = 1.0  # um the held box may move in 1 s
+PIVOT_LIMIT_MM = 0.05  # mm the prism may move in the world while the hand turns 30 deg about it
+PIVOT_LIMIT_DEG = 0.1  # deg likewise
+
+
+def _box_task(load: float, grip_force: float = 10.0, mu: float = 0.45, mass_g: float = 200.0,
+              wall: bool = True) -> Task:
+    """A 50 x 25 x 50 mm box under gravity in a grasp of two 5 mm pads; with `wall`, a pusher
+    `wall` along its left face whose mu puts the weight at `load` of the wall's cone when the pads
+    press the box into it with 2 mu N."""
+    data = {
+        "name": "friction-fidelity",
+        "object": {"shape": "box", "size": [50, 25, 50], "mass": mass_g},
+        "gripper": {"grip_force": grip_force, "mu": mu, "pad_rings": 1},
+        "gravity": [0, -G0],
+        "pushers": [{"name": "wall", "from": [-25, -25], "to": [-25, 25],
+                     "mu": (mass_g * 1e-3 * G0 / (load * 2 * mu * grip_force)) if wall else 0.5}],
+        "start": [0, 0, 0],
+        "goal": [0, 0, 0],
+    }
+    return parse_task(yaml.safe_dump(data), source="friction-fidelity scene")
+
+
+class KinematicGrasp:
+    """The arm's grasp of `task`'s object on a hand whose planar motion is prescribed, with the
+    features of `pushers` fixed in the world where they touch the object at the start."""
+
+    def __init__(self, task: Task, pushers: Sequence[str] = ()):
+        steps = [PlanStep(task.start, None)] + [PlanStep(task.start, name) for name in pushers]
+        scene = scene_description(task, place_features(task, steps), task.start)
+        self.task = task
+        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, kinematic_hand=True))
+        self.data = mujoco.MjData(self.model)
+        m = self.model
+        self._qpos = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
+        self._dof = [m.jnt_dofadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
+        fingers = [m.joint(j).id for j in scene_mod.FINGER_JOINTS]
+        self.data.qpos[[m.jnt_qposadr[j] for j in fingers]] = scene["object"]["thickness"] / 2
+        self.data.ctrl[[m.actuator(j).id for j in scene_mod.FINGER_JOINTS]] = 0.0  # close, force-capped
+        self._site = m.site(scene_mod.GRIPPER_SITE).id
+        self._object = m.body(scene_mod.OBJECT_BODY).id
+        self._pad_geoms = set(scene_mod.pad_geoms(m))
+        self.pad_friction = SlipSwitchedPadFriction(m, sorted(self._pad_geoms))
+        self.steps = 0
+        self.wall_time = 0.0
+        mujoco.mj_forward(m, self.data)
+
+    def step(self, motion: Sequence[float], velocity: Sequence[float]) -> None:
+        """One time step with the hand at `motion` (x m, z m, theta rad about y, from its start)
+        moving at `velocity` (m/s, m/s, rad/s)."""
+        self.data.qpos[self._qpos] = motion
+        self.data.qvel[self._dof] = velocity
+        t0 = time.perf_counter()
+        self.pad_friction.update(self.data)
+        mujoco.mj_step(self.model, self.data)
+        self.wall_time += time.perf_counter() - t0
+        self.steps += 1
+
+    def hold(self, duration: float) -> None:
+        for _ in range(int(round(duration / self.model.opt.timestep))):
+            self.step((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
+    def object_position(self) -> np.ndarray:
+        return self.data.xpos[self._object].copy()
+
+    def object_angle(self) -> float:
+        """The object's rotation about the world's y axis, rad."""
+        R = self.data.xmat[self._object].reshape(3, 3)
+        return math.atan2(R[0, 2], R[0, 0])
+
+    def in_grasp(self) -> dict:
+        T_g, T_o = np.eye(4), np.eye(4)
+        T_g[:3, :3], T_g[:3, 3] = self.data.site_xmat[self._site].reshape(3, 3), self.data.site_xpos[self._site]
+        T_o[:3, :3], T_o[:3, 3] = self.data.xmat[self._object].reshape(3, 3), self.data.xpos[self._object]
+        return in_grasp(T_g, T_o)
+
+    def feature_force(self, pusher: str) -> np.ndarray:
+        """Force [N, world frame] that feature `pusher` exerts on the object now."""
+        return force_on_object(self.model, self.data, [self.model.geom(scene_mod.feature_geom(pusher)).id])
+
+    def pad_contacts(self) -> int:
+        return sum(1 for i in range(self.data.ncon)
+                   if self.data.contact[i].geom1 in self._pad_geoms or self.data.contact[i].geom2 in self._pad_geoms)
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.steps / self.wall_time if self.wall_time else 0.0
+
+
+def _ramp(t: float, speed: float) -> tuple:
+    """Distance and speed of a smooth start (C1 ramp over RAMP_TIME) to constant `speed`."""
+    if t <= 0:
+        return 0.0, 0.0
+    if t < RAMP_TIME:
+        s = t / RAMP_TIME
+        return speed * RAMP_TIME * (s ** 3 - s ** 4 / 2), speed * (3 * s * s - 2 * s ** 3)
+    return speed * (RAMP_TIME / 2 + t - RAMP_TIME), speed
+
+
+@dataclass(frozen=True)
+class CreepResult:
+    load: float  # fraction of the wall's friction cone that carries the weight
+    pad_speed_mm_s: float
+    creep_um_per_mm: float  # box motion along the wall per mm of pad travel, steady half
+    pad_friction_ratio: float  # mean wall normal force / (2 mu N): the sliding pads' friction
+    wall_cone_use: float  # mean |tangential| / (mu_wall normal) at the wall
+    pad_dropout_steps: int  # steps in which fewer pad points touched than at the start
+    steps_per_s: float
+
+
+def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None) -> CreepResult:
+    """Slide the pads at `pad_speed` m/s over a box that a wall holds at `load` of its cone."""
+    task = _box_task(load)
+    rig = KinematicGrasp(task, ["wall"])
+    travel = travel if travel is not None else min(0.004, pad_speed * 0.5)
+    rig.hold(SETTLE_TIME)
+    full_contact = rig.pad_contacts()
+    h = rig.model.opt.timestep
+    duration = travel / pad_speed + RAMP_TIME / 2
+    samples = []
+    forces = []
+    drops = 0
+    for i in range(1, int(round(duration / h)) + 1):
+        s, v = _ramp(i * h, pad_speed)
+        rig.step((-s, 0.0, 0.0), (-v, 0.0, 0.0))  # the pads slide toward the wall
+        drops += rig.pad_contacts() < full_contact
+        if s >= travel / 2:
+            samples.append((s, rig.object_position()[2]))
+            if i % 10 == 0:
+                forces.append(rig.feature_force("wall"))
+    (s0, z0), (s1, z1) = samples[0], samples[-1]
+    fx, _, fz = np.mean(forces, axis=0)  # the wall's normal is +x, its tangent z
+    fn, ft = fx, abs(fz)
+    mu_wall = task.pushers[0].mu
+    return CreepResult(load=load, pad_speed_mm_s=pad_speed * 1e3,
+                       creep_um_per_mm=abs(z1 - z0) * 1e6 / ((s1 - s0) * 1e3),
+                       pad_friction_ratio=fn / (2 * task.mu * task.grip_force), wall_cone_use=ft / (mu_wall * fn),
+                       pad_dropout_steps=drops, steps_per_s=rig.steps_per_second)
+
+
+@dataclass(frozen=True)
+class HoldResult:
+    load: float  # weight over the pads' friction 2 mu N
+    moved_um: float  # how far the box moved in `duration`
+    duration_s: float
+
+
+def static_hold(load: float, duration: float = 1.0) -> HoldResult:
+    """The box hanging in the pads, its weight at `load` of their friction 2 mu N, the hand still."""
+    mu = 0.45
+    task = _box_task(0.5, grip_force=200e-3 * G0 / (load * 2 * mu), mu=mu, wall=False)
+    rig = KinematicGrasp(task)
+    rig.hold(SETTLE_TIME)
+    before = rig.object_position()
+    rig.hold(duration)
+    return HoldResult(load=load, moved_um=float(np.linalg.norm(rig.object_position() - before)) * 1e6,
+                      duration_s=duration)
+
+
+@dataclass(frozen=True)
+class PivotResult:
+    turned_deg: float  # the hand's turn, which the object should make in the grasp
+    moved_mm: float  # the prism's displacement in the world (the model: 0)
+    rotated_deg: float  # the prism's rotation in the world (the model: 0)
+    grasp_error_mm: float  # |(x, z) in the grasp - the pivot's (0, 0)|
+    grasp_error_deg: float  # theta in the grasp - the turn
+
+
+def pivot(task: Task, pusher: str = "left", turn_deg: float = 30.0, rate_deg_s: float = 10.0) -> PivotResult:
+    """Turn the hand by -`turn_deg` about the pad centre at `rate_deg_s` while feature `pusher`
+    holds the object: the object turns by +`turn_deg` in the grasp about the pad centre."""
+    rig = KinematicGrasp(task, [pusher])
+    rig.hold(SETTLE_TIME)
+    p0, a0 = rig.object_position(), rig.object_angle()
+    h = rig.model.opt.timestep
+    rate = math.radians(rate_deg_s)
+    duration = math.radians(turn_deg) / rate + RAMP_TIME / 2
+    for i in range(1, int(round(duration / h)) + 1):
+        a, w = _ramp(i * h, rate)
+        rig.step((0.0, 0.0, -a), (0.0, 0.0, -w))
+    turned = math.degrees(_ramp(int(round(duration / h)) * h, rate)[0])
+    pose = rig.in_grasp()
+    return PivotResult(turned_deg=turned, moved_mm=float(np.linalg.norm(rig.object_position() - p0)) * 1e3,
+                       rotated_deg=math.degrees(rig.object_angle() - a0),
+                       grasp_error_mm=math.hypot(pose["x"] - task.start[0], pose["z"] - task.start[1]),
+                       grasp_error_deg=pose["theta"] - task.start[2] - turned)
