@@ -21,6 +21,7 @@ Units: SI inside; results in mm, um, deg and N as their names say.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -65,6 +66,14 @@ def _box_task(load: float, grip_force: float = 10.0, mu: float = 0.45, mass_g: f
         "goal": [0, 0, 0],
     }
     return parse_task(yaml.safe_dump(data), source="friction-fidelity scene")
+
+
+def with_pusher_mu(task: Task, pusher: str, mu: float) -> Task:
+    """`task` with pusher `pusher`'s friction coefficient set to `mu` (mu >= 0)."""
+    index = task.pusher_index(pusher)
+    pushers = list(task.pushers)
+    pushers[index] = dataclasses.replace(pushers[index], mu=float(mu))
+    return dataclasses.replace(task, pushers=tuple(pushers))
 
 
 class KinematicGrasp:

@@ -1,0 +1,52 @@
+"""The friction-fidelity contract of the simulated arm as a table (README, "Friction fidelity"):
+the arm's contact setting against the contract's limits, and, with --stiff, the setting it
+replaced (pads that never switch to the soft friction reference).
+
+    python3 benchmarks/friction_fidelity.py [--stiff]
+"""
+import argparse
+import time
+from pathlib import Path
+
+from stablepush.mechanics import check_push
+from stablepush.sim import fidelity, friction
+from stablepush.task import load_task
+
+TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--stiff", action="store_true", help="measure the stiff pad friction the arm used before")
+    args = parser.parse_args()
+    if args.stiff:
+        friction.SLIDE_SPEED = float("inf")
+    started = time.perf_counter()
+    print("| wall load | pad speed mm/s | creep um per mm (limit) | pad friction / mu N | pad drop-out steps | steps/s |")
+    print("|---:|---:|---:|---:|---:|---:|")
+    for load in (0.5, 0.9):
+        for speed in (0.001, 0.005, 0.02):
+            r = fidelity.wall_creep(load, speed)
+            print(f"| {load:.0%} | {r.pad_speed_mm_s:g} | {r.creep_um_per_mm:.3f} ({fidelity.CREEP_LIMIT_UM_PER_MM[load]:g}) "
+                  f"| {r.pad_friction_ratio:.4f} | {r.pad_dropout_steps} | {r.steps_per_s:.0f} |", flush=True)
+    print()
+    print("| static hold, weight / 2 mu N | moved in 1 s, um (limit) |")
+    print("|---:|---:|")
+    for load in (0.5, 0.9):
+        r = fidelity.static_hold(load)
+        print(f"| {load:.0%} | {r.moved_um:.2f} ({fidelity.HOLD_LIMIT_UM:g}) |", flush=True)
+    print()
+    print("| pivot about the pad centre, 30 deg | model | prism moved in the world mm | rotated deg |")
+    print("|---|---|---:|---:|")
+    pivoting = load_task(TASKS / "pivoting.yaml")
+    for mu in (0.6, 0.2):
+        task = fidelity.with_pusher_mu(pivoting, "left", mu)
+        stable = check_push(task, (0, 0, 0), (0, 0, 1), "left")["left"]["feasible"]
+        r = fidelity.pivot(task, "left", turn_deg=30)
+        print(f"| pivoting, left pusher mu {mu} | {'stable' if stable else 'not stable'} | {r.moved_mm:.3f} "
+              f"| {r.rotated_deg:+.3f} |", flush=True)
+    print(f"\n{time.perf_counter() - started:.1f} s")
+
+
+if __name__ == "__main__":
+    main()
