@@ -237,3 +237,13 @@ def test_cone_draws_the_pushers_cone_and_names_a_bad_pusher(tmp_path):
     assert ok.exit_code == 0 and png.stat().st_size > 10_000
     bad = CliRunner().invoke(cli, ["cone", str(TASKS / "pivoting.yaml"), "--pusher", "nope"])
     assert bad.exit_code == 2 and "no pusher named 'nope'" in bad.output
+
+
+def test_world_deviations_need_the_simulated_arm(tmp_path):
+    from stablepush_cli.main import cli
+
+    plan = tmp_path / "p.json"
+    task = str(TASKS / "horizontal-offset-high-mu.yaml")
+    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--arm", "127.0.0.1:9", "--sim-mu-scale", "0.85"])
+    assert result.exit_code == 2 and "--sim-mu-scale" in result.output

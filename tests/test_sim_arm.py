@@ -128,3 +128,25 @@ def test_convex_pieces_of_the_t_cover_its_area():
         n = len(p)
         assert all((p[i][0] - p[i - 1][0]) * (p[(i + 1) % n][1] - p[i - 1][1])
                    - (p[i][1] - p[i - 1][1]) * (p[(i + 1) % n][0] - p[i - 1][0]) > 0 for i in range(n))
+
+
+def test_a_deviated_world_scales_every_pad_and_feature_mu():
+    from stablepush.sim.arm import WorldDeviation
+
+    task = shipped("horizontal-offset-low-mu")
+    steps = [PlanStep(task.start, None), PlanStep(task.start, "left")]
+    scene = scene_description(task, place_features(task, steps), task.start)
+    nominal, scaled = SimArm(scene), SimArm(scene, WorldDeviation(mu_scale=0.85))
+    assert scene["gripper"]["mu"] == task.mu  # the scene itself is left as the executor sent it
+    np.testing.assert_allclose(scaled.model.pair_friction, 0.85 * nominal.model.pair_friction)
+    assert sorted(set(np.round(nominal.model.pair_friction[:, 0], 9))) == sorted({task.mu, 0.2})
+
+
+def test_the_tracker_reports_the_pose_in_the_grasp_with_the_noise_asked_for():
+    from stablepush.sim.arm import WorldDeviation
+
+    task = shipped("horizontal-offset-low-mu")
+    arm = SimArm(scene_description(task, {}, task.start), WorldDeviation(tracker_noise_mm=0.2, tracker_noise_deg=0.1, seed=3))
+    readings = np.array([[s["x"], s["z"], s["theta"]] for s in (arm.state()["object_in_grasp"] for _ in range(2000))])
+    np.testing.assert_allclose(readings.std(axis=0), [0.2, 0.2, 0.1], rtol=0.1)
+    np.testing.assert_allclose(readings.mean(axis=0), [0, 0, 0], atol=0.03)  # the object itself is still at the start

@@ -323,8 +323,14 @@ def _host_port(value: str):
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the run's report (final pose in the grasp, slip per contact, features) as JSON.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
+              metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
+                                "the plan against a world whose friction differs from its model.")
+@click.option("--tracker-noise", "tracker_noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0),
+              metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise on the "
+                                     "object's pose in the grasp (x and z in mm, theta in deg).")
 def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resume_from: int, pace, reset: bool,
-            ack_timeout: float, json_path, quiet: bool) -> None:
+            ack_timeout: float, json_path, quiet: bool, mu_scale: float, tracker_noise) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -352,11 +358,16 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
     task, plan, steps = _load_plan_and_task(plan_file, task_file)
     if resume_from >= len(steps) - 1:
         _fail(f"--resume-from: must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} pushes)")
+    deviated = mu_scale != 1.0 or any(tracker_noise)
+    if deviated and not (sim and arm is None):
+        _fail("--sim-mu-scale and --tracker-noise: only with --sim (a simulated arm started here)")
     sim_arm = contextlib.ExitStack()
     if sim and arm is None:
+        from stablepush.sim.arm import WorldDeviation
         from stablepush.sim.server import running_sim_arm
 
-        server = sim_arm.enter_context(running_sim_arm(log=(lambda text: None) if quiet else None))
+        deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1])
+        server = sim_arm.enter_context(running_sim_arm(log=(lambda text: None) if quiet else None, deviation=deviation))
         host, port = server.host, server.port
     else:
         host, port = _host_port(arm) if arm else ("127.0.0.1", DEFAULT_PORT)
@@ -426,17 +437,27 @@ def _print_report(report) -> None:
               help="Port to listen on (0: any free port, printed).")
 @click.option("--exit-after", type=click.IntRange(min=1), default=None, metavar="N",
               help="Fault injection for testing executors: die abruptly after N waypoints.")
-def sim_arm(host: str, port: int, exit_after) -> None:
+@click.option("--mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
+              metavar="S", help="The pads' and features' mu are S times each task's (a world unlike the model).")
+@click.option("--tracker-noise", "tracker_noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0),
+              metavar="MM DEG", help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).")
+@click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
+              help="Seed of the tracker's noise.")
+def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, seed: int) -> None:
     """Serve a simulated arm (MuJoCo) over the arm protocol, until interrupted.
 
     A 7-joint arm of simple shapes (shipped MJCF) with a parallel-jaw gripper whose pads press with
     the task's grip force; the executor's hello carries the object, the features and the friction.
     Joint servos track the streamed waypoints by IK; the simulation steps in lock-step with the stream
-    (one waypoint period per waypoint), headless, and reports its steps/s.
+    (one waypoint period per waypoint), headless, and reports its steps/s. Each acknowledgement carries
+    the object's pose in the grasp as a tracker would (`object_in_grasp`), with --tracker-noise.
     """
+    from stablepush.sim.arm import WorldDeviation
     from stablepush.sim.server import SimArmServer
 
-    server = SimArmServer(host, port, exit_after=exit_after)
+    deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1],
+                               seed=seed)
+    server = SimArmServer(host, port, exit_after=exit_after, deviation=deviation)
     click.echo(f"sim-arm: listening on {server.host}:{server.port}", err=True)
     try:
         server.serve_forever()

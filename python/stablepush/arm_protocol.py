@@ -23,8 +23,12 @@ server -> client
   {"type": "error", "seq": 3 or null, "message": "..."}   the server has stopped the arm
       and closes the connection.
 
-`state` holds at least "ee_pose" (G's pose now) and "joints" [rad]; a simulator adds "time",
-"object_pose", "object_in_grasp" {x, z mm, theta deg, y mm, tilt deg} and "steps_per_s".
+`state` holds at least "ee_pose" (G's pose now) and "joints" [rad]. Optional:
+  "object_in_grasp" {x, z mm, theta deg; y mm, tilt deg where known}: the tracker field, the
+      object's pose in the grasp as the cell measures it (motion capture, fiducials, tactile
+      sensing), in the plan's coordinates. With a sticking pusher this pose is observable, and the
+      executor compares it with the plan. A cell without a tracker leaves it out.
+  "time", "object_pose" (the object's true world pose) and "steps_per_s": from a simulator.
 """
 from __future__ import annotations
 

@@ -6,8 +6,10 @@ midway between the pads.
 """
 from __future__ import annotations
 
+import copy
 import math
 import time
+from dataclasses import dataclass
 from typing import Dict, Optional, Sequence
 
 import mujoco
@@ -35,12 +37,36 @@ def in_grasp(T_world_gripper: np.ndarray, T_world_object: np.ndarray) -> Dict[st
             "y": T[1, 3] * 1e3, "tilt": tilt}
 
 
-class SimArm:
-    """The arm, the grasp and the world of one scene description."""
+@dataclass(frozen=True)
+class WorldDeviation:
+    """How the simulated world departs from the task it is given, to test plans against a world that
+    differs from their model: every pad's and feature's mu times `mu_scale`, and a tracker whose
+    `object_in_grasp` carries Gaussian noise (standard deviations in mm and deg, drawn from `seed`)."""
 
-    def __init__(self, scene: dict):
+    mu_scale: float = 1.0
+    tracker_noise_mm: float = 0.0
+    tracker_noise_deg: float = 0.0
+    seed: int = 0
+
+
+def _scaled_friction(scene: dict, scale: float) -> dict:
+    if scale == 1.0:
+        return scene
+    scene = copy.deepcopy(scene)
+    scene["gripper"]["mu"] *= scale
+    for feature in scene["features"]:
+        feature["mu"] *= scale
+    return scene
+
+
+class SimArm:
+    """The arm, the grasp and the world of one scene description (as `deviation` alters it)."""
+
+    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
         self.scene = scene
-        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene))
+        self.deviation = deviation
+        self._tracker_rng = np.random.default_rng(deviation.seed)
+        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(_scaled_friction(scene, deviation.mu_scale)))
         self.data = mujoco.MjData(self.model)
         m = self.model
         self._arm_qpos = np.array([m.jnt_qposadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
@@ -151,15 +177,20 @@ class SimArm:
         return self.steps / self.step_wall_time if self.step_wall_time > 0 else 0.0
 
     def state(self) -> dict:
-        """What the arm reports: G's pose and the joints; as a simulation it also reports the object's
-        world pose and its pose in the grasp (a real arm would not know these)."""
+        """What the arm reports: G's pose and the joints; the tracker's `object_in_grasp` (with the
+        deviation's noise); and, as a simulation, the object's true world pose."""
         T_g, T_o = self.gripper_matrix(), self.object_matrix()
+        tracked = in_grasp(T_g, T_o)
+        d = self.deviation
+        if d.tracker_noise_mm > 0 or d.tracker_noise_deg > 0:
+            nx, nz, nth = self._tracker_rng.normal(0.0, [d.tracker_noise_mm, d.tracker_noise_mm, d.tracker_noise_deg])
+            tracked.update(x=tracked["x"] + nx, z=tracked["z"] + nz, theta=tracked["theta"] + nth)
         return {
             "time": float(self.data.time),
             "ee_pose": matrix_to_pose(T_g),
             "joints": [float(v) for v in self.data.qpos[self._arm_qpos]],
             "object_pose": matrix_to_pose(T_o),
-            "object_in_grasp": in_grasp(T_g, T_o),
+            "object_in_grasp": tracked,
             "steps_per_s": round(self.steps_per_second, 1),
         }
 

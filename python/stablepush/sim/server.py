@@ -13,7 +13,7 @@ from contextlib import contextmanager
 from typing import Callable, Iterator, Optional
 
 from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
-from stablepush.sim.arm import SimArm
+from stablepush.sim.arm import SimArm, WorldDeviation
 
 # The scene keys that describe the world; the object's pose at the start may differ on a resume.
 _START_KEYS = ("object_pose", "object_in_grasp")
@@ -27,9 +27,10 @@ class SimArmServer:
     """Serves the simulated arm on host:port (port 0 picks a free one; see `.port`)."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, log: Callable[[str], None] = None,
-                 exit_after: Optional[int] = None):
+                 exit_after: Optional[int] = None, deviation: WorldDeviation = WorldDeviation()):
         self.log = log or (lambda text: print(f"sim-arm: {text}", file=sys.stderr, flush=True))
         self.exit_after = exit_after  # fault injection: die abruptly after this many waypoints
+        self.deviation = deviation  # how the simulated world departs from each task's model
         self.arm: Optional[SimArm] = None
         self._scene: Optional[dict] = None
         self._waypoints = 0
@@ -108,7 +109,7 @@ class SimArmServer:
         scene = message["scene"]
         self._period = 1.0 / float(message["rate_hz"])
         if self.arm is None or message.get("reset") or _world(scene) != _world(self._scene):
-            self.arm = SimArm(scene)
+            self.arm = SimArm(scene, self.deviation)
             self._scene = scene
             self.log(f"world built for {scene.get('task', 'a task')} ({self.arm.model.nbody} bodies, "
                      f"{self.arm.model.npair} contact pairs)")
@@ -117,10 +118,11 @@ class SimArmServer:
 
 
 @contextmanager
-def running_sim_arm(log: Optional[Callable[[str], None]] = None) -> Iterator[SimArmServer]:
+def running_sim_arm(log: Optional[Callable[[str], None]] = None,
+                    deviation: WorldDeviation = WorldDeviation()) -> Iterator[SimArmServer]:
     """A simulated arm served from a thread of this process on a free localhost port, for the
     length of the `with` block (`execute --sim`, the tests, the benchmark)."""
-    server = SimArmServer(log=log)
+    server = SimArmServer(log=log, deviation=deviation)
     server.start_in_thread()
     try:
         yield server
