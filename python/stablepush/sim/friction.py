@@ -1,5 +1,5 @@
-"""Pad friction in MuJoCo that slides and sticks as Coulomb's law says (docs/model.md, "The
-simulated arm").
+"""Pad friction in MuJoCo that slides and sticks as Coulomb's law says (README, "Friction
+fidelity").
 
 Why the pads need this. MuJoCo's contact model is convex: a contact that slides with its friction
 on the cone's boundary also gets a separating normal velocity of about mu |v_slip|. The jaws press

@@ -10,7 +10,7 @@ Contact settings that keep friction honest (the simulation's results rest on the
 - pad friction whose reference is switched per pad point by its own slip (`friction.py`): stiff
   while it sticks, soft while it slides, which removes the pads' drop-outs while they slide;
 - each pad is a disc of point contacts laid out as the task's `pad_rings` says, so the simulated
-  pad's force acts where the model's does (docs/model.md, "Contacts");
+  pad's force acts where the model's does (README, "The mechanics");
 - only the object touches pads and features (explicit contact pairs with the task's friction);
   the fingers are driven by force-capped joint servos, not as mocap bodies, so the pads press
   with exactly the task's grip force and friction can drag the object.
