@@ -420,7 +420,8 @@ def _print_report(report) -> None:
     x, z, th = report.planned_final
     f = report.final_in_grasp
     click.echo(f"final pose in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
-               f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg")
+               f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg; "
+               f"to the task's goal {report.goal_error['distance']:.3f} mm, {report.goal_error['theta']:+.3f} deg")
     for c in report.contacts:
         if c.slip_mm is not None:
             click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} slip at the pusher "

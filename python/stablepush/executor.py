@@ -54,6 +54,7 @@ class ExecutionReport:
     total_steps: int
     waypoints: int
     planned_final: Sequence[float]  # x mm, z mm, theta deg
+    goal: Sequence[float]  # the task's goal, x mm, z mm, theta deg
     # The object in the grasp as the arm reports it (a simulator does): at the end of the last push,
     # still resting on the pusher, and after the gripper has backed it off the feature.
     final_in_grasp: Optional[Dict[str, float]]
@@ -66,11 +67,19 @@ class ExecutionReport:
     @property
     def final_error(self) -> Optional[Dict[str, float]]:
         """Final pose in the grasp minus the plan's: x, z mm, theta deg, and the distance mm."""
+        return self._error_to(self.planned_final)
+
+    @property
+    def goal_error(self) -> Optional[Dict[str, float]]:
+        """Final pose in the grasp minus the task's goal (the plan may stop within its tolerance)."""
+        return self._error_to(self.goal)
+
+    def _error_to(self, pose: Sequence[float]) -> Optional[Dict[str, float]]:
         if self.final_in_grasp is None:
             return None
-        dx = self.final_in_grasp["x"] - self.planned_final[0]
-        dz = self.final_in_grasp["z"] - self.planned_final[1]
-        dth = self.final_in_grasp["theta"] - self.planned_final[2]
+        dx = self.final_in_grasp["x"] - pose[0]
+        dz = self.final_in_grasp["z"] - pose[1]
+        dth = self.final_in_grasp["theta"] - pose[2]
         return {"x": dx, "z": dz, "theta": dth, "distance": math.hypot(dx, dz)}
 
     @property
@@ -85,7 +94,8 @@ class ExecutionReport:
         return {
             "task": self.task, "resumed_from": self.resumed_from, "last_confirmed_step": self.last_confirmed_step,
             "total_steps": self.total_steps, "waypoints": self.waypoints, "planned_final": list(self.planned_final),
-            "final_in_grasp": self.final_in_grasp, "final_error": self.final_error,
+            "goal": list(self.goal), "final_in_grasp": self.final_in_grasp, "final_error": self.final_error,
+            "goal_error": self.goal_error,
             "released_in_grasp": self.released_in_grasp, "release_change": self.release_change,
             "contacts": [c.__dict__ for c in self.contacts], "features": self.features,
             "wall_time_s": self.wall_time_s, "sim_steps_per_s": self.sim_steps_per_s,
@@ -222,7 +232,7 @@ def execute_plan(
             link.close()
     return ExecutionReport(
         task=task.name, resumed_from=resume_from, last_confirmed_step=last_confirmed, total_steps=len(steps) - 1,
-        waypoints=len(waypoints), planned_final=steps[-1].pose,
+        waypoints=len(waypoints), planned_final=steps[-1].pose, goal=task.goal,
         final_in_grasp=(settled or state).get("object_in_grasp"), released_in_grasp=state.get("object_in_grasp"),
         contacts=list(contacts.values()), features=[f.as_dict() for f in features.values()],
         wall_time_s=time.perf_counter() - started, sim_steps_per_s=state.get("steps_per_s"),
