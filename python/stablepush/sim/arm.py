@@ -161,16 +161,10 @@ class SimArm:
     # -- state --------------------------------------------------------------------------------
 
     def gripper_matrix(self) -> np.ndarray:
-        T = np.eye(4)
-        T[:3, :3] = self.data.site_xmat[self._site].reshape(3, 3)
-        T[:3, 3] = self.data.site_xpos[self._site]
-        return T
+        return gripper_matrix(self.data, self._site)
 
     def object_matrix(self) -> np.ndarray:
-        T = np.eye(4)
-        T[:3, :3] = self.data.xmat[self._object].reshape(3, 3)
-        T[:3, 3] = self.data.xpos[self._object]
-        return T
+        return object_matrix(self.data, self._object)
 
     @property
     def steps_per_second(self) -> float:
@@ -197,6 +191,22 @@ class SimArm:
     def contact_force_on_object(self, pusher: str) -> np.ndarray:
         """Total force [N, world frame] that pusher `pusher`'s feature exerts on the object now."""
         return force_on_object(self.model, self.data, [self.model.geom(scene_mod.feature_geom(pusher)).id])
+
+
+def gripper_matrix(data, site: int) -> np.ndarray:
+    """T_WG (4x4, m) of the gripper site `site` now."""
+    T = np.eye(4)
+    T[:3, :3] = data.site_xmat[site].reshape(3, 3)
+    T[:3, 3] = data.site_xpos[site]
+    return T
+
+
+def object_matrix(data, body: int) -> np.ndarray:
+    """T_WO (4x4, m) of body `body` now."""
+    T = np.eye(4)
+    T[:3, :3] = data.xmat[body].reshape(3, 3)
+    T[:3, 3] = data.xpos[body]
+    return T
 
 
 def force_on_object(model, data, geoms) -> np.ndarray:

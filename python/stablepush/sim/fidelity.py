@@ -33,7 +33,7 @@ import yaml
 
 from stablepush.execution import PlanStep, place_features, scene_description
 from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import force_on_object, in_grasp
+from stablepush.sim.arm import force_on_object, gripper_matrix, in_grasp, object_matrix
 from stablepush.sim.friction import SlipSwitchedPadFriction
 from stablepush.task import Task, parse_task
 
@@ -124,10 +124,7 @@ class KinematicGrasp:
         return math.atan2(R[0, 2], R[0, 0])
 
     def in_grasp(self) -> dict:
-        T_g, T_o = np.eye(4), np.eye(4)
-        T_g[:3, :3], T_g[:3, 3] = self.data.site_xmat[self._site].reshape(3, 3), self.data.site_xpos[self._site]
-        T_o[:3, :3], T_o[:3, 3] = self.data.xmat[self._object].reshape(3, 3), self.data.xpos[self._object]
-        return in_grasp(T_g, T_o)
+        return in_grasp(gripper_matrix(self.data, self._site), object_matrix(self.data, self._object))
 
     def feature_force(self, pusher: str) -> np.ndarray:
         """Force [N, world frame] that feature `pusher` exerts on the object now."""
