@@ -10,7 +10,7 @@ import copy
 import math
 import time
 from dataclasses import dataclass
-from typing import Dict, Optional, Sequence
+from typing import Callable, Dict, Optional, Sequence
 
 import mujoco
 import numpy as np
@@ -59,38 +59,93 @@ def _scaled_friction(scene: dict, scale: float) -> dict:
     return scene
 
 
-class SimArm:
+class SimulatedGrasp:
+    """A scene's grasp in MuJoCo, shared by the arm and the friction-fidelity rig (`fidelity.py`):
+    the model (`scene.build_mjcf`), the jaws closed on the object with the grip force, the pad
+    friction switch stepped with the physics, and the read-outs of the grasp."""
+
+    def __init__(self, scene: dict, kinematic_hand: bool = False):
+        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, kinematic_hand=kinematic_hand))
+        self.data = mujoco.MjData(self.model)
+        m = self.model
+        self._site = m.site(scene_mod.GRIPPER_SITE).id
+        self._object = m.body(scene_mod.OBJECT_BODY).id
+        self._object_qpos = m.jnt_qposadr[m.joint(scene_mod.OBJECT_BODY).id]
+        self.pad_friction = SlipSwitchedPadFriction(m, scene_mod.pad_geoms(m))
+        self.steps = 0
+        self.step_wall_time = 0.0
+        self.data.qpos[[m.jnt_qposadr[m.joint(j).id] for j in scene_mod.FINGER_JOINTS]] = scene["object"]["thickness"] / 2
+        self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene["object_pose"]
+        self.data.ctrl[[m.actuator(j).id for j in scene_mod.FINGER_JOINTS]] = 0.0  # close: the servos saturate at the grip force
+        # the subclass sets its own drives, then calls mj_forward once
+
+    def _run(self, n: int, before_step: Callable[[int], None]) -> None:
+        """n time steps; `before_step(i)` (i = 1..n) sets the drives of step i."""
+        t0 = time.perf_counter()
+        for i in range(1, n + 1):
+            before_step(i)
+            self.pad_friction.update(self.data)
+            mujoco.mj_step(self.model, self.data)
+        self.step_wall_time += time.perf_counter() - t0
+        self.steps += n
+
+    def gripper_matrix(self) -> np.ndarray:
+        """T_WG (4x4, m) now."""
+        T = np.eye(4)
+        T[:3, :3] = self.data.site_xmat[self._site].reshape(3, 3)
+        T[:3, 3] = self.data.site_xpos[self._site]
+        return T
+
+    def object_matrix(self) -> np.ndarray:
+        """T_WO (4x4, m) now."""
+        T = np.eye(4)
+        T[:3, :3] = self.data.xmat[self._object].reshape(3, 3)
+        T[:3, 3] = self.data.xpos[self._object]
+        return T
+
+    def in_grasp(self) -> Dict[str, float]:
+        """The object's true pose in the grasp now (see `in_grasp`)."""
+        return in_grasp(self.gripper_matrix(), self.object_matrix())
+
+    def contact_force_on_object(self, pusher: str) -> np.ndarray:
+        """Total force [N, world frame] that pusher `pusher`'s feature exerts on the object now."""
+        geom = self.model.geom(scene_mod.feature_geom(pusher)).id
+        total = np.zeros(3)
+        f6 = np.zeros(6)
+        for i in range(self.data.ncon):
+            c = self.data.contact[i]
+            if geom not in (c.geom1, c.geom2):
+                continue
+            mujoco.mj_contactForce(self.model, self.data, i, f6)
+            f = c.frame.reshape(3, 3).T @ f6[:3]  # rows of frame: normal, tangents; the force acts on geom2
+            total += f if c.geom1 == geom else -f
+        return total
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.steps / self.step_wall_time if self.step_wall_time > 0 else 0.0
+
+
+class SimArm(SimulatedGrasp):
     """The arm, the grasp and the world of one scene description (as `deviation` alters it)."""
 
     def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
+        super().__init__(_scaled_friction(scene, deviation.mu_scale))
         self.scene = scene
         self.deviation = deviation
         self._tracker_rng = np.random.default_rng(deviation.seed)
-        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(_scaled_friction(scene, deviation.mu_scale)))
-        self.data = mujoco.MjData(self.model)
         m = self.model
         self._arm_qpos = np.array([m.jnt_qposadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
         self._arm_dof = np.array([m.jnt_dofadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
         self._arm_act = np.array([m.actuator(j).id for j in scene_mod.ARM_JOINTS])
-        self._finger_qpos = np.array([m.jnt_qposadr[m.joint(j).id] for j in scene_mod.FINGER_JOINTS])
-        self._finger_act = np.array([m.actuator(j).id for j in scene_mod.FINGER_JOINTS])
-        self._site = m.site(scene_mod.GRIPPER_SITE).id
-        self._object = m.body(scene_mod.OBJECT_BODY).id
-        self._object_qpos = m.jnt_qposadr[m.joint(scene_mod.OBJECT_BODY).id]
         self._scratch = mujoco.MjData(m)
-        self.pad_friction = SlipSwitchedPadFriction(m, scene_mod.pad_geoms(m))
-        self.steps = 0
-        self.step_wall_time = 0.0
 
         home = np.asarray(scene["gripper_pose"], float)
         self.home_posture = HOME_GUESS.copy()
         self.home_posture = self.solve_ik(home, HOME_GUESS, strict=True, iterations=1000)
         self.target = self.home_posture.copy()
         self.data.qpos[self._arm_qpos] = self.home_posture
-        self.data.qpos[self._finger_qpos] = scene["object"]["thickness"] / 2
-        self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene["object_pose"]
         self.data.ctrl[self._arm_act] = self.home_posture
-        self.data.ctrl[self._finger_act] = 0.0  # close: the servos saturate at the grip force
         mujoco.mj_forward(m, self.data)
         self.advance(SETTLE_TIME)
 
@@ -139,13 +194,11 @@ class SimArm:
         n = max(1, int(round(duration / self.model.opt.timestep)))
         start = self.target.copy()
         end = start if target is None else np.asarray(target, float)
-        t0 = time.perf_counter()
-        for i in range(1, n + 1):
+
+        def servo_setpoints(i: int) -> None:
             self.data.ctrl[self._arm_act] = start + (end - start) * (i / n)
-            self.pad_friction.update(self.data)
-            mujoco.mj_step(self.model, self.data)
-        self.step_wall_time += time.perf_counter() - t0
-        self.steps += n
+
+        self._run(n, servo_setpoints)
         self.target = end.copy()
 
     def move_to(self, pose: Sequence[float], duration: float) -> None:
@@ -160,21 +213,11 @@ class SimArm:
 
     # -- state --------------------------------------------------------------------------------
 
-    def gripper_matrix(self) -> np.ndarray:
-        return gripper_matrix(self.data, self._site)
-
-    def object_matrix(self) -> np.ndarray:
-        return object_matrix(self.data, self._object)
-
-    @property
-    def steps_per_second(self) -> float:
-        return self.steps / self.step_wall_time if self.step_wall_time > 0 else 0.0
-
     def state(self) -> dict:
         """What the arm reports: G's pose and the joints; the tracker's `object_in_grasp` (with the
         deviation's noise); and, as a simulation, the object's true world pose."""
         T_g, T_o = self.gripper_matrix(), self.object_matrix()
-        tracked = in_grasp(T_g, T_o)
+        tracked = in_grasp(T_g, T_o)  # the truth; a noisy tracker below
         d = self.deviation
         if d.tracker_noise_mm > 0 or d.tracker_noise_deg > 0:
             nx, nz, nth = self._tracker_rng.normal(0.0, [d.tracker_noise_mm, d.tracker_noise_mm, d.tracker_noise_deg])
@@ -187,42 +230,6 @@ class SimArm:
             "object_in_grasp": tracked,
             "steps_per_s": round(self.steps_per_second, 1),
         }
-
-    def contact_force_on_object(self, pusher: str) -> np.ndarray:
-        """Total force [N, world frame] that pusher `pusher`'s feature exerts on the object now."""
-        return force_on_object(self.model, self.data, [self.model.geom(scene_mod.feature_geom(pusher)).id])
-
-
-def gripper_matrix(data, site: int) -> np.ndarray:
-    """T_WG (4x4, m) of the gripper site `site` now."""
-    T = np.eye(4)
-    T[:3, :3] = data.site_xmat[site].reshape(3, 3)
-    T[:3, 3] = data.site_xpos[site]
-    return T
-
-
-def object_matrix(data, body: int) -> np.ndarray:
-    """T_WO (4x4, m) of body `body` now."""
-    T = np.eye(4)
-    T[:3, :3] = data.xmat[body].reshape(3, 3)
-    T[:3, 3] = data.xpos[body]
-    return T
-
-
-def force_on_object(model, data, geoms) -> np.ndarray:
-    """Total force [N, world frame] that the geoms `geoms` exert on whatever they touch now."""
-    geoms = set(geoms)
-    total = np.zeros(3)
-    f6 = np.zeros(6)
-    for i in range(data.ncon):
-        c = data.contact[i]
-        if c.geom1 not in geoms and c.geom2 not in geoms:
-            continue
-        mujoco.mj_contactForce(model, data, i, f6)
-        f = c.frame.reshape(3, 3).T @ f6[:3]  # rows of frame: normal, tangents; the force acts on geom2
-        total += f if c.geom1 in geoms else -f
-    return total
-
 
 def _rotation_vector(R: np.ndarray) -> np.ndarray:
     quat = np.zeros(4)

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import time
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
@@ -33,8 +32,7 @@ import yaml
 
 from stablepush.execution import PlanStep, place_features, scene_description
 from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import force_on_object, gripper_matrix, in_grasp, object_matrix
-from stablepush.sim.friction import SlipSwitchedPadFriction
+from stablepush.sim.arm import SimulatedGrasp
 from stablepush.task import Task, parse_task
 
 G0 = 9.81  # m/s^2
@@ -50,18 +48,17 @@ PIVOT_LIMIT_MM = 0.05  # mm the prism may move in the world while the hand turns
 PIVOT_LIMIT_DEG = 0.1  # deg likewise
 
 
-def _box_task(load: float, grip_force: float = 10.0, mu: float = 0.45, mass_g: float = 200.0,
-              wall: bool = True) -> Task:
-    """A 50 x 25 x 50 mm box under gravity in a grasp of two 5 mm pads; with `wall`, a pusher
-    `wall` along its left face whose mu puts the weight at `load` of the wall's cone when the pads
-    press the box into it with 2 mu N."""
+def _box_task(wall_load: Optional[float], grip_force: float = 10.0, mu: float = 0.45, mass_g: float = 200.0) -> Task:
+    """A 50 x 25 x 50 mm box under gravity in a grasp of two 5 mm pads, with a pusher `wall` along
+    its left face. With a `wall_load`, the wall's mu puts the weight at that fraction of its cone
+    when the pads press the box into it with 2 mu N; without, the wall is never placed (any mu)."""
+    wall_mu = mass_g * 1e-3 * G0 / (wall_load * 2 * mu * grip_force) if wall_load is not None else mu
     data = {
         "name": "friction-fidelity",
         "object": {"shape": "box", "size": [50, 25, 50], "mass": mass_g},
         "gripper": {"grip_force": grip_force, "mu": mu, "pad_rings": 1},
         "gravity": [0, -G0],
-        "pushers": [{"name": "wall", "from": [-25, -25], "to": [-25, 25],
-                     "mu": (mass_g * 1e-3 * G0 / (load * 2 * mu * grip_force)) if wall else 0.5}],
+        "pushers": [{"name": "wall", "from": [-25, -25], "to": [-25, 25], "mu": wall_mu}],
         "start": [0, 0, 0],
         "goal": [0, 0, 0],
     }
@@ -76,40 +73,28 @@ def with_pusher_mu(task: Task, pusher: str, mu: float) -> Task:
     return dataclasses.replace(task, pushers=tuple(pushers))
 
 
-class KinematicGrasp:
+class KinematicGrasp(SimulatedGrasp):
     """The arm's grasp of `task`'s object on a hand whose planar motion is prescribed, with the
     features of `pushers` fixed in the world where they touch the object at the start."""
 
     def __init__(self, task: Task, pushers: Sequence[str] = ()):
         steps = [PlanStep(task.start, None)] + [PlanStep(task.start, name) for name in pushers]
-        scene = scene_description(task, place_features(task, steps), task.start)
-        self.task = task
-        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, kinematic_hand=True))
-        self.data = mujoco.MjData(self.model)
+        super().__init__(scene_description(task, place_features(task, steps), task.start), kinematic_hand=True)
         m = self.model
         self._qpos = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
         self._dof = [m.jnt_dofadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
-        fingers = [m.joint(j).id for j in scene_mod.FINGER_JOINTS]
-        self.data.qpos[[m.jnt_qposadr[j] for j in fingers]] = scene["object"]["thickness"] / 2
-        self.data.ctrl[[m.actuator(j).id for j in scene_mod.FINGER_JOINTS]] = 0.0  # close, force-capped
-        self._site = m.site(scene_mod.GRIPPER_SITE).id
-        self._object = m.body(scene_mod.OBJECT_BODY).id
         self._pad_geoms = set(scene_mod.pad_geoms(m))
-        self.pad_friction = SlipSwitchedPadFriction(m, sorted(self._pad_geoms))
-        self.steps = 0
-        self.wall_time = 0.0
         mujoco.mj_forward(m, self.data)
 
     def step(self, motion: Sequence[float], velocity: Sequence[float]) -> None:
         """One time step with the hand at `motion` (x m, z m, theta rad about y, from its start)
         moving at `velocity` (m/s, m/s, rad/s)."""
-        self.data.qpos[self._qpos] = motion
-        self.data.qvel[self._dof] = velocity
-        t0 = time.perf_counter()
-        self.pad_friction.update(self.data)
-        mujoco.mj_step(self.model, self.data)
-        self.wall_time += time.perf_counter() - t0
-        self.steps += 1
+
+        def drive_hand(_: int) -> None:
+            self.data.qpos[self._qpos] = motion
+            self.data.qvel[self._dof] = velocity
+
+        self._run(1, drive_hand)
 
     def hold(self, duration: float) -> None:
         for _ in range(int(round(duration / self.model.opt.timestep))):
@@ -123,20 +108,9 @@ class KinematicGrasp:
         R = self.data.xmat[self._object].reshape(3, 3)
         return math.atan2(R[0, 2], R[0, 0])
 
-    def in_grasp(self) -> dict:
-        return in_grasp(gripper_matrix(self.data, self._site), object_matrix(self.data, self._object))
-
-    def feature_force(self, pusher: str) -> np.ndarray:
-        """Force [N, world frame] that feature `pusher` exerts on the object now."""
-        return force_on_object(self.model, self.data, [self.model.geom(scene_mod.feature_geom(pusher)).id])
-
     def pad_contacts(self) -> int:
         return sum(1 for i in range(self.data.ncon)
                    if self.data.contact[i].geom1 in self._pad_geoms or self.data.contact[i].geom2 in self._pad_geoms)
-
-    @property
-    def steps_per_second(self) -> float:
-        return self.steps / self.wall_time if self.wall_time else 0.0
 
 
 def _ramp(t: float, speed: float) -> tuple:
@@ -179,7 +153,7 @@ def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None) ->
         if s >= travel / 2:
             samples.append((s, rig.object_position()[2]))
             if i % 10 == 0:
-                forces.append(rig.feature_force("wall"))
+                forces.append(rig.contact_force_on_object("wall"))
     (s0, z0), (s1, z1) = samples[0], samples[-1]
     fx, _, fz = np.mean(forces, axis=0)  # the wall's normal is +x, its tangent z
     fn, ft = fx, abs(fz)
@@ -199,8 +173,8 @@ class HoldResult:
 
 def static_hold(load: float, duration: float = 1.0) -> HoldResult:
     """The box hanging in the pads, its weight at `load` of their friction 2 mu N, the hand still."""
-    mu = 0.45
-    task = _box_task(0.5, grip_force=200e-3 * G0 / (load * 2 * mu), mu=mu, wall=False)
+    mu, mass_g = 0.45, 200.0
+    task = _box_task(None, grip_force=mass_g * 1e-3 * G0 / (load * 2 * mu), mu=mu, mass_g=mass_g)
     rig = KinematicGrasp(task)
     rig.hold(SETTLE_TIME)
     before = rig.object_position()
