@@ -3,12 +3,13 @@ pose in the grasp against the plan's, and the slip at the pusher per contact (RE
 the tasks of data/tasks/more, which nothing was tuned for.
 `--mu-scale` runs each plan again in worlds whose pads' and features' mu differ from the task's.
 
-    python3 benchmarks/execute_shipped.py [--seed 1] [--mu-scale 1 0.85 1.15]
+    python3 benchmarks/execute_shipped.py [--seed 1] [--mu-scale 1 0.85 1.15] [--closed-loop]
 """
 import argparse
 import math
 from pathlib import Path
 
+from stablepush.closed_loop import ClosedLoop
 from stablepush.executor import execute_plan, plan_steps
 from stablepush.plan_io import plan_to_dict
 from stablepush.planning import plan_task
@@ -24,25 +25,30 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--mu-scale", type=float, nargs="+", default=[1.0], metavar="S",
                         help="world mu / task mu, one run per value (default 1)")
+    parser.add_argument("--closed-loop", action="store_true", help="re-plan from the tracked pose (stablepush.closed_loop)")
     args = parser.parse_args()
-    print("| task | world mu | pushes | contacts | final error mm | final error deg | max slip at pusher mm (deg) "
-          "| release moves it mm / deg | sim steps/s | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| task | world mu | loop | pushes | contacts | final error mm | final error deg | goal error mm / deg "
+          "| re-plans | max slip at pusher mm (deg) | release moves it mm / deg | sim steps/s | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for path in sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
         task = load_task(path)
         steps = plan_steps(task, plan_to_dict(plan_task(task, seed=args.seed)))
         for scale in args.mu_scale:
-            _run(task, steps, scale)
+            _run(task, steps, scale, ClosedLoop.for_task(task) if args.closed_loop else None)
 
 
-def _run(task, steps, mu_scale: float) -> None:
+def _run(task, steps, mu_scale: float, loop) -> None:
     with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=mu_scale)) as server:
-        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
-    err = report.final_error
+        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop)
+    err, goal = report.final_error, report.goal_error
+    replans = f"{sum(r.solved for r in report.replans)}" + (f" (+{sum(not r.solved for r in report.replans)} failed)"
+                                                            if any(not r.solved for r in report.replans) else "")
     slip = max(report.contacts, key=lambda c: c.slip_mm)
     release = report.release_change
-    print(f"| {task.name} | x{mu_scale:g} | {len(steps) - 1} | {' → '.join(c.pusher for c in report.contacts)} "
-          f"| {err['distance']:.2f} | {err['theta']:+.2f} | {slip.slip_mm:.2f} ({slip.slip_deg:.2f}) "
+    print(f"| {task.name} | x{mu_scale:g} | {'closed' if loop else 'open'} | {report.total_steps} "
+          f"| {' → '.join(c.pusher for c in report.contacts)} "
+          f"| {err['distance']:.2f} | {err['theta']:+.2f} | {goal['distance']:.2f} / {goal['theta']:+.2f} | {replans} "
+          f"| {slip.slip_mm:.2f} ({slip.slip_deg:.2f}) "
           f"| {math.hypot(release['x'], release['z']):.2f} / {release['theta']:+.2f} "
           f"| {report.sim_steps_per_s:.0f} | {report.wall_time_s:.1f} |", flush=True)
 

@@ -243,3 +243,14 @@ def test_capsule_reduces_to_disc_and_matches_sampling():
         assert section.contains_capsule(a, a, r) == section.contains_disc(a, r)
         if section.contains_capsule(a, b, r):  # sampled discs along the spine are all inside
             assert all(section.contains_disc(a + t * (b - a), r) for t in np.linspace(0, 1, 21))
+
+
+def test_a_start_the_pads_cannot_hold_is_reported_not_a_crash():
+    """Task files refuse such a start, but a re-plan from a tracked pose (closed loop) may ask for
+    one: the object 60 mm along x leaves the pads off a 100 mm prism. It used to segfault."""
+    import dataclasses
+
+    task = shipped("horizontal-offset-high-mu")
+    result = plan_task(dataclasses.replace(task, start=(60.0, 0.0, 0.0)), time_limit=0.2)
+    assert result.outcome == "invalid_start" and not result.solved
+    assert len(result.waypoints) == 1 and "do not hold the object" in result.message

@@ -329,8 +329,19 @@ def _host_port(value: str):
 @click.option("--tracker-noise", "tracker_noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0),
               metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise on the "
                                      "object's pose in the grasp (x and z in mm, theta in deg).")
+@click.option("--closed-loop", "closed_loop", is_flag=True,
+              help="After each push compare the arm's tracked pose in the grasp with the plan's; past "
+                   "--replan-threshold re-plan from the measured pose and continue with the new plan. "
+                   "An arm that reports no tracked pose runs open loop (and says so).")
+@click.option("--replan-threshold", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
+              metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a re-plan "
+                                     "(default: half the task's goal tolerance).")
+@click.option("--final-tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
+              metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
+                                     "this close to the goal (default: a fifth of the task's goal tolerance).")
 def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resume_from: int, pace, reset: bool,
-            ack_timeout: float, json_path, quiet: bool, mu_scale: float, tracker_noise) -> None:
+            ack_timeout: float, json_path, quiet: bool, mu_scale: float, tracker_noise, closed_loop: bool,
+            replan_threshold, final_tolerance) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -358,6 +369,13 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
     task, plan, steps = _load_plan_and_task(plan_file, task_file)
     if resume_from >= len(steps) - 1:
         _fail(f"--resume-from: must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} pushes)")
+    if (replan_threshold or final_tolerance) and not closed_loop:
+        _fail("--replan-threshold and --final-tolerance: only with --closed-loop")
+    loop = None
+    if closed_loop:
+        from stablepush.closed_loop import ClosedLoop
+
+        loop = ClosedLoop.for_task(task, replan_threshold, final_tolerance)
     deviated = mu_scale != 1.0 or any(tracker_noise)
     if deviated and not (sim and arm is None):
         _fail("--sim-mu-scale and --tracker-noise: only with --sim (a simulated arm started here)")
@@ -380,7 +398,9 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
         bar.__enter__()
     seen = [resume_from]
 
-    def progress(waypoint, confirmed):
+    def progress(waypoint, confirmed, total):
+        if bar is not None and total - resume_from != bar.length:  # a re-plan changed the plan's length
+            bar.length = total - resume_from
         if bar is not None and confirmed > seen[0]:
             bar.label = f"{task.name}: step {confirmed} ({waypoint.phase})"
             bar.update(confirmed - seen[0])
@@ -388,7 +408,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
 
     try:
         report = execute_plan(task, steps, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
-                              reset=reset, ack_timeout=ack_timeout, progress=progress)
+                              reset=reset, ack_timeout=ack_timeout, closed_loop=loop, progress=progress)
     except ExecutionFault as fault:
         if bar is not None:
             bar.__exit__(None, None, None)
@@ -422,6 +442,14 @@ def _print_report(report) -> None:
     click.echo(f"final pose in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
                f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg; "
                f"to the task's goal {report.goal_error['distance']:.3f} mm, {report.goal_error['theta']:+.3f} deg")
+    if report.closed_loop == "no tracker":
+        click.echo("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
+    for r in report.replans:
+        dx, dz, dth = (m - p for m, p in zip(r.measured, r.planned))
+        outcome = (f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}"
+                   f"{' (same pusher)' if r.kept_pusher else ''}" if r.solved else "no new plan in time; kept the old")
+        click.echo(f"  after step {r.after_step}: off the plan by {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; "
+                   f"{outcome} in {r.planning_ms:.1f} ms")
     for c in report.contacts:
         if c.slip_mm is not None:
             click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} slip at the pusher "

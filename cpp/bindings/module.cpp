@@ -179,7 +179,8 @@ PYBIND11_MODULE(_core, m) {
   py::enum_<PlanOutcome>(m, "PlanOutcome")
       .value("goal_reached", PlanOutcome::GoalReached)
       .value("goal_over_switch_limit", PlanOutcome::GoalOverSwitchLimit)
-      .value("time_limit", PlanOutcome::TimeLimit);
+      .value("time_limit", PlanOutcome::TimeLimit)
+      .value("invalid_start", PlanOutcome::InvalidStart);
 
   py::class_<PlanStats>(m, "PlanStats")
       .def_readonly("planning_time_s", &PlanStats::planning_time_s)

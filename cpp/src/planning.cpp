@@ -30,10 +30,12 @@ ob::RealVectorBounds sampling_region(const StablePushModel& model, const Planner
   const double grow = settings.sampling_margin * settings.step.length;
   const double turn = settings.sampling_margin * settings.step.angle;
   ob::RealVectorBounds bounds(3);
-  bounds.setLow(0, std::max(-reach, std::min(a.x, b.x) - grow));
-  bounds.setHigh(0, std::min(reach, std::max(a.x, b.x) + grow));
-  bounds.setLow(1, std::max(-reach, std::min(a.z, b.z) - grow));
-  bounds.setHigh(1, std::min(reach, std::max(a.z, b.z) + grow));
+  // The start and the goal always lie inside (a re-plan may start where no pad holds the object;
+  // the validity checker then refuses it, rather than OMPL dropping it as out of bounds).
+  bounds.setLow(0, std::min({std::max(-reach, std::min(a.x, b.x) - grow), a.x, b.x}));
+  bounds.setHigh(0, std::max({std::min(reach, std::max(a.x, b.x) + grow), a.x, b.x}));
+  bounds.setLow(1, std::min({std::max(-reach, std::min(a.z, b.z) - grow), a.z, b.z}));
+  bounds.setHigh(1, std::max({std::min(reach, std::max(a.z, b.z) + grow), a.z, b.z}));
   bounds.setLow(2, std::min(a.theta, b.theta) - turn);
   bounds.setHigh(2, std::max(a.theta, b.theta) + turn);
   return bounds;
@@ -82,6 +84,14 @@ Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& set
   Plan plan;
   plan.outcome = planner.outcome();
   const std::vector<PathNode> nodes = planner.solution();
+  if (nodes.empty()) {  // no valid start (the pads do not hold the object there): the start alone
+    plan.outcome = PlanOutcome::InvalidStart;
+    plan.waypoints.push_back({settings.start, kNoPusher, std::numeric_limits<double>::quiet_NaN(),
+                              ContactCase::AllSliding});
+    plan.goal_distance = space->distance(settings.start, settings.goal);
+    plan.stats.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return plan;
+  }
   plan.waypoints.push_back({nodes.front().pose, kNoPusher, std::numeric_limits<double>::quiet_NaN(),
                             ContactCase::AllSliding});
   for (std::size_t i = 1; i < nodes.size(); ++i) {

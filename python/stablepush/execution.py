@@ -159,17 +159,21 @@ def contacts_of(steps: Sequence[PlanStep]) -> List[Contact]:
     return out
 
 
-def place_features(task: Task, steps: Sequence[PlanStep]) -> Dict[str, Feature]:
-    """One feature per pusher the plan uses. The task's `environment.features` gives the object's
-    world pose on a feature; otherwise pusher k (in order of first use) gets a station k
-    `station_spacing` mm along +y from home, and the feature is placed where the pusher touches the
-    object at the start of its first contact with G at that station, axes aligned with W (so the
-    task's gravity, given in G, is W's there)."""
+def place_features(task: Task, steps: Sequence[PlanStep], every_pusher: bool = False) -> Dict[str, Feature]:
+    """One feature per pusher the plan uses (with `every_pusher`, then one for each other pusher of
+    the task, as if its first contact began at the plan's start: a re-planned run may use it). The
+    task's `environment.features` gives the object's world pose on a feature; otherwise pusher k
+    (in order of first use) gets a station k `station_spacing` mm along +y from home, and the
+    feature is placed where the pusher touches the object at the start of its first contact with G
+    at that station, axes aligned with W (so the task's gravity, given in G, is W's there)."""
     env = task.environment
     model = task.build_model()
     home = np.asarray(env["home"], float) * MM
     features: Dict[str, Feature] = {}
-    for contact in contacts_of(steps):
+    contacts = contacts_of(steps)
+    if every_pusher:
+        contacts += [Contact(name, 0, 0) for name in task.pusher_names]
+    for contact in contacts:
         name = contact.pusher
         if name in features:
             continue

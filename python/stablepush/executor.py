@@ -8,17 +8,20 @@ continues.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import socket
 import time
+from collections import deque
 from dataclasses import dataclass, field
 from typing import Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
 from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
-from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, place_features, pose_to_matrix,
-                                  scene_description)
+from stablepush.closed_loop import ClosedLoop, Replan, replan, switches_left
+from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, grasp_transform, place_features,
+                                  pose_to_matrix, scene_description)
 from stablepush.task import MM, Task, TaskError, pose_to_si
 
 DEFAULT_ACK_TIMEOUT = 5.0  # s to wait for any reply
@@ -63,6 +66,9 @@ class ExecutionReport:
     features: List[dict] = field(default_factory=list)
     wall_time_s: float = 0.0
     sim_steps_per_s: Optional[float] = None
+    # "off", "on", or "no tracker" (closed loop asked for, but the arm reports no object_in_grasp)
+    closed_loop: str = "off"
+    replans: List[Replan] = field(default_factory=list)
 
     @property
     def final_error(self) -> Optional[Dict[str, float]]:
@@ -99,6 +105,7 @@ class ExecutionReport:
             "released_in_grasp": self.released_in_grasp, "release_change": self.release_change,
             "contacts": [c.__dict__ for c in self.contacts], "features": self.features,
             "wall_time_s": self.wall_time_s, "sim_steps_per_s": self.sim_steps_per_s,
+            "closed_loop": self.closed_loop, "replans": [r.as_dict() for r in self.replans],
         }
 
 
@@ -182,27 +189,37 @@ def execute_plan(
     pace: bool = True,
     reset: bool = False,
     ack_timeout: float = DEFAULT_ACK_TIMEOUT,
-    progress: Optional[Callable[[ArmWaypoint, int], None]] = None,
+    closed_loop: Optional[ClosedLoop] = None,
+    progress: Optional[Callable[[ArmWaypoint, int, int], None]] = None,
 ) -> ExecutionReport:
     """Stream the plan from step `resume_from` to the arm server at host:port. `pace` holds the
     stream to rate_hz in wall-clock time (a real arm); without it waypoints go as fast as they are
-    acknowledged (a simulator keeps its own clock). `progress(waypoint, n)` is called per ack."""
-    features = place_features(task, steps)
+    acknowledged (a simulator keeps its own clock). With `closed_loop`, the tracker's pose after
+    each push is compared with the plan's and, past its threshold, the rest of the run is re-planned
+    from the measured pose and spliced into the stream (`stablepush.closed_loop`); the world then
+    holds a feature for every pusher of the task. `progress(waypoint, confirmed_step, total_steps)`
+    is called per ack."""
+    steps = list(steps)
+    features = place_features(task, steps, every_pusher=closed_loop is not None)
     scene = scene_description(task, features, steps[resume_from].pose)
     started = time.perf_counter()
     last_confirmed = resume_from
+    replans: List[Replan] = []
+    loop_status = "off" if closed_loop is None else "on"
     link = None
     try:
         link = _Link(host, port, ack_timeout)
         link.send({"type": "hello", "protocol": PROTOCOL, "rate_hz": rate_hz, "scene": scene, "reset": reset})
         ready = _expect(link.receive(), "ready")
-        waypoints = arm_trajectory(task, steps, features, rate_hz, ready["state"]["ee_pose"], resume_from)
+        pending = deque(arm_trajectory(task, steps, features, rate_hz, ready["state"]["ee_pose"], resume_from))
         contacts: Dict[int, ContactRecord] = {}
         touch_state: Optional[dict] = None
         state = ready["state"]
         settled: Optional[dict] = None
+        sent = 0
         next_time = time.perf_counter()
-        for w in waypoints:
+        while pending:
+            w = pending.popleft()
             if pace:
                 next_time += 1.0 / rate_hz
                 time.sleep(max(0.0, next_time - time.perf_counter()))
@@ -210,18 +227,29 @@ def execute_plan(
             reply = _expect(link.receive(), "ack")
             if reply["seq"] != w.seq:
                 raise ProtocolError(f"out-of-order acknowledgement: expected seq {w.seq}, got {reply['seq']}")
+            sent += 1
             if w.phase == "push" and state is not None and touch_state is None:
                 touch_state = state  # the object as it came to rest on the feature
             state = reply["state"]
             if w.completes:
                 last_confirmed = w.step
                 _record(contacts, task, steps, features, w.step, touch_state, state)
+            # Compare after each push but the last, and once the object has come to rest after it.
+            at_rest = w.phase == "settle" and not (pending and pending[0].phase == "settle")
+            if loop_status == "on" and ((w.completes and w.step < len(steps) - 1) or at_rest):
+                if "object_in_grasp" not in state:
+                    loop_status = "no tracker"  # the cell reports no pose in the grasp: open loop
+                elif closed_loop.may_replan(replans):
+                    spliced = _correct(task, steps, features, closed_loop, w, state, rate_hz, replans)
+                    if spliced is not None:
+                        steps, new_points = spliced
+                        pending = deque(dataclasses.replace(p, seq=w.seq + 1 + p.seq, t=w.t + p.t) for p in new_points)
             if w.phase != "push":
                 touch_state = None
             if w.phase == "settle":
                 settled = state
             if progress is not None:
-                progress(w, last_confirmed)
+                progress(w, last_confirmed, len(steps) - 1)
         link.send({"type": "bye"})
     except (ConnectionError, TimeoutError, ProtocolError, OSError, KeyError) as exc:
         stopped = _stop(link) if link is not None else None
@@ -232,11 +260,38 @@ def execute_plan(
             link.close()
     return ExecutionReport(
         task=task.name, resumed_from=resume_from, last_confirmed_step=last_confirmed, total_steps=len(steps) - 1,
-        waypoints=len(waypoints), planned_final=steps[-1].pose, goal=task.goal,
+        waypoints=sent, planned_final=steps[-1].pose, goal=task.goal,
         final_in_grasp=(settled or state).get("object_in_grasp"), released_in_grasp=state.get("object_in_grasp"),
         contacts=list(contacts.values()), features=[f.as_dict() for f in features.values()],
         wall_time_s=time.perf_counter() - started, sim_steps_per_s=state.get("steps_per_s"),
+        closed_loop=loop_status, replans=replans,
     )
+
+
+def _correct(task: Task, steps: List[PlanStep], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
+             state: dict, rate_hz: float, replans: List[Replan]):
+    """After plan step w.step: when the tracked pose is off the plan (or, at rest after the last
+    push, off the goal) by more than the loop allows, re-plan from it and return the spliced steps and the
+    waypoints that carry them out from where G is now (seq and t counted from this waypoint);
+    else None. `features` is updated in place: the object's pose on the current feature becomes
+    the measured one (G's pose times the tracked pose in the grasp), so the rest of this contact
+    pushes from where the object really is."""
+    k = w.step
+    tracked = state["object_in_grasp"]
+    last = k == len(steps) - 1
+    if not loop.off_by(tracked, task.goal if last else steps[k].pose, loop.final_tolerance if last else loop.threshold):
+        return None
+    measured = (float(tracked["x"]), float(tracked["z"]), float(tracked["theta"]))
+    record, new_steps = replan(task, measured, steps[k].pusher, switches_left(steps, k), loop, k, steps[k].pose)
+    replans.append(record)
+    if not record.solved or record.pushes == 0:
+        return None
+    pusher = steps[k].pusher
+    on_feature = pose_to_matrix(state["ee_pose"]) @ grasp_transform(measured)
+    features[pusher] = dataclasses.replace(features[pusher], object_pose=on_feature)
+    spliced = steps[:k] + [PlanStep(measured, pusher)] + new_steps[1:]
+    points = arm_trajectory(task, spliced, features, rate_hz, state["ee_pose"], resume_from=k)
+    return spliced, points
 
 
 def _expect(message: dict, kind: str) -> dict:

@@ -19,6 +19,7 @@ OUTCOME_NAMES = {
     _core.PlanOutcome.goal_reached: "goal_reached",
     _core.PlanOutcome.goal_over_switch_limit: "goal_over_switch_limit",
     _core.PlanOutcome.time_limit: "time_limit",
+    _core.PlanOutcome.invalid_start: "invalid_start",
 }
 
 
@@ -50,7 +51,7 @@ class Waypoint:
 class PlanResult:
     task: str
     solved: bool  # the goal is reached within tolerance with at most max_switches switch-overs
-    outcome: str  # goal_reached | goal_over_switch_limit | time_limit
+    outcome: str  # goal_reached | goal_over_switch_limit | time_limit | invalid_start
     message: str
     waypoints: List[Waypoint]
     stats: Dict[str, float] = field(default_factory=dict)
@@ -139,5 +140,7 @@ def _message(outcome: str, stats: dict) -> str:
         return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out with the goal reached only with "
                 f"{stats['switches']} switch-overs (max_switches {stats['max_switches']}); the plan written is that "
                 f"one; allow it with --max-switches {stats['switches']}")
+    if outcome == "invalid_start":
+        return "not solved: the pads do not hold the object at the start pose"
     return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out before the goal was reached; "
             f"the best partial path ends {stats['goal_distance_steps']:.1f} unit steps from the goal")

@@ -52,6 +52,7 @@ enum class PlanOutcome {
   GoalReached,          ///< a node within the goal tolerance with at most max_switches switch-overs
   GoalOverSwitchLimit,  ///< time ran out; the goal was reached, but only with more switch-overs
   TimeLimit,            ///< time ran out before the goal was reached; the path ends closest to it
+  InvalidStart,         ///< the pads do not hold the object at the start: nothing was planned
 };
 
 /// One node of a solution path: the pose and the pusher of the push into it (kNoPusher at the start).

@@ -1,0 +1,110 @@
+"""Closed-loop execution (issue 9): with a sticking pusher the object's pose in the grasp is
+observable, so after each push the executor compares the tracker's pose (`object_in_grasp` in the
+arm protocol) with the plan's and, past a threshold, re-plans from the measured pose.
+
+The policy lives here; `executor.py` streams and splices. A re-plan
+- aims at the task's goal within the final tolerance (a run is checked again at rest after its
+  last push, and corrected again while it is off by more);
+- first tries the pusher that is pushing now alone (no switch-over: the object stays on its
+  feature), then every pusher of the task, with at most as many switch-overs as the rest of the
+  current plan has: a switch-over carries the object between features in the pads alone, and the
+  model does not yet say which poses the pads can hold there (issue 9, item 5), so a correction
+  never adds one;
+- takes milliseconds (the planner's own time; limits below), between two waypoints.
+Poses are (x mm, z mm, theta deg), as in plan files.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Dict, List, Optional, Sequence, Tuple
+
+from stablepush.execution import PlanStep
+from stablepush.planning import PlanResult, plan_task
+from stablepush.task import Task
+
+THRESHOLD_FRACTION = 0.5  # default threshold: this fraction of the task's goal tolerance
+FINAL_FRACTION = 0.2  # default final tolerance: this fraction of the task's goal tolerance
+KEEP_PUSHER_TIME_LIMIT = 0.05  # s for the re-plan with the current pusher alone
+REPLAN_TIME_LIMIT = 0.5  # s for the re-plan with every pusher (or the task's limit, if lower)
+MAX_REPLANS = 20  # per run: a world that keeps undoing the corrections is reported, not chased
+MAX_FAILED_REPLANS = 3  # per run: past this, a pose the planner cannot leave is reported, not retried
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """When to re-plan: after a push, when the measured pose is off the planned one by more than
+    `threshold` (mm, deg) in x, z or theta; after the last push, when it is off the goal by more
+    than `final_tolerance` (mm, deg)."""
+
+    threshold: Tuple[float, float]
+    final_tolerance: Tuple[float, float]
+    max_replans: int = MAX_REPLANS
+    max_failed_replans: int = MAX_FAILED_REPLANS
+
+    @classmethod
+    def for_task(cls, task: Task, threshold: Optional[Sequence[float]] = None,
+                 final_tolerance: Optional[Sequence[float]] = None) -> "ClosedLoop":
+        tol = task.planner["tolerance"]
+        return cls(threshold=tuple(threshold) if threshold else (THRESHOLD_FRACTION * tol[0], THRESHOLD_FRACTION * tol[1]),
+                   final_tolerance=tuple(final_tolerance) if final_tolerance else (FINAL_FRACTION * tol[0], FINAL_FRACTION * tol[1]))
+
+    def may_replan(self, replans: Sequence["Replan"]) -> bool:
+        """Whether the run may still re-plan, given the re-plans it made."""
+        failed = sum(1 for r in replans if not r.solved)
+        return len(replans) < self.max_replans and failed < self.max_failed_replans
+
+    def off_by(self, measured: Dict[str, float], pose: Sequence[float], limit: Tuple[float, float]) -> bool:
+        dx, dz, dth = deviation(measured, pose)
+        return max(abs(dx), abs(dz)) > limit[0] or abs(dth) > limit[1]
+
+
+@dataclass(frozen=True)
+class Replan:
+    """One correction: after plan step `after_step` the object was measured at `measured` where
+    the plan had `planned`; the new plan from there (None when none was found in time)."""
+
+    after_step: int
+    measured: Tuple[float, float, float]
+    planned: Tuple[float, float, float]
+    solved: bool
+    pushers: List[str]  # the new plan's pushers, one per contact
+    pushes: int
+    kept_pusher: bool  # the new plan continues with the pusher that was pushing
+    planning_ms: float
+
+    def as_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+
+def switches_left(steps: Sequence[PlanStep], k: int) -> int:
+    """Switch-overs in the plan after step k."""
+    return sum(1 for a, b in zip(steps[k:], steps[k + 1:]) if a.pusher != b.pusher)
+
+
+def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float, float, float]:
+    """The measured pose minus `pose`: x mm, z mm, theta deg."""
+    return measured["x"] - pose[0], measured["z"] - pose[1], measured["theta"] - pose[2]
+
+
+def replan(task: Task, measured: Sequence[float], pusher: str, switches: int, loop: ClosedLoop,
+           after_step: int, planned: Sequence[float]) -> Tuple[Replan, List[PlanStep]]:
+    """Plan from the measured pose to the task's goal, keeping `pusher` (the one pushing now) when
+    it can do it alone, else with at most `switches` switch-overs. Returns the record and the new
+    plan's steps (empty when none was found); the first step is the measured pose."""
+    tolerance = list(loop.final_tolerance)
+    base = dataclasses.replace(task, start=tuple(measured),
+                               planner={**task.planner, "tolerance": tolerance})
+    spec = task.pushers[task.pusher_index(pusher)]
+    alone = dataclasses.replace(base, pushers=(spec,),
+                                planner={**base.planner, "max_switches": 0, "time_limit": KEEP_PUSHER_TIME_LIMIT})
+    result: PlanResult = plan_task(alone)
+    elapsed = result.stats["planning_time_s"]
+    if not result.solved and switches > 0:
+        result = plan_task(base, time_limit=min(REPLAN_TIME_LIMIT, task.planner["time_limit"]), max_switches=switches)
+        elapsed += result.stats["planning_time_s"]
+    steps = [PlanStep((w.x, w.z, w.theta), w.pusher) for w in result.waypoints] if result.solved else []
+    record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=result.solved,
+                    pushers=result.pusher_sequence if result.solved else [], pushes=max(len(steps) - 1, 0),
+                    kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3)
+    return record, steps
