@@ -161,3 +161,35 @@ class IndependentModel:
             return False, -math.inf
         assert res.status == 0, res.message
         return res.x[-1] > 0, res.x[-1]
+
+    def hold_ratio(self, q):
+        """The largest lambda with lambda * weight balanced by the pad points' friction polygons at
+        rest (every point sticks; each point's force a convex combination of its polygon's
+        vertices, scaled by beta_j in [0, 1]), by HiGHS; inf without gravity."""
+        if not np.any(self.gravity):
+            return math.inf
+        R = rot(q[2])
+        c = np.array(q[:2])
+        r_cm = R @ self.com
+        weight = self.mass * self.gravity  # in G
+        cols = []
+        for p, limit, _ in self.pad_points:
+            arm = p - c
+            for vtx in range(self.sides):
+                a = 2 * math.pi * vtx / self.sides
+                f = limit * np.array([math.cos(a), math.sin(a)])
+                cols.append([f[0], f[1], torque(arm, f)])
+        n = len(cols) + 1  # vertex weights, then lambda
+        A_eq = np.zeros((3, n))
+        A_eq[:, :-1] = np.array(cols).T
+        A_eq[:, -1] = [weight[0], weight[1], torque(r_cm, weight)]  # sum W(f) + lambda w_gravity = 0
+        b_eq = np.zeros(3)
+        A_ub = np.zeros((len(self.pad_points), n))
+        for j in range(len(self.pad_points)):  # sum_v beta_jv <= 1 (the polygon with its interior)
+            A_ub[j, j * self.sides:(j + 1) * self.sides] = 1.0
+        c_obj = np.zeros(n)
+        c_obj[-1] = -1.0
+        res = linprog(c_obj, A_ub=A_ub, b_ub=np.ones(len(self.pad_points)), A_eq=A_eq, b_eq=b_eq,
+                      bounds=[(0, None)] * n, method="highs")
+        assert res.status == 0, res.message
+        return res.x[-1]

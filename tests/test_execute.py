@@ -290,8 +290,7 @@ def test_closed_loop_on_an_arm_without_a_tracker_runs_open_loop_and_says_so():
 
 
 def test_closed_loop_thresholds_default_to_fractions_of_the_task_tolerance():
-    from stablepush.closed_loop import ClosedLoop, switches_left
-    from stablepush.execution import PlanStep
+    from stablepush.closed_loop import ClosedLoop
 
     task = shipped("t-shaped")  # tolerance [1, 1]
     loop = ClosedLoop.for_task(task)
@@ -299,8 +298,20 @@ def test_closed_loop_thresholds_default_to_fractions_of_the_task_tolerance():
     assert ClosedLoop.for_task(task, (0.3, 0.4)).threshold == (0.3, 0.4)
     assert loop.off_by({"x": 1.0, "z": 0.0, "theta": 0.0}, (0.4, 0.0, 0.0), loop.threshold)
     assert not loop.off_by({"x": 1.0, "z": 0.0, "theta": 0.4}, (0.6, 0.0, 0.0), loop.threshold)
-    steps = [PlanStep((0, 0, 0), None)] + [PlanStep((i, 0, 0), p) for i, p in enumerate("aabbba", start=1)]
-    assert [switches_left(steps, k) for k in range(1, 7)] == [2, 2, 1, 1, 1, 0]
+
+
+def test_a_correction_that_would_carry_an_unheld_object_between_features_is_refused():
+    """At the high-mu offset's end the pads hold only 0.91 of the prism's weight: a correction by
+    the right pusher would carry it there unheld (tried, it ended 21.7 mm / 61 deg off), so the
+    re-plan is refused; from the start pose, where the pads hold 4.3 times it, it is taken."""
+    from stablepush.closed_loop import ClosedLoop, replan
+
+    task = shipped("horizontal-offset-high-mu")
+    loop = ClosedLoop.for_task(task)
+    record, steps = replan(task, (20.095, -0.223, 0.449), "left", loop, 20, (20.0, 0.0, 0.0))
+    assert not record.solved and steps == []
+    record, steps = replan(task, (0.1, -0.1, 0.3), "left", loop, 1, (1.0, 0.0, 0.0))
+    assert record.solved and steps[0].pose == (0.1, -0.1, 0.3)
 
 
 def test_closed_loop_options_need_closed_loop(high_mu_plan):

@@ -195,3 +195,41 @@ def test_default_inertia_about_a_given_com_uses_parallel_axes():
     off = task_with("horizontal-offset-low-mu", lambda d: d["object"].update(com=[10, 0])).build_model().body
     assert off.inertia == pytest.approx(base.inertia + 0.202 * 0.010**2, rel=1e-12)
     np.testing.assert_allclose(off.com, [0.010, 0.0])
+
+
+def test_a_centred_grasp_holds_its_weight_by_the_pads_friction_2_mu_n_over_m_g():
+    """Hand-derived: centred, gravity straight down, the pads' polygons have a vertex on +z, so the
+    largest weight they hold is 2 mu N; the ratio is 2 mu N / (m g) = 8.5 / 1.98162."""
+    task = shipped("horizontal-offset-low-mu")  # 202 g, mu 0.425, 10 N, pads at the centroid
+    ratio = task.build_model().hold_ratio(pose_to_si(task.start))
+    assert ratio == pytest.approx(2 * 0.425 * 10 / (0.202 * 9.81), rel=1e-9)
+
+
+def test_hold_ratio_agrees_with_an_independent_lp_and_is_infinite_without_gravity():
+    import random
+
+    from independent_lp import IndependentModel
+
+    rng = random.Random(7)
+    for name in ("horizontal-offset-low-mu", "large-manipulation", "t-shaped"):
+        task = shipped(name)
+        model, reference = task.build_model(), IndependentModel(task)
+        for _ in range(40):
+            q = (rng.uniform(-20, 20), rng.uniform(-10, 10), rng.uniform(-90, 90))
+            if not model.grasp_maintained(pose_to_si(q)):
+                continue
+            assert model.hold_ratio(pose_to_si(q)) == pytest.approx(reference.hold_ratio(pose_to_si(q)), rel=1e-6), (name, q)
+    assert math.isinf(shipped("pivoting").build_model().hold_ratio((0.0, 0.0, 0.0)))
+
+
+def test_released_at_the_offsets_goal_the_prism_is_not_held_and_the_planner_can_require_a_held_goal():
+    from stablepush.planning import plan_task
+
+    task = shipped("horizontal-offset-high-mu")
+    free = plan_task(task)
+    assert free.solved and free.final_hold_ratio < 1.0  # the sim turns it 15 deg on release (README)
+    held = plan_task(task_with("horizontal-offset-high-mu", lambda d: d["planner"].update(min_hold_ratio=1.0)),
+                     time_limit=0.5)
+    assert not held.solved and "min_hold_ratio" in held.message  # no pose within 0.5 mm of x = 20 holds it
+    large = plan_task(task_with("large-manipulation", lambda d: d["planner"].update(min_hold_ratio=1.0)))
+    assert large.solved and large.final_hold_ratio >= 1.0

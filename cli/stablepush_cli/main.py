@@ -122,6 +122,11 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
                    f"{s['switches']} switch-over(s), pushers {' -> '.join(result.pusher_sequence) or '(none)'}; "
                    f"{s['iterations']} iterations, {s['nodes']} nodes, {s['feasibility_checks']} checks")
         click.echo(f"plan written to {json_path}" + (f" and {csv_path}" if csv_path else ""))
+    hold = result.final_hold_ratio
+    if hold < 1.0:
+        click.echo(f"note: at the plan's last pose the pads alone hold only {hold:.2f} times the object's weight: "
+                   f"released there, it moves in the grasp (planner.min_hold_ratio: 1 asks for a pose they hold)",
+                   err=True)
 
 
 @cli.command()

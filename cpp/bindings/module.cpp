@@ -145,6 +145,8 @@ PYBIND11_MODULE(_core, m) {
       .def("check_all", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq) {
         return m.check_all(to_pose(q), to_pose(dq));
       }, py::arg("q"), py::arg("dq"))
+      .def("hold_ratio", [](const StablePushModel& m, const std::array<double, 3>& q) { return m.hold_ratio(to_pose(q)); },
+           py::arg("q"), "The largest multiple of the weight the pads alone hold at rest at q (>= 1: held; inf: no gravity).")
       .def("grasp_maintained", [](const StablePushModel& m, const std::array<double, 3>& q) {
         return m.grasp_maintained(to_pose(q));
       }, py::arg("q"))
@@ -222,16 +224,19 @@ PYBIND11_MODULE(_core, m) {
 
   m.def("plan", [](const StablePushModel& model, const std::array<double, 3>& start, const std::array<double, 3>& goal,
                    const std::array<double, 2>& step, const std::array<double, 2>& tolerance, double time_limit,
-                   double min_margin, double sampling_margin, const std::map<std::string, std::string>& parameters) {
+                   double min_margin, double sampling_margin, const std::map<std::string, std::string>& parameters,
+                   double min_hold_ratio) {
           PlannerSettings settings{to_pose(start), to_pose(goal), to_step(step), to_step(tolerance), time_limit,
-                                   min_margin, sampling_margin, parameters};
+                                   min_margin, sampling_margin, min_hold_ratio, parameters};
           py::gil_scoped_release release;
           return plan_stable_pushes(model, settings);
         },
         py::arg("model"), py::arg("start"), py::arg("goal"), py::arg("step"), py::arg("tolerance"),
         py::arg("time_limit"), py::arg("min_margin"), py::arg("sampling_margin"), py::arg("parameters"),
+        py::arg("min_hold_ratio") = 0.0,
         "Plan stable pushes with TRRTstar. start, goal: (x m, z m, theta rad); step, tolerance: (m, rad);\n"
         "time_limit [s]; min_margin [N]; sampling_margin [unit steps]; parameters: TRRTstar's declared\n"
-        "parameters by name, as text.");
+        "parameters by name, as text; min_hold_ratio: the plan must end where the pads alone hold this\n"
+        "multiple of the weight (0: no requirement).");
   m.attr("TRRT_STAR_PARAMETERS") = trrt_star_parameters();
 }

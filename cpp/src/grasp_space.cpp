@@ -128,11 +128,14 @@ bool StablePushValidator::checkMotion(const ob::State* a, const ob::State* b,
   return false;
 }
 
-PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance)
+PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance,
+                   const StablePushModel* hold, double min_hold_ratio)
     : ob::GoalSampleableRegion(si),
       space_(*si->getStateSpace()->as<GraspPoseSpace>()),
       goal_(goal),
-      tolerance_(tolerance) {
+      tolerance_(tolerance),
+      hold_(min_hold_ratio > 0.0 ? hold : nullptr),
+      min_hold_ratio_(min_hold_ratio) {
   // OMPL's threshold: no state farther than this (unit steps) from the goal pose satisfies it.
   const double x = tolerance_.length / space_.step().length;
   const double t = tolerance_.angle / space_.step().angle;
@@ -141,8 +144,9 @@ PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize
 
 bool PoseGoal::isSatisfied(const ob::State* s) const {
   const Pose q = GraspPoseSpace::pose(s);
-  return std::abs(q.x - goal_.x) <= tolerance_.length && std::abs(q.z - goal_.z) <= tolerance_.length &&
-         std::abs(q.theta - goal_.theta) <= tolerance_.angle;
+  const bool near = std::abs(q.x - goal_.x) <= tolerance_.length && std::abs(q.z - goal_.z) <= tolerance_.length &&
+                    std::abs(q.theta - goal_.theta) <= tolerance_.angle;
+  return near && (hold_ == nullptr || hold_->hold_ratio(q) >= min_hold_ratio_);
 }
 
 bool PoseGoal::isSatisfied(const ob::State* s, double* distance) const {

@@ -73,7 +73,7 @@ Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& set
   ob::ScopedState<GraspPoseSpace> start(space);
   GraspPoseSpace::set_pose(start.get(), settings.start);
   pdef->addStartState(start);
-  pdef->setGoal(std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance));
+  pdef->setGoal(std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance, &model, settings.min_hold_ratio));
 
   TRRTstar planner(si);
   apply_parameters(planner, settings.parameters);

@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include <Eigen/LU>
+
 #include "motion_terms.hpp"
 #include "stablepush/small_lp.hpp"
 
@@ -86,6 +88,49 @@ MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq) con
   load.required = Wrench(force_in_O.x(), force_in_O.y(), loads.torque_sum);
   load.scale = loads.scale;
   return load;
+}
+
+double StablePushModel::hold_ratio(const Pose& q) const {
+  const Vec2 weight = body_.mass * gravity_;  // in G [N]
+  if (weight.isZero()) return std::numeric_limits<double>::infinity();
+  const Vec2 origin(q.x, q.z);
+  const Vec2 r_cm = Rotation2(q.theta).apply(body_.com);
+  std::vector<StickingGroup> groups;
+  for (const PadPoint& point : gripper_.points()) add_sticking_point(groups, point.position - origin, point.friction_limit);
+
+  // Unknowns x = (f_1, ..., f_G, lambda), forces in G. Balance in G about O's origin:
+  //   sum f_g + lambda W = 0,   sum arm_g x f_g + lambda (r_cm x W) = 0   (E x = 0),
+  // solved on E's null space x = N y (y = 0 is feasible), with every f_g in its polygon.
+  const int n = 2 * static_cast<int>(groups.size()) + 1;
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(3, n);
+  for (int g = 0; g < static_cast<int>(groups.size()); ++g) {
+    E(0, 2 * g) = 1.0;
+    E(1, 2 * g + 1) = 1.0;
+    E(2, 2 * g) = groups[g].arm.y();  // cross_y(arm, f) = arm_z f_x - arm_x f_z
+    E(2, 2 * g + 1) = -groups[g].arm.x();
+  }
+  E(0, n - 1) = weight.x();
+  E(1, n - 1) = weight.y();
+  E(2, n - 1) = cross_y(r_cm, weight);
+  const Eigen::MatrixXd N = Eigen::FullPivLU<Eigen::MatrixXd>(E).kernel();
+
+  constexpr double kCap = 1e3;  // lambda beyond this is reported as this: held a thousand times over
+  const int rows = static_cast<int>(groups.size()) * polygon_sides_ + 1;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(rows, n);
+  Eigen::VectorXd b(rows);
+  int r = 0;
+  for (int g = 0; g < static_cast<int>(groups.size()); ++g)
+    for (int k = 0; k < polygon_sides_; ++k, ++r) {
+      A.block<1, 2>(r, 2 * g) = polygon_normals_[k].transpose();
+      b[r] = groups[g].friction_limit * polygon_inradius_;
+    }
+  A(r, n - 1) = 1.0;
+  b[r] = kCap;
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
+  c[n - 1] = 1.0;
+  const SmallLpResult lp = maximize_from_feasible(A * N, b, N.transpose() * c, Eigen::VectorXd::Zero(N.cols()), 1000);
+  if (lp.status != SmallLpResult::Status::Optimal) throw std::runtime_error("hold_ratio: the LP did not converge");
+  return (N * lp.x)[n - 1];
 }
 
 PushResult StablePushModel::check(const Pose& q, const Motion& dq, int pusher) const {

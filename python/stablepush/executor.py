@@ -19,7 +19,7 @@ from typing import Callable, Dict, List, Optional, Sequence
 import numpy as np
 
 from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
-from stablepush.closed_loop import ClosedLoop, Replan, replan, switches_left
+from stablepush.closed_loop import ClosedLoop, Replan, replan
 from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, grasp_transform, place_features,
                                   pose_to_matrix, scene_description)
 from stablepush.task import MM, Task, TaskError, pose_to_si
@@ -282,7 +282,7 @@ def _correct(task: Task, steps: List[PlanStep], features: Dict[str, Feature], lo
     if not loop.off_by(tracked, task.goal if last else steps[k].pose, loop.final_tolerance if last else loop.threshold):
         return None
     measured = (float(tracked["x"]), float(tracked["z"]), float(tracked["theta"]))
-    record, new_steps = replan(task, measured, steps[k].pusher, switches_left(steps, k), loop, k, steps[k].pose)
+    record, new_steps = replan(task, measured, steps[k].pusher, loop, k, steps[k].pose)
     replans.append(record)
     if not record.solved or record.pushes == 0:
         return None

@@ -4,6 +4,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -35,6 +36,10 @@ def plan_to_dict(plan: PlanResult) -> dict:
         "outcome": plan.outcome,
         "message": plan.message,
         "stats": dict(plan.stats),
+        # Released at the last waypoint, do the pads alone hold the object? ratio: the largest
+        # multiple of its weight they hold there (null without gravity: any grasp holds).
+        "final_hold": {"ratio": None if math.isinf(plan.final_hold_ratio) else plan.final_hold_ratio,
+                       "holds": plan.final_hold_ratio >= 1.0},
         "units": {"x": "mm", "z": "mm", "theta": "deg", "margin": "N", "pusher_in_gripper": "mm in G"},
         "waypoints": [_waypoint_dict(w) for w in plan.waypoints],
     }

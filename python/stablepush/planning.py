@@ -55,6 +55,9 @@ class PlanResult:
     message: str
     waypoints: List[Waypoint]
     stats: Dict[str, float] = field(default_factory=dict)
+    # The largest multiple of the weight the pads alone hold at the last waypoint (>= 1: released
+    # there, the object stays; inf without gravity). StablePushModel.hold_ratio.
+    final_hold_ratio: float = math.inf
 
     @property
     def pusher_sequence(self) -> List[str]:
@@ -101,6 +104,7 @@ def plan_task(
     raw = _core.plan(
         model, pose_to_si(task.start), pose_to_si(task.goal), step, tolerance, float(settings["time_limit"]),
         float(settings["min_margin"]), float(settings["sampling_margin"]), parameters,
+        float(settings["min_hold_ratio"]),
     )
 
     names = task.pusher_names
@@ -127,9 +131,12 @@ def plan_task(
         "pushes": len(waypoints) - 1,
         "path_length_steps": s.length,
         "goal_distance_steps": raw.goal_distance,
+        "min_hold_ratio": float(settings["min_hold_ratio"]),
     }
+    last = waypoints[-1]
     return PlanResult(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
-                      message=_message(outcome, stats), waypoints=waypoints, stats=stats)
+                      message=_message(outcome, stats), waypoints=waypoints, stats=stats,
+                      final_hold_ratio=model.hold_ratio(pose_to_si((last.x, last.z, last.theta))))
 
 
 def _message(outcome: str, stats: dict) -> str:
@@ -142,5 +149,7 @@ def _message(outcome: str, stats: dict) -> str:
                 f"one; allow it with --max-switches {stats['switches']}")
     if outcome == "invalid_start":
         return "not solved: the pads do not hold the object at the start pose"
-    return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out before the goal was reached; "
+    held = (f" where the pads alone hold {stats['min_hold_ratio']:g} times the weight (planner.min_hold_ratio)"
+            if stats["min_hold_ratio"] > 0 else "")
+    return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out before the goal was reached{held}; "
             f"the best partial path ends {stats['goal_distance_steps']:.1f} unit steps from the goal")

@@ -40,6 +40,7 @@ PLANNER_DEFAULTS: Dict[str, Any] = {
     "tolerance": [1.0, 1.0],  # mm, deg
     "min_margin": 1e-3,  # N: least depth inside the pusher's cone for a push to count
     "sampling_margin": 5.0,  # unit steps around the start-goal box
+    "min_hold_ratio": 0.0,  # the plan must end where the pads alone hold this multiple of the weight (0: off)
 }
 # TRRTstar's tuning parameters (declared OMPL parameters; their defaults live in the C++ planner,
 # _core.TRRT_STAR_PARAMETERS): key -> (kind, lowest, highest).
@@ -412,7 +413,7 @@ def _validate_planner(value: Any) -> Dict[str, Any]:
     for key in ("step", "tolerance"):
         if key in planner:
             out[key] = list(_vector(f"planner.{key}", planner[key], 2, positive=True))
-    for key in ("min_margin", "sampling_margin"):
+    for key in ("min_margin", "sampling_margin", "min_hold_ratio"):
         if key in planner:
             out[key] = _number(f"planner.{key}", planner[key], nonnegative=True)
     for key, (kind, lowest, highest) in PLANNER_TUNING.items():

@@ -112,7 +112,10 @@ class StablePushValidator : public ompl::base::MotionValidator {
 /// |dtheta| <= tolerance.angle). distanceGoal is the distance in unit steps.
 class PoseGoal : public ompl::base::GoalSampleableRegion {
  public:
-  PoseGoal(const ompl::base::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance);
+  /// With `hold` (a model and min_hold_ratio > 0), a pose within tolerance satisfies the goal only
+  /// when the pads alone hold the object there with that factor (StablePushModel::hold_ratio).
+  PoseGoal(const ompl::base::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance,
+           const StablePushModel* hold = nullptr, double min_hold_ratio = 0.0);
 
   const Pose& pose() const { return goal_; }
   bool isSatisfied(const ompl::base::State* s) const override;
@@ -125,6 +128,8 @@ class PoseGoal : public ompl::base::GoalSampleableRegion {
   const GraspPoseSpace& space_;
   Pose goal_;
   StepSize tolerance_;
+  const StablePushModel* hold_;
+  double min_hold_ratio_;
 };
 
 }  // namespace stablepush

@@ -22,6 +22,9 @@ struct PlannerSettings {
   double min_margin = 1e-3;     ///< least depth inside the pusher's cone for a push to count [N]
   /// Samples are drawn from the box spanned by start and goal, grown by this many unit steps.
   double sampling_margin = 5.0;
+  /// The plan must end where the pads alone hold the object with this factor of its weight
+  /// (StablePushModel::hold_ratio); 0: no such requirement.
+  double min_hold_ratio = 0.0;
   /// TRRTstar's declared parameters by name (seed, max_switches, goal_bias, ...); values as text.
   std::map<std::string, std::string> parameters;
 };

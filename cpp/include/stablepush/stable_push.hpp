@@ -93,6 +93,14 @@ class StablePushModel {
   /// The test against a motion wrench already computed for (q, dq).
   PushResult check(const MotionWrench& load, const Pose& q, const Motion& dq, int pusher) const;
 
+  /// Whether the pads alone hold the object at rest at q, with no pusher (the grasp at the end of a
+  /// plan, or between two features): the largest factor lambda such that lambda times the weight
+  /// (m g at the centre of mass) is balanced by friction forces of the pad points, all sticking
+  /// at rest, each in its friction polygon (grouped by location as in the sticking case). The
+  /// grasp holds the object when lambda >= 1; +infinity without gravity. Double precision: a
+  /// report and a goal filter, not a certified decision.
+  double hold_ratio(const Pose& q) const;
+
   /// Every pad disc inside the cross-section at q.
   bool grasp_maintained(const Pose& q) const { return gripper_.grasp_maintained(section_, q); }
 
