@@ -54,7 +54,11 @@ class IndependentModel:
         else:
             d = centroid - self.com
             self.inertia = self.mass * (jc / area + d @ d)
-        self.gravity = np.array(task.gravity, float)
+        self.gravity = np.array(task.gravity, float)  # in G while G's axes are the world's
+        # Against fixed features the object keeps its world orientation phi_p on pusher p's feature,
+        # so gravity is fixed in O and turns in G: g_G = R(theta - phi_p) g (MODEL.md section 7).
+        self.fixed_features = task.pushes == "against_fixed_features"
+        self.feature_angles = [math.radians(task.feature_angle(p.name)) for p in task.pushers]
         self.dt = task.step_time
         self.sides = task.friction_polygon_sides
         k = 1 + sum(6 * i for i in range(1, task.pad_rings + 1))
@@ -100,7 +104,12 @@ class IndependentModel:
                 gens.append([e[0], e[1], torque(p, e)])
         return np.array(gens)
 
-    def motion_terms(self, q, dq):
+    def gravity_in_gripper(self, q, pusher):
+        if not self.fixed_features or pusher is None:
+            return self.gravity
+        return rot(q[2] - self.feature_angles[pusher]) @ self.gravity
+
+    def motion_terms(self, q, dq, pusher):
         """(w_motion in O, [(arm in G, friction limit) for each sticking point], R)."""
         R = rot(q[2])
         c = np.array(q[:2])
@@ -110,7 +119,7 @@ class IndependentModel:
         tau = 0.0
         r_cm = R @ self.com
         v_cm = v + w * np.array([r_cm[1], -r_cm[0]])
-        f = self.mass * (v_cm / self.dt - self.gravity)
+        f = self.mass * (v_cm / self.dt - self.gravity_in_gripper(q, pusher))
         F += f
         tau += torque(r_cm, f) + self.inertia * w / self.dt
         sticking = []
@@ -129,7 +138,7 @@ class IndependentModel:
 
     def stable(self, q, dq, pusher):
         """(feasible, s*) by HiGHS."""
-        w, sticking, R = self.motion_terms(q, dq)
+        w, sticking, R = self.motion_terms(q, dq, pusher)
         gens = self.cones[pusher]
         m = len(gens)
         cols = [g for g in gens]
@@ -162,16 +171,17 @@ class IndependentModel:
         assert res.status == 0, res.message
         return res.x[-1] > 0, res.x[-1]
 
-    def hold_ratio(self, q):
+    def hold_ratio(self, q, pusher=None):
         """The largest lambda with lambda * weight balanced by the pad points' friction polygons at
         rest (every point sticks; each point's force a convex combination of its polygon's
-        vertices, scaled by beta_j in [0, 1]), by HiGHS; inf without gravity."""
+        vertices, scaled by beta_j in [0, 1]), gravity as during a push by `pusher`, by HiGHS; inf
+        without gravity."""
         if not np.any(self.gravity):
             return math.inf
         R = rot(q[2])
         c = np.array(q[:2])
         r_cm = R @ self.com
-        weight = self.mass * self.gravity  # in G
+        weight = self.mass * self.gravity_in_gripper(q, pusher)  # in G
         cols = []
         for p, limit, _ in self.pad_points:
             arm = p - c

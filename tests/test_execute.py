@@ -318,3 +318,19 @@ def test_closed_loop_options_need_closed_loop(high_mu_plan):
     plan, task = high_mu_plan
     result = CliRunner().invoke(cli, ["execute", plan, "--task", task, "--sim", "--replan-threshold", "0.3", "0.3"])
     assert result.exit_code == 2 and "--closed-loop" in result.output
+
+
+def test_features_hold_the_object_at_the_world_orientation_the_model_assumes():
+    """Against fixed features the model keeps the object's world orientation on each feature (the
+    start's unless environment.features says): the executor places them so, turning G instead."""
+    import math
+
+    from stablepush.execution import PlanStep, place_features
+
+    task = shipped("large-manipulation")  # start theta 0
+    steps = [PlanStep((0.0, 0.0, 0.0), None), PlanStep((0.0, 0.0, 5.0), "bottom"), PlanStep((0.0, 0.0, 10.0), "left")]
+    features = place_features(task, steps)
+    for name in ("bottom", "left"):
+        R = features[name].object_pose[:3, :3]
+        assert task.feature_angle(name) == 0.0
+        assert math.degrees(math.atan2(R[0, 2], R[0, 0])) == pytest.approx(0.0, abs=1e-9)  # not the 5 deg left starts at

@@ -233,3 +233,33 @@ def test_released_at_the_offsets_goal_the_prism_is_not_held_and_the_planner_can_
     assert not held.solved and "min_hold_ratio" in held.message  # no pose within 0.5 mm of x = 20 holds it
     large = plan_task(task_with("large-manipulation", lambda d: d["planner"].update(min_hold_ratio=1.0)))
     assert large.solved and large.final_hold_ratio >= 1.0
+
+
+def test_against_fixed_features_gravity_turns_in_g_and_stays_fixed_in_o():
+    """Hand-derived (README, "Gravity during a push"): on a feature the object keeps its world
+    orientation phi_p, so G turns by phi_p - theta and gravity in G is R(theta - phi_p) g; pushed
+    by a moving pusher, gravity stays g in G."""
+    g = np.array([0.0, -9.81])
+    fixed = shipped("large-manipulation")  # dynamics.pushes defaults to against_fixed_features
+    moving = task_with("large-manipulation", lambda d: d["dynamics"].update(pushes="by_moving_pusher"))
+    tilted = task_with("large-manipulation", lambda d: d.setdefault("environment", {}).update(
+        features={"left": [400, 0, 300, 30]}))  # the object sits on the left feature turned 30 deg
+    for theta_deg in (0.0, 20.0, 45.0):
+        q = (0.0, 0.0, math.radians(theta_deg))
+        t = math.radians(theta_deg)
+        R = np.array([[math.cos(t), math.sin(t)], [-math.sin(t), math.cos(t)]])  # R(theta)
+        left = fixed.pusher_index("left")
+        np.testing.assert_allclose(fixed.build_model().gravity_in_gripper(q, left), R @ g, atol=1e-12)
+        np.testing.assert_allclose(moving.build_model().gravity_in_gripper(q, left), g, atol=1e-12)
+        a = math.radians(theta_deg - 30.0)
+        R30 = np.array([[math.cos(a), math.sin(a)], [-math.sin(a), math.cos(a)]])
+        np.testing.assert_allclose(tilted.build_model().gravity_in_gripper(q, left), R30 @ g, atol=1e-12)
+        # The motion wrench carries it: the force in O differs from the moving pusher's by
+        # -m (g - R^T g) (the weight is g in O against fixed features, R^T g with a moving pusher).
+        dq = (1e-3, 0.0, 0.0)
+        w_fixed = np.array(fixed.build_model().motion_wrench(q, dq, left).required)
+        w_moving = np.array(moving.build_model().motion_wrench(q, dq, left).required)
+        m = fixed.mass * 1e-3
+        np.testing.assert_allclose(w_fixed[:2] - w_moving[:2], -m * (g - R.T @ g), atol=1e-12)
+    with pytest.raises(Exception, match="dynamics.pushes"):
+        task_with("large-manipulation", lambda d: d["dynamics"].update(pushes="sideways"))

@@ -126,27 +126,42 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("sticking_points", &MotionWrench::sticking_points)
       .def_readonly("scale", &MotionWrench::scale);
 
+  py::enum_<GravityFrame>(m, "GravityFrame", "The frame in which gravity is fixed during a push")
+      .value("gripper", GravityFrame::Gripper)
+      .value("object", GravityFrame::Object);
+
   py::class_<StablePushModel>(m, "StablePushModel")
-      .def(py::init<CrossSection, RigidBody, Gripper, std::vector<Pusher>, const Vec2&, double, int>(),
+      .def(py::init<CrossSection, RigidBody, Gripper, std::vector<Pusher>, const Vec2&, double, int, GravityFrame,
+                    std::vector<double>>(),
            py::arg("section"), py::arg("body"), py::arg("gripper"), py::arg("pushers"), py::arg("gravity"),
-           py::arg("step_time"), py::arg("friction_polygon_sides") = 16)
+           py::arg("step_time"), py::arg("friction_polygon_sides") = 16, py::arg("gravity_frame") = GravityFrame::Gripper,
+           py::arg("feature_angles") = std::vector<double>{},
+           "gravity: in G's plane when G's axes are the world's [m/s^2]; gravity_frame, feature_angles (the\n"
+           "object's world orientation on each pusher's feature [rad]): how gravity turns during a push.")
+      .def_property_readonly("gravity_frame", &StablePushModel::gravity_frame)
+      .def("gravity_in_gripper", [](const StablePushModel& m, const std::array<double, 3>& q, int pusher) {
+        return m.gravity_in_gripper(to_pose(q), pusher);
+      }, py::arg("q"), py::arg("pusher"), "gravity in G [m/s^2] at q during a push by `pusher` (-1: G's axes the world's)")
       .def_property_readonly("section", &StablePushModel::section)
       .def_property_readonly("body", &StablePushModel::body)
       .def_property_readonly("gripper", &StablePushModel::gripper)
       .def_property_readonly("pushers", &StablePushModel::pushers)
       .def_property_readonly("pusher_cones", &StablePushModel::pusher_cones)
       .def_property_readonly("torque_length", &StablePushModel::torque_length)
-      .def("motion_wrench", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq) {
-        return m.motion_wrench(to_pose(q), to_pose(dq));
-      }, py::arg("q"), py::arg("dq"))
+      .def("motion_wrench", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq,
+                               int pusher) { return m.motion_wrench(to_pose(q), to_pose(dq), pusher); },
+           py::arg("q"), py::arg("dq"), py::arg("pusher") = 0)
       .def("check", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq,
                        int pusher) { return m.check(to_pose(q), to_pose(dq), pusher); },
            py::arg("q"), py::arg("dq"), py::arg("pusher"))
       .def("check_all", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq) {
         return m.check_all(to_pose(q), to_pose(dq));
       }, py::arg("q"), py::arg("dq"))
-      .def("hold_ratio", [](const StablePushModel& m, const std::array<double, 3>& q) { return m.hold_ratio(to_pose(q)); },
-           py::arg("q"), "The largest multiple of the weight the pads alone hold at rest at q (>= 1: held; inf: no gravity).")
+      .def("hold_ratio", [](const StablePushModel& m, const std::array<double, 3>& q, int pusher) {
+        return m.hold_ratio(to_pose(q), pusher);
+      }, py::arg("q"), py::arg("pusher") = kNoPusher,
+           "The largest multiple of the weight the pads alone hold at rest at q, gravity as during a push by\n"
+           "`pusher` (-1: G's axes the world's); >= 1: held; inf: no gravity.")
       .def("grasp_maintained", [](const StablePushModel& m, const std::array<double, 3>& q) {
         return m.grasp_maintained(to_pose(q));
       }, py::arg("q"))

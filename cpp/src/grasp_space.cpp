@@ -89,11 +89,13 @@ PusherSet StablePushValidator::stable_pushers(const Pose& a, const Pose& b, Push
     const Pose& to = poses[i + 1];
     if (!model_.gripper().grasp_maintained_along(model_.section(), from, to)) return 0;
     const Motion dq{to.x - from.x, to.z - from.z, to.theta - from.theta};
-    const MotionWrench load = model_.motion_wrench(from, dq);
+    // One motion wrench for every pusher, unless gravity depends on the pusher (GravityFrame).
+    const bool shared = !model_.gravity_depends_on_pusher();
+    const MotionWrench load = model_.motion_wrench(from, dq, 0);
     for (int p = 0; p < kMaxPushers; ++p) {
       if (!contains(candidates, p)) continue;
       ++checks_;
-      const PushResult r = model_.check(load, from, dq, p);
+      const PushResult r = shared ? model_.check(load, from, dq, p) : model_.check(from, dq, p);
       if (!(r.feasible && r.margin >= min_margin_)) candidates &= ~(PusherSet{1} << p);
     }
   }
@@ -144,9 +146,12 @@ PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize
 
 bool PoseGoal::isSatisfied(const ob::State* s) const {
   const Pose q = GraspPoseSpace::pose(s);
-  const bool near = std::abs(q.x - goal_.x) <= tolerance_.length && std::abs(q.z - goal_.z) <= tolerance_.length &&
-                    std::abs(q.theta - goal_.theta) <= tolerance_.angle;
-  return near && (hold_ == nullptr || hold_->hold_ratio(q) >= min_hold_ratio_);
+  return std::abs(q.x - goal_.x) <= tolerance_.length && std::abs(q.z - goal_.z) <= tolerance_.length &&
+         std::abs(q.theta - goal_.theta) <= tolerance_.angle;
+}
+
+bool PoseGoal::held(const Pose& q, int last_pusher) const {
+  return hold_ == nullptr || hold_->hold_ratio(q, last_pusher) >= min_hold_ratio_;
 }
 
 bool PoseGoal::isSatisfied(const ob::State* s, double* distance) const {

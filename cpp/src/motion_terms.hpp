@@ -9,7 +9,7 @@
 namespace stablepush {
 
 template <class Loads>
-void StablePushModel::visit_motion_terms(const Pose& q, const Motion& dq, Loads& loads) const {
+void StablePushModel::visit_motion_terms(const Pose& q, const Motion& dq, const Vec2& gravity, Loads& loads) const {
   const Rotation2 rotation(q.theta);
   const double dt = step_time_;
   const Vec2 origin(q.x, q.z);
@@ -21,7 +21,7 @@ void StablePushModel::visit_motion_terms(const Pose& q, const Motion& dq, Loads&
   // mass: the force m (v_cm / dt - g) at r_cm plus the pure torque I omega / dt.
   const Vec2 r_cm = rotation.apply(body_.com);
   const Vec2 v_cm = v + omega_cross(omega, r_cm);
-  loads.force(body_.mass * (v_cm / dt - gravity_), r_cm);
+  loads.force(body_.mass * (v_cm / dt - gravity), r_cm);
   loads.torque(body_.inertia * omega / dt);
 
   // Fingers: a sliding point exerts -mu N/k v_j/|v_j| (maximum dissipation), so -w_sliding adds

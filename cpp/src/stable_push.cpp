@@ -55,12 +55,15 @@ inline Vec2 pull_back(const Wrench& w, const Rotation2& R, const Vec2& arm) {
 }  // namespace
 
 StablePushModel::StablePushModel(CrossSection section, RigidBody body, Gripper gripper, std::vector<Pusher> pushers,
-                                 const Vec2& gravity, double step_time, int friction_polygon_sides)
+                                 const Vec2& gravity, double step_time, int friction_polygon_sides,
+                                 GravityFrame gravity_frame, std::vector<double> feature_angles)
     : section_(std::move(section)),
       body_(body),
       gripper_(std::move(gripper)),
       pushers_(std::move(pushers)),
       gravity_(gravity),
+      gravity_frame_(gravity_frame),
+      feature_angles_(std::move(feature_angles)),
       step_time_(step_time),
       torque_length_(section_.circumradius()),
       polygon_sides_(friction_polygon_sides) {
@@ -70,6 +73,10 @@ StablePushModel::StablePushModel(CrossSection section, RigidBody body, Gripper g
   if (!gravity_.allFinite()) throw std::invalid_argument("gravity must be finite");
   if (polygon_sides_ < 3) throw std::invalid_argument("friction_polygon_sides must be >= 3");
   if (pushers_.empty()) throw std::invalid_argument("at least one pusher is needed");
+  if (feature_angles_.empty()) feature_angles_.assign(pushers_.size(), 0.0);
+  if (feature_angles_.size() != pushers_.size()) throw std::invalid_argument("one feature angle per pusher is needed");
+  for (double a : feature_angles_)
+    if (!std::isfinite(a)) throw std::invalid_argument("feature angles must be finite");
   for (const Pusher& pusher : pushers_) cones_.emplace_back(pusher.cone_generators(), torque_length_);
   // The polygon inscribed in the friction disc has its vertices at angles 2 pi k / sides (the
   // first on +x of G); edge k then has its outward normal at angle pi (2k + 1) / sides.
@@ -77,12 +84,19 @@ StablePushModel::StablePushModel(CrossSection section, RigidBody body, Gripper g
   polygon_inradius_ = std::cos(M_PI / polygon_sides_);
 }
 
-MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq) const {
+Vec2 StablePushModel::gravity_in_gripper(const Pose& q, int pusher) const {
+  if (gravity_frame_ == GravityFrame::Gripper || pusher == kNoPusher) return gravity_;
+  if (pusher < 0 || pusher >= static_cast<int>(pushers_.size())) throw std::out_of_range("pusher index");
+  return Rotation2(q.theta - feature_angles_[pusher]).apply(gravity_);  // R(theta - phi_p) g
+}
+
+MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq, int pusher) const {
   if (dq.x == 0.0 && dq.z == 0.0 && dq.theta == 0.0) throw std::invalid_argument("the motion dq is zero");
   MotionWrench load;
+  load.gravity = gravity_in_gripper(q, pusher);
   DoubleLoads loads{1.0 / torque_length_};
   loads.out = &load;
-  visit_motion_terms(q, dq, loads);
+  visit_motion_terms(q, dq, load.gravity, loads);
   load.rotation = Rotation2(q.theta);
   const Vec2 force_in_O = load.rotation.apply_inverse(loads.force_sum);
   load.required = Wrench(force_in_O.x(), force_in_O.y(), loads.torque_sum);
@@ -90,8 +104,8 @@ MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq) con
   return load;
 }
 
-double StablePushModel::hold_ratio(const Pose& q) const {
-  const Vec2 weight = body_.mass * gravity_;  // in G [N]
+double StablePushModel::hold_ratio(const Pose& q, int pusher) const {
+  const Vec2 weight = body_.mass * gravity_in_gripper(q, pusher);  // in G [N]
   if (weight.isZero()) return std::numeric_limits<double>::infinity();
   const Vec2 origin(q.x, q.z);
   const Vec2 r_cm = Rotation2(q.theta).apply(body_.com);
@@ -134,14 +148,17 @@ double StablePushModel::hold_ratio(const Pose& q) const {
 }
 
 PushResult StablePushModel::check(const Pose& q, const Motion& dq, int pusher) const {
-  return check(motion_wrench(q, dq), q, dq, pusher);
+  return check(motion_wrench(q, dq, pusher), q, dq, pusher);
 }
 
 std::vector<PushResult> StablePushModel::check_all(const Pose& q, const Motion& dq) const {
-  const MotionWrench load = motion_wrench(q, dq);
+  MotionWrench load = motion_wrench(q, dq, 0);
   std::vector<PushResult> results;
   results.reserve(cones_.size());
-  for (int p = 0; p < static_cast<int>(cones_.size()); ++p) results.push_back(check(load, q, dq, p));
+  for (int p = 0; p < static_cast<int>(cones_.size()); ++p) {
+    if (p > 0 && gravity_depends_on_pusher()) load = motion_wrench(q, dq, p);
+    results.push_back(check(load, q, dq, p));
+  }
   return results;
 }
 

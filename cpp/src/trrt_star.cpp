@@ -254,7 +254,8 @@ void TRRTstar::rewire(Node* node, const std::vector<Node*>& near) {
 }
 
 void TRRTstar::note_goal_candidate(Node* node) {
-  if (pdef_->getGoal()->isSatisfied(node->state)) goal_nodes_.push_back(node);
+  const auto* goal = pdef_->getGoal()->as<PoseGoal>();
+  if (goal->isSatisfied(node->state) && goal->held(node->pose, node->pusher)) goal_nodes_.push_back(node);
   if (closest_ == nullptr || node->goal_distance < closest_->goal_distance ||
       (node->goal_distance == closest_->goal_distance && node->cost < closest_->cost))
     closest_ = node;

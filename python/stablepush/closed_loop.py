@@ -89,8 +89,9 @@ def _transits_held(task: Task, steps: Sequence[PlanStep], pusher: str) -> bool:
     model = task.build_model()
     previous = pusher
     for before, step in zip(steps, steps[1:]):
-        if step.pusher != previous and model.hold_ratio(pose_to_si(before.pose)) < TRANSIT_HOLD_RATIO:
-            return False
+        if step.pusher != previous:  # leaving `previous`'s feature: gravity in G as on that feature
+            if model.hold_ratio(pose_to_si(before.pose), task.pusher_index(previous)) < TRANSIT_HOLD_RATIO:
+                return False
         previous = step.pusher
     return True
 

@@ -165,7 +165,9 @@ def place_features(task: Task, steps: Sequence[PlanStep], every_pusher: bool = F
     task's `environment.features` gives the object's world pose on a feature; otherwise pusher k
     (in order of first use) gets a station k `station_spacing` mm along +y from home, and the
     feature is placed where the pusher touches the object at the start of its first contact with G
-    at that station, axes aligned with W (so the task's gravity, given in G, is W's there)."""
+    at that station, turned about y so that the object's world orientation there is the one the
+    model assumes for this feature (`Task.feature_angle`: the start's unless environment.features
+    says otherwise). Gravity in the world is the task's gravity (G's axes are W's at home)."""
     env = task.environment
     model = task.build_model()
     home = np.asarray(env["home"], float) * MM
@@ -181,9 +183,13 @@ def place_features(task: Task, steps: Sequence[PlanStep], every_pusher: bool = F
             x, y, z, theta = env["features"][name]
             T_WO = translation(np.array([x, y, z]) * MM)
             T_WO[:3, :3] = rot_y(math.radians(theta))
-        else:
+        else:  # G at the station, turned so that the object has the world orientation the model
+            # assumes on this feature (Task.feature_angle): G's turn plus theta is that angle
             station = home + np.array([0.0, len(features) * env["station_spacing"] * MM, 0.0])
-            T_WO = translation(station) @ grasp_transform(steps[contact.first].pose)
+            q_first = steps[contact.first].pose
+            T_WG = translation(station)
+            T_WG[:3, :3] = rot_y(math.radians(task.feature_angle(name) - q_first[2]))
+            T_WO = T_WG @ grasp_transform(q_first)
         index = task.pusher_index(name)
         spec = task.pushers[index]
         n_O = np.array(model.pushers[index].inward_normal, float)

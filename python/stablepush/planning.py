@@ -55,8 +55,8 @@ class PlanResult:
     message: str
     waypoints: List[Waypoint]
     stats: Dict[str, float] = field(default_factory=dict)
-    # The largest multiple of the weight the pads alone hold at the last waypoint (>= 1: released
-    # there, the object stays; inf without gravity). StablePushModel.hold_ratio.
+    # The largest multiple of the weight the pads alone hold at the last waypoint, gravity as during
+    # the last push (>= 1: released there, the object stays; inf without gravity). hold_ratio.
     final_hold_ratio: float = math.inf
 
     @property
@@ -136,7 +136,8 @@ def plan_task(
     last = waypoints[-1]
     return PlanResult(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
                       message=_message(outcome, stats), waypoints=waypoints, stats=stats,
-                      final_hold_ratio=model.hold_ratio(pose_to_si((last.x, last.z, last.theta))))
+                      final_hold_ratio=model.hold_ratio(pose_to_si((last.x, last.z, last.theta)),
+                                                        names.index(last.pusher) if last.pusher else -1))
 
 
 def _message(outcome: str, stats: dict) -> str:

@@ -20,6 +20,10 @@ G = 1e-3  # kg per g
 DEFAULT_PAD_RADIUS_MM = 5.0
 DEFAULT_GRAVITY = (0.0, -9.81)
 DEFAULT_STEP_TIME = 0.1
+# How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
+# (README, "Gravity during a push"): against features fixed in the world, the object keeps its
+# world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
+PUSHES = ("against_fixed_features", "by_moving_pusher")
 DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
@@ -172,7 +176,7 @@ class Task:
     mu: float  # pad-object friction
     pad_rings: int
     pads: Tuple[Tuple[Tuple[float, float], float], ...]  # (centre mm in G, radius mm)
-    gravity: Tuple[float, float]  # m/s^2 in G
+    gravity: Tuple[float, float]  # m/s^2 in G while G's axes are the world's (at the home pose)
     step_time: float  # s
     friction_polygon_sides: int
     pushers: Tuple[PusherSpec, ...]
@@ -181,6 +185,14 @@ class Task:
     planner: Dict[str, Any] = field(default_factory=dict)
     environment: Dict[str, Any] = field(default_factory=dict)  # the world around the arm, see ENVIRONMENT_DEFAULTS
     source: Optional[str] = None
+    pushes: str = PUSHES[0]  # see PUSHES
+
+    def feature_angle(self, pusher: str) -> float:
+        """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
+        feature: environment.features gives it, else the start's (the executor places the
+        features so; stablepush.execution.place_features)."""
+        pose = self.environment.get("features", {}).get(pusher)
+        return float(pose[3]) if pose is not None else float(self.start[2])
 
     @property
     def pusher_names(self) -> List[str]:
@@ -210,8 +222,11 @@ class Task:
         pushers = [
             _core.Pusher.on_boundary(section, p.name, _mm2(p.a), _mm2(p.b), p.mu, p.points) for p in self.pushers
         ]
+        fixed = self.pushes == "against_fixed_features"
         return _core.StablePushModel(
-            section, body, gripper, pushers, self.gravity, self.step_time, self.friction_polygon_sides
+            section, body, gripper, pushers, self.gravity, self.step_time, self.friction_polygon_sides,
+            _core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
+            [math.radians(self.feature_angle(p.name)) for p in self.pushers],
         )
 
 
@@ -293,7 +308,10 @@ def _validate(data: Any, source: Optional[str]) -> Task:
         pads = (((0.0, 0.0), DEFAULT_PAD_RADIUS_MM), ((0.0, 0.0), DEFAULT_PAD_RADIUS_MM))
 
     gravity = _vector("gravity", top.get("gravity", list(DEFAULT_GRAVITY)), 2)
-    dyn = _mapping("dynamics", top.get("dynamics", {}), [], ["step_time", "friction_polygon_sides"])
+    dyn = _mapping("dynamics", top.get("dynamics", {}), [], ["step_time", "friction_polygon_sides", "pushes"])
+    pushes = dyn.get("pushes", PUSHES[0])
+    if pushes not in PUSHES:
+        raise TaskError("dynamics.pushes", f"must be one of {', '.join(PUSHES)}, got {pushes!r}")
     step_time = _number("dynamics.step_time", dyn.get("step_time", DEFAULT_STEP_TIME), positive=True)
     sides = _integer("dynamics.friction_polygon_sides", dyn.get("friction_polygon_sides", DEFAULT_POLYGON_SIDES), 3)
 
@@ -313,7 +331,7 @@ def _validate(data: Any, source: Optional[str]) -> Task:
         name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
         grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
         friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner,
-        environment=environment, source=source,
+        environment=environment, source=source, pushes=pushes,
     )
 
 

@@ -27,7 +27,6 @@ struct StepSize {
 /// Pushers as a set: bit i stands for pusher i. At most kMaxPushers pushers per task.
 using PusherSet = std::uint32_t;
 inline constexpr int kMaxPushers = 32;
-inline constexpr int kNoPusher = -1;
 inline bool contains(PusherSet set, int pusher) { return pusher >= 0 && ((set >> pusher) & 1u); }
 
 /// The grasp poses (x [m], z [m], theta [rad]) with the metric
@@ -112,14 +111,16 @@ class StablePushValidator : public ompl::base::MotionValidator {
 /// |dtheta| <= tolerance.angle). distanceGoal is the distance in unit steps.
 class PoseGoal : public ompl::base::GoalSampleableRegion {
  public:
-  /// With `hold` (a model and min_hold_ratio > 0), a pose within tolerance satisfies the goal only
-  /// when the pads alone hold the object there with that factor (StablePushModel::hold_ratio).
+  /// With `hold` (a model and min_hold_ratio > 0), a node within tolerance ends a plan only when
+  /// the pads alone hold the object there with that factor (`held`, StablePushModel::hold_ratio).
   PoseGoal(const ompl::base::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance,
            const StablePushModel* hold = nullptr, double min_hold_ratio = 0.0);
 
   const Pose& pose() const { return goal_; }
   bool isSatisfied(const ompl::base::State* s) const override;
   bool isSatisfied(const ompl::base::State* s, double* distance) const override;
+  /// Whether a plan may end at q after a push by `last_pusher` (always, without a hold requirement).
+  bool held(const Pose& q, int last_pusher) const;
   double distanceGoal(const ompl::base::State* s) const override;
   void sampleGoal(ompl::base::State* s) const override;
   unsigned int maxSampleCount() const override { return 1; }

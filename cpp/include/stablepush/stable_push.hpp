@@ -27,10 +27,19 @@ namespace stablepush {
 
 /// Relative width of the band around a cone boundary inside which a double answer is re-made exactly.
 inline constexpr double kCertificationBand = 1e-9;
+/// "No pusher": the start of a plan, or the object held by the pads alone.
+inline constexpr int kNoPusher = -1;
 /// A pad point sticks when its slip speed is below this fraction of |v| + |omega| r_pad (MODEL.md section 2).
 inline constexpr double kStickingSpeedRatio = 1e-9;
 
 enum class ContactCase { AllSliding, Sticking };
+
+/// The frame in which gravity is fixed during a push (docs: README, "Gravity during a push").
+/// Gripper: the pusher moves and the gripper stays (the paper's assumption): gravity is fixed in G.
+/// Object: the pusher is a feature fixed in the world and sticks, so on pusher p's feature the
+/// object keeps its world orientation phi_p and G turns by phi_p - theta: gravity is fixed in O,
+/// and in G it is R(theta - phi_p) g, with g the gravity in G when G's axes are the world's.
+enum class GravityFrame { Gripper, Object };
 
 /// Pad points at one location that stick during the motion; their friction discs add up.
 struct StickingGroup {
@@ -47,7 +56,8 @@ struct MotionWrench {
   int sticking_points = 0;
   /// Sum of the magnitudes of the terms [N] (torques divided by the model's torque length).
   double scale = 0.0;
-  Rotation2 rotation;  ///< R(theta) at the pose
+  Rotation2 rotation;       ///< R(theta) at the pose
+  Vec2 gravity = Vec2::Zero();  ///< the gravity in G used [m/s^2] (it depends on the pusher, see GravityFrame)
 };
 
 /// The answer of the stable-push test for one pusher.
@@ -67,10 +77,13 @@ struct PushResult {
 
 class StablePushModel {
  public:
-  /// gravity: acceleration in G's grasp plane [m/s^2]; step_time: dt of one unit step [s];
-  /// friction_polygon_sides: facets of the polygon inscribed in a sticking point's friction disc.
+  /// gravity: acceleration in G's grasp plane when G's axes are the world's [m/s^2]; step_time:
+  /// dt of one unit step [s]; friction_polygon_sides: facets of the polygon inscribed in a sticking
+  /// point's friction disc; gravity_frame and feature_angles (phi_p per pusher [rad], the object's
+  /// world orientation on its feature; default 0): see GravityFrame.
   StablePushModel(CrossSection section, RigidBody body, Gripper gripper, std::vector<Pusher> pushers,
-                  const Vec2& gravity, double step_time, int friction_polygon_sides = 16);
+                  const Vec2& gravity, double step_time, int friction_polygon_sides = 16,
+                  GravityFrame gravity_frame = GravityFrame::Gripper, std::vector<double> feature_angles = {});
 
   const CrossSection& section() const { return section_; }
   const RigidBody& body() const { return body_; }
@@ -78,19 +91,26 @@ class StablePushModel {
   const std::vector<Pusher>& pushers() const { return pushers_; }
   const std::vector<WrenchCone>& pusher_cones() const { return cones_; }
   const Vec2& gravity() const { return gravity_; }
+  GravityFrame gravity_frame() const { return gravity_frame_; }
+  const std::vector<double>& feature_angles() const { return feature_angles_; }
+  /// Gravity in G [m/s^2] at q during a push by `pusher` (kNoPusher: G's axes the world's).
+  Vec2 gravity_in_gripper(const Pose& q, int pusher) const;
+  /// Whether the gravity term, and so the motion wrench, differs between pushers.
+  bool gravity_depends_on_pusher() const { return gravity_frame_ == GravityFrame::Object; }
   double step_time() const { return step_time_; }
   /// Length that converts torques to forces in margins and bands [m]: the cross-section's circumradius.
   double torque_length() const { return torque_length_; }
   int friction_polygon_sides() const { return polygon_sides_; }
 
-  /// The motion wrench of a unit motion dq from pose q (twist xi = dq / dt, constant over the step).
-  MotionWrench motion_wrench(const Pose& q, const Motion& dq) const;
+  /// The motion wrench of a unit motion dq from pose q (twist xi = dq / dt, constant over the step)
+  /// when `pusher` pushes (its index selects the gravity, see GravityFrame).
+  MotionWrench motion_wrench(const Pose& q, const Motion& dq, int pusher) const;
 
   /// The stable-push test of dq from q for pusher `pusher` (an index into pushers()).
   PushResult check(const Pose& q, const Motion& dq, int pusher) const;
   /// The test for every pusher, sharing one motion wrench.
   std::vector<PushResult> check_all(const Pose& q, const Motion& dq) const;
-  /// The test against a motion wrench already computed for (q, dq).
+  /// The test against a motion wrench already computed for (q, dq) and this pusher's gravity.
   PushResult check(const MotionWrench& load, const Pose& q, const Motion& dq, int pusher) const;
 
   /// Whether the pads alone hold the object at rest at q, with no pusher (the grasp at the end of a
@@ -99,16 +119,19 @@ class StablePushModel {
   /// at rest, each in its friction polygon (grouped by location as in the sticking case). The
   /// grasp holds the object when lambda >= 1; +infinity without gravity. Double precision: a
   /// report and a goal filter, not a certified decision.
-  double hold_ratio(const Pose& q) const;
+  /// Gravity as during a push by `pusher` (the last one before the object is let go), or with G's
+  /// axes the world's for kNoPusher.
+  double hold_ratio(const Pose& q, int pusher) const;
 
   /// Every pad disc inside the cross-section at q.
   bool grasp_maintained(const Pose& q) const { return gripper_.grasp_maintained(section_, q); }
 
   /// Walks the terms of the motion wrench in G: loads.force(f, arm) for a force f [N] at arm [m]
   /// from O's origin, loads.torque(t) for a pure torque [N m], loads.sticking(arm, limit) for a
-  /// sticking pad point. Shared by the double and the exact evaluations so both see the same doubles.
+  /// sticking pad point; `gravity` in G [m/s^2]. Shared by the double and the exact evaluations so
+  /// both see the same doubles.
   template <class Loads>
-  void visit_motion_terms(const Pose& q, const Motion& dq, Loads& loads) const;
+  void visit_motion_terms(const Pose& q, const Motion& dq, const Vec2& gravity, Loads& loads) const;
 
  private:
   PushResult all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq) const;
@@ -123,6 +146,8 @@ class StablePushModel {
   std::vector<Pusher> pushers_;
   std::vector<WrenchCone> cones_;
   Vec2 gravity_;
+  GravityFrame gravity_frame_;
+  std::vector<double> feature_angles_;  ///< phi_p per pusher [rad]
   double step_time_;
   double torque_length_;
   int polygon_sides_;
