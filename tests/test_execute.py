@@ -334,3 +334,22 @@ def test_features_hold_the_object_at_the_world_orientation_the_model_assumes():
         R = features[name].object_pose[:3, :3]
         assert task.feature_angle(name) == 0.0
         assert math.degrees(math.atan2(R[0, 2], R[0, 0])) == pytest.approx(0.0, abs=1e-9)  # not the 5 deg left starts at
+
+
+def test_protocol_versions_arm_2_and_arm_1_are_both_served_and_others_refused():
+    task = shipped("horizontal-offset-high-mu")
+    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    from stablepush.execution import place_features, scene_description
+
+    scene = scene_description(task, place_features(task, steps), task.start)
+    with running_sim_arm(log=lambda text: None) as server:
+        for version in ("stablepush.arm/1", PROTOCOL):
+            with socket.create_connection((server.host, server.port), timeout=30) as conn:
+                conn.sendall(encode({"type": "hello", "protocol": version, "rate_hz": 100, "scene": scene}))
+                ready = decode(conn.makefile("rb").readline(), "server")
+                assert ready["type"] == "ready" and ready["protocol"] == version
+                assert {"x", "z", "theta"} <= set(ready["state"]["object_in_grasp"])  # the tracker field
+                conn.sendall(encode({"type": "bye"}))
+    assert PROTOCOL == "stablepush.arm/2"
+    with pytest.raises(ProtocolError, match="stablepush.arm/3"):
+        decode(encode({"type": "hello", "protocol": "stablepush.arm/3", "rate_hz": 100, "scene": {}}), "client")

@@ -313,7 +313,7 @@ def _host_port(value: str):
 @click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
               help="The task the plan was made for (checked against the plan before anything moves).")
 @click.option("--arm", "arm", default=None, metavar="HOST:PORT",
-              help="The arm server (stablepush.arm/1 protocol, see README). Default: with --sim a simulated arm "
+              help="The arm server (stablepush.arm/2 protocol, see README). Default: with --sim a simulated arm "
                    "started in this process, else 127.0.0.1:47100.")
 @click.option("--sim", is_flag=True, help="Start a simulated arm (MuJoCo) here and run the plan on it.")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),

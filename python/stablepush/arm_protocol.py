@@ -1,12 +1,16 @@
-"""The arm protocol `stablepush.arm/1`: JSON lines over TCP between the executor (client) and an
+"""The arm protocol `stablepush.arm/2`: JSON lines over TCP between the executor (client) and an
 arm server (`stablepush sim-arm`, or a user's bridge to a real robot).
+
+Versions: arm/2 defines the tracker field `state.object_in_grasp` (below), which the executor's
+closed loop reads; it is otherwise arm/1, and a server speaks the version the client's hello asks
+for (an arm/1 bridge keeps working: the executor only needs `ready` to name arm/1 or arm/2).
 
 One JSON object per line, UTF-8, each with a "type". Poses are [x, y, z, qw, qx, qy, qz] of the
 gripper frame G in the world, m. The exchange is lock-step: every waypoint is acknowledged before
 the next is sent.
 
 client -> server
-  {"type": "hello", "protocol": "stablepush.arm/1", "rate_hz": 100, "scene": {...}, "reset": false}
+  {"type": "hello", "protocol": "stablepush.arm/2", "rate_hz": 100, "scene": {...}, "reset": false}
       `scene` describes the world (stablepush.execution.scene_description); a real arm may ignore
       it. A simulator builds its world from it, or keeps the one it has when `reset` is false and
       the scene is the same (so a run can resume).
@@ -17,7 +21,7 @@ client -> server
   {"type": "bye"}       end of the run; the server keeps its state for a later connection
 
 server -> client
-  {"type": "ready", "protocol": "stablepush.arm/1", "arm": "...", "state": {...}}
+  {"type": "ready", "protocol": "stablepush.arm/2", "arm": "...", "state": {...}}
   {"type": "ack", "seq": 0, "state": {...}}
   {"type": "stopped", "state": {...}}
   {"type": "error", "seq": 3 or null, "message": "..."}   the server has stopped the arm
@@ -36,7 +40,8 @@ import json
 import math
 from typing import Any, Dict
 
-PROTOCOL = "stablepush.arm/1"
+PROTOCOL = "stablepush.arm/2"
+SUPPORTED_PROTOCOLS = ("stablepush.arm/1", PROTOCOL)
 DEFAULT_PORT = 47100
 DEFAULT_RATE_HZ = 100.0
 
@@ -85,8 +90,8 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
             raise ProtocolError("waypoint: field 'pose' must be 7 finite numbers [x, y, z, qw, qx, qy, qz]")
         if abs(math.sqrt(sum(v * v for v in pose[3:])) - 1.0) > 1e-6:
             raise ProtocolError("waypoint: the quaternion in 'pose' is not of unit length")
-    if kind == "hello" and message["protocol"] != PROTOCOL:
-        raise ProtocolError(f"hello: protocol {message['protocol']!r} is not {PROTOCOL!r}")
+    if kind in ("hello", "ready") and message["protocol"] not in SUPPORTED_PROTOCOLS:
+        raise ProtocolError(f"{kind}: protocol {message['protocol']!r} is not one of {', '.join(SUPPORTED_PROTOCOLS)}")
     return message
 
 

@@ -12,7 +12,7 @@ import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator, Optional
 
-from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
+from stablepush.arm_protocol import ProtocolError, decode, encode
 from stablepush.sim.arm import SimArm, WorldDeviation
 
 # The scene keys that describe the world; the object's pose at the start may differ on a resume.
@@ -74,7 +74,8 @@ class SimArmServer:
                         self._hello(message)
                         greeted = True
                         expected_seq = 0
-                        connection.sendall(encode({"type": "ready", "protocol": PROTOCOL, "arm": "stablepush sim-arm (MuJoCo)",
+                        connection.sendall(encode({"type": "ready", "protocol": message["protocol"],
+                                                   "arm": "stablepush sim-arm (MuJoCo)",
                                                    "state": self.arm.state()}))
                     elif kind == "waypoint":
                         if message["seq"] != expected_seq:
