@@ -2,8 +2,9 @@
 arm server (`stablepush sim-arm`, or a user's bridge to a real robot).
 
 Versions: arm/2 defines the tracker field `state.object_in_grasp` (below), which the executor's
-closed loop reads; it is otherwise arm/1, and a server speaks the version the client's hello asks
-for (an arm/1 bridge keeps working: the executor only needs `ready` to name arm/1 or arm/2).
+closed loop reads; it is otherwise arm/1. The simulated arm answers the version the client's hello
+asks for; a bridge written for arm/1 that checks the version refuses the executor's arm/2 hello,
+and needs only that check widened (nothing else changed).
 
 One JSON object per line, UTF-8, each with a "type". Poses are [x, y, z, qw, qx, qy, qz] of the
 gripper frame G in the world, m. The exchange is lock-step: every waypoint is acknowledged before
