@@ -67,7 +67,8 @@ class ClosedLoop:
 @dataclass(frozen=True)
 class Replan:
     """One correction: after plan step `after_step` the object was measured at `measured` where
-    the plan had `planned`; the new plan from there (None when none was found in time)."""
+    the plan had `planned`; whether a new plan from there was found and taken (`solved`), and its
+    pushers and length."""
 
     after_step: int
     measured: Tuple[float, float, float]
