@@ -89,13 +89,18 @@ PusherSet StablePushValidator::stable_pushers(const Pose& a, const Pose& b, Push
     const Pose& to = poses[i + 1];
     if (!model_.gripper().grasp_maintained_along(model_.section(), from, to)) return 0;
     const Motion dq{to.x - from.x, to.z - from.z, to.theta - from.theta};
-    // One motion wrench for every pusher, unless gravity depends on the pusher (GravityFrame).
-    const bool shared = !model_.gravity_depends_on_pusher();
-    const MotionWrench load = model_.motion_wrench(from, dq, 0);
+    // One motion wrench serves every pusher whose gravity is the same (all of them, unless the
+    // features hold the object at different world orientations; see GravityFrame).
+    int loaded_for = -1;
+    MotionWrench load;
     for (int p = 0; p < kMaxPushers; ++p) {
       if (!contains(candidates, p)) continue;
       ++checks_;
-      const PushResult r = shared ? model_.check(load, from, dq, p) : model_.check(from, dq, p);
+      if (loaded_for < 0 || !model_.same_gravity(loaded_for, p)) {
+        load = model_.motion_wrench(from, dq, p);
+        loaded_for = p;
+      }
+      const PushResult r = model_.check(load, from, dq, p);
       if (!(r.feasible && r.margin >= min_margin_)) candidates &= ~(PusherSet{1} << p);
     }
   }

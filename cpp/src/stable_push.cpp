@@ -155,8 +155,11 @@ std::vector<PushResult> StablePushModel::check_all(const Pose& q, const Motion& 
   MotionWrench load = motion_wrench(q, dq, 0);
   std::vector<PushResult> results;
   results.reserve(cones_.size());
-  for (int p = 0; p < static_cast<int>(cones_.size()); ++p) {
-    if (p > 0 && gravity_depends_on_pusher()) load = motion_wrench(q, dq, p);
+  for (int p = 0, loaded_for = 0; p < static_cast<int>(cones_.size()); ++p) {
+    if (!same_gravity(loaded_for, p)) {
+      load = motion_wrench(q, dq, p);
+      loaded_for = p;
+    }
     results.push_back(check(load, q, dq, p));
   }
   return results;

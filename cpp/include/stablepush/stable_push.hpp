@@ -95,8 +95,10 @@ class StablePushModel {
   const std::vector<double>& feature_angles() const { return feature_angles_; }
   /// Gravity in G [m/s^2] at q during a push by `pusher` (kNoPusher: G's axes the world's).
   Vec2 gravity_in_gripper(const Pose& q, int pusher) const;
-  /// Whether the gravity term, and so the motion wrench, differs between pushers.
-  bool gravity_depends_on_pusher() const { return gravity_frame_ == GravityFrame::Object; }
+  /// Whether pushers a and b see the same gravity at every pose (so they share a motion wrench).
+  bool same_gravity(int a, int b) const {
+    return gravity_frame_ == GravityFrame::Gripper || feature_angles_[a] == feature_angles_[b];
+  }
   double step_time() const { return step_time_; }
   /// Length that converts torques to forces in margins and bands [m]: the cross-section's circumradius.
   double torque_length() const { return torque_length_; }
