@@ -75,8 +75,10 @@ StablePushModel::StablePushModel(CrossSection section, RigidBody body, Gripper g
   if (pushers_.empty()) throw std::invalid_argument("at least one pusher is needed");
   if (feature_angles_.empty()) feature_angles_.assign(pushers_.size(), 0.0);
   if (feature_angles_.size() != pushers_.size()) throw std::invalid_argument("one feature angle per pusher is needed");
-  for (double a : feature_angles_)
+  for (double a : feature_angles_) {
     if (!std::isfinite(a)) throw std::invalid_argument("feature angles must be finite");
+    gravity_in_object_.push_back(Rotation2(a).apply_inverse(gravity_));  // R(phi_p)^T g
+  }
   for (const Pusher& pusher : pushers_) cones_.emplace_back(pusher.cone_generators(), torque_length_);
   // The polygon inscribed in the friction disc has its vertices at angles 2 pi k / sides (the
   // first on +x of G); edge k then has its outward normal at angle pi (2k + 1) / sides.
@@ -85,19 +87,23 @@ StablePushModel::StablePushModel(CrossSection section, RigidBody body, Gripper g
 }
 
 Vec2 StablePushModel::gravity_in_gripper(const Pose& q, int pusher) const {
+  return gravity_in_gripper(Rotation2(q.theta), pusher);
+}
+
+Vec2 StablePushModel::gravity_in_gripper(const Rotation2& R, int pusher) const {
   if (gravity_frame_ == GravityFrame::Gripper || pusher == kNoPusher) return gravity_;
   if (pusher < 0 || pusher >= static_cast<int>(pushers_.size())) throw std::out_of_range("pusher index");
-  return Rotation2(q.theta - feature_angles_[pusher]).apply(gravity_);  // R(theta - phi_p) g
+  return R.apply(gravity_in_object_[pusher]);  // R(theta) R(phi_p)^T g = R(theta - phi_p) g
 }
 
 MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq, int pusher) const {
   if (dq.x == 0.0 && dq.z == 0.0 && dq.theta == 0.0) throw std::invalid_argument("the motion dq is zero");
   MotionWrench load;
-  load.gravity = gravity_in_gripper(q, pusher);
+  load.rotation = Rotation2(q.theta);
+  load.gravity = gravity_in_gripper(load.rotation, pusher);
   DoubleLoads loads{1.0 / torque_length_};
   loads.out = &load;
   visit_motion_terms(q, dq, load.gravity, loads);
-  load.rotation = Rotation2(q.theta);
   const Vec2 force_in_O = load.rotation.apply_inverse(loads.force_sum);
   load.required = Wrench(force_in_O.x(), force_in_O.y(), loads.torque_sum);
   load.scale = loads.scale;

@@ -95,6 +95,8 @@ class StablePushModel {
   const std::vector<double>& feature_angles() const { return feature_angles_; }
   /// Gravity in G [m/s^2] at q during a push by `pusher` (kNoPusher: G's axes the world's).
   Vec2 gravity_in_gripper(const Pose& q, int pusher) const;
+  /// The same, from R(theta) already at hand.
+  Vec2 gravity_in_gripper(const Rotation2& R, int pusher) const;
   /// Whether pushers a and b see the same gravity at every pose (so they share a motion wrench).
   bool same_gravity(int a, int b) const {
     return gravity_frame_ == GravityFrame::Gripper || feature_angles_[a] == feature_angles_[b];
@@ -150,6 +152,7 @@ class StablePushModel {
   Vec2 gravity_;
   GravityFrame gravity_frame_;
   std::vector<double> feature_angles_;  ///< phi_p per pusher [rad]
+  std::vector<Vec2> gravity_in_object_;  ///< R(phi_p)^T g per pusher: gravity in O on p's feature
   double step_time_;
   double torque_length_;
   int polygon_sides_;
