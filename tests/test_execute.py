@@ -19,8 +19,10 @@ from stablepush.sim.server import running_sim_arm
 from stablepush_cli.main import cli
 
 # The bound the end-to-end test holds the simulated run to (the paper's robot: 0.5 mm, 0.5 deg).
-FINAL_BOUND_MM = 0.5
-FINAL_BOUND_DEG = 0.5
+# The paper's robot ended within 0.5 mm and 0.5 deg; the simulated arm does better on these plans
+# (0.04 mm / 0.05 deg and 0.02 mm / 0.03 deg, README), so the tests hold it to 0.2.
+FINAL_BOUND_MM = 0.2
+FINAL_BOUND_DEG = 0.2
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +57,7 @@ def test_t_shape_end_to_end_through_two_switch_overs():
     with running_sim_arm(log=lambda text: None) as server:
         report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
     assert [c.pusher for c in report.contacts] == ["left", "under-web", "left"]
-    # 0.12 mm measured since the pads' friction is switched by slip (1.0 mm was allowed before)
+    # 0.02 mm measured since the pads' friction is switched by slip (1.0 mm was allowed before)
     assert report.final_error["distance"] < FINAL_BOUND_MM and abs(report.final_error["theta"]) < FINAL_BOUND_DEG
 
 
@@ -259,7 +261,7 @@ def test_world_deviations_need_the_simulated_arm(tmp_path):
 
 def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     """The T in a world whose pads and features have 15% less mu than the task says: open loop it
-    ends 0.51 mm from the goal (README); closed loop it re-plans from the tracked pose and ends
+    ends 0.56 mm from the goal (README); closed loop it re-plans from the tracked pose and ends
     within the final tolerance of the goal."""
     from stablepush.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
