@@ -451,8 +451,10 @@ def _print_report(report) -> None:
         click.echo("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
     for r in report.replans:
         dx, dz, dth = (m - p for m, p in zip(r.measured, r.planned))
-        outcome = (f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}"
-                   f"{' (same pusher)' if r.kept_pusher else ''}" if r.solved else "no correction found (in time, with held transits); kept the plan")
+        if r.solved:
+            outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{' (same pusher)' if r.kept_pusher else ''}"
+        else:
+            outcome = "no correction found (in time, with held transits); kept the plan"
         click.echo(f"  after step {r.after_step}: off the plan by {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; "
                    f"{outcome} in {r.planning_ms:.1f} ms")
     for c in report.contacts:
