@@ -355,3 +355,19 @@ def test_protocol_versions_arm_2_and_arm_1_are_both_served_and_others_refused():
     assert PROTOCOL == "stablepush.arm/2"
     with pytest.raises(ProtocolError, match="stablepush.arm/3"):
         decode(encode({"type": "hello", "protocol": "stablepush.arm/3", "rate_hz": 100, "scene": {}}), "client")
+
+
+def test_executing_a_moving_pusher_task_warns_that_the_arm_pushes_against_fixed_features(tmp_path):
+    import yaml
+
+    from conftest import task_text
+
+    data = yaml.safe_load(task_text("horizontal-offset-high-mu"))
+    data.setdefault("dynamics", {})["pushes"] = "by_moving_pusher"
+    task_file = tmp_path / "moving.yaml"
+    task_file.write_text(yaml.safe_dump(data))
+    plan = tmp_path / "moving.plan.json"
+    assert CliRunner().invoke(cli, ["plan", str(task_file), "-o", str(plan)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", str(task_file), "--sim", "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert "by_moving_pusher" in result.output and "another cell" in result.output

@@ -372,6 +372,10 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
     from stablepush.plan_io import write_atomically
 
     task, plan, steps = _load_plan_and_task(plan_file, task_file)
+    if task.pushes == "by_moving_pusher":
+        click.echo("warning: the task's pushes are by_moving_pusher (gravity fixed in G), but the executor pushes "
+                   "against fixed features, where gravity turns in G with theta: the plan was made for another cell",
+                   err=True)
     if resume_from >= len(steps) - 1:
         _fail(f"--resume-from: must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} pushes)")
     if (replan_threshold or final_tolerance) and not closed_loop:
