@@ -150,7 +150,7 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("torque_length", &StablePushModel::torque_length)
       .def("motion_wrench", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq,
                                int pusher) { return m.motion_wrench(to_pose(q), to_pose(dq), pusher); },
-           py::arg("q"), py::arg("dq"), py::arg("pusher") = 0)
+           py::arg("q"), py::arg("dq"), py::arg("pusher") = kNoPusher)
       .def("check", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq,
                        int pusher) { return m.check(to_pose(q), to_pose(dq), pusher); },
            py::arg("q"), py::arg("dq"), py::arg("pusher"))

@@ -107,12 +107,13 @@ class StablePushModel {
   int friction_polygon_sides() const { return polygon_sides_; }
 
   /// The motion wrench of a unit motion dq from pose q (twist xi = dq / dt, constant over the step)
-  /// when `pusher` pushes (its index selects the gravity, see GravityFrame).
+  /// when `pusher` pushes (its index selects the gravity, see GravityFrame; kNoPusher: G's axes the
+  /// world's).
   MotionWrench motion_wrench(const Pose& q, const Motion& dq, int pusher) const;
 
   /// The stable-push test of dq from q for pusher `pusher` (an index into pushers()).
   PushResult check(const Pose& q, const Motion& dq, int pusher) const;
-  /// The test for every pusher, sharing one motion wrench.
+  /// The test for every pusher, one motion wrench shared by the pushers with the same gravity.
   std::vector<PushResult> check_all(const Pose& q, const Motion& dq) const;
   /// The test against a motion wrench already computed for (q, dq) and this pusher's gravity.
   PushResult check(const MotionWrench& load, const Pose& q, const Motion& dq, int pusher) const;
