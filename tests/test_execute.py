@@ -13,7 +13,7 @@ from click.testing import CliRunner
 from conftest import TASKS, shipped
 from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
 from stablepush.executor import ExecutionFault, execute_plan, plan_steps
-from stablepush.plan_io import plan_to_dict, write_plan_json
+from stablepush.plan_io import plan_to_dict, write_plan
 from stablepush.planning import plan_task
 from stablepush.sim.server import running_sim_arm
 from stablepush_cli.main import cli
@@ -29,7 +29,7 @@ FINAL_BOUND_DEG = 0.2
 def high_mu_plan(tmp_path_factory):
     task = shipped("horizontal-offset-high-mu")
     path = tmp_path_factory.mktemp("plans") / "high-mu.plan.json"
-    write_plan_json(plan_task(task, seed=1), path)
+    write_plan(plan_task(task, seed=1), path)
     return str(path), str(TASKS / "horizontal-offset-high-mu.yaml")
 
 
@@ -68,7 +68,7 @@ def test_a_plan_for_another_task_is_refused_before_anything_moves(high_mu_plan):
     plan, _ = high_mu_plan
     result = CliRunner().invoke(cli, ["execute", plan, "--task", str(TASKS / "pivoting.yaml"), "--sim"])
     assert result.exit_code == 2
-    assert "plan.task" in result.output and "'horizontal-offset-high-mu'" in result.output
+    assert "plan.json: task: the plan is for task" in result.output and "'horizontal-offset-high-mu'" in result.output
 
 
 def test_a_plan_for_another_version_of_the_task_is_refused(high_mu_plan, tmp_path):
@@ -82,7 +82,7 @@ def test_a_plan_for_another_version_of_the_task_is_refused(high_mu_plan, tmp_pat
     edited.write_text(yaml.safe_dump(data))
     result = CliRunner().invoke(cli, ["execute", plan, "--task", str(edited), "--sim"])
     assert result.exit_code == 2
-    assert "plan.waypoints[1]" in result.output and "not a stable push" in result.output
+    assert "plan.json: waypoints[1]: " in result.output and "not a stable push" in result.output
 
 
 # -- faults -------------------------------------------------------------------------------------
@@ -171,7 +171,7 @@ class FakeArm:
 
 @pytest.mark.parametrize("bad_reply, says", [
     (lambda msg: b"ack, but not JSON\n", "not a JSON line"),
-    (lambda msg: encode({"type": "ack", "seq": msg["seq"] + 1, "state": {}}), "out-of-order acknowledgement"),
+    (lambda msg: encode({"type": "ack", "seq": msg["seq"] + 1, "state": {"ee_pose": msg["pose"]}}), "out-of-order acknowledgement"),
     (lambda msg: encode({"type": "ack", "seq": msg["seq"]}), "field 'state' missing"),
     (lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "joint 4 over its torque limit"}), "torque limit"),
 ])

@@ -6,13 +6,29 @@ import json
 import math
 import sys
 
+import os
+
 import click
 
+from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError
 from stablepush.mechanics import check_push
-from stablepush.task import TaskError, load_task
+from stablepush.task import load_task
 
 EXIT_NOT_SOLVED = 1
 EXIT_BAD_INPUT = 2
+EXIT_ARM_FAULT = 3
+EXIT_INTERNAL = 4
+# Every error stablepush raises on purpose, and its exit status (the first class that matches).
+EXIT_STATUS = (
+    (TaskError, EXIT_BAD_INPUT),
+    (PlanError, EXIT_BAD_INPUT),
+    (OutputError, EXIT_BAD_INPUT),
+    (ArmFault, EXIT_ARM_FAULT),
+)
+
+
+def _exit_status(error: StablepushError) -> int:
+    return next(status for kind, status in EXIT_STATUS if isinstance(error, kind))
 
 
 def _fail(message: str) -> None:
@@ -20,7 +36,28 @@ def _fail(message: str) -> None:
     sys.exit(EXIT_BAD_INPUT)
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+class _Commands(click.Group):
+    """The command group: each StablepushError becomes one line on stderr and its exit status;
+    anything else is a bug, reported in one line (STABLEPUSH_DEBUG=1 shows the traceback)."""
+
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except StablepushError as error:
+            click.echo(f"error: {error}", err=True)
+            ctx.exit(_exit_status(error))
+        except (click.exceptions.Exit, click.ClickException, click.Abort, KeyboardInterrupt, SystemExit):
+            raise
+        except Exception as error:  # noqa: BLE001 - the last line of defence, reported as a bug
+            if os.environ.get("STABLEPUSH_DEBUG"):
+                raise
+            text = " ".join(str(error).split())[:300]
+            click.echo(f"internal error: {type(error).__name__}: {text} (a bug; please report it with the input; "
+                       f"STABLEPUSH_DEBUG=1 shows the traceback)", err=True)
+            ctx.exit(EXIT_INTERNAL)
+
+
+@click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="stablepush")
 def cli() -> None:
     """In-hand manipulation planning by stable prehensile pushing.
@@ -50,11 +87,8 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
     Example:
       stablepush check data/tasks/horizontal-offset-low-mu.yaml --at 0 0 0 --move 1 0 0
     """
-    try:
-        task = load_task(task_file)
-        results = check_push(task, at if at else task.start, move, pusher)
-    except TaskError as exc:
-        _fail(str(exc))
+    task = load_task(task_file)
+    results = check_push(task, at if at else task.start, move, pusher)
     if as_json:
         click.echo(json.dumps(results))
         return
@@ -67,7 +101,7 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
 @cli.command()
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
 @click.option("-o", "--output", "json_path", type=click.Path(dir_okay=False), default=None,
-              help="Plan file (JSON). Default: <task name>.plan.json in the current directory.")
+              help="Plan file (JSON). Default: <TASK file name>.plan.json in the current directory.")
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None,
               help="Also write the waypoints as CSV (step,x,z,theta,pusher,...).")
 @click.option("--seed", type=click.IntRange(min=0), default=None, help="Random seed (default: the task's planner.seed).")
@@ -97,21 +131,13 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     Example:
       stablepush plan data/tasks/horizontal-offset-low-mu.yaml -o low-mu.plan.json --csv low-mu.csv
     """
-    from stablepush.plan_io import write_plan_csv, write_plan_json
+    from stablepush.plan_io import default_output, write_plan
     from stablepush.planning import plan_task
 
-    try:
-        task = load_task(task_file)
-        result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
-    except TaskError as exc:
-        _fail(str(exc))
-    json_path = json_path or f"{task.name}.plan.json"
-    try:
-        write_plan_json(result, json_path)
-        if csv_path:
-            write_plan_csv(result, csv_path)
-    except OSError as exc:
-        _fail(f"cannot write the plan: {exc}")
+    task = load_task(task_file)
+    result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
+    json_path = json_path or default_output(task_file, ".plan.json")
+    write_plan(result, json_path, csv_path)
     s = result.stats
     if not result.solved:
         click.echo(f"{task.name}: {result.message}", err=True)
@@ -158,10 +184,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     """
     from stablepush import benchmark
 
-    try:
-        tasks = [load_task(path) for path in task_files]
-    except TaskError as exc:
-        _fail(str(exc))
+    tasks = [load_task(path) for path in task_files]
     if checks_only:
         _bench_checks(tasks, count, seed)
         return
@@ -220,22 +243,14 @@ def _write_bench(path: str, trials, rows) -> None:
     write_atomically(path, buffer.getvalue())
 
 
-EXIT_ARM_FAULT = 3
-
-
 def _load_plan_and_task(plan_file: str, task_file: str):
     """The task and the plan's steps, once the plan is shown to belong to the task (exit 2 if not)."""
     from stablepush.executor import plan_steps
     from stablepush.plan_io import read_plan
 
-    try:
-        task = load_task(task_file)
-        plan = read_plan(plan_file)
-        return task, plan, plan_steps(task, plan)
-    except TaskError as exc:
-        _fail(f"{plan_file}: {exc}" if str(exc).startswith("plan") else str(exc))
-    except (OSError, ValueError) as exc:
-        _fail(f"{plan_file}: {exc}")
+    task = load_task(task_file)
+    plan = read_plan(plan_file)
+    return task, plan, plan_steps(task, plan, source=plan_file)
 
 
 @cli.command()
@@ -266,7 +281,7 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     stats = plan.get("stats", {})
     title = f"{task.name}: {len(steps) - 1} pushes, {stats.get('switches', '?')} switch-over(s), seed {stats.get('seed', '?')}"
     fig = figures.plan_figure(task, steps, title)
-    fig.savefig(png_path, dpi=110, bbox_inches="tight")
+    figures.save_figure(fig, png_path)
     click.echo(f"figure written to {png_path}")
     if gif_path:
         figures.save_plan_gif(task, steps, gif_path)
@@ -277,7 +292,7 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
 @click.option("--pusher", required=True, metavar="NAME", help="The pusher whose cone to draw.")
 @click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,
-              help="PNG to write. Default: <task name>.<pusher>.cone.png.")
+              help="PNG to write. Default: <TASK file name>.<pusher>.cone.png in the current directory.")
 def cone(task_file: str, pusher: str, png_path) -> None:
     """Draw a pusher's generalized friction cone in wrench space (paper figs. 5-6).
 
@@ -290,14 +305,12 @@ def cone(task_file: str, pusher: str, png_path) -> None:
       stablepush cone data/tasks/pivoting.yaml --pusher left -o left-cone.png
     """
     from stablepush import figures
+    from stablepush.plan_io import default_output
 
-    try:
-        task = load_task(task_file)
-        task.pusher_index(pusher)
-    except TaskError as exc:
-        _fail(str(exc))
-    png_path = png_path or f"{task.name}.{pusher}.cone.png"
-    figures.cone_figure(task, pusher).savefig(png_path, dpi=110, bbox_inches="tight")
+    task = load_task(task_file)
+    task.pusher_index(pusher)
+    png_path = png_path or default_output(task_file, f".{pusher}.cone.png")
+    figures.save_figure(figures.cone_figure(task, pusher), png_path)
     click.echo(f"figure written to {png_path}")
 
 
@@ -319,10 +332,10 @@ def _host_port(value: str):
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
               metavar="HZ", help="Waypoints per second of motion.")
 @click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
-              help="Continue after plan step STEP (the last confirmed step a fault reported).")
+              help="Continue after plan step STEP (the last confirmed step a fault reported); a simulated arm then "
+                   "keeps the world it has, where every other run starts from a fresh one.")
 @click.option("--pace/--no-pace", default=None,
               help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
-@click.option("--reset", is_flag=True, help="Ask a simulated arm to rebuild its world instead of keeping it.")
 @click.option("--ack-timeout", default=5.0, show_default=True, type=click.FloatRange(min=0.01), metavar="S",
               help="Give up when the arm does not reply within S seconds.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
@@ -344,7 +357,7 @@ def _host_port(value: str):
 @click.option("--final-tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
                                      "this close to the goal (default: a fifth of the task's goal tolerance).")
-def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resume_from: int, pace, reset: bool,
+def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resume_from: int, pace,
             ack_timeout: float, json_path, quiet: bool, mu_scale: float, tracker_noise, closed_loop: bool,
             replan_threshold, final_tolerance) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
@@ -417,7 +430,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
 
     try:
         report = execute_plan(task, steps, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
-                              reset=reset, ack_timeout=ack_timeout, closed_loop=loop, progress=progress)
+                              ack_timeout=ack_timeout, closed_loop=loop, progress=progress)
     except ExecutionFault as fault:
         if bar is not None:
             bar.__exit__(None, None, None)
@@ -483,11 +496,16 @@ def _print_report(report) -> None:
               metavar="MM DEG", help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).")
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
               help="Seed of the tracker's noise.")
-def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, seed: int) -> None:
+@click.option("--idle-timeout", default=30.0, show_default=True, type=click.FloatRange(min=0.1, max=3600), metavar="S",
+              help="Drop a client that sends no complete message for S seconds (the arm is stopped).")
+def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, seed: int, idle_timeout: float) -> None:
     """Serve a simulated arm (MuJoCo) over the arm protocol, until interrupted.
 
     A 7-joint arm of simple shapes (shipped MJCF) with a parallel-jaw gripper whose pads press with
     the task's grip force; the executor's hello carries the object, the features and the friction.
+    One session at a time (a second client is told the arm is busy); each starts from a fresh
+    world unless the executor resumes a run (--resume-from). An object outline of more than 64
+    vertices is simplified for the simulated world only (the tolerance is logged).
     Joint servos track the streamed waypoints by IK; the simulation steps in lock-step with the stream
     (one waypoint period per waypoint), headless, and reports its steps/s. Each acknowledgement carries
     the object's pose in the grasp as a tracker would (`object_in_grasp`), with --tracker-noise.
@@ -497,7 +515,7 @@ def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, se
 
     deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1],
                                seed=seed)
-    server = SimArmServer(host, port, exit_after=exit_after, deviation=deviation)
+    server = SimArmServer(host, port, exit_after=exit_after, deviation=deviation, idle_timeout=idle_timeout)
     click.echo(f"sim-arm: listening on {server.host}:{server.port}", err=True)
     try:
         server.serve_forever()

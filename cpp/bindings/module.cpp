@@ -253,5 +253,15 @@ PYBIND11_MODULE(_core, m) {
         "time_limit [s]; min_margin [N]; sampling_margin [unit steps]; parameters: TRRTstar's declared\n"
         "parameters by name, as text; min_hold_ratio: the plan must end where the pads alone hold this\n"
         "multiple of the weight (0: no requirement).");
+  m.def("steps_between", [](const std::array<double, 3>& a, const std::array<double, 3>& b,
+                            const std::array<double, 2>& step) { return steps_between(to_pose(a), to_pose(b), to_step(step)); },
+        py::arg("a"), py::arg("b"), py::arg("step"),
+        "The distance from pose a to b in unit steps (poses (x m, z m, theta rad), step (m, rad)); a unit push "
+        "moves at most 1.");
   m.attr("TRRT_STAR_PARAMETERS") = trrt_star_parameters();
+  py::dict ranges;
+  for (const auto& [name, r] : trrt_star_parameter_ranges())
+    ranges[py::str(name)] = py::make_tuple(r.integer ? "integer" : "number", r.lowest, r.highest);
+  m.attr("TRRT_STAR_PARAMETER_RANGES") = ranges;
+  m.attr("MAX_TIME_LIMIT") = kMaxTimeLimit;
 }

@@ -17,26 +17,26 @@ struct ExactLoads {
   boost::container::small_vector<StickingGroup, 2> groups;
 
   void force(const Vec2& f, const Vec2& arm) {
-    const ExactFT f_x(f.x()), f_z(f.y());
+    const ExactFT f_x = exact(f.x()), f_z = exact(f.y());
     fx += f_x;
     fz += f_z;
-    tau += ExactFT(arm.y()) * f_x - ExactFT(arm.x()) * f_z;
+    tau += exact(arm.y()) * f_x - exact(arm.x()) * f_z;
   }
-  void torque(double t) { tau += ExactFT(t); }
+  void torque(double t) { tau += exact(t); }
   void sticking(const Vec2& arm, double friction_limit) { add_sticking_point(groups, arm, friction_limit); }
 };
 
 /// The motion wrench in O, exactly, from the same doubles (R^T applied with the same cos and sin).
 ExactWrench exact_required(const ExactLoads& loads, const Rotation2& R) {
-  const ExactFT c(R.c), s(R.s);
+  const ExactFT c = exact(R.c), s = exact(R.s);
   return ExactWrench(c * loads.fx - s * loads.fz, s * loads.fx + c * loads.fz, loads.tau);
 }
 
 /// row^T L_g: the covector a wrench row induces on a sticking group's force (f in G).
 std::pair<ExactFT, ExactFT> exact_pull_back(const ExactWrench& row, const Rotation2& R, const Vec2& arm) {
-  const ExactFT c(R.c), s(R.s);
-  return {row.x() * c + row.y() * s + row.z() * ExactFT(arm.y()),
-          -(row.x() * s) + row.y() * c - row.z() * ExactFT(arm.x())};
+  const ExactFT c = exact(R.c), s = exact(R.s);
+  return {row.x() * c + row.y() * s + row.z() * exact(arm.y()),
+          -(row.x() * s) + row.y() * c - row.z() * exact(arm.x())};
 }
 
 }  // namespace
@@ -71,14 +71,14 @@ PushResult StablePushModel::exact_sticking(const WrenchCone& cone, const MotionW
   Program lp(CGAL::SMALLER, false, 0, false, 0);  // free variables, rows "<=" unless set
   int row = 0;
   for (std::size_t i = 0; i < cone.exact_facets().size(); ++i, ++row) {
-    const ExactFT k(cone.facet_scales()[i]);
+    const ExactFT k = exact(cone.facet_scales()[i]);
     const ExactWrench a = cone.exact_facets()[i];
     for (int g = 0; g < groups; ++g) {
       const auto [u, v] = exact_pull_back(a, load.rotation, loads.groups[g].arm);
       lp.set_a(2 * g, row, -(k * u));
       lp.set_a(2 * g + 1, row, -(k * v));
     }
-    lp.set_a(t_var, row, ExactFT(1));
+    lp.set_a(t_var, row, exact(1));
     lp.set_b(row, -(k * (a * required)));
   }
   for (const ExactWrench& e : cone.exact_equalities()) {
@@ -93,11 +93,11 @@ PushResult StablePushModel::exact_sticking(const WrenchCone& cone, const MotionW
   }
   for (int g = 0; g < groups; ++g)
     for (int k = 0; k < polygon_sides_; ++k, ++row) {
-      lp.set_a(2 * g, row, ExactFT(polygon_normals_[k].x()));
-      lp.set_a(2 * g + 1, row, ExactFT(polygon_normals_[k].y()));
-      lp.set_b(row, ExactFT(loads.groups[g].friction_limit * polygon_inradius_));
+      lp.set_a(2 * g, row, exact(polygon_normals_[k].x()));
+      lp.set_a(2 * g + 1, row, exact(polygon_normals_[k].y()));
+      lp.set_b(row, exact(loads.groups[g].friction_limit * polygon_inradius_));
     }
-  lp.set_c(t_var, ExactFT(-1));
+  lp.set_c(t_var, exact(-1));
   const auto solution = CGAL::solve_linear_program(lp, ExactFT());
 
   PushResult result;

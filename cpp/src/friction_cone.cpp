@@ -7,7 +7,7 @@
 namespace stablepush {
 namespace {
 
-ExactWrench to_exact(const Wrench& w) { return ExactWrench(ExactFT(w.x()), ExactFT(w.y()), ExactFT(w.z())); }
+ExactWrench to_exact(const Wrench& w) { return ExactWrench(exact(w.x()), exact(w.y()), exact(w.z())); }
 
 bool is_zero(const ExactWrench& v) { return CGAL::is_zero(v.x()) && CGAL::is_zero(v.y()) && CGAL::is_zero(v.z()); }
 

@@ -21,10 +21,12 @@ GraspPoseSpace::GraspPoseSpace(StepSize step, const ob::RealVectorBounds& bounds
 
 double GraspPoseSpace::distance(const ob::State* a, const ob::State* b) const { return distance(pose(a), pose(b)); }
 
-double GraspPoseSpace::distance(const Pose& a, const Pose& b) const {
-  const Eigen::Vector3d d = in_unit_steps(Motion{b.x - a.x, b.z - a.z, b.theta - a.theta});
-  return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+double steps_between(const Pose& a, const Pose& b, const StepSize& step) {
+  const double dx = (b.x - a.x) / step.length, dz = (b.z - a.z) / step.length, dt = (b.theta - a.theta) / step.angle;
+  return std::sqrt(dx * dx + dz * dz + dt * dt);
 }
+
+double GraspPoseSpace::distance(const Pose& a, const Pose& b) const { return steps_between(a, b, step_); }
 
 double GraspPoseSpace::getMaximumExtent() const {
   const double dx = (bounds_.high[0] - bounds_.low[0]) / step_.length;

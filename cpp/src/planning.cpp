@@ -56,10 +56,26 @@ void apply_parameters(ob::Planner& planner, const std::map<std::string, std::str
   }
 }
 
+void check_settings(const PlannerSettings& s) {
+  auto finite = [](const Pose& q) { return std::isfinite(q.x) && std::isfinite(q.z) && std::isfinite(q.theta); };
+  if (!finite(s.start) || !finite(s.goal)) throw std::invalid_argument("start and goal must be finite");
+  if (!(s.time_limit > 0.0 && s.time_limit <= kMaxTimeLimit))
+    throw std::invalid_argument("time_limit must be > 0 and at most 1e6 s (kMaxTimeLimit)");
+  for (const StepSize& size : {s.step, s.tolerance})
+    if (!(std::isfinite(size.length) && std::isfinite(size.angle)))
+      throw std::invalid_argument("step and tolerance must be finite");
+  if (!(std::isfinite(s.min_margin) && s.min_margin >= 0.0)) throw std::invalid_argument("min_margin must be >= 0");
+  if (!(std::isfinite(s.sampling_margin) && s.sampling_margin >= 0.0))
+    throw std::invalid_argument("sampling_margin must be >= 0");
+  if (!(std::isfinite(s.min_hold_ratio) && s.min_hold_ratio >= 0.0))
+    throw std::invalid_argument("min_hold_ratio must be >= 0");
+}
+
 }  // namespace
 
 Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& settings) {
   const auto started = std::chrono::steady_clock::now();
+  check_settings(settings);
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 
   auto space = std::make_shared<GraspPoseSpace>(settings.step, sampling_region(model, settings));

@@ -97,7 +97,13 @@ Vec2 StablePushModel::gravity_in_gripper(const Rotation2& R, int pusher) const {
 }
 
 MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq, int pusher) const {
-  if (dq.x == 0.0 && dq.z == 0.0 && dq.theta == 0.0) throw std::invalid_argument("the motion dq is zero");
+  if (!(std::isfinite(q.x) && std::isfinite(q.z) && std::isfinite(q.theta)))
+    throw std::invalid_argument("the pose q is not finite");
+  if (!(std::isfinite(dq.x) && std::isfinite(dq.z) && std::isfinite(dq.theta)))
+    throw std::invalid_argument("the motion dq is not finite");
+  // Below this the motion's velocity and acceleration terms underflow to (sub)normal noise.
+  if (std::max({std::abs(dq.x), std::abs(dq.z), std::abs(dq.theta)}) < kSmallestMotion)
+    throw std::invalid_argument("the motion dq is zero (or under 1e-12 m and rad)");
   MotionWrench load;
   load.rotation = Rotation2(q.theta);
   load.gravity = gravity_in_gripper(load.rotation, pusher);
@@ -107,6 +113,8 @@ MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq, int
   const Vec2 force_in_O = load.rotation.apply_inverse(loads.force_sum);
   load.required = Wrench(force_in_O.x(), force_in_O.y(), loads.torque_sum);
   load.scale = loads.scale;
+  if (!load.required.allFinite() || !std::isfinite(load.scale))
+    throw std::domain_error("the motion wrench overflows (a mass, inertia, com, mu or step time far out of range?)");
   return load;
 }
 

@@ -9,7 +9,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <sstream>
+#include <stdexcept>
 
 
 namespace stablepush {
@@ -34,7 +37,41 @@ struct TRRTstar::Candidate {
   PusherSet pushers = 0;
 };
 
+const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges() {
+  static const std::map<std::string, ParameterRange> ranges{
+      {"goal_bias", {false, 0.0, 1.0}},                  // probability of sampling the goal
+      {"rewire_radius", {false, 0.0, 100.0}},            // [unit steps]
+      {"init_temperature", {false, 1e-12, 1e6}},         // T-RRT's first temperature
+      {"temp_change_factor", {false, 1.0, 1e3}},
+      {"max_transition_failures", {true, 1.0, 1e6}},
+      {"max_switches", {true, 0.0, 100.0}},              // switch-overs a plan may make
+      {"steer_angle", {false, 0.0, 90.0}},               // [deg]
+      {"seed", {true, 0.0, 4294967295.0}},               // 0 .. 2^32 - 1
+  };
+  return ranges;
+}
+
+double TRRTstar::checked(const char* name, double value) {
+  const ParameterRange& range = trrt_star_parameter_ranges().at(name);
+  if (!(value >= range.lowest && value <= range.highest)) {  // also refuses NaN
+    std::ostringstream msg;
+    msg << "planner parameter '" << name << "' must be between " << range.lowest << " and " << range.highest
+        << ", got " << value;
+    throw std::invalid_argument(msg.str());
+  }
+  return value;
+}
+
 namespace {
+/// OMPL's range suggestion "lowest:step:highest" for a declared parameter.
+std::string range_text(const char* name) {
+  const ParameterRange& r = trrt_star_parameter_ranges().at(name);
+  std::ostringstream out;
+  out << std::setprecision(10) << r.lowest << ':' << (r.integer ? 1.0 : (r.highest - r.lowest) / 20.0) << ':'
+      << r.highest;
+  return out.str();
+}
+
 /// Edges shorter than this [unit steps] are not pushes (co-located nodes differ only by pusher).
 constexpr double kMinEdge = 1e-9;
 
@@ -45,17 +82,20 @@ TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTsta
   specs_.approximateSolutions = true;
   specs_.optimizingPaths = true;
   specs_.directed = true;
-  declareParam<double>("goal_bias", this, &TRRTstar::setGoalBias, &TRRTstar::getGoalBias, "0.:.05:1.");
-  declareParam<double>("rewire_radius", this, &TRRTstar::setRewireRadius, &TRRTstar::getRewireRadius, "0.:.5:10.");
+  declareParam<double>("goal_bias", this, &TRRTstar::setGoalBias, &TRRTstar::getGoalBias, range_text("goal_bias"));
+  declareParam<double>("rewire_radius", this, &TRRTstar::setRewireRadius, &TRRTstar::getRewireRadius,
+                       range_text("rewire_radius"));
   declareParam<double>("init_temperature", this, &TRRTstar::setInitTemperature, &TRRTstar::getInitTemperature,
-                       "0.:.01:10.");
+                       range_text("init_temperature"));
   declareParam<double>("temp_change_factor", this, &TRRTstar::setTempChangeFactor, &TRRTstar::getTempChangeFactor,
-                       "1.:.1:10.");
-  declareParam<unsigned>("max_transition_failures", this, &TRRTstar::setMaxTransitionFailures,
-                         &TRRTstar::getMaxTransitionFailures, "1:1:1000");
-  declareParam<unsigned>("max_switches", this, &TRRTstar::setMaxSwitches, &TRRTstar::getMaxSwitches, "0:1:20");
-  declareParam<double>("steer_angle", this, &TRRTstar::setSteerAngle, &TRRTstar::getSteerAngle, "0.:5.:90.");
-  declareParam<unsigned>("seed", this, &TRRTstar::setSeed, &TRRTstar::getSeed, "0:1:1000000");
+                       range_text("temp_change_factor"));
+  declareParam<long long>("max_transition_failures", this, &TRRTstar::setMaxTransitionFailures,
+                          &TRRTstar::getMaxTransitionFailures, range_text("max_transition_failures"));
+  declareParam<long long>("max_switches", this, &TRRTstar::setMaxSwitches, &TRRTstar::getMaxSwitches,
+                          range_text("max_switches"));
+  declareParam<double>("steer_angle", this, &TRRTstar::setSteerAngle, &TRRTstar::getSteerAngle,
+                       range_text("steer_angle"));
+  declareParam<long long>("seed", this, &TRRTstar::setSeed, &TRRTstar::getSeed, range_text("seed"));
 }
 
 TRRTstar::~TRRTstar() { free_tree(); }
@@ -142,7 +182,7 @@ TRRTstar::Node* TRRTstar::nearest_extendable(const Pose& q) const {
   Node* best = nullptr;
   double best_d2 = 0.0;
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    if (nodes_[i]->cost.switches > static_cast<int>(max_switches_)) continue;
+    if (nodes_[i]->cost.switches > max_switches_) continue;
     const double d2 = (unit_coords_[i] - u).squaredNorm();
     if (best == nullptr || d2 < best_d2) {
       best = nodes_[i];
@@ -156,7 +196,7 @@ TRRTstar::Node* TRRTstar::most_promising_toward_goal() const {
   Node* best = nullptr;
   PathCost best_estimate;
   for (Node* n : nodes_) {
-    if (n->extended_to_goal || n->cost.switches > static_cast<int>(max_switches_)) continue;
+    if (n->extended_to_goal || n->cost.switches > max_switches_) continue;
     const PathCost estimate = n->cost + PathCost{0, n->goal_distance};
     if (best == nullptr || estimate < best_estimate) {
       best = n;
@@ -282,7 +322,7 @@ TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stabl
     if (first == nullptr) first = node;
   }
   const Node* reached = best_goal();
-  if (reached != nullptr && reached->cost.switches <= static_cast<int>(max_switches_))
+  if (reached != nullptr && reached->cost.switches <= max_switches_)
     outcome_ = PlanOutcome::GoalReached;
   return first;
 }
@@ -306,7 +346,7 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
     const PusherSet stable = validator_->stable_pushers(from->pose, q_new, validator_->all_pushers());
     if (stable == 0) break;
     Node* next = connect(from, q_new, stable);
-    if (last || next->cost.switches > static_cast<int>(max_switches_)) break;
+    if (last || next->cost.switches > max_switches_) break;
     from = next;
   }
   si_->freeState(step_state);
@@ -331,7 +371,7 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     const Eigen::Vector3d e1 = u.cross(axis).normalized();
     const Eigen::Vector3d e2 = u.cross(e1);
     // Pushers this node may use without exceeding the switch-over budget.
-    const PusherSet allowed = from->pusher == kNoPusher || from->cost.switches < static_cast<int>(max_switches_)
+    const PusherSet allowed = from->pusher == kNoPusher || from->cost.switches < max_switches_
                                   ? validator_->all_pushers()
                                   : single(from->pusher);
     // The step toward the goal, or the nearest deviation from it (in rings of growing angle up
@@ -361,7 +401,7 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     for (Node* sibling : next->parent->children)
       if (sibling->pose.x == q_new.x && sibling->pose.z == q_new.z && sibling->pose.theta == q_new.theta)
         sibling->extended_to_goal = true;
-    if (next->cost.switches > static_cast<int>(max_switches_)) break;
+    if (next->cost.switches > max_switches_) break;
     from = next;
   }
   si_->freeState(step_state);
@@ -376,8 +416,11 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
 
   free_tree();
   iterations_ = 0;
-  rng_ = std::make_unique<ompl::RNG>(2u * seed_ + 1u);
-  sampler_ = std::make_shared<SeededPoseSampler>(si_->getStateSpace().get(), 2u * seed_);
+  // Two 32-bit streams per seed, one-to-one over all 2^32 seeds (the generators keep 32 bits):
+  // the sampler's is 2 seed for seed < 2^31 (as it always was) and odd above; the search's the other parity.
+  const std::uint32_t sampler_seed = seed_ < 0x80000000u ? 2u * seed_ : 2u * (seed_ - 0x80000000u) + 1u;
+  rng_ = std::make_unique<ompl::RNG>(sampler_seed ^ 1u);
+  sampler_ = std::make_shared<SeededPoseSampler>(si_->getStateSpace().get(), sampler_seed);
   temperature_ = init_temperature_;
   transition_failures_ = 0;
   validator_->reset_feasibility_checks();

@@ -11,24 +11,28 @@ gripper frame G in the world, m. The exchange is lock-step: every waypoint is ac
 the next is sent.
 
 client -> server
-  {"type": "hello", "protocol": "stablepush.arm/2", "rate_hz": 100, "scene": {...}, "reset": false}
+  {"type": "hello", "protocol": "stablepush.arm/2", "rate_hz": 100, "scene": {...}, "continue": false}
       `scene` describes the world (stablepush.execution.scene_description); a real arm may ignore
-      it. A simulator builds its world from it, or keeps the one it has when `reset` is false and
-      the scene is the same (so a run can resume).
+      it. A simulator builds a fresh world from it for each session, or, when `continue` is true
+      and the scene is the one it has, keeps its world (so a run can resume after a fault).
   {"type": "waypoint", "seq": 0, "t": 0.01, "step": 1, "phase": "push", "pose": [...]}
       `seq` counts from 0 on each connection, one up per waypoint; `t` is s since the stream began;
       the server moves G to `pose` over one period (1 / rate_hz) and then acknowledges.
   {"type": "stop"}      hold the arm where it is now
-  {"type": "bye"}       end of the run; the server keeps its state for a later connection
+  {"type": "bye"}       end of the run (a later session with "continue" may pick the world up)
 
 server -> client
   {"type": "ready", "protocol": "stablepush.arm/2", "arm": "...", "state": {...}}
   {"type": "ack", "seq": 0, "state": {...}}
   {"type": "stopped", "state": {...}}
   {"type": "error", "seq": 3 or null, "message": "..."}   the server has stopped the arm
-      and closes the connection.
+      and closes the connection. A server already serving a session answers a second client
+      with an error whose message starts "busy" and closes that connection.
 
-`state` holds at least "ee_pose" (G's pose now) and "joints" [rad]. Optional:
+Limits: a line is at most MAX_LINE_BYTES; `rate_hz` lies in RATE_HZ. A reader waits at most
+its deadline for a whole line (a line trickled a byte at a time does not extend it).
+
+`state` holds at least "ee_pose" (G's pose now, 7 finite numbers) and "joints" [rad]. Optional:
   "object_in_grasp" {x, z mm, theta deg; y mm, tilt deg where known}: the tracker field, the
       object's pose in the grasp as the cell measures it (motion capture, fiducials, tactile
       sensing), in the plan's coordinates. With a sticking pusher this pose is observable, and the
@@ -39,12 +43,16 @@ from __future__ import annotations
 
 import json
 import math
+import socket
+import time
 from typing import Any, Dict
 
 PROTOCOL = "stablepush.arm/2"
 SUPPORTED_PROTOCOLS = ("stablepush.arm/1", PROTOCOL)
 DEFAULT_PORT = 47100
 DEFAULT_RATE_HZ = 100.0
+RATE_HZ = (1.0, 1000.0)  # waypoints per second a hello may ask for
+MAX_LINE_BYTES = 4_000_000  # a hello carries the scene (a 1,000-vertex object is about 40 kB)
 
 _CLIENT_FIELDS = {
     "hello": {"protocol": str, "rate_hz": (int, float), "scene": dict},
@@ -73,9 +81,11 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
     """A message from `sender` ("client" or "server"), checked against the protocol."""
     fields = _CLIENT_FIELDS if sender == "client" else _SERVER_FIELDS
     try:
-        message = json.loads(line.decode())
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        message = json.loads(line.decode(), parse_constant=_refuse_constant)
+    except (UnicodeDecodeError, ValueError) as exc:
         raise ProtocolError(f"not a JSON line ({exc.__class__.__name__}: {_clip(line)})") from None
+    except RecursionError:
+        raise ProtocolError(f"not a JSON line (nested too deeply: {_clip(line)})") from None
     if not isinstance(message, dict):
         raise ProtocolError(f"not a JSON object: {_clip(line)}")
     kind = message.get("type")
@@ -86,14 +96,71 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
         if not isinstance(value, types) or isinstance(value, bool):
             raise ProtocolError(f"{kind}: field {name!r} missing or not a {_kind(types)}")
     if kind == "waypoint":
-        pose = message["pose"]
-        if len(pose) != 7 or not all(isinstance(v, (int, float)) and math.isfinite(v) for v in pose):
-            raise ProtocolError("waypoint: field 'pose' must be 7 finite numbers [x, y, z, qw, qx, qy, qz]")
-        if abs(math.sqrt(sum(v * v for v in pose[3:])) - 1.0) > 1e-6:
+        _check_pose(message["pose"], "waypoint: field 'pose'")
+        if abs(math.sqrt(sum(v * v for v in message["pose"][3:])) - 1.0) > 1e-6:
             raise ProtocolError("waypoint: the quaternion in 'pose' is not of unit length")
+    if kind == "hello" and not RATE_HZ[0] <= message["rate_hz"] <= RATE_HZ[1]:
+        raise ProtocolError(f"hello: rate_hz must be between {RATE_HZ[0]:g} and {RATE_HZ[1]:g}, got {message['rate_hz']}")
+    if "state" in fields[kind]:
+        _check_state(message["state"], kind)
     if kind in ("hello", "ready") and message["protocol"] not in SUPPORTED_PROTOCOLS:
         raise ProtocolError(f"{kind}: protocol {message['protocol']!r} is not one of {', '.join(SUPPORTED_PROTOCOLS)}")
     return message
+
+
+def _check_pose(pose: Any, what: str) -> None:
+    if not (isinstance(pose, list) and len(pose) == 7 and all(_finite(v) for v in pose)):
+        raise ProtocolError(f"{what} must be 7 finite numbers [x, y, z, qw, qx, qy, qz]")
+
+
+def _check_state(state: dict, kind: str) -> None:
+    """A server's `state`: ee_pose 7 finite numbers; object_in_grasp, when given, finite x, z, theta."""
+    _check_pose(state.get("ee_pose"), f"{kind}: state.ee_pose")
+    tracked = state.get("object_in_grasp")
+    if tracked is not None and not (isinstance(tracked, dict) and all(_finite(tracked.get(k)) for k in ("x", "z", "theta"))):
+        raise ProtocolError(f"{kind}: state.object_in_grasp must hold finite numbers x, z, theta")
+    if "object_pose" in state:
+        _check_pose(state["object_pose"], f"{kind}: state.object_pose")
+
+
+def _finite(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _refuse_constant(name: str):
+    raise ValueError(f"{name} is not JSON")
+
+
+class LineReader:
+    """Reads one protocol line at a time from a socket, within a deadline per line: a peer that
+    goes silent, or trickles a line a byte at a time, raises TimeoutError when the deadline
+    passes; a line over MAX_LINE_BYTES raises ProtocolError; a closed peer ConnectionError."""
+
+    def __init__(self, sock: socket.socket, where: str):
+        self.sock = sock
+        self.where = where
+        self._buffer = b""
+
+    def read_line(self, timeout: float) -> bytes:
+        deadline = time.monotonic() + timeout
+        while True:
+            end = self._buffer.find(b"\n")
+            if end >= 0:
+                line, self._buffer = self._buffer[: end + 1], self._buffer[end + 1:]
+                return line
+            if len(self._buffer) > MAX_LINE_BYTES:
+                raise ProtocolError(f"a line from {self.where} is longer than {MAX_LINE_BYTES} bytes")
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise TimeoutError(f"no complete message from {self.where} within {timeout:g} s")
+            self.sock.settimeout(remaining)
+            try:
+                data = self.sock.recv(65536)
+            except socket.timeout:
+                continue  # the loop reports the deadline
+            if not data:
+                raise ConnectionError(f"{self.where} closed the connection")
+            self._buffer += data
 
 
 def _kind(types) -> str:

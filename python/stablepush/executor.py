@@ -18,23 +18,21 @@ from typing import Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
-from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
+from stablepush.arm_protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.closed_loop import ClosedLoop, Replan, replan
 from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, grasp_transform, place_features,
                                   pose_to_matrix, scene_description)
-from stablepush.task import MM, Task, TaskError, pose_to_si
+from stablepush import _core
+from stablepush.errors import ArmFault, PlanError
+from stablepush.plan_io import check_plan_dict
+from stablepush.task import MM, Task, pose_to_si
 
 DEFAULT_ACK_TIMEOUT = 5.0  # s to wait for any reply
+STEP_SLACK = 1e-6  # unit steps: rounding in a plan file's decimal poses
 
 
-class ExecutionFault(RuntimeError):
-    """The run stopped early. `last_confirmed_step` is the last plan step the arm acknowledged."""
-
-    def __init__(self, reason: str, last_confirmed_step: int, arm_stopped: Optional[bool]):
-        self.reason = reason
-        self.last_confirmed_step = last_confirmed_step
-        self.arm_stopped = arm_stopped  # None: the arm could not be reached to stop it
-        super().__init__(reason)
+# The run stopped early (stablepush.errors.ArmFault); the name the executor has always used.
+ExecutionFault = ArmFault
 
 
 @dataclass
@@ -109,67 +107,71 @@ class ExecutionReport:
         }
 
 
-def plan_steps(task: Task, plan: dict) -> List[PlanStep]:
-    """The plan's waypoints, once they are shown to belong to `task`: same task name and start,
-    pushers the task has, and every push a stable push of this task with the pads inside the object
-    (so a plan made for another version of the file is refused). TaskError names what differs."""
-    if plan.get("task") != task.name:
-        raise TaskError("plan.task", f"the plan is for task {plan.get('task')!r}, not {task.name!r}")
-    if not plan.get("solved"):
-        raise TaskError("plan.solved", f"the plan does not reach the goal ({plan.get('message', 'not solved')})")
-    raw = plan.get("waypoints")
-    if not isinstance(raw, list) or len(raw) < 2:
-        raise TaskError("plan.waypoints", "needs the start and at least one push")
+def plan_steps(task: Task, plan: dict, source: Optional[str] = None) -> List[PlanStep]:
+    """The plan's waypoints, once they are shown to belong to `task`: a structurally valid plan
+    (plan_io.check_plan_dict), solved, for the same task name and start, with pushers the task
+    has, no step longer than the task's unit step, and every push a stable push of this task with
+    the pads inside the object (so a plan made for another version of the file, or edited by
+    hand, is refused). PlanError names what differs."""
+    def fail(field: str, reason: str):
+        raise PlanError(field, reason, source)
+
+    check_plan_dict(plan, source)
+    if plan["task"] != task.name:
+        fail("task", f"the plan is for task {plan['task'][:100]!r}, not {task.name!r}")
+    if not plan["solved"]:
+        fail("solved", f"the plan does not reach the goal ({str(plan.get('message', 'not solved'))[:200]})")
+    raw = plan["waypoints"]
+    if len(raw) < 2:
+        fail("waypoints", "needs the start and at least one push")
     steps = []
     for i, w in enumerate(raw):
-        try:
-            pose = (float(w["x"]), float(w["z"]), float(w["theta"]))
-            pusher = w["pusher"]
-        except (KeyError, TypeError, ValueError):
-            raise TaskError(f"plan.waypoints[{i}]", "needs numbers x, z, theta and a pusher (null for the start)") from None
+        pose, pusher = (float(w["x"]), float(w["z"]), float(w["theta"])), w.get("pusher")
         if (pusher is None) != (i == 0):
-            raise TaskError(f"plan.waypoints[{i}].pusher", "only the first waypoint (the start) has no pusher")
+            fail(f"waypoints[{i}].pusher", "only the first waypoint (the start) has no pusher")
         if pusher is not None and pusher not in task.pusher_names:
-            raise TaskError(f"plan.waypoints[{i}].pusher", f"the task has no pusher {pusher!r}")
+            fail(f"waypoints[{i}].pusher", f"the task has no pusher {pusher[:100]!r}")
         steps.append(PlanStep(pose, pusher))
     if max(abs(a - b) for a, b in zip(steps[0].pose, task.start)) > 1e-6:
-        raise TaskError("plan.waypoints[0]", f"the plan starts at {list(steps[0].pose)}, the task at {list(task.start)}")
+        fail("waypoints[0]", f"the plan starts at {list(steps[0].pose)}, the task at {list(task.start)}")
+    unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
     model = task.build_model()
     for i in range(1, len(steps)):
         q0, q1 = pose_to_si(steps[i - 1].pose), pose_to_si(steps[i].pose)
+        length = _core.steps_between(q0, q1, unit)
+        if length > 1.0 + STEP_SLACK:
+            fail(f"waypoints[{i}]", f"a step of {length:.3g} unit steps (planner.step {task.planner['step']}); "
+                                    f"a plan's pushes are at most one unit step")
         dq = tuple(b - a for a, b in zip(q0, q1))
+        if max(abs(v) for v in dq) < 1e-12:
+            fail(f"waypoints[{i}]", "repeats the pose before it (a push that does not move the object)")
         verdict = model.check(q0, dq, task.pusher_index(steps[i].pusher))
         if not verdict.feasible:
-            raise TaskError(f"plan.waypoints[{i}]", f"the push by {steps[i].pusher!r} is not a stable push for this task "
-                                                    f"(margin {verdict.margin:+.4f} N); was the plan made for another version of it?")
+            fail(f"waypoints[{i}]", f"the push by {steps[i].pusher!r} is not a stable push for this task "
+                                    f"(margin {verdict.margin:+.4f} N); was the plan made for another version of it?")
         if not model.grasp_maintained(q1):
-            raise TaskError(f"plan.waypoints[{i}]", "the pads leave the object at this pose")
+            fail(f"waypoints[{i}]", "the pads leave the object at this pose")
     return steps
 
 
 class _Link:
-    """The socket to the arm server, reading one JSON line at a time with a timeout."""
+    """The socket to the arm server: one JSON line at a time, each within the ack timeout."""
 
     def __init__(self, host: str, port: int, timeout: float):
-        self.where = f"{host}:{port}"
+        self.where = f"the arm server at {host}:{port}"
+        self.timeout = timeout
         try:
             self.sock = socket.create_connection((host, port), timeout=timeout)
         except OSError as exc:
-            raise ConnectionError(f"cannot reach the arm server at {self.where} ({exc.strerror or exc})") from None
-        self.sock.settimeout(timeout)
-        self.reader = self.sock.makefile("rb")
+            raise ConnectionError(f"cannot reach {self.where} ({exc.strerror or exc})") from None
+        self.reader = LineReader(self.sock, self.where)
 
     def send(self, message: dict) -> None:
+        self.sock.settimeout(self.timeout)
         self.sock.sendall(encode(message))
 
-    def receive(self) -> dict:
-        try:
-            line = self.reader.readline()
-        except socket.timeout:
-            raise TimeoutError(f"no reply from the arm server at {self.where} within {self.sock.gettimeout():g} s") from None
-        if not line:
-            raise ConnectionError(f"the arm server at {self.where} closed the connection")
-        return decode(line, "server")
+    def receive(self, timeout: Optional[float] = None) -> dict:
+        return decode(self.reader.read_line(self.timeout if timeout is None else timeout), "server")
 
     def close(self) -> None:
         try:
@@ -187,7 +189,6 @@ def execute_plan(
     rate_hz: float,
     resume_from: int = 0,
     pace: bool = True,
-    reset: bool = False,
     ack_timeout: float = DEFAULT_ACK_TIMEOUT,
     closed_loop: Optional[ClosedLoop] = None,
     progress: Optional[Callable[[ArmWaypoint, int, int], None]] = None,
@@ -209,7 +210,8 @@ def execute_plan(
     link = None
     try:
         link = _Link(host, port, ack_timeout)
-        link.send({"type": "hello", "protocol": PROTOCOL, "rate_hz": rate_hz, "scene": scene, "reset": reset})
+        link.send({"type": "hello", "protocol": PROTOCOL, "rate_hz": rate_hz, "scene": scene,
+                   "continue": resume_from > 0})
         ready = _expect(link.receive(), "ready")
         pending = deque(arm_trajectory(task, steps, features, rate_hz, ready["state"]["ee_pose"], resume_from))
         contacts: Dict[int, ContactRecord] = {}
@@ -302,16 +304,15 @@ def _expect(message: dict, kind: str) -> dict:
     return message
 
 
-def _stop(link: _Link) -> Optional[bool]:
-    """Tell the arm to hold still; True when it confirmed, None when it could not be reached."""
+def _stop(link: _Link, within: float = 2.0) -> Optional[bool]:
+    """Tell the arm to hold still; True when it confirmed within `within` s (replies that keep
+    coming do not extend it), None when it could not be reached or did not confirm."""
+    deadline = time.monotonic() + within
     try:
-        link.sock.settimeout(2.0)
         link.send({"type": "stop"})
         while True:
-            reply = link.receive()
-            if reply["type"] == "stopped":
-                return True
-            if reply["type"] == "error":  # the server stops the arm itself before reporting an error
+            reply = link.receive(max(0.0, deadline - time.monotonic()))
+            if reply["type"] in ("stopped", "error"):  # the server stops the arm itself before reporting an error
                 return True
     except (ConnectionError, TimeoutError, ProtocolError, OSError):
         return None

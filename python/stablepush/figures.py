@@ -7,7 +7,11 @@ theta against the step. `cone_figure` draws a pusher's generalized friction cone
 """
 from __future__ import annotations
 
+import io
 import math
+import os
+import tempfile
+from pathlib import Path
 from typing import List, Optional, Sequence
 
 import matplotlib
@@ -19,6 +23,7 @@ from matplotlib import animation  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from stablepush.execution import PlanStep, contacts_of  # noqa: E402
+from stablepush.plan_io import write_atomically  # noqa: E402
 from stablepush.task import Task  # noqa: E402
 
 MAX_SNAPSHOTS = 6
@@ -131,8 +136,18 @@ def save_plan_gif(task: Task, steps: Sequence[PlanStep], path: str, max_frames: 
         _draw_grasp(ax, task, steps[i].pose, pusher, f"{task.name}: step {i}/{len(steps) - 1} ({pusher})", limits)
 
     anim = animation.FuncAnimation(fig, draw, frames=frames)
-    anim.save(path, writer=animation.PillowWriter(fps=10))
+    with tempfile.TemporaryDirectory() as scratch:  # Pillow writes a path; the output is then written safely
+        anim.save(os.path.join(scratch, "plan.gif"), writer=animation.PillowWriter(fps=10))
+        plt.close(fig)
+        write_atomically(path, Path(scratch, "plan.gif").read_bytes())
+
+
+def save_figure(fig, path: str, dpi: int = 110) -> None:
+    """Write a figure as PNG the way every output is written (plan_io.write_files)."""
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
     plt.close(fig)
+    write_atomically(path, buffer.getvalue())
 
 
 def cone_figure(task: Task, pusher: str):

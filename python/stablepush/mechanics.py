@@ -4,7 +4,10 @@ from __future__ import annotations
 from typing import Dict, Optional, Sequence
 
 from stablepush import _core
-from stablepush.task import Task, TaskError, pose_to_si
+from stablepush.errors import TaskError
+from stablepush.task import Task, pose_field, pose_to_si
+
+SMALLEST_MOVE = 1e-6  # mm or deg: below, the motion's velocity terms are rounding noise
 
 CASE_NAMES = {_core.ContactCase.all_sliding: "all_sliding", _core.ContactCase.sticking: "sticking"}
 
@@ -30,8 +33,11 @@ def check_push(
 ) -> Dict[str, dict]:
     """Is the unit motion `move` (dx mm, dz mm, dtheta deg) from pose `at` (x mm, z mm, theta deg)
     a stable push? One entry per pusher (or only `pusher`), keyed by pusher name."""
-    if all(v == 0 for v in move):
-        raise TaskError("move", "the motion is zero; give a non-zero (dx, dz, dtheta)")
+    at = pose_field("at", list(at))
+    move = pose_field("move", list(move))
+    if max(abs(v) for v in move) < SMALLEST_MOVE:
+        raise TaskError("move", f"the motion is zero or too small (every component under {SMALLEST_MOVE:g} mm or deg); "
+                                f"give a unit motion (dx, dz, dtheta)")
     model = model or task.build_model()
     q, dq = pose_to_si(at), pose_to_si(move)
     if pusher is not None:

@@ -1,14 +1,21 @@
 """Plan files (MODEL.md section 5): JSON, with a CSV beside it, written atomically."""
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
 import math
 import os
+import re
+import signal
+import stat
 import tempfile
+import threading
 from pathlib import Path
-from typing import Union
+from typing import Mapping, Optional, Union
+
+from stablepush.errors import OutputError, PlanError
 
 from stablepush.planning import PlanResult, Waypoint
 
@@ -56,33 +63,147 @@ def plan_to_csv(plan: PlanResult) -> str:
     return buffer.getvalue()
 
 
-def write_atomically(path: Union[str, Path], text: str) -> None:
-    """Write `text` to `path` so that a reader sees the old file or the whole new one, never a part."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+def default_output(input_file: Union[str, Path], suffix: str) -> str:
+    """The default output for an input file: its stem plus `suffix`, in the current directory.
+    Derived from the file's own name (never from names inside it), so it cannot point elsewhere."""
+    stem = Path(input_file).name.split(".")[0] or "stablepush"
+    return re.sub(r"[^\w.+-]", "_", stem + suffix)
+
+
+def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
+    """Write each file so that a reader sees its old content or the whole new one, never a part,
+    and a set of files is replaced together: every new file is written and synced beside its
+    target first, then all are renamed into place with SIGINT, SIGTERM and SIGHUP held off, so
+    that only a SIGKILL or a power cut between two renames can leave old and new side by side.
+
+    A symlink is written through (its target is replaced; the link stays). A character device or
+    FIFO (/dev/null, /dev/stdout) is written to, never replaced. A directory or any other kind of
+    file is refused, as is a missing directory: OutputError naming the path. New files take the
+    umask's permissions; a replaced file keeps its own."""
+    plan = []
+    for path, content in files.items():
+        target = Path(os.path.realpath(path))
+        try:
+            mode = os.stat(target).st_mode
+        except FileNotFoundError:
+            mode = None
+        except OSError as exc:
+            raise OutputError(f"{path}: cannot write ({exc.strerror})") from None
+        if mode is not None and (stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)):
+            plan.append((path, target, content, "stream", None))
+        elif mode is not None and not stat.S_ISREG(mode):
+            raise OutputError(f"{path}: not a regular file; refusing to replace it")
+        elif not target.parent.is_dir():
+            raise OutputError(f"{path}: the directory {target.parent} does not exist")
+        else:
+            plan.append((path, target, content, "replace", stat.S_IMODE(mode) if mode is not None else None))
+    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, held) if threading.current_thread() is threading.main_thread() else None
+    temporaries = []
     try:
-        with os.fdopen(fd, "w") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+        for path, target, content, how, mode in plan:
+            data = content.encode() if isinstance(content, str) else content
+            if how == "stream":
+                with open(target, "wb") as handle:
+                    handle.write(data)
+                continue
+            fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+            temporaries.append((tmp, target))
+            with os.fdopen(fd, "wb") as handle:
+                handle.write(data)
+                handle.flush()
+                os.fsync(handle.fileno())
+            os.chmod(tmp, mode if mode is not None else 0o666 & ~_umask())
+        for tmp, target in temporaries:
+            os.replace(tmp, target)
+        temporaries = []
+    except OSError as exc:
+        raise OutputError(f"cannot write {exc.filename or 'the output'}: {exc.strerror or exc}") from None
+    finally:
+        for tmp, _ in temporaries:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        if blocked is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
 
-def write_plan_json(plan: PlanResult, path: Union[str, Path]) -> None:
-    write_atomically(path, json.dumps(plan_to_dict(plan), indent=1) + "\n")
+def write_atomically(path: Union[str, Path], text: Union[str, bytes]) -> None:
+    """Write one file as `write_files` does."""
+    write_files({path: text})
 
 
-def write_plan_csv(plan: PlanResult, path: Union[str, Path]) -> None:
-    write_atomically(path, plan_to_csv(plan))
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def write_plan(plan: PlanResult, json_path: Union[str, Path], csv_path: Optional[Union[str, Path]] = None) -> None:
+    """The plan as JSON, and as CSV beside it when `csv_path` is given, replaced together."""
+    files = {json_path: json.dumps(plan_to_dict(plan), indent=1) + "\n"}
+    if csv_path:
+        files[csv_path] = plan_to_csv(plan)
+    write_files(files)
+
+
+MAX_PLAN_BYTES = 16_000_000
+MAX_WAYPOINTS = 10_000  # a plan this long streams for about 2 h at 100 waypoints/s with no retracts
 
 
 def read_plan(path: Union[str, Path]) -> dict:
-    """A plan file as a dict; ValueError if it is not a stablepush plan."""
-    data = json.loads(Path(path).read_text())
-    if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise ValueError(f"{path}: not a {FORMAT} file")
+    """A plan file as a dict, once its structure is checked (PlanError naming the field): the
+    format, `solved` a boolean, `stats` a mapping, at most MAX_WAYPOINTS waypoints, each with
+    finite x, z, theta and a pusher name (null at the start). Whether the plan belongs to a task
+    is stablepush.executor.plan_steps's question."""
+    source = str(path)
+    try:
+        with open(path, "rb") as handle:
+            raw = handle.read(MAX_PLAN_BYTES + 1)
+    except OSError as exc:
+        raise PlanError("", f"cannot read the plan file ({exc.strerror or exc})", source) from None
+    if len(raw) > MAX_PLAN_BYTES:
+        raise PlanError("", f"larger than {MAX_PLAN_BYTES} bytes; not a plan this tool wrote", source)
+    try:
+        data = json.loads(raw.decode("utf-8"), parse_constant=_refuse_constant)
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise PlanError("", f"not valid JSON ({' '.join(str(exc).split())[:120]})", source) from None
+    except RecursionError:
+        raise PlanError("", "not valid JSON (nested too deeply)", source) from None
+    check_plan_dict(data, source)
     return data
+
+
+def _refuse_constant(name: str):
+    raise ValueError(f"{name} is not a number a plan may hold")
+
+
+def check_plan_dict(data, source: Optional[str] = None) -> None:
+    """PlanError unless `data` has the structure of a plan document (see read_plan)."""
+    def fail(field: str, reason: str):
+        raise PlanError(field, reason, source)
+
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        fail("format", f"not a {FORMAT} file")
+    for key, kind in (("task", str), ("solved", bool), ("stats", dict), ("waypoints", list)):
+        if not isinstance(data.get(key), kind):
+            fail(key, f"must be {'a boolean' if kind is bool else 'a ' + _KIND_NAMES[kind]}, got "
+                      f"{type(data.get(key)).__name__}")
+    for key in ("outcome", "message"):
+        if key in data and not isinstance(data[key], str):
+            fail(key, f"must be a string, got {type(data[key]).__name__}")
+    waypoints = data["waypoints"]
+    if len(waypoints) > MAX_WAYPOINTS:
+        fail("waypoints", f"{len(waypoints)} waypoints; a plan has at most {MAX_WAYPOINTS}")
+    for i, w in enumerate(waypoints):
+        field = f"waypoints[{i}]"
+        if not isinstance(w, dict):
+            fail(field, f"must be a mapping, got {type(w).__name__}")
+        for key in ("x", "z", "theta"):
+            v = w.get(key)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                fail(f"{field}.{key}", f"must be a finite number, got {str(v)[:40]}")
+        if not (w.get("pusher") is None or isinstance(w.get("pusher"), str)):
+            fail(f"{field}.pusher", f"must be a pusher name or null, got {type(w.get('pusher')).__name__}")
+
+
+_KIND_NAMES = {str: "string", dict: "mapping", list: "list"}

@@ -13,7 +13,7 @@ from typing import Dict, List, Optional, Tuple
 
 from stablepush import _core
 from stablepush.mechanics import CASE_NAMES
-from stablepush.task import MM, PLANNER_TUNING, Task, pose_from_si, pose_to_si
+from stablepush.task import MM, PLANNER_TUNING, Task, planner_limit, planner_parameter, pose_from_si, pose_to_si
 
 OUTCOME_NAMES = {
     _core.PlanOutcome.goal_reached: "goal_reached",
@@ -93,9 +93,12 @@ def plan_task(
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
     task's planner section (which has defaults for every key)."""
     settings = dict(task.planner)
-    for key, value in (("seed", seed), ("time_limit", time_limit), ("max_switches", max_switches)):
-        if value is not None:
-            settings[key] = value
+    if seed is not None:
+        settings["seed"] = planner_parameter("seed", "seed", seed)
+    if max_switches is not None:
+        settings["max_switches"] = planner_parameter("max_switches", "max_switches", max_switches)
+    if time_limit is not None:
+        settings["time_limit"] = planner_limit("time_limit", time_limit)
     model = model or task.build_model()
     step = (settings["step"][0] * MM, math.radians(settings["step"][1]))
     tolerance = (settings["tolerance"][0] * MM, math.radians(settings["tolerance"][1]))

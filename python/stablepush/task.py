@@ -6,6 +6,8 @@ Files use mm, degrees, grams and newtons; the core is SI. Every bad input is ref
 from __future__ import annotations
 
 import math
+import re
+import reprlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
@@ -13,6 +15,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 import yaml
 
 from stablepush import _core
+from stablepush.errors import TaskError
 
 MM = 1e-3  # m per mm
 G = 1e-3  # kg per g
@@ -27,6 +30,35 @@ PUSHES = ("against_fixed_features", "by_moving_pusher")
 DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
+# Resource caps: each bounds the model's size (and so the time and memory to build it and to
+# test a push) before anything reaches the core. README, "Limits".
+MAX_TASK_BYTES = 1_000_000
+MAX_VERTICES = 1000  # of the cross-section
+MAX_PAD_RINGS = 10  # 1 + 3 r (r + 1) points per pad: 331 at the cap
+MAX_PADS = 8
+MAX_PUSHER_POINTS = 50
+MAX_POLYGON_SIDES = 64
+MAX_YAML_ALIASES = 32  # anchors (*name) a task file may use
+MAX_YAML_NODES = 100_000  # values in the file, aliases expanded
+# Plausible-physics bounds on each number, in file units; past them the model's arithmetic
+# (doubles and the exact re-check) is no longer meaningful. Far wider than any real cell.
+MAX_COORDINATE = 1e4  # mm: vertices, com, pusher ends, pad centres, poses, world positions
+MAX_ANGLE = 3600.0  # deg: poses and feature orientations
+LIMITS: Dict[str, Tuple[float, float]] = {  # kind -> (lowest, highest); both inclusive
+    "length": (1e-2, MAX_COORDINATE),  # mm: sizes, radii, distances
+    "mass": (1e-3, 1e7),  # g
+    "inertia": (1e-15, 1e6),  # kg m^2
+    "force": (1e-6, 1e5),  # N
+    "mu": (0.0, 100.0),
+    "gravity": (-1e3, 1e3),  # m/s^2 per component
+    "step_time": (1e-4, 1e3),  # s
+    "step": (1e-3, 1e3),  # mm or deg per unit step
+    "tolerance": (1e-4, 1e4),  # mm or deg
+    "time_limit": (1e-6, _core.MAX_TIME_LIMIT),  # s
+    "min_margin": (0.0, 1e6),  # N
+    "sampling_margin": (0.0, 1e3),  # unit steps
+    "min_hold_ratio": (0.0, 1e3),
+}
 # Where the arm works (stablepush.execution): mm in the world frame (x forward, y along the
 # gripping axis at home, z up).
 ENVIRONMENT_DEFAULTS: Dict[str, Any] = {
@@ -46,48 +78,92 @@ PLANNER_DEFAULTS: Dict[str, Any] = {
     "sampling_margin": 5.0,  # unit steps around the start-goal box
     "min_hold_ratio": 0.0,  # the plan must end where the pads alone hold this multiple of the weight (0: off)
 }
-# TRRTstar's tuning parameters (declared OMPL parameters; their defaults live in the C++ planner,
-# _core.TRRT_STAR_PARAMETERS): key -> (kind, lowest, highest).
-PLANNER_TUNING: Dict[str, Tuple[str, float, float]] = {
-    "goal_bias": ("number", 0.0, 1.0),
-    "rewire_radius": ("number", 0.0, 100.0),  # unit steps
-    "steer_angle": ("number", 0.0, 90.0),  # deg
-    "init_temperature": ("number", 1e-12, 1e6),
-    "temp_change_factor": ("number", 1.0, 1e3),
-    "max_transition_failures": ("integer", 1, 1_000_000),
-}
-
-
-class TaskError(ValueError):
-    """A task that cannot be used; `field` is the dotted path of the offending key."""
-
-    def __init__(self, field: str, reason: str, source: Optional[str] = None):
-        self.field = field
-        self.reason = reason
-        self.source = source
-        where = f"{source}: " if source else ""
-        super().__init__(f"{where}{field}: {reason}" if field else f"{where}{reason}")
+# TRRTstar's declared parameters and their ranges live in the C++ planner (declared once there;
+# its setters refuse values outside them): key -> (kind, lowest, highest). seed and max_switches
+# are among them; the rest are tuning keys, written to the plan only when the task gives them.
+PLANNER_PARAMETER_RANGES: Dict[str, Tuple[str, float, float]] = dict(_core.TRRT_STAR_PARAMETER_RANGES)
+PLANNER_TUNING = {k: v for k, v in PLANNER_PARAMETER_RANGES.items() if k not in ("seed", "max_switches")}
 
 
 # ---------------------------------------------------------------------------------------------
-# YAML with duplicate keys refused (PyYAML silently keeps the last one).
+# YAML: duplicate keys refused (PyYAML silently keeps the last one), YAML 1.2 numbers (1e-3 is a
+# number, not a string), and a budget on aliases and on the values they expand to (a few hundred
+# bytes of nested aliases otherwise expand to gigabytes).
 
 
 class _StrictLoader(yaml.SafeLoader):
-    pass
+    def __init__(self, stream):
+        super().__init__(stream)
+        self.aliases = 0
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.AliasEvent):
+            self.aliases += 1
+            if self.aliases > MAX_YAML_ALIASES:
+                line = self.peek_event().start_mark.line + 1
+                raise TaskError("", f"line {line}: more than {MAX_YAML_ALIASES} YAML aliases (*name); "
+                                    f"write the values out")
+        return super().compose_node(parent, index)
 
 
 def _construct_mapping(loader: _StrictLoader, node: yaml.MappingNode, deep: bool = False) -> dict:
-    seen = {}
+    seen = set()
     for key_node, _ in node.value:
         key = loader.construct_object(key_node, deep=deep)
+        line = key_node.start_mark.line + 1
+        if not isinstance(key, (str, int, float, bool, type(None))):
+            raise TaskError("", f"line {line}: a mapping key must be a name, got a {type(key).__name__}")
         if key in seen:
-            raise TaskError(str(key), f"duplicate key (line {key_node.start_mark.line + 1})")
-        seen[key] = True
+            raise TaskError(str(key), f"duplicate key (line {line})")
+        seen.add(key)
     return loader.construct_mapping(node, deep=deep)
 
 
 _StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+_StrictLoader.add_implicit_resolver(  # YAML 1.2 floats without a dot: 1e-3, 2E+2
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$"), list("-+0123456789"))
+
+
+def _expanded_size(node: yaml.Node) -> int:
+    """How many values `node` stands for with its aliases expanded (TaskError past the budget or
+    on a value that contains itself)."""
+    sizes: Dict[int, int] = {}
+    open_nodes = set()
+
+    def size(n: yaml.Node) -> int:
+        if id(n) in sizes:
+            return sizes[id(n)]
+        if id(n) in open_nodes:
+            raise TaskError("", f"line {n.start_mark.line + 1}: a YAML value contains itself (through an alias)")
+        open_nodes.add(id(n))
+        children = [c for pair in n.value for c in pair] if isinstance(n, yaml.MappingNode) else (
+            n.value if isinstance(n, yaml.SequenceNode) else [])
+        total = 1
+        for child in children:
+            total += size(child)
+            if total > MAX_YAML_NODES:
+                raise TaskError("", f"the file stands for more than {MAX_YAML_NODES} values (aliases expanded)")
+        open_nodes.discard(id(n))
+        sizes[id(n)] = total
+        return total
+
+    return size(node)
+
+
+def _load_yaml(text: str) -> Any:
+    if len(text) > MAX_TASK_BYTES:
+        raise TaskError("", f"the file has {len(text)} characters; a task file has at most {MAX_TASK_BYTES}")
+    loader = _StrictLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _expanded_size(node)
+        return loader.construct_document(node)
+    except RecursionError:
+        raise TaskError("", "values nested too deeply") from None
+    finally:
+        loader.dispose()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -97,10 +173,13 @@ _StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _c
 def _mapping(path: str, value: Any, required: Sequence[str], optional: Sequence[str]) -> dict:
     if not isinstance(value, dict):
         raise TaskError(path, f"must be a mapping, got {type(value).__name__}")
+    if len(value) > 64:
+        raise TaskError(path, f"has {len(value)} keys; at most 64")
     for key in value:
         if key not in required and key not in optional:
             allowed = ", ".join(list(required) + list(optional))
-            raise TaskError(_join(path, str(key)), f"unknown key (allowed here: {allowed})")
+            raise TaskError(_join(path, _shown(key, 40) if not isinstance(key, str) else _shown(key, 40).strip("'")),
+                            f"unknown key (allowed here: {allowed})")
     for key in required:
         if key not in value:
             raise TaskError(_join(path, key), "missing")
@@ -111,37 +190,61 @@ def _join(path: str, key: str) -> str:
     return f"{path}.{key}" if path else key
 
 
-def _number(path: str, value: Any, *, positive: bool = False, nonnegative: bool = False) -> float:
+def _number(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> float:
+    """A finite number, inside `within` (lowest, highest; both inclusive) when given."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise TaskError(path, f"must be a number, got {value!r}")
-    x = float(value)
+        raise TaskError(path, f"must be a number, got {_shown(value)}")
+    try:
+        x = float(value)
+    except OverflowError:  # an int past the double range
+        raise TaskError(path, f"must be finite, got {_shown(value)}") from None
     if not math.isfinite(x):
-        raise TaskError(path, f"must be finite, got {value!r}")
-    if positive and not x > 0:
-        raise TaskError(path, f"must be > 0, got {value!r}")
-    if nonnegative and not x >= 0:
-        raise TaskError(path, f"must be >= 0, got {value!r}")
+        raise TaskError(path, f"must be finite, got {_shown(value)}")
+    if within is not None and not within[0] <= x <= within[1]:
+        raise TaskError(path, f"must be between {within[0]:g} and {within[1]:g}, got {x:g}")
     return x
 
 
-def _integer(path: str, value: Any, minimum: int) -> int:
+def _integer(path: str, value: Any, lowest: int, highest: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
-        raise TaskError(path, f"must be an integer, got {value!r}")
-    if value < minimum:
-        raise TaskError(path, f"must be >= {minimum}, got {value}")
+        raise TaskError(path, f"must be an integer, got {_shown(value)}")
+    if not lowest <= value <= highest:
+        raise TaskError(path, f"must be an integer from {lowest} to {highest}, got {_shown(value)}")
     return value
 
 
-def _vector(path: str, value: Any, n: int, **kw) -> Tuple[float, ...]:
+def _vector(path: str, value: Any, n: int, within: Optional[Tuple[float, float]] = None) -> Tuple[float, ...]:
     if not isinstance(value, (list, tuple)) or len(value) != n:
-        raise TaskError(path, f"must be a list of {n} numbers, got {value!r}")
-    return tuple(_number(f"{path}[{i}]", v, **kw) for i, v in enumerate(value))
+        raise TaskError(path, f"must be a list of {n} numbers, got {_shown(value)}")
+    return tuple(_number(f"{path}[{i}]", v, within) for i, v in enumerate(value))
+
+
+COORDINATE = (-MAX_COORDINATE, MAX_COORDINATE)
+ANGLE = (-MAX_ANGLE, MAX_ANGLE)
+
+
+def pose_field(path: str, value: Any) -> Tuple[float, float, float]:
+    """[x mm, z mm, theta deg] within the coordinate and angle bounds."""
+    _vector(path, value, 3)
+    return (_number(f"{path}[0]", value[0], COORDINATE), _number(f"{path}[1]", value[1], COORDINATE),
+            _number(f"{path}[2]", value[2], ANGLE))
 
 
 def _name(path: str, value: Any) -> str:
     if not isinstance(value, str) or not value.strip():
-        raise TaskError(path, f"must be a non-empty string, got {value!r}")
+        raise TaskError(path, f"must be a non-empty string, got {_shown(value)}")
+    if len(value) > 100 or any(not ch.isprintable() for ch in value):
+        raise TaskError(path, f"must be at most 100 printable characters, got {_shown(value)}")
     return value
+
+
+def _shown(value: Any, limit: int = 60) -> str:
+    """A value for a message: its repr, cut to one short line."""
+    text = reprlib.Repr()
+    text.maxstring = text.maxother = limit
+    text.maxlevel = 2
+    shown = text.repr(value).replace("\n", " ")
+    return shown if len(shown) <= limit else shown[: limit - 3] + "..."
 
 
 # ---------------------------------------------------------------------------------------------
@@ -268,7 +371,7 @@ def load_task(path: "str | Path") -> Task:
 
 def parse_task(text: str, source: Optional[str] = None) -> Task:
     try:
-        data = yaml.load(text, Loader=_StrictLoader)
+        data = _load_yaml(text)
     except TaskError:
         raise
     except yaml.YAMLError as exc:
@@ -292,32 +395,34 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     section = _core.CrossSection(vertices_m)
 
     grip = _mapping("gripper", top["gripper"], ["grip_force", "mu"], ["pad_rings", "pads"])
-    grip_force = _number("gripper.grip_force", grip["grip_force"], positive=True)
-    mu = _number("gripper.mu", grip["mu"], nonnegative=True)
-    pad_rings = _integer("gripper.pad_rings", grip.get("pad_rings", 1), 0)
+    grip_force = _number("gripper.grip_force", grip["grip_force"], LIMITS["force"])
+    mu = _number("gripper.mu", grip["mu"], LIMITS["mu"])
+    pad_rings = _integer("gripper.pad_rings", grip.get("pad_rings", 1), 0, MAX_PAD_RINGS)
     if "pads" in grip:
-        if not isinstance(grip["pads"], list) or not grip["pads"]:
-            raise TaskError("gripper.pads", "must be a non-empty list of {center: [x, z], radius: r}")
+        if not isinstance(grip["pads"], list) or not 1 <= len(grip["pads"]) <= MAX_PADS:
+            raise TaskError("gripper.pads", f"must be a list of 1 to {MAX_PADS} {{center: [x, z], radius: r}}")
         pads = []
         for i, pad in enumerate(grip["pads"]):
             path = f"gripper.pads[{i}]"
             pad = _mapping(path, pad, ["center", "radius"], [])
-            pads.append((_vector(f"{path}.center", pad["center"], 2), _number(f"{path}.radius", pad["radius"], positive=True)))
+            pads.append((_vector(f"{path}.center", pad["center"], 2, COORDINATE),
+                         _number(f"{path}.radius", pad["radius"], LIMITS["length"])))
         pads = tuple(pads)
     else:
         pads = (((0.0, 0.0), DEFAULT_PAD_RADIUS_MM), ((0.0, 0.0), DEFAULT_PAD_RADIUS_MM))
 
-    gravity = _vector("gravity", top.get("gravity", list(DEFAULT_GRAVITY)), 2)
+    gravity = _vector("gravity", top.get("gravity", list(DEFAULT_GRAVITY)), 2, LIMITS["gravity"])
     dyn = _mapping("dynamics", top.get("dynamics", {}), [], ["step_time", "friction_polygon_sides", "pushes"])
     pushes = dyn.get("pushes", PUSHES[0])
     if pushes not in PUSHES:
         raise TaskError("dynamics.pushes", f"must be one of {', '.join(PUSHES)}, got {pushes!r}")
-    step_time = _number("dynamics.step_time", dyn.get("step_time", DEFAULT_STEP_TIME), positive=True)
-    sides = _integer("dynamics.friction_polygon_sides", dyn.get("friction_polygon_sides", DEFAULT_POLYGON_SIDES), 3)
+    step_time = _number("dynamics.step_time", dyn.get("step_time", DEFAULT_STEP_TIME), LIMITS["step_time"])
+    sides = _integer("dynamics.friction_polygon_sides", dyn.get("friction_polygon_sides", DEFAULT_POLYGON_SIDES), 3,
+                     MAX_POLYGON_SIDES)
 
     pushers = _validate_pushers(top["pushers"], section)
-    start = _vector("start", top["start"], 3)
-    goal = _vector("goal", top["goal"], 3)
+    start = pose_field("start", top["start"])
+    goal = pose_field("goal", top["goal"])
     for label, q in (("start", start), ("goal", goal)):
         inside = _make_gripper(pads, grip_force, mu, pad_rings).pads_inside(section, pose_to_si(q))
         for i, ok in enumerate(inside):
@@ -345,7 +450,7 @@ def _validate_object(obj: Any):
             raise TaskError("object.thickness", "only for shape: polygon (a box's thickness is size[1])")
         if "size" not in obj:
             raise TaskError("object.size", "missing (a box needs [L along x, B along y, H along z] in mm)")
-        length, thickness, height = _vector("object.size", obj["size"], 3, positive=True)
+        length, thickness, height = _vector("object.size", obj["size"], 3, LIMITS["length"])
         vertices = ((-length / 2, -height / 2), (length / 2, -height / 2), (length / 2, height / 2), (-length / 2, height / 2))
     elif shape == "polygon":
         if "size" in obj:
@@ -353,15 +458,16 @@ def _validate_object(obj: Any):
         if "polygon" not in obj:
             raise TaskError("object.polygon", "missing (a list of [x, z] vertices in mm)")
         poly = obj["polygon"]
-        if not isinstance(poly, list) or len(poly) < 3:
-            raise TaskError("object.polygon", "must be a list of at least 3 [x, z] vertices")
-        vertices = tuple(_vector(f"object.polygon[{i}]", v, 2) for i, v in enumerate(poly))
-        thickness = _number("object.thickness", obj.get("thickness", 25.0), positive=True)
+        if not isinstance(poly, list) or not 3 <= len(poly) <= MAX_VERTICES:
+            raise TaskError("object.polygon", f"must be a list of 3 to {MAX_VERTICES} [x, z] vertices"
+                                              + (f", got {len(poly)}" if isinstance(poly, list) else ""))
+        vertices = tuple(_vector(f"object.polygon[{i}]", v, 2, COORDINATE) for i, v in enumerate(poly))
+        thickness = _number("object.thickness", obj.get("thickness", 25.0), LIMITS["length"])
     else:
         raise TaskError("object.shape", f"must be box or polygon, got {shape!r}")
-    mass = _number("object.mass", obj["mass"], positive=True)
-    com = _vector("object.com", obj["com"], 2) if "com" in obj else None
-    inertia = _number("object.inertia", obj["inertia"], positive=True) if "inertia" in obj else None
+    mass = _number("object.mass", obj["mass"], LIMITS["mass"])
+    com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else None
+    inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else None
     return vertices, thickness, mass, com, inertia
 
 
@@ -377,19 +483,19 @@ def _validate_pushers(value: Any, section: "_core.CrossSection") -> Tuple[Pusher
             raw = _mapping(path, raw, ["name", "at", "mu"], [])
             if "from" in raw or "to" in raw:
                 raise TaskError(path, "give either at (a point pusher) or from/to (a segment), not both")
-            a = b = _vector(f"{path}.at", raw["at"], 2)
+            a = b = _vector(f"{path}.at", raw["at"], 2, COORDINATE)
             points = 1
         else:
             raw = _mapping(path, raw, ["name", "from", "to", "mu"], ["points"])
-            a = _vector(f"{path}.from", raw["from"], 2)
-            b = _vector(f"{path}.to", raw["to"], 2)
+            a = _vector(f"{path}.from", raw["from"], 2, COORDINATE)
+            b = _vector(f"{path}.to", raw["to"], 2, COORDINATE)
             if a == b:
                 raise TaskError(f"{path}.to", "equals from; a point pusher is written at: [x, z]")
-            points = _integer(f"{path}.points", raw.get("points", DEFAULT_PUSHER_POINTS), 2)
+            points = _integer(f"{path}.points", raw.get("points", DEFAULT_PUSHER_POINTS), 2, MAX_PUSHER_POINTS)
         name = _name(f"{path}.name", raw["name"])
         if any(s.name == name for s in specs):
             raise TaskError(f"{path}.name", f"duplicate pusher name {name!r}")
-        mu = _number(f"{path}.mu", raw["mu"], nonnegative=True)
+        mu = _number(f"{path}.mu", raw["mu"], LIMITS["mu"])
         try:
             _core.Pusher.on_boundary(section, name, _mm2(a), _mm2(b), mu, points)
         except ValueError as exc:
@@ -404,9 +510,9 @@ def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Dict[str, 
     feature; pushers not listed get a feature placed by the executor (stablepush.execution)."""
     env = _mapping("environment", value, [], list(ENVIRONMENT_DEFAULTS) + ["features"])
     out: Dict[str, Any] = {key: env.get(key, default) for key, default in ENVIRONMENT_DEFAULTS.items()}
-    out["home"] = list(_vector("environment.home", out["home"], 3))
+    out["home"] = list(_vector("environment.home", out["home"], 3, COORDINATE))
     for key in ("retract", "lane_offset", "station_spacing"):
-        out[key] = _number(f"environment.{key}", out[key], positive=True)
+        out[key] = _number(f"environment.{key}", out[key], LIMITS["length"])
     features = env.get("features", {})
     if not isinstance(features, dict):
         raise TaskError("environment.features", "must map pusher names to [x, y, z, theta] (mm, deg)")
@@ -414,32 +520,39 @@ def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Dict[str, 
     for name, pose in features.items():
         if name not in pusher_names:
             raise TaskError(f"environment.features.{name}", f"no pusher named {name!r} (the task has {', '.join(pusher_names)})")
-        out["features"][name] = list(_vector(f"environment.features.{name}", pose, 4))
+        _vector(f"environment.features.{name}", pose, 4)
+        out["features"][name] = [_number(f"environment.features.{name}[{i}]", v, COORDINATE if i < 3 else ANGLE)
+                                 for i, v in enumerate(pose)]
     return out
+
+
+def planner_parameter(path: str, key: str, value: Any) -> "int | float":
+    """`value` for TRRTstar's declared parameter `key`, checked against the core's range for it
+    (the CLI's --seed and --max-switches go through here too)."""
+    kind, lowest, highest = PLANNER_PARAMETER_RANGES[key]
+    if kind == "integer":
+        return _integer(path, value, int(lowest), int(highest))
+    return _number(path, value, (lowest, highest))
+
+
+def planner_limit(path: str, value: Any) -> float:
+    """A time limit [s]: finite, positive, at most the core's MAX_TIME_LIMIT."""
+    return _number(path, value, LIMITS["time_limit"])
 
 
 def _validate_planner(value: Any) -> Dict[str, Any]:
     """The planner section with defaults filled in; tuning keys appear only when given."""
-    planner = _mapping("planner", value, [], list(PLANNER_DEFAULTS) + list(PLANNER_TUNING))
+    planner = _mapping("planner", value, [], list(PLANNER_DEFAULTS) + list(PLANNER_PARAMETER_RANGES))
     out = dict(PLANNER_DEFAULTS)
     if "time_limit" in planner:
-        out["time_limit"] = _number("planner.time_limit", planner["time_limit"], positive=True)
-    if "seed" in planner:
-        out["seed"] = _integer("planner.seed", planner["seed"], 0)
-    if "max_switches" in planner:
-        out["max_switches"] = _integer("planner.max_switches", planner["max_switches"], 0)
+        out["time_limit"] = planner_limit("planner.time_limit", planner["time_limit"])
     for key in ("step", "tolerance"):
         if key in planner:
-            out[key] = list(_vector(f"planner.{key}", planner[key], 2, positive=True))
+            out[key] = list(_vector(f"planner.{key}", planner[key], 2, LIMITS[key]))
     for key in ("min_margin", "sampling_margin", "min_hold_ratio"):
         if key in planner:
-            out[key] = _number(f"planner.{key}", planner[key], nonnegative=True)
-    for key, (kind, lowest, highest) in PLANNER_TUNING.items():
-        if key not in planner:
-            continue
-        path = f"planner.{key}"
-        v = _integer(path, planner[key], int(lowest)) if kind == "integer" else _number(path, planner[key])
-        if not lowest <= v <= highest:
-            raise TaskError(path, f"must be between {lowest:g} and {highest:g}, got {v:g}")
-        out[key] = v
+            out[key] = _number(f"planner.{key}", planner[key], LIMITS[key])
+    for key, value in planner.items():
+        if key in PLANNER_PARAMETER_RANGES:
+            out[key] = planner_parameter(f"planner.{key}", key, value)
     return out

@@ -6,11 +6,21 @@
 #include <CGAL/Gmpzf.h>
 #include <CGAL/Simple_cartesian.h>
 
+#include <cmath>
+#include <stdexcept>
+
 namespace stablepush {
 
 using ExactFT = CGAL::Gmpzf;
 using ExactKernel = CGAL::Simple_cartesian<ExactFT>;
 /// An exact planar wrench (f_x, f_z, tau_y).
 using ExactWrench = ExactKernel::Vector_3;
+
+/// The exact value of a double the fast path used. Gmpzf(double) traps (SIGFPE) on a non-finite
+/// value instead of throwing, so an overflow upstream is refused here, by name.
+inline ExactFT exact(double x) {
+  if (!std::isfinite(x)) throw std::domain_error("a non-finite value reached the exact re-check (an input too large?)");
+  return ExactFT(x);
+}
 
 }  // namespace stablepush

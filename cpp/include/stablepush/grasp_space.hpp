@@ -33,6 +33,10 @@ inline bool contains(PusherSet set, int pusher) { return pusher >= 0 && ((set >>
 ///     d(q1, q2) = sqrt((dx^2 + dz^2) / length^2 + dtheta^2 / angle^2)   [unit steps],
 /// so that a unit step is a step of length 1. theta is not wrapped: a plan turns the object
 /// through the angles it passes, and the bounds decide how far it may turn.
+/// The distance from a to b in unit steps: |(dx / length, dz / length, dtheta / angle)|. A unit
+/// push moves at most 1; the planner cuts longer motions into pushes by it (unit_pushes).
+double steps_between(const Pose& a, const Pose& b, const StepSize& step);
+
 class GraspPoseSpace : public ompl::base::RealVectorStateSpace {
  public:
   GraspPoseSpace(StepSize step, const ompl::base::RealVectorBounds& bounds);

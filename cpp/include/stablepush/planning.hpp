@@ -13,6 +13,9 @@
 
 namespace stablepush {
 
+/// The longest time limit a plan accepts [s] (OMPL's timed termination counts in integer ns).
+inline constexpr double kMaxTimeLimit = 1e6;
+
 struct PlannerSettings {
   Pose start;                   ///< [m, m, rad]
   Pose goal;                    ///< [m, m, rad]

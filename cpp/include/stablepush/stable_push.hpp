@@ -27,6 +27,8 @@ namespace stablepush {
 
 /// Relative width of the band around a cone boundary inside which a double answer is re-made exactly.
 inline constexpr double kCertificationBand = 1e-9;
+/// The least unit motion (largest of |dx|, |dz| [m], |dtheta| [rad]) the model evaluates.
+inline constexpr double kSmallestMotion = 1e-12;
 /// "No pusher": the start of a plan, or the object held by the pads alone.
 inline constexpr int kNoPusher = -1;
 /// A pad point sticks when its slip speed is below this fraction of |v| + |omega| r_pad (MODEL.md section 2).

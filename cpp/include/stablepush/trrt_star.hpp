@@ -26,7 +26,9 @@
 #include <ompl/util/RandomNumbers.h>
 
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "stablepush/grasp_space.hpp"
@@ -61,6 +63,17 @@ struct PathNode {
   int pusher = kNoPusher;
 };
 
+/// A declared parameter's kind and the closed range its setter accepts.
+struct ParameterRange {
+  bool integer = false;
+  double lowest = 0.0;
+  double highest = 0.0;
+};
+
+/// TRRTstar's declared parameters and their ranges: the one table the setters enforce and the
+/// task validation reads (Python: _core.TRRT_STAR_PARAMETER_RANGES).
+const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges();
+
 class TRRTstar : public ompl::base::Planner {
  public:
   explicit TRRTstar(const ompl::base::SpaceInformationPtr& si);
@@ -72,24 +85,29 @@ class TRRTstar : public ompl::base::Planner {
   void getPlannerData(ompl::base::PlannerData& data) const override;
 
   // Declared parameters (Planner::params()), settable by name from the task's planner section.
-  void setGoalBias(double p) { goal_bias_ = p; }
+  // Each setter refuses a value outside its range in trrt_star_parameter_ranges()
+  // (std::invalid_argument naming the parameter); integers arrive as 64-bit so that no value
+  // wraps on its way in.
+  void setGoalBias(double p) { goal_bias_ = checked("goal_bias", p); }
   double getGoalBias() const { return goal_bias_; }
-  void setRewireRadius(double steps) { rewire_radius_ = steps; }
+  void setRewireRadius(double steps) { rewire_radius_ = checked("rewire_radius", steps); }
   double getRewireRadius() const { return rewire_radius_; }
-  void setInitTemperature(double t) { init_temperature_ = t; }
+  void setInitTemperature(double t) { init_temperature_ = checked("init_temperature", t); }
   double getInitTemperature() const { return init_temperature_; }
-  void setTempChangeFactor(double f) { temp_change_factor_ = f; }
+  void setTempChangeFactor(double f) { temp_change_factor_ = checked("temp_change_factor", f); }
   double getTempChangeFactor() const { return temp_change_factor_; }
-  void setMaxTransitionFailures(unsigned n) { max_transition_failures_ = n; }
-  unsigned getMaxTransitionFailures() const { return max_transition_failures_; }
-  void setMaxSwitches(unsigned k) { max_switches_ = k; }
-  unsigned getMaxSwitches() const { return max_switches_; }
+  void setMaxTransitionFailures(long long n) {
+    max_transition_failures_ = static_cast<unsigned>(checked("max_transition_failures", n));
+  }
+  long long getMaxTransitionFailures() const { return max_transition_failures_; }
+  void setMaxSwitches(long long k) { max_switches_ = static_cast<int>(checked("max_switches", k)); }
+  long long getMaxSwitches() const { return max_switches_; }
   /// Largest deviation from the straight step toward the goal tried when that step is not a
   /// stable push [deg]; 0 keeps to straight steps.
-  void setSteerAngle(double degrees) { steer_angle_ = degrees; }
+  void setSteerAngle(double degrees) { steer_angle_ = checked("steer_angle", degrees); }
   double getSteerAngle() const { return steer_angle_; }
-  void setSeed(unsigned seed) { seed_ = seed; }
-  unsigned getSeed() const { return seed_; }
+  void setSeed(long long seed) { seed_ = static_cast<std::uint32_t>(checked("seed", seed)); }
+  long long getSeed() const { return seed_; }
 
   // The last solve.
   PlanOutcome outcome() const { return outcome_; }
@@ -137,6 +155,9 @@ class TRRTstar : public ompl::base::Planner {
   std::vector<Eigen::Vector3d> unit_coords_;  ///< nodes_[i]'s pose in unit steps
   std::vector<Node*> goal_nodes_;
   std::vector<Node*> near_;  ///< scratch for near-node queries
+  /// `value` if it lies in `name`'s declared range, else std::invalid_argument.
+  static double checked(const char* name, double value);
+
   Node* closest_ = nullptr;
   std::unique_ptr<ompl::RNG> rng_;
   ompl::base::StateSamplerPtr sampler_;
@@ -147,8 +168,8 @@ class TRRTstar : public ompl::base::Planner {
   double temp_change_factor_ = 2.0;
   double steer_angle_ = 45.0;
   unsigned max_transition_failures_ = 10;
-  unsigned max_switches_ = 1;
-  unsigned seed_ = 1;
+  int max_switches_ = 1;
+  std::uint32_t seed_ = 1;
 
   double temperature_ = 0.0;
   unsigned transition_failures_ = 0;

@@ -29,6 +29,7 @@ ARM_JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6", "j7")
 FINGER_JOINTS = ("finger_pos", "finger_neg")
 GRIPPER_SITE = "G"
 OBJECT_BODY = "object"
+MAX_SIM_VERTICES = 64  # the simulated object's outline; more are simplified away (simulated_outline)
 PAD_PREFIX = "pad_"  # pad point geoms are named pad_<finger>_<pad>_<point>
 HAND_JOINTS = ("hand_x", "hand_z", "hand_theta")  # the kinematic hand's slide x, slide z, hinge y
 
@@ -53,6 +54,28 @@ def pad_points(center: Sequence[float], radius: float, rings: int) -> List[Tuple
             a = 2.0 * math.pi * k / (6 * i)
             points.append((center[0] + rho * math.cos(a), center[1] + rho * math.sin(a)))
     return points
+
+
+def simulated_outline(polygon: Sequence[Sequence[float]]) -> Tuple[List[Tuple[float, float]], float]:
+    """The outline the simulator builds (m, in O): the polygon itself when it has at most
+    MAX_SIM_VERTICES vertices, else the polygon simplified (shapely, topology kept) with the
+    smallest tolerance, doubling from 0.01 mm, that brings it under the cap; with the tolerance
+    used (m; 0 when unchanged). The planner always uses the full polygon; only the simulated
+    world is simplified, so that it builds in bounded time (the convex decomposition is cubic in
+    the vertices)."""
+    pts = [tuple(map(float, p)) for p in polygon]
+    if len(pts) <= MAX_SIM_VERTICES:
+        return pts, 0.0
+    from shapely.geometry import Polygon
+    from shapely.geometry.polygon import orient
+
+    shape, tolerance = Polygon(pts), 1e-5
+    while True:
+        simple = orient(shape.simplify(tolerance, preserve_topology=True), 1.0)
+        outline = list(simple.exterior.coords)[:-1]
+        if len(outline) <= MAX_SIM_VERTICES:
+            return [tuple(map(float, p)) for p in outline], tolerance
+        tolerance *= 2.0
 
 
 def convex_pieces(polygon: Sequence[Sequence[float]]) -> List[List[Tuple[float, float]]]:
@@ -198,7 +221,7 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
     assets = root.find("asset")
     if assets is None:
         assets = ET.SubElement(root, "asset")
-    for i, piece in enumerate(convex_pieces(obj["polygon"])):
+    for i, piece in enumerate(convex_pieces(simulated_outline(obj["polygon"])[0])):
         name = f"object_piece{i}"
         if _axis_aligned_rectangle(piece):
             xs = [p[0] for p in piece]

@@ -1,7 +1,11 @@
 """`stablepush sim-arm`: the simulated arm (arm.py) behind the arm protocol (arm_protocol.py).
 
-One client at a time. The world persists across connections, so an executor can resume a run
-after a fault; a `hello` with `reset` true, or with a different scene, rebuilds it.
+One session at a time: a second client is told the arm is busy and let go. Each session starts
+from a fresh world built from its hello's scene, unless the hello asks to `continue` and the scene
+is the one the server has (an executor resuming after a fault). Every message is validated; a
+client that breaks the protocol gets an error and is let go, one silent for `idle_timeout` s (or
+stuck in half a line) is dropped, and the arm is stopped whenever a session ends: no client can
+stop the server from serving the next one.
 """
 from __future__ import annotations
 
@@ -12,28 +16,33 @@ import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator, Optional
 
-from stablepush.arm_protocol import ProtocolError, decode, encode
+from stablepush.arm_protocol import LineReader, ProtocolError, decode, encode
 from stablepush.sim.arm import SimArm, WorldDeviation
+from stablepush.sim.scene import simulated_outline
 
 # The scene keys that describe the world; the object's pose at the start may differ on a resume.
 _START_KEYS = ("object_pose", "object_in_grasp")
+DEFAULT_IDLE_TIMEOUT = 30.0  # s a client may stay silent within a session
 
 
-def _world(scene: dict) -> dict:
-    return {k: v for k, v in scene.items() if k not in _START_KEYS}
+def _world(scene: Optional[dict]) -> Optional[dict]:
+    return None if scene is None else {k: v for k, v in scene.items() if k not in _START_KEYS}
 
 
 class SimArmServer:
     """Serves the simulated arm on host:port (port 0 picks a free one; see `.port`)."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, log: Callable[[str], None] = None,
-                 exit_after: Optional[int] = None, deviation: WorldDeviation = WorldDeviation()):
+                 exit_after: Optional[int] = None, deviation: WorldDeviation = WorldDeviation(),
+                 idle_timeout: float = DEFAULT_IDLE_TIMEOUT):
         self.log = log or (lambda text: print(f"sim-arm: {text}", file=sys.stderr, flush=True))
         self.exit_after = exit_after  # fault injection: die abruptly after this many waypoints
         self.deviation = deviation  # how the simulated world departs from each task's model
+        self.idle_timeout = idle_timeout
         self.arm: Optional[SimArm] = None
         self._scene: Optional[dict] = None
         self._waypoints = 0
+        self._session = threading.Lock()
         self._socket = socket.create_server((host, port))
         self.host, self.port = self._socket.getsockname()[:2]
         self._closed = threading.Event()
@@ -41,11 +50,14 @@ class SimArmServer:
     def serve_forever(self) -> None:
         while not self._closed.is_set():
             try:
-                connection, peer = self._socket.accept()
+                connection, _ = self._socket.accept()
             except OSError:
                 break
-            with connection:
-                self._serve(connection)
+            if not self._session.acquire(blocking=False):
+                self._refuse(connection)
+                continue
+            threading.Thread(target=self._session_thread, args=(connection,), name="sim-arm session",
+                             daemon=True).start()
 
     def start_in_thread(self) -> threading.Thread:
         thread = threading.Thread(target=self.serve_forever, name="sim-arm", daemon=True)
@@ -56,66 +68,103 @@ class SimArmServer:
         self._closed.set()
         self._socket.close()
 
-    # -- one connection -----------------------------------------------------------------------
+    # -- one session ----------------------------------------------------------------------------
+
+    def _refuse(self, connection: socket.socket) -> None:
+        with connection:
+            _send_quietly(connection, {"type": "error", "seq": None,
+                                       "message": "busy: the simulated arm is serving another session"})
+        self.log("refused a second client (busy)")
+
+    def _session_thread(self, connection: socket.socket) -> None:
+        try:
+            with connection:
+                self._serve(connection)
+        except Exception as exc:  # noqa: BLE001 - a session must never take the server down
+            self.log(f"session ended by {type(exc).__name__}: {' '.join(str(exc).split())[:200]}")
+        finally:
+            if self.arm is not None:
+                self.arm.stop()
+            self._session.release()
 
     def _serve(self, connection: socket.socket) -> None:
-        reader = connection.makefile("rb")
+        reader = LineReader(connection, "the client")
         expected_seq = 0
         greeted = False
-        try:
-            for line in reader:
-                message = None
-                try:
-                    message = decode(line, "client")
-                    kind = message["type"]
-                    if not greeted and kind != "hello":
-                        raise ProtocolError(f"expected hello first, got {kind!r}")
-                    if kind == "hello":
-                        self._hello(message)
-                        greeted = True
-                        expected_seq = 0
-                        connection.sendall(encode({"type": "ready", "protocol": message["protocol"],
-                                                   "arm": "stablepush sim-arm (MuJoCo)",
-                                                   "state": self.arm.state()}))
-                    elif kind == "waypoint":
-                        if message["seq"] != expected_seq:
-                            raise ProtocolError(f"out-of-order waypoint: expected seq {expected_seq}, got {message['seq']}")
-                        self.arm.move_to(message["pose"], self._period)
-                        expected_seq += 1
-                        self._waypoints += 1
-                        if self.exit_after is not None and self._waypoints >= self.exit_after:
-                            self.log(f"exiting after {self._waypoints} waypoints (--exit-after)")
-                            os._exit(3)
-                        connection.sendall(encode({"type": "ack", "seq": message["seq"], "state": self.arm.state()}))
-                    elif kind == "stop":
-                        self.arm.stop()
-                        connection.sendall(encode({"type": "stopped", "state": self.arm.state()}))
-                    elif kind == "bye":
-                        self.log(f"run ended after {expected_seq} waypoints; {self.arm.steps_per_second:.0f} steps/s")
-                        return
-                except (ProtocolError, ValueError, KeyError, TypeError) as exc:
-                    if self.arm is not None:
-                        self.arm.stop()
-                    self.log(f"error: {exc}; arm stopped")
-                    seq = message.get("seq") if message else None
-                    connection.sendall(encode({"type": "error", "seq": seq, "message": f"{exc}; the arm is stopped"}))
+        while True:
+            message = None
+            try:
+                message = decode(reader.read_line(self.idle_timeout), "client")
+                kind = message["type"]
+                if not greeted and kind != "hello":
+                    raise ProtocolError(f"expected hello first, got {kind!r}")
+                if kind == "hello":
+                    self._hello(message)
+                    greeted = True
+                    expected_seq = 0
+                    reply = {"type": "ready", "protocol": message["protocol"], "arm": "stablepush sim-arm (MuJoCo)",
+                             "state": self.arm.state()}
+                elif kind == "waypoint":
+                    if message["seq"] != expected_seq:
+                        raise ProtocolError(f"out-of-order waypoint: expected seq {expected_seq}, got {message['seq']}")
+                    self.arm.move_to(message["pose"], self._period)
+                    expected_seq += 1
+                    self._waypoints += 1
+                    if self.exit_after is not None and self._waypoints >= self.exit_after:
+                        self.log(f"exiting after {self._waypoints} waypoints (--exit-after)")
+                        os._exit(3)
+                    reply = {"type": "ack", "seq": message["seq"], "state": self.arm.state()}
+                elif kind == "stop":
+                    self.arm.stop()
+                    reply = {"type": "stopped", "state": self.arm.state()}
+                else:  # bye
+                    self.log(f"run ended after {expected_seq} waypoints; {self.arm.steps_per_second:.0f} steps/s")
                     return
-        except (ConnectionError, OSError) as exc:
-            self.log(f"connection lost ({exc})")
-        if self.arm is not None:
-            self.arm.stop()
-            self.log(f"client left after {expected_seq} waypoints; arm stopped")
+                connection.sendall(encode(reply))
+            except (TimeoutError, ConnectionError, ProtocolError, ValueError, KeyError, TypeError) as exc:
+                if self.arm is not None:  # stopped before the client hears of it
+                    self.arm.stop()
+                self._end(connection, exc, message, expected_seq)
+                return
+
+    def _end(self, connection: socket.socket, exc: Exception, message: Optional[dict], expected_seq: int) -> None:
+        """Report how a session ended to the log and, unless the client has gone, to the client."""
+        if isinstance(exc, ConnectionError):
+            self.log(f"connection lost ({exc}) after {expected_seq} waypoints; arm stopped")
+            return
+        if isinstance(exc, TimeoutError):
+            self.log(f"{exc}; client dropped, arm stopped")
+        else:
+            self.log(f"error: {exc}; arm stopped")
+        seq = message.get("seq") if message else None
+        _send_quietly(connection, {"type": "error", "seq": seq if isinstance(seq, int) else None,
+                                   "message": f"{exc}; the arm is stopped"})
 
     def _hello(self, message: dict) -> None:
         scene = message["scene"]
         self._period = 1.0 / float(message["rate_hz"])
-        if self.arm is None or message.get("reset") or _world(scene) != _world(self._scene):
-            self.arm = SimArm(scene, self.deviation)
-            self._scene = scene
-            self.log(f"world built for {scene.get('task', 'a task')} ({self.arm.model.nbody} bodies, "
-                     f"{self.arm.model.npair} contact pairs)")
-        else:
-            self.log("world kept from the previous connection")
+        if self.arm is not None and message.get("continue") is True and _world(scene) == _world(self._scene):
+            self.log("world kept from the previous session (continue)")
+            return
+        try:
+            arm = SimArm(scene, self.deviation)
+        except Exception as exc:  # noqa: BLE001 - any malformed scene is the client's error
+            raise ProtocolError(f"hello: cannot build a world from this scene ({type(exc).__name__}: "
+                                f"{' '.join(str(exc).split())[:200]})") from None
+        self.arm, self._scene = arm, scene
+        _, tolerance = simulated_outline(scene["object"]["polygon"])
+        simplified = f"; outline simplified within {tolerance * 1e3:g} mm" if tolerance else ""
+        self.log(f"world built for {scene.get('task', 'a task')} ({self.arm.model.nbody} bodies, "
+                 f"{self.arm.model.npair} contact pairs{simplified})")
+
+
+def _send_quietly(connection: socket.socket, message: dict) -> None:
+    """Send a last message to a client that may already be gone."""
+    try:
+        connection.settimeout(1.0)
+        connection.sendall(encode(message))
+    except OSError:
+        pass
 
 
 @contextmanager

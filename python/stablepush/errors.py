@@ -1,0 +1,49 @@
+"""The errors stablepush raises on purpose: one base class, one subclass per kind of fault.
+
+The CLI maps each kind to its exit status in one table (stablepush_cli.main.EXIT_STATUS); a
+caller of the Python API catches `StablepushError` for all of them. Each message is one line
+that names the offending field, file or message.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+
+class StablepushError(Exception):
+    """Base of every error stablepush raises on purpose."""
+
+
+class _FieldError(StablepushError, ValueError):
+    """An input refused at a named field: `field` is its dotted path ('' for the whole input),
+    `source` the file it came from, if any."""
+
+    def __init__(self, field: str, reason: str, source: Optional[str] = None):
+        self.field = field
+        self.reason = reason
+        self.source = source
+        where = f"{source}: " if source else ""
+        super().__init__(f"{where}{field}: {reason}" if field else f"{where}{reason}")
+
+
+class TaskError(_FieldError):
+    """A task that cannot be used (task file or API input)."""
+
+
+class PlanError(_FieldError):
+    """A plan file that is not a valid plan, or a plan that does not belong to the task."""
+
+
+class OutputError(StablepushError, OSError):
+    """An output file that cannot, or must not, be written (the path is in the message)."""
+
+
+class ArmFault(StablepushError, RuntimeError):
+    """Execution stopped on the arm's side or on its link: the arm was told to stop when it could
+    be (`arm_stopped`: True, or None when the arm could not be reached), and
+    `last_confirmed_step` is the last plan step the arm confirmed (resume after it)."""
+
+    def __init__(self, reason: str, last_confirmed_step: int, arm_stopped: Optional[bool]):
+        super().__init__(reason)
+        self.reason = reason
+        self.last_confirmed_step = last_confirmed_step
+        self.arm_stopped = arm_stopped
