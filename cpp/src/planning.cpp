@@ -51,8 +51,15 @@ void apply_parameters(ob::Planner& planner, const std::map<std::string, std::str
       for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
       throw std::invalid_argument("unknown planner parameter '" + name + "' (TRRTstar declares " + known + ")");
     }
-    if (!declared.setParam(name, value))
-      throw std::invalid_argument("planner parameter '" + name + "' cannot take the value '" + value + "'");
+    bool taken = false;
+    try {
+      taken = declared.setParam(name, value);
+    } catch (const std::invalid_argument&) {
+      throw;  // a setter's range check, which names the parameter
+    } catch (const std::exception&) {
+      taken = false;  // OMPL's number conversion ("nan", "1e", ...)
+    }
+    if (!taken) throw std::invalid_argument("planner parameter '" + name + "' cannot take the value '" + value + "'");
   }
 }
 

@@ -124,7 +124,12 @@ def _check_state(state: dict, kind: str) -> None:
 
 
 def _finite(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    if not isinstance(v, (int, float)) or isinstance(v, bool):
+        return False
+    try:
+        return math.isfinite(v)
+    except OverflowError:  # an integer past the double range
+        return False
 
 
 def _refuse_constant(name: str):

@@ -187,23 +187,41 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
     for key, kind in (("task", str), ("solved", bool), ("stats", dict), ("waypoints", list)):
         if not isinstance(data.get(key), kind):
             fail(key, f"must be {'a boolean' if kind is bool else 'a ' + _KIND_NAMES[kind]}, got "
-                      f"{type(data.get(key)).__name__}")
+                      f"{_json_kind(data.get(key))}")
     for key in ("outcome", "message"):
         if key in data and not isinstance(data[key], str):
-            fail(key, f"must be a string, got {type(data[key]).__name__}")
+            fail(key, f"must be a string, got {_json_kind(data[key])}")
     waypoints = data["waypoints"]
     if len(waypoints) > MAX_WAYPOINTS:
         fail("waypoints", f"{len(waypoints)} waypoints; a plan has at most {MAX_WAYPOINTS}")
     for i, w in enumerate(waypoints):
         field = f"waypoints[{i}]"
         if not isinstance(w, dict):
-            fail(field, f"must be a mapping, got {type(w).__name__}")
+            fail(field, f"must be a mapping, got {_json_kind(w)}")
         for key in ("x", "z", "theta"):
-            v = w.get(key)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                fail(f"{field}.{key}", f"must be a finite number, got {str(v)[:40]}")
+            if not is_finite_number(w.get(key)):
+                fail(f"{field}.{key}", f"must be a finite number, got {str(w.get(key))[:40]}")
         if not (w.get("pusher") is None or isinstance(w.get("pusher"), str)):
-            fail(f"{field}.pusher", f"must be a pusher name or null, got {type(w.get('pusher')).__name__}")
+            fail(f"{field}.pusher", f"must be a pusher name or null, got {_json_kind(w.get('pusher'))}")
 
 
 _KIND_NAMES = {str: "string", dict: "mapping", list: "list"}
+
+
+def _json_kind(v) -> str:
+    """What a JSON value is, in JSON's words."""
+    if v is None:
+        return "null"
+    if isinstance(v, bool):
+        return "a boolean"
+    return {str: "a string", dict: "a mapping", list: "a list"}.get(type(v), "a number")
+
+
+def is_finite_number(v) -> bool:
+    """A JSON number that is a finite double (an integer past the double range is not)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        return False
+    try:
+        return math.isfinite(v)
+    except OverflowError:
+        return False

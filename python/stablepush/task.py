@@ -34,11 +34,12 @@ MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
 # test a push) before anything reaches the core. README, "Limits".
 MAX_TASK_BYTES = 1_000_000
 MAX_VERTICES = 1000  # of the cross-section
-MAX_PAD_RINGS = 10  # 1 + 3 r (r + 1) points per pad: 331 at the cap
+MAX_PAD_RINGS = 6  # 1 + 3 r (r + 1) points per pad: 127 at the cap
+MAX_PAD_POINTS = 128  # over all pads: the hold ratio's LP grows with the cube of the points (about 2 s at the cap)
 MAX_PADS = 8
 MAX_PUSHER_POINTS = 50
 MAX_POLYGON_SIDES = 64
-MAX_YAML_ALIASES = 32  # anchors (*name) a task file may use
+MAX_YAML_ALIASES = 1000  # aliases (*name) a task file may use (PyYAML writes one per shared value)
 MAX_YAML_NODES = 100_000  # values in the file, aliases expanded
 # Plausible-physics bounds on each number, in file units; past them the model's arithmetic
 # (doubles and the exact re-check) is no longer meaningful. Far wider than any real cell.
@@ -120,8 +121,9 @@ def _construct_mapping(loader: _StrictLoader, node: yaml.MappingNode, deep: bool
 
 
 _StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
-_StrictLoader.add_implicit_resolver(  # YAML 1.2 floats without a dot: 1e-3, 2E+2
-    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$"), list("-+0123456789"))
+_StrictLoader.add_implicit_resolver(  # YAML 1.2 exponents, which 1.1 reads as strings: 1e-3, 2.02e2, 1.5E+2
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."))
 
 
 def _expanded_size(node: yaml.Node) -> int:
@@ -410,6 +412,10 @@ def _validate(data: Any, source: Optional[str]) -> Task:
         pads = tuple(pads)
     else:
         pads = (((0.0, 0.0), DEFAULT_PAD_RADIUS_MM), ((0.0, 0.0), DEFAULT_PAD_RADIUS_MM))
+    points = len(pads) * (1 + 3 * pad_rings * (pad_rings + 1))
+    if points > MAX_PAD_POINTS:
+        raise TaskError("gripper.pad_rings", f"{len(pads)} pads of {pad_rings} rings make {points} pad points; "
+                                             f"at most {MAX_PAD_POINTS} (fewer rings or pads)")
 
     gravity = _vector("gravity", top.get("gravity", list(DEFAULT_GRAVITY)), 2, LIMITS["gravity"])
     dyn = _mapping("dynamics", top.get("dynamics", {}), [], ["step_time", "friction_polygon_sides", "pushes"])

@@ -71,21 +71,34 @@ class SimArmServer:
     # -- one session ----------------------------------------------------------------------------
 
     def _refuse(self, connection: socket.socket) -> None:
+        threading.Thread(target=self._refusal, args=(connection,), name="sim-arm busy", daemon=True).start()
+
+    def _refusal(self, connection: socket.socket) -> None:
+        """Tell a second client the arm is busy; read what it sent for up to 1 s first (closing on
+        unread data would reset the connection before the client reads the reply)."""
         with connection:
             _send_quietly(connection, {"type": "error", "seq": None,
                                        "message": "busy: the simulated arm is serving another session"})
+            try:
+                connection.shutdown(socket.SHUT_WR)
+                connection.settimeout(1.0)
+                for _ in range(64):
+                    if not connection.recv(65536):
+                        break
+            except OSError:
+                pass
         self.log("refused a second client (busy)")
 
     def _session_thread(self, connection: socket.socket) -> None:
         try:
-            with connection:
-                self._serve(connection)
+            self._serve(connection)
         except Exception as exc:  # noqa: BLE001 - a session must never take the server down
             self.log(f"session ended by {type(exc).__name__}: {' '.join(str(exc).split())[:200]}")
         finally:
             if self.arm is not None:
                 self.arm.stop()
-            self._session.release()
+            self._session.release()  # before the client sees the connection close, so it may come straight back
+            connection.close()
 
     def _serve(self, connection: socket.socket) -> None:
         reader = LineReader(connection, "the client")

@@ -1,0 +1,166 @@
+"""Seeded mutation fuzzing of the CLI (run by tests/test_fuzz.py in a child process, so that a
+crash by signal fails the test instead of killing pytest).
+
+    python3 tests/fuzz_cli.py tasks N SEED SCRATCH    # N mutated task files: plan, and check every 4th
+    python3 tests/fuzz_cli.py plans N SEED SCRATCH    # N mutated plan files of the shipped tasks: show
+
+Each case runs the CLI in this process (click's CliRunner) and must end with exit status 0, 1 or
+2; a refusal (2) is one line on stderr starting "error:"; no traceback, no internal error. The
+case about to run is written to SCRATCH/current first (a crash leaves it there). The summary is
+one JSON line on stdout: cases, exit statuses, the slowest case.
+"""
+from __future__ import annotations
+
+import collections
+import copy
+import json
+import random
+import sys
+import time
+from pathlib import Path
+
+import yaml
+from click.testing import CliRunner
+
+from stablepush_cli.main import cli
+
+ROOT = Path(__file__).resolve().parent.parent
+TASKS = sorted((ROOT / "data" / "tasks").glob("*.yaml")) + sorted((ROOT / "data" / "tasks" / "more").glob("*.yaml"))
+
+HOSTILE = [float("nan"), float("inf"), -float("inf"), 1.797e308, -1.797e308, 1e-300, 1e-160, 0, 0.0, -1, -0.5,
+           2**31, 2**32, 2**62, 2**64, 10**400, 1e9, 1e30, "", "x", "1e-3", "../x", "/tmp/x", "a\x00b", None, True,
+           False, [], {}, [1, 2], [[1, 2]], {"a": 1}, [0, 0, 0], [[0, 0], [0, 0], [0, 0]], "\u202e" * 5, "y" * 5000]
+
+
+def _paths(node, prefix=()):
+    """Every path into a YAML/JSON tree (containers and leaves)."""
+    yield prefix
+    if isinstance(node, dict):
+        for key, value in node.items():
+            yield from _paths(value, prefix + (key,))
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            yield from _paths(value, prefix + (i,))
+
+
+def _mutate(data, rng: random.Random):
+    """One to three random edits of a tree: a hostile value, a scaled number, a deleted or an
+    unknown key, a nested value, a duplicated list entry."""
+    data = copy.deepcopy(data)
+    for _ in range(rng.randint(1, 3)):
+        paths = [p for p in _paths(data) if p]
+        if not paths:
+            return rng.choice(HOSTILE)
+        path = rng.choice(paths)
+        parent = data
+        for key in path[:-1]:
+            parent = parent[key]
+        key, value = path[-1], parent[path[-1]]
+        kind = rng.random()
+        if kind < 0.45:
+            parent[key] = rng.choice(HOSTILE)
+        elif kind < 0.65 and isinstance(value, (int, float)) and not isinstance(value, bool):
+            parent[key] = value * 10.0 ** rng.randint(-12, 12) * rng.choice((1, -1))
+        elif kind < 0.75 and isinstance(parent, dict):
+            del parent[key]
+        elif kind < 0.8 and isinstance(parent, dict):
+            parent[rng.choice(["extra", "Name", 1, "name "])] = rng.choice(HOSTILE)
+        elif kind < 0.88:
+            nested = value
+            for _ in range(rng.choice((3, 50))):
+                nested = [nested]
+            parent[key] = nested
+        elif isinstance(value, list) and value:
+            value.append(copy.deepcopy(rng.choice(value)) if rng.random() < 0.5 else rng.choice(HOSTILE))
+        else:
+            parent[key] = rng.choice(HOSTILE)
+    return data
+
+
+def _text_mutation(text: str, rng: random.Random) -> str:
+    """A whole-file mutation: truncated, a byte changed, an alias bomb, deep nesting, not UTF-8."""
+    kind = rng.randrange(5)
+    if kind == 0:
+        return text[: rng.randrange(len(text))]
+    if kind == 1:
+        i = rng.randrange(len(text))
+        return text[:i] + rng.choice("[]{}:&*!|>-'\"\t\n#%@`") + text[i + 1:]
+    if kind == 2:
+        bomb = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+            f"{chr(98 + i)}: &{chr(98 + i)} [{', '.join(['*' + chr(97 + i)] * 9)}]\n" for i in range(8))
+        return bomb + text
+    if kind == 3:
+        return text.replace("name:", "name: " + "[" * 3000 + "]" * 3000 + "\nx:", 1)
+    return text.encode().replace(b"a", b"\xff", 3).decode("latin-1")
+
+
+def run_tasks(count: int, seed: int, scratch: Path):
+    rng = random.Random(seed)
+    sources = [(path, path.read_text(), yaml.safe_load(path.read_text())) for path in TASKS]
+    for case in range(count):
+        path, text, data = rng.choice(sources)
+        if rng.random() < 0.15:
+            mutated = _text_mutation(text, rng)
+        else:
+            tree = _mutate(data, rng)
+            try:
+                mutated = yaml.safe_dump(tree, allow_unicode=True)
+            except (yaml.YAMLError, ValueError, RecursionError):
+                mutated = json.dumps(tree, default=str)
+        task = scratch / f"case.yaml"
+        task.write_text(mutated, encoding="utf-8", errors="surrogateescape")
+        args = ["plan", str(task), "--time-limit", "0.02", "-o", str(scratch / "out.plan.json"), "--quiet"]
+        yield f"task {case} from {path.name}", args, mutated
+        if case % 4 == 0:
+            move = [rng.choice([1.0, 0.0, -1.0, 1e-160, float("nan"), 1e308, 0.5]) for _ in range(3)]
+            yield (f"task {case} check", ["check", str(task), "--move", *map(repr, move)], mutated)
+
+
+def run_plans(count: int, seed: int, scratch: Path):
+    from stablepush.plan_io import plan_to_dict
+    from stablepush.planning import plan_task
+    from stablepush.task import load_task
+
+    rng = random.Random(seed)
+    plans = []
+    for path in TASKS[:5]:
+        plans.append((path, plan_to_dict(plan_task(load_task(path), seed=1))))
+    for case in range(count):
+        path, plan = rng.choice(plans)
+        if rng.random() < 0.1:
+            text = _text_mutation(json.dumps(plan), rng)
+        else:
+            text = json.dumps(_mutate(plan, rng), default=str)  # NaN and inf written as JSON allows them
+        plan_file = scratch / "case.plan.json"
+        plan_file.write_text(text, encoding="utf-8", errors="surrogateescape")
+        yield f"plan {case} of {path.name}", ["show", str(plan_file), "--task", str(path), "-o", str(scratch / "out.png")], text
+
+
+def main() -> None:
+    kind, count, seed, scratch = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), Path(sys.argv[4])
+    cases = run_tasks(count, seed, scratch) if kind == "tasks" else run_plans(count, seed, scratch)
+    runner = CliRunner()
+    statuses, failures, slowest = collections.Counter(), [], (0.0, "")
+    for label, args, content in cases:
+        (scratch / "current").write_text(f"{label}\n{args}\n{content[:20000]}", errors="replace")
+        started = time.perf_counter()
+        result = runner.invoke(cli, args, catch_exceptions=True)
+        elapsed = time.perf_counter() - started
+        slowest = max(slowest, (elapsed, label))
+        statuses[result.exit_code] += 1
+        stderr = [line for line in result.stderr.splitlines() if line.strip()]
+        problem = None
+        if result.exit_code not in (0, 1, 2):
+            problem = f"exit {result.exit_code}: {result.stderr.strip()[-300:] or result.exception!r}"
+        elif "Traceback" in result.output + result.stderr:
+            problem = "a traceback"
+        elif result.exit_code == 2 and (len(stderr) != 1 or not stderr[0].startswith("error: ")):
+            problem = f"a refusal not in one 'error:' line: {stderr[:3]}"
+        if problem:
+            failures.append({"case": label, "args": args[:2], "problem": problem, "input": content[:300]})
+    print(json.dumps({"cases": sum(statuses.values()), "exit_statuses": dict(statuses), "failures": failures[:20],
+                      "failure_count": len(failures), "slowest_s": round(slowest[0], 3), "slowest": slowest[1]}))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,35 @@
+"""Hostile inputs, fuzzed: 2,000 mutated task files and 200 mutated plan files per run, each given
+to the CLI (tests/fuzz_cli.py), in child processes with a memory cap, so that a crash by signal or
+a runaway allocation fails here instead of taking pytest down."""
+import json
+import resource
+import subprocess
+import sys
+from pathlib import Path
+
+FUZZ = Path(__file__).with_name("fuzz_cli.py")
+MEMORY_CAP = 3 * 1024 ** 3  # bytes of address space per worker
+
+
+def _cap_memory():
+    resource.setrlimit(resource.RLIMIT_AS, (MEMORY_CAP, MEMORY_CAP))
+
+
+def test_mutated_task_and_plan_files_get_exit_0_1_or_2_with_one_line(tmp_path):
+    runs = {}
+    for kind, count in (("tasks", 2000), ("plans", 200)):
+        scratch = tmp_path / kind
+        scratch.mkdir()
+        runs[kind] = (scratch, subprocess.Popen([sys.executable, str(FUZZ), kind, str(count), "2026", str(scratch)],
+                                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                                preexec_fn=_cap_memory))
+    for kind, (scratch, worker) in runs.items():
+        out, err = worker.communicate(timeout=900)
+        current = (scratch / "current").read_text()[:2000] if (scratch / "current").exists() else ""
+        assert worker.returncode == 0, f"{kind} worker died ({worker.returncode}) on:\n{current}\n{err[-2000:]}"
+        summary = json.loads(out.strip().splitlines()[-1])
+        assert summary["failure_count"] == 0, summary["failures"]
+        assert summary["cases"] >= (2000 if kind == "tasks" else 200)
+        assert set(summary["exit_statuses"]) <= {"0", "1", "2"}
+        # Bounded time per case (a hang guard, not a speed target): planning is limited to 0.02 s.
+        assert summary["slowest_s"] < 20.0, summary

@@ -1,0 +1,346 @@
+"""Each hostile input and fault of the reliability issue, one by one: the exact message or the
+safe behaviour, never a crash, a hang or a file written where it should not be."""
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from conftest import TASKS, shipped, task_text
+from stablepush import _core
+from stablepush.arm_protocol import PROTOCOL, decode, encode
+from stablepush.errors import ArmFault, OutputError, PlanError, TaskError
+from stablepush.executor import execute_plan, plan_steps
+from stablepush.plan_io import plan_to_dict, read_plan, write_files
+from stablepush.planning import plan_task
+from stablepush.sim.server import SimArmServer
+from stablepush.task import parse_task, pose_to_si
+from stablepush_cli.main import cli
+
+LOW_MU = TASKS / "horizontal-offset-low-mu.yaml"
+
+
+def _run(args, cwd=None):
+    result = CliRunner().invoke(cli, args, catch_exceptions=False) if cwd is None else None
+    return result
+
+
+def _edited(tmp_path, old, new, name="task.yaml"):
+    text = task_text("horizontal-offset-low-mu")
+    assert old in text
+    path = tmp_path / name
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+# -- numbers at the boundary ----------------------------------------------------------------------
+
+@pytest.mark.parametrize("old, new, says", [
+    ("size: [100, 25, 25]          # mm; Al 6061 square prism",
+     "size: [100, 25, 25]\n  com: [1e300, 0]", "object.com[0]: must be between -10000 and 10000, got 1e+300"),
+    ("step_time: 0.1", "step_time: 1.797e308", "dynamics.step_time: must be between 0.0001 and 1000"),
+    ("mu: 0.425 ", "mu: 1.797e308 ", "gripper.mu: must be between 0 and 100"),
+    ("max_switches: 1", "max_switches: 2147483648", "planner.max_switches: must be an integer from 0 to 100"),
+    ("max_switches: 1", "max_switches: 4294967296", "planner.max_switches: must be an integer from 0 to 100"),
+    ("seed: 1", "seed: 18446744073709551616", "planner.seed: must be an integer from 0 to 4294967295"),
+    ("pad_rings: 1", "pad_rings: 1000000000", "gripper.pad_rings: must be an integer from 0 to 6"),
+    ("pad_rings: 1", "pad_rings: 6", "gripper.pad_rings: 2 pads of 6 rings make 254 pad points; at most 128"),
+    ("mu: 0.2}\n  - {name: right", "mu: 0.2, points: 4611686018427387904}\n  - {name: right",
+     "pushers[0].points: must be an integer from 2 to 50"),
+    ("step_time: 0.1", "step_time: 0.1\n  friction_polygon_sides: 100000000",
+     "dynamics.friction_polygon_sides: must be an integer from 3 to 64"),
+    ("step: [1.0, 1.0]", "step: [1e-300, 1.0]", "planner.step[0]: must be between 0.001 and 1000"),
+    ("start: [0, 0, 0]", "start: [0, 0, 1e30]", "start[2]: must be between -3600 and 3600"),
+    ("time_limit: 10", "time_limit: .inf", "planner.time_limit: must be finite"),
+    ("time_limit: 10", "time_limit: .nan", "planner.time_limit: must be finite"),
+    ("time_limit: 10", "time_limit: 9.3e9", "planner.time_limit: must be between 1e-06 and 1e+06"),
+    ("name: horizontal-offset-low-mu", "name: \"a\\0b\"", "name: must be at most 100 printable characters"),
+    ("name: horizontal-offset-low-mu", "name: " + "[" * 3000 + "]" * 3000, "values nested too deeply"),
+    ("name: horizontal-offset-low-mu", "name: x\n? [1, 2]\n: y", "a mapping key must be a name, got a list"),
+])
+def test_hostile_numbers_and_yaml_are_refused_in_one_line_naming_the_field(tmp_path, old, new, says):
+    result = CliRunner().invoke(cli, ["plan", str(_edited(tmp_path, old, new)), "-o", str(tmp_path / "p.json")])
+    assert result.exit_code == 2, result.output
+    assert says in result.stderr and len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert not (tmp_path / "p.json").exists()
+
+
+def test_an_alias_bomb_is_refused_before_it_grows(tmp_path):
+    bomb = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{chr(98 + i)}: &{chr(98 + i)} [{', '.join(['*' + chr(97 + i)] * 9)}]\n" for i in range(8))
+    path = tmp_path / "bomb.yaml"
+    path.write_text(bomb + task_text("horizontal-offset-low-mu"))
+    result = CliRunner().invoke(cli, ["plan", str(path)])
+    assert result.exit_code == 2 and "more than 100000 values (aliases expanded)" in result.stderr
+
+
+def test_yaml_1_2_numbers_are_numbers():
+    text = task_text("horizontal-offset-low-mu").replace("mass: 202", "mass: 2.02e2").replace("mu: 0.2}", "mu: 2e-1}")
+    task = parse_task(text)
+    assert task.mass == 202.0 and task.pushers[0].mu == 0.2
+
+
+@pytest.mark.parametrize("move, says", [
+    (["1e-160", "0", "0"], "move: the motion is zero or too small"),
+    (["nan", "0", "0"], "move[0]: must be finite"),
+    (["1e308", "0", "0"], "move[0]: must be between -10000 and 10000"),
+])
+def test_check_refuses_non_finite_and_vanishing_motions(move, says):
+    result = CliRunner().invoke(cli, ["check", str(LOW_MU), "--move", *move])
+    assert result.exit_code == 2 and says in result.stderr
+
+
+def test_check_refuses_a_non_finite_pose():
+    result = CliRunner().invoke(cli, ["check", str(LOW_MU), "--at", "nan", "0", "0", "--move", "1", "0", "0"])
+    assert result.exit_code == 2 and "at[0]: must be finite" in result.stderr
+
+
+def test_the_core_refuses_what_python_would_never_pass_instead_of_trapping():
+    """The C++ guards behind the validation, in a child process: a SIGFPE there fails the test."""
+    script = textwrap.dedent(f"""
+        import dataclasses
+        from stablepush.task import load_task
+        task = load_task({str(LOW_MU)!r})
+        model, heavy = task.build_model(), dataclasses.replace(task, mass=1e305).build_model()  # 1e302 kg
+        for m, q, dq in ((model, (0, 0, 0), (float("nan"), 0, 0)), (model, (float("inf"), 0, 0), (1e-3, 0, 0)),
+                         (model, (0, 0, 0), (1e-163, 0, 0)), (heavy, (0, 0, 0), (1e300, 0, 0))):
+            try:
+                m.check(q, dq, 0)
+                print("accepted", q, dq)
+            except ValueError as exc:
+                print("refused:", exc)
+    """)
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[:3] == ["refused: the motion dq is not finite", "refused: the pose q is not finite",
+                         "refused: the motion dq is zero (or under 1e-12 m and rad)"]
+    assert lines[3].startswith("refused: the motion wrench overflows"), lines[3]
+
+
+def test_planner_parameters_are_refused_out_of_their_declared_range():
+    task = shipped("horizontal-offset-high-mu")
+    model = task.build_model()
+    args = (model, pose_to_si(task.start), pose_to_si(task.goal), (1e-3, 0.0175), (1e-3, 0.0175), 1.0, 1e-3, 5.0)
+    for name, value in (("max_switches", "4294967296"), ("max_switches", "2147483648"), ("seed", "4294967296"),
+                        ("seed", "-1"), ("goal_bias", "1.5"), ("rewire_radius", "nan")):
+        with pytest.raises(ValueError, match=f"planner parameter '{name}'"):
+            _core.plan(*args, {name: value})
+    with pytest.raises(ValueError, match="time_limit must be > 0 and at most 1e6 s"):
+        _core.plan(model, *args[1:5], 9.3e9, *args[6:], {})
+    ranges = _core.TRRT_STAR_PARAMETER_RANGES
+    assert ranges["seed"] == ("integer", 0.0, 4294967295.0) and ranges["max_switches"][2] == 100.0
+
+
+def test_seeds_above_2_31_are_their_own_seeds():
+    task = shipped("horizontal-offset-low-mu")
+    plans = [plan_to_dict(plan_task(task, seed=s)) for s in (5, 5 + 2 ** 31, 2 ** 32 - 1)]
+    assert plans[0]["stats"]["seed"] == 5 and plans[1]["stats"]["seed"] == 5 + 2 ** 31
+    assert plans[0]["waypoints"] != plans[1]["waypoints"]  # not seed 5 again
+    assert plan_to_dict(plan_task(task, seed=2 ** 32 - 1))["waypoints"] == plans[2]["waypoints"]  # reproducible
+
+
+# -- plan files -----------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def low_mu_plan():
+    return plan_to_dict(plan_task(shipped("horizontal-offset-low-mu"), seed=1))
+
+
+@pytest.mark.parametrize("edit, says", [
+    (lambda p: p["waypoints"][2].update(x=float("nan")), "not valid JSON (NaN is not a number a plan may hold)"),
+    (lambda p: p.update(stats=[]), "stats: must be a mapping, got a list"),
+    (lambda p: p.update(stats=None), "stats: must be a mapping, got null"),
+    (lambda p: p.update(solved="no"), "solved: must be a boolean, got a string"),
+    (lambda p: p["waypoints"][2].update(x=p["waypoints"][2]["x"] + 50), "waypoints[2]: a step of 51 unit steps"),
+    (lambda p: p["waypoints"][3].update(x=10 ** 400), "waypoints[3].x: must be a finite number"),
+    (lambda p: p["waypoints"].extend([p["waypoints"][-1]] * 10_001), "a plan has at most 10000"),
+])
+def test_bad_plan_files_are_refused_before_anything_moves(tmp_path, low_mu_plan, edit, says):
+    plan = json.loads(json.dumps(low_mu_plan))
+    edit(plan)
+    path = tmp_path / "bad.plan.json"
+    path.write_text(json.dumps(plan))
+    with pytest.raises(PlanError) as error:
+        plan_steps(shipped("horizontal-offset-low-mu"), read_plan(path), source=str(path))
+    assert says in str(error.value)
+    result = CliRunner().invoke(cli, ["execute", str(path), "--task", str(LOW_MU), "--arm", "127.0.0.1:9"])
+    assert result.exit_code == 2 and says in result.stderr
+
+
+def test_deeply_nested_plan_json_is_refused(tmp_path):
+    path = tmp_path / "nested.plan.json"
+    path.write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(PlanError, match="nested too deeply"):
+        read_plan(path)
+
+
+# -- output files ---------------------------------------------------------------------------------
+
+def test_the_default_output_comes_from_the_task_file_name_never_its_name_field(tmp_path, monkeypatch):
+    path = _edited(tmp_path, "name: horizontal-offset-low-mu", "name: ../escaped", name="mine.yaml")
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    result = CliRunner().invoke(cli, ["plan", str(path), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert (work / "mine.plan.json").exists() and not (tmp_path / "escaped.plan.json").exists()
+
+
+def test_outputs_write_through_symlinks_refuse_directories_and_keep_devices(tmp_path):
+    target = tmp_path / "real.json"
+    target.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(target)
+    write_files({link: "new"})
+    assert link.is_symlink() and target.read_text() == "new"
+    (tmp_path / "dir.json").mkdir()
+    with pytest.raises(OutputError, match="not a regular file; refusing to replace it"):
+        write_files({tmp_path / "dir.json": "x"})
+    write_files({os.devnull: "discarded"})
+    assert Path(os.devnull).is_char_device()
+    with pytest.raises(OutputError, match="does not exist"):
+        write_files({tmp_path / "no" / "such.json": "x"})
+
+
+def test_outputs_respect_the_umask(tmp_path):
+    old = os.umask(0o027)
+    try:
+        write_files({tmp_path / "a.json": "x"})
+    finally:
+        os.umask(old)
+    assert (tmp_path / "a.json").stat().st_mode & 0o777 == 0o640
+
+
+def test_a_json_and_csv_pair_stays_consistent_when_the_writer_is_killed(tmp_path):
+    """A writer replaces the pair over and over; SIGTERM at random moments must never leave a
+    new JSON beside an old CSV, nor a temporary file."""
+    script = textwrap.dedent(f"""
+        import sys
+        from stablepush.plan_io import write_files
+        k = 0
+        print("ready", flush=True)
+        while True:
+            k += 1
+            write_files({{{str(tmp_path / 'p.json')!r}: str(k) * 20000, {str(tmp_path / 'p.csv')!r}: str(k) * 20000}})
+    """)
+    import random
+
+    rng = random.Random(3)
+    for _ in range(40):
+        writer = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+        writer.stdout.readline()
+        time.sleep(rng.uniform(0.0, 0.05))
+        writer.send_signal(signal.SIGTERM)
+        writer.wait(timeout=30)
+        if (tmp_path / "p.json").exists():
+            assert (tmp_path / "p.json").read_text() == (tmp_path / "p.csv").read_text()
+        assert not list(tmp_path.glob(".p.*.tmp"))
+
+
+# -- the arm link ---------------------------------------------------------------------------------
+
+def _hello(scene, rate_hz=100):
+    return encode({"type": "hello", "protocol": PROTOCOL, "rate_hz": rate_hz, "scene": scene})
+
+
+@pytest.fixture(scope="module")
+def high_mu_run():
+    from stablepush.execution import place_features, scene_description
+
+    task = shipped("horizontal-offset-high-mu")
+    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    return task, steps, scene_description(task, place_features(task, steps), task.start)
+
+
+def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu_run):
+    task, steps, scene = high_mu_run
+    server = SimArmServer(log=lambda text: None, idle_timeout=0.5)
+    server.start_in_thread()
+    try:
+        def exchange(payload, wait=True):
+            with socket.create_connection((server.host, server.port), timeout=10) as conn:
+                conn.sendall(payload)
+                reader = conn.makefile("rb")
+                return [decode(line, "server") for line in reader] if wait else None
+
+        replies = exchange(b"[" * 100_000 + b"\n")
+        assert replies[-1]["type"] == "error" and "nested too deeply" in replies[-1]["message"]
+        replies = exchange(_hello(scene, rate_hz=0))
+        assert "rate_hz must be between 1 and 1000" in replies[-1]["message"]
+        replies = exchange(b'{"type": "hello", "prot')  # half a line, then silence: dropped
+        assert "no complete message from the client within 0.5 s" in replies[-1]["message"]
+        # A session in progress: a second client is told the arm is busy.
+        with socket.create_connection((server.host, server.port), timeout=30) as first:
+            first.sendall(_hello(scene))
+            assert decode(first.makefile("rb").readline(), "server")["type"] == "ready"
+            assert "busy" in exchange(b"")[-1]["message"]
+        time.sleep(0.2)
+        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
+        assert report.last_confirmed_step == len(steps) - 1 and report.final_error["distance"] < 0.5
+    finally:
+        server.close()
+
+
+def test_the_executor_holds_its_ack_deadline_against_a_trickling_arm(high_mu_run):
+    task, steps, scene = high_mu_run
+    listener = socket.create_server(("127.0.0.1", 0))
+
+    def trickle():
+        conn, _ = listener.accept()
+        with conn:
+            conn.makefile("rb").readline()
+            for byte in encode({"type": "ready", "protocol": PROTOCOL, "arm": "x", "state": {}}):
+                time.sleep(0.1)
+                conn.sendall(bytes([byte]))
+
+    threading.Thread(target=trickle, daemon=True).start()
+    started = time.monotonic()
+    with pytest.raises(ArmFault, match="no complete message from the arm server .* within 1 s"):
+        execute_plan(task, steps, "127.0.0.1", listener.getsockname()[1], rate_hz=100.0, pace=False, ack_timeout=1.0)
+    assert time.monotonic() - started < 5.0  # the deadline plus the stop's 2 s, not the trickle's 8 s
+    listener.close()
+
+
+@pytest.mark.parametrize("state, says", [
+    ({"ee_pose": "here"}, "state.ee_pose must be 7 finite numbers"),
+    ({"ee_pose": [0, 0, 0, 1, 0, 0]}, "state.ee_pose must be 7 finite numbers"),
+    ({"ee_pose": [0, 0, float("nan"), 1, 0, 0, 0]}, "not a JSON line"),
+    ({"ee_pose": [0, 0, 0, 1, 0, 0, 0], "object_in_grasp": {"x": "1"}}, "object_in_grasp must hold finite numbers"),
+])
+def test_bad_arm_states_end_in_an_arm_fault_and_a_stop(high_mu_run, state, says):
+    task, steps, _ = high_mu_run
+    listener = socket.create_server(("127.0.0.1", 0))
+    stops = []
+
+    def arm():
+        conn, _ = listener.accept()
+        with conn:
+            reader = conn.makefile("rb")
+            reader.readline()
+            conn.sendall(json.dumps({"type": "ready", "protocol": PROTOCOL, "arm": "x", "state": state}).encode() + b"\n")
+            stops.append(reader.readline())
+
+    threading.Thread(target=arm, daemon=True).start()
+    with pytest.raises(ArmFault, match=says) as fault:
+        execute_plan(task, steps, "127.0.0.1", listener.getsockname()[1], rate_hz=100.0, pace=False, ack_timeout=2.0)
+    time.sleep(0.1)
+    assert stops and json.loads(stops[0])["type"] == "stop"
+    assert fault.value.last_confirmed_step == 0
+    listener.close()
+
+
+def test_a_task_error_is_a_stablepush_error_with_exit_status_2():
+    from stablepush.errors import StablepushError
+    from stablepush_cli.main import EXIT_STATUS
+
+    assert issubclass(TaskError, StablepushError) and issubclass(PlanError, StablepushError)
+    assert dict(EXIT_STATUS)[TaskError] == 2 and dict(EXIT_STATUS)[ArmFault] == 3
