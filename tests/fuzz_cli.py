@@ -32,6 +32,10 @@ HOSTILE = [float("nan"), float("inf"), -float("inf"), 1.797e308, -1.797e308, 1e-
            False, [], {}, [1, 2], [[1, 2]], {"a": 1}, [0, 0, 0], [[0, 0], [0, 0], [0, 0]], "\u202e" * 5, "y" * 5000]
 
 
+def _hostile(rng: random.Random):
+    return copy.deepcopy(rng.choice(HOSTILE))  # a copy: the pool must not grow or loop as cases edit it
+
+
 def _paths(node, prefix=()):
     """Every path into a YAML/JSON tree (containers and leaves)."""
     yield prefix
@@ -50,7 +54,7 @@ def _mutate(data, rng: random.Random):
     for _ in range(rng.randint(1, 3)):
         paths = [p for p in _paths(data) if p]
         if not paths:
-            return rng.choice(HOSTILE)
+            return _hostile(rng)
         path = rng.choice(paths)
         parent = data
         for key in path[:-1]:
@@ -58,22 +62,22 @@ def _mutate(data, rng: random.Random):
         key, value = path[-1], parent[path[-1]]
         kind = rng.random()
         if kind < 0.45:
-            parent[key] = rng.choice(HOSTILE)
+            parent[key] = _hostile(rng)
         elif kind < 0.65 and isinstance(value, (int, float)) and not isinstance(value, bool):
             parent[key] = value * 10.0 ** rng.randint(-12, 12) * rng.choice((1, -1))
         elif kind < 0.75 and isinstance(parent, dict):
             del parent[key]
         elif kind < 0.8 and isinstance(parent, dict):
-            parent[rng.choice(["extra", "Name", 1, "name "])] = rng.choice(HOSTILE)
+            parent[rng.choice(["extra", "Name", 1, "name "])] = _hostile(rng)
         elif kind < 0.88:
             nested = value
             for _ in range(rng.choice((3, 50))):
                 nested = [nested]
             parent[key] = nested
         elif isinstance(value, list) and value:
-            value.append(copy.deepcopy(rng.choice(value)) if rng.random() < 0.5 else rng.choice(HOSTILE))
+            value.append(copy.deepcopy(rng.choice(value)) if rng.random() < 0.5 else _hostile(rng))
         else:
-            parent[key] = rng.choice(HOSTILE)
+            parent[key] = _hostile(rng)
     return data
 
 
