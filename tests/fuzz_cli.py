@@ -63,7 +63,7 @@ def _mutate(data, rng: random.Random):
         kind = rng.random()
         if kind < 0.45:
             parent[key] = _hostile(rng)
-        elif kind < 0.65 and isinstance(value, (int, float)) and not isinstance(value, bool):
+        elif kind < 0.65 and isinstance(value, (int, float)) and not isinstance(value, bool) and abs(value) < 1e300:
             parent[key] = value * 10.0 ** rng.randint(-12, 12) * rng.choice((1, -1))
         elif kind < 0.75 and isinstance(parent, dict):
             del parent[key]

@@ -54,7 +54,7 @@ def _edited(tmp_path, old, new, name="task.yaml"):
     ("pad_rings: 1", "pad_rings: 1000000000", "gripper.pad_rings: must be an integer from 0 to 6"),
     ("pad_rings: 1", "pad_rings: 6", "gripper.pad_rings: 2 pads of 6 rings make 254 pad points; at most 128"),
     ("mu: 0.2}\n  - {name: right", "mu: 0.2, points: 4611686018427387904}\n  - {name: right",
-     "pushers[0].points: must be an integer from 2 to 50"),
+     "pushers[0].points: must be an integer from 2 to 20"),
     ("step_time: 0.1", "step_time: 0.1\n  friction_polygon_sides: 100000000",
      "dynamics.friction_polygon_sides: must be an integer from 3 to 64"),
     ("step: [1.0, 1.0]", "step: [1e-300, 1.0]", "planner.step[0]: must be between 0.001 and 1000"),

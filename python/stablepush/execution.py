@@ -22,6 +22,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from stablepush import _core
 from stablepush.task import MM, Task, TaskError
 
 MOVE_SPEED = 0.1  # m/s of G between contacts
@@ -169,7 +170,7 @@ def place_features(task: Task, steps: Sequence[PlanStep], every_pusher: bool = F
     model assumes for this feature (`Task.feature_angle`: the start's unless environment.features
     says otherwise). Gravity in the world is the task's gravity (G's axes are W's at home)."""
     env = task.environment
-    model = task.build_model()
+    section = task.section()
     home = np.asarray(env["home"], float) * MM
     features: Dict[str, Feature] = {}
     contacts = contacts_of(steps)
@@ -192,7 +193,9 @@ def place_features(task: Task, steps: Sequence[PlanStep], every_pusher: bool = F
             T_WO = T_WG @ grasp_transform(q_first)
         index = task.pusher_index(name)
         spec = task.pushers[index]
-        n_O = np.array(model.pushers[index].inward_normal, float)
+        pusher = _core.Pusher.on_boundary(section, name, (spec.a[0] * MM, spec.a[1] * MM), (spec.b[0] * MM, spec.b[1] * MM),
+                                          spec.mu, spec.points)  # the pusher alone: its cone is not needed here
+        n_O = np.array(pusher.inward_normal, float)
         to_w = lambda p: (T_WO @ np.array([p[0] * MM, 0.0, p[1] * MM, 1.0]))[:3]  # noqa: E731
         features[name] = Feature(pusher=name, object_pose=T_WO, start=to_w(spec.a), end=to_w(spec.b),
                                  normal=T_WO[:3, :3] @ np.array([n_O[0], 0.0, n_O[1]]), mu=spec.mu)
@@ -202,13 +205,13 @@ def place_features(task: Task, steps: Sequence[PlanStep], every_pusher: bool = F
 def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float]) -> dict:
     """What a simulated arm needs to build the world (SI units): the object, the gripper, gravity,
     the features, G's home pose and the object's pose when the run starts (`in_grasp`, mm/deg)."""
-    model = task.build_model()
+    body = task.rigid_body()
     home = translation(np.asarray(task.environment["home"], float) * MM)
     return {
         "task": task.name,
         "gravity": list(task.gravity),
         "object": {"polygon": [[x * MM, z * MM] for x, z in task.vertices], "thickness": task.thickness * MM,
-                   "mass": model.body.mass, "com": list(model.body.com), "inertia": model.body.inertia},
+                   "mass": body.mass, "com": list(body.com), "inertia": body.inertia},
         "gripper": {"grip_force": task.grip_force, "mu": task.mu, "pad_rings": task.pad_rings,
                     "pads": [{"center": [c[0] * MM, c[1] * MM], "radius": r * MM} for c, r in task.pads]},
         "features": [f.as_dict() for f in features.values()],

@@ -37,7 +37,7 @@ MAX_VERTICES = 1000  # of the cross-section
 MAX_PAD_RINGS = 6  # 1 + 3 r (r + 1) points per pad: 127 at the cap
 MAX_PAD_POINTS = 128  # over all pads: the hold ratio's LP grows with the cube of the points (about 2 s at the cap)
 MAX_PADS = 8
-MAX_PUSHER_POINTS = 50
+MAX_PUSHER_POINTS = 20  # the cone of a segment is its end points' anyway; building it grows fast with more (0.1 s a pusher at 50)
 MAX_POLYGON_SIDES = 64
 MAX_YAML_ALIASES = 1000  # aliases (*name) a task file may use (PyYAML writes one per shared value)
 MAX_YAML_NODES = 100_000  # values in the file, aliases expanded
@@ -312,17 +312,21 @@ class Task:
     def section(self) -> "_core.CrossSection":
         return _core.CrossSection([_mm2(v) for v in self.vertices])
 
-    def build_model(self) -> "_core.StablePushModel":
-        """The core's stable-push model of this task, in SI units."""
-        section = self.section()
-        uniform = _core.RigidBody.uniform(section, self.mass * G)
+    def rigid_body(self, section: "Optional[_core.CrossSection]" = None) -> "_core.RigidBody":
+        """The object's mass [kg], com [m, in O] and moment of inertia about y at the com [kg m^2]."""
+        uniform = _core.RigidBody.uniform(section or self.section(), self.mass * G)
         com = _mm2(self.com) if self.com is not None else tuple(uniform.com)
         if self.inertia is not None:
             inertia = self.inertia
         else:  # the uniform body's inertia about the given com (parallel axes)
             offset2 = (com[0] - uniform.com[0]) ** 2 + (com[1] - uniform.com[1]) ** 2
             inertia = uniform.inertia + self.mass * G * offset2
-        body = _core.RigidBody(self.mass * G, com, inertia)
+        return _core.RigidBody(self.mass * G, com, inertia)
+
+    def build_model(self) -> "_core.StablePushModel":
+        """The core's stable-push model of this task, in SI units."""
+        section = self.section()
+        body = self.rigid_body(section)
         gripper = _make_gripper(self.pads, self.grip_force, self.mu, self.pad_rings)
         pushers = [
             _core.Pusher.on_boundary(section, p.name, _mm2(p.a), _mm2(p.b), p.mu, p.points) for p in self.pushers
