@@ -41,7 +41,7 @@ def main() -> None:
     t1 = time.perf_counter()
     model = task.build_model()
     t2 = time.perf_counter()
-    result = plan_task(task, model=model)
+    result = plan_task(task, models=[model])
     t3 = time.perf_counter()
     steps = [PlanStep(task.start, None), PlanStep(task.start, task.pushers[0].name)]
     scene = scene_description(task, place_features(task, steps), task.start)

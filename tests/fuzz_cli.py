@@ -111,7 +111,7 @@ def run_tasks(count: int, seed: int, scratch: Path):
                 mutated = yaml.safe_dump(tree, allow_unicode=True)
             except (yaml.YAMLError, ValueError, RecursionError):
                 mutated = json.dumps(tree, default=str)
-        task = scratch / f"case.yaml"
+        task = scratch / "case.yaml"
         task.write_text(mutated, encoding="utf-8", errors="surrogateescape")
         args = ["plan", str(task), "--time-limit", "0.02", "-o", str(scratch / "out.plan.json"), "--quiet"]
         yield f"task {case} from {path.name}", args, mutated

@@ -1,4 +1,4 @@
-"""An independent formulation of the stable-push test, written from MODEL.md section 2 alone.
+"""An independent formulation of the stable-push test, written from docs/model.md section 2 alone.
 
 It shares no code with the core: pad points, forces, the pusher cone (as generators, a
 V-representation) and the sticking polygons (as vertices) are rebuilt here, and the decision is
@@ -56,7 +56,7 @@ class IndependentModel:
             self.inertia = self.mass * (jc / area + d @ d)
         self.gravity = np.array(task.gravity, float)  # in G while G's axes are the world's
         # Against fixed features the object keeps its world orientation phi_p on pusher p's feature,
-        # so gravity is fixed in O and turns in G: g_G = R(theta - phi_p) g (MODEL.md section 7).
+        # so gravity is fixed in O and turns in G: g_G = R(theta - phi_p) g (docs/model.md section 7).
         self.fixed_features = task.pushes == "against_fixed_features"
         self.feature_angles = [math.radians(task.feature_angle(p.name)) for p in task.pushers]
         self.dt = task.step_time

@@ -1,4 +1,4 @@
-"""Hand-derived mechanics cases (MODEL.md section 2, paper section V)."""
+"""Hand-derived mechanics cases (docs/model.md section 2, paper section V)."""
 import math
 
 import numpy as np

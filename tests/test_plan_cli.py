@@ -25,7 +25,7 @@ def test_plan_writes_json_and_csv(tmp_path):
     for key in ("planning_time_s", "iterations", "nodes", "feasibility_checks", "switches"):
         assert key in plan["stats"]
     first, second = plan["waypoints"][0], plan["waypoints"][1]
-    assert first == {"x": 0.0, "z": 0.0, "theta": 0.0, "pusher": None, "margin": None, "case": None,
+    assert first == {"x": 0.0, "z": 0.0, "theta": 0.0, "pusher": None, "margin": None, "margin_per_normal": None, "case": None,
                      "pusher_in_gripper": None}
     assert second["pusher"] == "bottom" and second["margin"] > 0
     contact = second["pusher_in_gripper"]

@@ -1,4 +1,4 @@
-"""The planner: the paper's behaviours (MODEL.md section 6) on the shipped tasks, every step of
+"""The planner: the paper's behaviours (docs/model.md section 6) on the shipped tasks, every step of
 every plan re-checked independently, determinism, limits and the swept grasp test."""
 import math
 import time

@@ -28,11 +28,6 @@ from stablepush_cli.main import cli
 LOW_MU = TASKS / "horizontal-offset-low-mu.yaml"
 
 
-def _run(args, cwd=None):
-    result = CliRunner().invoke(cli, args, catch_exceptions=False) if cwd is None else None
-    return result
-
-
 def _edited(tmp_path, old, new, name="task.yaml"):
     text = task_text("horizontal-offset-low-mu")
     assert old in text
@@ -263,7 +258,7 @@ def high_mu_run():
 
 def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu_run):
     task, steps, scene = high_mu_run
-    server = SimArmServer(log=lambda text: None, idle_timeout=0.5)
+    server = SimArmServer(log=lambda text: None, idle_timeout=3.0)  # longer than the 2 s a new client waits
     server.start_in_thread()
     try:
         def exchange(payload, wait=True):
@@ -277,7 +272,7 @@ def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu
         replies = exchange(_hello(scene, rate_hz=0))
         assert "rate_hz must be between 1 and 1000" in replies[-1]["message"]
         replies = exchange(b'{"type": "hello", "prot')  # half a line, then silence: dropped
-        assert "no complete message from the client within 0.5 s" in replies[-1]["message"]
+        assert "no complete message from the client within 3 s" in replies[-1]["message"]
         # A session in progress: a second client is told the arm is busy.
         with socket.create_connection((server.host, server.port), timeout=30) as first:
             first.sendall(_hello(scene))

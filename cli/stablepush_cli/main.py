@@ -119,7 +119,7 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     that reaches the goal within tolerance with at most --max-switches switch-overs, or at the
     time limit. The same task and seed give the same plan.
 
-    The plan file (MODEL.md section 5) lists the pose after each unit push (x mm, z mm, theta
+    The plan file (docs/model.md section 5) lists the pose after each unit push (x mm, z mm, theta
     deg), the pusher that made it, its margin in N, and where the pusher touches the object in
     the gripper frame. It is written even when the goal is not reached ("solved": false, the
     best partial path).

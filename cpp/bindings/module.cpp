@@ -237,22 +237,40 @@ PYBIND11_MODULE(_core, m) {
         return out;
       });
 
-  m.def("plan", [](const StablePushModel& model, const std::array<double, 3>& start, const std::array<double, 3>& goal,
-                   const std::array<double, 2>& step, const std::array<double, 2>& tolerance, double time_limit,
-                   double min_margin, double sampling_margin, const std::map<std::string, std::string>& parameters,
-                   double min_hold_ratio) {
-          PlannerSettings settings{to_pose(start), to_pose(goal), to_step(step), to_step(tolerance), time_limit,
-                                   min_margin, sampling_margin, min_hold_ratio, parameters};
-          py::gil_scoped_release release;
-          return plan_stable_pushes(model, settings);
+  const char* plan_doc =
+      "Plan stable pushes with TRRTstar. models: one StablePushModel, or a list of them (the corners of an\n"
+      "uncertainty box, sharing the geometry; a push counts when it is stable in all, its margin the least).\n"
+      "start, goal: (x m, z m, theta rad); step, tolerance: (m, rad); time_limit [s]; min_margin [N];\n"
+      "sampling_margin [unit steps]; parameters: TRRTstar's declared parameters by name, as text;\n"
+      "min_hold_ratio: the plan must end where the pads alone hold this multiple of the weight (0: none).";
+  auto plan = [](const ModelSet& models, const std::array<double, 3>& start, const std::array<double, 3>& goal,
+                 const std::array<double, 2>& step, const std::array<double, 2>& tolerance, double time_limit,
+                 double min_margin, double sampling_margin, const std::map<std::string, std::string>& parameters,
+                 double min_hold_ratio) {
+    PlannerSettings settings{to_pose(start), to_pose(goal), to_step(step), to_step(tolerance), time_limit,
+                             min_margin, sampling_margin, min_hold_ratio, parameters};
+    py::gil_scoped_release release;
+    return plan_stable_pushes(models, settings);
+  };
+  m.def("plan", [plan](const StablePushModel& model, const std::array<double, 3>& start,
+                       const std::array<double, 3>& goal, const std::array<double, 2>& step,
+                       const std::array<double, 2>& tolerance, double time_limit, double min_margin,
+                       double sampling_margin, const std::map<std::string, std::string>& parameters,
+                       double min_hold_ratio) {
+          return plan(ModelSet{&model}, start, goal, step, tolerance, time_limit, min_margin, sampling_margin,
+                      parameters, min_hold_ratio);
         },
         py::arg("model"), py::arg("start"), py::arg("goal"), py::arg("step"), py::arg("tolerance"),
         py::arg("time_limit"), py::arg("min_margin"), py::arg("sampling_margin"), py::arg("parameters"),
-        py::arg("min_hold_ratio") = 0.0,
-        "Plan stable pushes with TRRTstar. start, goal: (x m, z m, theta rad); step, tolerance: (m, rad);\n"
-        "time_limit [s]; min_margin [N]; sampling_margin [unit steps]; parameters: TRRTstar's declared\n"
-        "parameters by name, as text; min_hold_ratio: the plan must end where the pads alone hold this\n"
-        "multiple of the weight (0: no requirement).");
+        py::arg("min_hold_ratio") = 0.0, plan_doc);
+  m.def("plan", plan, py::arg("models"), py::arg("start"), py::arg("goal"), py::arg("step"), py::arg("tolerance"),
+        py::arg("time_limit"), py::arg("min_margin"), py::arg("sampling_margin"), py::arg("parameters"),
+        py::arg("min_hold_ratio") = 0.0, plan_doc);
+  m.def("worst_case", [](const ModelSet& models, const std::array<double, 3>& q, const std::array<double, 3>& dq,
+                         int pusher) { return worst_case(models, to_pose(q), to_pose(dq), pusher); },
+        py::arg("models"), py::arg("q"), py::arg("dq"), py::arg("pusher"),
+        "The push q -> q + dq (m, m, rad) by `pusher` as the least stable of `models` sees it (the corners of\n"
+        "an uncertainty box): the result with the least margin, an infeasible one first.");
   m.def("steps_between", [](const std::array<double, 3>& a, const std::array<double, 3>& b,
                             const std::array<double, 2>& step) { return steps_between(to_pose(a), to_pose(b), to_step(step)); },
         py::arg("a"), py::arg("b"), py::arg("step"),

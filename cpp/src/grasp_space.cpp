@@ -1,5 +1,7 @@
 #include "stablepush/grasp_space.hpp"
 
+#include <array>
+
 #include <ompl/base/SpaceInformation.h>
 #include <ompl/util/Exception.h>
 
@@ -73,40 +75,60 @@ bool GraspValidityChecker::isValid(const ob::State* s) const {
   return model_.grasp_maintained(GraspPoseSpace::pose(s));
 }
 
-StablePushValidator::StablePushValidator(const ob::SpaceInformationPtr& si, const StablePushModel& model,
-                                         double min_margin)
+StablePushValidator::StablePushValidator(const ob::SpaceInformationPtr& si, ModelSet models, double min_margin)
     : ob::MotionValidator(si),
-      model_(model),
+      models_(std::move(models)),
       space_(*si->getStateSpace()->as<GraspPoseSpace>()),
       min_margin_(min_margin) {
-  const int n = static_cast<int>(model_.pushers().size());
+  if (models_.empty() || static_cast<int>(models_.size()) > kMaxModels)
+    throw std::invalid_argument("a push is checked in 1 to 4 models");
+  const int n = static_cast<int>(models_.front()->pushers().size());
   if (n < 1 || n > kMaxPushers) throw std::invalid_argument("a task has between 1 and 32 pushers");
   all_ = n == kMaxPushers ? ~PusherSet{0} : ((PusherSet{1} << n) - 1u);
 }
 
 PusherSet StablePushValidator::stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const {
   const std::vector<Pose> poses = space_.unit_pushes(a, b);
+  const StablePushModel& geometry = *models_.front();
+  const int models = static_cast<int>(models_.size());
   for (std::size_t i = 0; i + 1 < poses.size() && candidates != 0; ++i) {
     const Pose& from = poses[i];
     const Pose& to = poses[i + 1];
-    if (!model_.gripper().grasp_maintained_along(model_.section(), from, to)) return 0;
+    if (!geometry.gripper().grasp_maintained_along(geometry.section(), from, to)) return 0;
     const Motion dq{to.x - from.x, to.z - from.z, to.theta - from.theta};
-    // One motion wrench serves every pusher whose gravity is the same (all of them, unless the
-    // features hold the object at different world orientations; see GravityFrame).
-    int loaded_for = -1;
-    MotionWrench load;
+    // One motion wrench per model serves every pusher whose gravity is the same (all of them,
+    // unless the features hold the object at different world orientations; see GravityFrame).
+    std::array<int, kMaxModels> loaded_for;
+    loaded_for.fill(-1);
+    std::array<MotionWrench, kMaxModels> loads;
     for (int p = 0; p < kMaxPushers; ++p) {
       if (!contains(candidates, p)) continue;
       ++checks_;
-      if (loaded_for < 0 || !model_.same_gravity(loaded_for, p)) {
-        load = model_.motion_wrench(from, dq, p);
-        loaded_for = p;
+      for (int m = 0; m < models; ++m) {
+        const StablePushModel& model = *models_[m];
+        if (loaded_for[m] < 0 || !model.same_gravity(loaded_for[m], p)) {
+          loads[m] = model.motion_wrench(from, dq, p);
+          loaded_for[m] = p;
+        }
+        const PushResult r = model.check(loads[m], from, dq, p);
+        if (!(r.feasible && r.margin >= min_margin_)) {
+          candidates &= ~(PusherSet{1} << p);
+          break;
+        }
       }
-      const PushResult r = model_.check(load, from, dq, p);
-      if (!(r.feasible && r.margin >= min_margin_)) candidates &= ~(PusherSet{1} << p);
     }
   }
   return candidates;
+}
+
+PushResult worst_case(const ModelSet& models, const Pose& q, const Motion& dq, int pusher) {
+  if (models.empty()) throw std::invalid_argument("worst_case needs at least one model");
+  PushResult worst = models.front()->check(q, dq, pusher);
+  for (std::size_t m = 1; m < models.size(); ++m) {
+    const PushResult r = models[m]->check(q, dq, pusher);
+    if ((!r.feasible && worst.feasible) || (r.feasible == worst.feasible && r.margin < worst.margin)) worst = r;
+  }
+  return worst;
 }
 
 bool StablePushValidator::checkMotion(const ob::State* a, const ob::State* b) const {
@@ -138,12 +160,12 @@ bool StablePushValidator::checkMotion(const ob::State* a, const ob::State* b,
 }
 
 PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance,
-                   const StablePushModel* hold, double min_hold_ratio)
+                   ModelSet hold, double min_hold_ratio)
     : ob::GoalSampleableRegion(si),
       space_(*si->getStateSpace()->as<GraspPoseSpace>()),
       goal_(goal),
       tolerance_(tolerance),
-      hold_(min_hold_ratio > 0.0 ? hold : nullptr),
+      hold_(min_hold_ratio > 0.0 ? std::move(hold) : ModelSet{}),
       min_hold_ratio_(min_hold_ratio) {
   // OMPL's threshold: no state farther than this (unit steps) from the goal pose satisfies it.
   const double x = tolerance_.length / space_.step().length;
@@ -158,7 +180,9 @@ bool PoseGoal::isSatisfied(const ob::State* s) const {
 }
 
 bool PoseGoal::held(const Pose& q, int last_pusher) const {
-  return hold_ == nullptr || hold_->hold_ratio(q, last_pusher) >= min_hold_ratio_;
+  for (const StablePushModel* model : hold_)
+    if (model->hold_ratio(q, last_pusher) < min_hold_ratio_) return false;
+  return true;
 }
 
 bool PoseGoal::isSatisfied(const ob::State* s, double* distance) const {

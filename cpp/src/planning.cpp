@@ -81,14 +81,20 @@ void check_settings(const PlannerSettings& s) {
 }  // namespace
 
 Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& settings) {
+  return plan_stable_pushes(ModelSet{&model}, settings);
+}
+
+Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings) {
   const auto started = std::chrono::steady_clock::now();
   check_settings(settings);
+  if (models.empty()) throw std::invalid_argument("no model to plan in");
+  const StablePushModel& model = *models.front();  // the geometry, which every model shares
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 
   auto space = std::make_shared<GraspPoseSpace>(settings.step, sampling_region(model, settings));
   auto si = std::make_shared<ob::SpaceInformation>(space);
   si->setStateValidityChecker(std::make_shared<GraspValidityChecker>(si, model));
-  auto validator = std::make_shared<StablePushValidator>(si, model, settings.min_margin);
+  auto validator = std::make_shared<StablePushValidator>(si, models, settings.min_margin);
   si->setMotionValidator(validator);
   si->setup();
 
@@ -96,7 +102,7 @@ Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& set
   ob::ScopedState<GraspPoseSpace> start(space);
   GraspPoseSpace::set_pose(start.get(), settings.start);
   pdef->addStartState(start);
-  pdef->setGoal(std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance, &model, settings.min_hold_ratio));
+  pdef->setGoal(std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance, models, settings.min_hold_ratio));
 
   TRRTstar planner(si);
   apply_parameters(planner, settings.parameters);
@@ -124,7 +130,7 @@ Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& set
       const Pose& from = poses[k - 1];
       const Pose& to = poses[k];
       const PushResult r =
-          model.check(from, Motion{to.x - from.x, to.z - from.z, to.theta - from.theta}, nodes[i].pusher);
+          worst_case(models, from, Motion{to.x - from.x, to.z - from.z, to.theta - from.theta}, nodes[i].pusher);
       plan.waypoints.push_back({to, nodes[i].pusher, r.margin, r.contact_case});
     }
   }

@@ -7,7 +7,6 @@ trials run the task with seeds seed, seed + 1, ...; the time is the core's own (
 """
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass
 from typing import Callable, Dict, Optional
@@ -104,10 +103,10 @@ class PlanningTrial:
 def bench_planning(task: Task, trials: int, seed: int = 1, time_limit: Optional[float] = None,
                    progress: Optional[Callable[[int], None]] = None) -> "list[PlanningTrial]":
     """Plan `task` with seeds seed .. seed + trials - 1."""
-    model = task.build_model()
+    models = task.corner_models()
     out = []
     for k in range(trials):
-        plan = plan_task(task, seed=seed + k, time_limit=time_limit, model=model)
+        plan = plan_task(task, seed=seed + k, time_limit=time_limit, models=models)
         s = plan.stats
         out.append(PlanningTrial(
             task=task.name, seed=seed + k, solved=plan.solved, outcome=plan.outcome,

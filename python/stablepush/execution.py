@@ -5,7 +5,7 @@ these waypoints) and no simulation (`sim/`).
 World frame W: x forward, z up, y along the gripping axis at the home pose, where G's axes are
 W's. During a push the pusher sticks to the object (that is what the plan guarantees), so the
 object rests on its feature, fixed in W, while the gripper moves: with T_GO(q) the object's pose in
-the grasp (MODEL.md section 1), G's world pose is
+the grasp (docs/model.md section 1), G's world pose is
 
     T_WG(t) = T_WO · T_GO(q(t))^-1.
 
@@ -85,7 +85,7 @@ class Contact:
 
 
 def rot_y(angle: float) -> np.ndarray:
-    """Right-handed rotation by `angle` rad about +y (MODEL.md section 1: R(theta) in xz)."""
+    """Right-handed rotation by `angle` rad about +y (docs/model.md section 1: R(theta) in xz)."""
     c, s = math.cos(angle), math.sin(angle)
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 

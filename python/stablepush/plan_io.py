@@ -1,4 +1,4 @@
-"""Plan files (MODEL.md section 5): JSON, with a CSV beside it, written atomically."""
+"""Plan files (docs/model.md section 5): JSON, with a CSV beside it, written atomically."""
 from __future__ import annotations
 
 import contextlib
@@ -20,13 +20,13 @@ from stablepush.errors import OutputError, PlanError
 from stablepush.planning import PlanResult, Waypoint
 
 FORMAT = "stablepush.plan/1"
-CSV_COLUMNS = ["step", "x", "z", "theta", "pusher", "margin", "case",
+CSV_COLUMNS = ["step", "x", "z", "theta", "pusher", "margin", "margin_per_normal", "case",
                "pusher_from_x", "pusher_from_z", "pusher_to_x", "pusher_to_z", "pusher_normal_x", "pusher_normal_z"]
 
 
 def _waypoint_dict(w: Waypoint) -> dict:
-    out = {"x": w.x, "z": w.z, "theta": w.theta, "pusher": w.pusher, "margin": w.margin, "case": w.case,
-           "pusher_in_gripper": None}
+    out = {"x": w.x, "z": w.z, "theta": w.theta, "pusher": w.pusher, "margin": w.margin,
+           "margin_per_normal": w.margin_per_normal, "case": w.case, "pusher_in_gripper": None}
     if w.contact is not None:
         out["pusher_in_gripper"] = {"from": list(w.contact.start), "to": list(w.contact.end),
                                     "normal": list(w.contact.normal)}
@@ -34,7 +34,7 @@ def _waypoint_dict(w: Waypoint) -> dict:
 
 
 def plan_to_dict(plan: PlanResult) -> dict:
-    """The plan as the JSON document of MODEL.md section 5 (mm, deg; margins in N; the pusher's
+    """The plan as the JSON document of docs/model.md section 5 (mm, deg; margins in N; the pusher's
     contact in the gripper frame G per waypoint)."""
     return {
         "format": FORMAT,
@@ -43,11 +43,15 @@ def plan_to_dict(plan: PlanResult) -> dict:
         "outcome": plan.outcome,
         "message": plan.message,
         "stats": dict(plan.stats),
+        # Every push is stable for every value in this box (+- fractions of the task's values;
+        # empty: the nominal values only), and each margin is the least over it.
+        "uncertainty": dict(plan.uncertainty),
         # Released at the last waypoint, do the pads alone hold the object? ratio: the largest
         # multiple of its weight they hold there (null without gravity: any grasp holds).
         "final_hold": {"ratio": None if math.isinf(plan.final_hold_ratio) else plan.final_hold_ratio,
                        "holds": plan.final_hold_ratio >= 1.0},
-        "units": {"x": "mm", "z": "mm", "theta": "deg", "margin": "N", "pusher_in_gripper": "mm in G"},
+        "units": {"x": "mm", "z": "mm", "theta": "deg", "margin": "N", "margin_per_normal": "1 (N per N)",
+                  "pusher_in_gripper": "mm in G"},
         "waypoints": [_waypoint_dict(w) for w in plan.waypoints],
     }
 
@@ -59,7 +63,8 @@ def plan_to_csv(plan: PlanResult) -> str:
     for i, w in enumerate(plan.waypoints):
         contact = ([*w.contact.start, *w.contact.end, *w.contact.normal] if w.contact is not None else [""] * 6)
         writer.writerow([i, repr(w.x), repr(w.z), repr(w.theta), w.pusher or "",
-                         "" if w.margin is None else repr(w.margin), w.case or "", *map(str, contact)])
+                         "" if w.margin is None else repr(w.margin),
+                         "" if w.margin_per_normal is None else repr(w.margin_per_normal), w.case or "", *map(str, contact)])
     return buffer.getvalue()
 
 

@@ -1,4 +1,4 @@
-"""Planning a task with the core's T-RRT* (MODEL.md section 3), in file units.
+"""Planning a task with the core's T-RRT* (docs/model.md section 3), in file units.
 
 `plan_task` turns a validated Task into a `PlanResult`: waypoints in mm and degrees, the pusher
 of each push, the test's verdict on it, and the pusher's contact seen from the gripper, which is
@@ -45,6 +45,7 @@ class Waypoint:
     margin: Optional[float] = None  # N, depth inside the pusher's cone
     case: Optional[str] = None  # all_sliding | sticking
     contact: Optional[PusherContact] = None  # the pusher's contact in G at this pose
+    margin_per_normal: Optional[float] = None  # margin / the pusher's normal force (least stable corner)
 
 
 @dataclass(frozen=True)
@@ -58,6 +59,7 @@ class PlanResult:
     # The largest multiple of the weight the pads alone hold at the last waypoint, gravity as during
     # the last push (>= 1: released there, the object stays; inf without gravity). hold_ratio.
     final_hold_ratio: float = math.inf
+    uncertainty: Dict[str, float] = field(default_factory=dict)  # the task's, under which every push is stable
 
     @property
     def pusher_sequence(self) -> List[str]:
@@ -74,7 +76,7 @@ def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, 
     x, z, theta = pose_mm_deg
     c, s = math.cos(math.radians(theta)), math.sin(math.radians(theta))
 
-    def to_g(p):  # p_G = (x, z) + R(theta) p_O  (MODEL.md section 1)
+    def to_g(p):  # p_G = (x, z) + R(theta) p_O  (docs/model.md section 1)
         return (x + c * p[0] + s * p[1], z - s * p[0] + c * p[1])
 
     spec = task.pushers[pusher]
@@ -88,10 +90,12 @@ def plan_task(
     seed: Optional[int] = None,
     time_limit: Optional[float] = None,
     max_switches: Optional[int] = None,
-    model: "Optional[_core.StablePushModel]" = None,
+    models: "Optional[List[_core.StablePushModel]]" = None,
 ) -> PlanResult:
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
-    task's planner section (which has defaults for every key)."""
+    task's planner section (which has defaults for every key). `models` are the task's
+    corner_models() (built here unless given, e.g. once for many seeds): with an `uncertainty`
+    section every push must be stable at every corner, and each waypoint's margin is the least."""
     settings = dict(task.planner)
     if seed is not None:
         settings["seed"] = planner_parameter("seed", "seed", seed)
@@ -99,26 +103,28 @@ def plan_task(
         settings["max_switches"] = planner_parameter("max_switches", "max_switches", max_switches)
     if time_limit is not None:
         settings["time_limit"] = planner_limit("time_limit", time_limit)
-    model = model or task.build_model()
+    models = models or task.corner_models()
+    model = models[0]
     step = (settings["step"][0] * MM, math.radians(settings["step"][1]))
     tolerance = (settings["tolerance"][0] * MM, math.radians(settings["tolerance"][1]))
     parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}
     parameters.update({key: repr(settings[key]) for key in PLANNER_TUNING if key in settings})
     raw = _core.plan(
-        model, pose_to_si(task.start), pose_to_si(task.goal), step, tolerance, float(settings["time_limit"]),
+        models, pose_to_si(task.start), pose_to_si(task.goal), step, tolerance, float(settings["time_limit"]),
         float(settings["min_margin"]), float(settings["sampling_margin"]), parameters,
         float(settings["min_hold_ratio"]),
     )
 
     names = task.pusher_names
     waypoints: List[Waypoint] = []
-    for q, p, margin, case in zip(raw.poses, raw.pushers, raw.margins, raw.contact_cases):
+    for k, (q, p, margin, case) in enumerate(zip(raw.poses, raw.pushers, raw.margins, raw.contact_cases)):
         pose = tuple(float(v) for v in pose_from_si(q))
         if p < 0:
             waypoints.append(Waypoint(*pose))
         else:
             waypoints.append(Waypoint(*pose, pusher=names[p], margin=float(margin), case=CASE_NAMES[case],
-                                      contact=contact_in_gripper(task, model, p, pose)))
+                                      contact=contact_in_gripper(task, model, p, pose),
+                                      margin_per_normal=_margin_per_normal(models, raw.poses[k - 1], q, p)))
 
     outcome = OUTCOME_NAMES[raw.outcome]
     s = raw.stats
@@ -137,10 +143,20 @@ def plan_task(
         "min_hold_ratio": float(settings["min_hold_ratio"]),
     }
     last = waypoints[-1]
+    last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1
     return PlanResult(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
                       message=_message(outcome, stats), waypoints=waypoints, stats=stats,
-                      final_hold_ratio=model.hold_ratio(pose_to_si((last.x, last.z, last.theta)),
-                                                        names.index(last.pusher) if last.pusher else -1))
+                      final_hold_ratio=min(m.hold_ratio(last_q, last_pusher) for m in models),
+                      uncertainty=dict(task.uncertainty))
+
+
+def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:
+    """The push's margin over the pusher's normal force (both at the least stable corner): how
+    deep inside the cone the push is, relative to how hard the pusher presses."""
+    r = _core.worst_case(models, tuple(q0), tuple(b - a for a, b in zip(q0, q1)), pusher)
+    n = models[0].pushers[pusher].inward_normal
+    normal_force = r.witness[0] * n[0] + r.witness[1] * n[1]
+    return float(r.margin / normal_force) if normal_force > 0 else None
 
 
 def _message(outcome: str, stats: dict) -> str:

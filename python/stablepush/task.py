@@ -1,10 +1,11 @@
-"""Task files (MODEL.md section 4): load, validate, convert to SI, build the core model.
+"""Task files (docs/model.md section 4): load, validate, convert to SI, build the core model.
 
 Files use mm, degrees, grams and newtons; the core is SI. Every bad input is refused with a
 `TaskError` that names the field and the reason, before anything reaches the C++ core.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 import reprlib
@@ -27,6 +28,10 @@ DEFAULT_STEP_TIME = 0.1
 # (README, "Gravity during a push"): against features fixed in the world, the object keeps its
 # world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
 PUSHES = ("against_fixed_features", "by_moving_pusher")
+# uncertainty: key -> the task value it widens (+- this fraction of it); a push must be stable for
+# every value in the box (Task.corner_models).
+UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers[].mu", "grip_force": "gripper.grip_force",
+             "mass": "object.mass"}
 DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
@@ -291,6 +296,7 @@ class Task:
     environment: Dict[str, Any] = field(default_factory=dict)  # the world around the arm, see ENVIRONMENT_DEFAULTS
     source: Optional[str] = None
     pushes: str = PUSHES[0]  # see PUSHES
+    uncertainty: Dict[str, float] = field(default_factory=dict)  # key -> +- fraction of nominal (UNCERTAIN)
 
     def feature_angle(self, pusher: str) -> float:
         """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
@@ -322,6 +328,25 @@ class Task:
             offset2 = (com[0] - uniform.com[0]) ** 2 + (com[1] - uniform.com[1]) ** 2
             inertia = uniform.inertia + self.mass * G * offset2
         return _core.RigidBody(self.mass * G, com, inertia)
+
+    def corner_models(self) -> List["_core.StablePushModel"]:
+        """The models every push must be stable in (docs/model.md section 7): the nominal model
+        alone, or with `uncertainty`, the 4 corners of (pad mu x grip force, mass) at the smallest
+        pusher mu. The required pusher wrench is affine in mu N and in m, the sticking polygons
+        scale with mu N and a pusher's cone shrinks with its mu, so a push stable at these corners
+        is stable for every value in the box (a convex combination of the corners' witnesses is a
+        witness). mu and N enter only as their product, so the corners scale mu alone."""
+        u = self.uncertainty
+        if not any(u.values()):
+            return [self.build_model()]
+        low_pushers = tuple(dataclasses.replace(p, mu=p.mu * (1.0 - u.get("pusher_mu", 0.0))) for p in self.pushers)
+        friction = [(1.0 - u.get("pad_mu", 0.0)) * (1.0 - u.get("grip_force", 0.0)),
+                    (1.0 + u.get("pad_mu", 0.0)) * (1.0 + u.get("grip_force", 0.0))]
+        masses = [1.0 - u.get("mass", 0.0), 1.0 + u.get("mass", 0.0)]
+        return [dataclasses.replace(self, mu=self.mu * f, mass=self.mass * m, pushers=low_pushers,
+                                    inertia=None if self.inertia is None else self.inertia * m,
+                                    uncertainty={}).build_model()
+                for f in friction for m in masses]
 
     def build_model(self) -> "_core.StablePushModel":
         """The core's stable-push model of this task, in SI units."""
@@ -389,7 +414,7 @@ def parse_task(text: str, source: Optional[str] = None) -> Task:
 
 def _validate(data: Any, source: Optional[str]) -> Task:
     top = _mapping(
-        "", data, ["name", "object", "gripper", "pushers", "start", "goal"], ["gravity", "dynamics", "planner", "environment"]
+        "", data, ["name", "object", "gripper", "pushers", "start", "goal"], ["gravity", "dynamics", "planner", "environment", "uncertainty"]
     )
     name = _name("name", top["name"])
     vertices, thickness, mass, com, inertia = _validate_object(top["object"])
@@ -441,12 +466,14 @@ def _validate(data: Any, source: Optional[str]) -> Task:
                 raise TaskError(label, f"{where} does not lie inside the object at the {label} pose {list(q)}")
 
     planner = _validate_planner(top.get("planner", {}))
+    uncertain = _mapping("uncertainty", top.get("uncertainty", {}), [], list(UNCERTAIN))
+    uncertainty = {key: _number(f"uncertainty.{key}", v, (0.0, 0.9)) for key, v in uncertain.items()}
     environment = _validate_environment(top.get("environment", {}), [p.name for p in pushers])
     return Task(
         name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
         grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
         friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner,
-        environment=environment, source=source, pushes=pushes,
+        environment=environment, source=source, pushes=pushes, uncertainty=uncertainty,
     )
 
 

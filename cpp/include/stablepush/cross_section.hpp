@@ -14,7 +14,7 @@ class CrossSection {
   /// a clockwise list is reversed. Throws std::invalid_argument with defect() as the message.
   explicit CrossSection(std::vector<Vec2> vertices);
 
-  /// The box of MODEL.md section 4: length along x, height along z [m], centred on O.
+  /// The box of docs/model.md section 4: length along x, height along z [m], centred on O.
   static CrossSection box(double length_x, double height_z);
 
   /// Why these vertices are not a usable cross-section ("" when they are): fewer than three

@@ -1,4 +1,4 @@
-// The planning problem as OMPL sees it (paper section VI, MODEL.md section 3), kept apart from
+// The planning problem as OMPL sees it (paper section VI, docs/model.md section 3), kept apart from
 // the search: the space of grasp poses q = (x, z, theta), its metric in unit steps, the state
 // validity (grasp maintained), the motion validity (a stable push by some pusher, the grasp kept
 // throughout) and the goal region.
@@ -72,6 +72,15 @@ class SeededPoseSampler : public ompl::base::RealVectorStateSampler {
   SeededPoseSampler(const ompl::base::StateSpace* space, std::uint_fast32_t seed);
 };
 
+/// The models a push must be stable in: the nominal model alone, or the corners of the task's
+/// uncertainty box (docs/model.md section 7), which share the geometry (section, pads, pushers).
+/// A push is stable when it is stable in every model; its margin is the least. Non-owning.
+using ModelSet = std::vector<const StablePushModel*>;
+
+/// The push q -> q + dq by `pusher` as the least stable model of the set sees it: the result with
+/// the least margin (an infeasible one first).
+PushResult worst_case(const ModelSet& models, const Pose& q, const Motion& dq, int pusher);
+
 /// A pose is valid when the grasp is maintained: every pad disc inside the cross-section.
 class GraspValidityChecker : public ompl::base::StateValidityChecker {
  public:
@@ -83,17 +92,20 @@ class GraspValidityChecker : public ompl::base::StateValidityChecker {
 };
 
 /// A motion a -> b is valid when, for one same pusher, each of its unit pushes
-/// (GraspPoseSpace::unit_pushes) is a stable push with a margin of at least `min_margin` [N],
-/// and the grasp is maintained throughout (swept pads, Gripper::grasp_maintained_along).
+/// (GraspPoseSpace::unit_pushes) is a stable push with a margin of at least `min_margin` [N] in
+/// every model of the set, and the grasp is maintained throughout (swept pads,
+/// Gripper::grasp_maintained_along).
 class StablePushValidator : public ompl::base::MotionValidator {
  public:
-  StablePushValidator(const ompl::base::SpaceInformationPtr& si, const StablePushModel& model,
-                      double min_margin);
+  /// At most kMaxModels models (the 4 corners of an uncertainty box).
+  StablePushValidator(const ompl::base::SpaceInformationPtr& si, ModelSet models, double min_margin);
+  static constexpr int kMaxModels = 4;
 
   /// The pushers among `candidates` that make every unit push of a -> b stable; 0 when the
   /// grasp is lost on the way.
   PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const;
   PusherSet all_pushers() const { return all_; }
+  const ModelSet& models() const { return models_; }
 
   bool checkMotion(const ompl::base::State* a, const ompl::base::State* b) const override;
   bool checkMotion(const ompl::base::State* a, const ompl::base::State* b,
@@ -104,7 +116,7 @@ class StablePushValidator : public ompl::base::MotionValidator {
   void reset_feasibility_checks() { checks_ = 0; }
 
  private:
-  const StablePushModel& model_;
+  ModelSet models_;
   const GraspPoseSpace& space_;
   double min_margin_;
   PusherSet all_;
@@ -118,7 +130,7 @@ class PoseGoal : public ompl::base::GoalSampleableRegion {
   /// With `hold` (a model and min_hold_ratio > 0), a node within tolerance ends a plan only when
   /// the pads alone hold the object there with that factor (`held`, StablePushModel::hold_ratio).
   PoseGoal(const ompl::base::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance,
-           const StablePushModel* hold = nullptr, double min_hold_ratio = 0.0);
+           ModelSet hold = {}, double min_hold_ratio = 0.0);
 
   const Pose& pose() const { return goal_; }
   bool isSatisfied(const ompl::base::State* s) const override;
@@ -133,7 +145,7 @@ class PoseGoal : public ompl::base::GoalSampleableRegion {
   const GraspPoseSpace& space_;
   Pose goal_;
   StepSize tolerance_;
-  const StablePushModel* hold_;
+  ModelSet hold_;  ///< empty: no hold requirement; else the pads must hold in every model
   double min_hold_ratio_;
 };
 

@@ -1,5 +1,5 @@
 // The parallel-jaw gripper: finger pads discretized into hard frictional point contacts
-// (paper section IV-A, MODEL.md section 2).
+// (paper section IV-A, docs/model.md section 2).
 #pragma once
 
 #include <vector>
@@ -37,7 +37,7 @@ class Gripper {
 
   /// For each pad, whether its disc lies inside the cross-section when the object is at q.
   std::vector<bool> pads_inside(const CrossSection& section, const Pose& q) const;
-  /// The grasp is maintained when every pad disc lies inside the cross-section (MODEL.md section 3).
+  /// The grasp is maintained when every pad disc lies inside the cross-section (docs/model.md section 3).
   bool grasp_maintained(const CrossSection& section, const Pose& q) const;
   /// The grasp is maintained throughout the motion that interpolates (x, z, theta) linearly from
   /// `from` to `to`: every pad disc stays inside the cross-section at every instant, not only at

@@ -60,6 +60,9 @@ struct Plan {
 /// Plan stable pushes from settings.start to settings.goal. Throws std::invalid_argument for a
 /// parameter that TRRTstar does not declare or cannot take.
 Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& settings);
+/// The same, with every push stable in every model of `models` (the corners of an uncertainty
+/// box, docs/model.md section 7); each waypoint's margin is the least over them.
+Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings);
 
 /// TRRTstar's declared parameters and their default values (as text).
 std::map<std::string, std::string> trrt_star_parameters();

@@ -1,4 +1,4 @@
-// The stable prehensile push test (paper section V, MODEL.md section 2).
+// The stable prehensile push test (paper section V, docs/model.md section 2).
 //
 // Quasi-dynamic balance over one step from rest (paper eq. 5, rearranged as eqs. 6 and 7):
 //     w_pusher = M xi / dt - w_sliding fingers - w_gravity - w_sticking fingers,
@@ -31,7 +31,7 @@ inline constexpr double kCertificationBand = 1e-9;
 inline constexpr double kSmallestMotion = 1e-12;
 /// "No pusher": the start of a plan, or the object held by the pads alone.
 inline constexpr int kNoPusher = -1;
-/// A pad point sticks when its slip speed is below this fraction of |v| + |omega| r_pad (MODEL.md section 2).
+/// A pad point sticks when its slip speed is below this fraction of |v| + |omega| r_pad (docs/model.md section 2).
 inline constexpr double kStickingSpeedRatio = 1e-9;
 
 enum class ContactCase { AllSliding, Sticking };

@@ -1,5 +1,5 @@
 // Small value types shared by the whole core. Everything inside the core is SI:
-// metres, radians, kilograms, newtons, seconds (MODEL.md section 1).
+// metres, radians, kilograms, newtons, seconds (docs/model.md section 1).
 #pragma once
 
 #include <Eigen/Core>
@@ -30,7 +30,7 @@ inline double cross_y(const Vec2& r, const Vec2& f) { return r.y() * f.x() - r.x
 /// omega x r for an angular velocity omega about +y and r in the grasp plane: (omega r_z, -omega r_x).
 inline Vec2 omega_cross(double omega, const Vec2& r) { return Vec2(omega * r.y(), -omega * r.x()); }
 
-/// The rotation R(theta) of MODEL.md section 1: p_G = c + R p_O, R = [[cos, sin], [-sin, cos]].
+/// The rotation R(theta) of docs/model.md section 1: p_G = c + R p_O, R = [[cos, sin], [-sin, cos]].
 struct Rotation2 {
   double c = 1.0;
   double s = 0.0;

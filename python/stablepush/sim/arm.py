@@ -28,7 +28,7 @@ SETTLE_TIME = 0.3  # s of simulation after the grasp closes, before the first wa
 
 
 def in_grasp(T_world_gripper: np.ndarray, T_world_object: np.ndarray) -> Dict[str, float]:
-    """The object's pose in the grasp as MODEL.md section 1 defines it (x, z mm; theta deg), with the
+    """The object's pose in the grasp as docs/model.md section 1 defines it (x, z mm; theta deg), with the
     out-of-plane parts (y mm, tilt deg) that the planar model assumes to be zero."""
     T = np.linalg.inv(T_world_gripper) @ T_world_object
     R = T[:3, :3]

@@ -46,7 +46,7 @@ FEATURE_CLEARANCE = 0.002  # m, a feature is this much narrower than the object 
 
 def pad_points(center: Sequence[float], radius: float, rings: int) -> List[Tuple[float, float]]:
     """The points of a pad disc in G's xz-plane [m]: the centre, and ring i of 6i points at radius
-    i r / rings, the first on +x (the same layout as the model's, MODEL.md section 2)."""
+    i r / rings, the first on +x (the same layout as the model's, docs/model.md section 2)."""
     points = [(center[0], center[1])]
     for i in range(1, rings + 1):
         rho = radius * i / rings
@@ -214,7 +214,7 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
     ET.SubElement(body, "freejoint", name=OBJECT_BODY)
     com = obj["com"]
     inertia = _prism_inertia(obj["polygon"], obj["thickness"], obj["mass"], com)
-    inertia[1, 1] = obj["inertia"]  # the task's moment about y (MODEL.md section 4)
+    inertia[1, 1] = obj["inertia"]  # the task's moment about y (docs/model.md section 4)
     ET.SubElement(body, "inertial", pos=_fmt((com[0], 0.0, com[1])), mass=repr(obj["mass"]),
                   fullinertia=_fmt((inertia[0, 0], inertia[1, 1], inertia[2, 2], 0.0, inertia[0, 2], 0.0)))
     piece_names = []

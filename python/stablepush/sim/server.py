@@ -23,6 +23,7 @@ from stablepush.sim.scene import simulated_outline
 # The scene keys that describe the world; the object's pose at the start may differ on a resume.
 _START_KEYS = ("object_pose", "object_in_grasp")
 DEFAULT_IDLE_TIMEOUT = 30.0  # s a client may stay silent within a session
+BUSY_WAIT = 2.0  # s a new client waits for a session to end before it is told the arm is busy
 
 
 def _world(scene: Optional[dict]) -> Optional[dict]:
@@ -53,11 +54,7 @@ class SimArmServer:
                 connection, _ = self._socket.accept()
             except OSError:
                 break
-            if not self._session.acquire(blocking=False):
-                self._refuse(connection)
-                continue
-            threading.Thread(target=self._session_thread, args=(connection,), name="sim-arm session",
-                             daemon=True).start()
+            threading.Thread(target=self._connection, args=(connection,), name="sim-arm client", daemon=True).start()
 
     def start_in_thread(self) -> threading.Thread:
         thread = threading.Thread(target=self.serve_forever, name="sim-arm", daemon=True)
@@ -70,8 +67,12 @@ class SimArmServer:
 
     # -- one session ----------------------------------------------------------------------------
 
-    def _refuse(self, connection: socket.socket) -> None:
-        threading.Thread(target=self._refusal, args=(connection,), name="sim-arm busy", daemon=True).start()
+    def _connection(self, connection: socket.socket) -> None:
+        # A client that comes straight back after its own session ended waits for it to wind down.
+        if self._session.acquire(timeout=BUSY_WAIT):
+            self._run_session(connection)
+        else:
+            self._refusal(connection)
 
     def _refusal(self, connection: socket.socket) -> None:
         """Tell a second client the arm is busy; read what it sent for up to 1 s first (closing on
@@ -89,7 +90,7 @@ class SimArmServer:
                 pass
         self.log("refused a second client (busy)")
 
-    def _session_thread(self, connection: socket.socket) -> None:
+    def _run_session(self, connection: socket.socket) -> None:
         try:
             self._serve(connection)
         except Exception as exc:  # noqa: BLE001 - a session must never take the server down
