@@ -32,15 +32,19 @@ def check_push(
     model: "Optional[_core.StablePushModel]" = None,
 ) -> Dict[str, dict]:
     """Is the unit motion `move` (dx mm, dz mm, dtheta deg) from pose `at` (x mm, z mm, theta deg)
-    a stable push? One entry per pusher (or only `pusher`), keyed by pusher name."""
+    a stable push? One entry per pusher (or only `pusher`), keyed by pusher name. With the task's
+    `uncertainty`, robustly: the verdict of the least stable corner of the box."""
     at = pose_field("at", list(at))
     move = pose_field("move", list(move))
     if max(abs(v) for v in move) < SMALLEST_MOVE:
         raise TaskError("move", f"the motion is zero or too small (every component under {SMALLEST_MOVE:g} mm or deg); "
                                 f"give a unit motion (dx, dz, dtheta)")
-    model = model or task.build_model()
     q, dq = pose_to_si(at), pose_to_si(move)
+    names = [pusher] if pusher is not None else task.pusher_names
+    if task.uncertainty and model is None:  # robust: the least stable corner of the box decides
+        corners = task.corner_models()
+        return {name: result_to_dict(_core.worst_case(corners, q, dq, task.pusher_index(name))) for name in names}
+    model = model or task.build_model()
     if pusher is not None:
-        index = task.pusher_index(pusher)
-        return {pusher: result_to_dict(model.check(q, dq, index))}
+        return {pusher: result_to_dict(model.check(q, dq, task.pusher_index(pusher)))}
     return {name: result_to_dict(r) for name, r in zip(task.pusher_names, model.check_all(q, dq))}
