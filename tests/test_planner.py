@@ -254,3 +254,27 @@ def test_a_start_the_pads_cannot_hold_is_reported_not_a_crash():
     result = plan_task(dataclasses.replace(task, start=(60.0, 0.0, 0.0)), time_limit=0.2)
     assert result.outcome == "invalid_start" and not result.solved
     assert len(result.waypoints) == 1 and "do not hold the object" in result.message
+
+
+@pytest.mark.parametrize("name", ["horizontal-offset-low-mu", "horizontal-offset-high-mu", "pivoting",
+                                  "large-manipulation", "t-shaped"])
+def test_a_solved_plan_ends_at_the_goal_itself_or_says_why_not(name):
+    from stablepush.executor import plan_steps
+    from stablepush.plan_io import plan_to_dict
+
+    task = shipped(name)
+    plan = plan_task(task, seed=1)
+    assert plan.solved
+    last = plan.waypoints[-1]
+    if plan.ends_at_goal:
+        assert (last.x, last.z, last.theta) == tuple(task.goal)
+        assert "ending at the goal" in plan.message and plan_to_dict(plan)["ends_at"] == "goal"
+    else:
+        assert "ending within tolerance" in plan.message and plan_to_dict(plan)["ends_at"] == "within_tolerance"
+    plan_steps(task, plan_to_dict(plan))  # the last, shorter pushes are checked pushes of this task
+
+
+def test_most_shipped_plans_end_exactly_at_the_goal():
+    ends = [plan_task(shipped(n), seed=s).ends_at_goal for n in ("horizontal-offset-low-mu", "large-manipulation",
+                                                                  "t-shaped", "pivoting") for s in (1, 2, 3)]
+    assert sum(ends) >= 9, ends

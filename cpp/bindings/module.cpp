@@ -211,6 +211,8 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("outcome", &Plan::outcome)
       .def_readonly("stats", &Plan::stats)
       .def_readonly("goal_distance", &Plan::goal_distance, "from the last waypoint [unit steps]")
+      .def_readonly("ends_at_goal", &Plan::ends_at_goal,
+                    "a solved plan's last push reaches the goal pose itself (else it ends within tolerance)")
       .def_property_readonly("poses", [](const Plan& p) {
         py::array_t<double> out({static_cast<py::ssize_t>(p.waypoints.size()), py::ssize_t{3}});
         auto o = out.mutable_unchecked<2>();

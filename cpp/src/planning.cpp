@@ -78,6 +78,29 @@ void check_settings(const PlannerSettings& s) {
     throw std::invalid_argument("min_hold_ratio must be >= 0");
 }
 
+/// Append the last, shorter push from the plan's end (within tolerance) to the goal pose itself,
+/// cut into unit pushes as every motion is, with the last pusher, when each is a stable push in
+/// every model and the goal's hold requirement holds there (Plan::ends_at_goal).
+void finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushValidator& validator,
+                    const PoseGoal& goal, const Pose& target, const ModelSet& models) {
+  const PlanStep last = plan.waypoints.back();
+  const Pose& end = last.pose;
+  if (end.x == target.x && end.z == target.z && end.theta == target.theta) {
+    plan.ends_at_goal = true;
+    return;
+  }
+  if (last.pusher == kNoPusher || validator.stable_pushers(end, target, PusherSet{1} << last.pusher) == 0) return;
+  if (!goal.held(target, last.pusher)) return;
+  const std::vector<Pose> poses = space.unit_pushes(end, target);
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    const Pose& from = poses[k - 1];
+    const Pose& to = poses[k];
+    const PushResult r = worst_case(models, from, Motion{to.x - from.x, to.z - from.z, to.theta - from.theta}, last.pusher);
+    plan.waypoints.push_back({to, last.pusher, r.margin, r.contact_case});
+  }
+  plan.ends_at_goal = true;
+}
+
 }  // namespace
 
 Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& settings) {
@@ -102,7 +125,8 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   ob::ScopedState<GraspPoseSpace> start(space);
   GraspPoseSpace::set_pose(start.get(), settings.start);
   pdef->addStartState(start);
-  pdef->setGoal(std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance, models, settings.min_hold_ratio));
+  auto goal = std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance, models, settings.min_hold_ratio);
+  pdef->setGoal(goal);
 
   TRRTstar planner(si);
   apply_parameters(planner, settings.parameters);
@@ -134,12 +158,15 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
       plan.waypoints.push_back({to, nodes[i].pusher, r.margin, r.contact_case});
     }
   }
+  if (plan.outcome == PlanOutcome::GoalReached) finish_at_goal(plan, *space, *validator, *goal, settings.goal, models);
   const PathCost cost = planner.solution_cost();
   plan.stats.iterations = planner.iterations();
   plan.stats.nodes = planner.node_count();
   plan.stats.feasibility_checks = validator->feasibility_checks();
   plan.stats.switches = cost.switches;
-  plan.stats.length = cost.length;
+  plan.stats.length = 0.0;  // along the waypoints, the last push to the goal included
+  for (std::size_t i = 1; i < plan.waypoints.size(); ++i)
+    plan.stats.length += space->distance(plan.waypoints[i - 1].pose, plan.waypoints[i].pose);
   plan.goal_distance = space->distance(plan.waypoints.back().pose, settings.goal);
   plan.stats.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return plan;

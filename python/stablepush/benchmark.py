@@ -131,6 +131,7 @@ def summarize_planning(trials: "list[PlanningTrial]") -> dict:
         "trials": len(trials),
         "success_rate": len(solved) / len(trials),
         "median_time_s": float(np.median(times)),
+        "p95_time_s": float(np.percentile(times, 95)),
         "min_time_s": times[0],
         "max_time_s": times[-1],
         "median_switches": float(np.median([t.switches for t in solved])) if solved else None,

@@ -42,6 +42,9 @@ def plan_to_dict(plan: PlanResult) -> dict:
         "solved": plan.solved,
         "outcome": plan.outcome,
         "message": plan.message,
+        # A solved plan ends at the goal pose itself ("goal") or, when the last, shorter push to it
+        # is not stable, within the tolerance ("within_tolerance"); null when not solved.
+        "ends_at": ("goal" if plan.ends_at_goal else "within_tolerance") if plan.solved else None,
         "stats": dict(plan.stats),
         # Every push is stable for every value in this box (+- fractions of the task's values;
         # empty: the nominal values only), and each margin is the least over it.

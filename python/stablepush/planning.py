@@ -60,6 +60,9 @@ class PlanResult:
     # the last push (>= 1: released there, the object stays; inf without gravity). hold_ratio.
     final_hold_ratio: float = math.inf
     uncertainty: Dict[str, float] = field(default_factory=dict)  # the task's, under which every push is stable
+    # A solved plan's last push reaches the goal pose itself; False: it ends within the tolerance
+    # (the last, shorter push to the goal was not a stable push).
+    ends_at_goal: bool = False
 
     @property
     def pusher_sequence(self) -> List[str]:
@@ -145,9 +148,9 @@ def plan_task(
     last = waypoints[-1]
     last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1
     return PlanResult(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
-                      message=_message(outcome, stats), waypoints=waypoints, stats=stats,
+                      message=_message(outcome, stats, bool(raw.ends_at_goal)), waypoints=waypoints, stats=stats,
                       final_hold_ratio=min(m.hold_ratio(last_q, last_pusher) for m in models),
-                      uncertainty=dict(task.uncertainty))
+                      uncertainty=dict(task.uncertainty), ends_at_goal=bool(raw.ends_at_goal))
 
 
 def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:
@@ -159,10 +162,13 @@ def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:
     return float(r.margin / normal_force) if normal_force > 0 else None
 
 
-def _message(outcome: str, stats: dict) -> str:
+def _message(outcome: str, stats: dict, ends_at_goal: bool) -> str:
     if outcome == "goal_reached":
+        end = ("ending at the goal" if ends_at_goal else
+               f"ending within tolerance, {stats['goal_distance_steps']:.2f} unit steps from the goal (a last push "
+               f"to the goal itself is not stable)")
         return (f"solved in {stats['planning_time_s'] * 1e3:.1f} ms: {stats['pushes']} pushes, "
-                f"{stats['switches']} switch-over(s)")
+                f"{stats['switches']} switch-over(s), {end}")
     if outcome == "goal_over_switch_limit":
         return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out with the goal reached only with "
                 f"{stats['switches']} switch-overs (max_switches {stats['max_switches']}); the plan written is that "

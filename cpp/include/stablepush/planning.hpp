@@ -55,6 +55,10 @@ struct Plan {
   std::vector<PlanStep> waypoints;
   PlanStats stats;
   double goal_distance = 0.0;  ///< from the last waypoint [unit steps]
+  /// A solved plan ends exactly at the goal when a last, shorter push by the last pusher from the
+  /// node within tolerance to the goal pose is stable (in every model; and held, when a hold
+  /// ratio is required); else it ends where the search reached the tolerance.
+  bool ends_at_goal = false;
 };
 
 /// Plan stable pushes from settings.start to settings.goal. Throws std::invalid_argument for a
