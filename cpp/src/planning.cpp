@@ -85,7 +85,8 @@ void finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushVal
                     const PoseGoal& goal, const Pose& target, const ModelSet& models) {
   const PlanStep last = plan.waypoints.back();
   const Pose& end = last.pose;
-  if (end.x == target.x && end.z == target.z && end.theta == target.theta) {
+  if (space.distance(end, target) < 1e-9) {  // there to rounding: no push is that short (kSmallestMotion)
+    plan.waypoints.back().pose = target;
     plan.ends_at_goal = true;
     return;
   }
