@@ -292,6 +292,42 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
 
 
 @cli.command()
+@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
+@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
+              help="The task the plan was made for (checked against the plan).")
+@click.option("-o", "--output", "out_path", required=True, type=click.Path(dir_okay=False), metavar="TRAJ.csv|.json",
+              help="Where to write the trajectory: CSV (a header, one row per sample) or JSON (columns and rows).")
+@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
+              metavar="HZ", help="Samples per second (the executor streams at this rate).")
+@click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default="xyzw", show_default=True,
+              help="Quaternion order: xyzw as ROS writes it, wxyz as the arm protocol and MuJoCo do.")
+def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str) -> None:
+    """Write the gripper's timed trajectory for a plan: what the executor streams, for your robot.
+
+    One sample per 1/HZ s: time (s), G's position in the world (m) and orientation (a unit
+    quaternion), its linear (m/s) and angular (rad/s) velocity in the world over the period that
+    ends there, the phase (push, settle, retract, move, approach) and the plan step. The world
+    is the executor's: G starts at the task's environment.home, each pusher a fixed feature
+    placed as `execute` places it.
+
+    \b
+    Example:
+      stablepush plan data/tasks/t-shaped.yaml -o t.plan.json
+      stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.traj.csv
+    """
+    from stablepush.plan_io import plan_from_dict, write_atomically
+    from stablepush.trajectory import timed_trajectory
+
+    if not out_path.endswith((".csv", ".json")):
+        _fail(f"-o {out_path}: the file name must end in .csv or .json")
+    task, plan, steps = _load_plan_and_task(plan_file, task_file)
+    traj = timed_trajectory(task, steps, rate_hz)
+    write_atomically(out_path, traj.to_json(quat) if out_path.endswith(".json") else traj.to_csv(quat))
+    click.echo(f"{task.name}: {len(traj)} samples at {rate_hz:g} Hz, {traj.t[-1]:.2f} s, "
+               f"{len(steps) - 1} pushes; written to {out_path}")
+
+
+@cli.command()
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
 @click.option("--pusher", required=True, metavar="NAME", help="The pusher whose cone to draw.")
 @click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,

@@ -17,7 +17,7 @@ from typing import Mapping, Optional, Union
 
 from stablepush.errors import OutputError, PlanError
 
-from stablepush.planning import PlanResult, Waypoint
+from stablepush.planning import Plan, PlanResult, PusherContact, Waypoint
 
 FORMAT = "stablepush.plan/1"
 CSV_COLUMNS = ["step", "x", "z", "theta", "pusher", "margin", "margin_per_normal", "case",
@@ -82,7 +82,8 @@ def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
     """Write each file so that a reader sees its old content or the whole new one, never a part,
     and a set of files is replaced together: every new file is written and synced beside its
     target first, then all are renamed into place with SIGINT, SIGTERM and SIGHUP held off, so
-    that only a SIGKILL or a power cut between two renames can leave old and new side by side.
+    that only a SIGKILL or a power cut between two renames can leave old and new side by side
+    (or a temporary file behind).
 
     A symlink is written through (its target is replaced; the link stays). A character device or
     FIFO (/dev/null, /dev/stdout) is written to, never replaced. A directory or any other kind of
@@ -105,9 +106,12 @@ def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
             raise OutputError(f"{path}: the directory {target.parent} does not exist")
         else:
             plan.append((path, target, content, "replace", stat.S_IMODE(mode) if mode is not None else None))
-    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
-    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, held) if threading.current_thread() is threading.main_thread() else None
-    temporaries = []
+    with _signals_deferred():
+        _write_and_rename(plan)
+
+
+def _write_and_rename(plan) -> None:
+    temporaries = []  # written, not yet renamed: removed on any failure
     try:
         for path, target, content, how, mode in plan:
             data = content.encode() if isinstance(content, str) else content
@@ -131,8 +135,28 @@ def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
         for tmp, _ in temporaries:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
-        if blocked is not None:
-            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+
+
+@contextlib.contextmanager
+def _signals_deferred():
+    """Hold SIGINT, SIGTERM and SIGHUP until the block ends, then deliver them as if they came
+    then. A handler, not a signal mask: a process-directed signal goes to any thread that does
+    not block it (numpy's BLAS threads), and its default action ends the whole process."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending = []
+    previous = {sig: signal.signal(sig, lambda signum, frame: pending.append(signum)) for sig in _DEFERRED}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        for sig in dict.fromkeys(pending):
+            signal.raise_signal(sig)
+
+
+_DEFERRED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 def write_atomically(path: Union[str, Path], text: Union[str, bytes]) -> None:
@@ -152,6 +176,23 @@ def write_plan(plan: PlanResult, json_path: Union[str, Path], csv_path: Optional
     if csv_path:
         files[csv_path] = plan_to_csv(plan)
     write_files(files)
+
+
+def plan_from_dict(data: dict) -> Plan:
+    """A plan document (checked by check_plan_dict) as a Plan."""
+    check_plan_dict(data)
+    waypoints = []
+    for w in data["waypoints"]:
+        contact = w.get("pusher_in_gripper")
+        contact = (PusherContact(tuple(contact["from"]), tuple(contact["to"]), tuple(contact["normal"]))
+                   if isinstance(contact, dict) else None)
+        waypoints.append(Waypoint(float(w["x"]), float(w["z"]), float(w["theta"]), w.get("pusher"), w.get("margin"),
+                                  w.get("case"), contact, w.get("margin_per_normal")))
+    hold = (data.get("final_hold") or {}).get("ratio")
+    return Plan(task=data["task"], solved=data["solved"], outcome=data.get("outcome", ""),
+                message=data.get("message", ""), waypoints=waypoints, stats=dict(data["stats"]),
+                final_hold_ratio=math.inf if hold is None else float(hold),
+                uncertainty=dict(data.get("uncertainty") or {}), ends_at_goal=data.get("ends_at") == "goal")
 
 
 MAX_PLAN_BYTES = 16_000_000

@@ -11,6 +11,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 
+import numpy as np
+
 from stablepush import _core
 from stablepush.mechanics import CASE_NAMES
 from stablepush.task import MM, PLANNER_TUNING, Task, planner_limit, planner_parameter, pose_from_si, pose_to_si
@@ -49,7 +51,12 @@ class Waypoint:
 
 
 @dataclass(frozen=True)
-class PlanResult:
+class Plan:
+    """A plan: waypoints from the start (no pusher) through each unit push (docs/model.md section 5),
+    how the search ended, and its statistics. The one plan type: `plan()` makes it, `save` and
+    `load` write and read plan files, `check` shows it belongs to a task, and `trajectory` and
+    `figure` turn it into what a robot or a reader needs."""
+
     task: str
     solved: bool  # the goal is reached within tolerance with at most max_switches switch-overs
     outcome: str  # goal_reached | goal_over_switch_limit | time_limit | invalid_start
@@ -73,6 +80,65 @@ class PlanResult:
                 out.append(w.pusher)
         return out
 
+    @property
+    def poses(self) -> np.ndarray:
+        """(n, 3): x mm, z mm, theta deg of every waypoint, the start first."""
+        return np.array([(w.x, w.z, w.theta) for w in self.waypoints], float)
+
+    @property
+    def steps(self) -> "List[PlanStep]":
+        """The waypoints as the executor takes them (pose, pusher)."""
+        from stablepush.execution import PlanStep
+
+        return [PlanStep((w.x, w.z, w.theta), w.pusher) for w in self.waypoints]
+
+    def __repr__(self) -> str:
+        return (f"Plan({self.task!r}, {'solved' if self.solved else self.outcome}, {len(self.waypoints) - 1} pushes, "
+                f"pushers {' -> '.join(self.pusher_sequence) or '(none)'})")
+
+    def to_dict(self) -> dict:
+        """The plan file's JSON document (docs/model.md section 5)."""
+        from stablepush.plan_io import plan_to_dict
+
+        return plan_to_dict(self)
+
+    def save(self, path, csv_path=None) -> None:
+        """Write the plan file (JSON), and its CSV beside it when `csv_path` is given."""
+        from stablepush.plan_io import write_plan
+
+        write_plan(self, path, csv_path)
+
+    @classmethod
+    def load(cls, path) -> "Plan":
+        """Read a plan file; PlanError naming the field if it is not a well-formed plan."""
+        from stablepush.plan_io import plan_from_dict, read_plan
+
+        return plan_from_dict(read_plan(path))
+
+    def check(self, task: Task) -> "Plan":
+        """This plan, once it is shown to belong to `task` (every push re-checked as a stable push
+        of it; stablepush.executor.plan_steps); PlanError names what differs."""
+        from stablepush.executor import plan_steps
+
+        plan_steps(task, self.to_dict())
+        return self
+
+    def trajectory(self, task: Task, rate_hz: float = 100.0):
+        """The timed gripper trajectory that carries the plan out (stablepush.trajectory)."""
+        from stablepush.trajectory import timed_trajectory
+
+        return timed_trajectory(task, self.check(task).steps, rate_hz)
+
+    def figure(self, task: Task):
+        """The plan drawn as `stablepush show` draws it (a matplotlib figure)."""
+        from stablepush.figures import plan_figure
+
+        title = f"{task.name}: {len(self.waypoints) - 1} pushes, {self.stats.get('switches', '?')} switch-over(s)"
+        return plan_figure(task, self.check(task).steps, title)
+
+
+PlanResult = Plan  # the name planning used before there was one plan type
+
 
 def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, pose_mm_deg) -> PusherContact:
     """Where pusher `pusher` touches the object, seen from G, when the object is at the pose."""
@@ -94,7 +160,7 @@ def plan_task(
     time_limit: Optional[float] = None,
     max_switches: Optional[int] = None,
     models: "Optional[List[_core.StablePushModel]]" = None,
-) -> PlanResult:
+) -> Plan:
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
     task's planner section (which has defaults for every key). `models` are the task's
     corner_models() (built here unless given, e.g. once for many seeds): with an `uncertainty`
@@ -147,7 +213,7 @@ def plan_task(
     }
     last = waypoints[-1]
     last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1
-    return PlanResult(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
+    return Plan(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
                       message=_message(outcome, stats, bool(raw.ends_at_goal)), waypoints=waypoints, stats=stats,
                       final_hold_ratio=min(m.hold_ratio(last_q, last_pusher) for m in models),
                       uncertainty=dict(task.uncertainty), ends_at_goal=bool(raw.ends_at_goal))

@@ -1,0 +1,102 @@
+"""Timed trajectories: the gripper's world poses that carry out a plan, with time, linear and
+angular velocity, phase and plan step (`stablepush trajectory`, `Plan.trajectory`).
+
+They are the executor's stream (execution.arm_trajectory) for an arm that starts at the task's
+home pose with every feature placed as the executor places it, sampled at the stream's rate.
+World frame W (x forward, y the gripping axis at home, z up), m, s. Velocities are those of G's
+origin and frame over the period that ends at each sample (backward differences), in W:
+v_i = (p_i - p_{i-1}) / dt, omega_i = axis-angle(R_i R_{i-1}^T) / dt.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from dataclasses import dataclass
+from typing import List, Sequence
+
+import numpy as np
+
+from stablepush.execution import PlanStep, arm_trajectory, place_features, scene_description
+from stablepush.task import Task
+
+QUATERNION_ORDERS = ("xyzw", "wxyz")  # xyzw: ROS (geometry_msgs/Quaternion); wxyz: the arm protocol, MuJoCo
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Samples i = 0..n-1 at t[i] s (the first one period after the start pose, which is not a
+    sample): position [m] and unit quaternion (w, x, y, z) of G in W, linear velocity [m/s] and
+    angular velocity [rad/s] in W, the phase (push | settle | retract | move | approach) and the plan
+    step (the one a push is heading for, else the last one reached)."""
+
+    t: np.ndarray  # (n,)
+    position: np.ndarray  # (n, 3)
+    quaternion_wxyz: np.ndarray  # (n, 4)
+    linear_velocity: np.ndarray  # (n, 3)
+    angular_velocity: np.ndarray  # (n, 3)
+    phase: List[str]
+    step: np.ndarray  # (n,) int
+    rate_hz: float
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def __repr__(self) -> str:
+        return (f"Trajectory({len(self)} samples at {self.rate_hz:g} Hz, {self.t[-1] if len(self) else 0:.2f} s, "
+                f"plan steps to {int(self.step.max()) if len(self) else 0})")
+
+    def columns(self, quat: str = "xyzw") -> List[str]:
+        if quat not in QUATERNION_ORDERS:
+            raise ValueError(f"quat must be one of {', '.join(QUATERNION_ORDERS)}, got {quat!r}")
+        q = ["qx", "qy", "qz", "qw"] if quat == "xyzw" else ["qw", "qx", "qy", "qz"]
+        return ["t", "x", "y", "z", *q, "vx", "vy", "vz", "wx", "wy", "wz", "phase", "step"]
+
+    def rows(self, quat: str = "xyzw") -> List[list]:
+        self.columns(quat)  # checks the order
+        q = self.quaternion_wxyz[:, [1, 2, 3, 0]] if quat == "xyzw" else self.quaternion_wxyz
+        return [[float(self.t[i]), *map(float, self.position[i]), *map(float, q[i]),
+                 *map(float, self.linear_velocity[i]), *map(float, self.angular_velocity[i]), self.phase[i],
+                 int(self.step[i])] for i in range(len(self))]
+
+    def to_csv(self, quat: str = "xyzw") -> str:
+        buffer = io.StringIO()
+        writer = csv.writer(buffer, lineterminator="\n")
+        writer.writerow(self.columns(quat))
+        writer.writerows(self.rows(quat))
+        return buffer.getvalue()
+
+    def to_json(self, quat: str = "xyzw") -> str:
+        return json.dumps({
+            "format": "stablepush.trajectory/1", "frame": "world (x forward, y the gripping axis at home, z up)",
+            "rate_hz": self.rate_hz, "quaternion_order": quat,
+            "units": {"t": "s", "x y z": "m", "v": "m/s", "w": "rad/s"},
+            "columns": self.columns(quat), "rows": self.rows(quat)}, indent=None) + "\n"
+
+
+def timed_trajectory(task: Task, steps: Sequence[PlanStep], rate_hz: float = 100.0) -> Trajectory:
+    """The executor's stream for these plan steps, from G at the task's home pose."""
+    features = place_features(task, steps)
+    start = scene_description(task, features, steps[0].pose)["gripper_pose"]
+    points = arm_trajectory(task, steps, features, rate_hz, start)
+    poses = np.array([start] + [p.pose for p in points], float)  # [x, y, z, qw, qx, qy, qz]
+    dt = 1.0 / rate_hz
+    quats = poses[:, 3:] * np.sign(poses[:, 3:4] + (poses[:, 3:4] == 0))  # w >= 0: one of the two signs
+    return Trajectory(
+        t=np.array([p.t for p in points]), position=poses[1:, :3], quaternion_wxyz=quats[1:],
+        linear_velocity=np.diff(poses[:, :3], axis=0) / dt,
+        angular_velocity=np.array([_rotation_vector(a, b) / dt for a, b in zip(quats[:-1], quats[1:])]).reshape(-1, 3),
+        phase=[p.phase for p in points], step=np.array([p.step for p in points], int), rate_hz=rate_hz)
+
+
+def _rotation_vector(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """axis * angle [rad] of the rotation R1 R0^T, from unit quaternions (w, x, y, z), in W."""
+    w0, v0 = q0[0], q0[1:]
+    w1, v1 = q1[0], q1[1:]
+    w = w1 * w0 + v1 @ v0  # q1 * conj(q0)
+    v = -w1 * v0 + w0 * v1 - np.cross(v1, v0)
+    if w < 0:
+        w, v = -w, -v
+    s = float(np.linalg.norm(v))
+    return np.zeros(3) if s < 1e-15 else v / s * 2.0 * math.atan2(s, w)
