@@ -5,7 +5,8 @@ crash by signal fails the test instead of killing pytest).
     python3 tests/fuzz_cli.py plans N SEED SCRATCH    # N mutated plan files of the shipped tasks: show
 
 Each case runs the CLI in this process (click's CliRunner) and must end with exit status 0, 1 or
-2; a refusal (2) is one line on stderr starting "error:"; no traceback, no internal error. The
+2; a refusal (2) is one line on stderr starting "error:" (besides "warning:" lines); no
+traceback, no internal error. The
 case about to run is written to SCRATCH/current first (a crash leaves it there). The summary is
 one JSON line on stdout: cases, exit statuses, the slowest case.
 """
@@ -152,7 +153,7 @@ def main() -> None:
         elapsed = time.perf_counter() - started
         slowest = max(slowest, (elapsed, label))
         statuses[result.exit_code] += 1
-        stderr = [line for line in result.stderr.splitlines() if line.strip()]
+        stderr = [line for line in result.stderr.splitlines() if line.strip() and not line.startswith("warning: ")]
         problem = None
         if result.exit_code not in (0, 1, 2):
             problem = f"exit {result.exit_code}: {result.stderr.strip()[-300:] or result.exception!r}"

@@ -36,6 +36,14 @@ def _fail(message: str) -> None:
     sys.exit(EXIT_BAD_INPUT)
 
 
+def _load(task_file: str):
+    """The task, its warnings printed to stderr (legal, but probably not what was meant)."""
+    task = load_task(task_file)
+    for warning in task.warnings:
+        click.echo(f"warning: {task_file}: {warning}", err=True)
+    return task
+
+
 class _Commands(click.Group):
     """The command group: each StablepushError becomes one line on stderr and its exit status;
     anything else is a bug, reported in one line (STABLEPUSH_DEBUG=1 shows the traceback)."""
@@ -87,7 +95,7 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
     Example:
       stablepush check data/tasks/horizontal-offset-low-mu.yaml --at 0 0 0 --move 1 0 0
     """
-    task = load_task(task_file)
+    task = _load(task_file)
     results = check_push(task, at if at else task.start, move, pusher)
     if as_json:
         click.echo(json.dumps(results))
@@ -134,7 +142,12 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     from stablepush.plan_io import default_output, write_plan
     from stablepush.planning import plan_task
 
-    task = load_task(task_file)
+    task = _load(task_file)
+    tolerance = task.planner["tolerance"]
+    if all(abs(a - b) <= tol for a, b, tol in zip(task.start, task.goal, (tolerance[0], tolerance[0], tolerance[1]))):
+        raise TaskError("goal", f"the start {list(task.start)} is already within planner.tolerance {tolerance} of the "
+                                f"goal {list(task.goal)}: there is nothing to plan (a task written in metres? "
+                                f"task files use mm)", task_file)
     result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
     json_path = json_path or default_output(task_file, ".plan.json")
     write_plan(result, json_path, csv_path)
@@ -187,7 +200,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     """
     from stablepush import benchmark
 
-    tasks = [load_task(path) for path in task_files]
+    tasks = [_load(path) for path in task_files]
     if checks_only:
         _bench_checks(tasks, count, seed)
         return
@@ -251,7 +264,7 @@ def _load_plan_and_task(plan_file: str, task_file: str):
     from stablepush.executor import plan_steps
     from stablepush.plan_io import read_plan
 
-    task = load_task(task_file)
+    task = _load(task_file)
     plan = read_plan(plan_file)
     return task, plan, plan_steps(task, plan, source=plan_file)
 
@@ -346,7 +359,7 @@ def cone(task_file: str, pusher: str, png_path) -> None:
     from stablepush import figures
     from stablepush.plan_io import default_output
 
-    task = load_task(task_file)
+    task = _load(task_file)
     task.pusher_index(pusher)
     png_path = png_path or default_output(task_file, f".{pusher}.cone.png")
     figures.save_figure(figures.cone_figure(task, pusher), png_path)

@@ -43,6 +43,8 @@ PYBIND11_MODULE(_core, m) {
            "Whether the disc of `radius` swept along the segment a-b lies inside the polygon.")
       .def("distance_to_boundary", &CrossSection::distance_to_boundary, py::arg("point"))
       .def("edges_holding", &CrossSection::edges_holding, py::arg("a"), py::arg("b"), py::arg("tolerance"))
+      .def("nearest_edge", &CrossSection::nearest_edge, py::arg("a"), py::arg("b"),
+           "(edge index, distance m): the edge nearest to the segment a-b as a whole")
       .def("inward_normal", &CrossSection::inward_normal, py::arg("edge"));
 
   py::class_<RigidBody>(m, "RigidBody", "Mass [kg], centre of mass in O [m], inertia about it [kg m^2].")

@@ -166,6 +166,18 @@ double CrossSection::distance_to_boundary(const Vec2& p) const {
   return std::sqrt(min_d2);
 }
 
+std::pair<int, double> CrossSection::nearest_edge(const Vec2& a, const Vec2& b) const {
+  std::pair<int, double> best{-1, std::numeric_limits<double>::infinity()};
+  for (std::size_t i = 0; i < vertices_.size(); ++i) {
+    const Vec2& p = vertices_[i];
+    const Vec2& q = vertices_[(i + 1) % vertices_.size()];
+    const double d2 = std::max(squared_distance_to_segment(a, p, q), squared_distance_to_segment(b, p, q));
+    if (d2 < best.second) best = {static_cast<int>(i), d2};
+  }
+  best.second = std::sqrt(best.second);
+  return best;
+}
+
 std::vector<int> CrossSection::edges_holding(const Vec2& a, const Vec2& b, double tolerance) const {
   std::vector<int> edges;
   const double tol2 = tolerance * tolerance;

@@ -15,8 +15,9 @@ Pusher Pusher::on_boundary(const CrossSection& section, std::string name, const 
   const std::vector<int> edges = section.edges_holding(a, b, kOnBoundaryTolerance);
   if (edges.empty()) {
     std::ostringstream msg;
-    msg << "pusher '" << name << "' is not on the object's boundary (it is "
-        << 1e3 * std::max(section.distance_to_boundary(a), section.distance_to_boundary(b)) << " mm away)";
+    const auto [edge, distance] = section.nearest_edge(a, b);
+    msg << "pusher '" << name << "' is not on the object's boundary: it is " << 1e3 * distance
+        << " mm from the nearest edge (edge " << edge << ", from vertex " << edge << ")";
     throw std::invalid_argument(msg.str());
   }
   if (is_point && edges.size() > 1)

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
+import numpy as np
 import yaml
 
 from stablepush import _core
@@ -35,6 +36,8 @@ UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers[].mu", "grip_force": 
 DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
+SNAP_TO_EDGE = 0.05  # mm: a pusher this close to an edge is put on it (a warning says so)
+ON_BOUNDARY = 1e-6  # mm: closer than this, a pusher is on its edge (the core's tolerance)
 # Resource caps: each bounds the model's size (and so the time and memory to build it and to
 # test a push) before anything reaches the core. README, "Limits".
 MAX_TASK_BYTES = 1_000_000
@@ -42,7 +45,8 @@ MAX_VERTICES = 1000  # of the cross-section
 MAX_PAD_RINGS = 6  # 1 + 3 r (r + 1) points per pad: 127 at the cap
 MAX_PAD_POINTS = 128  # over all pads: the hold ratio's LP grows with the cube of the points (about 2 s at the cap)
 MAX_PADS = 8
-MAX_PUSHER_POINTS = 20  # the cone of a segment is its end points' anyway; building it grows fast with more (0.1 s a pusher at 50)
+# A segment's cone is its end points' anyway, and building it grows fast with more (0.1 s a pusher at 50).
+MAX_PUSHER_POINTS = 20
 MAX_POLYGON_SIDES = 64
 MAX_YAML_ALIASES = 1000  # aliases (*name) a task file may use (PyYAML writes one per shared value)
 MAX_YAML_NODES = 100_000  # values in the file, aliases expanded
@@ -297,6 +301,9 @@ class Task:
     source: Optional[str] = None
     pushes: str = PUSHES[0]  # see PUSHES
     uncertainty: Dict[str, float] = field(default_factory=dict)  # key -> +- fraction of nominal (UNCERTAIN)
+    # What the file says that is legal but probably not meant (each names the field); the CLI
+    # prints them as "warning:" lines.
+    warnings: Tuple[str, ...] = ()
 
     def feature_angle(self, pusher: str) -> float:
         """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
@@ -413,10 +420,9 @@ def parse_task(text: str, source: Optional[str] = None) -> Task:
 
 
 def _validate(data: Any, source: Optional[str]) -> Task:
-    top = _mapping(
-        "", data, ["name", "object", "gripper", "pushers", "start", "goal"], ["gravity", "dynamics", "planner", "environment", "uncertainty"]
-    )
-    name = _name("name", top["name"])
+    top = _mapping("", data, ["object", "gripper", "pushers", "start", "goal"],
+                   ["name", "gravity", "dynamics", "planner", "environment", "uncertainty"])
+    name = _name("name", top["name"]) if "name" in top else _default_name(source)
     vertices, thickness, mass, com, inertia = _validate_object(top["object"])
 
     vertices_m = [_mm2(v) for v in vertices]
@@ -455,7 +461,8 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     sides = _integer("dynamics.friction_polygon_sides", dyn.get("friction_polygon_sides", DEFAULT_POLYGON_SIDES), 3,
                      MAX_POLYGON_SIDES)
 
-    pushers = _validate_pushers(top["pushers"], section)
+    notes: List[str] = []
+    pushers = _validate_pushers(top["pushers"], section, notes)
     start = pose_field("start", top["start"])
     goal = pose_field("goal", top["goal"])
     for label, q in (("start", start), ("goal", goal)):
@@ -474,7 +481,37 @@ def _validate(data: Any, source: Optional[str]) -> Task:
         grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
         friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner,
         environment=environment, source=source, pushes=pushes, uncertainty=uncertainty,
+        warnings=tuple(notes + _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity)),
     )
+
+
+def _default_name(source: Optional[str]) -> str:
+    """A task without `name:` is named after its file (its stem), else "task"."""
+    stem = Path(source).name.split(".")[0] if source else ""
+    return stem if stem and stem.isprintable() and len(stem) <= 100 else "task"
+
+
+def _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity) -> List[str]:
+    """Warnings for magnitudes no cell has, each naming the field and the likely unit slip."""
+    out = []
+    size = max(max(x for x, _ in vertices) - min(x for x, _ in vertices),
+               max(z for _, z in vertices) - min(z for _, z in vertices), thickness)
+    if size < 2.0:
+        out.append(f"object: {size:g} mm across; written in metres? Task files use mm")
+    elif size > 2000.0:
+        out.append(f"object: {size:g} mm across (over 2 m); written in micrometres, or meant in mm?")
+    if mass > 50_000.0:
+        out.append(f"object.mass: {mass:g} g (over 50 kg); task files use grams")
+    if grip_force > 500.0:
+        out.append(f"gripper.grip_force: {grip_force:g} N per pad (over 500 N); task files use newtons")
+    for path, value in [("gripper.mu", mu)] + [(f"pushers[{i}].mu", p.mu) for i, p in enumerate(pushers)]:
+        if value > 3.0:
+            out.append(f"{path}: {value:g}; a friction coefficient over 3 is unusual (a percentage?)")
+    g = math.hypot(*gravity)
+    if g != 0.0 and abs(g - 9.81) > 0.5:
+        out.append(f"gravity: |g| = {g:g} m/s^2, neither 0 (a horizontal grasp plane) nor about 9.81; "
+                   f"task files give gravity in m/s^2")
+    return out
 
 
 def _validate_object(obj: Any):
@@ -508,7 +545,16 @@ def _validate_object(obj: Any):
     return vertices, thickness, mass, com, inertia
 
 
-def _validate_pushers(value: Any, section: "_core.CrossSection") -> Tuple[PusherSpec, ...]:
+def _onto_edge(section: "_core.CrossSection", edge: int, p: Tuple[float, float]) -> Tuple[float, float]:
+    """p (mm) projected onto edge `edge` of the section."""
+    vertices = section.vertices
+    u = np.array(vertices[edge]) / MM
+    v = np.array(vertices[(edge + 1) % len(vertices)]) / MM
+    t = float(np.clip(np.dot(np.array(p) - u, v - u) / np.dot(v - u, v - u), 0.0, 1.0))
+    return tuple(float(c) for c in u + t * (v - u))
+
+
+def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str]) -> Tuple[PusherSpec, ...]:
     if not isinstance(value, list) or not value:
         raise TaskError("pushers", "must be a non-empty list")
     if len(value) > MAX_PUSHERS:
@@ -533,6 +579,12 @@ def _validate_pushers(value: Any, section: "_core.CrossSection") -> Tuple[Pusher
         if any(s.name == name for s in specs):
             raise TaskError(f"{path}.name", f"duplicate pusher name {name!r}")
         mu = _number(f"{path}.mu", raw["mu"], LIMITS["mu"])
+        edge, distance = section.nearest_edge(_mm2(a), _mm2(b))
+        if ON_BOUNDARY < distance / MM <= SNAP_TO_EDGE:  # a rounding slip: put it on that edge, and say so
+            a, b = (_onto_edge(section, edge, a), _onto_edge(section, edge, b))
+            if a == b and points > 1:
+                raise TaskError(path, "lies across a vertex; it must lie along one edge")
+            notes.append(f"{path}: {distance / MM:.3g} mm off the object's edge {edge}; moved onto it")
         try:
             _core.Pusher.on_boundary(section, name, _mm2(a), _mm2(b), mu, points)
         except ValueError as exc:

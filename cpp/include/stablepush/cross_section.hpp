@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "stablepush/types.hpp"
@@ -42,6 +43,9 @@ class CrossSection {
 
   /// Euclidean distance from a point of O to the boundary [m].
   double distance_to_boundary(const Vec2& p) const;
+  /// The edge nearest to the segment a-b as a whole: the one whose larger distance to a and b is
+  /// least; returns (edge index, that distance [m]). Edge i runs from vertex i to vertex i + 1.
+  std::pair<int, double> nearest_edge(const Vec2& a, const Vec2& b) const;
 
   /// Indices of the edges (edge i runs from vertex i to vertex i+1) that hold the segment a-b
   /// within `tolerance` [m]; for a point (a == b) on a vertex this names both edges.

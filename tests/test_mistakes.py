@@ -1,0 +1,66 @@
+"""Help for the mistakes people make: each gets the stated message (issue 11)."""
+import pytest
+from click.testing import CliRunner
+from conftest import task_text
+
+from stablepush.task import parse_task
+from stablepush_cli.main import cli
+
+
+def _write(tmp_path, text, name="mine.yaml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_name_is_optional_and_defaults_to_the_file_stem(tmp_path):
+    text = task_text("horizontal-offset-high-mu").replace("name: horizontal-offset-high-mu\n", "")
+    path = _write(tmp_path, text, "my-part.yaml")
+    result = CliRunner().invoke(cli, ["plan", str(path), "-o", str(tmp_path / "p.json")])
+    assert result.exit_code == 0 and result.output.startswith("my-part: solved"), result.output
+    assert parse_task(text).name == "task"
+
+
+def test_a_task_written_in_metres_is_warned_about_and_refused_plainly(tmp_path):
+    text = (task_text("horizontal-offset-low-mu").replace("size: [100, 25, 25]", "size: [0.1, 0.025, 0.025]")
+            .replace("pads:\n    - {center: [0, 0], radius: 5}\n    - {center: [0, 0], radius: 5}",
+                     "pads:\n    - {center: [0, 0], radius: 0.01}\n    - {center: [0, 0], radius: 0.01}")
+            .replace("{name: left,   from: [-50, -12.5], to: [-50, 12.5], mu: 0.2}",
+                     "{name: left,   from: [-0.05, -0.0125], to: [-0.05, 0.0125], mu: 0.2}")
+            .replace("{name: right,  from: [50, -12.5],  to: [50, 12.5],  mu: 0.2}",
+                     "{name: right,  from: [0.05, -0.0125],  to: [0.05, 0.0125],  mu: 0.2}")
+            .replace("{name: bottom, from: [-10, -12.5], to: [10, -12.5], mu: 0.2}",
+                     "{name: bottom, from: [-0.01, -0.0125], to: [0.01, -0.0125], mu: 0.2}")
+            .replace("goal: [20, 0, 0]", "goal: [0.02, 0, 0]"))
+    result = CliRunner().invoke(cli, ["plan", str(_write(tmp_path, text))])
+    assert result.exit_code == 2
+    lines = result.stderr.strip().splitlines()
+    assert "warning:" in lines[0] and "object: 0.1 mm across; written in metres? Task files use mm" in lines[0]
+    assert lines[-1].startswith("error:") and "already within planner.tolerance" in lines[-1]
+    assert "nothing to plan" in lines[-1]
+
+
+@pytest.mark.parametrize("old, new, says", [
+    ("mass: 202 ", "mass: 202000 ", "object.mass: 202000 g (over 50 kg); task files use grams"),
+    ("grip_force: 10 ", "grip_force: 1000 ", "gripper.grip_force: 1000 N per pad (over 500 N)"),
+    ("mu: 0.425 ", "mu: 42.5 ", "gripper.mu: 42.5; a friction coefficient over 3 is unusual"),
+    ("gravity: [0, -9.81]", "gravity: [0, -98.1]", "gravity: |g| = 98.1 m/s^2, neither 0"),
+])
+def test_implausible_magnitudes_are_warned_about_naming_the_field(old, new, says):
+    text = task_text("horizontal-offset-low-mu")
+    assert old in text
+    task = parse_task(text.replace(old, new, 1))
+    assert any(says in w for w in task.warnings), task.warnings
+    assert parse_task(text).warnings == ()
+
+
+def test_a_pusher_a_hair_off_its_edge_is_snapped_and_one_far_off_gets_its_true_distance():
+    near = task_text("horizontal-offset-low-mu").replace("from: [-50, -12.5], to: [-50, 12.5]",
+                                                         "from: [-49.99, -12.5], to: [-49.99, 12.5]")
+    task = parse_task(near)
+    assert task.pushers[0].a == (-50.0, -12.5) and task.pushers[0].b == (-50.0, 12.5)
+    assert any("pushers[0]: 0.01 mm off the object's edge" in w for w in task.warnings)
+    far = task_text("horizontal-offset-low-mu").replace("from: [-50, -12.5], to: [-50, 12.5]",
+                                                        "from: [-40, -12.5], to: [-40, 12.5]")
+    with pytest.raises(Exception, match="it is 10 mm from the nearest edge"):
+        parse_task(far)
