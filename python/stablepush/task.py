@@ -423,7 +423,7 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     top = _mapping("", data, ["object", "gripper", "pushers", "start", "goal"],
                    ["name", "gravity", "dynamics", "planner", "environment", "uncertainty"])
     name = _name("name", top["name"]) if "name" in top else _default_name(source)
-    vertices, thickness, mass, com, inertia = _validate_object(top["object"])
+    vertices, thickness, mass, com, inertia = _validate_object(top["object"], source)
 
     vertices_m = [_mm2(v) for v in vertices]
     section_defect = _core.CrossSection.defect(vertices_m)
@@ -514,9 +514,20 @@ def _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity) ->
     return out
 
 
-def _validate_object(obj: Any):
-    obj = _mapping("object", obj, ["shape", "mass"], ["size", "polygon", "thickness", "com", "inertia"])
+MESH_KEYS = ["file", "scale", "plane_y", "tolerance", "density"]
+
+
+def _validate_object(obj: Any, source: Optional[str]):
+    obj = _mapping("object", obj, ["shape"], ["mass", "size", "polygon", "thickness", "com", "inertia"] + MESH_KEYS)
     shape = obj["shape"]
+    if shape != "mesh":
+        for key in MESH_KEYS:
+            if key in obj:
+                raise TaskError(f"object.{key}", "only for shape: mesh")
+        if "mass" not in obj:
+            raise TaskError("object.mass", "missing")
+    if shape == "mesh":
+        return _mesh_object(obj, source)
     if shape == "box":
         if "polygon" in obj:
             raise TaskError("object.polygon", "only for shape: polygon (a box takes size)")
@@ -538,7 +549,7 @@ def _validate_object(obj: Any):
         vertices = tuple(_vector(f"object.polygon[{i}]", v, 2, COORDINATE) for i, v in enumerate(poly))
         thickness = _number("object.thickness", obj.get("thickness", 25.0), LIMITS["length"])
     else:
-        raise TaskError("object.shape", f"must be box or polygon, got {shape!r}")
+        raise TaskError("object.shape", f"must be box, polygon or mesh, got {_shown(shape)}")
     mass = _number("object.mass", obj["mass"], LIMITS["mass"])
     com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else None
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else None
@@ -552,6 +563,36 @@ def _onto_edge(section: "_core.CrossSection", edge: int, p: Tuple[float, float])
     v = np.array(vertices[(edge + 1) % len(vertices)]) / MM
     t = float(np.clip(np.dot(np.array(p) - u, v - u) / np.dot(v - u, v - u), 0.0, 1.0))
     return tuple(float(c) for c in u + t * (v - u))
+
+
+def _mesh_object(obj: dict, source: Optional[str]):
+    """shape: mesh (stablepush.mesh): the file relative to the task file's directory; `mass` g or
+    `density` g/cm^3; `scale` to mm; `plane_y` mm (default: the centre of mass's); `tolerance` mm
+    of the simplified section (default 0.1). com and inertia come from the solid unless given."""
+    from stablepush.mesh import load_mesh_object
+
+    for key in ("size", "polygon", "thickness"):
+        if key in obj:
+            raise TaskError(f"object.{key}", "not for shape: mesh (the mesh gives the section and thickness)")
+    if "file" not in obj:
+        raise TaskError("object.file", "missing (an STL, OBJ or PLY file, relative to the task file)")
+    if not isinstance(obj["file"], str) or not obj["file"]:
+        raise TaskError("object.file", f"must be a file name, got {_shown(obj['file'])}")
+    base = Path(source).parent if source else Path.cwd()
+    path = base / obj["file"]
+    if not path.is_file():
+        raise TaskError("object.file", f"no such file: {path}")
+    mesh = load_mesh_object(
+        path, "object", scale=_number("object.scale", obj.get("scale", 1.0), (1e-6, 1e6)),
+        plane_y=_number("object.plane_y", obj["plane_y"], COORDINATE) if "plane_y" in obj else None,
+        tolerance=_number("object.tolerance", obj.get("tolerance", 0.1), (1e-4, 100.0)),
+        mass=_number("object.mass", obj["mass"], LIMITS["mass"]) if "mass" in obj else None,
+        density=_number("object.density", obj["density"], (1e-3, 100.0)) if "density" in obj else None,
+        max_vertices=MAX_VERTICES)
+    com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else mesh.com
+    inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else mesh.inertia
+    _number("object.mass", mesh.mass, LIMITS["mass"])
+    return mesh.vertices, mesh.thickness, mesh.mass, com, inertia
 
 
 def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str]) -> Tuple[PusherSpec, ...]:

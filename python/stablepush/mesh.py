@@ -1,0 +1,84 @@
+"""Objects given as meshes (STL, OBJ, PLY; read by trimesh): the cross-section at the grasp plane,
+simplified to a stated tolerance, and the mass, centre of mass and moment of inertia of the solid.
+
+The mesh's own axes are O's (docs/model.md section 1): x and z span the grasp plane, y is the
+gripping axis (pad to pad). The grasp plane is the plane y = plane_y of the mesh. Units: the mesh's,
+times `scale`, must give mm.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional, Tuple
+
+import numpy as np
+
+from stablepush.errors import TaskError
+
+G_PER_CM3 = 1e-3  # g/mm^3 per g/cm^3
+
+
+@dataclass(frozen=True)
+class MeshObject:
+    """What the task takes from a mesh (mm, g, kg m^2)."""
+
+    vertices: Tuple[Tuple[float, float], ...]  # the simplified section, counterclockwise (x right, z up)
+    thickness: float  # mm: the solid's extent along y
+    mass: float  # g
+    com: Tuple[float, float]  # mm: the solid's centre of mass (x, z)
+    inertia: float  # kg m^2: the solid's moment about y through its centre of mass
+    section_vertices: int  # before simplification
+
+
+def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Optional[float] = None,
+                     tolerance: float = 0.1, mass: Optional[float] = None, density: Optional[float] = None,
+                     max_vertices: int = 1000) -> MeshObject:
+    """The object of a mesh file. `mass` [g] or `density` [g/cm^3] (exactly one); `plane_y` [mm,
+    after scaling] defaults to the centre of mass's y; `tolerance` [mm] bounds how far the
+    simplified section departs from the true one. TaskError naming `field` on any problem."""
+    try:
+        import trimesh
+        from shapely.geometry import Polygon
+        from shapely.geometry.polygon import orient
+    except ImportError as exc:  # pragma: no cover - both are dependencies
+        raise TaskError(field, f"mesh objects need trimesh and shapely ({exc})") from None
+    try:
+        mesh = trimesh.load_mesh(str(path), force="mesh")
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds on a bad file
+        raise TaskError(f"{field}.file", f"cannot read {path} as a mesh ({type(exc).__name__}: "
+                                         f"{' '.join(str(exc).split())[:120]})") from None
+    if len(mesh.faces) == 0:
+        raise TaskError(f"{field}.file", f"{path} holds no triangles")
+    if not mesh.is_watertight:
+        raise TaskError(f"{field}.file", f"{path} is not a closed surface (watertight), so it has no volume")
+    mesh.apply_scale(scale)
+    volume = float(mesh.volume)  # mm^3
+    if not volume > 0:
+        raise TaskError(f"{field}.file", f"{path} encloses no volume (inside out?)")
+    if (mass is None) == (density is None):
+        raise TaskError(field, "give exactly one of mass (g) and density (g/cm^3)")
+    grams = mass if mass is not None else density * G_PER_CM3 * volume
+    com = mesh.center_mass
+    y = float(com[1]) if plane_y is None else plane_y
+    low, high = mesh.bounds[:, 1]
+    if not low < y < high:
+        raise TaskError(f"{field}.plane_y", f"{y:g} mm is outside the mesh, which spans y {low:g} to {high:g} mm")
+    section = mesh.section(plane_origin=[0.0, y, 0.0], plane_normal=[0.0, 1.0, 0.0])
+    if section is None:
+        raise TaskError(f"{field}.plane_y", f"the plane y = {y:g} mm does not cut the mesh")
+    to_xz = np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0], [0, -1.0, 0, y], [0, 0, 0, 1.0]])  # (x, y, z) -> (x, z, y0 - y)
+    planar, _ = section.to_2D(to_2D=to_xz)
+    polygons = list(planar.polygons_full)
+    if not polygons:
+        raise TaskError(f"{field}.plane_y", f"the section at y = {y:g} mm is not a closed outline")
+    outline = max(polygons, key=lambda p: p.area)
+    raw = len(outline.exterior.coords) - 1
+    simple = orient(Polygon(outline.exterior).simplify(tolerance, preserve_topology=True), 1.0)
+    vertices = tuple((float(x), float(z)) for x, z in list(simple.exterior.coords)[:-1])
+    if len(vertices) > max_vertices:
+        raise TaskError(f"{field}.tolerance", f"the section keeps {len(vertices)} vertices at {tolerance:g} mm; "
+                                              f"at most {max_vertices} (a larger tolerance)")
+    mesh.density = grams / volume  # g/mm^3, so moment_inertia is in g mm^2
+    inertia = float(mesh.moment_inertia[1, 1]) * 1e-9  # g mm^2 -> kg m^2
+    return MeshObject(vertices=vertices, thickness=float(high - low), mass=float(grams),
+                      com=(float(com[0]), float(com[2])), inertia=inertia, section_vertices=raw)

@@ -1,0 +1,82 @@
+"""Mesh input (object: {shape: mesh}): the section, simplification and the solid's mass
+properties, checked against the core's uniform prism and against shapely; a mesh task planned end
+to end."""
+import math
+
+import numpy as np
+import pytest
+import trimesh
+from conftest import ROOT
+from shapely.geometry import Polygon
+
+from stablepush import _core
+from stablepush.errors import TaskError
+from stablepush.mesh import load_mesh_object
+from stablepush.planning import plan_task
+from stablepush.task import load_task, parse_task
+
+BRACKET = ROOT / "data" / "tasks" / "more" / "l-bracket-mesh.yaml"
+
+
+def test_the_shipped_bracket_gives_its_outline_and_a_prisms_mass_properties():
+    task = load_task(BRACKET)
+    outline = [(-30, -25), (30, -25), (30, -5), (-10, -5), (-10, 25), (-30, 25)]
+    assert sorted(task.vertices) == sorted(map(lambda p: (float(p[0]), float(p[1])), outline))
+    assert task.thickness == pytest.approx(25.0) and task.mass == pytest.approx(1.41e-3 * 45_000)
+    # For an extrusion the solid's com and moment about y are the uniform prism's (core, independently).
+    section = _core.CrossSection([(x * 1e-3, z * 1e-3) for x, z in outline])
+    prism = _core.RigidBody.uniform(section, task.mass * 1e-3)
+    assert np.allclose(np.array(task.com) * 1e-3, prism.com, atol=1e-12)
+    assert task.inertia == pytest.approx(prism.inertia, rel=1e-9)
+
+
+def test_a_mesh_task_is_planned_end_to_end():
+    task = load_task(BRACKET)
+    plan = plan_task(task, seed=1)
+    assert plan.solved
+    plan.check(task)
+    assert len(plan.trajectory(task)) > 0
+
+
+def _cylinder(tmp_path, sections=256):
+    solid = trimesh.creation.cylinder(radius=20.0, height=25.0, sections=sections)  # axis z
+    solid.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))  # axis y
+    path = tmp_path / "disc.stl"
+    solid.export(path)
+    return path
+
+
+def test_a_fine_section_is_simplified_within_its_tolerance(tmp_path):
+    path = _cylinder(tmp_path)
+    for tolerance in (0.01, 0.1, 1.0):
+        obj = load_mesh_object(path, "object", mass=100.0, tolerance=tolerance)
+        assert obj.section_vertices >= 256 and len(obj.vertices) <= obj.section_vertices
+        exact = Polygon([(20 * math.cos(a), 20 * math.sin(a)) for a in np.linspace(0, 2 * math.pi, 2048)])
+        # Simplified within the tolerance (plus the 256-gon's own sagitta, 0.003 mm).
+        assert Polygon(obj.vertices).hausdorff_distance(exact) <= tolerance + 0.01
+    assert len(load_mesh_object(path, "object", mass=100.0, tolerance=1.0).vertices) < 40
+
+
+@pytest.mark.parametrize("edit, field, says", [
+    ({"density": 1.0}, "object", "give exactly one of mass (g) and density"),
+    ({"plane_y": 40.0}, "object.plane_y", "outside the mesh"),
+    ({"file": "nowhere.stl"}, "object.file", "no such file"),
+    ({"size": [1, 2, 3]}, "object.size", "not for shape: mesh"),
+])
+def test_mesh_mistakes_name_the_field(tmp_path, edit, field, says):
+    path = _cylinder(tmp_path)
+    obj = {"shape": "mesh", "file": path.name, "mass": 100.0, **edit}
+    text = (f"object: {obj}\ngripper: {{grip_force: 10, mu: 0.5}}\n"
+            f"pushers: [{{name: left, from: [-20, 0.0001], to: [-20, -0.0001], mu: 0.5}}]\nstart: [0, 0, 0]\n"
+            f"goal: [1, 0, 0]\n")
+    with pytest.raises(TaskError) as error:
+        parse_task(text, source=str(tmp_path / "task.yaml"))
+    assert error.value.field == field and says in error.value.reason
+
+
+def test_an_open_surface_is_refused(tmp_path):
+    box = trimesh.creation.box([60, 25, 40])
+    box.update_faces(np.arange(len(box.faces)) != 0)  # one triangle gone: no longer closed
+    box.export(tmp_path / "open.stl")
+    with pytest.raises(TaskError, match="not a closed surface"):
+        load_mesh_object(tmp_path / "open.stl", "object", mass=10.0)
