@@ -64,3 +64,23 @@ def test_a_pusher_a_hair_off_its_edge_is_snapped_and_one_far_off_gets_its_true_d
                                                         "from: [-40, -12.5], to: [-40, 12.5]")
     with pytest.raises(Exception, match="it is 10 mm from the nearest edge"):
         parse_task(far)
+
+
+def test_show_draws_an_unsolved_plan_marked_as_such_and_point_pushers(tmp_path):
+    from conftest import TASKS, task_with
+    from stablepush import figures
+    from stablepush.execution import PlanStep
+
+    task = TASKS / "horizontal-offset-low-mu.yaml"
+    plan = tmp_path / "part.json"
+    assert CliRunner().invoke(cli, ["plan", str(task), "--time-limit", "0.0005", "-o", str(plan)]).exit_code == 1
+    result = CliRunner().invoke(cli, ["show", str(plan), "--task", str(task), "-o", str(tmp_path / "p.png")])
+    assert result.exit_code == 0 and (tmp_path / "p.png").stat().st_size > 0, result.output
+    # A point pusher is a dot; the object's x axis an arrow (its orientation).
+    pegs = task_with("horizontal-offset-low-mu", lambda d: d.update(
+        gravity=[0, 0], pushers=[{"name": "tip", "at": [-50, 0], "mu": 0.6}]))
+    fig = figures.plan_figure(pegs, [PlanStep((0, 0, 0), None), PlanStep((1, 0, 0), "tip")], reaches_goal=False)
+    first = fig.axes[0]
+    assert any(line.get_marker() == "o" for line in first.get_lines())
+    assert first.texts or first.patches  # the orientation arrow
+    assert fig.axes[1].get_title().startswith("end")

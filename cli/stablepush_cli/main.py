@@ -259,14 +259,14 @@ def _write_bench(path: str, trials, rows) -> None:
     write_atomically(path, buffer.getvalue())
 
 
-def _load_plan_and_task(plan_file: str, task_file: str):
+def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = True):
     """The task and the plan's steps, once the plan is shown to belong to the task (exit 2 if not)."""
     from stablepush.executor import plan_steps
     from stablepush.plan_io import read_plan
 
     task = _load(task_file)
     plan = read_plan(plan_file)
-    return task, plan, plan_steps(task, plan, source=plan_file)
+    return task, plan, plan_steps(task, plan, source=plan_file, require_solved=require_solved)
 
 
 @cli.command()
@@ -279,9 +279,11 @@ def _load_plan_and_task(plan_file: str, task_file: str):
 def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     """Draw a plan: snapshots of the object in the grasp and x, z, theta against step.
 
-    The snapshots (as in the paper's fig. 1) show the object's outline in the gripper frame G, the
-    pads (dashed), every pusher (grey) and the active one (thick, coloured); switch-overs are named
-    above the snapshot where they happen and dashed in the lower plot.
+    The snapshots (as in the paper's fig. 1) show the object's outline in the gripper frame G with
+    an arrow along its x axis (its orientation), the pads (dashed), every pusher (grey; a dot for a
+    point pusher) and the active one (thick, coloured); switch-overs are named above the snapshot
+    where they happen and dashed in the lower plot. An unsolved (partial) plan is drawn too, its
+    title saying so.
 
     \b
     Example:
@@ -292,11 +294,13 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
 
     from stablepush import figures
 
-    task, plan, steps = _load_plan_and_task(plan_file, task_file)
+    task, plan, steps = _load_plan_and_task(plan_file, task_file, require_solved=False)
     png_path = png_path or str(Path(plan_file).with_suffix("").with_suffix(".png"))
     stats = plan.get("stats", {})
     title = f"{task.name}: {len(steps) - 1} pushes, {stats.get('switches', '?')} switch-over(s), seed {stats.get('seed', '?')}"
-    fig = figures.plan_figure(task, steps, title)
+    if not plan["solved"]:
+        title = f"NOT SOLVED ({plan.get('outcome') or 'partial plan'}): {title}"
+    fig = figures.plan_figure(task, steps, title, reaches_goal=plan["solved"])
     figures.save_figure(fig, png_path)
     click.echo(f"figure written to {png_path}")
     if gif_path:

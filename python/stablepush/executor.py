@@ -107,19 +107,20 @@ class ExecutionReport:
         }
 
 
-def plan_steps(task: Task, plan: dict, source: Optional[str] = None) -> List[PlanStep]:
+def plan_steps(task: Task, plan: dict, source: Optional[str] = None, require_solved: bool = True) -> List[PlanStep]:
     """The plan's waypoints, once they are shown to belong to `task`: a structurally valid plan
     (plan_io.check_plan_dict), solved, for the same task name and start, with pushers the task
     has, no step longer than the task's unit step, and every push a stable push of this task with
     the pads inside the object (so a plan made for another version of the file, or edited by
-    hand, is refused). PlanError names what differs."""
+    hand, is refused). PlanError names what differs. `require_solved=False` lets an unsolved
+    (partial) plan through, for drawing it."""
     def fail(field: str, reason: str):
         raise PlanError(field, reason, source)
 
     check_plan_dict(plan, source)
     if plan["task"] != task.name:
         fail("task", f"the plan is for task {plan['task'][:100]!r}, not {task.name!r}")
-    if not plan["solved"]:
+    if require_solved and not plan["solved"]:
         fail("solved", f"the plan does not reach the goal ({str(plan.get('message', 'not solved'))[:200]})")
     raw = plan["waypoints"]
     if len(raw) < 2:

@@ -51,8 +51,17 @@ def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits)
     for spec in task.pushers:
         seg = _in_gripper(task, pose, [spec.a, spec.b])
         active = spec.name == pusher
-        ax.plot(seg[:, 0], seg[:, 1], color=_colour(task, spec.name) if active else "0.6",
-                lw=5 if active else 1.5, solid_capstyle="butt", zorder=4 if active else 2)
+        colour = _colour(task, spec.name) if active else "0.6"
+        if spec.is_point:  # a segment of length 0 would draw nothing
+            ax.plot(seg[:1, 0], seg[:1, 1], "o", color=colour, ms=8 if active else 5, zorder=4 if active else 2)
+        else:
+            ax.plot(seg[:, 0], seg[:, 1], color=colour, lw=5 if active else 1.5, solid_capstyle="butt",
+                    zorder=4 if active else 2)
+    # O's x axis from its origin: the object's orientation (a symmetric outline looks alike turned).
+    size = 0.3 * max(max(abs(v) for v in p) for p in task.vertices)
+    axis = _in_gripper(task, pose, [(0.0, 0.0), (size, 0.0)])
+    ax.annotate("", xy=axis[1], xytext=axis[0], zorder=5,
+                arrowprops={"arrowstyle": "->", "color": "0.15", "lw": 1.2})
     ax.set_title(title, fontsize=9)
     ax.set_aspect("equal")
     ax.set_xlim(*limits[0])
@@ -81,8 +90,9 @@ def _snapshots(steps: Sequence[PlanStep]) -> List[int]:
     return keys[:MAX_SNAPSHOTS] if len(keys) <= MAX_SNAPSHOTS else keys[:MAX_SNAPSHOTS - 1] + [keys[-1]]
 
 
-def plan_figure(task: Task, steps: Sequence[PlanStep], title: str = ""):
-    """The plan in the grasp: snapshots above, x, z, theta against step below."""
+def plan_figure(task: Task, steps: Sequence[PlanStep], title: str = "", reaches_goal: bool = True):
+    """The plan in the grasp: snapshots above, x, z, theta against step below. The last snapshot
+    is labelled "goal", or "end" for a plan that does not reach it."""
     keys = _snapshots(steps)
     switches = {c.first for c in contacts_of(steps)[1:]}
     fig = plt.figure(figsize=(2.3 * len(keys) + 0.5, 6.2))
@@ -91,7 +101,7 @@ def plan_figure(task: Task, steps: Sequence[PlanStep], title: str = ""):
     for k, i in enumerate(keys):
         ax = fig.add_subplot(grid[0, k])
         pusher = steps[i + 1].pusher if i + 1 < len(steps) else steps[i].pusher
-        label = "start" if i == 0 else ("goal" if i == len(steps) - 1 else f"step {i}")
+        label = "start" if i == 0 else (("goal" if reaches_goal else "end") if i == len(steps) - 1 else f"step {i}")
         if i in switches:
             label += f"\nswitch to {pusher}"
         elif pusher:
