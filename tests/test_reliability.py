@@ -151,7 +151,7 @@ def low_mu_plan():
 
 
 @pytest.mark.parametrize("edit, says", [
-    (lambda p: p["waypoints"][2].update(x=float("nan")), "not valid JSON (NaN is not a number a plan may hold)"),
+    (lambda p: p["waypoints"][2].update(x=float("nan")), "not valid JSON (NaN is not a number JSON allows here)"),
     (lambda p: p.update(stats=[]), "stats: must be a mapping, got a list"),
     (lambda p: p.update(stats=None), "stats: must be a mapping, got null"),
     (lambda p: p.update(solved="no"), "solved: must be a boolean, got a string"),

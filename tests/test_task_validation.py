@@ -60,7 +60,7 @@ BAD = [
     ("zero size", _set(["object", "size"], [100, 0, 25]), "object.size[1]", "between 0.01 and 10000, got 0"),
     ("negative pad mu", _set(["gripper", "mu"], -0.1), "gripper.mu", "between 0 and 100, got -0.1"),
     ("negative pusher mu", lambda d: d["pushers"][1].update(mu=-0.5), "pushers[1].mu", "between 0 and 100, got -0.5"),
-    ("unknown shape", _set(["object", "shape"], "sphere"), "object.shape", "box or polygon"),
+    ("unknown shape", _set(["object", "shape"], "sphere"), "object.shape", "box, polygon or mesh"),
     ("duplicate pusher", lambda d: d["pushers"][1].update(name="left"), "pushers[1].name", "duplicate"),
     ("pusher off boundary", lambda d: d["pushers"][0].update({"from": [-40, -12.5], "to": [-40, 12.5]}), "pushers[0]", "not on the object's boundary"),
     ("point pusher on vertex", lambda d: d["pushers"].append({"name": "corner", "at": [50, 12.5], "mu": 0.3}), "pushers[3]", "vertex"),

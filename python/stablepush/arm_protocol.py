@@ -47,6 +47,9 @@ import socket
 import time
 from typing import Any, Dict
 
+from stablepush import strict_json
+from stablepush.strict_json import is_finite_number
+
 PROTOCOL = "stablepush.arm/2"
 SUPPORTED_PROTOCOLS = ("stablepush.arm/1", PROTOCOL)
 DEFAULT_PORT = 47100
@@ -81,11 +84,9 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
     """A message from `sender` ("client" or "server"), checked against the protocol."""
     fields = _CLIENT_FIELDS if sender == "client" else _SERVER_FIELDS
     try:
-        message = json.loads(line.decode(), parse_constant=_refuse_constant)
+        message = strict_json.loads(line.decode())
     except (UnicodeDecodeError, ValueError) as exc:
-        raise ProtocolError(f"not a JSON line ({exc.__class__.__name__}: {_clip(line)})") from None
-    except RecursionError:
-        raise ProtocolError(f"not a JSON line (nested too deeply: {_clip(line)})") from None
+        raise ProtocolError(f"not a JSON line ({exc.__class__.__name__}: {exc}; {_clip(line)})") from None
     if not isinstance(message, dict):
         raise ProtocolError(f"not a JSON object: {_clip(line)}")
     kind = message.get("type")
@@ -109,7 +110,7 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
 
 
 def _check_pose(pose: Any, what: str) -> None:
-    if not (isinstance(pose, list) and len(pose) == 7 and all(_finite(v) for v in pose)):
+    if not (isinstance(pose, list) and len(pose) == 7 and all(is_finite_number(v) for v in pose)):
         raise ProtocolError(f"{what} must be 7 finite numbers [x, y, z, qw, qx, qy, qz]")
 
 
@@ -117,23 +118,10 @@ def _check_state(state: dict, kind: str) -> None:
     """A server's `state`: ee_pose 7 finite numbers; object_in_grasp, when given, finite x, z, theta."""
     _check_pose(state.get("ee_pose"), f"{kind}: state.ee_pose")
     tracked = state.get("object_in_grasp")
-    if tracked is not None and not (isinstance(tracked, dict) and all(_finite(tracked.get(k)) for k in ("x", "z", "theta"))):
+    if tracked is not None and not (isinstance(tracked, dict) and all(is_finite_number(tracked.get(k)) for k in ("x", "z", "theta"))):
         raise ProtocolError(f"{kind}: state.object_in_grasp must hold finite numbers x, z, theta")
     if "object_pose" in state:
         _check_pose(state["object_pose"], f"{kind}: state.object_pose")
-
-
-def _finite(v: Any) -> bool:
-    if not isinstance(v, (int, float)) or isinstance(v, bool):
-        return False
-    try:
-        return math.isfinite(v)
-    except OverflowError:  # an integer past the double range
-        return False
-
-
-def _refuse_constant(name: str):
-    raise ValueError(f"{name} is not JSON")
 
 
 class LineReader:

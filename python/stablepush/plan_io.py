@@ -15,7 +15,9 @@ import threading
 from pathlib import Path
 from typing import Mapping, Optional, Union
 
+from stablepush import strict_json
 from stablepush.errors import OutputError, PlanError
+from stablepush.strict_json import is_finite_number
 
 from stablepush.planning import Plan, PlanResult, PusherContact, Waypoint
 
@@ -213,17 +215,11 @@ def read_plan(path: Union[str, Path]) -> dict:
     if len(raw) > MAX_PLAN_BYTES:
         raise PlanError("", f"larger than {MAX_PLAN_BYTES} bytes; not a plan this tool wrote", source)
     try:
-        data = json.loads(raw.decode("utf-8"), parse_constant=_refuse_constant)
+        data = strict_json.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, ValueError) as exc:
         raise PlanError("", f"not valid JSON ({' '.join(str(exc).split())[:120]})", source) from None
-    except RecursionError:
-        raise PlanError("", "not valid JSON (nested too deeply)", source) from None
     check_plan_dict(data, source)
     return data
-
-
-def _refuse_constant(name: str):
-    raise ValueError(f"{name} is not a number a plan may hold")
 
 
 def check_plan_dict(data, source: Optional[str] = None) -> None:
@@ -265,12 +261,3 @@ def _json_kind(v) -> str:
         return "a boolean"
     return {str: "a string", dict: "a mapping", list: "a list"}.get(type(v), "a number")
 
-
-def is_finite_number(v) -> bool:
-    """A JSON number that is a finite double (an integer past the double range is not)."""
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        return False
-    try:
-        return math.isfinite(v)
-    except OverflowError:
-        return False
