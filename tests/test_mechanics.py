@@ -1,4 +1,4 @@
-"""Hand-derived mechanics cases (docs/model.md section 2, paper section V)."""
+"""Hand-derived mechanics cases (docs/model.md section 2, paper section IV)."""
 import math
 
 import numpy as np
@@ -98,7 +98,7 @@ def test_pivot_is_feasible_only_through_the_sticking_pad_centre():
     q, dq = (0, 0, 0), (0, 0, math.radians(1))
     result = model.check(q, dq, left)
     assert result.feasible and result.contact_case.name == "sticking" and result.sticking_points == 2
-    # Without the sticking centre's friction the same motion wrench lies outside the cone (fig. 8, left).
+    # Without the sticking centre's friction the same motion wrench lies outside the cone (fig. 7, left).
     required = model.motion_wrench(q, dq).required
     cone = model.pusher_cones[left]
     assert max(row @ required for row in cone.facet_rows) > 0
@@ -135,7 +135,7 @@ def test_point_pusher_cone_is_a_wedge_and_in_plane_pushes_are_decided_exactly():
 
 
 def test_point_pusher_pivot_uses_the_exact_lp():
-    # Paper fig. 7-8: a point pusher and the sticking pad centre. A point pusher's wedge has no
+    # Paper figs. 6-7: a point pusher and the sticking pad centre. A point pusher's wedge has no
     # interior in wrench space, so the sticking case needs the equality-constrained exact LP.
     task = point_pusher_task([-50, 0], mu=0.6)
     model = task.build_model()

@@ -131,7 +131,7 @@ def test_pivot_turns_the_object_with_a_side_pusher_through_sticking_steps():
         assert plan.solved and reaches_goal(task, plan)
         assert len(plan.pusher_sequence) == 1 and plan.pusher_sequence[0] in ("left", "right")
         sticking = [w for w in plan.waypoints[1:] if w.case == "sticking"]
-        # The turn is made about the pad centre, which sticks (paper fig. 8).
+        # The turn is made about the pad centre, which sticks (paper figs. 6-7).
         turned_sticking = sum(abs(b.theta - a.theta) for a, b in zip(plan.waypoints, plan.waypoints[1:]) if b.case == "sticking")
         assert turned_sticking >= 0.9 * abs(task.goal[2] - task.start[2]), (len(sticking), turned_sticking)
         recheck(task, plan)

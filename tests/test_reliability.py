@@ -1,5 +1,6 @@
 """Each hostile input and fault of the reliability issue, one by one: the exact message or the
 safe behaviour, never a crash, a hang or a file written where it should not be."""
+import contextlib
 import json
 import os
 import signal
@@ -291,7 +292,7 @@ def test_the_executor_holds_its_ack_deadline_against_a_trickling_arm(high_mu_run
 
     def trickle():
         conn, _ = listener.accept()
-        with conn:
+        with conn, contextlib.suppress(OSError):  # the executor hangs up when its deadline passes
             conn.makefile("rb").readline()
             for byte in encode({"type": "ready", "protocol": PROTOCOL, "arm": "x", "state": {}}):
                 time.sleep(0.1)

@@ -122,7 +122,7 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
 def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, quiet: bool) -> None:
     """Plan stable pushes from the task's start to its goal.
 
-    The planner is T-RRT* (paper section VI): it grows a tree of grasp poses joined by stable
+    The planner is T-RRT* (paper section V): it grows a tree of grasp poses joined by stable
     pushes, counts pusher switch-overs first and path length second, and stops at the first plan
     that reaches the goal within tolerance with at most --max-switches switch-overs, or at the
     time limit. The same task and seed give the same plan.
@@ -350,7 +350,7 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
 @click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,
               help="PNG to write. Default: <TASK file name>.<pusher>.cone.png in the current directory.")
 def cone(task_file: str, pusher: str, png_path) -> None:
-    """Draw a pusher's generalized friction cone in wrench space (paper figs. 5-6).
+    """Draw a pusher's generalized friction cone in wrench space (paper figs. 4-5).
 
     The cone is the conic hull of the wrenches of the edges n +- mu t of each of the pusher's contact
     points, in the object frame O; axes f_x, f_z (N) and tau_y / l (N), with l the torque length that

@@ -12,7 +12,7 @@ Gripper::Gripper(std::vector<Pad> pads, double grip_force, double mu, int pad_ri
   if (!(grip_force_ > 0.0)) throw std::invalid_argument("grip_force must be > 0");
   if (!(mu_ >= 0.0)) throw std::invalid_argument("mu must be >= 0");
   if (pad_rings_ < 0) throw std::invalid_argument("pad_rings must be >= 0");
-  // Uniform pressure: the grip force is spread evenly over the k points of each pad (paper V-C).
+  // Uniform pressure: the grip force is spread evenly over the k points of each pad (paper IV-A).
   const int k = 1 + 3 * pad_rings_ * (pad_rings_ + 1);  // 1 + sum_{i=1..rings} 6 i
   const double friction_limit = mu_ * grip_force_ / k;
   for (int p = 0; p < static_cast<int>(pads_.size()); ++p) {

@@ -1,4 +1,4 @@
-// The terms of the motion wrench (paper eq. 7), walked once for the double evaluation and again,
+// The terms of the motion wrench (paper eqs. 8-9), walked once for the double evaluation and again,
 // on the rare exact path, for the exact one. Private to the core.
 #pragma once
 

@@ -185,7 +185,7 @@ PushResult StablePushModel::check(const MotionWrench& load, const Pose& q, const
   return load.sticking.empty() ? all_sliding(cone, load, q, dq) : with_sticking(cone, load, q, dq);
 }
 
-// All pad points slide: w_pusher = w_motion is fixed; project it on the face normals (paper V-A).
+// All pad points slide: w_pusher = w_motion is fixed; project it on the face normals (paper IV-D).
 PushResult StablePushModel::all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q,
                                         const Motion& dq) const {
   PushResult result;
@@ -207,7 +207,7 @@ PushResult StablePushModel::all_sliding(const WrenchCone& cone, const MotionWren
 }
 
 // Some pad points stick: search their friction polytope for a force that puts w_pusher strictly
-// inside the cone (paper V-B): maximize t s.t. facet_i . (w - sum_g L_g f_g) <= -t, f_g in P_g.
+// inside the cone (paper IV-E): maximize t s.t. facet_i . (w - sum_g L_g f_g) <= -t, f_g in P_g.
 PushResult StablePushModel::with_sticking(const WrenchCone& cone, const MotionWrench& load, const Pose& q,
                                           const Motion& dq) const {
   const int groups = static_cast<int>(load.sticking.size());

@@ -86,12 +86,13 @@ class Replan:
 def _transits_held(task: Task, steps: Sequence[PlanStep], pusher: str) -> bool:
     """Whether the pads hold TRANSIT_HOLD_RATIO times the object's weight at every pose of `steps`
     where the pusher changes (the object travels between features there), `pusher` being the one
-    in contact at steps[0]."""
-    model = task.build_model()
+    in contact at steps[0]; with the task's uncertainty, at every corner of its box."""
+    models = task.corner_models()
     previous = pusher
     for before, step in zip(steps, steps[1:]):
         if step.pusher != previous:  # leaving `previous`'s feature: gravity in G as on that feature
-            if model.hold_ratio(pose_to_si(before.pose), task.pusher_index(previous)) < TRANSIT_HOLD_RATIO:
+            q, index = pose_to_si(before.pose), task.pusher_index(previous)
+            if min(m.hold_ratio(q, index) for m in models) < TRANSIT_HOLD_RATIO:
                 return False
         previous = step.pusher
     return True
@@ -118,7 +119,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
     if not result.solved:
         result = plan_task(base, time_limit=min(REPLAN_TIME_LIMIT, task.planner["time_limit"]))
         elapsed += result.stats["planning_time_s"]
-    steps = [PlanStep((w.x, w.z, w.theta), w.pusher) for w in result.waypoints] if result.solved else []
+    steps = result.steps if result.solved else []
     if steps and not _transits_held(task, steps, pusher):
         steps = []
     record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=bool(steps),

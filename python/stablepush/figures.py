@@ -3,7 +3,7 @@
 `plan_figure` draws, as the paper's fig. 1 does, snapshots of the object in the grasp along the
 plan (outline, pads, the active pusher thick and coloured, switch-overs marked) above x, z and
 theta against the step. `cone_figure` draws a pusher's generalized friction cone in wrench space
-(f_x, f_z, tau_y / l), as the paper's figs. 5-6 do; l is the torque length of the margin metric.
+(f_x, f_z, tau_y / l), as the paper's figs. 4-5 do; l is the torque length of the margin metric.
 """
 from __future__ import annotations
 

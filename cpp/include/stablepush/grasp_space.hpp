@@ -1,4 +1,4 @@
-// The planning problem as OMPL sees it (paper section VI, docs/model.md section 3), kept apart from
+// The planning problem as OMPL sees it (paper section V, docs/model.md section 3), kept apart from
 // the search: the space of grasp poses q = (x, z, theta), its metric in unit steps, the state
 // validity (grasp maintained), the motion validity (a stable push by some pusher, the grasp kept
 // throughout) and the goal region.

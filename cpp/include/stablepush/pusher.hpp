@@ -1,5 +1,5 @@
 // Pushers: environment features that stick to the object during a stable push. Each is fixed in O
-// for the whole push, so its generalized friction cone is computed once per task (paper section VI-A).
+// for the whole push, so its generalized friction cone is computed once per task (paper section V-A).
 #pragma once
 
 #include <string>
@@ -24,7 +24,7 @@ struct Pusher {
                             double mu, int n_points);
 
   /// The generators of its generalized friction cone in O: for every point, the wrenches of the
-  /// friction-cone edges n +- mu t (paper section V-A, "Generalized Friction Cone for a Pusher").
+  /// friction-cone edges n +- mu t (paper section IV-D, "Generalized Friction Cone for a Pusher").
   std::vector<Wrench> cone_generators() const;
 };
 

@@ -1,6 +1,6 @@
-// The stable prehensile push test (paper section V, docs/model.md section 2).
+// The stable prehensile push test (paper section IV, docs/model.md section 2).
 //
-// Quasi-dynamic balance over one step from rest (paper eq. 5, rearranged as eqs. 6 and 7):
+// Quasi-dynamic balance over one step from rest (paper eq. 5, rearranged as eqs. 8 and 9):
 //     w_pusher = M xi / dt - w_sliding fingers - w_gravity - w_sticking fingers,
 // all in O about O's origin. The push is stable for a pusher when some w_sticking in the
 // sticking points' friction polytope puts w_pusher in the relative interior of that pusher's
@@ -49,7 +49,7 @@ struct StickingGroup {
   double friction_limit;  ///< radius of the summed friction disc, sum of mu N / k [N]
 };
 
-/// The paper's net motion wrench: everything in eq. 7 that the motion fixes.
+/// The paper's net motion wrench: everything in eqs. 8-9 that the motion fixes.
 struct MotionWrench {
   /// M xi / dt - w_sliding - w_gravity in O about O's origin [N, N, N m].
   Wrench required = Wrench::Zero();

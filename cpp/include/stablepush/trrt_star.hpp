@@ -1,4 +1,4 @@
-// T-RRT* over grasp poses with the pusher in the search state (paper section VI, Algorithm 1).
+// T-RRT* over grasp poses with the pusher in the search state (paper section V-B, Algorithm 1).
 //
 // Each tree node is a grasp pose q together with the pusher that made the push into it, so that
 // the path cost (switch-overs first, then length in unit steps) is a sum over edges and RRT*'s
