@@ -86,13 +86,14 @@ class Replan:
 def _transits_held(task: Task, steps: Sequence[PlanStep], pusher: str) -> bool:
     """Whether the pads hold TRANSIT_HOLD_RATIO times the object's weight at every pose of `steps`
     where the pusher changes (the object travels between features there), `pusher` being the one
-    in contact at steps[0]; with the task's uncertainty, at every corner of its box."""
-    models = task.corner_models()
+    in contact at steps[0]. With the task's uncertainty the pads must also hold at least the
+    weight at every corner of its box: the box then says what the 1.5 stands in for."""
+    nominal, corners = task.build_model(), task.corner_models()
     previous = pusher
     for before, step in zip(steps, steps[1:]):
         if step.pusher != previous:  # leaving `previous`'s feature: gravity in G as on that feature
             q, index = pose_to_si(before.pose), task.pusher_index(previous)
-            if min(m.hold_ratio(q, index) for m in models) < TRANSIT_HOLD_RATIO:
+            if nominal.hold_ratio(q, index) < TRANSIT_HOLD_RATIO or any(m.hold_ratio(q, index) < 1.0 for m in corners):
                 return False
         previous = step.pusher
     return True
