@@ -76,7 +76,7 @@ def plan_to_csv(plan: PlanResult) -> str:
 def default_output(input_file: Union[str, Path], suffix: str) -> str:
     """The default output for an input file: its stem plus `suffix`, in the current directory.
     Derived from the file's own name (never from names inside it), so it cannot point elsewhere."""
-    stem = Path(input_file).name.split(".")[0] or "stablepush"
+    stem = Path(input_file).stem or "stablepush"
     return re.sub(r"[^\w.+-]", "_", stem + suffix)
 
 

@@ -487,7 +487,7 @@ def _validate(data: Any, source: Optional[str]) -> Task:
 
 def _default_name(source: Optional[str]) -> str:
     """A task without `name:` is named after its file (its stem), else "task"."""
-    stem = Path(source).name.split(".")[0] if source else ""
+    stem = Path(source).stem if source else ""
     return stem if stem and stem.isprintable() and len(stem) <= 100 else "task"
 
 
