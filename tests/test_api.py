@@ -85,3 +85,15 @@ def test_trajectory_command_writes_csv_and_json_in_either_quaternion_order(tmp_p
     assert doc["columns"][4:8] == ["qw", "qx", "qy", "qz"] and doc["rate_hz"] == 50
     bad = CliRunner().invoke(cli, ["trajectory", str(plan_file), "--task", str(task), "-o", str(tmp_path / "t.txt")])
     assert bad.exit_code == 2 and "must end in .csv or .json" in bad.stderr
+
+
+def test_figures_the_executor_and_trajectories_take_a_plan_or_its_waypoints():
+    from stablepush import figures
+    from stablepush.execution import as_steps
+    from stablepush.trajectory import timed_trajectory
+
+    task = sp.load_task(TASKS / "horizontal-offset-high-mu.yaml")
+    plan = sp.plan(task, seed=1)
+    assert as_steps(plan) == as_steps(plan.waypoints) == as_steps(plan.steps) == plan.steps
+    assert figures.plan_figure(task, plan.waypoints).axes  # the issue's `plan_figure(task, result.waypoints)`
+    assert len(timed_trajectory(task, plan)) == len(plan.trajectory(task))

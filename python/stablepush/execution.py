@@ -40,6 +40,14 @@ class PlanStep:
     pusher: Optional[str]
 
 
+def as_steps(plan) -> List[PlanStep]:
+    """The steps of a plan given as a `Plan`, or a sequence of its `Waypoint`s or of `PlanStep`s
+    (every entry point that carries a plan out or draws it takes any of them)."""
+    if hasattr(plan, "steps") and not isinstance(plan, (list, tuple)):
+        return list(plan.steps)
+    return [s if isinstance(s, PlanStep) else PlanStep((s.x, s.z, s.theta), s.pusher) for s in plan]
+
+
 @dataclass(frozen=True)
 class Feature:
     """A fixed feature of the world acting as pusher `pusher`: it touches the object along the

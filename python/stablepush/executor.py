@@ -20,8 +20,8 @@ import numpy as np
 
 from stablepush.arm_protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.closed_loop import ClosedLoop, Replan, replan
-from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, grasp_transform, place_features,
-                                  pose_to_matrix, scene_description)
+from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, as_steps, grasp_transform,
+                                  place_features, pose_to_matrix, scene_description)
 from stablepush import _core
 from stablepush.errors import ArmFault, PlanError
 from stablepush.plan_io import check_plan_dict
@@ -200,8 +200,8 @@ def execute_plan(
     each push is compared with the plan's and, past its threshold, the rest of the run is re-planned
     from the measured pose and spliced into the stream (`stablepush.closed_loop`); the world then
     holds a feature for every pusher of the task. `progress(waypoint, confirmed_step, total_steps)`
-    is called per ack."""
-    steps = list(steps)
+    is called per ack. `steps`: checked plan steps (plan_steps, or a Plan after Plan.check)."""
+    steps = as_steps(steps)
     features = place_features(task, steps, every_pusher=closed_loop is not None)
     scene = scene_description(task, features, steps[resume_from].pose)
     started = time.perf_counter()

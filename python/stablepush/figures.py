@@ -22,7 +22,7 @@ import numpy as np  # noqa: E402
 from matplotlib import animation  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-from stablepush.execution import PlanStep, contacts_of  # noqa: E402
+from stablepush.execution import PlanStep, as_steps, contacts_of  # noqa: E402
 from stablepush.plan_io import write_atomically  # noqa: E402
 from stablepush.task import Task  # noqa: E402
 
@@ -90,9 +90,11 @@ def _snapshots(steps: Sequence[PlanStep]) -> List[int]:
     return keys[:MAX_SNAPSHOTS] if len(keys) <= MAX_SNAPSHOTS else keys[:MAX_SNAPSHOTS - 1] + [keys[-1]]
 
 
-def plan_figure(task: Task, steps: Sequence[PlanStep], title: str = "", reaches_goal: bool = True):
-    """The plan in the grasp: snapshots above, x, z, theta against step below. The last snapshot
-    is labelled "goal", or "end" for a plan that does not reach it."""
+def plan_figure(task: Task, steps, title: str = "", reaches_goal: bool = True):
+    """The plan in the grasp: snapshots above, x, z, theta against step below. `steps`: a Plan,
+    its waypoints or PlanSteps. The last snapshot is labelled "goal", or "end" for a plan that
+    does not reach it."""
+    steps = as_steps(steps)
     keys = _snapshots(steps)
     switches = {c.first for c in contacts_of(steps)[1:]}
     fig = plt.figure(figsize=(2.3 * len(keys) + 0.5, 6.2))
@@ -134,8 +136,10 @@ def plan_figure(task: Task, steps: Sequence[PlanStep], title: str = "", reaches_
     return fig
 
 
-def save_plan_gif(task: Task, steps: Sequence[PlanStep], path: str, max_frames: int = 80) -> None:
-    """The plan animated, one frame per step (thinned to at most `max_frames`)."""
+def save_plan_gif(task: Task, steps, path: str, max_frames: int = 80) -> None:
+    """The plan animated, one frame per step (thinned to at most `max_frames`); `steps` as for
+    plan_figure."""
+    steps = as_steps(steps)
     fig, ax = plt.subplots(figsize=(4, 4))
     limits = _limits(task, steps)
     frames = sorted(set(np.linspace(0, len(steps) - 1, min(max_frames, len(steps))).round().astype(int)))

@@ -14,11 +14,11 @@ import io
 import json
 import math
 from dataclasses import dataclass
-from typing import List, Sequence
+from typing import List
 
 import numpy as np
 
-from stablepush.execution import PlanStep, arm_trajectory, place_features, scene_description
+from stablepush.execution import arm_trajectory, as_steps, place_features, scene_description
 from stablepush.task import Task
 
 QUATERNION_ORDERS = ("xyzw", "wxyz")  # xyzw: ROS (geometry_msgs/Quaternion); wxyz: the arm protocol, MuJoCo
@@ -75,8 +75,10 @@ class Trajectory:
             "columns": self.columns(quat), "rows": self.rows(quat)}, indent=None) + "\n"
 
 
-def timed_trajectory(task: Task, steps: Sequence[PlanStep], rate_hz: float = 100.0) -> Trajectory:
-    """The executor's stream for these plan steps, from G at the task's home pose."""
+def timed_trajectory(task: Task, steps, rate_hz: float = 100.0) -> Trajectory:
+    """The executor's stream for these plan steps (a checked Plan, or its steps), from G at the
+    task's home pose."""
+    steps = as_steps(steps)
     features = place_features(task, steps)
     start = scene_description(task, features, steps[0].pose)["gripper_pose"]
     points = arm_trajectory(task, steps, features, rate_hz, start)
