@@ -8,7 +8,6 @@ theta against the step. `cone_figure` draws a pusher's generalized friction cone
 from __future__ import annotations
 
 import io
-import math
 import os
 import tempfile
 from pathlib import Path
@@ -23,6 +22,7 @@ from matplotlib import animation  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from stablepush.execution import PlanStep, as_steps, contacts_of  # noqa: E402
+from stablepush.frames import in_gripper  # noqa: E402
 from stablepush.plan_io import write_atomically  # noqa: E402
 from stablepush.task import Task  # noqa: E402
 
@@ -30,26 +30,19 @@ MAX_SNAPSHOTS = 6
 PUSHER_COLOURS = plt.rcParams["axes.prop_cycle"].by_key()["color"]
 
 
-def _in_gripper(task: Task, pose: Sequence[float], points) -> np.ndarray:
-    """Points of O (mm) seen from G at pose (x mm, z mm, theta deg): p_G = (x, z) + R(theta) p_O."""
-    c, s = math.cos(math.radians(pose[2])), math.sin(math.radians(pose[2]))
-    p = np.asarray(points, float)
-    return np.column_stack([pose[0] + c * p[:, 0] + s * p[:, 1], pose[1] - s * p[:, 0] + c * p[:, 1]])
-
-
 def _colour(task: Task, pusher: str) -> str:
     return PUSHER_COLOURS[task.pusher_index(pusher) % len(PUSHER_COLOURS)]
 
 
 def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits) -> None:
-    outline = _in_gripper(task, pose, list(task.vertices) + [task.vertices[0]])
+    outline = in_gripper(pose, list(task.vertices) + [task.vertices[0]])
     ax.fill(outline[:, 0], outline[:, 1], color="0.85", zorder=1)
     ax.plot(outline[:, 0], outline[:, 1], color="0.25", lw=1.2, zorder=2)
     for (cx, cz), r in task.pads:
         ax.add_patch(plt.Circle((cx, cz), r, fill=False, ec="0.1", lw=1.0, ls="--", zorder=3))
     ax.plot([0], [0], "+", color="0.1", ms=6, zorder=3)
     for spec in task.pushers:
-        seg = _in_gripper(task, pose, [spec.a, spec.b])
+        seg = in_gripper(pose, [spec.a, spec.b])
         active = spec.name == pusher
         colour = _colour(task, spec.name) if active else "0.6"
         if spec.is_point:  # a segment of length 0 would draw nothing
@@ -59,7 +52,7 @@ def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits)
                     zorder=4 if active else 2)
     # O's x axis from its origin: the object's orientation (a symmetric outline looks alike turned).
     size = 0.3 * max(max(abs(v) for v in p) for p in task.vertices)
-    axis = _in_gripper(task, pose, [(0.0, 0.0), (size, 0.0)])
+    axis = in_gripper(pose, [(0.0, 0.0), (size, 0.0)])
     ax.annotate("", xy=axis[1], xytext=axis[0], zorder=5,
                 arrowprops={"arrowstyle": "->", "color": "0.15", "lw": 1.2})
     ax.set_title(title, fontsize=9)
@@ -70,7 +63,7 @@ def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits)
 
 
 def _limits(task: Task, steps: Sequence[PlanStep]):
-    pts = np.vstack([_in_gripper(task, s.pose, task.vertices) for s in steps])
+    pts = np.vstack([in_gripper(s.pose, task.vertices) for s in steps])
     pad = 5.0
     return ((pts[:, 0].min() - pad, pts[:, 0].max() + pad), (pts[:, 1].min() - pad, pts[:, 1].max() + pad))
 

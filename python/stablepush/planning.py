@@ -9,13 +9,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
+from typing import TYPE_CHECKING, Dict, List, Optional, Tuple
 
 import numpy as np
 
 from stablepush import _core
+from stablepush.frames import direction_in_gripper, in_gripper
 from stablepush.mechanics import CASE_NAMES
 from stablepush.task import MM, PLANNER_TUNING, Task, planner_limit, planner_parameter, pose_from_si, pose_to_si
+
+if TYPE_CHECKING:
+    from stablepush.execution import PlanStep
 
 OUTCOME_NAMES = {
     _core.PlanOutcome.goal_reached: "goal_reached",
@@ -142,15 +146,10 @@ PlanResult = Plan  # the name planning used before there was one plan type
 
 def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, pose_mm_deg) -> PusherContact:
     """Where pusher `pusher` touches the object, seen from G, when the object is at the pose."""
-    x, z, theta = pose_mm_deg
-    c, s = math.cos(math.radians(theta)), math.sin(math.radians(theta))
-
-    def to_g(p):  # p_G = (x, z) + R(theta) p_O  (docs/model.md section 1)
-        return (x + c * p[0] + s * p[1], z - s * p[0] + c * p[1])
-
     spec = task.pushers[pusher]
-    n = [float(v) for v in model.pushers[pusher].inward_normal]
-    return PusherContact(start=to_g(spec.a), end=to_g(spec.b), normal=(c * n[0] + s * n[1], -s * n[0] + c * n[1]))
+    start, end = (tuple(float(v) for v in p) for p in in_gripper(pose_mm_deg, [spec.a, spec.b]))
+    normal = direction_in_gripper(pose_mm_deg[2], model.pushers[pusher].inward_normal)
+    return PusherContact(start=start, end=end, normal=tuple(float(v) for v in normal))
 
 
 def plan_task(

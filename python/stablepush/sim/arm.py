@@ -15,7 +15,7 @@ from typing import Callable, Dict, Optional, Sequence
 import mujoco
 import numpy as np
 
-from stablepush.execution import matrix_to_pose, pose_to_matrix
+from stablepush.frames import matrix_to_pose, pose_to_matrix
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.friction import SlipSwitchedPadFriction
 

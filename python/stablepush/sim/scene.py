@@ -24,6 +24,8 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
+from stablepush.frames import quat_about_y
+
 ARM_XML = Path(__file__).with_name("arm.xml")
 ARM_JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6", "j7")
 FINGER_JOINTS = ("finger_pos", "finger_neg")
@@ -167,11 +169,6 @@ def _prism_inertia(polygon, thickness: float, mass: float, com) -> np.ndarray:
     mx, mz, mxz = density * sxx, density * szz, density * sxz
     my = mass * thickness**2 / 12
     return np.array([[my + mz, 0.0, -mxz], [0.0, mx + mz, 0.0], [-mxz, 0.0, mx + my]])
-
-
-def quat_about_y(angle: float) -> Tuple[float, float, float, float]:
-    """(w, x, y, z) of a right-handed rotation by `angle` rad about +y."""
-    return (math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0)
 
 
 def _fmt(values) -> str:
