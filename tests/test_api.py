@@ -8,7 +8,8 @@ from click.testing import CliRunner
 from conftest import TASKS
 
 import stablepush as sp
-from stablepush.execution import grasp_transform, place_features, pose_to_matrix
+from stablepush.execution import place_features
+from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush_cli.main import cli
 
 

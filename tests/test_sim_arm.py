@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from conftest import shipped, task_with
-from stablepush.execution import (PlanStep, arm_trajectory, grasp_transform, place_features, pose_to_matrix,
-                                  scene_description)
+from stablepush.execution import PlanStep, arm_trajectory, place_features, scene_description
+from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.sim.arm import SimArm
 from stablepush.sim.scene import convex_pieces
 
@@ -76,7 +76,7 @@ def test_ik_tracks_a_rotation_about_the_pads():
 
 
 def _pose(T):
-    from stablepush.execution import matrix_to_pose
+    from stablepush.frames import matrix_to_pose
 
     return matrix_to_pose(T)
 

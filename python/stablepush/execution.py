@@ -23,7 +23,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from stablepush import _core
-from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, rot_y, slerp, translation  # noqa: F401
+from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, rot_y, slerp, translation
 from stablepush.task import MM, Task, TaskError
 
 MOVE_SPEED = 0.1  # m/s of G between contacts

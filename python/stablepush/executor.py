@@ -20,8 +20,9 @@ import numpy as np
 
 from stablepush.arm_protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.closed_loop import ClosedLoop, Replan, replan
-from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, as_steps, grasp_transform,
-                                  place_features, pose_to_matrix, scene_description)
+from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, as_steps, place_features,
+                                  scene_description)
+from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush import _core
 from stablepush.errors import ArmFault, PlanError
 from stablepush.plan_io import check_plan_dict
