@@ -1,6 +1,6 @@
 """The friction-fidelity contract of the simulated arm as a table (README, "Friction fidelity"):
 the arm's contact setting against the contract's limits, and, with --stiff, the setting it
-replaced (pads that never switch to the soft friction reference).
+replaced (the solver's stiff friction on every pad point, sliding or not).
 
     python3 benchmarks/friction_fidelity.py [--stiff]
 """
@@ -17,7 +17,7 @@ TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--stiff", action="store_true", help="measure the stiff pad friction the arm used before")
+    parser.add_argument("--stiff", action="store_true", help="measure the solver's stiff pad friction alone (no pad point ever slides with explicit friction)")
     args = parser.parse_args()
     if args.stiff:
         friction.SLIDE_SPEED = float("inf")
@@ -45,6 +45,10 @@ def main() -> None:
         r = fidelity.pivot(task, "left", turn_deg=30)
         print(f"| pivoting, left pusher mu {mu} | {'stable' if stable else 'not stable'} | {r.moved_mm:.3f} "
               f"| {r.rotated_deg:+.3f} |", flush=True)
+    print()
+    r = fidelity.pivot_on_arm(pivoting)
+    print(f"Pivot on the arm, first {r.pushes} pushes of the pivoting plan: {r.error_mm:.3f} mm, {r.error_deg:+.3f} deg "
+          f"from the plan (limits {fidelity.ARM_PIVOT_LIMIT_MM} mm, {fidelity.ARM_PIVOT_LIMIT_DEG} deg), {r.steps_per_s:.0f} steps/s")
     print(f"\n{time.perf_counter() - started:.1f} s")
 
 

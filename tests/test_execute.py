@@ -57,7 +57,7 @@ def test_t_shape_end_to_end_through_two_switch_overs():
     with running_sim_arm(log=lambda text: None) as server:
         report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
     assert [c.pusher for c in report.contacts] == ["left", "under-web", "left"]
-    # 0.02 mm measured since the pads' friction is switched by slip (1.0 mm was allowed before)
+    # 0.09 mm measured with Coulomb friction on the sliding pad points (1.0 mm was allowed before they slid right)
     assert report.final_error["distance"] < FINAL_BOUND_MM and abs(report.final_error["theta"]) < FINAL_BOUND_DEG
 
 
@@ -260,13 +260,13 @@ def test_world_deviations_need_the_simulated_arm(tmp_path):
 
 
 def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
-    """The T in a world whose pads and features have 15% less mu than the task says: open loop it
-    ends 0.56 mm from the goal (README); closed loop it re-plans from the tracked pose and ends
-    within the final tolerance of the goal."""
+    """The low-mu offset in a world whose pads and features have 15% less mu than the task says:
+    open loop its pusher slips and it ends 1.2 mm from the goal (README); closed loop it re-plans
+    from the tracked pose and ends within the final tolerance of the goal."""
     from stablepush.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
 
-    task = shipped("t-shaped")
+    task = shipped("horizontal-offset-low-mu")
     steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
     loop = ClosedLoop.for_task(task)
     with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=0.85)) as server:

@@ -20,8 +20,8 @@ def test_a_wall_holds_the_box_while_the_pads_slide_over_it(load, pad_speed):
 
 
 def test_stiff_pad_friction_alone_fails_the_contract(monkeypatch):
-    """The setting the arm used before: pads that never switch to the soft reference drop their
-    contacts while sliding and the wall creeps ~37 um/mm. The contract catches it."""
+    """The solver's stiff friction on every pad point, sliding or not (the arm's first setting):
+    sliding pads drop their contacts and the wall creeps ~37 um/mm. The contract catches it."""
     monkeypatch.setattr(friction, "SLIDE_SPEED", float("inf"))
     result = fidelity.wall_creep(0.5, 0.01, travel=0.004)
     assert result.creep_um_per_mm > 10 * fidelity.CREEP_LIMIT_UM_PER_MM[0.5]
@@ -51,3 +51,13 @@ def test_a_pivot_the_model_calls_unstable_slips_at_the_pusher():
     assert not check_push(task, (0, 0, 0), (0, 0, 1), "left")["left"]["feasible"]
     result = fidelity.pivot(task, "left", turn_deg=30)
     assert abs(result.rotated_deg) > 5 * fidelity.PIVOT_LIMIT_DEG, result
+
+
+def test_a_pivot_by_the_servo_driven_arm_follows_its_plan():
+    """The rig's hand is infinitely stiff; the arm's is not. On the arm, with its servos, IK and the
+    executor's stream, the first 30 degrees of the pivoting plan must still turn about the stuck pad
+    centre (with the sliding ring points' friction a few degrees off their slip it lost 0.5 deg here)."""
+    result = fidelity.pivot_on_arm(shipped("pivoting"))
+    assert result.pushes == fidelity.ARM_PIVOT_PUSHES
+    assert result.error_mm <= fidelity.ARM_PIVOT_LIMIT_MM, result
+    assert abs(result.error_deg) <= fidelity.ARM_PIVOT_LIMIT_DEG, result

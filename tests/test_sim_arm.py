@@ -39,7 +39,7 @@ def _ledge_force(task, speed=0.01, duration=1.0):
 
 @pytest.mark.parametrize("grip_force, mu", [
     (10.0, 0.425), (10.0, 0.6), (5.0, 0.3),
-    (20.0, 0.8),  # chattered (16% high) before the pads' friction was switched by slip (sim/friction.py)
+    (20.0, 0.8),  # chattered (16% high) before sliding pad points got Coulomb friction (sim/friction.py)
 ])
 def test_ledge_force_to_slide_the_held_object_is_coulombs(grip_force, mu):
     def edit(data):

@@ -17,7 +17,7 @@ import numpy as np
 
 from stablepush.frames import matrix_to_pose, pose_to_matrix
 from stablepush.sim import scene as scene_mod
-from stablepush.sim.friction import SlipSwitchedPadFriction
+from stablepush.sim.friction import CoulombPadFriction
 
 IK_DAMPING = 1e-4  # DLS damping lambda^2 [m^2]
 IK_ITERATIONS = 50
@@ -62,7 +62,7 @@ def _scaled_friction(scene: dict, scale: float) -> dict:
 class SimulatedGrasp:
     """A scene's grasp in MuJoCo, shared by the arm and the friction-fidelity rig (`fidelity.py`):
     the model (`scene.build_mjcf`), the jaws closed on the object with the grip force, the pad
-    friction switch stepped with the physics, and the read-outs of the grasp."""
+    friction (friction.py) stepped with the physics, and the read-outs of the grasp."""
 
     def __init__(self, scene: dict, kinematic_hand: bool = False):
         self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, kinematic_hand=kinematic_hand))
@@ -71,7 +71,7 @@ class SimulatedGrasp:
         self._site = m.site(scene_mod.GRIPPER_SITE).id
         self._object = m.body(scene_mod.OBJECT_BODY).id
         self._object_qpos = m.jnt_qposadr[m.joint(scene_mod.OBJECT_BODY).id]
-        self.pad_friction = SlipSwitchedPadFriction(m, scene_mod.pad_geoms(m))
+        self.pad_friction = CoulombPadFriction(m, scene_mod.pad_geoms(m))
         self.steps = 0
         self.step_wall_time = 0.0
         self.data.qpos[[m.jnt_qposadr[m.joint(j).id] for j in scene_mod.FINGER_JOINTS]] = scene["object"]["thickness"] / 2

@@ -1,4 +1,4 @@
-"""Pad friction in MuJoCo that slides and sticks as Coulomb's law says (README, "Friction
+"""Pad friction in MuJoCo that sticks and slides as Coulomb's law says (README, "Friction
 fidelity").
 
 Why the pads need this. MuJoCo's contact model is convex: a contact that slides with its friction
@@ -6,47 +6,64 @@ on the cone's boundary also gets a separating normal velocity of about mu |v_sli
 with a capped force, so while the pads slide over the object they are pushed apart at ~5 mm/s
 (mu 0.45, 10 mm/s), lose every pad contact for one time step every ~2.75 ms, and the object, held
 for that step by nothing, creeps along the feature that should hold it (37 um per mm pushed).
-A soft friction reference (`solreffriction`, time constant SLIDING_SOLREFFRICTION[0] s) keeps a
-sliding pad on its cone without the separation, and its friction within 0.1% of mu N; but a pad
-that must stick under load then creeps. So each pad point chooses its friction reference by its
-own slip speed, measured by the simulator from its own state (never told by the plan): soft once
-it has slid faster than SLIDE_SPEED for SLIDE_STEPS steps, stiff again once it is slower than
-STICK_SPEED. The gap between the two thresholds (hysteresis) keeps a point from chattering.
+A soft friction reference (`solreffriction` 30 ms) avoided the separation but turned a sliding
+point's friction 1.3-4.7 deg off its slip, and the pivot's twelve sliding ring points then pushed
+its sticking pad centre 1.3 deg along (issue 9). Even the stiff solver's friction on a sliding
+pivot ring point is ~5 deg off the slip it produces.
+
+So a sliding pad point gets Coulomb's friction from us: mu N, opposite the slip at the end of the
+step (backward Euler, as an implicit solver would), with its contact made frictionless for that
+step (no cone, so no separation). The direction is found by trial steps on a scratch copy of the
+state: apply mu N along d, step, and compare d with the slip it produced; move d halfway toward
+the opposite of that slip and try again, until they agree within DIRECTION_TOLERANCE. Halving
+matters: explicit friction on a slow slip (one 0.25 ms step of 15 N changes a hand's speed by
+mm/s) would otherwise flip its direction every step and chatter. A sliding point whose trial slip
+turns against its friction or falls under STICK_SPEED sticks instead. In a steady slide the last
+step's direction passes at once, so sliding costs one trial step per step.
+
+Which points may slide is decided from their own slip, measured by the simulator from its own
+state (never told by the plan): a point that has slipped faster than SLIDE_SPEED for SLIDE_STEPS
+steps is a candidate; a candidate that did not slide in the last step slides if, in a step with
+every pad contact's friction left to the solver (stiff, implicit), its friction is on its cone and
+it still slips. Every other point keeps the solver's stiff friction, which is what keeps a loaded
+sticking pad in place.
 """
 from __future__ import annotations
 
-from typing import Dict, List, Sequence
+from typing import Sequence
 
+import mujoco
 import numpy as np
 
-SLIDING_SOLREFFRICTION = (0.03, 1.0)  # time constant s, damping ratio: friction of a sliding pad point
-STICKING_SOLREFFRICTION = (0.0, 0.0)  # MuJoCo's "same as the contact's solref": stiff
-SLIDE_SPEED = 5e-4  # m/s: a sticking pad point whose slip exceeds this starts to slide
+SLIDE_SPEED = 5e-4  # m/s: a pad point slipping faster than this (SLIDE_STEPS steps running) may slide
 STICK_SPEED = 1e-4  # m/s: a sliding pad point whose slip falls below this sticks again
-# Consecutive time steps (1 ms) above SLIDE_SPEED before a point counts as sliding: the arm's jolt
-# at the start of a push makes a sticking pad centre slip for a step or two, and switched to the
-# soft reference it then drifts (the pivot lost 3.6 deg with 1 step, 1.9 deg with 4). Longer waits
-# outlast the ~11 steps between the drop-outs of a stiff sliding pad and never switch it.
+# Consecutive time steps above SLIDE_SPEED before a point may slide: the arm's jolt at the start of
+# a push makes a sticking pad centre slip for a step or two.
 SLIDE_STEPS = 4
+ON_CONE = 0.99  # |friction| / (mu N) in the solver's step from which a contact counts as sliding
+DIRECTION_TOLERANCE_DEG = 0.5  # friction vs the opposite of the slip it produces, at the end of a step
+MAX_TRIALS = 8  # trial steps per time step; the last trial's direction is taken if none agrees
+FRICTIONLESS_MU = 1e-5  # MuJoCo's least friction coefficient (mjMINMU): the contact of a sliding point
 
 
-class SlipSwitchedPadFriction:
-    """Per pad point, the friction reference of its contact pairs, switched by its slip speed.
+class CoulombPadFriction:
+    """Per pad point, stick by the solver or slide with Coulomb friction we apply (module docstring).
 
     `pad_geoms` are the ids of the pad point geoms; every explicit contact pair that holds one of
-    them is switched with it. Call `update(data)` before each `mj_step`: it reads the slip of the
-    previous step's pad contacts (the tangential rows of `efc_vel`, m/s; the cones are elliptic, so
-    those rows are the contact frame's tangents) and writes `model.pair_solreffriction`.
+    them is switched with it. Call `update(data)` before each `mj_step`, after the step's drives
+    are set: it writes `model.pair_friction` of the pad pairs and `data.qfrc_applied` (which it
+    owns: nothing else in the simulated arm applies forces) with the sliding points' friction,
+    sum of J_t^T f_t with f_t = mu N d [N], d the unit friction direction in the contact's tangent plane.
     """
 
     def __init__(self, model, pad_geoms: Sequence[int]):
         self.model = model
-        slot_of_geom: Dict[int, int] = {int(g): k for k, g in enumerate(pad_geoms)}
+        n_points = len(pad_geoms)
+        slot_of_geom = {int(g): k for k, g in enumerate(pad_geoms)}
         self._slot_of_geom = np.full(model.ngeom, -1, dtype=int)
         for geom, slot in slot_of_geom.items():
             self._slot_of_geom[geom] = slot
-        pairs: List[int] = []
-        pair_slots: List[int] = []
+        pairs, pair_slots = [], []
         for i in range(model.npair):
             for geom in (model.pair_geom1[i], model.pair_geom2[i]):
                 if geom in slot_of_geom:
@@ -54,34 +71,203 @@ class SlipSwitchedPadFriction:
                     pair_slots.append(slot_of_geom[geom])
         self._pairs = np.array(pairs, dtype=int)
         self._pair_slots = np.array(pair_slots, dtype=int)
-        self.sliding = np.zeros(len(pad_geoms), dtype=bool)
-        self._fast_steps = np.zeros(len(pad_geoms), dtype=int)
-        self._sliding_ref = np.array(SLIDING_SOLREFFRICTION)
-        self._sticking_ref = np.array(STICKING_SOLREFFRICTION)
-        self._apply()
+        self._mu = model.pair_friction[self._pairs, :2].copy()  # the task's (and world's) pad mu
+        self._point_mu = np.zeros(n_points)
+        self._point_mu[self._pair_slots] = self._mu[:, 0]
+        self._scratch = mujoco.MjData(model)
+        self._state_kind = mujoco.mjtState.mjSTATE_INTEGRATION
+        self._state = np.zeros(mujoco.mj_stateSize(model, self._state_kind))
+        self.slipping = np.zeros(n_points, dtype=bool)  # candidates, by their own slip speed
+        self.sliding = np.zeros(n_points, dtype=bool)  # sliding with our friction in the last step
+        self._direction = np.zeros((n_points, 3))  # unit friction on the object in the world, per sliding point
+        self._fast_steps = np.zeros(n_points, dtype=int)
+        self.solver_steps = 0  # scratch steps with the solver's friction, deciding new sliders
+        self.trial_steps = 0  # scratch steps finding the friction's direction
+        self._set_frictionless(self.sliding)
 
     def update(self, data) -> None:
+        contacts = _PadContacts(self, data)
+        # Candidates from the previous step's slip (the tangential rows of efc_vel, m/s: the cones are
+        # elliptic, so those rows are the contact frame's tangents). A point touching the object through
+        # several convex pieces slips if any of them does; a point that touches nothing does not.
+        slip = np.hypot(data.efc_vel[contacts.rows + 1], data.efc_vel[contacts.rows + 2])
+        fast = contacts.count(slip > SLIDE_SPEED) > 0
+        slow = contacts.count(slip >= STICK_SPEED) == 0
+        self._fast_steps = np.where(fast, self._fast_steps + 1, 0)
+        self.slipping = contacts.touched & ((self._fast_steps >= SLIDE_STEPS) | (self.slipping & ~slow))
+        data.qfrc_applied[:] = 0.0
+        sliding = self.sliding & self.slipping
+        if self.slipping.any():
+            mujoco.mj_getState(self.model, data, self._state, self._state_kind)
+            # N of each pad contact in the previous step, where a sliding contact had no cone to skew it
+            normal = contacts.normal_by_key()
+            solver = None
+            if (self.slipping & ~sliding).any():
+                solver = self._solver_step()
+                sliding |= self._new_sliders(solver, self.slipping & ~sliding)
+            if sliding.any():
+                sliding = self._coulomb_friction(data, sliding, normal, solver if solver is not None else contacts)
+        if (sliding != self.sliding).any() or self.slipping.any():
+            self._set_frictionless(sliding)  # a scratch step may have changed the pairs
+        self.sliding = sliding
+
+    def _solver_step(self) -> "_PadContacts":
+        """The step from the current state with every pad contact's friction left to the solver."""
+        s = self._scratch
+        self._set_frictionless(np.zeros_like(self.sliding))
+        mujoco.mj_setState(self.model, s, self._state, self._state_kind)
+        s.qfrc_applied[:] = 0.0
+        mujoco.mj_step(self.model, s)
+        self.solver_steps += 1
+        return _PadContacts(self, s)
+
+    def _new_sliders(self, solver: "_PadContacts", new: np.ndarray) -> np.ndarray:
+        """Which `new` candidates slide in the solver's step (all their contacts on the cone and
+        slipping at its end); their friction direction starts from the solver's."""
+        s = self._scratch
+        mu = self._point_mu[solver.slots]
+        on_cone = np.hypot(s.efc_force[solver.rows + 1], s.efc_force[solver.rows + 2]) >= ON_CONE * mu * s.efc_force[solver.rows]
+        slip = np.linalg.norm(solver.tangential(solver.end_velocity()), axis=1)
+        slides = on_cone & (slip >= STICK_SPEED)
+        sliding = new & (solver.count(~slides) == 0) & solver.touched
+        friction = solver.tangential(s.efc_force)
+        take = sliding[solver.slots]
+        self._direction[solver.slots[take]] = _unit(friction[take])
+        return sliding
+
+    def _coulomb_friction(self, data, sliding: np.ndarray, normal, at: "_PadContacts") -> np.ndarray:
+        """Find each sliding point's friction direction by trial steps (module docstring), write the
+        friction into data.qfrc_applied and return the points that slide."""
+        m, s = self.model, self._scratch
+        history = None  # (directions, residual) of the last trial, for the Anderson step
+        for _ in range(MAX_TRIALS):
+            take = sliding[at.slots]
+            qfrc = at.generalized_force(take, self._friction(at, take, normal))
+            self._set_frictionless(sliding)
+            mujoco.mj_setState(m, s, self._state, self._state_kind)
+            s.qfrc_applied[:] = qfrc
+            mujoco.mj_step(m, s)
+            self.trial_steps += 1
+            trial = _PadContacts(self, s)
+            sliding = sliding & trial.touched  # a point that touches nothing has no friction
+            v_end = trial.tangential(trial.end_velocity())
+            in_trial = sliding[trial.slots]
+            speed = np.linalg.norm(v_end, axis=1)
+            opposite = -v_end / np.maximum(speed, 1e-12)[:, None]
+            agree = (self._direction[trial.slots] * opposite).sum(1)
+            # our friction turned the slip back, or stopped it: the point sticks (the solver's friction)
+            sticks = in_trial & ((agree <= 0) | (speed < STICK_SPEED))
+            at = trial
+            if sticks.any():
+                sliding = sliding & (trial.count(sticks) == 0)
+                history = None
+            if not sliding.any():
+                return sliding
+            if sticks.any():
+                continue
+            if agree[in_trial].min() >= np.cos(np.radians(DIRECTION_TOLERANCE_DEG)):
+                break
+            points = trial.slots[in_trial]
+            history = self._next_directions(points, opposite[in_trial], history)
+        take = sliding[at.slots]
+        data.qfrc_applied[:] = at.generalized_force(take, self._friction(at, take, normal))
+        return sliding
+
+    def _next_directions(self, points: np.ndarray, opposite: np.ndarray, history):
+        """Move the directions of `points` toward `opposite` (the opposite of the slip each produced):
+        a fixed-point problem d = F(d). All points ride one object and one hand, so their slips answer
+        together and a plain step can overshoot (on the large manipulation a turn of d by 1 deg turned
+        the slip by -3 deg, and averaging cycled); one Anderson step (the secant over the last two
+        trials, all points at once) takes that gain out. Returns the history for the next call."""
+        d = self._direction[points].ravel()
+        residual = opposite.ravel() - d
+        if history is not None and history[0].shape == d.shape:
+            dd, dr = d - history[0], residual - history[1]
+            denominator = dr @ dr
+            gamma = (dr @ residual) / denominator if denominator > 0 else 0.0
+            step = residual - gamma * (dd + dr)
+        else:
+            step = 0.5 * residual
+        self._direction[points] = _unit((d + step).reshape(-1, 3))
+        return d, residual
+
+    def _friction(self, at: "_PadContacts", take: np.ndarray, normal) -> np.ndarray:
+        """mu N d of `at`'s contacts `take` (world vectors, N), d in each contact's tangent plane."""
+        points = at.slots[take]
+        return (self._point_mu[points] * normal(at, take))[:, None] * at.in_tangent_plane(take, self._direction[points])
+
+    def _set_frictionless(self, sliding: np.ndarray) -> None:
+        mu = self._mu.copy()
+        mu[sliding[self._pair_slots]] = FRICTIONLESS_MU
+        self.model.pair_friction[self._pairs, :2] = mu
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.maximum(np.linalg.norm(v, axis=1), 1e-12)[:, None]
+
+
+class _PadContacts:
+    """The pad contacts of an MjData after its step (so its contacts, efc_J and efc_force belong to
+    the state the step started from, and qvel to the state it ended in): per contact its pad point
+    (slot), first constraint row, geom-pair key and tangent directions.
+
+    Tangential vectors are in the world, with the sign convention of the contact frame's rows (the
+    one in which J maps generalized velocities to contact velocities and friction dissipates)."""
+
+    def __init__(self, friction: CoulombPadFriction, data):
+        self.model, self.data = friction.model, data
         n = data.ncon
         geoms = data.contact.geom[:n]
-        slots = np.maximum(self._slot_of_geom[geoms[:, 0]], self._slot_of_geom[geoms[:, 1]])
+        slots = np.maximum(friction._slot_of_geom[geoms[:, 0]], friction._slot_of_geom[geoms[:, 1]])
         rows = data.contact.efc_address[:n]
-        keep = (slots >= 0) & (rows >= 0)
-        slots, rows = slots[keep], rows[keep]
-        slip = np.hypot(data.efc_vel[rows + 1], data.efc_vel[rows + 2])
-        # A point touching the object through several convex pieces slides if any of them does;
-        # a point that touches nothing does not slide.
-        touched = np.zeros_like(self.sliding)
-        fast = np.zeros_like(self.sliding)
-        slow = np.ones_like(self.sliding)
-        touched[slots] = True
-        np.logical_or.at(fast, slots, slip > SLIDE_SPEED)
-        np.logical_and.at(slow, slots, slip < STICK_SPEED)
-        self._fast_steps = np.where(fast, self._fast_steps + 1, 0)
-        sliding = touched & ((self._fast_steps >= SLIDE_STEPS) | (self.sliding & ~slow))
-        if (sliding != self.sliding).any():
-            self.sliding = sliding
-            self._apply()
+        index = np.nonzero((slots >= 0) & (rows >= 0))[0]
+        self.slots, self.rows = slots[index], rows[index]
+        self.keys = geoms[index, 0] * self.model.ngeom + geoms[index, 1]
+        frames = data.contact.frame[index].reshape(-1, 3, 3)
+        self._t1, self._t2 = frames[:, 1], frames[:, 2]
+        self._n_points = len(friction.slipping)
+        self.touched = self.count(np.ones(len(self.slots))) > 0
 
-    def _apply(self) -> None:
-        on = self.sliding[self._pair_slots][:, None]
-        self.model.pair_solreffriction[self._pairs] = np.where(on, self._sliding_ref, self._sticking_ref)
+    def count(self, flags: np.ndarray) -> np.ndarray:
+        """How many of each pad point's contacts have `flags`."""
+        return np.bincount(self.slots, weights=flags, minlength=self._n_points)
+
+    def tangential(self, per_row: np.ndarray) -> np.ndarray:
+        """The tangential rows of a constraint-space vector as world vectors, one per contact."""
+        return per_row[self.rows + 1][:, None] * self._t1 + per_row[self.rows + 2][:, None] * self._t2
+
+    def in_tangent_plane(self, take: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+        """World unit `vectors` projected on the tangent planes of these contacts `take`, made unit again."""
+        t1, t2 = self._t1[take], self._t2[take]
+        return _unit((vectors * t1).sum(1)[:, None] * t1 + (vectors * t2).sum(1)[:, None] * t2)
+
+    def end_velocity(self) -> np.ndarray:
+        """J qvel: each constraint row's velocity at the end of the step [m/s]."""
+        velocity = np.zeros(self.data.nefc)
+        mujoco.mj_mulJacVec(self.model, self.data, velocity, self.data.qvel)
+        return velocity
+
+    def normal_by_key(self):
+        """N of each of these contacts, to look up by geom pair: `normal(at, take)` gives N of
+        `at`'s contacts `take`, from here where the pair was in contact, else from `at` itself."""
+        order = np.argsort(self.keys)
+        keys, forces = self.keys[order], self.data.efc_force[self.rows[order]]
+
+        def normal(at: "_PadContacts", take: np.ndarray) -> np.ndarray:
+            wanted = at.keys[take]
+            found = at.data.efc_force[at.rows[take]].copy()
+            if len(keys):
+                i = np.minimum(np.searchsorted(keys, wanted), len(keys) - 1)
+                hit = keys[i] == wanted
+                found[hit] = forces[i[hit]]
+            return found
+        return normal
+
+    def generalized_force(self, take: np.ndarray, force: np.ndarray) -> np.ndarray:
+        """J^T of tangential world vectors `force` on these contacts `take` [N -> generalized]."""
+        per_row = np.zeros(self.data.nefc)
+        per_row[self.rows[take] + 1] = (force * self._t1[take]).sum(1)
+        per_row[self.rows[take] + 2] = (force * self._t2[take]).sum(1)
+        out = np.zeros(self.model.nv)
+        mujoco.mj_mulJacTVec(self.model, self.data, out, per_row)
+        return out

@@ -7,8 +7,9 @@ Contact settings that keep friction honest (the simulation's results rest on the
 - elliptic friction cones with impratio 100, so sticking contacts do not creep;
 - noslip iterations, which remove the residual slip of MuJoCo's soft constraints;
 - a small solref time constant (stiff contacts, 4 time steps);
-- pad friction whose reference is switched per pad point by its own slip (`friction.py`): stiff
-  while it sticks, soft while it slides, which removes the pads' drop-outs while they slide;
+- pad friction chosen per pad point by its own slip (`friction.py`): the solver's stiff friction
+  while it sticks, explicit Coulomb friction (mu N opposite its slip) while it slides, which
+  removes the pads' drop-outs while they slide;
 - each pad is a disc of point contacts laid out as the task's `pad_rings` says, so the simulated
   pad's force acts where the model's does (README, "The mechanics");
 - only the object touches pads and features (explicit contact pairs with the task's friction);
