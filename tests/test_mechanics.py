@@ -119,14 +119,18 @@ def point_pusher_task(at, mu=0.5):
     return task_with("horizontal-offset-low-mu", edit)
 
 
-def test_point_pusher_cone_is_a_wedge_and_in_plane_pushes_are_decided_exactly():
+def test_point_pusher_cone_is_a_wedge_and_in_plane_pushes_are_stable():
     task = point_pusher_task([-50, 0])
     model = task.build_model()
     assert model.pusher_cones[0].dimension == 2
-    # Pushing along x through the centre: the motion wrench (F, 0, 0) lies exactly in the wedge's
-    # plane only in exact arithmetic (the pad points' torques cancel by symmetry).
+    # Pushing along x through the centre: the motion wrench (F, 0, 0) lies in the wedge's plane
+    # (the pad points' torques cancel by symmetry, to rounding), inside its two friction edges.
     r = model.check((0, 0, 0), (1 * MM, 0, 0), 0)
-    assert r.feasible and r.exact
+    assert r.feasible and r.margin > 0
+    # The plane is met within the certification band of the loads (docs/model.md section 2); a
+    # turn of 1e-3 deg per mm off it leaves a torque the point cannot give.
+    tilted = model.check((0, 0, 0), (1 * MM, 0, math.radians(1e-3)), 0)
+    assert not tilted.feasible and tilted.margin < 0
     # The same pusher 5 mm off the axis would need torque 5 mm x F: not stable, and certain.
     off = point_pusher_task([-50, 5]).build_model().check((0, 0, 0), (1 * MM, 0, 0), 0)
     assert not off.feasible and off.margin < 0

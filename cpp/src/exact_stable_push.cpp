@@ -47,12 +47,9 @@ PushResult StablePushModel::exact_all_sliding(const WrenchCone& cone, const Moti
   visit_motion_terms(q, dq, load.gravity, loads);
   const ExactWrench required = exact_required(loads, load.rotation);
   answer.exact = true;
-  answer.feasible = cone.contains_in_relative_interior(required);
-  for (const ExactWrench& e : cone.exact_equalities())
-    if (!CGAL::is_zero(e * required)) {  // off the span by less than the band
-      answer.margin = -cone.distance_to_span(load.required);
-      break;
-    }
+  // The caller found the wrench within the certification band of the cone's span (all_sliding):
+  // the facets decide, and they measure its projection onto the span.
+  answer.feasible = cone.strictly_inside_facets(required);
   return answer;
 }
 

@@ -126,9 +126,7 @@ double WrenchCone::distance_to_span(const Wrench& w) const {
   return distance;
 }
 
-bool WrenchCone::contains_in_relative_interior(const ExactWrench& w) const {
-  for (const ExactWrench& e : exact_equalities_)
-    if (!CGAL::is_zero(e * w)) return false;
+bool WrenchCone::strictly_inside_facets(const ExactWrench& w) const {
   for (const ExactWrench& f : exact_facets_)
     if (!CGAL::is_negative(f * w)) return false;
   return true;

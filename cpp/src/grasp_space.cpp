@@ -6,6 +6,7 @@
 #include <ompl/util/Exception.h>
 
 #include <cmath>
+#include <iterator>
 
 namespace stablepush {
 
@@ -85,6 +86,72 @@ StablePushValidator::StablePushValidator(const ob::SpaceInformationPtr& si, Mode
   const int n = static_cast<int>(models_.front()->pushers().size());
   if (n < 1 || n > kMaxPushers) throw std::invalid_argument("a task has between 1 and 32 pushers");
   all_ = n == kMaxPushers ? ~PusherSet{0} : ((PusherSet{1} << n) - 1u);
+  for (int p = 0; p < n; ++p)
+    if (models_.front()->pusher_cones()[p].dimension() == 2) wedges_ |= PusherSet{1} << p;
+}
+
+std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction,
+                                                            double length, int pusher) const {
+  if (!contains(wedges_, pusher)) return std::nullopt;
+  const double heading_norm = std::hypot(direction[0], direction[1]);
+  if (!(heading_norm > 1e-9 * direction.norm())) return std::nullopt;
+  const double hx = direction[0] / heading_norm, hz = direction[1] / heading_norm;
+  const StablePushModel& model = *models_.front();
+  const Wrench& plane_normal = model.pusher_cones()[pusher].equality_rows().front();
+  const auto motion = [&](double beta) {
+    return space_.from_unit_steps(length * Eigen::Vector3d(std::cos(beta) * hx, std::cos(beta) * hz, std::sin(beta)));
+  };
+  const auto off_plane = [&](double beta) {
+    return plane_normal.dot(model.motion_wrench(a, motion(beta), pusher).required);
+  };
+  // The grid in beta [deg], finer toward pure rotation, where a peg's roots crowd (a motion whose
+  // translation is small against its rotation in unit steps).
+  static constexpr double kGridDeg[] = {-89.95, -89.5, -88, -85, -80, -70, -60, -50, -40, -30, -20, -10, 0,
+                                        10,     20,    30,  40,  50,  60,  70,  80,  85,  88,  89.5, 89.95};
+  const double beta0 = std::atan2(direction[2], heading_norm);
+  std::optional<double> best;
+  double below = kGridDeg[0] * M_PI / 180.0, f_below = off_plane(below);
+  for (std::size_t i = 1; i < std::size(kGridDeg); ++i) {
+    const double above = kGridDeg[i] * M_PI / 180.0, f_above = off_plane(above);
+    if ((f_below <= 0.0) != (f_above <= 0.0)) {
+      // Regula falsi with the Illinois rule, to rounding.
+      double lo = below, hi = above, f_lo = f_below, f_hi = f_above;
+      int kept = 0;  // which end was kept last: -1 lo, +1 hi
+      for (int k = 0; k < 60; ++k) {
+        double mid = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+        if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+        if (!(mid > lo && mid < hi)) break;  // lo and hi are adjacent doubles
+        const double f_mid = off_plane(mid);
+        if (f_mid == 0.0) {
+          lo = hi = mid;
+          f_lo = f_hi = 0.0;
+          break;
+        }
+        if ((f_mid < 0.0) == (f_lo < 0.0)) {
+          lo = mid;
+          f_lo = f_mid;
+          if (kept == -1) f_hi *= 0.5;
+          kept = -1;
+        } else {
+          hi = mid;
+          f_hi = f_mid;
+          if (kept == 1) f_lo *= 0.5;
+          kept = 1;
+        }
+        if (hi - lo <= 1e-15) break;
+      }
+      const double root = std::abs(off_plane(lo)) <= std::abs(off_plane(hi)) ? lo : hi;
+      // A sign change across a jump (a pad point's slip reversing) is not a root.
+      const MotionWrench load = model.motion_wrench(a, motion(root), pusher);
+      const bool on_plane = std::abs(plane_normal.dot(load.required)) <= kCertificationBand * load.scale;
+      if (on_plane && (!best || std::abs(root - beta0) < std::abs(*best - beta0))) best = root;
+    }
+    below = above;
+    f_below = f_above;
+  }
+  if (!best) return std::nullopt;
+  const Motion dq = motion(*best);
+  return Pose{a.x + dq.x, a.z + dq.z, a.theta + dq.theta};
 }
 
 PusherSet StablePushValidator::stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const {

@@ -197,12 +197,16 @@ PushResult StablePushModel::all_sliding(const WrenchCone& cone, const MotionWren
     result.margin = -off_span;
     return result;
   }
+  // Within the band of a lower-dimensional cone's span (a point pusher's wedge plane) the wrench
+  // counts as on it: a point pusher's stable motions form a surface (the planner finds them by a
+  // root in the rotation, StablePushValidator::onto_wedge_surface), and a motion on it, given in
+  // doubles, misses the plane by rounding; what it leaves is 1e-9 of the push's loads. The facet
+  // rows of such a cone lie in its span, so they measure the wrench's projection onto it.
   double margin = std::numeric_limits<double>::infinity();
   for (const Wrench& row : cone.facet_rows()) margin = std::min(margin, -row.dot(load.required));
   result.margin = margin;
   result.feasible = margin > 0.0;
-  // On a lower-dimensional cone the equalities hold only to rounding, so the decision is exact.
-  if (std::abs(margin) > band && cone.equality_rows().empty()) return result;
+  if (std::abs(margin) > band) return result;
   return exact_all_sliding(cone, load, q, dq, result);
 }
 

@@ -308,6 +308,87 @@ TRRTstar::Node* TRRTstar::best_goal() const {
   return best;
 }
 
+PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob::State* scratch) const {
+  const PusherSet wedges = allowed & validator_->wedge_pushers();
+  if (wedges == 0) return 0;
+  const Eigen::Vector3d step = space_->in_unit_steps(Motion{q.x - from.x, q.z - from.z, q.theta - from.theta});
+  const double length = step.norm();
+  if (!(length > 0.0)) return 0;
+  for (int p = 0; p < kMaxPushers; ++p) {
+    if (!contains(wedges, p)) continue;
+    const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, step / length, length, p);
+    if (!on_surface) continue;
+    GraspPoseSpace::set_pose(scratch, *on_surface);
+    if (!si_->isValid(scratch)) continue;
+    const PusherSet stable = validator_->stable_pushers(from, *on_surface, PusherSet{1} << p);
+    if (stable != 0) {
+      q = *on_surface;
+      return stable;
+    }
+  }
+  GraspPoseSpace::set_pose(scratch, q);
+  return 0;
+}
+
+std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal, double length,
+                                                        PusherSet wedges) const {
+  const Eigen::Vector3d to_goal =
+      space_->in_unit_steps(Motion{goal.x - from.x, goal.z - from.z, goal.theta - from.theta});
+  const double heading = std::atan2(to_goal[1], to_goal[0]);
+  const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
+  std::vector<WedgeStep> steps;
+  constexpr int kHeadings = 24;
+  for (int p = 0; p < kMaxPushers; ++p) {
+    if (!contains(wedges, p)) continue;
+    for (int k = 0; k < kHeadings; ++k) {
+      const double psi = heading + 2.0 * M_PI * k / kHeadings;
+      // The goal's elevation picks the root nearest to it.
+      const Eigen::Vector3d direction(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]);
+      const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, direction.normalized(), length, p);
+      if (on_surface) steps.push_back({space_->distance(*on_surface, goal), *on_surface, p});
+    }
+  }
+  std::sort(steps.begin(), steps.end(),
+            [](const WedgeStep& a, const WedgeStep& b) { return a.goal_distance < b.goal_distance; });
+  return steps;
+}
+
+bool TRRTstar::wedge_step_valid(const Pose& from, const WedgeStep& step, ob::State* scratch) const {
+  GraspPoseSpace::set_pose(scratch, step.pose);
+  return si_->isValid(scratch) && validator_->stable_pushers(from, step.pose, PusherSet{1} << step.pusher) != 0;
+}
+
+PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
+                                      ob::State* scratch, Pose& q) const {
+  const PusherSet wedges = allowed & validator_->wedge_pushers();
+  if (wedges == 0) return 0;
+  const double now = space_->distance(from, goal);
+  const std::vector<WedgeStep> steps = wedge_steps(from, goal, length, wedges);
+  const auto take = [&](const WedgeStep& step) {
+    q = step.pose;
+    GraspPoseSpace::set_pose(scratch, q);
+    return PusherSet{1} << step.pusher;
+  };
+  std::vector<const WedgeStep*> valid;
+  for (const WedgeStep& step : steps) {
+    if (!wedge_step_valid(from, step, scratch)) continue;
+    if (step.goal_distance < now) return take(step);
+    valid.push_back(&step);
+  }
+  // A local minimum of one step: one surface alone moves q in two of its three coordinates, so
+  // look two steps ahead (the second on any point pusher's surface) from the best first steps.
+  constexpr std::size_t kFirstSteps = 8;
+  for (std::size_t i = 0; i < std::min(valid.size(), kFirstSteps); ++i) {
+    const double next_length = std::min(1.0, valid[i]->goal_distance);
+    for (const WedgeStep& second : wedge_steps(valid[i]->pose, goal, next_length, validator_->wedge_pushers())) {
+      if (second.goal_distance >= now) break;
+      if (wedge_step_valid(valid[i]->pose, second, scratch)) return take(*valid[i]);
+    }
+  }
+  GraspPoseSpace::set_pose(scratch, q);
+  return 0;
+}
+
 TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stable) {
   near(q_new, rewire_radius_, near_);
   const Candidate best = choose_parent(q_new, near_, from, stable);
@@ -342,8 +423,11 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
     const double step = last ? d : si_->distance(from->state, step_state);
     if (!transition_test(from->goal_distance, goal->distanceGoal(step_state), step)) break;
     if (!si_->isValid(step_state)) break;  // the grasp is lost at the new pose
-    const Pose q_new = GraspPoseSpace::pose(step_state);
-    const PusherSet stable = validator_->stable_pushers(from->pose, q_new, validator_->all_pushers());
+    Pose q_new = GraspPoseSpace::pose(step_state);
+    PusherSet stable = validator_->stable_pushers(from->pose, q_new, validator_->all_pushers());
+    if (stable == 0 && (stable = onto_wedge(from->pose, q_new, validator_->all_pushers(), step_state)) != 0 &&
+        !transition_test(from->goal_distance, goal->distanceGoal(step_state), step))
+      break;
     if (stable == 0) break;
     Node* next = connect(from, q_new, stable);
     if (last || next->cost.switches > max_switches_) break;
@@ -391,6 +475,8 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
         if (!si_->isValid(step_state)) continue;
         stable = validator_->stable_pushers(from->pose, q_new, allowed);
       }
+      // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
+      if (ring == 0 && stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
     }
     if (stable == 0) break;
     if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state),

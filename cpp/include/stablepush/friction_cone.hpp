@@ -35,8 +35,10 @@ class WrenchCone {
   /// Distance [N] from w to the cone's linear span (largest |e . w| over the equality rows; 0 in 3-D).
   double distance_to_span(const Wrench& w) const;
 
-  /// Exact test: w lies in the relative interior of the cone (all facets strict, equalities exact).
-  bool contains_in_relative_interior(const ExactWrench& w) const;
+  /// Exact test of the facets alone (every facet row strictly negative on w): for a
+  /// lower-dimensional cone, whether w's projection onto the span is in the relative interior
+  /// (its facet rows lie in the span).
+  bool strictly_inside_facets(const ExactWrench& w) const;
 
  private:
   void add_facet(const ExactWrench& outward);

@@ -10,6 +10,7 @@
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "stablepush/stable_push.hpp"
@@ -105,7 +106,22 @@ class StablePushValidator : public ompl::base::MotionValidator {
   /// grasp is lost on the way.
   PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const;
   PusherSet all_pushers() const { return all_; }
+  /// The pushers whose cone is a wedge (a point pusher with mu > 0): their stable all-sliding
+  /// motions form a surface in motion space, which onto_wedge_surface finds.
+  PusherSet wedge_pushers() const { return wedges_; }
   const ModelSet& models() const { return models_; }
+
+  /// A point pusher's stable pushes (docs/model.md section 3): the motion from `a` of `length` unit
+  /// steps whose translation keeps the heading of `direction` (in unit steps) and whose rotation
+  /// puts the required pusher wrench in the plane of wedge pusher `pusher`'s cone, in the first
+  /// model. Writing the motion's elevation above the translation plane as beta, the motion is
+  /// length (cos beta h, sin beta) with h the unit heading, and e . w(a, dq(beta)) = 0 for the
+  /// wedge's plane normal e is a root in beta: bracketed on a grid over |beta| < 90 deg (10 deg, finer
+  /// toward pure rotation) and refined to rounding (regula falsi, Illinois), the root nearest the direction's own elevation. Empty when `pusher`'s
+  /// cone is not a wedge, the direction has no translation, or no root exists. The motion still has
+  /// to pass stable_pushers (the wedge's facets, every model, the grasp).
+  std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
+                                         int pusher) const;
 
   bool checkMotion(const ompl::base::State* a, const ompl::base::State* b) const override;
   bool checkMotion(const ompl::base::State* a, const ompl::base::State* b,
@@ -120,6 +136,7 @@ class StablePushValidator : public ompl::base::MotionValidator {
   const GraspPoseSpace& space_;
   double min_margin_;
   PusherSet all_;
+  PusherSet wedges_ = 0;
   mutable std::uint64_t checks_ = 0;
 };
 

@@ -14,7 +14,8 @@
 //        the temperature T falls by temp_change_factor after an accepted climb and rises by it
 //        after max_transition_failures refused climbs in a row;
 //   2. the grasp is maintained at the new pose (the space's validity checker);
-//   3. some pusher makes the step a stable push (StablePushValidator);
+//   3. some pusher makes the step a stable push (StablePushValidator), or, for a point pusher,
+//      the step of the same length and heading turned onto its surface of stable pushes;
 // then connect the new pose to the cheapest near node whose push to it is stable, and rewire
 // the near nodes through it when that is cheaper (Karaman and Frazzoli, RRT*, 2011).
 //
@@ -132,6 +133,28 @@ class TRRTstar : public ompl::base::Planner {
   /// Unit steps from `from` toward the goal, each the straight step or the nearest deviation
   /// from it within steer_angle that a pusher allowed by the switch-over budget makes stable.
   void extend_toward_goal(Node* from, const ompl::base::PlannerTerminationCondition& ptc);
+  /// When no pusher makes the step from -> q stable: the step of the same length and heading onto
+  /// the stable surface of a point pusher in `allowed` (StablePushValidator::onto_wedge_surface)
+  /// that the grasp survives and that pusher makes stable. Sets q (and `scratch`) to it and returns
+  /// that pusher; 0, q unchanged, when there is none.
+  PusherSet onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ompl::base::State* scratch) const;
+  /// A step onto a point pusher's surface of stable pushes and where it ends.
+  struct WedgeStep {
+    double goal_distance;  ///< [unit steps]
+    Pose pose;
+    int pusher;
+  };
+  /// The steps of `length` from `from` onto the surfaces of the point pushers in `wedges`, over 24
+  /// headings around the goal's, nearest the goal first (not yet checked for the grasp and facets).
+  std::vector<WedgeStep> wedge_steps(const Pose& from, const Pose& goal, double length, PusherSet wedges) const;
+  /// The grasp survives `step` and its pusher makes it stable.
+  bool wedge_step_valid(const Pose& from, const WedgeStep& step, ompl::base::State* scratch) const;
+  /// Toward the goal when no straight or steered step is stable: the valid wedge step (wedge_steps)
+  /// ending nearest the goal, if closer than `from`; else, since one surface moves q in only two of
+  /// three coordinates, the first of the best 8 valid steps from which a second valid wedge step
+  /// ends closer. Sets q (and `scratch`) and returns that pusher; 0, q unchanged, when neither.
+  PusherSet descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
+                              ompl::base::State* scratch, Pose& q) const;
   Node* add_node(const Pose& q, int pusher, Node* parent, const PathCost& cost);
   /// optimEdge: the cheapest stable connection to q_new among the near nodes; `via` is the node
   /// the extension came from, `via_pushers` the pushers stable along via -> q_new.
