@@ -9,6 +9,7 @@ from conftest import shipped, task_with
 from independent_lp import IndependentModel
 
 from stablepush.planning import plan_task
+from stablepush.errors import TaskError
 from stablepush.task import MM, pose_to_si
 
 SEEDS = range(1, 6)
@@ -278,3 +279,31 @@ def test_most_shipped_plans_end_exactly_at_the_goal():
     ends = [plan_task(shipped(n), seed=s).ends_at_goal for n in ("horizontal-offset-low-mu", "large-manipulation",
                                                                   "t-shaped", "pivoting") for s in (1, 2, 3)]
     assert sum(ends) >= 9, ends
+
+
+# ---------------------------------------------------------------------------------------------
+# Anytime improvement (planner.improve_for, issue 10).
+
+
+@pytest.mark.parametrize("name", ["t-shaped", "horizontal-offset-low-mu", "large-manipulation"])
+def test_an_anytime_search_returns_no_worse_a_plan_than_its_first(name):
+    """Fewer switch-overs first, then a larger least margin, then shorter: the improved plan is at
+    least as good as the first by that order, and every push passes the independent LP."""
+    task = shipped(name)
+    for seed in (1, 2, 3):
+        plan = plan_task(task, seed=seed, improve_for=0.1)
+        first, s = plan.stats["first"], plan.stats
+        assert plan.solved and first is not None and 0 <= first["planning_time_s"] <= s["planning_time_s"]
+        assert s["planning_time_s"] >= 0.1  # it went on after the first plan
+        recheck(task, plan)
+        assert s["switches"] <= first["switches"]
+        if s["switches"] == first["switches"]:
+            assert s["path_min_margin"] >= first["min_margin"]
+    # Without improve_for the first plan is the plan: the same as a search that was never told.
+    plain = plan_task(task, seed=1)
+    assert "first" not in plain.stats
+
+
+def test_improve_for_is_refused_outside_its_declared_range():
+    with pytest.raises(TaskError, match="improve_for"):
+        task_with("t-shaped", lambda d: d["planner"].update(improve_for=-1))

@@ -207,7 +207,12 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("nodes", &PlanStats::nodes)
       .def_readonly("feasibility_checks", &PlanStats::feasibility_checks)
       .def_readonly("switches", &PlanStats::switches)
-      .def_readonly("length", &PlanStats::length, "[unit steps]");
+      .def_readonly("length", &PlanStats::length, "[unit steps]")
+      .def_readonly("first_time_s", &PlanStats::first_time_s, "when the first plan was found [s]; NaN: none")
+      .def_readonly("first_switches", &PlanStats::first_switches)
+      .def_readonly("first_length", &PlanStats::first_length, "[unit steps]")
+      .def_readonly("first_min_margin", &PlanStats::first_min_margin, "[N]")
+      .def_readonly("path_min_margin", &PlanStats::path_min_margin, "[N], the search's path (no last push to the goal)");
 
   py::class_<Plan>(m, "Plan", "Waypoints after each unit push, start first (SI units).")
       .def_readonly("outcome", &Plan::outcome)

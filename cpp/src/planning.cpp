@@ -165,6 +165,13 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   plan.stats.nodes = planner.node_count();
   plan.stats.feasibility_checks = validator->feasibility_checks();
   plan.stats.switches = cost.switches;
+  plan.stats.first_time_s = planner.first_solution_time() >= 0.0 ? planner.first_solution_time()
+                                                                  : std::numeric_limits<double>::quiet_NaN();
+  plan.stats.first_switches = planner.first_solution_cost().switches;
+  plan.stats.first_length = planner.first_solution_cost().length;
+  plan.stats.first_min_margin = planner.first_solution_margin();
+  plan.stats.path_min_margin =
+      planner.getImproveFor() > 0.0 ? planner.solution_margin() : std::numeric_limits<double>::quiet_NaN();
   plan.stats.length = 0.0;  // along the waypoints, the last push to the goal included
   for (std::size_t i = 1; i < plan.waypoints.size(); ++i)
     plan.stats.length += space->distance(plan.waypoints[i - 1].pose, plan.waypoints[i].pose);

@@ -47,6 +47,7 @@ const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges() {
       {"max_switches", {true, 0.0, 100.0}},              // switch-overs a plan may make
       {"steer_angle", {false, 0.0, 90.0}},               // [deg]
       {"seed", {true, 0.0, 4294967295.0}},               // 0 .. 2^32 - 1
+      {"improve_for", {false, 0.0, 1e6}},                // [s] after the first plan
   };
   return ranges;
 }
@@ -96,6 +97,8 @@ TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTsta
   declareParam<double>("steer_angle", this, &TRRTstar::setSteerAngle, &TRRTstar::getSteerAngle,
                        range_text("steer_angle"));
   declareParam<long long>("seed", this, &TRRTstar::setSeed, &TRRTstar::getSeed, range_text("seed"));
+  declareParam<double>("improve_for", this, &TRRTstar::setImproveFor, &TRRTstar::getImproveFor,
+                       range_text("improve_for"));
 }
 
 TRRTstar::~TRRTstar() { free_tree(); }
@@ -116,6 +119,8 @@ void TRRTstar::free_tree() {
   nodes_.clear();
   goal_nodes_.clear();
   closest_ = nullptr;
+  kept_paths_.clear();
+  improved_.reset();
   unit_coords_.clear();
 }
 
@@ -123,6 +128,10 @@ void TRRTstar::clear() {
   ob::Planner::clear();
   free_tree();
   iterations_ = 0;
+  solve_started_ = std::chrono::steady_clock::now();
+  first_time_ = -1.0;
+  first_cost_ = PathCost{};
+  first_margin_ = std::numeric_limits<double>::quiet_NaN();
   outcome_ = PlanOutcome::TimeLimit;
 }
 
@@ -295,7 +304,13 @@ void TRRTstar::rewire(Node* node, const std::vector<Node*>& near) {
 
 void TRRTstar::note_goal_candidate(Node* node) {
   const auto* goal = pdef_->getGoal()->as<PoseGoal>();
-  if (goal->isSatisfied(node->state) && goal->held(node->pose, node->pusher)) goal_nodes_.push_back(node);
+  if (goal->isSatisfied(node->state) && goal->held(node->pose, node->pusher)) {
+    goal_nodes_.push_back(node);
+    // While improving, keep the path as it is now: a later rewiring may trade its margin for length.
+    if (outcome_ == PlanOutcome::GoalReached && improve_for_ > 0.0 && node->cost.switches <= max_switches_ &&
+        node->cost.switches <= best_goal()->cost.switches)
+      kept_paths_.push_back(goal_path(node));
+  }
   if (closest_ == nullptr || node->goal_distance < closest_->goal_distance ||
       (node->goal_distance == closest_->goal_distance && node->cost < closest_->cost))
     closest_ = node;
@@ -403,8 +418,16 @@ TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stabl
     if (first == nullptr) first = node;
   }
   const Node* reached = best_goal();
-  if (reached != nullptr && reached->cost.switches <= max_switches_)
+  if (reached != nullptr && reached->cost.switches <= max_switches_ && outcome_ != PlanOutcome::GoalReached) {
     outcome_ = PlanOutcome::GoalReached;
+    first_time_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_started_).count();
+    first_cost_ = reached->cost;
+    if (improve_for_ > 0.0) {  // margins cost a test per push: only an improvement needs them
+      first_margin_ = path_margin(reached);
+      for (const Node* g : goal_nodes_)  // the goal paths as they are now, the first plan's among them
+        if (g->cost.switches <= max_switches_) kept_paths_.push_back(goal_path(g));
+    }
+  }
   return first;
 }
 
@@ -412,7 +435,7 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
   // Algorithm 1's inner loop: unit steps toward the target while each is accepted.
   const auto* goal = pdef_->getGoal()->as<ob::GoalRegion>();
   ob::State* step_state = si_->allocState();
-  while (outcome_ != PlanOutcome::GoalReached && !ptc) {
+  while (!finished(ptc)) {
     const double d = si_->distance(from->state, target);
     if (d < kMinEdge) break;
     const bool last = d <= 1.0;
@@ -439,7 +462,7 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
 void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
   const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
   ob::State* step_state = si_->allocState();
-  while (outcome_ != PlanOutcome::GoalReached && !ptc) {
+  while (!finished(ptc)) {
     // The step in unit-step coordinates, u toward the goal.
     const Eigen::Vector3d to_goal =
         space_->in_unit_steps(Motion{goal.x - from->pose.x, goal.z - from->pose.z, goal.theta - from->pose.theta});
@@ -502,6 +525,10 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
 
   free_tree();
   iterations_ = 0;
+  solve_started_ = std::chrono::steady_clock::now();
+  first_time_ = -1.0;
+  first_cost_ = PathCost{};
+  first_margin_ = std::numeric_limits<double>::quiet_NaN();
   // Two 32-bit streams per seed, one-to-one over all 2^32 seeds (the generators keep 32 bits):
   // the sampler's is 2 seed for seed < 2^31 (as it always was) and odd above; the search's the other parity.
   const std::uint32_t sampler_seed = seed_ < 0x80000000u ? 2u * seed_ : 2u * (seed_ - 0x80000000u) + 1u;
@@ -514,10 +541,14 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
 
   Node* root = add_node(GraspPoseSpace::pose(start), kNoPusher, nullptr, PathCost{});
   note_goal_candidate(root);
-  if (best_goal() != nullptr) outcome_ = PlanOutcome::GoalReached;  // already there
+  if (best_goal() != nullptr) {  // already there
+    outcome_ = PlanOutcome::GoalReached;
+    first_time_ = 0.0;
+    first_margin_ = path_margin(root);  // no push: +inf
+  }
 
   ob::State* sample = si_->allocState();
-  while (outcome_ != PlanOutcome::GoalReached && !ptc) {
+  while (!finished(ptc)) {
     ++iterations_;
     // A goal sample extends from the node that promises the cheapest plan, cost so far plus
     // the straight distance left (an A* estimate), among those not yet extended toward the
@@ -536,6 +567,8 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
 
   if (outcome_ != PlanOutcome::GoalReached)
     outcome_ = best_goal() != nullptr ? PlanOutcome::GoalOverSwitchLimit : PlanOutcome::TimeLimit;
+  else if (improve_for_ > 0.0)
+    choose_improved_path();
   auto path = std::make_shared<ompl::geometric::PathGeometric>(si_);
   for (const PathNode& n : solution()) {
     ob::State* s = si_->allocState();
@@ -549,7 +582,56 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
   return {true, !exact};
 }
 
+bool TRRTstar::finished(const ob::PlannerTerminationCondition& ptc) const {
+  if (ptc) return true;
+  if (outcome_ != PlanOutcome::GoalReached) return false;
+  return improve_for_ <= 0.0 ||
+         std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_started_).count() - first_time_ >=
+             improve_for_;
+}
+
+double TRRTstar::path_margin(const Node* node) const {
+  double margin = std::numeric_limits<double>::infinity();
+  for (; node != nullptr && node->parent != nullptr; node = node->parent) {
+    const std::vector<Pose> poses = space_->unit_pushes(node->parent->pose, node->pose);
+    for (std::size_t i = 0; i + 1 < poses.size(); ++i) {
+      const Motion dq{poses[i + 1].x - poses[i].x, poses[i + 1].z - poses[i].z, poses[i + 1].theta - poses[i].theta};
+      margin = std::min(margin, worst_case(validator_->models(), poses[i], dq, node->pusher).margin);
+    }
+  }
+  return margin;
+}
+
+TRRTstar::GoalPath TRRTstar::goal_path(const Node* node) const {
+  GoalPath out;
+  out.cost = node->cost;
+  out.margin = path_margin(node);
+  for (const Node* n = node; n != nullptr; n = n->parent) out.nodes.push_back({n->pose, n->pusher});
+  std::reverse(out.nodes.begin(), out.nodes.end());
+  return out;
+}
+
+void TRRTstar::choose_improved_path() {
+  for (const Node* g : goal_nodes_)
+    if (g->cost.switches <= max_switches_) kept_paths_.push_back(goal_path(g));
+  const auto better = [](const GoalPath& a, const GoalPath& b) {  // fewer switch-overs, larger margin, shorter
+    if (a.cost.switches != b.cost.switches) return a.cost.switches < b.cost.switches;
+    if (a.margin != b.margin) return a.margin > b.margin;
+    return a.cost.length < b.cost.length;
+  };
+  for (GoalPath& p : kept_paths_)
+    if (!improved_ || better(p, *improved_)) improved_ = std::move(p);
+  kept_paths_.clear();
+}
+
+double TRRTstar::solution_margin() const {
+  if (improved_) return improved_->margin;
+  const Node* end = best_goal();
+  return path_margin(end != nullptr ? end : closest_);
+}
+
 std::vector<PathNode> TRRTstar::solution() const {
+  if (improved_) return improved_->nodes;
   std::vector<PathNode> path;
   const Node* end = best_goal();
   if (end == nullptr) end = closest_;
@@ -559,6 +641,7 @@ std::vector<PathNode> TRRTstar::solution() const {
 }
 
 PathCost TRRTstar::solution_cost() const {
+  if (improved_) return improved_->cost;
   const Node* end = best_goal();
   if (end == nullptr) end = closest_;
   return end ? end->cost : PathCost{};

@@ -98,21 +98,33 @@ class PlanningTrial:
     feasibility_checks: int
     nodes: int
     pusher_sequence: str
+    min_margin: Optional[float]  # N: the least margin over the plan's pushes (None: no push)
+    # The first plan of an anytime search (improve_for > 0), before the improvement; None otherwise.
+    first_time_s: Optional[float] = None
+    first_switches: Optional[int] = None
+    first_path_length_steps: Optional[float] = None
+    first_min_margin: Optional[float] = None
 
 
 def bench_planning(task: Task, trials: int, seed: int = 1, time_limit: Optional[float] = None,
-                   progress: Optional[Callable[[int], None]] = None) -> "list[PlanningTrial]":
-    """Plan `task` with seeds seed .. seed + trials - 1."""
+                   progress: Optional[Callable[[int], None]] = None,
+                   improve_for: Optional[float] = None) -> "list[PlanningTrial]":
+    """Plan `task` with seeds seed .. seed + trials - 1 (with `improve_for`, an anytime search that
+    goes on that many seconds after its first plan; the trial records both)."""
     models = task.corner_models()
     out = []
     for k in range(trials):
-        plan = plan_task(task, seed=seed + k, time_limit=time_limit, models=models)
+        plan = plan_task(task, seed=seed + k, time_limit=time_limit, models=models, improve_for=improve_for)
         s = plan.stats
+        first = s.get("first") or {}
         out.append(PlanningTrial(
             task=task.name, seed=seed + k, solved=plan.solved, outcome=plan.outcome,
             planning_time_s=s["planning_time_s"], switches=s["switches"], pushes=s["pushes"],
             path_length_steps=s["path_length_steps"], feasibility_checks=s["feasibility_checks"], nodes=s["nodes"],
             pusher_sequence="-".join(plan.pusher_sequence),
+            min_margin=min((w.margin for w in plan.waypoints[1:]), default=None),
+            first_time_s=first.get("planning_time_s"), first_switches=first.get("switches"),
+            first_path_length_steps=first.get("path_length_steps"), first_min_margin=first.get("min_margin"),
         ))
         if progress is not None:
             progress(1)
@@ -139,5 +151,26 @@ def summarize_planning(trials: "list[PlanningTrial]") -> dict:
         "checks_per_s": sum(t.feasibility_checks for t in trials) / total_time if total_time > 0 else 0.0,
         "paper_time_s": paper,
         "earlier_planner_time_s": earlier,
+        **_first_and_improved(solved),
+    }
+
+
+def _first_and_improved(solved: "list[PlanningTrial]") -> dict:
+    """Medians of the first and the improved plans of anytime trials (empty without improve_for)."""
+    anytime = [t for t in solved if t.first_time_s is not None and t.min_margin is not None]
+    if not anytime:
+        return {}
+
+    def median(values):
+        return float(np.median(values))
+
+    return {
+        "first_median_time_s": median([t.first_time_s for t in anytime]),
+        "first_median_switches": median([t.first_switches for t in anytime]),
+        "first_median_path_length_steps": median([t.first_path_length_steps for t in anytime]),
+        "first_median_min_margin": median([t.first_min_margin for t in anytime]),
+        "improved_median_switches": median([t.switches for t in anytime]),
+        "improved_median_path_length_steps": median([t.path_length_steps for t in anytime]),
+        "improved_median_min_margin": median([t.min_margin for t in anytime]),
     }
 

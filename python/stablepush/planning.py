@@ -158,6 +158,7 @@ def plan_task(
     seed: Optional[int] = None,
     time_limit: Optional[float] = None,
     max_switches: Optional[int] = None,
+    improve_for: Optional[float] = None,
     models: "Optional[List[_core.StablePushModel]]" = None,
 ) -> Plan:
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
@@ -171,6 +172,8 @@ def plan_task(
         settings["max_switches"] = planner_parameter("max_switches", "max_switches", max_switches)
     if time_limit is not None:
         settings["time_limit"] = planner_limit("time_limit", time_limit)
+    if improve_for is not None:
+        settings["improve_for"] = planner_parameter("improve_for", "improve_for", improve_for)
     models = models or task.corner_models()
     model = models[0]
     step = (settings["step"][0] * MM, math.radians(settings["step"][1]))
@@ -210,6 +213,13 @@ def plan_task(
         "goal_distance_steps": raw.goal_distance,
         "min_hold_ratio": float(settings["min_hold_ratio"]),
     }
+    if "improve_for" in settings:
+        # the first plan of an anytime search (planner.improve_for), before the improvement; None: no plan
+        # (path_min_margin: the same measure for the returned path, the last push to the goal left out)
+        solved_once = math.isfinite(s.first_time_s)
+        stats["first"] = {"planning_time_s": s.first_time_s, "switches": int(s.first_switches),
+                          "path_length_steps": s.first_length, "min_margin": s.first_min_margin} if solved_once else None
+        stats["path_min_margin"] = s.path_min_margin if solved_once else None
     last = waypoints[-1]
     last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1
     return Plan(task=task.name, solved=outcome == "goal_reached", outcome=outcome,

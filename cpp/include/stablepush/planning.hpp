@@ -48,6 +48,16 @@ struct PlanStats {
   std::uint64_t feasibility_checks = 0;  ///< stable-push tests, one per pusher and unit push
   int switches = 0;
   double length = 0.0;  ///< [unit steps]
+  /// The first plan the search found (TRRTstar's improve_for; the final plan's own without it):
+  /// when [s into the search, NaN when none], its switch-overs, length [unit steps] and least margin [N].
+  double first_time_s = 0.0;
+  int first_switches = 0;
+  double first_length = 0.0;
+  double first_min_margin = 0.0;
+  /// The least margin over the pushes of the search's path [N] (the last push to the goal pose,
+  /// Plan::ends_at_goal, not counted): what an improvement compares with first_min_margin. Both
+  /// margins are computed only with improve_for > 0 (NaN otherwise: a test per push).
+  double path_min_margin = 0.0;
 };
 
 struct Plan {

@@ -20,15 +20,21 @@
 // the near nodes through it when that is cheaper (Karaman and Frazzoli, RRT*, 2011).
 //
 // The planner stops when a node within the goal tolerance costs at most max_switches
-// switch-overs, or when the termination condition (time) fires; outcome() says which.
+// switch-overs, or when the termination condition (time) fires; outcome() says which. With
+// improve_for > 0 it goes on for that long after the first such node (the paper's anytime stop
+// rule), and the plan is the goal node's path with the fewest switch-overs, then the largest least
+// margin of its unit pushes (worst over the models), then the shortest.
 #pragma once
 
 #include <ompl/base/Planner.h>
 #include <ompl/util/RandomNumbers.h>
 
+#include <chrono>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -109,14 +115,25 @@ class TRRTstar : public ompl::base::Planner {
   double getSteerAngle() const { return steer_angle_; }
   void setSeed(long long seed) { seed_ = static_cast<std::uint32_t>(checked("seed", seed)); }
   long long getSeed() const { return seed_; }
+  /// How long to keep improving after the first plan [s] (0: stop at the first).
+  void setImproveFor(double seconds) { improve_for_ = checked("improve_for", seconds); }
+  double getImproveFor() const { return improve_for_; }
 
   // The last solve.
   PlanOutcome outcome() const { return outcome_; }
-  /// The best path of the last solve, start first: to the cheapest goal node, or, when the goal
-  /// was not reached, to the node closest to the goal.
+  /// The best path of the last solve, start first: to the cheapest goal node (after an
+  /// improvement, the path choose_improved_path took), or, when the goal was not reached, to the
+  /// node closest to the goal.
   std::vector<PathNode> solution() const;
   PathCost solution_cost() const;
   std::uint64_t iterations() const { return iterations_; }
+  /// The first plan found: when [s since the solve began], its cost and its least margin [N];
+  /// time < 0 when none was found. The margin is computed only with improve_for > 0 (else NaN).
+  double first_solution_time() const { return first_time_; }
+  PathCost first_solution_cost() const { return first_cost_; }
+  double first_solution_margin() const { return first_margin_; }
+  /// The least margin [N] over the unit pushes of the returned path (worst over the models).
+  double solution_margin() const;
   std::size_t node_count() const { return nodes_.size(); }
   double temperature() const { return temperature_; }
 
@@ -170,7 +187,24 @@ class TRRTstar : public ompl::base::Planner {
   /// cost plus distance to the goal; nullptr when there is none.
   Node* most_promising_toward_goal() const;
   void note_goal_candidate(Node* node);
+  /// The goal node with the least cost (switch-overs, then length).
   Node* best_goal() const;
+  /// A goal node's path as it was when noted (rewiring may shorten a path later and lower its
+  /// margin, so an improvement keeps the paths it saw), its cost and least margin [N].
+  struct GoalPath {
+    std::vector<PathNode> nodes;
+    PathCost cost;
+    double margin = 0.0;
+  };
+  GoalPath goal_path(const Node* node) const;
+  /// The least margin over the unit pushes of the path to `node` [N] (+inf at the root).
+  double path_margin(const Node* node) const;
+  /// After an improvement: improved_ = among the goal paths kept while improving and those of the
+  /// goal nodes now, within the budget, the one with the fewest switch-overs, then the largest
+  /// least margin, then the shortest.
+  void choose_improved_path();
+  /// Whether the search is over: the time is up, or a plan exists and improve_for has passed since.
+  bool finished(const ompl::base::PlannerTerminationCondition& ptc) const;
 
   StablePushValidator* validator_ = nullptr;
   const GraspPoseSpace* space_ = nullptr;
@@ -193,6 +227,7 @@ class TRRTstar : public ompl::base::Planner {
   unsigned max_transition_failures_ = 10;
   int max_switches_ = 1;
   std::uint32_t seed_ = 1;
+  double improve_for_ = 0.0;
 
   double temperature_ = 0.0;
   unsigned transition_failures_ = 0;
@@ -200,6 +235,12 @@ class TRRTstar : public ompl::base::Planner {
   double max_goal_distance_ = 0.0;
   std::uint64_t iterations_ = 0;
   PlanOutcome outcome_ = PlanOutcome::TimeLimit;
+  std::chrono::steady_clock::time_point solve_started_;
+  double first_time_ = -1.0;
+  PathCost first_cost_;
+  double first_margin_ = std::numeric_limits<double>::quiet_NaN();
+  std::vector<GoalPath> kept_paths_;  ///< goal paths seen while improving
+  std::optional<GoalPath> improved_;
 };
 
 }  // namespace stablepush
