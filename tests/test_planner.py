@@ -307,3 +307,19 @@ def test_an_anytime_search_returns_no_worse_a_plan_than_its_first(name):
 def test_improve_for_is_refused_outside_its_declared_range():
     with pytest.raises(TaskError, match="improve_for"):
         task_with("t-shaped", lambda d: d["planner"].update(improve_for=-1))
+
+
+# ---------------------------------------------------------------------------------------------
+# Restarts against the long tail (planner.restart_checks, issue 10).
+
+
+def test_restarts_are_counted_in_tests_so_a_seed_gives_the_same_plan_and_doubling_still_solves():
+    task = task_with("horizontal-offset-low-mu", lambda d: d["planner"].update(restart_checks=300))
+    plans = [plan_task(task, seed=6) for _ in range(2)]
+    assert plans[0].stats["restarts"] > 0 and plans[0].solved
+    assert plans[0].stats["restarts"] == plans[1].stats["restarts"]
+    assert [(w.x, w.z, w.theta, w.pusher) for w in plans[0].waypoints] == \
+        [(w.x, w.z, w.theta, w.pusher) for w in plans[1].waypoints]
+    recheck(task, plans[0])
+    never = plan_task(task_with("horizontal-offset-low-mu", lambda d: d["planner"].update(restart_checks=0)), seed=6)
+    assert never.stats["restarts"] == 0 and never.solved

@@ -208,6 +208,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("feasibility_checks", &PlanStats::feasibility_checks)
       .def_readonly("switches", &PlanStats::switches)
       .def_readonly("length", &PlanStats::length, "[unit steps]")
+      .def_readonly("restarts", &PlanStats::restarts)
       .def_readonly("first_time_s", &PlanStats::first_time_s, "when the first plan was found [s]; NaN: none")
       .def_readonly("first_switches", &PlanStats::first_switches)
       .def_readonly("first_length", &PlanStats::first_length, "[unit steps]")

@@ -165,6 +165,7 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   plan.stats.nodes = planner.node_count();
   plan.stats.feasibility_checks = validator->feasibility_checks();
   plan.stats.switches = cost.switches;
+  plan.stats.restarts = planner.restarts();
   plan.stats.first_time_s = planner.first_solution_time() >= 0.0 ? planner.first_solution_time()
                                                                   : std::numeric_limits<double>::quiet_NaN();
   plan.stats.first_switches = planner.first_solution_cost().switches;

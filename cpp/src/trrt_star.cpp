@@ -48,6 +48,7 @@ const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges() {
       {"steer_angle", {false, 0.0, 90.0}},               // [deg]
       {"seed", {true, 0.0, 4294967295.0}},               // 0 .. 2^32 - 1
       {"improve_for", {false, 0.0, 1e6}},                // [s] after the first plan
+      {"restart_checks", {true, 0.0, 1e12}},             // stable-push tests before a restart (0: never)
   };
   return ranges;
 }
@@ -99,6 +100,8 @@ TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTsta
   declareParam<long long>("seed", this, &TRRTstar::setSeed, &TRRTstar::getSeed, range_text("seed"));
   declareParam<double>("improve_for", this, &TRRTstar::setImproveFor, &TRRTstar::getImproveFor,
                        range_text("improve_for"));
+  declareParam<long long>("restart_checks", this, &TRRTstar::setRestartChecks, &TRRTstar::getRestartChecks,
+                          range_text("restart_checks"));
 }
 
 TRRTstar::~TRRTstar() { free_tree(); }
@@ -404,7 +407,7 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
   return 0;
 }
 
-TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stable) {
+TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stable, int prefer) {
   near(q_new, rewire_radius_, near_);
   const Candidate best = choose_parent(q_new, near_, from, stable);
   // One node per pusher that can make the push when it starts a new contact (or is the first
@@ -415,7 +418,7 @@ TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stabl
     Node* node = add_node(q_new, p, best.parent, best.cost);
     rewire(node, near_);
     note_goal_candidate(node);
-    if (first == nullptr) first = node;
+    if (first == nullptr || p == prefer) first = node;
   }
   const Node* reached = best_goal();
   if (reached != nullptr && reached->cost.switches <= max_switches_ && outcome_ != PlanOutcome::GoalReached) {
@@ -505,11 +508,10 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state),
                          length))
       break;
-    Node* next = connect(from, q_new, stable);
-    // Nodes on this descent would only repeat it: none of them is tried toward the goal again.
-    for (Node* sibling : next->parent->children)
-      if (sibling->pose.x == q_new.x && sibling->pose.z == q_new.z && sibling->pose.theta == q_new.theta)
-        sibling->extended_to_goal = true;
+    // Go on with the same pusher where it can (no switch-over); the nodes of the other pushers at
+    // q_new stay candidates for descents of their own, which start each pusher's straight way in.
+    Node* next = connect(from, q_new, stable, from->pusher);
+    next->extended_to_goal = true;  // this descent goes on from it
     if (next->cost.switches > max_switches_) break;
     from = next;
   }
@@ -523,32 +525,32 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
   const ob::State* start = pis_.nextStart();
   if (start == nullptr) return ob::PlannerStatus::INVALID_START;
 
-  free_tree();
   iterations_ = 0;
+  restarts_ = 0;
   solve_started_ = std::chrono::steady_clock::now();
   first_time_ = -1.0;
   first_cost_ = PathCost{};
   first_margin_ = std::numeric_limits<double>::quiet_NaN();
-  // Two 32-bit streams per seed, one-to-one over all 2^32 seeds (the generators keep 32 bits):
-  // the sampler's is 2 seed for seed < 2^31 (as it always was) and odd above; the search's the other parity.
-  const std::uint32_t sampler_seed = seed_ < 0x80000000u ? 2u * seed_ : 2u * (seed_ - 0x80000000u) + 1u;
-  rng_ = std::make_unique<ompl::RNG>(sampler_seed ^ 1u);
-  sampler_ = std::make_shared<SeededPoseSampler>(si_->getStateSpace().get(), sampler_seed);
-  temperature_ = init_temperature_;
-  transition_failures_ = 0;
   validator_->reset_feasibility_checks();
-  outcome_ = PlanOutcome::TimeLimit;
+  const Pose start_pose = GraspPoseSpace::pose(start);
+  begin_attempt(start_pose);
 
-  Node* root = add_node(GraspPoseSpace::pose(start), kNoPusher, nullptr, PathCost{});
-  note_goal_candidate(root);
-  if (best_goal() != nullptr) {  // already there
-    outcome_ = PlanOutcome::GoalReached;
-    first_time_ = 0.0;
-    first_margin_ = path_margin(root);  // no push: +inf
-  }
+  // Restarts against the long tail (restart_checks): a search that has made that many stable-push
+  // tests without a plan starts again from the start with fresh streams and twice the budget, so
+  // a seed whose first descents die where the chosen pusher cannot go on does not search there
+  // for long; doubling keeps it complete. Counted in tests, not seconds, so a seed's plan is the
+  // same on any machine.
+  std::uint64_t budget = restart_checks_, attempt_began = 0;
 
   ob::State* sample = si_->allocState();
   while (!finished(ptc)) {
+    if (budget > 0 && outcome_ != PlanOutcome::GoalReached &&
+        validator_->feasibility_checks() - attempt_began >= budget) {
+      ++restarts_;
+      begin_attempt(start_pose);
+      attempt_began = validator_->feasibility_checks();
+      budget = budget > (std::numeric_limits<std::uint64_t>::max() >> 1) ? budget : 2 * budget;
+    }
     ++iterations_;
     // A goal sample extends from the node that promises the cheapest plan, cost so far plus
     // the straight distance left (an A* estimate), among those not yet extended toward the
@@ -580,6 +582,33 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
   const Node* end = best_goal() ? best_goal() : closest_;
   pdef_->addSolutionPath(path, !exact, exact ? 0.0 : end->goal_distance, getName());
   return {true, !exact};
+}
+
+void TRRTstar::begin_attempt(const Pose& start) {
+  free_tree();
+  // Two 32-bit streams per seed, one-to-one over all 2^32 seeds (the generators keep 32 bits):
+  // the sampler's is 2 seed for seed < 2^31 (as it always was) and odd above; the search's the
+  // other parity. A restart draws its seed from (seed, restart) by SplitMix64.
+  std::uint32_t seed = seed_;
+  if (restarts_ > 0) {
+    std::uint64_t z = (static_cast<std::uint64_t>(seed_) << 32 | restarts_) + 0x9E3779B97F4A7C15ull;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    seed = static_cast<std::uint32_t>((z ^ (z >> 31)) >> 32);
+  }
+  const std::uint32_t sampler_seed = seed < 0x80000000u ? 2u * seed : 2u * (seed - 0x80000000u) + 1u;
+  rng_ = std::make_unique<ompl::RNG>(sampler_seed ^ 1u);
+  sampler_ = std::make_shared<SeededPoseSampler>(si_->getStateSpace().get(), sampler_seed);
+  temperature_ = init_temperature_;
+  transition_failures_ = 0;
+  outcome_ = PlanOutcome::TimeLimit;
+  Node* root = add_node(start, kNoPusher, nullptr, PathCost{});
+  note_goal_candidate(root);
+  if (best_goal() != nullptr) {  // already there
+    outcome_ = PlanOutcome::GoalReached;
+    first_time_ = 0.0;
+    first_margin_ = path_margin(root);  // no push: +inf
+  }
 }
 
 bool TRRTstar::finished(const ob::PlannerTerminationCondition& ptc) const {

@@ -205,6 +205,7 @@ def plan_task(
         "nodes": int(s.nodes),
         "feasibility_checks": int(s.feasibility_checks),
         "switches": int(s.switches),
+        "restarts": int(s.restarts),
         "seed": int(settings["seed"]),
         "max_switches": int(settings["max_switches"]),
         "time_limit_s": float(settings["time_limit"]),

@@ -48,6 +48,7 @@ struct PlanStats {
   std::uint64_t feasibility_checks = 0;  ///< stable-push tests, one per pusher and unit push
   int switches = 0;
   double length = 0.0;  ///< [unit steps]
+  unsigned restarts = 0;  ///< times the search started again (TRRTstar's restart_checks)
   /// The first plan the search found (TRRTstar's improve_for; the final plan's own without it):
   /// when [s into the search, NaN when none], its switch-overs, length [unit steps] and least margin [N].
   double first_time_s = 0.0;

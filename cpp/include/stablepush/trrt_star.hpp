@@ -118,6 +118,14 @@ class TRRTstar : public ompl::base::Planner {
   /// How long to keep improving after the first plan [s] (0: stop at the first).
   void setImproveFor(double seconds) { improve_for_ = checked("improve_for", seconds); }
   double getImproveFor() const { return improve_for_; }
+  /// Stable-push tests without a plan before the search starts again with fresh streams and twice
+  /// the budget (0: never restart).
+  void setRestartChecks(long long checks) {
+    restart_checks_ = static_cast<std::uint64_t>(checked("restart_checks", static_cast<double>(checks)));
+  }
+  long long getRestartChecks() const { return static_cast<long long>(restart_checks_); }
+  /// Restarts in the last solve.
+  unsigned restarts() const { return restarts_; }
 
   // The last solve.
   PlanOutcome outcome() const { return outcome_; }
@@ -142,9 +150,11 @@ class TRRTstar : public ompl::base::Planner {
   struct Candidate;
 
   void free_tree();
+  /// A fresh tree at the start, the streams seeded from (seed, restarts_).
+  void begin_attempt(const Pose& start);
   /// Connect q_new (stable from `from` by `stable`) through the cheapest near parent, rewire,
-  /// and note a goal; returns the first node added.
-  Node* connect(Node* from, const Pose& q_new, PusherSet stable);
+  /// and note a goal; returns the node added for pusher `prefer` if there is one, else the first.
+  Node* connect(Node* from, const Pose& q_new, PusherSet stable, int prefer = kNoPusher);
   /// Unit steps from `from` straight toward `target` while each is accepted (Algorithm 1).
   void extend(Node* from, const ompl::base::State* target, const ompl::base::PlannerTerminationCondition& ptc);
   /// Unit steps from `from` toward the goal, each the straight step or the nearest deviation
@@ -228,6 +238,8 @@ class TRRTstar : public ompl::base::Planner {
   int max_switches_ = 1;
   std::uint32_t seed_ = 1;
   double improve_for_ = 0.0;
+  std::uint64_t restart_checks_ = 10000;
+  unsigned restarts_ = 0;
 
   double temperature_ = 0.0;
   unsigned transition_failures_ = 0;
