@@ -113,7 +113,7 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
   double below = kGridDeg[0] * M_PI / 180.0, f_below = off_plane(below);
   for (std::size_t i = 1; i < std::size(kGridDeg); ++i) {
     const double above = kGridDeg[i] * M_PI / 180.0, f_above = off_plane(above);
-    if ((f_below <= 0.0) != (f_above <= 0.0)) {
+    if ((f_below < 0.0) != (f_above < 0.0)) {
       // Regula falsi with the Illinois rule, to rounding.
       double lo = below, hi = above, f_lo = f_below, f_hi = f_above;
       int kept = 0;  // which end was kept last: -1 lo, +1 hi
