@@ -79,7 +79,8 @@ class CoulombPadFriction:
         self._state = np.zeros(mujoco.mj_stateSize(model, self._state_kind))
         self.slipping = np.zeros(n_points, dtype=bool)  # candidates, by their own slip speed
         self.sliding = np.zeros(n_points, dtype=bool)  # sliding with our friction in the last step
-        self._direction = np.zeros((n_points, 3))  # unit friction on the object in the world, per sliding point
+        # per sliding point, its unit friction as a world vector in the contact rows' sign convention (_PadContacts)
+        self._direction = np.zeros((n_points, 3))
         self._fast_steps = np.zeros(n_points, dtype=int)
         self.solver_steps = 0  # scratch steps with the solver's friction, deciding new sliders
         self.trial_steps = 0  # scratch steps finding the friction's direction
