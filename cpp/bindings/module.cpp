@@ -21,6 +21,36 @@ using namespace stablepush;
 namespace {
 Pose to_pose(const std::array<double, 3>& q) { return Pose{q[0], q[1], q[2]}; }
 StepSize to_step(const std::array<double, 2>& s) { return StepSize{s[0], s[1]}; }
+
+py::tuple to_tuple(const Pose& q) { return py::make_tuple(q.x, q.z, q.theta); }
+
+/// A PushChecker written in Python (the toy checkers of the search's tests): subclass
+/// _core.PushChecker and define all_pushers(), stable_pushers(a, b, candidates) and
+/// push_margin(a, b, pusher); poses are (x m, z m, theta rad) tuples, pusher sets int bit masks.
+class PyPushChecker : public PushChecker {
+ public:
+  PusherSet all_pushers() const override { return call("all_pushers").cast<PusherSet>(); }
+  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
+    ++checks_;
+    return call("stable_pushers", to_tuple(a), to_tuple(b), candidates).cast<PusherSet>();
+  }
+  double push_margin(const Pose& a, const Pose& b, int pusher) const override {
+    return call("push_margin", to_tuple(a), to_tuple(b), pusher).cast<double>();
+  }
+  std::uint64_t feasibility_checks() const override { return checks_; }
+  void reset_feasibility_checks() override { checks_ = 0; }
+
+ private:
+  template <class... Args>
+  py::object call(const char* name, Args&&... args) const {
+    py::gil_scoped_acquire gil;
+    const py::function f = py::get_override(static_cast<const PushChecker*>(this), name);
+    if (!f) throw std::runtime_error(std::string("PushChecker.") + name + " is not defined");
+    return f(std::forward<Args>(args)...);
+  }
+  mutable std::uint64_t checks_ = 0;
+};
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -276,6 +306,36 @@ PYBIND11_MODULE(_core, m) {
   m.def("plan", plan, py::arg("models"), py::arg("start"), py::arg("goal"), py::arg("step"), py::arg("tolerance"),
         py::arg("time_limit"), py::arg("min_margin"), py::arg("sampling_margin"), py::arg("parameters"),
         py::arg("min_hold_ratio") = 0.0, plan_doc);
+  py::class_<PushChecker, PyPushChecker, std::shared_ptr<PushChecker>>(
+      m, "PushChecker",
+      "What the search asks of the mechanics: subclass it and define all_pushers() -> int (a bit mask),\n"
+      "stable_pushers(a, b, candidates) -> int (the pushers among candidates that make the motion a -> b\n"
+      "stable; poses (x m, z m, theta rad)) and push_margin(a, b, pusher) -> float (N), then plan with\n"
+      "plan_with_checker: the search tested apart from the mechanics.")
+      .def(py::init<>());
+  m.def("plan_with_checker",
+        [](std::shared_ptr<PushChecker> checker, const std::array<double, 3>& start, const std::array<double, 3>& goal,
+           const std::array<double, 2>& step, const std::array<double, 2>& tolerance, double time_limit,
+           double sampling_margin, const std::map<std::string, std::string>& parameters) {
+          PlannerSettings settings{to_pose(start), to_pose(goal), to_step(step), to_step(tolerance), time_limit,
+                                   0.0, sampling_margin, 0.0, parameters};
+          const CheckedPlan plan = plan_with_checker(std::move(checker), settings);
+          py::list path;
+          for (const PathNode& n : plan.path) path.append(py::make_tuple(to_tuple(n.pose), n.pusher));
+          py::dict out;
+          out["outcome"] = plan.outcome;
+          out["path"] = path;
+          out["switches"] = plan.cost.switches;
+          out["length"] = plan.cost.length;
+          out["restarts"] = plan.restarts;
+          return out;
+        },
+        py::arg("checker"), py::arg("start"), py::arg("goal"), py::arg("step"), py::arg("tolerance"),
+        py::arg("time_limit"), py::arg("sampling_margin") = 5.0,
+        py::arg("parameters") = std::map<std::string, std::string>{},
+        "TRRTstar with `checker` (a PushChecker) deciding which pushers make a motion stable; every pose is\n"
+        "valid. Poses (m, m, rad), step and tolerance (m, rad). Returns outcome, path [((x, z, theta), pusher)]\n"
+        "start first (pusher -1 at the start), switches, length (unit steps) and restarts.");
   m.def("worst_case", [](const ModelSet& models, const std::array<double, 3>& q, const std::array<double, 3>& dq,
                          int pusher) { return worst_case(models, to_pose(q), to_pose(dq), pusher); },
         py::arg("models"), py::arg("q"), py::arg("dq"), py::arg("pusher"),

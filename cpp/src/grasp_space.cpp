@@ -90,6 +90,14 @@ StablePushValidator::StablePushValidator(const ob::SpaceInformationPtr& si, Mode
     if (models_.front()->pusher_cones()[p].dimension() == 2) wedges_ |= PusherSet{1} << p;
 }
 
+std::optional<Pose> PushChecker::onto_wedge_surface(const Pose&, const Eigen::Vector3d&, double, int) const {
+  return std::nullopt;
+}
+
+double StablePushValidator::push_margin(const Pose& a, const Pose& b, int pusher) const {
+  return worst_case(models_, a, Motion{b.x - a.x, b.z - a.z, b.theta - a.theta}, pusher).margin;
+}
+
 std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction,
                                                             double length, int pusher) const {
   if (!contains(wedges_, pusher)) return std::nullopt;

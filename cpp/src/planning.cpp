@@ -17,14 +17,17 @@ namespace ob = ompl::base;
 
 namespace {
 
-/// The region the planner samples: the box spanned by the start and the goal, grown by
-/// settings.sampling_margin unit steps on every side, and cut to where some pad can still hold the object
-/// (a pad centre p in G lies in the cross-section, so |p - c| <= circumradius and each of x, z
-/// is within circumradius + |p| of 0).
-ob::RealVectorBounds sampling_region(const StablePushModel& model, const PlannerSettings& settings) {
+/// How far x and z can be from 0 with some pad still on the object: a pad centre p in G lies in the
+/// cross-section, so |p - c| <= circumradius and each of x, z is within circumradius + |p| of 0.
+double pad_reach(const StablePushModel& model) {
   double reach = 0.0;
   for (const Pad& pad : model.gripper().pads()) reach = std::max(reach, pad.center.norm());
-  reach += model.section().circumradius();
+  return reach + model.section().circumradius();
+}
+
+/// The region the planner samples: the box spanned by the start and the goal, grown by
+/// settings.sampling_margin unit steps on every side, and cut to |x|, |z| <= reach.
+ob::RealVectorBounds sampling_region(const PlannerSettings& settings, double reach) {
   const Pose& a = settings.start;
   const Pose& b = settings.goal;
   const double grow = settings.sampling_margin * settings.step.length;
@@ -115,7 +118,7 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   const StablePushModel& model = *models.front();  // the geometry, which every model shares
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 
-  auto space = std::make_shared<GraspPoseSpace>(settings.step, sampling_region(model, settings));
+  auto space = std::make_shared<GraspPoseSpace>(settings.step, sampling_region(settings, pad_reach(model)));
   auto si = std::make_shared<ob::SpaceInformation>(space);
   si->setStateValidityChecker(std::make_shared<GraspValidityChecker>(si, model));
   auto validator = std::make_shared<StablePushValidator>(si, models, settings.min_margin);
@@ -179,6 +182,66 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   plan.goal_distance = space->distance(plan.waypoints.back().pose, settings.goal);
   plan.stats.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return plan;
+}
+
+namespace {
+
+/// The motion validator of a search with a PushChecker written elsewhere: OMPL's question (is
+/// a -> b valid?) and the search's (which pushers?) both go to it.
+class CheckerMotionValidator : public ob::MotionValidator, public PushChecker {
+ public:
+  CheckerMotionValidator(const ob::SpaceInformationPtr& si, std::shared_ptr<PushChecker> checker)
+      : ob::MotionValidator(si), checker_(std::move(checker)) {}
+  bool checkMotion(const ob::State* a, const ob::State* b) const override {
+    return stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_pushers()) != 0;
+  }
+  bool checkMotion(const ob::State* a, const ob::State* b, std::pair<ob::State*, double>& last_valid) const override {
+    const bool ok = checkMotion(a, b);
+    if (!ok) last_valid.second = 0.0;
+    return ok;
+  }
+  PusherSet all_pushers() const override { return checker_->all_pushers(); }
+  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
+    return checker_->stable_pushers(a, b, candidates);
+  }
+  double push_margin(const Pose& a, const Pose& b, int pusher) const override {
+    return checker_->push_margin(a, b, pusher);
+  }
+  PusherSet wedge_pushers() const override { return checker_->wedge_pushers(); }
+  std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
+                                         int pusher) const override {
+    return checker_->onto_wedge_surface(a, direction, length, pusher);
+  }
+  std::uint64_t feasibility_checks() const override { return checker_->feasibility_checks(); }
+  void reset_feasibility_checks() override { checker_->reset_feasibility_checks(); }
+
+ private:
+  std::shared_ptr<PushChecker> checker_;
+};
+
+}  // namespace
+
+CheckedPlan plan_with_checker(std::shared_ptr<PushChecker> checker, const PlannerSettings& settings) {
+  check_settings(settings);
+  if (!checker) throw std::invalid_argument("no push checker");
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  auto space = std::make_shared<GraspPoseSpace>(settings.step,
+                                                sampling_region(settings, std::numeric_limits<double>::infinity()));
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  si->setStateValidityChecker([](const ob::State*) { return true; });
+  si->setMotionValidator(std::make_shared<CheckerMotionValidator>(si, std::move(checker)));
+  si->setup();
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  ob::ScopedState<GraspPoseSpace> start(space);
+  GraspPoseSpace::set_pose(start.get(), settings.start);
+  pdef->addStartState(start);
+  pdef->setGoal(std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance));
+  TRRTstar planner(si);
+  apply_parameters(planner, settings.parameters);
+  planner.setProblemDefinition(pdef);
+  planner.setup();
+  planner.solve(ob::timedPlannerTerminationCondition(settings.time_limit));
+  return {planner.outcome(), planner.solution(), planner.solution_cost(), planner.restarts()};
 }
 
 std::map<std::string, std::string> trrt_star_parameters() {

@@ -109,9 +109,9 @@ TRRTstar::~TRRTstar() { free_tree(); }
 void TRRTstar::setup() {
   ob::Planner::setup();
   space_ = dynamic_cast<const GraspPoseSpace*>(si_->getStateSpace().get());
-  validator_ = dynamic_cast<StablePushValidator*>(si_->getMotionValidator().get());
+  validator_ = dynamic_cast<PushChecker*>(si_->getMotionValidator().get());
   if (space_ == nullptr || validator_ == nullptr)
-    throw ompl::Exception(getName(), "needs a GraspPoseSpace and a StablePushValidator");
+    throw ompl::Exception(getName(), "needs a GraspPoseSpace and a motion validator that is a PushChecker");
 }
 
 void TRRTstar::free_tree() {
@@ -624,8 +624,7 @@ double TRRTstar::path_margin(const Node* node) const {
   for (; node != nullptr && node->parent != nullptr; node = node->parent) {
     const std::vector<Pose> poses = space_->unit_pushes(node->parent->pose, node->pose);
     for (std::size_t i = 0; i + 1 < poses.size(); ++i) {
-      const Motion dq{poses[i + 1].x - poses[i].x, poses[i + 1].z - poses[i].z, poses[i + 1].theta - poses[i].theta};
-      margin = std::min(margin, worst_case(validator_->models(), poses[i], dq, node->pusher).margin);
+      margin = std::min(margin, validator_->push_margin(poses[i], poses[i + 1], node->pusher));
     }
   }
   return margin;

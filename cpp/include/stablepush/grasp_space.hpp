@@ -92,11 +92,35 @@ class GraspValidityChecker : public ompl::base::StateValidityChecker {
   const StablePushModel& model_;
 };
 
+/// What the search asks of the mechanics: which pushers make a motion a stable push, and how
+/// deep. TRRTstar is written against this alone (OMPL keeps validity apart from search the same
+/// way), so it can be tested with a toy rule; StablePushValidator answers it for the model. The
+/// search finds it as its SpaceInformation's motion validator, which must implement both.
+class PushChecker {
+ public:
+  virtual ~PushChecker() = default;
+  /// Every pusher of the task as a set.
+  virtual PusherSet all_pushers() const = 0;
+  /// The pushers among `candidates` that make every unit push of a -> b stable; 0 when none.
+  virtual PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const = 0;
+  /// The margin [N] of one unit push a -> b by `pusher` (the least over the models), for the
+  /// anytime choice between plans (TRRTstar's improve_for).
+  virtual double push_margin(const Pose& a, const Pose& b, int pusher) const = 0;
+  /// Point pushers, whose stable pushes are a surface (StablePushValidator::onto_wedge_surface);
+  /// by default there are none.
+  virtual PusherSet wedge_pushers() const { return 0; }
+  virtual std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
+                                                 int pusher) const;
+  /// Stable-push tests made so far (what restarts count).
+  virtual std::uint64_t feasibility_checks() const = 0;
+  virtual void reset_feasibility_checks() = 0;
+};
+
 /// A motion a -> b is valid when, for one same pusher, each of its unit pushes
 /// (GraspPoseSpace::unit_pushes) is a stable push with a margin of at least `min_margin` [N] in
 /// every model of the set, and the grasp is maintained throughout (swept pads,
 /// Gripper::grasp_maintained_along).
-class StablePushValidator : public ompl::base::MotionValidator {
+class StablePushValidator : public ompl::base::MotionValidator, public PushChecker {
  public:
   /// At most kMaxModels models (the 4 corners of an uncertainty box).
   StablePushValidator(const ompl::base::SpaceInformationPtr& si, ModelSet models, double min_margin);
@@ -104,11 +128,12 @@ class StablePushValidator : public ompl::base::MotionValidator {
 
   /// The pushers among `candidates` that make every unit push of a -> b stable; 0 when the
   /// grasp is lost on the way.
-  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const;
-  PusherSet all_pushers() const { return all_; }
+  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override;
+  PusherSet all_pushers() const override { return all_; }
+  double push_margin(const Pose& a, const Pose& b, int pusher) const override;
   /// The pushers whose cone is a wedge (a point pusher with mu > 0): their stable all-sliding
   /// motions form a surface in motion space, which onto_wedge_surface finds.
-  PusherSet wedge_pushers() const { return wedges_; }
+  PusherSet wedge_pushers() const override { return wedges_; }
   const ModelSet& models() const { return models_; }
 
   /// A point pusher's stable pushes (docs/model.md section 3): the motion from `a` of `length` unit
@@ -121,15 +146,15 @@ class StablePushValidator : public ompl::base::MotionValidator {
   /// cone is not a wedge, the direction has no translation, or no root exists. The motion still has
   /// to pass stable_pushers (the wedge's facets, every model, the grasp).
   std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
-                                         int pusher) const;
+                                         int pusher) const override;
 
   bool checkMotion(const ompl::base::State* a, const ompl::base::State* b) const override;
   bool checkMotion(const ompl::base::State* a, const ompl::base::State* b,
                    std::pair<ompl::base::State*, double>& last_valid) const override;
 
   /// Stable-push tests made so far (one per pusher and unit push).
-  std::uint64_t feasibility_checks() const { return checks_; }
-  void reset_feasibility_checks() { checks_ = 0; }
+  std::uint64_t feasibility_checks() const override { return checks_; }
+  void reset_feasibility_checks() override { checks_ = 0; }
 
  private:
   ModelSet models_;

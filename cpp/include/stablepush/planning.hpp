@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,20 @@ Plan plan_stable_pushes(const StablePushModel& model, const PlannerSettings& set
 /// The same, with every push stable in every model of `models` (the corners of an uncertainty
 /// box, docs/model.md section 7); each waypoint's margin is the least over them.
 Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings);
+
+/// A search's outcome with a PushChecker of one's own: the path (start first) and its cost.
+struct CheckedPlan {
+  PlanOutcome outcome = PlanOutcome::TimeLimit;
+  std::vector<PathNode> path;
+  PathCost cost;
+  unsigned restarts = 0;
+};
+
+/// TRRTstar from settings.start to settings.goal with `checker` deciding which pushers make a
+/// motion stable (grasp_space.hpp, PushChecker): every pose valid, no hold requirement, samples
+/// from the start-goal box grown by sampling_margin unit steps. Tests the search apart from the
+/// mechanics with a toy checker; min_margin and min_hold_ratio are not used.
+CheckedPlan plan_with_checker(std::shared_ptr<PushChecker> checker, const PlannerSettings& settings);
 
 /// TRRTstar's declared parameters and their default values (as text).
 std::map<std::string, std::string> trrt_star_parameters();

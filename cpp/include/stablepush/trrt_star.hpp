@@ -216,7 +216,7 @@ class TRRTstar : public ompl::base::Planner {
   /// Whether the search is over: the time is up, or a plan exists and improve_for has passed since.
   bool finished(const ompl::base::PlannerTerminationCondition& ptc) const;
 
-  StablePushValidator* validator_ = nullptr;
+  PushChecker* validator_ = nullptr;  ///< the motion validator, as what the search asks of it
   const GraspPoseSpace* space_ = nullptr;
   std::vector<Node*> nodes_;
   std::vector<Eigen::Vector3d> unit_coords_;  ///< nodes_[i]'s pose in unit steps

@@ -1,0 +1,87 @@
+"""TRRTstar tested apart from the mechanics (issue 10, item 6): the search asks a PushChecker
+which pushers make a motion stable, so a toy rule can stand in for the model, OMPL-style.
+
+The toy: two pushers, each able to move the object only within a narrow cone of directions in
+unit steps, pusher 0 along +x and pusher 1 along +z. A goal up and to the right needs both, so
+one switch-over; with no switch-over allowed it is out of reach."""
+import math
+
+import pytest
+
+from stablepush import _core
+
+MM, DEG = 1e-3, math.radians(1)
+STEP = (1 * MM, DEG)
+
+
+def unit(a, b):
+    """b - a in unit steps."""
+    return ((b[0] - a[0]) / STEP[0], (b[1] - a[1]) / STEP[0], (b[2] - a[2]) / STEP[1])
+
+
+class ConeChecker(_core.PushChecker):
+    AXES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))  # pusher 0: +x, pusher 1: +z
+    COS = 0.9  # a motion is stable for a pusher when within acos(0.9) = 26 deg of its axis
+
+    def __init__(self):
+        super().__init__()
+        self.calls = 0
+
+    def alignment(self, a, b, pusher):
+        d = unit(a, b)
+        n = math.sqrt(sum(c * c for c in d))
+        return sum(c * e for c, e in zip(d, self.AXES[pusher])) / n if n > 0 else -1.0
+
+    def all_pushers(self):
+        return 0b11
+
+    def stable_pushers(self, a, b, candidates):
+        self.calls += 1
+        return sum(1 << p for p in (0, 1) if candidates >> p & 1 and self.alignment(a, b, p) >= self.COS)
+
+    def push_margin(self, a, b, pusher):
+        return self.alignment(a, b, pusher) - self.COS
+
+
+def plan(checker, goal, time_limit=5.0, **parameters):
+    return _core.plan_with_checker(checker, (0.0, 0.0, 0.0), goal, STEP, (0.5 * MM, 0.5 * DEG), time_limit,
+                                   parameters={k: str(v) for k, v in parameters.items()})
+
+
+def test_a_goal_that_needs_both_toy_pushers_takes_one_switch_over_and_every_edge_obeys_the_toy():
+    checker = ConeChecker()
+    out = plan(checker, (6 * MM, 6 * MM, 0.0), max_switches=1, seed=3)
+    assert out["outcome"] == _core.PlanOutcome.goal_reached
+    path = out["path"]
+    assert path[0] == ((0.0, 0.0, 0.0), -1)
+    pushers = [p for _, p in path[1:]]
+    switches = sum(1 for p, q in zip(pushers, pushers[1:]) if p != q)
+    assert switches == out["switches"] == 1 and set(pushers) == {0, 1}
+    for (a, _), (b, pusher) in zip(path, path[1:]):
+        assert ConeChecker().alignment(a, b, pusher) >= ConeChecker.COS  # the rule the search was given
+    end = path[-1][0]
+    assert abs(end[0] - 6 * MM) <= 0.5 * MM and abs(end[1] - 6 * MM) <= 0.5 * MM
+    assert checker.calls > 0
+
+
+def test_with_no_switch_over_allowed_the_toy_goal_is_out_of_reach():
+    out = plan(ConeChecker(), (6 * MM, 6 * MM, 0.0), time_limit=1.0, max_switches=0, seed=3)
+    assert out["outcome"] in (_core.PlanOutcome.goal_over_switch_limit, _core.PlanOutcome.time_limit)
+    assert out["outcome"] != _core.PlanOutcome.goal_reached
+
+
+def test_a_goal_along_one_toy_pusher_takes_no_switch_over_and_the_same_seed_the_same_path():
+    first = plan(ConeChecker(), (8 * MM, 1 * MM, 0.0), seed=5)
+    again = plan(ConeChecker(), (8 * MM, 1 * MM, 0.0), seed=5)
+    assert first["outcome"] == _core.PlanOutcome.goal_reached and first["switches"] == 0
+    assert {p for _, p in first["path"][1:]} == {0}
+    assert first["path"] == again["path"]
+
+
+def test_a_checker_that_leaves_out_a_method_is_a_clear_error():
+    class Incomplete(_core.PushChecker):
+        def all_pushers(self):
+            return 1
+
+    with pytest.raises(RuntimeError, match="stable_pushers"):
+        plan(Incomplete(), (3 * MM, 0.0, 0.0))
