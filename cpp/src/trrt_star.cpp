@@ -335,13 +335,9 @@ PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob:
   for (int p = 0; p < kMaxPushers; ++p) {
     if (!contains(wedges, p)) continue;
     const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, step / length, length, p);
-    if (!on_surface) continue;
-    GraspPoseSpace::set_pose(scratch, *on_surface);
-    if (!si_->isValid(scratch)) continue;
-    const PusherSet stable = validator_->stable_pushers(from, *on_surface, PusherSet{1} << p);
-    if (stable != 0) {
+    if (on_surface && wedge_step_valid(from, WedgeStep{0.0, *on_surface, p}, scratch)) {
       q = *on_surface;
-      return stable;
+      return PusherSet{1} << p;
     }
   }
   GraspPoseSpace::set_pose(scratch, q);
