@@ -8,6 +8,7 @@ import pytest
 from conftest import shipped, task_with
 from independent_lp import IndependentModel
 
+from stablepush import _core
 from stablepush.planning import plan_task
 from stablepush.errors import TaskError
 from stablepush.task import MM, pose_to_si
@@ -207,7 +208,6 @@ def test_switch_budget_is_a_hard_stop_criterion():
 
 
 def test_planner_parameters_reach_the_ompl_planner():
-    from stablepush import _core
 
     declared = set(_core.TRRT_STAR_PARAMETERS)
     assert {"goal_bias", "rewire_radius", "steer_angle", "init_temperature", "temp_change_factor",
@@ -244,6 +244,40 @@ def test_capsule_reduces_to_disc_and_matches_sampling():
         assert section.contains_capsule(a, a, r) == section.contains_disc(a, r)
         if section.contains_capsule(a, b, r):  # sampled discs along the spine are all inside
             assert all(section.contains_disc(a + t * (b - a), r) for t in np.linspace(0, 1, 21))
+
+
+@pytest.mark.parametrize("vertices, convex", [
+    ([(-50, -12.5), (50, -12.5), (50, 12.5), (-50, 12.5)], True),                 # the paper's prism
+    ([(0, 0), (30, 0), (30, 10), (30, 20), (0, 20)], True),                         # a collinear vertex
+    ([(20 * np.cos(a), 20 * np.sin(a)) for a in np.linspace(0, 2 * np.pi, 7)[:-1] + 0.3], True),  # hexagon
+    ([(-20, -10), (25, -5), (-3, 18)], True),                                        # triangle
+    ([(-35, -25), (35, -25), (35, -10), (10, -10), (10, 25), (-10, 25), (-10, -10), (-35, -10)], False),  # the T
+])
+def test_sections_contain_capsules_as_shapely_says(vertices, convex):
+    """A convex section decides containment by its edges' half-planes, a concave one by crossings
+    and distances; shapely's covering and distances decide it independently (cases within 1e-9 mm
+    of tangency skipped)."""
+    from shapely.geometry import LineString, Point, Polygon
+
+    section = _core.CrossSection([np.array(v) * MM for v in vertices])
+    assert section.convex == convex
+    polygon = Polygon(vertices)
+    low, high = np.min(vertices, axis=0), np.max(vertices, axis=0)
+    rng = np.random.default_rng(11)
+    decided = inside = 0
+    for _ in range(2000):
+        a = rng.uniform(low - 5, high + 5)
+        b = a + rng.uniform(-6, 6, 2) * (rng.uniform() < 0.7)
+        r = rng.uniform(0, 6)
+        spine = Point(a) if (a == b).all() else LineString([a, b])
+        clearance = polygon.exterior.distance(spine)
+        if abs(clearance - r) < 1e-9:
+            continue
+        expected = polygon.covers(spine) and clearance >= r
+        assert section.contains_capsule(a * MM, b * MM, r * MM) == expected, (a, b, r)
+        decided += 1
+        inside += expected
+    assert decided > 1900 and 100 < inside < decided - 100  # both answers well represented
 
 
 def test_a_start_the_pads_cannot_hold_is_reported_not_a_crash():

@@ -68,6 +68,7 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("centroid", &CrossSection::centroid)
       .def_property_readonly("polar_moment_about_centroid", &CrossSection::polar_moment_about_centroid)
       .def_property_readonly("circumradius", &CrossSection::circumradius)
+      .def_property_readonly("convex", &CrossSection::convex)
       .def("contains_disc", &CrossSection::contains_disc, py::arg("center"), py::arg("radius"))
       .def("contains_capsule", &CrossSection::contains_capsule, py::arg("a"), py::arg("b"), py::arg("radius"),
            "Whether the disc of `radius` swept along the segment a-b lies inside the polygon.")

@@ -44,6 +44,10 @@ double signed_area(const std::vector<Vec2>& v) {
 
 }  // namespace
 
+struct CrossSection::ExactPolygon {
+  std::vector<Epick::Point_2> points;
+};
+
 Vec2 unit_circle_point(long j, long n) {
   // Work with the angle fraction P/Q = j/n scaled so that Q/2 and Q/4 are integers.
   long Q = 8 * n;
@@ -107,6 +111,19 @@ CrossSection::CrossSection(std::vector<Vec2> vertices) : vertices_(std::move(ver
   centroid_ = Vec2(cx / (3.0 * a2), cz / (3.0 * a2));
   polar_moment_centroid_ = j_origin / 12.0 - area_ * centroid_.squaredNorm();
   for (const Vec2& v : vertices_) circumradius_ = std::max(circumradius_, v.norm());
+
+  auto exact = std::make_shared<ExactPolygon>();
+  exact->points = to_cgal(vertices_);
+  const auto& pts = exact->points;
+  const std::size_t n = pts.size();
+  convex_ = true;  // counterclockwise and simple: convex iff no vertex turns right
+  for (std::size_t i = 0; i < n && convex_; ++i)
+    convex_ = CGAL::orientation(pts[i], pts[(i + 1) % n], pts[(i + 2) % n]) != CGAL::RIGHT_TURN;
+  exact_ = std::move(exact);
+  for (std::size_t i = 0; i < n; ++i) {
+    inward_normals_.push_back(inward_normal(static_cast<int>(i)));
+    offsets_.push_back(inward_normals_.back().dot(vertices_[i]));
+  }
 }
 
 CrossSection CrossSection::box(double length_x, double height_z) {
@@ -119,7 +136,18 @@ bool CrossSection::contains_disc(const Vec2& center, double radius) const {
 }
 
 bool CrossSection::contains_capsule(const Vec2& a, const Vec2& b, double radius) const {
-  const auto points = to_cgal(vertices_);
+  if (convex_) {
+    // The least signed distance of the spine's ends inside the edges' lines, in double: each is
+    // good to a few ulps of |a|, |b| and the circumradius.
+    double least = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < offsets_.size(); ++i)
+      least = std::min({least, inward_normals_[i].dot(a) - offsets_[i], inward_normals_[i].dot(b) - offsets_[i]});
+    const double band = 1e-12 * (circumradius_ + a.norm() + b.norm() + radius);
+    if (least - radius > band) return true;
+    if (radius - least > band) return false;
+    return contains_capsule_exactly(a, b, radius);
+  }
+  const auto& points = exact_->points;
   // Exact predicate (filtered by CGAL): is the spine's start inside the closed polygon?
   if (CGAL::bounded_side_2(points.begin(), points.end(), Epick::Point_2(a.x(), a.y()), Epick()) ==
       CGAL::ON_UNBOUNDED_SIDE)
@@ -146,7 +174,18 @@ bool CrossSection::contains_capsule(const Vec2& a, const Vec2& b, double radius)
   const double band = 1e-12 * (circumradius_ * circumradius_ + a.squaredNorm() + b.squaredNorm() + r2);
   if (min_d2 - r2 > band) return true;
   if (r2 - min_d2 > band) return false;
-  // Within rounding of tangency: decide with exact constructions.
+  return contains_capsule_exactly(a, b, radius);
+}
+
+bool CrossSection::contains_capsule_exactly(const Vec2& a, const Vec2& b, double radius) const {
+  const auto& points = exact_->points;
+  if (CGAL::bounded_side_2(points.begin(), points.end(), Epick::Point_2(a.x(), a.y()), Epick()) ==
+      CGAL::ON_UNBOUNDED_SIDE)
+    return false;
+  const bool is_point = a == b;
+  const Epick::Segment_2 spine(Epick::Point_2(a.x(), a.y()), Epick::Point_2(b.x(), b.y()));
+  for (std::size_t i = 0; i < points.size() && !is_point; ++i)
+    if (CGAL::do_intersect(spine, Epick::Segment_2(points[i], points[(i + 1) % points.size()]))) return false;
   const Epeck::Point_2 ea(a.x(), a.y()), eb(b.x(), b.y());
   const Epeck::FT exact_r2 = Epeck::FT(radius) * Epeck::FT(radius);
   for (std::size_t i = 0; i < vertices_.size(); ++i) {

@@ -44,7 +44,7 @@ std::pair<ExactFT, ExactFT> exact_pull_back(const ExactWrench& row, const Rotati
 PushResult StablePushModel::exact_all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q,
                                               const Motion& dq, PushResult answer) const {
   ExactLoads loads;
-  visit_motion_terms(q, dq, load.gravity, loads);
+  visit_motion_terms(q, load.rotation, dq, load.gravity, loads);
   const ExactWrench required = exact_required(loads, load.rotation);
   answer.exact = true;
   // The caller found the wrench within the certification band of the cone's span (all_sliding):
@@ -59,7 +59,7 @@ PushResult StablePushModel::exact_all_sliding(const WrenchCone& cone, const Moti
 PushResult StablePushModel::exact_sticking(const WrenchCone& cone, const MotionWrench& load, const Pose& q,
                                            const Motion& dq) const {
   ExactLoads loads;
-  visit_motion_terms(q, dq, load.gravity, loads);
+  visit_motion_terms(q, load.rotation, dq, load.gravity, loads);
   const ExactWrench required = exact_required(loads, load.rotation);
   const int groups = static_cast<int>(loads.groups.size());
   const int t_var = 2 * groups;

@@ -9,8 +9,8 @@
 namespace stablepush {
 
 template <class Loads>
-void StablePushModel::visit_motion_terms(const Pose& q, const Motion& dq, const Vec2& gravity, Loads& loads) const {
-  const Rotation2 rotation(q.theta);
+void StablePushModel::visit_motion_terms(const Pose& q, const Rotation2& rotation, const Motion& dq,
+                                         const Vec2& gravity, Loads& loads) const {
   const double dt = step_time_;
   const Vec2 origin(q.x, q.z);
   const Vec2 v(dq.x / dt, dq.z / dt);  // velocity of O's origin in G [m/s]

@@ -109,7 +109,7 @@ MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq, int
   load.gravity = gravity_in_gripper(load.rotation, pusher);
   DoubleLoads loads{1.0 / torque_length_};
   loads.out = &load;
-  visit_motion_terms(q, dq, load.gravity, loads);
+  visit_motion_terms(q, load.rotation, dq, load.gravity, loads);
   const Vec2 force_in_O = load.rotation.apply_inverse(loads.force_sum);
   load.required = Wrench(force_in_O.x(), force_in_O.y(), loads.torque_sum);
   load.scale = loads.scale;

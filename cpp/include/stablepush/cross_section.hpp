@@ -1,6 +1,7 @@
 // The object's cross-section in its own frame O: a simple polygon (concave allowed).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -32,13 +33,19 @@ class CrossSection {
   /// Largest distance from O's origin to the boundary [m]; the length that turns torques into forces
   /// when wrench components are compared (margins in newtons).
   double circumradius() const { return circumradius_; }
+  /// Whether the polygon is convex (collinear vertices allowed); containment is then a test
+  /// against its edges' half-planes.
+  bool convex() const { return convex_; }
 
   /// Whether the closed disc (centre in O [m], radius [m]) lies inside the closed polygon.
-  /// Decided in double unless the answer is within rounding of tangency; then with CGAL's exact kernel.
+  /// Decided in double unless the answer is within rounding of tangency; then with CGAL's exact
+  /// kernel. A convex polygon is the intersection of its edges' inner half-planes, so the disc is
+  /// inside iff its centre is at least `radius` inside every edge's line.
   bool contains_disc(const Vec2& center, double radius) const;
 
   /// Whether the capsule swept by a disc of `radius` [m] whose centre moves along the segment a-b
   /// (in O [m]) lies inside the closed polygon. contains_capsule(c, c, r) == contains_disc(c, r).
+  /// In a convex polygon the capsule, the hull of its two end discs, is inside iff both are.
   bool contains_capsule(const Vec2& a, const Vec2& b, double radius) const;
 
   /// Euclidean distance from a point of O to the boundary [m].
@@ -60,6 +67,16 @@ class CrossSection {
   Vec2 centroid_ = Vec2::Zero();
   double polar_moment_centroid_ = 0.0;
   double circumradius_ = 0.0;
+  bool convex_ = false;
+  /// Edge i's inward unit normal and offset: n_i . p - offset_i is p's signed distance [m] inside
+  /// edge i's line (the containment test's half-planes when convex).
+  std::vector<Vec2> inward_normals_;
+  std::vector<double> offsets_;
+  /// The vertices as CGAL points, built once (the general, concave, test and the exact decisions).
+  struct ExactPolygon;
+  std::shared_ptr<const ExactPolygon> exact_;
+  /// contains_capsule decided in exact arithmetic (within rounding of tangency).
+  bool contains_capsule_exactly(const Vec2& a, const Vec2& b, double radius) const;
 };
 
 }  // namespace stablepush

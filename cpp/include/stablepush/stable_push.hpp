@@ -135,10 +135,11 @@ class StablePushModel {
 
   /// Walks the terms of the motion wrench in G: loads.force(f, arm) for a force f [N] at arm [m]
   /// from O's origin, loads.torque(t) for a pure torque [N m], loads.sticking(arm, limit) for a
-  /// sticking pad point; `gravity` in G [m/s^2]. Shared by the double and the exact evaluations so
-  /// both see the same doubles.
+  /// sticking pad point; `rotation` R(q.theta), computed once by the caller; `gravity` in G
+  /// [m/s^2]. Shared by the double and the exact evaluations so both see the same doubles.
   template <class Loads>
-  void visit_motion_terms(const Pose& q, const Motion& dq, const Vec2& gravity, Loads& loads) const;
+  void visit_motion_terms(const Pose& q, const Rotation2& rotation, const Motion& dq, const Vec2& gravity,
+                          Loads& loads) const;
 
  private:
   PushResult all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq) const;
