@@ -1,5 +1,5 @@
 """Cross-check of the core's stable-push test against an independent HiGHS LP (tests/independent_lp.py)
-on 10,000 random queries over the paper's tasks and a point-pusher task.
+on 11,500 random queries over the paper's tasks, a point-pusher task and one whose pads are apart.
 
 Agreement is required outside a band around the cone boundary: |core margin| > BAND_N.
 """
@@ -19,6 +19,15 @@ def point_pusher_task():
     def edit(d):
         d["gravity"] = [0, 0]
         d["pushers"] = [{"name": "tip-left", "at": [-50, 0], "mu": 0.6}, {"name": "tip-bottom", "at": [0, -12.5], "mu": 0.6}]
+
+    return task_with("horizontal-offset-low-mu", edit)
+
+
+def offset_pads_task():
+    """Pads at different places with different radii: no pad points coincide (Gripper::sites merges
+    only coincident ones)."""
+    def edit(d):
+        d["gripper"]["pads"] = [{"center": [-8, 0], "radius": 5}, {"center": [6, 2], "radius": 4}]
 
     return task_with("horizontal-offset-low-mu", edit)
 
@@ -47,12 +56,14 @@ CASES = [
     ("large-manipulation", 1500),
     ("t-shaped", 1500),
     ("point-pushers", 1500),
+    ("offset-pads", 1500),
 ]
 
 
 @pytest.mark.parametrize("name,n", CASES)
 def test_core_agrees_with_independent_lp(name, n):
-    task = point_pusher_task() if name == "point-pushers" else shipped(name)
+    built = {"point-pushers": point_pusher_task, "offset-pads": offset_pads_task}
+    task = built[name]() if name in built else shipped(name)
     model, reference = task.build_model(), IndependentModel(task)
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     compared = near = sticking = feasible = 0

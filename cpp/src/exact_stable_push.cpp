@@ -23,7 +23,7 @@ struct ExactLoads {
     tau += exact(arm.y()) * f_x - exact(arm.x()) * f_z;
   }
   void torque(double t) { tau += exact(t); }
-  void sticking(const Vec2& arm, double friction_limit) { add_sticking_point(groups, arm, friction_limit); }
+  void sticking(const Vec2& arm, double friction_limit, int) { add_sticking_point(groups, arm, friction_limit); }
 };
 
 /// The motion wrench in O, exactly, from the same doubles (R^T applied with the same cos and sin).

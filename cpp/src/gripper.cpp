@@ -25,6 +25,17 @@ Gripper::Gripper(std::vector<Pad> pads, double grip_force, double mu, int pad_ri
         points_.push_back({pad.center + radius * unit_circle_point(j, 6 * ring), friction_limit, pad.radius, p});
     }
   }
+  for (const PadPoint& point : points_) {
+    auto same = std::find_if(sites_.begin(), sites_.end(), [&](const PadPoint& site) {
+      return site.position == point.position && site.pad_radius == point.pad_radius;
+    });
+    if (same == sites_.end()) {
+      sites_.push_back(point);
+    } else {
+      same->friction_limit += point.friction_limit;
+      same->count += point.count;
+    }
+  }
 }
 
 std::vector<bool> Gripper::pads_inside(const CrossSection& section, const Pose& q) const {

@@ -30,9 +30,9 @@ struct DoubleLoads {
     torque_sum += t;
     scale += std::abs(t) * inverse_length;
   }
-  void sticking(const Vec2& arm, double friction_limit) {
+  void sticking(const Vec2& arm, double friction_limit, int points) {
     add_sticking_point(out->sticking, arm, friction_limit);
-    out->sticking_points += 1;
+    out->sticking_points += points;
     scale += 2.0 * friction_limit * (1.0 + (std::abs(arm.x()) + std::abs(arm.y())) * inverse_length);
   }
 };
@@ -124,7 +124,7 @@ double StablePushModel::hold_ratio(const Pose& q, int pusher) const {
   const Vec2 origin(q.x, q.z);
   const Vec2 r_cm = Rotation2(q.theta).apply(body_.com);
   std::vector<StickingGroup> groups;
-  for (const PadPoint& point : gripper_.points()) add_sticking_point(groups, point.position - origin, point.friction_limit);
+  for (const PadPoint& site : gripper_.sites()) add_sticking_point(groups, site.position - origin, site.friction_limit);
 
   // Unknowns x = (f_1, ..., f_G, lambda), forces in G. Balance in G about O's origin:
   //   sum f_g + lambda W = 0,   sum arm_g x f_g + lambda (r_cm x W) = 0   (E x = 0),

@@ -20,7 +20,8 @@ struct PadPoint {
   Vec2 position;          ///< in G [m]
   double friction_limit;  ///< mu N / k [N]: the largest friction force this point can exert
   double pad_radius;      ///< radius of its pad [m]; sets the slip-speed scale of the stick test
-  int pad;                ///< index of its pad
+  int pad;                ///< index of its (first) pad
+  int count = 1;          ///< pad points it stands for (Gripper::sites merges coincident ones)
 };
 
 class Gripper {
@@ -31,6 +32,11 @@ class Gripper {
 
   const std::vector<Pad>& pads() const { return pads_; }
   const std::vector<PadPoint>& points() const { return points_; }
+  /// The pad points with coincident ones merged: points at the same place with the same pad
+  /// radius (the two pads of a parallel-jaw grasp meet the object at the same place of the grasp
+  /// plane) slip, stick and load the object alike, so each becomes one site whose friction limit
+  /// is their sum and whose count is their number. What the mechanics walks.
+  const std::vector<PadPoint>& sites() const { return sites_; }
   double grip_force() const { return grip_force_; }
   double mu() const { return mu_; }
   int pad_rings() const { return pad_rings_; }
@@ -50,6 +56,7 @@ class Gripper {
   double mu_;
   int pad_rings_;
   std::vector<PadPoint> points_;
+  std::vector<PadPoint> sites_;
 };
 
 }  // namespace stablepush

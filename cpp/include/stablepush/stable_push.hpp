@@ -134,8 +134,8 @@ class StablePushModel {
   bool grasp_maintained(const Pose& q) const { return gripper_.grasp_maintained(section_, q); }
 
   /// Walks the terms of the motion wrench in G: loads.force(f, arm) for a force f [N] at arm [m]
-  /// from O's origin, loads.torque(t) for a pure torque [N m], loads.sticking(arm, limit) for a
-  /// sticking pad point; `rotation` R(q.theta), computed once by the caller; `gravity` in G
+  /// from O's origin, loads.torque(t) for a pure torque [N m], loads.sticking(arm, limit, n) for a
+  /// sticking site of n pad points (Gripper::sites); `rotation` R(q.theta), computed once by the caller; `gravity` in G
   /// [m/s^2]. Shared by the double and the exact evaluations so both see the same doubles.
   template <class Loads>
   void visit_motion_terms(const Pose& q, const Rotation2& rotation, const Motion& dq, const Vec2& gravity,
