@@ -261,8 +261,10 @@ def test_world_deviations_need_the_simulated_arm(tmp_path):
 
 def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     """The low-mu offset in a world whose pads and features have 15% less mu than the task says:
-    open loop its pusher slips and it ends 1.2 mm from the goal (README); closed loop it re-plans
-    from the tracked pose and ends within the final tolerance of the goal."""
+    open loop its pusher slips and it ends about 1 mm from the goal; closed loop it re-plans from
+    the tracked pose and ends within the loop's threshold (half the goal tolerance). Whether it
+    also ends within the final tolerance depends on the plan (README, "Closed loop"): drift that
+    shows after the prism has passed the bottom pusher can no longer be lifted out."""
     from stablepush.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
 
@@ -270,10 +272,14 @@ def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
     loop = ClosedLoop.for_task(task)
     with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=0.85)) as server:
+        open_loop = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
+    with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=0.85)) as server:
         report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop)
+    assert open_loop.goal_error["distance"] > 0.5, open_loop.goal_error
     assert report.closed_loop == "on"
     assert any(r.solved and r.pushes > 0 for r in report.replans), report.replans
-    assert report.goal_error["distance"] <= loop.final_tolerance[0], report.goal_error
+    assert report.goal_error["distance"] <= min(loop.threshold[0], open_loop.goal_error["distance"] / 4), \
+        (report.goal_error, open_loop.goal_error)
     assert abs(report.goal_error["theta"]) <= loop.final_tolerance[1], report.goal_error
     assert report.last_confirmed_step == report.total_steps  # the spliced plan ran to its end
     assert report.as_dict()["replans"][0]["after_step"] >= 1

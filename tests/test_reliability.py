@@ -156,7 +156,7 @@ def low_mu_plan():
     (lambda p: p.update(stats=[]), "stats: must be a mapping, got a list"),
     (lambda p: p.update(stats=None), "stats: must be a mapping, got null"),
     (lambda p: p.update(solved="no"), "solved: must be a boolean, got a string"),
-    (lambda p: p["waypoints"][2].update(x=p["waypoints"][2]["x"] + 50), "waypoints[2]: a step of 51 unit steps"),
+    (lambda p: p["waypoints"][2].update(x=p["waypoints"][2]["x"] + 50), "waypoints[2]: a step of 5"),
     (lambda p: p["waypoints"][3].update(x=10 ** 400), "waypoints[3].x: must be a finite number"),
     (lambda p: p["waypoints"].extend([p["waypoints"][-1]] * 10_001), "a plan has at most 10000"),
 ])

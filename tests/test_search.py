@@ -26,6 +26,7 @@ class ConeChecker(_core.PushChecker):
     def __init__(self):
         super().__init__()
         self.calls = 0
+        self.asked = []  # the candidate set of each call
 
     def alignment(self, a, b, pusher):
         d = unit(a, b)
@@ -37,6 +38,7 @@ class ConeChecker(_core.PushChecker):
 
     def stable_pushers(self, a, b, candidates):
         self.calls += 1
+        self.asked.append(candidates)
         return sum(1 << p for p in (0, 1) if candidates >> p & 1 and self.alignment(a, b, p) >= self.COS)
 
     def push_margin(self, a, b, pusher):
@@ -76,6 +78,16 @@ def test_a_goal_along_one_toy_pusher_takes_no_switch_over_and_the_same_seed_the_
     assert first["outcome"] == _core.PlanOutcome.goal_reached and first["switches"] == 0
     assert {p for _, p in first["path"][1:]} == {0}
     assert first["path"] == again["path"]
+
+
+def test_a_descent_asks_for_its_own_pusher_first_and_for_no_other_while_it_works():
+    """Toward a goal along +x every descent goes on with pusher 0; only pushes from the start,
+    where no pusher is the descent's own yet, ask for both."""
+    checker = ConeChecker()
+    out = plan(checker, (12 * MM, 0.0, 0.0), goal_bias=1.0, seed=2)
+    assert out["outcome"] == _core.PlanOutcome.goal_reached and {p for _, p in out["path"][1:]} == {0}
+    assert checker.asked.count(0b01) >= 11  # each push after the first asks for pusher 0 alone
+    assert 0b10 not in checker.asked and checker.asked.count(0b11) <= 3
 
 
 def test_a_checker_that_leaves_out_a_method_is_a_clear_error():

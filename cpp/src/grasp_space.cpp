@@ -162,38 +162,59 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
   return Pose{a.x + dq.x, a.z + dq.z, a.theta + dq.theta};
 }
 
+PusherSet PushChecker::stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,
+                                                PusherSet preferred) const {
+  if ((candidates & preferred) == 0 || (candidates & ~preferred) == 0) return stable_pushers(a, b, candidates);
+  const PusherSet first = stable_pushers(a, b, candidates & preferred);
+  return first != 0 ? first : stable_pushers(a, b, candidates & ~preferred);
+}
+
 PusherSet StablePushValidator::stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const {
   const std::vector<Pose> poses = space_.unit_pushes(a, b);
+  for (std::size_t i = 0; i + 1 < poses.size() && candidates != 0; ++i)
+    candidates = stable_in_unit_push(poses[i], poses[i + 1], candidates, 0);
+  return candidates;
+}
+
+PusherSet StablePushValidator::stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,
+                                                         PusherSet preferred) const {
+  const std::vector<Pose> poses = space_.unit_pushes(a, b);
+  if (poses.size() != 2) return PushChecker::stable_pushers_preferring(a, b, candidates, preferred);
+  return stable_in_unit_push(poses[0], poses[1], candidates, preferred);
+}
+
+PusherSet StablePushValidator::stable_in_unit_push(const Pose& from, const Pose& to, PusherSet candidates,
+                                                   PusherSet preferred) const {
+  if (candidates == 0) return 0;
   const StablePushModel& geometry = *models_.front();
+  if (!geometry.gripper().grasp_maintained_along(geometry.section(), from, to)) return 0;
+  const Motion dq{to.x - from.x, to.z - from.z, to.theta - from.theta};
   const int models = static_cast<int>(models_.size());
-  for (std::size_t i = 0; i + 1 < poses.size() && candidates != 0; ++i) {
-    const Pose& from = poses[i];
-    const Pose& to = poses[i + 1];
-    if (!geometry.gripper().grasp_maintained_along(geometry.section(), from, to)) return 0;
-    const Motion dq{to.x - from.x, to.z - from.z, to.theta - from.theta};
-    // One motion wrench per model serves every pusher whose gravity is the same (all of them,
-    // unless the features hold the object at different world orientations; see GravityFrame).
-    std::array<int, kMaxModels> loaded_for;
-    loaded_for.fill(-1);
-    std::array<MotionWrench, kMaxModels> loads;
+  // One motion wrench per model serves every pusher whose gravity is the same (all of them,
+  // unless the features hold the object at different world orientations; see GravityFrame).
+  std::array<int, kMaxModels> loaded_for;
+  loaded_for.fill(-1);
+  std::array<MotionWrench, kMaxModels> loads;
+  PusherSet stable = 0;
+  for (const PusherSet group : {candidates & preferred, candidates & ~preferred}) {
     for (int p = 0; p < kMaxPushers; ++p) {
-      if (!contains(candidates, p)) continue;
+      if (!contains(group, p)) continue;
       ++checks_;
-      for (int m = 0; m < models; ++m) {
+      bool stable_in_every_model = true;
+      for (int m = 0; m < models && stable_in_every_model; ++m) {
         const StablePushModel& model = *models_[m];
         if (loaded_for[m] < 0 || !model.same_gravity(loaded_for[m], p)) {
           loads[m] = model.motion_wrench(from, dq, p);
           loaded_for[m] = p;
         }
         const PushResult r = model.check(loads[m], from, dq, p);
-        if (!(r.feasible && r.margin >= min_margin_)) {
-          candidates &= ~(PusherSet{1} << p);
-          break;
-        }
+        stable_in_every_model = r.feasible && r.margin >= min_margin_;
       }
+      if (stable_in_every_model) stable |= PusherSet{1} << p;
     }
+    if (stable != 0) break;  // the preferred pushers that work, or (none preferred) every one that does
   }
-  return candidates;
+  return stable;
 }
 
 PushResult worst_case(const ModelSet& models, const Pose& q, const Motion& dq, int pusher) {

@@ -16,7 +16,6 @@
 
 
 namespace stablepush {
-
 namespace ob = ompl::base;
 
 struct TRRTstar::Node {
@@ -28,6 +27,7 @@ struct TRRTstar::Node {
   PathCost cost;
   double goal_distance = 0.0;  ///< T-RRT configuration cost [unit steps]
   bool extended_to_goal = false;  ///< a goal sample has already been extended from here
+  int descent = -1;  ///< the descent that made this node or started from it (index into descent_ends_)
 };
 
 /// A way to connect a new pose: from `parent`, at `cost`, by any pusher of `pushers`.
@@ -125,6 +125,7 @@ void TRRTstar::free_tree() {
   kept_paths_.clear();
   improved_.reset();
   unit_coords_.clear();
+  descent_ends_.clear();
 }
 
 void TRRTstar::clear() {
@@ -194,12 +195,12 @@ TRRTstar::Node* TRRTstar::nearest_extendable(const Pose& q) const {
   Node* best = nullptr;
   double best_d2 = 0.0;
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    if (nodes_[i]->cost.switches > max_switches_) continue;
     const double d2 = (unit_coords_[i] - u).squaredNorm();
-    if (best == nullptr || d2 < best_d2) {
-      best = nodes_[i];
-      best_d2 = d2;
-    }
+    // The coordinates are contiguous, the nodes are not: look at a node only when it would be nearer.
+    if (best != nullptr && !(d2 < best_d2)) continue;
+    if (nodes_[i]->cost.switches > max_switches_) continue;
+    best = nodes_[i];
+    best_d2 = d2;
   }
   return best;
 }
@@ -461,6 +462,19 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
 void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
   const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
   ob::State* step_state = si_->allocState();
+  int turn = 0;  // the last step's deviation, as ring * 8 + k (0: none)
+  const int descent = static_cast<int>(descent_ends_.size());
+  descent_ends_.push_back(-1.0);
+  if (from->descent < 0) from->descent = descent;
+  // Where this descent meets one that ended in a dead end well away from the goal (a node of it
+  // within half a step, with the same pusher and no more switch-overs), the rest would retrace
+  // it. Descents that ended near the goal are not cut short: there the last steps decide, and
+  // descents from nearby starts end differently.
+  const double far = 2.0 * pdef_->getGoal()->as<ob::GoalRegion>()->getThreshold();
+  const auto retraces = [&](const Node* m, const Node* next) {
+    return m != next && m->descent >= 0 && descent_ends_[m->descent] > far && m->pusher == next->pusher &&
+           m->cost.switches <= next->cost.switches && space_->distance(m->pose, next->pose) < 0.5;
+  };
   while (!finished(ptc)) {
     // The step in unit-step coordinates, u toward the goal.
     const Eigen::Vector3d to_goal =
@@ -480,26 +494,31 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     const PusherSet allowed = from->pusher == kNoPusher || from->cost.switches < max_switches_
                                   ? validator_->all_pushers()
                                   : single(from->pusher);
-    // The step toward the goal, or the nearest deviation from it (in rings of growing angle up
-    // to steer_angle, eight directions per ring) that some allowed pusher makes stable.
-    PusherSet stable = 0;
-    Pose q_new;
+    // The step toward the goal, or a deviation from it (ring r > 0 turns by r / rings of
+    // steer_angle toward the k-th of eight directions square to u) that an allowed pusher makes
+    // stable, the descent's own pusher tested first (it costs no switch-over, and when it works
+    // the others need no test). After the straight step (and a point pusher's surface), the last
+    // step's deviation comes first, since a steered descent tends to keep its turn; then the
+    // rings, nearest first.
+    const PusherSet own = from->pusher == kNoPusher ? 0 : single(from->pusher);
     const int rings = steer_angle_ > 0.0 ? 4 : 0;
-    for (int ring = 0; ring <= rings && stable == 0; ++ring) {
-      const double alpha = steer_angle_ * M_PI / 180.0 * ring / std::max(rings, 1);
-      for (int k = 0; k < (ring == 0 ? 1 : 8) && stable == 0; ++k) {
-        const double phi = 2.0 * M_PI * k / 8.0;
-        const Eigen::Vector3d dir =
-            std::cos(alpha) * u + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
-        const Motion delta = space_->from_unit_steps(length * dir);
-        q_new = Pose{from->pose.x + delta.x, from->pose.z + delta.z, from->pose.theta + delta.theta};
-        GraspPoseSpace::set_pose(step_state, q_new);
-        if (!si_->isValid(step_state)) continue;
-        stable = validator_->stable_pushers(from->pose, q_new, allowed);
-      }
-      // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
-      if (ring == 0 && stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
-    }
+    const auto try_direction = [&](int turn_index, Pose& q) -> PusherSet {
+      const double alpha = steer_angle_ * M_PI / 180.0 * (turn_index / 8) / std::max(rings, 1);
+      const double phi = 2.0 * M_PI * (turn_index % 8) / 8.0;
+      const Eigen::Vector3d dir = std::cos(alpha) * u + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
+      const Motion delta = space_->from_unit_steps(length * dir);
+      q = Pose{from->pose.x + delta.x, from->pose.z + delta.z, from->pose.theta + delta.theta};
+      GraspPoseSpace::set_pose(step_state, q);
+      return si_->isValid(step_state) ? validator_->stable_pushers_preferring(from->pose, q, allowed, own) : 0;
+    };
+    Pose q_new;
+    int turn_taken = 0;  // ring * 8 + k of the step taken (0: straight, or onto a surface)
+    PusherSet stable = try_direction(0, q_new);
+    // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
+    if (stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
+    if (stable == 0 && turn > 0 && (stable = try_direction(turn, q_new)) != 0) turn_taken = turn;
+    for (int t = 8; t < 8 * (rings + 1) && stable == 0; ++t)
+      if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
     if (stable == 0) break;
     if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state),
                          length))
@@ -508,9 +527,14 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     // q_new stay candidates for descents of their own, which start each pusher's straight way in.
     Node* next = connect(from, q_new, stable, from->pusher);
     next->extended_to_goal = true;  // this descent goes on from it
+    next->descent = descent;
     if (next->cost.switches > max_switches_) break;
     from = next;
+    // connect left q_new's near nodes in near_.
+    if (std::any_of(near_.begin(), near_.end(), [&](const Node* m) { return retraces(m, next); })) break;
+    turn = turn_taken;
   }
+  descent_ends_[descent] = from->goal_distance;
   si_->freeState(step_state);
 }
 

@@ -103,6 +103,10 @@ class PushChecker {
   virtual PusherSet all_pushers() const = 0;
   /// The pushers among `candidates` that make every unit push of a -> b stable; 0 when none.
   virtual PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const = 0;
+  /// The same, except that when some of the `preferred` candidates are stable only they are
+  /// returned, and the others need not be tested (a descent going on with its own pusher).
+  virtual PusherSet stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,
+                                              PusherSet preferred) const;
   /// The margin [N] of one unit push a -> b by `pusher` (the least over the models), for the
   /// anytime choice between plans (TRRTstar's improve_for).
   virtual double push_margin(const Pose& a, const Pose& b, int pusher) const = 0;
@@ -129,6 +133,9 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   /// The pushers among `candidates` that make every unit push of a -> b stable; 0 when the
   /// grasp is lost on the way.
   PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override;
+  /// One unit push is tested once for the grasp and its motion wrench, the preferred pushers first.
+  PusherSet stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,
+                                      PusherSet preferred) const override;
   PusherSet all_pushers() const override { return all_; }
   double push_margin(const Pose& a, const Pose& b, int pusher) const override;
   /// The pushers whose cone is a wedge (a point pusher with mu > 0): their stable all-sliding
@@ -157,6 +164,10 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   void reset_feasibility_checks() override { checks_ = 0; }
 
  private:
+  /// The pushers of `candidates` that make the unit push from -> to stable, those of `preferred`
+  /// first: when some of them are, the others are not tested. 0 when the grasp is lost on the way.
+  PusherSet stable_in_unit_push(const Pose& from, const Pose& to, PusherSet candidates, PusherSet preferred) const;
+
   ModelSet models_;
   const GraspPoseSpace& space_;
   double min_margin_;

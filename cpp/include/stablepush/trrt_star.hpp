@@ -222,6 +222,8 @@ class TRRTstar : public ompl::base::Planner {
   std::vector<Eigen::Vector3d> unit_coords_;  ///< nodes_[i]'s pose in unit steps
   std::vector<Node*> goal_nodes_;
   std::vector<Node*> near_;  ///< scratch for near-node queries
+  /// Per descent (extend_toward_goal): the goal distance where it ended [unit steps]; -1 while it runs.
+  std::vector<double> descent_ends_;
   /// `value` if it lies in `name`'s declared range, else std::invalid_argument.
   static double checked(const char* name, double value);
 
@@ -238,7 +240,7 @@ class TRRTstar : public ompl::base::Planner {
   int max_switches_ = 1;
   std::uint32_t seed_ = 1;
   double improve_for_ = 0.0;
-  std::uint64_t restart_checks_ = 10000;
+  std::uint64_t restart_checks_ = 5000;
   unsigned restarts_ = 0;
 
   double temperature_ = 0.0;
