@@ -147,22 +147,14 @@ bool CrossSection::contains_capsule(const Vec2& a, const Vec2& b, double radius)
     if (radius - least > band) return false;
     return contains_capsule_exactly(a, b, radius);
   }
-  const auto& points = exact_->points;
-  // Exact predicate (filtered by CGAL): is the spine's start inside the closed polygon?
-  if (CGAL::bounded_side_2(points.begin(), points.end(), Epick::Point_2(a.x(), a.y()), Epick()) ==
-      CGAL::ON_UNBOUNDED_SIDE)
-    return false;
-  // The capsule is inside iff its spine stays at least `radius` from every edge (a spine that
-  // crosses an edge is at distance 0 from it). Crossings are an exact predicate; distances
-  // are computed in double and re-made exactly only within rounding of tangency.
+  // The capsule is inside iff its spine is inside and stays at least `radius` from every edge.
+  // Distances are computed in double and re-made exactly only within rounding of tangency.
+  if (!spine_inside(a, b)) return false;
   const bool is_point = a == b;
-  const Epick::Segment_2 spine(Epick::Point_2(a.x(), a.y()), Epick::Point_2(b.x(), b.y()));
   double min_d2 = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < vertices_.size(); ++i) {
     const Vec2& p = vertices_[i];
     const Vec2& q = vertices_[(i + 1) % vertices_.size()];
-    if (!is_point && CGAL::do_intersect(spine, Epick::Segment_2(points[i], points[(i + 1) % points.size()])))
-      return false;
     double d2 = squared_distance_to_segment(a, p, q);
     if (!is_point)
       d2 = std::min({d2, squared_distance_to_segment(b, p, q), squared_distance_to_segment(p, a, b),
@@ -177,15 +169,22 @@ bool CrossSection::contains_capsule(const Vec2& a, const Vec2& b, double radius)
   return contains_capsule_exactly(a, b, radius);
 }
 
-bool CrossSection::contains_capsule_exactly(const Vec2& a, const Vec2& b, double radius) const {
+bool CrossSection::spine_inside(const Vec2& a, const Vec2& b) const {
+  // Exact predicates (filtered by CGAL): the start inside the closed polygon, and no edge crossed.
   const auto& points = exact_->points;
   if (CGAL::bounded_side_2(points.begin(), points.end(), Epick::Point_2(a.x(), a.y()), Epick()) ==
       CGAL::ON_UNBOUNDED_SIDE)
     return false;
-  const bool is_point = a == b;
+  if (a == b) return true;
   const Epick::Segment_2 spine(Epick::Point_2(a.x(), a.y()), Epick::Point_2(b.x(), b.y()));
-  for (std::size_t i = 0; i < points.size() && !is_point; ++i)
+  for (std::size_t i = 0; i < points.size(); ++i)
     if (CGAL::do_intersect(spine, Epick::Segment_2(points[i], points[(i + 1) % points.size()]))) return false;
+  return true;
+}
+
+bool CrossSection::contains_capsule_exactly(const Vec2& a, const Vec2& b, double radius) const {
+  if (!spine_inside(a, b)) return false;
+  const bool is_point = a == b;
   const Epeck::Point_2 ea(a.x(), a.y()), eb(b.x(), b.y());
   const Epeck::FT exact_r2 = Epeck::FT(radius) * Epeck::FT(radius);
   for (std::size_t i = 0; i < vertices_.size(); ++i) {

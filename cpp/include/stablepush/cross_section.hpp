@@ -75,6 +75,9 @@ class CrossSection {
   /// The vertices as CGAL points, built once (the general, concave, test and the exact decisions).
   struct ExactPolygon;
   std::shared_ptr<const ExactPolygon> exact_;
+  /// The segment a-b starts inside the closed polygon and crosses no edge (touching one counts as
+  /// crossing unless a == b); exact predicates.
+  bool spine_inside(const Vec2& a, const Vec2& b) const;
   /// contains_capsule decided in exact arithmetic (within rounding of tangency).
   bool contains_capsule_exactly(const Vec2& a, const Vec2& b, double radius) const;
 };
