@@ -15,11 +15,16 @@ import numpy as np
 from stablepush.task import MM
 
 
-def in_gripper(pose_mm_deg: Sequence[float], points) -> np.ndarray:
-    """Points of O (n x 2, mm) seen from G at q (x mm, z mm, theta deg): p_G = (x, z) + R(theta) p_O."""
+def point_in_gripper(pose_mm_deg: Sequence[float], p: Sequence[float]) -> Tuple[float, float]:
+    """A point of O (mm) seen from G at q (x mm, z mm, theta deg): p_G = (x, z) + R(theta) p_O.
+    Plain floats: a plan asks this for every waypoint, where numpy's per-call cost would dominate."""
     c, s = math.cos(math.radians(pose_mm_deg[2])), math.sin(math.radians(pose_mm_deg[2]))
-    p = np.asarray(points, float).reshape(-1, 2)
-    return np.column_stack([pose_mm_deg[0] + c * p[:, 0] + s * p[:, 1], pose_mm_deg[1] - s * p[:, 0] + c * p[:, 1]])
+    return (pose_mm_deg[0] + c * p[0] + s * p[1], pose_mm_deg[1] - s * p[0] + c * p[1])
+
+
+def in_gripper(pose_mm_deg: Sequence[float], points) -> np.ndarray:
+    """Points of O (n x 2, mm) seen from G at q, as an n x 2 array (point_in_gripper for each)."""
+    return np.array([point_in_gripper(pose_mm_deg, p) for p in np.asarray(points, float).reshape(-1, 2)]).reshape(-1, 2)
 
 
 def direction_in_gripper(theta_deg: float, v: Sequence[float]) -> Tuple[float, float]:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Dict, List, Optional, Tuple
 import numpy as np
 
 from stablepush import _core
-from stablepush.frames import direction_in_gripper, in_gripper
+from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.mechanics import CASE_NAMES
 from stablepush.task import MM, PLANNER_TUNING, Task, planner_limit, planner_parameter, pose_from_si, pose_to_si
 
@@ -147,9 +147,9 @@ PlanResult = Plan  # the name planning used before there was one plan type
 def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, pose_mm_deg) -> PusherContact:
     """Where pusher `pusher` touches the object, seen from G, when the object is at the pose."""
     spec = task.pushers[pusher]
-    start, end = (tuple(float(v) for v in p) for p in in_gripper(pose_mm_deg, [spec.a, spec.b]))
     normal = direction_in_gripper(pose_mm_deg[2], model.pushers[pusher].inward_normal)
-    return PusherContact(start=start, end=end, normal=tuple(float(v) for v in normal))
+    return PusherContact(start=point_in_gripper(pose_mm_deg, spec.a), end=point_in_gripper(pose_mm_deg, spec.b),
+                         normal=tuple(float(v) for v in normal))
 
 
 def plan_task(
