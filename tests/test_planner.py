@@ -208,7 +208,6 @@ def test_switch_budget_is_a_hard_stop_criterion():
 
 
 def test_planner_parameters_reach_the_ompl_planner():
-
     declared = set(_core.TRRT_STAR_PARAMETERS)
     assert {"goal_bias", "rewire_radius", "steer_angle", "init_temperature", "temp_change_factor",
             "max_transition_failures", "max_switches", "seed"} <= declared

@@ -24,8 +24,9 @@ void StablePushModel::visit_motion_terms(const Pose& q, const Rotation2& rotatio
   loads.force(body_.mass * (v_cm / dt - gravity), r_cm);
   loads.torque(body_.inertia * omega / dt);
 
-  // Fingers (coincident pad points merged, Gripper::sites): a sliding point exerts -mu N/k v_j/|v_j| (maximum dissipation), so -w_sliding adds
-  // +mu N/k v_j/|v_j|; a sticking point contributes its friction disc instead.
+  // Fingers, coincident pad points merged (Gripper::sites): a sliding point exerts
+  // -mu N/k v_j/|v_j| (maximum dissipation), so -w_sliding adds +mu N/k v_j/|v_j|; a sticking
+  // point contributes its friction disc instead.
   for (const PadPoint& point : gripper_.sites()) {
     const Vec2 arm = point.position - origin;
     const Vec2 slip = v + omega_cross(omega, arm);

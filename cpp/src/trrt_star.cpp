@@ -16,6 +16,7 @@
 
 
 namespace stablepush {
+
 namespace ob = ompl::base;
 
 struct TRRTstar::Node {

@@ -157,8 +157,10 @@ class TRRTstar : public ompl::base::Planner {
   Node* connect(Node* from, const Pose& q_new, PusherSet stable, int prefer = kNoPusher);
   /// Unit steps from `from` straight toward `target` while each is accepted (Algorithm 1).
   void extend(Node* from, const ompl::base::State* target, const ompl::base::PlannerTerminationCondition& ptc);
-  /// Unit steps from `from` toward the goal, each the straight step or the nearest deviation
-  /// from it within steer_angle that a pusher allowed by the switch-over budget makes stable.
+  /// A descent: unit steps from `from` toward the goal, each the straight step, else the last
+  /// step's deviation, else the nearest deviation within steer_angle that a pusher allowed by the
+  /// switch-over budget makes stable (the descent's own pusher tested first). It stops at a dead
+  /// end, or where it meets a descent that ended in a dead end far from the goal.
   void extend_toward_goal(Node* from, const ompl::base::PlannerTerminationCondition& ptc);
   /// When no pusher makes the step from -> q stable: the step of the same length and heading onto
   /// the stable surface of a point pusher in `allowed` (StablePushValidator::onto_wedge_surface)
