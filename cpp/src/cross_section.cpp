@@ -138,10 +138,13 @@ bool CrossSection::contains_disc(const Vec2& center, double radius) const {
 bool CrossSection::contains_capsule(const Vec2& a, const Vec2& b, double radius) const {
   if (convex_) {
     // The least signed distance of the spine's ends inside the edges' lines, in double: each is
-    // good to a few ulps of |a|, |b| and the circumradius.
+    // good to a few ulps of |a|, |b| and the circumradius. A disc (a == b) has one end.
+    const bool is_point = a == b;
     double least = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < offsets_.size(); ++i)
-      least = std::min({least, inward_normals_[i].dot(a) - offsets_[i], inward_normals_[i].dot(b) - offsets_[i]});
+    for (std::size_t i = 0; i < offsets_.size(); ++i) {
+      least = std::min(least, inward_normals_[i].dot(a) - offsets_[i]);
+      if (!is_point) least = std::min(least, inward_normals_[i].dot(b) - offsets_[i]);
+    }
     const double band = 1e-12 * (circumradius_ + a.norm() + b.norm() + radius);
     if (least - radius > band) return true;
     if (radius - least > band) return false;
