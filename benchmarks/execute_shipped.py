@@ -3,7 +3,7 @@ pose in the grasp against the plan's, and the slip at the pusher per contact (RE
 the tasks of data/tasks/more, which nothing was tuned for.
 `--mu-scale` runs each plan again in worlds whose pads' and features' mu differ from the task's.
 
-    python3 benchmarks/execute_shipped.py [--seed 1] [--mu-scale 1 0.85 1.15] [--closed-loop]
+    python3 benchmarks/execute_shipped.py [TASK.yaml ...] [--seed 1] [--mu-scale 1 0.85 1.15] [--closed-loop]
 """
 import argparse
 import math
@@ -22,6 +22,7 @@ TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("tasks", nargs="*", type=Path, help="task files (default: every shipped task)")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--mu-scale", type=float, nargs="+", default=[1.0], metavar="S",
                         help="world mu / task mu, one run per value (default 1)")
@@ -30,7 +31,7 @@ def main() -> None:
     print("| task | world mu | loop | pushes | contacts | final error mm | final error deg | goal error mm / deg "
           "| re-plans | max slip at pusher mm (deg) | release moves it mm / deg | sim steps/s | wall s |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for path in sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
+    for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
         task = load_task(path)
         steps = plan_steps(task, plan_to_dict(plan_task(task, seed=args.seed)))
         for scale in args.mu_scale:

@@ -174,7 +174,9 @@ def test_t_shape_straight_path_loses_the_grasp_and_the_plan_goes_around():
 
 
 def test_same_seed_same_plan_and_seeds_matter():
-    task = shipped("horizontal-offset-low-mu")
+    # The large manipulation: the low-mu offset's plan comes from the start's descents and run
+    # across, before any random sample, so there every seed gives one plan.
+    task = shipped("large-manipulation")
     a = plan_task(task, seed=3)
     b = plan_task(task, seed=3)
     assert a.waypoints == b.waypoints and a.stats["iterations"] == b.stats["iterations"]
@@ -347,12 +349,12 @@ def test_improve_for_is_refused_outside_its_declared_range():
 
 
 def test_restarts_are_counted_in_tests_so_a_seed_gives_the_same_plan_and_doubling_still_solves():
-    task = task_with("horizontal-offset-low-mu", lambda d: d["planner"].update(restart_checks=300))
+    task = task_with("large-manipulation", lambda d: d["planner"].update(restart_checks=300))
     plans = [plan_task(task, seed=6) for _ in range(2)]
     assert plans[0].stats["restarts"] > 0 and plans[0].solved
     assert plans[0].stats["restarts"] == plans[1].stats["restarts"]
     assert [(w.x, w.z, w.theta, w.pusher) for w in plans[0].waypoints] == \
         [(w.x, w.z, w.theta, w.pusher) for w in plans[1].waypoints]
     recheck(task, plans[0])
-    never = plan_task(task_with("horizontal-offset-low-mu", lambda d: d["planner"].update(restart_checks=0)), seed=6)
+    never = plan_task(task_with("large-manipulation", lambda d: d["planner"].update(restart_checks=0)), seed=6)
     assert never.stats["restarts"] == 0 and never.solved

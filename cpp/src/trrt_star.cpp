@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -80,6 +81,51 @@ constexpr double kMinEdge = 1e-9;
 
 PusherSet single(int pusher) { return pusher < 0 ? 0u : (1u << pusher); }
 }  // namespace
+
+/// The unit steps a descent tries from `from`: turn 0 goes straight toward the goal; turn
+/// ring * 8 + k turns from it toward the k-th of eight directions square to the way to the goal,
+/// by ring / kRings of steer_angle for rings 1..kRings, and on from steer_angle evenly to 90 deg
+/// for the wide rings kRings + 1 .. 2 kRings (the start's first steps across, descend_across).
+struct TRRTstar::Steering {
+  static constexpr int kRings = 4;
+
+  Steering(const GraspPoseSpace& space, double steer_angle_deg, const Pose& from, const Pose& goal)
+      : space(space), steer_angle_deg(steer_angle_deg), from(from) {
+    const Eigen::Vector3d to_goal =
+        space.in_unit_steps(Motion{goal.x - from.x, goal.z - from.z, goal.theta - from.theta});
+    distance = to_goal.norm();
+    length = std::min(1.0, distance);
+    if (distance < kMinEdge) return;
+    u = to_goal / distance;
+    // Two directions square to u, from the coordinate axis least aligned with it.
+    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+    Eigen::Index least;
+    u.cwiseAbs().minCoeff(&least);
+    axis[least] = 1.0;
+    e1 = u.cross(axis).normalized();
+    e2 = u.cross(e1);
+  }
+
+  /// The last ring a descent tries: kRings (none when steer_angle is 0).
+  int rings() const { return steer_angle_deg > 0.0 ? kRings : 0; }
+
+  Pose step(int turn) const {
+    const int ring = turn / 8;
+    const double alpha_deg = ring <= kRings ? steer_angle_deg * ring / kRings
+                                            : steer_angle_deg + (90.0 - steer_angle_deg) * (ring - kRings) / kRings;
+    const double alpha = alpha_deg * M_PI / 180.0, phi = 2.0 * M_PI * (turn % 8) / 8.0;
+    const Eigen::Vector3d dir = std::cos(alpha) * u + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
+    const Motion delta = space.from_unit_steps(length * dir);
+    return Pose{from.x + delta.x, from.z + delta.z, from.theta + delta.theta};
+  }
+
+  const GraspPoseSpace& space;
+  double steer_angle_deg;
+  Pose from;
+  double distance = 0.0;  ///< to the goal [unit steps]
+  double length = 0.0;    ///< of a step [unit steps]: 1, or what is left
+  Eigen::Vector3d u = Eigen::Vector3d::Zero(), e1 = Eigen::Vector3d::Zero(), e2 = Eigen::Vector3d::Zero();
+};
 
 TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTstar") {
   specs_.approximateSolutions = true;
@@ -460,10 +506,9 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
   si_->freeState(step_state);
 }
 
-void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
+void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc, int turn) {
   const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
   ob::State* step_state = si_->allocState();
-  int turn = 0;  // the last step's deviation, as ring * 8 + k (0: none)
   const int descent = static_cast<int>(descent_ends_.size());
   descent_ends_.push_back(-1.0);
   if (from->descent < 0) from->descent = descent;
@@ -477,38 +522,21 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
            m->cost.switches <= next->cost.switches && space_->distance(m->pose, next->pose) < 0.5;
   };
   while (!finished(ptc)) {
-    // The step in unit-step coordinates, u toward the goal.
-    const Eigen::Vector3d to_goal =
-        space_->in_unit_steps(Motion{goal.x - from->pose.x, goal.z - from->pose.z, goal.theta - from->pose.theta});
-    const double d = to_goal.norm();
-    if (d < kMinEdge) break;
-    const double length = std::min(1.0, d);
-    const Eigen::Vector3d u = to_goal / d;
-    // Two directions square to u, from the coordinate axis least aligned with it.
-    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
-    Eigen::Index least;
-    u.cwiseAbs().minCoeff(&least);
-    axis[least] = 1.0;
-    const Eigen::Vector3d e1 = u.cross(axis).normalized();
-    const Eigen::Vector3d e2 = u.cross(e1);
+    const Steering steering(*space_, steer_angle_, from->pose, goal);
+    if (steering.distance < kMinEdge) break;
+    const double length = steering.length;
     // Pushers this node may use without exceeding the switch-over budget.
     const PusherSet allowed = from->pusher == kNoPusher || from->cost.switches < max_switches_
                                   ? validator_->all_pushers()
                                   : single(from->pusher);
-    // The step toward the goal, or a deviation from it (ring r > 0 turns by r / rings of
-    // steer_angle toward the k-th of eight directions square to u) that an allowed pusher makes
-    // stable, the descent's own pusher tested first (it costs no switch-over, and when it works
+    // The step toward the goal, or a deviation from it within steer_angle (Steering) that an
+    // allowed pusher makes stable, the descent's own pusher tested first (it costs no switch-over, and when it works
     // the others need no test). After the straight step (and a point pusher's surface), the last
     // step's deviation comes first, since a steered descent tends to keep its turn; then the
     // rings, nearest first.
     const PusherSet own = from->pusher == kNoPusher ? 0 : single(from->pusher);
-    const int rings = steer_angle_ > 0.0 ? 4 : 0;
-    const auto try_direction = [&](int turn_index, Pose& q) -> PusherSet {
-      const double alpha = steer_angle_ * M_PI / 180.0 * (turn_index / 8) / std::max(rings, 1);
-      const double phi = 2.0 * M_PI * (turn_index % 8) / 8.0;
-      const Eigen::Vector3d dir = std::cos(alpha) * u + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
-      const Motion delta = space_->from_unit_steps(length * dir);
-      q = Pose{from->pose.x + delta.x, from->pose.z + delta.z, from->pose.theta + delta.theta};
+    const auto try_direction = [&](int turn, Pose& q) -> PusherSet {
+      q = steering.step(turn);
       GraspPoseSpace::set_pose(step_state, q);
       return si_->isValid(step_state) ? validator_->stable_pushers_preferring(from->pose, q, allowed, own) : 0;
     };
@@ -518,7 +546,7 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
     if (stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
     if (stable == 0 && turn > 0 && (stable = try_direction(turn, q_new)) != 0) turn_taken = turn;
-    for (int t = 8; t < 8 * (rings + 1) && stable == 0; ++t)
+    for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
       if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
     if (stable == 0) break;
     if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state),
@@ -537,6 +565,55 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
   }
   descent_ends_[descent] = from->goal_distance;
   si_->freeState(step_state);
+}
+
+void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition& ptc) {
+  const auto* goal = pdef_->getGoal()->as<PoseGoal>();
+  const Steering steering(*space_, steer_angle_, root->pose, goal->pose());
+  if (steering.distance < kMinEdge || steering.rings() == 0) return;
+  PusherSet across = validator_->all_pushers();
+  for (const Node* child : root->children) across &= ~single(child->pusher);
+  // The candidates are tested together at each direction, sharing its motion wrench.
+  ob::State* scratch = si_->allocState();
+  const auto stable_at = [&](int turn, PusherSet candidates) -> PusherSet {
+    const Pose q = steering.step(turn);
+    GraspPoseSpace::set_pose(scratch, q);
+    return si_->isValid(scratch) ? validator_->stable_pushers(root->pose, q, candidates) : 0;
+  };
+  const int within = 8 * (steering.rings() + 1), wide = 8 * (2 * Steering::kRings + 1);
+  for (int turn = 0; turn < within && across != 0; turn = turn == 0 ? 8 : turn + 1)
+    across &= ~stable_at(turn, across);
+  std::array<int, kMaxPushers> first_turn{};
+  PusherSet found = 0;
+  for (int turn = within; turn < wide && (across & ~found) != 0; ++turn) {
+    const PusherSet stable = stable_at(turn, across & ~found);
+    for (int p = 0; p < kMaxPushers; ++p)
+      if (contains(stable, p)) first_turn[p] = turn;
+    found |= stable;
+  }
+  // Each such pusher repeats its first step (a run across, no longer than the way to the goal),
+  // with a descent from every node of the run, while the descents end nearer the goal than the
+  // one before: a lift high enough for the drag that follows, and no higher. The run is a
+  // deliberate climb, so the transition test does not judge it; its pusher and the grasp bound it.
+  const int longest_run = static_cast<int>(std::ceil(steering.distance));
+  for (int p = 0; p < kMaxPushers && !finished(ptc); ++p) {
+    if (!contains(found, p)) continue;
+    const Pose first = steering.step(first_turn[p]);
+    const Motion dq{first.x - root->pose.x, first.z - root->pose.z, first.theta - root->pose.theta};
+    Node* node = root;
+    double previous_end = std::numeric_limits<double>::infinity();  // [unit steps from the goal]
+    for (int k = 0; k < longest_run && !finished(ptc); ++k) {
+      const Pose q{node->pose.x + dq.x, node->pose.z + dq.z, node->pose.theta + dq.theta};
+      GraspPoseSpace::set_pose(scratch, q);
+      if (k > 0 && (!si_->isValid(scratch) || validator_->stable_pushers(node->pose, q, single(p)) == 0)) break;
+      node = connect(node, q, single(p), p);
+      node->extended_to_goal = true;  // its descent is made here
+      extend_toward_goal(node, ptc);
+      if (!(descent_ends_.back() < previous_end)) break;
+      previous_end = descent_ends_.back();
+    }
+  }
+  si_->freeState(scratch);
 }
 
 ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
@@ -581,6 +658,7 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
     if (rng_->uniform01() < goal_bias_ && (from = most_promising_toward_goal()) != nullptr) {
       from->extended_to_goal = true;
       extend_toward_goal(from, ptc);
+      if (from->parent == nullptr && !finished(ptc)) descend_across(from, ptc);
     } else {
       sampler_->sampleUniform(sample);
       extend(nearest_extendable(GraspPoseSpace::pose(sample)), sample, ptc);
