@@ -117,6 +117,40 @@ def test_a_pusher_that_can_only_push_across_the_way_to_the_goal_starts_from_the_
             assert checker.alignment(a, b, p) >= checker.COS[p]
 
 
+class AskewChecker(ConeChecker):
+    """Pusher 0 makes a motion stable only 5-30 deg off the straight way to the goal, so each step
+    that ends a descent lands a fifth as far from the goal as it started (a ring-1 turn)."""
+
+    GOAL = (3 * MM, 0.0, 0.0)
+
+    def __init__(self):
+        super().__init__()
+        self.shortest = math.inf  # the shortest motion asked about [unit steps]
+
+    def all_pushers(self):
+        return 0b01
+
+    def stable_pushers(self, a, b, candidates):
+        d, g = unit(a, b), unit(a, self.GOAL)
+        n, m = math.sqrt(sum(c * c for c in d)), math.sqrt(sum(c * c for c in g))
+        self.shortest = min(self.shortest, n)
+        if not (candidates & 1 and n > 0 and m > 0):
+            return 0
+        off = math.degrees(math.acos(max(-1.0, min(1.0, sum(x * y for x, y in zip(d, g)) / (n * m)))))
+        return 1 if 5.0 <= off <= 30.0 else 0
+
+
+def test_descents_near_the_goal_stop_short_of_pushes_too_short_to_model():
+    """Searching on after the first plan (improve_for), descents went on from nodes ever nearer the
+    goal, a fifth as far each time, until their steps were under the model's smallest motion
+    (1e-12 m) and the T-shaped task's seed 17 raised "the motion dq is zero". Now a pose within
+    SHORTEST_PUSH unit steps of the goal is at it."""
+    checker = AskewChecker()
+    out = plan(checker, AskewChecker.GOAL, time_limit=2.0, improve_for=0.2, seed=1)
+    assert out["outcome"] == _core.PlanOutcome.goal_reached
+    assert checker.shortest >= _core.SHORTEST_PUSH
+
+
 def test_a_checker_that_leaves_out_a_method_is_a_clear_error():
     class Incomplete(_core.PushChecker):
         def all_pushers(self):

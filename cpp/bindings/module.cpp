@@ -353,4 +353,5 @@ PYBIND11_MODULE(_core, m) {
     ranges[py::str(name)] = py::make_tuple(r.integer ? "integer" : "number", r.lowest, r.highest);
   m.attr("TRRT_STAR_PARAMETER_RANGES") = ranges;
   m.attr("MAX_TIME_LIMIT") = kMaxTimeLimit;
+  m.attr("SHORTEST_PUSH") = GraspPoseSpace::kShortestPush;  // [unit steps]
 }

@@ -74,6 +74,9 @@ void check_settings(const PlannerSettings& s) {
   for (const StepSize& size : {s.step, s.tolerance})
     if (!(std::isfinite(size.length) && std::isfinite(size.angle)))
       throw std::invalid_argument("step and tolerance must be finite");
+  // GraspPoseSpace::kShortestPush holds for unit steps of at least 0.001 mm and 0.001 deg.
+  if (!(s.step.length >= 1e-6 && s.step.angle >= 1e-3 * M_PI / 180.0))
+    throw std::invalid_argument("step must be at least 0.001 mm and 0.001 deg");
   if (!(std::isfinite(s.min_margin) && s.min_margin >= 0.0)) throw std::invalid_argument("min_margin must be >= 0");
   if (!(std::isfinite(s.sampling_margin) && s.sampling_margin >= 0.0))
     throw std::invalid_argument("sampling_margin must be >= 0");
@@ -88,7 +91,7 @@ void finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushVal
                     const PoseGoal& goal, const Pose& target, const ModelSet& models) {
   const PlanStep last = plan.waypoints.back();
   const Pose& end = last.pose;
-  if (space.distance(end, target) < 1e-9) {  // there to rounding: no push is that short (kSmallestMotion)
+  if (space.distance(end, target) < GraspPoseSpace::kShortestPush) {  // there: no push is that short
     plan.waypoints.back().pose = target;
     plan.ends_at_goal = true;
     return;

@@ -76,8 +76,9 @@ std::string range_text(const char* name) {
   return out.str();
 }
 
-/// Edges shorter than this [unit steps] are not pushes (co-located nodes differ only by pusher).
-constexpr double kMinEdge = 1e-9;
+/// Edges shorter than this [unit steps] are not pushes (co-located nodes differ only by pusher),
+/// and a descent this near the goal is there.
+constexpr double kMinEdge = GraspPoseSpace::kShortestPush;
 
 PusherSet single(int pusher) { return pusher < 0 ? 0u : (1u << pusher); }
 }  // namespace

@@ -45,6 +45,11 @@ class GraspPoseSpace : public ompl::base::RealVectorStateSpace {
   const StepSize& step() const { return step_; }
   double distance(const ompl::base::State* a, const ompl::base::State* b) const override;
   double distance(const Pose& a, const Pose& b) const;
+  /// Motions shorter than this [unit steps] are no push (co-located poses; a pose at the goal).
+  /// With unit steps of at least 0.001 mm and 0.001 deg (the task's range), a longer motion has a
+  /// component above the model's kSmallestMotion (1e-12 m or rad), where its wrenches are defined;
+  /// at 1e-9, a descent's ever shorter steps toward the goal (improve_for) reached motions below it.
+  static constexpr double kShortestPush = 1e-5;
   /// A motion (or a pose, as the motion from the origin) in unit steps: (dx, dz) / length, dtheta / angle.
   Eigen::Vector3d in_unit_steps(const Motion& d) const {
     return Eigen::Vector3d(d.x / step_.length, d.z / step_.length, d.theta / step_.angle);
