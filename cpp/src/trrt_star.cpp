@@ -507,9 +507,10 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
   si_->freeState(step_state);
 }
 
-void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc, int turn) {
+void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
   const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
   ob::State* step_state = si_->allocState();
+  int turn = 0;  // the last step's deviation (Steering; 0: none)
   const int descent = static_cast<int>(descent_ends_.size());
   descent_ends_.push_back(-1.0);
   if (from->descent < 0) from->descent = descent;
@@ -531,10 +532,10 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
                                   ? validator_->all_pushers()
                                   : single(from->pusher);
     // The step toward the goal, or a deviation from it within steer_angle (Steering) that an
-    // allowed pusher makes stable, the descent's own pusher tested first (it costs no switch-over, and when it works
-    // the others need no test). After the straight step (and a point pusher's surface), the last
-    // step's deviation comes first, since a steered descent tends to keep its turn; then the
-    // rings, nearest first.
+    // allowed pusher makes stable, the descent's own pusher tested first (it costs no switch-over,
+    // and when it works the others need no test). After the straight step (and a point pusher's
+    // surface), the last step's deviation comes first, since a steered descent tends to keep its
+    // turn; then the rings, nearest first.
     const PusherSet own = from->pusher == kNoPusher ? 0 : single(from->pusher);
     const auto try_direction = [&](int turn, Pose& q) -> PusherSet {
       q = steering.step(turn);
@@ -572,7 +573,9 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
   const auto* goal = pdef_->getGoal()->as<PoseGoal>();
   const Steering steering(*space_, steer_angle_, root->pose, goal->pose());
   if (steering.distance < kMinEdge || steering.rings() == 0) return;
-  PusherSet across = validator_->all_pushers();
+  // A point pusher's stable pushes are a surface that no ring meets (descend_on_wedges steers
+  // onto it instead).
+  PusherSet across = validator_->all_pushers() & ~validator_->wedge_pushers();
   for (const Node* child : root->children) across &= ~single(child->pusher);
   // The candidates are tested together at each direction, sharing its motion wrench.
   ob::State* scratch = si_->allocState();

@@ -162,14 +162,13 @@ class TRRTstar : public ompl::base::Planner {
   /// step's deviation, else the nearest deviation within steer_angle that a pusher allowed by the
   /// switch-over budget makes stable (the descent's own pusher tested first). It stops at a dead
   /// end, or where it meets a descent that ended in a dead end far from the goal.
-  /// `turn` is the deviation (Steering) of the step into `from`, tried first after the straight step.
-  void extend_toward_goal(Node* from, const ompl::base::PlannerTerminationCondition& ptc, int turn = 0);
-  /// After the start's descent, for each pusher that its first step did not use and that cannot
-  /// push within steer_angle of the way to the goal (a ledge that can only lift): the nearest
-  /// stable step turned further, up to 90 deg (Steering's wide rings), repeated as a run with a
-  /// descent from each of its nodes while those descents end nearer the goal. The first push
-  /// costs no switch-over, so such a pusher may well start the plan, but descents never try it and
-  /// random extensions find it only by chance.
+  void extend_toward_goal(Node* from, const ompl::base::PlannerTerminationCondition& ptc);
+  /// After the start's descent, for each pusher (not a point pusher) that its first step did not
+  /// use and that cannot push within steer_angle of the way to the goal (a ledge that can only
+  /// lift): the nearest stable step turned further, up to 90 deg (Steering's wide rings),
+  /// repeated as a run with a descent from each of its nodes while those descents end nearer the
+  /// goal. The first push costs no switch-over, so such a pusher may well start the plan, but
+  /// descents never try it and random extensions find it only by chance.
   void descend_across(Node* root, const ompl::base::PlannerTerminationCondition& ptc);
   /// When no pusher makes the step from -> q stable: the step of the same length and heading onto
   /// the stable surface of a point pusher in `allowed` (StablePushValidator::onto_wedge_surface)
