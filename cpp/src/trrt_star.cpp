@@ -587,22 +587,28 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
   const int within = 8 * (steering.rings() + 1), wide = 8 * (2 * Steering::kRings + 1);
   for (int turn = 0; turn < within && across != 0; turn = turn == 0 ? 8 : turn + 1)
     across &= ~stable_at(turn, across);
-  std::array<int, kMaxPushers> first_turn{};
-  PusherSet found = 0;
-  for (int turn = within; turn < wide && (across & ~found) != 0; ++turn) {
-    const PusherSet stable = stable_at(turn, across & ~found);
-    for (int p = 0; p < kMaxPushers; ++p)
-      if (contains(stable, p)) first_turn[p] = turn;
-    found |= stable;
+  // Each such pusher's first steps: every stable direction of the nearest wide ring where it has
+  // one. All of them, since they tie (at 90 deg, lifting and turning the object are equally far
+  // from the goal) and only the descents after them tell which leads there.
+  std::array<std::vector<int>, kMaxPushers> first_turns;
+  for (int ring = within; ring < wide && across != 0; ring += 8) {
+    PusherSet in_ring = 0;
+    for (int turn = ring; turn < ring + 8; ++turn) {
+      const PusherSet stable = stable_at(turn, across);
+      for (int p = 0; p < kMaxPushers; ++p)
+        if (contains(stable, p)) first_turns[p].push_back(turn);
+      in_ring |= stable;
+    }
+    across &= ~in_ring;
   }
-  // Each such pusher repeats its first step (a run across, no longer than the way to the goal),
-  // with a descent from every node of the run, while the descents end nearer the goal than the
-  // one before: a lift high enough for the drag that follows, and no higher. The run is a
-  // deliberate climb, so the transition test does not judge it; its pusher and the grasp bound it.
+  // Each first step is repeated (a run across, no longer than the way to the goal), with a
+  // descent from every node of the run, while the descents end nearer the goal than the one
+  // before. The run is a deliberate climb, so the transition test does not judge it; its pusher
+  // and the grasp bound it.
   const int longest_run = static_cast<int>(std::ceil(steering.distance));
-  for (int p = 0; p < kMaxPushers && !finished(ptc); ++p) {
-    if (!contains(found, p)) continue;
-    const Pose first = steering.step(first_turn[p]);
+  for (int p = 0; p < kMaxPushers; ++p) for (const int first_turn : first_turns[p]) {
+    if (finished(ptc)) break;
+    const Pose first = steering.step(first_turn);
     const Motion dq{first.x - root->pose.x, first.z - root->pose.z, first.theta - root->pose.theta};
     Node* node = root;
     double previous_end = std::numeric_limits<double>::infinity();  // [unit steps from the goal]
