@@ -100,3 +100,18 @@ def test_uncertainty_is_validated():
         uncertain("pivoting", {"friction": 0.1})
     assert len(uncertain("pivoting", {}).corner_models()) == 1
     assert math.isclose(uncertain("pivoting", {"mass": 0.2}).corner_models()[1].body.mass, 1.2 * 0.202)
+
+
+def test_a_point_pusher_is_robust_to_its_own_mu_only_and_the_loader_says_so():
+    """docs/model.md, "Point pushers and the box": a peg's stable pushes are a surface that moves
+    with pad mu x grip force and with mass, so with any width in those no push is stable at every
+    corner; a width in pusher mu only narrows the wedge."""
+    own = uncertain("more/cube-pegs", {"pusher_mu": 0.15}, time_limit=5)
+    assert not any("point pusher" in w for w in own.warnings)
+    assert plan_task(own, seed=1).solved
+    for key in ("pad_mu", "grip_force", "mass"):
+        task = uncertain("more/cube-pegs", {key: 0.01}, time_limit=0.3)
+        says = [w for w in task.warnings if f"a point pusher makes no push robust to uncertainty.{key}" in w]
+        assert [w.split(" ")[0] for w in says] == ["pushers[0]", "pushers[1]"]
+        plan = plan_task(task, seed=1)
+        assert not plan.solved and plan.stats["nodes"] == 1  # not one push found, even at 1%

@@ -475,6 +475,15 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     planner = _validate_planner(top.get("planner", {}))
     uncertain = _mapping("uncertainty", top.get("uncertainty", {}), [], list(UNCERTAIN))
     uncertainty = {key: _number(f"uncertainty.{key}", v, (0.0, 0.9)) for key, v in uncertain.items()}
+    # A point pusher's stable pushes are a surface on which the required wrench lies in its wedge's
+    # plane; that wrench moves with pad mu x grip force and with mass, so the surfaces of the
+    # corners meet at isolated motions at most (docs/model.md, "Point pushers and the box").
+    widened = [key for key in ("pad_mu", "grip_force", "mass") if uncertainty.get(key, 0.0) > 0.0]
+    for i, p in enumerate(pushers):
+        if p.is_point and widened:
+            notes.append(f"pushers[{i}] ({p.name}): a point pusher makes no push robust to uncertainty."
+                         f"{', '.join(widened)} (its stable pushes move with pad mu x grip force and with mass; "
+                         f"a width in pusher_mu alone is fine): plans will not use it")
     environment = _validate_environment(top.get("environment", {}), [p.name for p in pushers])
     return Task(
         name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
