@@ -606,21 +606,24 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
   // before. The run is a deliberate climb, so the transition test does not judge it; its pusher
   // and the grasp bound it.
   const int longest_run = static_cast<int>(std::ceil(steering.distance));
-  for (int p = 0; p < kMaxPushers; ++p) for (const int first_turn : first_turns[p]) {
-    if (finished(ptc)) break;
-    const Pose first = steering.step(first_turn);
-    const Motion dq{first.x - root->pose.x, first.z - root->pose.z, first.theta - root->pose.theta};
-    Node* node = root;
-    double previous_end = std::numeric_limits<double>::infinity();  // [unit steps from the goal]
-    for (int k = 0; k < longest_run && !finished(ptc); ++k) {
-      const Pose q{node->pose.x + dq.x, node->pose.z + dq.z, node->pose.theta + dq.theta};
-      GraspPoseSpace::set_pose(scratch, q);
-      if (k > 0 && (!si_->isValid(scratch) || validator_->stable_pushers(node->pose, q, single(p)) == 0)) break;
-      node = connect(node, q, single(p), p);
-      node->extended_to_goal = true;  // its descent is made here
-      extend_toward_goal(node, ptc);
-      if (!(descent_ends_.back() < previous_end)) break;
-      previous_end = descent_ends_.back();
+  for (int p = 0; p < kMaxPushers; ++p) {
+    for (const int first_turn : first_turns[p]) {
+      if (finished(ptc)) break;
+      const Pose first = steering.step(first_turn);
+      const Motion dq{first.x - root->pose.x, first.z - root->pose.z, first.theta - root->pose.theta};
+      Node* node = root;
+      double previous_end = std::numeric_limits<double>::infinity();  // [unit steps from the goal]
+      for (int k = 0; k < longest_run && !finished(ptc); ++k) {
+        const Pose q{node->pose.x + dq.x, node->pose.z + dq.z, node->pose.theta + dq.theta};
+        GraspPoseSpace::set_pose(scratch, q);
+        // The first step is the probe's, already tested.
+        if (k > 0 && !(si_->isValid(scratch) && validator_->stable_pushers(node->pose, q, single(p)) != 0)) break;
+        node = connect(node, q, single(p), p);
+        node->extended_to_goal = true;  // its descent is made here
+        extend_toward_goal(node, ptc);
+        if (!(descent_ends_.back() < previous_end)) break;
+        previous_end = descent_ends_.back();
+      }
     }
   }
   si_->freeState(scratch);
