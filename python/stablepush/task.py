@@ -481,8 +481,9 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     widened = [key for key in ("pad_mu", "grip_force", "mass") if uncertainty.get(key, 0.0) > 0.0]
     for i, p in enumerate(pushers):
         if p.is_point and widened:
-            notes.append(f"pushers[{i}] ({p.name}): a point pusher makes no push robust to uncertainty."
-                         f"{', '.join(widened)} (its stable pushes move with pad mu x grip force and with mass; "
+            notes.append(f"pushers[{i}] ({p.name}): a point pusher makes no push robust to "
+                         f"{', '.join('uncertainty.' + key for key in widened)} (its stable pushes move with pad mu "
+                         f"x grip force and with mass; "
                          f"a width in pusher_mu alone is fine): plans will not use it")
     environment = _validate_environment(top.get("environment", {}), [p.name for p in pushers])
     return Task(
