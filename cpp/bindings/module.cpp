@@ -20,6 +20,7 @@ using namespace stablepush;
 
 namespace {
 Pose to_pose(const std::array<double, 3>& q) { return Pose{q[0], q[1], q[2]}; }
+Motion to_motion(const std::array<double, 3>& dq) { return Motion{dq[0], dq[1], dq[2]}; }
 StepSize to_step(const std::array<double, 2>& s) { return StepSize{s[0], s[1]}; }
 
 py::tuple to_tuple(const Pose& q) { return py::make_tuple(q.x, q.z, q.theta); }
@@ -182,13 +183,13 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("pusher_cones", &StablePushModel::pusher_cones)
       .def_property_readonly("torque_length", &StablePushModel::torque_length)
       .def("motion_wrench", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq,
-                               int pusher) { return m.motion_wrench(to_pose(q), to_pose(dq), pusher); },
+                               int pusher) { return m.motion_wrench(to_pose(q), to_motion(dq), pusher); },
            py::arg("q"), py::arg("dq"), py::arg("pusher") = kNoPusher)
       .def("check", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq,
-                       int pusher) { return m.check(to_pose(q), to_pose(dq), pusher); },
+                       int pusher) { return m.check(to_pose(q), to_motion(dq), pusher); },
            py::arg("q"), py::arg("dq"), py::arg("pusher"))
       .def("check_all", [](const StablePushModel& m, const std::array<double, 3>& q, const std::array<double, 3>& dq) {
-        return m.check_all(to_pose(q), to_pose(dq));
+        return m.check_all(to_pose(q), to_motion(dq));
       }, py::arg("q"), py::arg("dq"))
       .def("hold_ratio", [](const StablePushModel& m, const std::array<double, 3>& q, int pusher) {
         return m.hold_ratio(to_pose(q), pusher);
@@ -215,7 +216,7 @@ PYBIND11_MODULE(_core, m) {
              {
                py::gil_scoped_release release;
                for (py::ssize_t i = 0; i < n; ++i) {
-                 const PushResult r = m.check(Pose{Q(i, 0), Q(i, 1), Q(i, 2)}, Pose{D(i, 0), D(i, 1), D(i, 2)}, pusher);
+                 const PushResult r = m.check(Pose{Q(i, 0), Q(i, 1), Q(i, 2)}, Motion{D(i, 0), D(i, 1), D(i, 2)}, pusher);
                  F(i) = r.feasible;
                  M(i) = r.margin;
                  E(i) = r.exact;
@@ -338,7 +339,7 @@ PYBIND11_MODULE(_core, m) {
         "valid. Poses (m, m, rad), step and tolerance (m, rad). Returns outcome, path [((x, z, theta), pusher)]\n"
         "start first (pusher -1 at the start), switches, length (unit steps) and restarts.");
   m.def("worst_case", [](const ModelSet& models, const std::array<double, 3>& q, const std::array<double, 3>& dq,
-                         int pusher) { return worst_case(models, to_pose(q), to_pose(dq), pusher); },
+                         int pusher) { return worst_case(models, to_pose(q), to_motion(dq), pusher); },
         py::arg("models"), py::arg("q"), py::arg("dq"), py::arg("pusher"),
         "The push q -> q + dq (m, m, rad) by `pusher` as the least stable of `models` sees it (the corners of\n"
         "an uncertainty box): the result with the least margin, an infeasible one first.");

@@ -25,7 +25,8 @@ GraspPoseSpace::GraspPoseSpace(StepSize step, const ob::RealVectorBounds& bounds
 double GraspPoseSpace::distance(const ob::State* a, const ob::State* b) const { return distance(pose(a), pose(b)); }
 
 double steps_between(const Pose& a, const Pose& b, const StepSize& step) {
-  const double dx = (b.x - a.x) / step.length, dz = (b.z - a.z) / step.length, dt = (b.theta - a.theta) / step.angle;
+  const Motion d = b - a;
+  const double dx = d.dx / step.length, dz = d.dz / step.length, dt = d.dtheta / step.angle;
   return std::sqrt(dx * dx + dz * dz + dt * dt);
 }
 
@@ -58,7 +59,7 @@ std::vector<Pose> GraspPoseSpace::unit_pushes(const Pose& a, const Pose& b) cons
   poses.reserve(n + 1);
   for (int i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) / n;
-    poses.push_back(Pose{a.x + t * (b.x - a.x), a.z + t * (b.z - a.z), a.theta + t * (b.theta - a.theta)});
+    poses.push_back(a + t * (b - a));
   }
   poses.push_back(b);
   return poses;
@@ -95,7 +96,7 @@ std::optional<Pose> PushChecker::onto_wedge_surface(const Pose&, const Eigen::Ve
 }
 
 double StablePushValidator::push_margin(const Pose& a, const Pose& b, int pusher) const {
-  return worst_case(models_, a, Motion{b.x - a.x, b.z - a.z, b.theta - a.theta}, pusher).margin;
+  return worst_case(models_, a, b - a, pusher).margin;
 }
 
 std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction,
@@ -158,8 +159,7 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
     f_below = f_above;
   }
   if (!best) return std::nullopt;
-  const Motion dq = motion(*best);
-  return Pose{a.x + dq.x, a.z + dq.z, a.theta + dq.theta};
+  return a + motion(*best);
 }
 
 PusherSet PushChecker::stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,
@@ -188,7 +188,7 @@ PusherSet StablePushValidator::stable_in_unit_push(const Pose& from, const Pose&
   if (candidates == 0) return 0;
   const StablePushModel& geometry = *models_.front();
   if (!geometry.gripper().grasp_maintained_along(geometry.section(), from, to)) return 0;
-  const Motion dq{to.x - from.x, to.z - from.z, to.theta - from.theta};
+  const Motion dq = to - from;
   const int models = static_cast<int>(models_.size());
   // One motion wrench per model serves every pusher whose gravity is the same (all of them,
   // unless the features hold the object at different world orientations; see GravityFrame).

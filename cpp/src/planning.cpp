@@ -102,7 +102,7 @@ void finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushVal
   for (std::size_t k = 1; k < poses.size(); ++k) {
     const Pose& from = poses[k - 1];
     const Pose& to = poses[k];
-    const PushResult r = worst_case(models, from, Motion{to.x - from.x, to.z - from.z, to.theta - from.theta}, last.pusher);
+    const PushResult r = worst_case(models, from, to - from, last.pusher);
     plan.waypoints.push_back({to, last.pusher, r.margin, r.contact_case});
   }
   plan.ends_at_goal = true;
@@ -161,7 +161,7 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
       const Pose& from = poses[k - 1];
       const Pose& to = poses[k];
       const PushResult r =
-          worst_case(models, from, Motion{to.x - from.x, to.z - from.z, to.theta - from.theta}, nodes[i].pusher);
+          worst_case(models, from, to - from, nodes[i].pusher);
       plan.waypoints.push_back({to, nodes[i].pusher, r.margin, r.contact_case});
     }
   }

@@ -99,10 +99,10 @@ Vec2 StablePushModel::gravity_in_gripper(const Rotation2& R, int pusher) const {
 MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq, int pusher) const {
   if (!(std::isfinite(q.x) && std::isfinite(q.z) && std::isfinite(q.theta)))
     throw std::invalid_argument("the pose q is not finite");
-  if (!(std::isfinite(dq.x) && std::isfinite(dq.z) && std::isfinite(dq.theta)))
+  if (!(std::isfinite(dq.dx) && std::isfinite(dq.dz) && std::isfinite(dq.dtheta)))
     throw std::invalid_argument("the motion dq is not finite");
   // Below this the motion's velocity and acceleration terms underflow to (sub)normal noise.
-  if (std::max({std::abs(dq.x), std::abs(dq.z), std::abs(dq.theta)}) < kSmallestMotion)
+  if (std::max({std::abs(dq.dx), std::abs(dq.dz), std::abs(dq.dtheta)}) < kSmallestMotion)
     throw std::invalid_argument("the motion dq is zero (or under 1e-12 m and rad)");
   MotionWrench load;
   load.rotation = Rotation2(q.theta);

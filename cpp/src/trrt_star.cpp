@@ -92,8 +92,7 @@ struct TRRTstar::Steering {
 
   Steering(const GraspPoseSpace& space, double steer_angle_deg, const Pose& from, const Pose& goal)
       : space(space), steer_angle_deg(steer_angle_deg), from(from) {
-    const Eigen::Vector3d to_goal =
-        space.in_unit_steps(Motion{goal.x - from.x, goal.z - from.z, goal.theta - from.theta});
+    const Eigen::Vector3d to_goal = space.in_unit_steps(goal - from);
     distance = to_goal.norm();
     length = std::min(1.0, distance);
     if (distance < kMinEdge) return;
@@ -116,8 +115,7 @@ struct TRRTstar::Steering {
                                             : steer_angle_deg + (90.0 - steer_angle_deg) * (ring - kRings) / kRings;
     const double alpha = alpha_deg * M_PI / 180.0, phi = 2.0 * M_PI * (turn % 8) / 8.0;
     const Eigen::Vector3d dir = std::cos(alpha) * u + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
-    const Motion delta = space.from_unit_steps(length * dir);
-    return Pose{from.x + delta.x, from.z + delta.z, from.theta + delta.theta};
+    return from + space.from_unit_steps(length * dir);
   }
 
   const GraspPoseSpace& space;
@@ -378,7 +376,7 @@ TRRTstar::Node* TRRTstar::best_goal() const {
 PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob::State* scratch) const {
   const PusherSet wedges = allowed & validator_->wedge_pushers();
   if (wedges == 0) return 0;
-  const Eigen::Vector3d step = space_->in_unit_steps(Motion{q.x - from.x, q.z - from.z, q.theta - from.theta});
+  const Eigen::Vector3d step = space_->in_unit_steps(q - from);
   const double length = step.norm();
   if (!(length > 0.0)) return 0;
   for (int p = 0; p < kMaxPushers; ++p) {
@@ -395,8 +393,7 @@ PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob:
 
 std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal, double length,
                                                         PusherSet wedges) const {
-  const Eigen::Vector3d to_goal =
-      space_->in_unit_steps(Motion{goal.x - from.x, goal.z - from.z, goal.theta - from.theta});
+  const Eigen::Vector3d to_goal = space_->in_unit_steps(goal - from);
   const double heading = std::atan2(to_goal[1], to_goal[0]);
   const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
   std::vector<WedgeStep> steps;
@@ -610,11 +607,11 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
     for (const int first_turn : first_turns[p]) {
       if (finished(ptc)) break;
       const Pose first = steering.step(first_turn);
-      const Motion dq{first.x - root->pose.x, first.z - root->pose.z, first.theta - root->pose.theta};
+      const Motion dq = first - root->pose;
       Node* node = root;
       double previous_end = std::numeric_limits<double>::infinity();  // [unit steps from the goal]
       for (int k = 0; k < longest_run && !finished(ptc); ++k) {
-        const Pose q{node->pose.x + dq.x, node->pose.z + dq.z, node->pose.theta + dq.theta};
+        const Pose q = node->pose + dq;
         GraspPoseSpace::set_pose(scratch, q);
         // The first step is the probe's, already tested.
         if (k > 0 && !(si_->isValid(scratch) && validator_->stable_pushers(node->pose, q, single(p)) != 0)) break;

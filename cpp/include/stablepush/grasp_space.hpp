@@ -50,11 +50,15 @@ class GraspPoseSpace : public ompl::base::RealVectorStateSpace {
   /// component above the model's kSmallestMotion (1e-12 m or rad), where its wrenches are defined;
   /// at 1e-9, a descent's ever shorter steps toward the goal (improve_for) reached motions below it.
   static constexpr double kShortestPush = 1e-5;
-  /// A motion (or a pose, as the motion from the origin) in unit steps: (dx, dz) / length, dtheta / angle.
+  /// A motion in unit steps: (dx, dz) / length, dtheta / angle.
   Eigen::Vector3d in_unit_steps(const Motion& d) const {
-    return Eigen::Vector3d(d.x / step_.length, d.z / step_.length, d.theta / step_.angle);
+    return Eigen::Vector3d(d.dx / step_.length, d.dz / step_.length, d.dtheta / step_.angle);
   }
-  /// The inverse of in_unit_steps.
+  /// A pose's coordinates in unit steps: (x, z) / length, theta / angle (where the metric is Euclidean).
+  Eigen::Vector3d in_unit_steps(const Pose& q) const {
+    return Eigen::Vector3d(q.x / step_.length, q.z / step_.length, q.theta / step_.angle);
+  }
+  /// The inverse of in_unit_steps for a motion.
   Motion from_unit_steps(const Eigen::Vector3d& u) const {
     return Motion{u[0] * step_.length, u[1] * step_.length, u[2] * step_.angle};
   }

@@ -21,8 +21,24 @@ struct Pose {
   double theta = 0.0;
 };
 
-/// A unit motion Delta q over one step: (dx [m], dz [m], dtheta [rad]).
-using Motion = Pose;
+/// A displacement of the object in the grasp, Delta q = q_b - q_a: (dx [m], dz [m], dtheta [rad]),
+/// all in G. The stable-push test takes one as the unit motion of a step: the twist xi = Delta q / dt,
+/// constant over the step time dt from rest (the quasi-dynamic step of paper eq. 5). The planner
+/// cuts longer motions into such steps.
+struct Motion {
+  double dx = 0.0;
+  double dz = 0.0;
+  double dtheta = 0.0;
+};
+
+/// The motion that takes pose a to pose b: b - a, coordinate by coordinate (theta is not wrapped).
+inline Motion operator-(const Pose& b, const Pose& a) { return Motion{b.x - a.x, b.z - a.z, b.theta - a.theta}; }
+/// The motion from a to b (b - a).
+inline Motion between(const Pose& a, const Pose& b) { return b - a; }
+/// The pose reached from q by the motion m.
+inline Pose operator+(const Pose& q, const Motion& m) { return Pose{q.x + m.dx, q.z + m.dz, q.theta + m.dtheta}; }
+/// The motion m scaled by s (a fraction of it, when 0 <= s <= 1).
+inline Motion operator*(double s, const Motion& m) { return Motion{s * m.dx, s * m.dz, s * m.dtheta}; }
 
 /// y-component of r x f for r, f in a grasp plane: tau_y = r_z f_x - r_x f_z.
 inline double cross_y(const Vec2& r, const Vec2& f) { return r.y() * f.x() - r.x() * f.y(); }
