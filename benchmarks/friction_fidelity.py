@@ -8,9 +8,8 @@ import argparse
 import time
 from pathlib import Path
 
-from stablepush.mechanics import check_push
 from stablepush.sim import fidelity, friction
-from stablepush.task import load_task
+from stablepush.task import check_push, load_task
 
 TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 

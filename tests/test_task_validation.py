@@ -5,10 +5,11 @@ import sys
 import pytest
 import yaml
 from click.testing import CliRunner
-from conftest import TASKS, task_text, task_with
 
-from stablepush.task import TaskError
+from stablepush.errors import TaskError
 from stablepush_cli.main import cli
+
+from conftest import TASKS, task_text, task_with
 
 BASE = yaml.safe_load(task_text("horizontal-offset-low-mu"))
 
