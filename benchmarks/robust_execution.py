@@ -45,9 +45,13 @@ def main() -> None:
                 with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=scale)) as server:
                     report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
                 errors.append(f"{report.final_error['distance']:.2f} / {report.final_error['theta']:+.2f}")
-            print(f"| {task.name} | {label} | {plan.stats['pushes']} | {' → '.join(plan.pusher_sequence)} "
-                  f"| {took * 1e3:.0f} ms | {min(w.margin for w in plan.waypoints[1:]):.3f} | " + " | ".join(errors) + " |",
-                  flush=True)
+            print(
+                f"| {task.name} | {label} | {plan.stats['pushes']} | {' → '.join(plan.pusher_sequence)} "
+                f"| {took * 1e3:.0f} ms | {min(w.margin for w in plan.waypoints[1:]):.3f} | "
+                + " | ".join(errors)
+                + " |",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

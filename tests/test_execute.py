@@ -171,12 +171,21 @@ class FakeArm:
                     return
 
 
-@pytest.mark.parametrize("bad_reply, says", [
-    (lambda msg: b"ack, but not JSON\n", "not a JSON line"),
-    (lambda msg: encode({"type": "ack", "seq": msg["seq"] + 1, "state": {"ee_pose": msg["pose"]}}), "out-of-order acknowledgement"),
-    (lambda msg: encode({"type": "ack", "seq": msg["seq"]}), "field 'state' missing"),
-    (lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "joint 4 over its torque limit"}), "torque limit"),
-])
+@pytest.mark.parametrize(
+    "bad_reply, says",
+    [
+        (lambda msg: b"ack, but not JSON\n", "not a JSON line"),
+        (
+            lambda msg: encode({"type": "ack", "seq": msg["seq"] + 1, "state": {"ee_pose": msg["pose"]}}),
+            "out-of-order acknowledgement",
+        ),
+        (lambda msg: encode({"type": "ack", "seq": msg["seq"]}), "field 'state' missing"),
+        (
+            lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "joint 4 over its torque limit"}),
+            "torque limit",
+        ),
+    ],
+)
 def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
     task = shipped("horizontal-offset-high-mu")
     plan = check_plan(task, plan_task(task, seed=1))

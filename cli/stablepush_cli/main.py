@@ -111,7 +111,9 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
               help="Plan file (JSON). Default: <TASK file name>.plan.json in the current directory.")
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None,
               help="Also write the waypoints as CSV (step,x,z,theta,pusher,...).")
-@click.option("--seed", type=click.IntRange(min=0), default=None, help="Random seed (default: the task's planner.seed).")
+@click.option(
+    "--seed", type=click.IntRange(min=0), default=None, help="Random seed (default: the task's planner.seed)."
+)
 @click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
               help="Give up after S seconds (default: the task's planner.time_limit).")
 @click.option("--max-switches", type=click.IntRange(min=0), default=None, metavar="K",
@@ -168,13 +170,21 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
 @cli.command()
 @click.argument("task_files", metavar="TASK.yaml...", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--checks", "checks_only", is_flag=True, help="Benchmark the stable-push test instead of planning.")
-@click.option("--trials", default=10, show_default=True, type=click.IntRange(min=1), help="Planning runs per task (seeds seed, seed+1, ...).")
+@click.option(
+    "--trials",
+    default=10,
+    show_default=True,
+    type=click.IntRange(min=1),
+    help="Planning runs per task (seeds seed, seed+1, ...).",
+)
 @click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0), help="First seed.")
 @click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
               help="Per-trial time limit (default: each task's planner.time_limit).")
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), default=None,
               help="Also write every trial to this file: .csv (one row per trial) or .json (trials and summary).")
-@click.option("-n", "--count", default=200_000, show_default=True, help="With --checks: checks per contact case and task.")
+@click.option(
+    "-n", "--count", default=200_000, show_default=True, help="With --checks: checks per contact case and task."
+)
 @click.option("--improve-for", type=float, default=None, metavar="S",
               help="Anytime planning: keep improving S seconds after the first plan (planner.improve_for), "
                    "and report the first and the improved plans.")
@@ -495,9 +505,11 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
         stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
         click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
                    f"{len(plan.waypoints) - 1}", err=True)
-        click.echo(f"continue with: stablepush execute {plan_file} --task {task_file} "
-                   f"{'--arm ' + arm + ' ' if arm else ''}{'--sim ' if sim else ''}--resume-from {fault.last_confirmed_step}",
-                   err=True)
+        click.echo(
+            f"continue with: stablepush execute {plan_file} --task {task_file} "
+            f"{'--arm ' + arm + ' ' if arm else ''}{'--sim ' if sim else ''}--resume-from {fault.last_confirmed_step}",
+            err=True,
+        )
         sys.exit(EXIT_ARM_FAULT)
     finally:
         sim_arm.close()
@@ -550,8 +562,15 @@ def _print_report(report) -> None:
               help="Fault injection for testing executors: die abruptly after N waypoints.")
 @click.option("--mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
               metavar="S", help="The pads' and features' mu are S times each task's (a world unlike the model).")
-@click.option("--tracker-noise", "tracker_noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0),
-              metavar="MM DEG", help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).")
+@click.option(
+    "--tracker-noise",
+    "tracker_noise",
+    nargs=2,
+    type=click.FloatRange(min=0),
+    default=(0.0, 0.0),
+    metavar="MM DEG",
+    help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).",
+)
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
               help="Seed of the tracker's noise.")
 @click.option("--idle-timeout", default=30.0, show_default=True, type=click.FloatRange(min=0.1, max=3600), metavar="S",

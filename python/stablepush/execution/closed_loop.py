@@ -52,8 +52,12 @@ class ClosedLoop:
     def for_task(cls, task: Task, threshold: Optional[Sequence[float]] = None,
                  final_tolerance: Optional[Sequence[float]] = None) -> "ClosedLoop":
         tol = task.planner["tolerance"]
-        return cls(threshold=tuple(threshold) if threshold else (THRESHOLD_FRACTION * tol[0], THRESHOLD_FRACTION * tol[1]),
-                   final_tolerance=tuple(final_tolerance) if final_tolerance else (FINAL_FRACTION * tol[0], FINAL_FRACTION * tol[1]))
+        return cls(
+            threshold=tuple(threshold) if threshold else (THRESHOLD_FRACTION * tol[0], THRESHOLD_FRACTION * tol[1]),
+            final_tolerance=tuple(final_tolerance)
+            if final_tolerance
+            else (FINAL_FRACTION * tol[0], FINAL_FRACTION * tol[1]),
+        )
 
     def may_replan(self, replans: Sequence["Replan"]) -> bool:
         """Whether the run may still re-plan, given the re-plans it made."""

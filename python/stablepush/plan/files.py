@@ -60,9 +60,19 @@ def plan_to_csv(plan: Plan) -> str:
     writer.writerow(CSV_COLUMNS)
     for i, w in enumerate(plan.waypoints):
         contact = ([*w.contact.start, *w.contact.end, *w.contact.normal] if w.contact is not None else [""] * 6)
-        writer.writerow([i, repr(w.x), repr(w.z), repr(w.theta), w.pusher or "",
-                         "" if w.margin is None else repr(w.margin),
-                         "" if w.margin_per_normal is None else repr(w.margin_per_normal), w.case or "", *map(str, contact)])
+        writer.writerow(
+            [
+                i,
+                repr(w.x),
+                repr(w.z),
+                repr(w.theta),
+                w.pusher or "",
+                "" if w.margin is None else repr(w.margin),
+                "" if w.margin_per_normal is None else repr(w.margin_per_normal),
+                w.case or "",
+                *map(str, contact),
+            ]
+        )
     return buffer.getvalue()
 
 

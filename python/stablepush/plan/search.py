@@ -98,8 +98,16 @@ def plan_task(
         # the first plan of an anytime search (planner.improve_for), before the improvement; None: no plan
         # (path_min_margin: the same measure for the returned path, the last push to the goal left out)
         solved_once = math.isfinite(s.first_time_s)
-        stats["first"] = {"planning_time_s": s.first_time_s, "switches": int(s.first_switches),
-                          "path_length_steps": s.first_length, "min_margin": s.first_min_margin} if solved_once else None
+        stats["first"] = (
+            {
+                "planning_time_s": s.first_time_s,
+                "switches": int(s.first_switches),
+                "path_length_steps": s.first_length,
+                "min_margin": s.first_min_margin,
+            }
+            if solved_once
+            else None
+        )
         stats["path_min_margin"] = s.path_min_margin if solved_once else None
     last = waypoints[-1]
     last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1

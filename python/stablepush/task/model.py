@@ -130,7 +130,8 @@ class Task:
         body = self.rigid_body(section)
         gripper = make_gripper(self.pads, self.grip_force, self.mu, self.pad_rings)
         pushers = [
-            _core.Pusher.on_boundary(section, p.name, mm2_to_si(p.a), mm2_to_si(p.b), p.mu, p.points) for p in self.pushers
+            _core.Pusher.on_boundary(section, p.name, mm2_to_si(p.a), mm2_to_si(p.b), p.mu, p.points)
+            for p in self.pushers
         ]
         fixed = self.pushes == "against_fixed_features"
         return _core.StablePushModel(
