@@ -2,16 +2,8 @@
 arm builds from them. No sockets here (`executor.py`) and no simulation (`stablepush.sim`).
 
 World frame W: x forward, z up, y along the gripping axis at the home pose, where G's axes are
-W's. During a push the pusher sticks to the object (that is what the plan guarantees), so the
-object rests on its feature, fixed in W, while the gripper moves: with T_GO(q) the object's pose in
-the grasp (docs/model.md section 1), G's world pose is
-
-    T_WG(t) = T_WO · T_GO(q(t))^-1.
-
-Between two contacts the gripper retracts the object from the feature along the pusher's inward
-normal, moves it along y into a lane between features (lifting it over everything first when the
-lanes differ), brings it opposite the next feature and approaches until the pusher's segment
-touches. Poses are (x, y, z, qw, qx, qy, qz) in W [m].
+W's. A feature is fixed in W; during a push the object rests on it while the gripper moves
+(`stream.py`). Positions in W are in m.
 """
 from __future__ import annotations
 
