@@ -8,7 +8,7 @@ reproduced without the CLI.
 import argparse
 from pathlib import Path
 
-from stablepush.benchmark import bench_checks
+from stablepush.plan.benchmark import bench_checks
 from stablepush.task import load_task
 
 ROOT = Path(__file__).resolve().parent.parent

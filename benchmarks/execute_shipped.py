@@ -9,10 +9,9 @@ import argparse
 import math
 from pathlib import Path
 
-from stablepush.closed_loop import ClosedLoop
-from stablepush.executor import execute_plan, plan_steps
-from stablepush.plan_io import plan_to_dict
-from stablepush.planning import plan_task
+from stablepush.execution import execute_plan
+from stablepush.execution.closed_loop import ClosedLoop
+from stablepush.plan import check_plan, plan_task
 from stablepush.sim.arm import WorldDeviation
 from stablepush.sim.server import running_sim_arm
 from stablepush.task import load_task
@@ -33,14 +32,14 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
         task = load_task(path)
-        steps = plan_steps(task, plan_to_dict(plan_task(task, seed=args.seed)))
+        plan = check_plan(task, plan_task(task, seed=args.seed))
         for scale in args.mu_scale:
-            _run(task, steps, scale, ClosedLoop.for_task(task) if args.closed_loop else None)
+            _run(task, plan, scale, ClosedLoop.for_task(task) if args.closed_loop else None)
 
 
-def _run(task, steps, mu_scale: float, loop) -> None:
+def _run(task, plan, mu_scale: float, loop) -> None:
     with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=mu_scale)) as server:
-        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop)
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop)
     err, goal = report.final_error, report.goal_error
     replans = f"{sum(r.solved for r in report.replans)}" + (f" (+{sum(not r.solved for r in report.replans)} failed)"
                                                             if any(not r.solved for r in report.replans) else "")

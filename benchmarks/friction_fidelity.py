@@ -8,9 +8,8 @@ import argparse
 import time
 from pathlib import Path
 
-from stablepush.mechanics import check_push
 from stablepush.sim import fidelity, friction
-from stablepush.task import load_task
+from stablepush.task import check_push, load_task
 
 TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 
@@ -47,8 +46,10 @@ def main() -> None:
               f"| {r.rotated_deg:+.3f} |", flush=True)
     print()
     r = fidelity.pivot_on_arm(pivoting)
-    print(f"Pivot on the arm, first {r.pushes} pushes of the pivoting plan: {r.error_mm:.3f} mm, {r.error_deg:+.3f} deg "
-          f"from the plan (limits {fidelity.ARM_PIVOT_LIMIT_MM} mm, {fidelity.ARM_PIVOT_LIMIT_DEG} deg), {r.steps_per_s:.0f} steps/s")
+    print(
+        f"Pivot on the arm, first {r.pushes} pushes of the pivoting plan: {r.error_mm:.3f} mm, {r.error_deg:+.3f} deg "
+        f"from the plan (limits {fidelity.ARM_PIVOT_LIMIT_MM} mm, {fidelity.ARM_PIVOT_LIMIT_DEG} deg), {r.steps_per_s:.0f} steps/s"
+    )
     print(f"\n{time.perf_counter() - started:.1f} s")
 
 

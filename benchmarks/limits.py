@@ -11,11 +11,11 @@ import time
 
 import yaml
 
-from stablepush.execution import place_features, scene_description
-from stablepush.executor import PlanStep
-from stablepush.planning import plan_task
+from stablepush.execution.world import place_features, scene_description
+from stablepush.plan import Waypoint, plan_task
 from stablepush.sim.arm import SimArm
-from stablepush.task import MAX_PUSHER_POINTS, MAX_PUSHERS, MAX_VERTICES, parse_task
+from stablepush.task import parse_task
+from stablepush.task.schema import MAX_PUSHER_POINTS, MAX_PUSHERS, MAX_VERTICES
 
 
 def task_at_the_caps() -> str:
@@ -43,7 +43,7 @@ def main() -> None:
     t2 = time.perf_counter()
     result = plan_task(task, models=[model])
     t3 = time.perf_counter()
-    steps = [PlanStep(task.start, None), PlanStep(task.start, task.pushers[0].name)]
+    steps = [Waypoint(*task.start), Waypoint(*task.start, pusher=task.pushers[0].name)]
     scene = scene_description(task, place_features(task, steps), task.start)
     t4 = time.perf_counter()
     arm = SimArm(scene)

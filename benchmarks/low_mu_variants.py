@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from stablepush.planning import plan_task
+from stablepush.plan import plan_task
 from stablepush.task import parse_task
 
 TASK = Path(__file__).resolve().parent.parent / "data" / "tasks" / "horizontal-offset-low-mu.yaml"

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stablepush.planning import plan_task
+from stablepush.plan import plan_task
 from stablepush.task import load_task
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -1,4 +1,4 @@
-"""Point pushers (issue 10): the cube with two pegs (data/tasks/more/cube-pegs.yaml) over seeds,
+"""Point pushers: the cube with two pegs (data/tasks/more/cube-pegs.yaml) over seeds,
 then goals 10 mm from the start in 8 directions at +-20 degrees, to show where a peg's surface of
 stable pushes reaches and where it does not.
 
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from stablepush.planning import plan_task
+from stablepush.plan import plan_task
 from stablepush.task import load_task
 
 TASK = Path(__file__).resolve().parent.parent / "data" / "tasks" / "more" / "cube-pegs.yaml"

@@ -10,9 +10,8 @@ from pathlib import Path
 
 import yaml
 
-from stablepush.executor import execute_plan, plan_steps
-from stablepush.plan_io import plan_to_dict
-from stablepush.planning import plan_task
+from stablepush.execution import execute_plan
+from stablepush.plan import check_plan, plan_task
 from stablepush.sim.arm import WorldDeviation
 from stablepush.sim.server import running_sim_arm
 from stablepush.task import parse_task
@@ -40,15 +39,19 @@ def main() -> None:
             if not plan.solved:
                 print(f"| {task.name} | {label} | not solved ({plan.outcome}) in {took:.0f} s |", flush=True)
                 continue
-            steps = plan_steps(task, plan_to_dict(plan))
+            check_plan(task, plan)
             errors = []
             for scale in WORLDS:
                 with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=scale)) as server:
-                    report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
+                    report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
                 errors.append(f"{report.final_error['distance']:.2f} / {report.final_error['theta']:+.2f}")
-            print(f"| {task.name} | {label} | {plan.stats['pushes']} | {' → '.join(plan.pusher_sequence)} "
-                  f"| {took * 1e3:.0f} ms | {min(w.margin for w in plan.waypoints[1:]):.3f} | " + " | ".join(errors) + " |",
-                  flush=True)
+            print(
+                f"| {task.name} | {label} | {plan.stats['pushes']} | {' → '.join(plan.pusher_sequence)} "
+                f"| {took * 1e3:.0f} ms | {min(w.margin for w in plan.waypoints[1:]):.3f} | "
+                + " | ".join(errors)
+                + " |",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

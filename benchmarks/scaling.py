@@ -19,7 +19,7 @@ from pathlib import Path
 
 import yaml
 
-from stablepush.benchmark import bench_planning
+from stablepush.plan.benchmark import bench_planning
 from stablepush.task import parse_task
 
 TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"

@@ -9,6 +9,23 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from stablepush.task import load_task, parse_task  # noqa: E402
 
+# Modules that run the simulated arm, a fuzz campaign or thousands of LP cross-checks, and single
+# tests of several seconds: `-m "not slow"` leaves them out, so the rest (the mechanics, the
+# planner, files, the CLI) runs in about a minute.
+SLOW_MODULES = {"test_fuzz", "test_execute", "test_sim_arm", "test_friction_fidelity", "test_reliability",
+                "test_robust", "test_point_pushers", "test_cross_check"}
+SLOW_TESTS = {
+    "test_h_representation_matches_generators",
+    "test_large_manipulation_reaches_a_zero_switch_plan_for_nine_of_ten_seeds",
+    "test_pivot_turns_the_object_with_a_side_pusher_through_sticking_steps",
+}
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.module.__name__ in SLOW_MODULES or item.originalname in SLOW_TESTS:
+            item.add_marker(pytest.mark.slow)
+
 
 @pytest.fixture(scope="session")
 def tasks_dir():

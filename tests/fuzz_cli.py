@@ -122,8 +122,8 @@ def run_tasks(count: int, seed: int, scratch: Path):
 
 
 def run_plans(count: int, seed: int, scratch: Path):
-    from stablepush.plan_io import plan_to_dict
-    from stablepush.planning import plan_task
+    from stablepush.plan import plan_task
+    from stablepush.plan.files import plan_to_dict
     from stablepush.task import load_task
 
     rng = random.Random(seed)

@@ -5,32 +5,61 @@ import math
 import numpy as np
 import pytest
 from click.testing import CliRunner
-from conftest import TASKS
 
 import stablepush as sp
-from stablepush.execution import place_features
+from stablepush.execution.world import place_features
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush_cli.main import cli
+
+from conftest import TASKS
 
 
 def test_plan_save_load_check_trajectory_figure_round_trip(tmp_path):
     task = sp.load_task(TASKS / "t-shaped.yaml")
     plan = sp.plan(task, seed=1, time_limit=2.0)
     assert isinstance(plan, sp.Plan) and plan.solved and "40 pushes" in repr(plan)
-    plan.save(tmp_path / "t.plan.json", tmp_path / "t.csv")
-    loaded = sp.Plan.load(tmp_path / "t.plan.json")
+    sp.save_plan(plan, tmp_path / "t.plan.json", tmp_path / "t.csv")
+    loaded = sp.load_plan(tmp_path / "t.plan.json")
     assert loaded.waypoints == plan.waypoints and loaded.ends_at_goal == plan.ends_at_goal
     assert np.array_equal(loaded.poses, plan.poses) and loaded.poses.shape == (41, 3)
-    assert loaded.check(task) is loaded
-    traj = loaded.trajectory(task, rate_hz=50)
+    assert sp.check_plan(task, loaded) is loaded
+    traj = sp.trajectory(task, loaded, rate_hz=50)
     assert len(traj) > 0 and traj.rate_hz == 50
-    fig = loaded.figure(task)
-    assert fig.axes
+    assert sp.plan_figure(task, loaded).axes
     with pytest.raises(sp.PlanError, match="the plan is for task 't-shaped', not 'pivoting'"):
-        loaded.check(sp.load_task(TASKS / "pivoting.yaml"))
-    assert sp.check(task, at=task.start, move=(1, 0, 0))["left"]["feasible"] in (True, False)
+        sp.check_plan(sp.load_task(TASKS / "pivoting.yaml"), loaded)
     with pytest.raises(sp.StablepushError):
         sp.load_task(tmp_path / "missing.yaml")
+
+
+def test_check_says_a_pusher_pushes_and_never_pulls():
+    """The plan's first push is stable for its pusher; the same pusher moving the object the
+    opposite way would have to pull it, which no contact can (its cone holds no such wrench)."""
+    task = sp.load_task(TASKS / "t-shaped.yaml")
+    first = sp.plan(task, seed=1).waypoints[1]
+    move = tuple(b - a for a, b in zip(first.pose, task.start))
+    forward = tuple(-d for d in move)
+    assert sp.check(task, at=task.start, move=forward)[first.pusher]["feasible"] is True
+    backward = sp.check(task, at=task.start, move=move, pusher=first.pusher)[first.pusher]
+    assert backward["feasible"] is False and backward["margin"] < 0
+
+
+def test_the_package_leaves_the_plotting_backend_alone():
+    """Drawing a figure neither needs pyplot nor switches the caller's backend, and `import
+    stablepush` does not load matplotlib at all."""
+    import subprocess
+    import sys
+
+    code = ("import sys, matplotlib; matplotlib.use('svg'); import stablepush as sp; "
+            "assert 'matplotlib.pyplot' not in sys.modules; "
+            "t = sp.load_task(sys.argv[1]); sp.plan_figure(t, sp.plan(t, seed=1)); "
+            "assert matplotlib.get_backend() == 'svg', matplotlib.get_backend(); "
+            "assert 'matplotlib.pyplot' not in sys.modules")
+    done = subprocess.run([sys.executable, "-c", code, str(TASKS / "pivoting.yaml")], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    bare = subprocess.run([sys.executable, "-c", "import sys, stablepush; assert 'matplotlib' not in sys.modules"],
+                          capture_output=True, text=True)
+    assert bare.returncode == 0, bare.stderr
 
 
 def test_the_trajectory_puts_the_object_where_the_plan_says_at_every_push():
@@ -38,8 +67,8 @@ def test_the_trajectory_puts_the_object_where_the_plan_says_at_every_push():
     object give back plan pose k: T_GO(q_k) = T_WG^-1 T_WO (docs/model.md section 1)."""
     task = sp.load_task(TASKS / "horizontal-offset-low-mu.yaml")
     plan = sp.plan(task, seed=1)
-    traj = plan.trajectory(task, rate_hz=100)
-    features = place_features(task, plan.steps)
+    traj = sp.trajectory(task, plan, rate_hz=100)
+    features = place_features(task, plan.waypoints)
     done = {}
     for i in range(len(traj)):
         if traj.phase[i] == "push":
@@ -59,7 +88,7 @@ def test_velocities_match_the_motion():
     """Pivoting: G turns about y by the plan's 1 deg per 0.1 s push while the object rests on its
     feature, so |omega| = 0.1745 rad/s about y; and the velocities integrate to the positions."""
     task = sp.load_task(TASKS / "pivoting.yaml")
-    traj = sp.plan(task, seed=1).trajectory(task)
+    traj = sp.trajectory(task, sp.plan(task, seed=1))
     steady = [i for i in range(1, len(traj) - 1) if traj.phase[i] == "push" and traj.phase[i - 1] == "push"
               and 2 <= traj.step[i] <= 80]
     w = traj.angular_velocity[steady]
@@ -86,15 +115,3 @@ def test_trajectory_command_writes_csv_and_json_in_either_quaternion_order(tmp_p
     assert doc["columns"][4:8] == ["qw", "qx", "qy", "qz"] and doc["rate_hz"] == 50
     bad = CliRunner().invoke(cli, ["trajectory", str(plan_file), "--task", str(task), "-o", str(tmp_path / "t.txt")])
     assert bad.exit_code == 2 and "must end in .csv or .json" in bad.stderr
-
-
-def test_figures_the_executor_and_trajectories_take_a_plan_or_its_waypoints():
-    from stablepush import figures
-    from stablepush.execution import as_steps
-    from stablepush.trajectory import timed_trajectory
-
-    task = sp.load_task(TASKS / "horizontal-offset-high-mu.yaml")
-    plan = sp.plan(task, seed=1)
-    assert as_steps(plan) == as_steps(plan.waypoints) == as_steps(plan.steps) == plan.steps
-    assert figures.plan_figure(task, plan.waypoints).axes  # the issue's `plan_figure(task, result.waypoints)`
-    assert len(timed_trajectory(task, plan)) == len(plan.trajectory(task))

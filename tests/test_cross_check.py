@@ -8,6 +8,7 @@ import zlib
 
 import numpy as np
 import pytest
+
 from conftest import shipped, task_with
 from independent_lp import IndependentModel
 

@@ -10,13 +10,15 @@ import threading
 import pytest
 from click.testing import CliRunner
 
-from conftest import TASKS, shipped
-from stablepush.arm_protocol import PROTOCOL, ProtocolError, decode, encode
-from stablepush.executor import ExecutionFault, execute_plan, plan_steps
-from stablepush.plan_io import plan_to_dict, write_plan
-from stablepush.planning import plan_task
+from stablepush.errors import ArmFault
+from stablepush.execution import execute_plan
+from stablepush.execution.protocol import PROTOCOL, ProtocolError, decode, encode
+from stablepush.plan import check_plan, plan_task
+from stablepush.plan.files import write_plan
 from stablepush.sim.server import running_sim_arm
 from stablepush_cli.main import cli
+
+from conftest import TASKS, shipped
 
 # The bound the end-to-end test holds the simulated run to (the paper's robot: 0.5 mm, 0.5 deg).
 # The paper's robot ended within 0.5 mm and 0.5 deg; the simulated arm does better on these plans
@@ -53,9 +55,9 @@ def test_end_to_end_plan_execute_on_the_sim_arm(high_mu_plan, tmp_path):
 
 def test_t_shape_end_to_end_through_two_switch_overs():
     task = shipped("t-shaped")
-    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    plan = check_plan(task, plan_task(task, seed=1))
     with running_sim_arm(log=lambda text: None) as server:
-        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
     assert [c.pusher for c in report.contacts] == ["left", "under-web", "left"]
     # 0.09 mm measured with Coulomb friction on the sliding pad points (1.0 mm was allowed before they slid right)
     assert report.final_error["distance"] < FINAL_BOUND_MM and abs(report.final_error["theta"]) < FINAL_BOUND_DEG
@@ -169,18 +171,27 @@ class FakeArm:
                     return
 
 
-@pytest.mark.parametrize("bad_reply, says", [
-    (lambda msg: b"ack, but not JSON\n", "not a JSON line"),
-    (lambda msg: encode({"type": "ack", "seq": msg["seq"] + 1, "state": {"ee_pose": msg["pose"]}}), "out-of-order acknowledgement"),
-    (lambda msg: encode({"type": "ack", "seq": msg["seq"]}), "field 'state' missing"),
-    (lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "joint 4 over its torque limit"}), "torque limit"),
-])
+@pytest.mark.parametrize(
+    "bad_reply, says",
+    [
+        (lambda msg: b"ack, but not JSON\n", "not a JSON line"),
+        (
+            lambda msg: encode({"type": "ack", "seq": msg["seq"] + 1, "state": {"ee_pose": msg["pose"]}}),
+            "out-of-order acknowledgement",
+        ),
+        (lambda msg: encode({"type": "ack", "seq": msg["seq"]}), "field 'state' missing"),
+        (
+            lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "joint 4 over its torque limit"}),
+            "torque limit",
+        ),
+    ],
+)
 def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
     task = shipped("horizontal-offset-high-mu")
-    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    plan = check_plan(task, plan_task(task, seed=1))
     arm = FakeArm(good=41, bad_reply=bad_reply)  # the approach and 4 pushes
-    with pytest.raises(ExecutionFault) as fault:
-        execute_plan(task, steps, "127.0.0.1", arm.port, rate_hz=100.0, pace=False, ack_timeout=5.0)
+    with pytest.raises(ArmFault) as fault:
+        execute_plan(task, plan, "127.0.0.1", arm.port, rate_hz=100.0, pace=False, ack_timeout=5.0)
     assert says in fault.value.reason
     assert fault.value.last_confirmed_step == 4
     assert fault.value.arm_stopped is True and arm.stopped
@@ -188,10 +199,10 @@ def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
 
 def test_the_sim_arm_refuses_malformed_and_out_of_order_waypoints_and_stops():
     task = shipped("horizontal-offset-high-mu")
-    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
-    from stablepush.execution import place_features, scene_description
+    plan = check_plan(task, plan_task(task, seed=1))
+    from stablepush.execution.world import place_features, scene_description
 
-    scene = scene_description(task, place_features(task, steps), task.start)
+    scene = scene_description(task, place_features(task, plan.waypoints), task.start)
     with running_sim_arm(log=lambda text: None) as server:
         for bad, says in ((b"{not json\n", "not a JSON line"),
                           (encode({"type": "waypoint", "seq": 5, "t": 0.0, "step": 0, "phase": "push",
@@ -224,8 +235,8 @@ def test_protocol_decoding_names_what_is_wrong():
 
 
 def test_show_writes_a_png_and_a_gif_of_the_plan(high_mu_plan, tmp_path):
-    from PIL import Image
     import numpy as np
+    from PIL import Image
 
     plan, task = high_mu_plan
     png, gif = tmp_path / "plan.png", tmp_path / "plan.gif"
@@ -265,16 +276,16 @@ def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     the tracked pose and ends within the loop's threshold (half the goal tolerance). Whether it
     also ends within the final tolerance depends on the plan (README, "Closed loop"): drift that
     shows after the prism has passed the bottom pusher can no longer be lifted out."""
-    from stablepush.closed_loop import ClosedLoop
+    from stablepush.execution.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
 
     task = shipped("horizontal-offset-low-mu")
-    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    plan = check_plan(task, plan_task(task, seed=1))
     loop = ClosedLoop.for_task(task)
     with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=0.85)) as server:
-        open_loop = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
+        open_loop = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
     with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=0.85)) as server:
-        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop)
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop)
     assert open_loop.goal_error["distance"] > 0.5, open_loop.goal_error
     assert report.closed_loop == "on"
     assert any(r.solved and r.pushes > 0 for r in report.replans), report.replans
@@ -286,19 +297,19 @@ def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
 
 
 def test_closed_loop_on_an_arm_without_a_tracker_runs_open_loop_and_says_so():
-    from stablepush.closed_loop import ClosedLoop
+    from stablepush.execution.closed_loop import ClosedLoop
 
     task = shipped("horizontal-offset-high-mu")
-    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
+    plan = check_plan(task, plan_task(task, seed=1))
     arm = FakeArm(good=10**9, bad_reply=None)  # acknowledges everything, reports no object_in_grasp
-    report = execute_plan(task, steps, "127.0.0.1", arm.port, rate_hz=100.0, pace=False,
+    report = execute_plan(task, plan, "127.0.0.1", arm.port, rate_hz=100.0, pace=False,
                           closed_loop=ClosedLoop.for_task(task))
     assert report.closed_loop == "no tracker" and report.replans == []
     assert report.last_confirmed_step == 20 and report.final_error is None
 
 
 def test_closed_loop_thresholds_default_to_fractions_of_the_task_tolerance():
-    from stablepush.closed_loop import ClosedLoop
+    from stablepush.execution.closed_loop import ClosedLoop
 
     task = shipped("t-shaped")  # tolerance [1, 1]
     loop = ClosedLoop.for_task(task)
@@ -312,7 +323,7 @@ def test_a_correction_that_would_carry_an_unheld_object_between_features_is_refu
     """At the high-mu offset's end the pads hold only 0.91 of the prism's weight: a correction by
     the right pusher would carry it there unheld (tried, it ended 21.7 mm / 61 deg off), so the
     re-plan is refused; from the start pose, where the pads hold 4.3 times it, it is taken."""
-    from stablepush.closed_loop import ClosedLoop, replan
+    from stablepush.execution.closed_loop import ClosedLoop, replan
 
     task = shipped("horizontal-offset-high-mu")
     loop = ClosedLoop.for_task(task)
@@ -333,10 +344,11 @@ def test_features_hold_the_object_at_the_world_orientation_the_model_assumes():
     start's unless environment.features says): the executor places them so, turning G instead."""
     import math
 
-    from stablepush.execution import PlanStep, place_features
+    from stablepush.execution.world import place_features
+    from stablepush.plan import Waypoint
 
     task = shipped("large-manipulation")  # start theta 0
-    steps = [PlanStep((0.0, 0.0, 0.0), None), PlanStep((0.0, 0.0, 5.0), "bottom"), PlanStep((0.0, 0.0, 10.0), "left")]
+    steps = [Waypoint(0.0, 0.0, 0.0), Waypoint(0.0, 0.0, 5.0, pusher="bottom"), Waypoint(0.0, 0.0, 10.0, pusher="left")]
     features = place_features(task, steps)
     for name in ("bottom", "left"):
         R = features[name].object_pose[:3, :3]
@@ -346,10 +358,10 @@ def test_features_hold_the_object_at_the_world_orientation_the_model_assumes():
 
 def test_protocol_versions_arm_2_and_arm_1_are_both_served_and_others_refused():
     task = shipped("horizontal-offset-high-mu")
-    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
-    from stablepush.execution import place_features, scene_description
+    plan = check_plan(task, plan_task(task, seed=1))
+    from stablepush.execution.world import place_features, scene_description
 
-    scene = scene_description(task, place_features(task, steps), task.start)
+    scene = scene_description(task, place_features(task, plan.waypoints), task.start)
     with running_sim_arm(log=lambda text: None) as server:
         for version in ("stablepush.arm/1", PROTOCOL):
             with socket.create_connection((server.host, server.port), timeout=30) as conn:

@@ -1,12 +1,13 @@
-"""The friction-fidelity contract (issue 9; `stablepush.sim.fidelity`): the simulated arm's contacts
+"""The friction-fidelity contract (`stablepush.sim.fidelity`): the simulated arm's contacts
 must stick where Coulomb's law sticks and slide with mu N where it slides, or no plan measured on
 it means anything. `python3 benchmarks/friction_fidelity.py` prints the same numbers as a table.
 """
 import pytest
 
-from conftest import shipped
-from stablepush.mechanics import check_push
 from stablepush.sim import fidelity, friction
+from stablepush.task import check_push
+
+from conftest import shipped
 
 
 @pytest.mark.parametrize("load", [0.5, 0.9])

@@ -3,9 +3,10 @@ import math
 
 import numpy as np
 import pytest
-from conftest import shipped, task_with
 
-from stablepush.task import pose_to_si
+from stablepush.units import pose_to_si
+
+from conftest import shipped, task_with
 
 MM = 1e-3
 
@@ -227,7 +228,7 @@ def test_hold_ratio_agrees_with_an_independent_lp_and_is_infinite_without_gravit
 
 
 def test_released_at_the_offsets_goal_the_prism_is_not_held_and_the_planner_can_require_a_held_goal():
-    from stablepush.planning import plan_task
+    from stablepush.plan import plan_task
 
     task = shipped("horizontal-offset-high-mu")
     free = plan_task(task)

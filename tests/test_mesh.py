@@ -6,14 +6,16 @@ import math
 import numpy as np
 import pytest
 import trimesh
-from conftest import ROOT
 from shapely.geometry import Polygon
 
+import stablepush as sp
 from stablepush import _core
 from stablepush.errors import TaskError
-from stablepush.mesh import load_mesh_object
-from stablepush.planning import plan_task
+from stablepush.plan import plan_task
 from stablepush.task import load_task, parse_task
+from stablepush.task.mesh import load_mesh_object
+
+from conftest import ROOT
 
 BRACKET = ROOT / "data" / "tasks" / "more" / "l-bracket-mesh.yaml"
 
@@ -34,8 +36,7 @@ def test_a_mesh_task_is_planned_end_to_end():
     task = load_task(BRACKET)
     plan = plan_task(task, seed=1)
     assert plan.solved
-    plan.check(task)
-    assert len(plan.trajectory(task)) > 0
+    assert len(sp.trajectory(task, sp.check_plan(task, plan))) > 0
 
 
 def _cylinder(tmp_path, sections=256):

@@ -1,10 +1,12 @@
-"""Help for the mistakes people make: each gets the stated message (issue 11)."""
+"""Help for the mistakes people make: each gets the stated message."""
+import numpy as np
 import pytest
 from click.testing import CliRunner
-from conftest import task_text
 
 from stablepush.task import parse_task
 from stablepush_cli.main import cli
+
+from conftest import task_text
 
 
 def _write(tmp_path, text, name="mine.yaml"):
@@ -67,9 +69,12 @@ def test_a_pusher_a_hair_off_its_edge_is_snapped_and_one_far_off_gets_its_true_d
 
 
 def test_show_draws_an_unsolved_plan_marked_as_such_and_point_pushers(tmp_path):
+    from matplotlib.text import Annotation
+
+    from stablepush.plan import Plan, Waypoint
+    from stablepush.viz import figures
+
     from conftest import TASKS, task_with
-    from stablepush import figures
-    from stablepush.execution import PlanStep
 
     task = TASKS / "horizontal-offset-low-mu.yaml"
     plan = tmp_path / "part.json"
@@ -81,8 +86,16 @@ def test_show_draws_an_unsolved_plan_marked_as_such_and_point_pushers(tmp_path):
     # A point pusher is a dot; the object's x axis an arrow (its orientation).
     pegs = task_with("horizontal-offset-low-mu", lambda d: d.update(
         gravity=[0, 0], pushers=[{"name": "tip", "at": [-50, 0], "mu": 0.6}]))
-    fig = figures.plan_figure(pegs, [PlanStep((0, 0, 0), None), PlanStep((1, 0, 0), "tip")], reaches_goal=False)
-    first = fig.axes[0]
+    partial = Plan(task=pegs.name, solved=False, outcome="time_limit", message="", stats={},
+                   waypoints=[Waypoint(0, 0, 0), Waypoint(1, 0, 30, pusher="tip")])
+    fig = figures.plan_figure(pegs, partial)
+    first, last = fig.axes[0], fig.axes[1]
     assert any(line.get_marker() == "o" for line in first.get_lines())
-    assert first.texts or first.patches  # the orientation arrow
+    # The orientation arrow runs along O's x axis: from the pose's (x, z), turned by its theta.
+    size = 0.3 * max(max(abs(v) for v in p) for p in pegs.vertices)
+    for ax, (x, z, theta) in ((first, (0, 0, 0)), (last, (1, 0, 30))):
+        arrows = [t for t in ax.texts if isinstance(t, Annotation) and t.arrow_patch is not None]
+        assert len(arrows) == 1
+        c, s = np.cos(np.radians(theta)), np.sin(np.radians(theta))
+        assert np.allclose(arrows[0].xyann, (x, z)) and np.allclose(arrows[0].xy, (x + c * size, z - s * size))
     assert fig.axes[1].get_title().startswith("end")

@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import yaml
+
 from conftest import TASKS, task_text
 
 LOW_MU = str(TASKS / "horizontal-offset-low-mu.yaml")

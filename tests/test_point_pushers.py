@@ -1,4 +1,4 @@
-"""Point pushers (issue 10; docs/model.md sections 2 and 3). A peg's cone is a wedge, so with the
+"""Point pushers (docs/model.md sections 2 and 3). A peg's cone is a wedge, so with the
 pads sliding its stable pushes form a surface in motion space: random motions are never stable,
 and the planner finds the surface as a root in the push's rotation."""
 import math
@@ -6,10 +6,11 @@ import math
 import numpy as np
 import pytest
 
+from stablepush.plan import plan_task
+from stablepush.task import load_task
+
 from conftest import TASKS
 from independent_lp import IndependentModel
-from stablepush.planning import plan_task
-from stablepush.task import load_task
 from test_planner import reaches_goal, recheck, unit_steps
 
 MM = 1e-3

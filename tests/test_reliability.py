@@ -15,16 +15,19 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from conftest import TASKS, shipped, task_text
 from stablepush import _core
-from stablepush.arm_protocol import PROTOCOL, decode, encode
 from stablepush.errors import ArmFault, OutputError, PlanError, TaskError
-from stablepush.executor import execute_plan, plan_steps
-from stablepush.plan_io import plan_to_dict, read_plan, write_files
-from stablepush.planning import plan_task
+from stablepush.execution import execute_plan
+from stablepush.execution.protocol import PROTOCOL, decode, encode
+from stablepush.outputs import write_files
+from stablepush.plan import check_plan, load_plan, plan_task
+from stablepush.plan.files import plan_to_dict, read_plan
 from stablepush.sim.server import SimArmServer
-from stablepush.task import parse_task, pose_to_si
+from stablepush.task import parse_task
+from stablepush.units import pose_to_si
 from stablepush_cli.main import cli
+
+from conftest import TASKS, shipped, task_text
 
 LOW_MU = TASKS / "horizontal-offset-low-mu.yaml"
 
@@ -166,7 +169,7 @@ def test_bad_plan_files_are_refused_before_anything_moves(tmp_path, low_mu_plan,
     path = tmp_path / "bad.plan.json"
     path.write_text(json.dumps(plan))
     with pytest.raises(PlanError) as error:
-        plan_steps(shipped("horizontal-offset-low-mu"), read_plan(path), source=str(path))
+        check_plan(shipped("horizontal-offset-low-mu"), load_plan(path), source=str(path))
     assert says in str(error.value)
     result = CliRunner().invoke(cli, ["execute", str(path), "--task", str(LOW_MU), "--arm", "127.0.0.1:9"])
     assert result.exit_code == 2 and says in result.stderr
@@ -221,7 +224,7 @@ def test_a_json_and_csv_pair_stays_consistent_when_the_writer_is_killed(tmp_path
     new JSON beside an old CSV, nor a temporary file."""
     script = textwrap.dedent(f"""
         import sys
-        from stablepush.plan_io import write_files
+        from stablepush.outputs import write_files
         k = 0
         print("ready", flush=True)
         while True:
@@ -250,15 +253,15 @@ def _hello(scene, rate_hz=100):
 
 @pytest.fixture(scope="module")
 def high_mu_run():
-    from stablepush.execution import place_features, scene_description
+    from stablepush.execution.world import place_features, scene_description
 
     task = shipped("horizontal-offset-high-mu")
-    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=1)))
-    return task, steps, scene_description(task, place_features(task, steps), task.start)
+    plan = check_plan(task, plan_task(task, seed=1))
+    return task, plan, scene_description(task, place_features(task, plan.waypoints), task.start)
 
 
 def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu_run):
-    task, steps, scene = high_mu_run
+    task, plan, scene = high_mu_run
     server = SimArmServer(log=lambda text: None, idle_timeout=3.0)  # longer than the 2 s a new client waits
     server.start_in_thread()
     try:
@@ -280,14 +283,14 @@ def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu
             assert decode(first.makefile("rb").readline(), "server")["type"] == "ready"
             assert "busy" in exchange(b"")[-1]["message"]
         time.sleep(0.2)
-        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
-        assert report.last_confirmed_step == len(steps) - 1 and report.final_error["distance"] < 0.5
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
+        assert report.last_confirmed_step == len(plan.waypoints) - 1 and report.final_error["distance"] < 0.5
     finally:
         server.close()
 
 
 def test_the_executor_holds_its_ack_deadline_against_a_trickling_arm(high_mu_run):
-    task, steps, scene = high_mu_run
+    task, plan, scene = high_mu_run
     listener = socket.create_server(("127.0.0.1", 0))
 
     def trickle():
@@ -301,7 +304,7 @@ def test_the_executor_holds_its_ack_deadline_against_a_trickling_arm(high_mu_run
     threading.Thread(target=trickle, daemon=True).start()
     started = time.monotonic()
     with pytest.raises(ArmFault, match="no complete message from the arm server .* within 1 s"):
-        execute_plan(task, steps, "127.0.0.1", listener.getsockname()[1], rate_hz=100.0, pace=False, ack_timeout=1.0)
+        execute_plan(task, plan, "127.0.0.1", listener.getsockname()[1], rate_hz=100.0, pace=False, ack_timeout=1.0)
     assert time.monotonic() - started < 5.0  # the deadline plus the stop's 2 s, not the trickle's 8 s
     listener.close()
 
@@ -313,7 +316,7 @@ def test_the_executor_holds_its_ack_deadline_against_a_trickling_arm(high_mu_run
     ({"ee_pose": [0, 0, 0, 1, 0, 0, 0], "object_in_grasp": {"x": "1"}}, "object_in_grasp must hold finite numbers"),
 ])
 def test_bad_arm_states_end_in_an_arm_fault_and_a_stop(high_mu_run, state, says):
-    task, steps, _ = high_mu_run
+    task, plan, _ = high_mu_run
     listener = socket.create_server(("127.0.0.1", 0))
     stops = []
 
@@ -327,7 +330,7 @@ def test_bad_arm_states_end_in_an_arm_fault_and_a_stop(high_mu_run, state, says)
 
     threading.Thread(target=arm, daemon=True).start()
     with pytest.raises(ArmFault, match=says) as fault:
-        execute_plan(task, steps, "127.0.0.1", listener.getsockname()[1], rate_hz=100.0, pace=False, ack_timeout=2.0)
+        execute_plan(task, plan, "127.0.0.1", listener.getsockname()[1], rate_hz=100.0, pace=False, ack_timeout=2.0)
     time.sleep(0.1)
     assert stops and json.loads(stops[0])["type"] == "stop"
     assert fault.value.last_confirmed_step == 0

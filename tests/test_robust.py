@@ -9,14 +9,15 @@ import zlib
 
 import numpy as np
 import pytest
-from conftest import shipped, task_with
-from independent_lp import IndependentModel
 from test_cross_check import BAND_N, random_queries
 
 from stablepush import _core
 from stablepush.errors import TaskError
-from stablepush.planning import plan_task
-from stablepush.task import pose_to_si
+from stablepush.plan import plan_task
+from stablepush.units import pose_to_si
+
+from conftest import task_with
+from independent_lp import IndependentModel
 
 UNCERTAINTY = {"pad_mu": 0.1, "pusher_mu": 0.15, "grip_force": 0.1, "mass": 0.05}
 

@@ -1,4 +1,4 @@
-"""TRRTstar tested apart from the mechanics (issue 10, item 6): the search asks a PushChecker
+"""TRRTstar tested apart from the mechanics: the search asks a PushChecker
 which pushers make a motion stable, so a toy rule can stand in for the model, OMPL-style.
 
 The toy: two pushers, each able to move the object only within a narrow cone of directions in
@@ -27,6 +27,7 @@ class ConeChecker(_core.PushChecker):
         super().__init__()
         self.calls = 0
         self.asked = []  # the candidate set of each call
+        self.stable = set()  # (a, b, pusher) of every motion this checker answered stable
 
     def alignment(self, a, b, pusher):
         d = unit(a, b)
@@ -39,7 +40,9 @@ class ConeChecker(_core.PushChecker):
     def stable_pushers(self, a, b, candidates):
         self.calls += 1
         self.asked.append(candidates)
-        return sum(1 << p for p in (0, 1) if candidates >> p & 1 and self.alignment(a, b, p) >= self.COS[p])
+        stable = [p for p in (0, 1) if candidates >> p & 1 and self.alignment(a, b, p) >= self.COS[p]]
+        self.stable.update((tuple(a), tuple(b), p) for p in stable)
+        return sum(1 << p for p in stable)
 
     def push_margin(self, a, b, pusher):
         return self.alignment(a, b, pusher) - self.COS[pusher]
@@ -63,7 +66,8 @@ def test_a_goal_that_needs_both_toy_pushers_takes_one_switch_over_and_every_edge
         assert ConeChecker().alignment(a, b, pusher) >= ConeChecker.COS[pusher]  # the rule the search was given
     end = path[-1][0]
     assert abs(end[0] - 6 * MM) <= 0.5 * MM and abs(end[1] - 6 * MM) <= 0.5 * MM
-    assert checker.calls > 0
+    # every edge of the path is a motion this checker itself answered stable for that pusher
+    assert all((tuple(a), tuple(b), pusher) in checker.stable for (a, _), (b, pusher) in zip(path, path[1:]))
 
 
 def test_with_no_switch_over_allowed_the_toy_goal_is_out_of_reach():

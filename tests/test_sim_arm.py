@@ -8,11 +8,14 @@ import math
 import numpy as np
 import pytest
 
-from conftest import shipped, task_with
-from stablepush.execution import PlanStep, arm_trajectory, place_features, scene_description
+from stablepush.execution.stream import arm_trajectory
+from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
+from stablepush.plan import Waypoint
 from stablepush.sim.arm import SimArm
 from stablepush.sim.scene import convex_pieces
+
+from conftest import shipped, task_with
 
 G0 = 9.81
 
@@ -21,7 +24,7 @@ def _ledge_force(task, speed=0.01, duration=1.0):
     """Hold the object above the task's bottom pusher, made a ledge, and lower the gripper onto it at
     `speed` m/s: the mean ledge force on the object (N, world z) once the pads slide steadily."""
     start = task.start
-    steps = [PlanStep(start, None), PlanStep(start, "bottom")]
+    steps = [Waypoint(*start), Waypoint(*start, pusher="bottom")]
     features = place_features(task, steps)
     arm = SimArm(scene_description(task, features, start))
     pose = list(arm.state()["ee_pose"])
@@ -84,10 +87,10 @@ def _pose(T):
 def test_during_a_push_the_object_stays_on_its_feature():
     """T_WG(t) · T_GO(q(t)) is the feature's object pose at every push waypoint (the pusher sticks)."""
     task = shipped("t-shaped")
-    from stablepush.planning import plan_task
+    from stablepush.plan import plan_task
 
     plan = plan_task(task, seed=2)
-    steps = [PlanStep((w.x, w.z, w.theta), w.pusher) for w in plan.waypoints]
+    steps = plan.waypoints
     features = place_features(task, steps)
     home = scene_description(task, features, task.start)["gripper_pose"]
     waypoints = arm_trajectory(task, steps, features, 100.0, home)
@@ -109,7 +112,7 @@ def test_features_from_the_task_environment():
         data["environment"] = {"features": {"left": [400, 50, 250, 10]}}
 
     task = task_with("horizontal-offset-high-mu", edit)
-    steps = [PlanStep(task.start, None), PlanStep((1.0, 0.0, 0.0), "left")]
+    steps = [Waypoint(*task.start), Waypoint(1.0, 0.0, 0.0, pusher="left")]
     feature = place_features(task, steps)["left"]
     np.testing.assert_allclose(feature.object_pose[:3, 3], [0.4, 0.05, 0.25])
     # The left face, 50 mm left of O, rotated 10 deg about y; its inward normal is O's +x.
@@ -134,7 +137,7 @@ def test_a_deviated_world_scales_every_pad_and_feature_mu():
     from stablepush.sim.arm import WorldDeviation
 
     task = shipped("horizontal-offset-low-mu")
-    steps = [PlanStep(task.start, None), PlanStep(task.start, "left")]
+    steps = [Waypoint(*task.start), Waypoint(*task.start, pusher="left")]
     scene = scene_description(task, place_features(task, steps), task.start)
     nominal, scaled = SimArm(scene), SimArm(scene, WorldDeviation(mu_scale=0.85))
     assert scene["gripper"]["mu"] == task.mu  # the scene itself is left as the executor sent it

@@ -5,10 +5,11 @@ import sys
 import pytest
 import yaml
 from click.testing import CliRunner
-from conftest import TASKS, task_text, task_with
 
-from stablepush.task import TaskError
+from stablepush.errors import TaskError
 from stablepush_cli.main import cli
+
+from conftest import TASKS, task_text, task_with
 
 BASE = yaml.safe_load(task_text("horizontal-offset-low-mu"))
 
@@ -62,23 +63,56 @@ BAD = [
     ("negative pusher mu", lambda d: d["pushers"][1].update(mu=-0.5), "pushers[1].mu", "between 0 and 100, got -0.5"),
     ("unknown shape", _set(["object", "shape"], "sphere"), "object.shape", "box, polygon or mesh"),
     ("duplicate pusher", lambda d: d["pushers"][1].update(name="left"), "pushers[1].name", "duplicate"),
-    ("pusher off boundary", lambda d: d["pushers"][0].update({"from": [-40, -12.5], "to": [-40, 12.5]}), "pushers[0]", "not on the object's boundary"),
-    ("point pusher on vertex", lambda d: d["pushers"].append({"name": "corner", "at": [50, 12.5], "mu": 0.3}), "pushers[3]", "vertex"),
+    (
+        "pusher off boundary",
+        lambda d: d["pushers"][0].update({"from": [-40, -12.5], "to": [-40, 12.5]}),
+        "pushers[0]",
+        "not on the object's boundary",
+    ),
+    (
+        "point pusher on vertex",
+        lambda d: d["pushers"].append({"name": "corner", "at": [50, 12.5], "mu": 0.3}),
+        "pushers[3]",
+        "vertex",
+    ),
     ("pad outside at start", _set(["start"], [0, 10, 0]), "start", "does not lie inside"),
     ("pad outside at goal", _set(["goal"], [60, 0, 0]), "goal", "does not lie inside"),
-    ("bad pad radius", _set(["gripper", "pads"], [{"center": [0, 0], "radius": -5}]), "gripper.pads[0].radius", "between 0.01 and 10000, got -5"),
-    ("negative step time", _set(["dynamics", "step_time"], -0.1), "dynamics.step_time", "between 0.0001 and 1000, got -0.1"),
+    (
+        "bad pad radius",
+        _set(["gripper", "pads"], [{"center": [0, 0], "radius": -5}]),
+        "gripper.pads[0].radius",
+        "between 0.01 and 10000, got -5",
+    ),
+    (
+        "negative step time",
+        _set(["dynamics", "step_time"], -0.1),
+        "dynamics.step_time",
+        "between 0.0001 and 1000, got -0.1",
+    ),
     ("planner unknown", _set(["planner", "speed"], 1), "planner.speed", "unknown key"),
     ("planner seed", _set(["planner", "seed"], -3), "planner.seed", "an integer from 0 to 4294967295, got -3"),
-    ("self-intersecting polygon",
-     lambda d: d.update(object={"shape": "polygon", "polygon": [[-50, -12.5], [50, 12.5], [50, -12.5], [-50, 12.5]], "mass": 100}),
-     "object.polygon", "self-intersecting"),
-    ("degenerate polygon",
-     lambda d: d.update(object={"shape": "polygon", "polygon": [[-50, 0], [0, 0], [50, 0]], "mass": 100}),
-     "object.polygon", "degenerate"),
-    ("repeated vertex",
-     lambda d: d.update(object={"shape": "polygon", "polygon": [[-50, -12.5], [-50, -12.5], [50, -12.5], [50, 12.5]], "mass": 100}),
-     "object.polygon", "coincide"),
+    (
+        "self-intersecting polygon",
+        lambda d: d.update(
+            object={"shape": "polygon", "polygon": [[-50, -12.5], [50, 12.5], [50, -12.5], [-50, 12.5]], "mass": 100}
+        ),
+        "object.polygon",
+        "self-intersecting",
+    ),
+    (
+        "degenerate polygon",
+        lambda d: d.update(object={"shape": "polygon", "polygon": [[-50, 0], [0, 0], [50, 0]], "mass": 100}),
+        "object.polygon",
+        "degenerate",
+    ),
+    (
+        "repeated vertex",
+        lambda d: d.update(
+            object={"shape": "polygon", "polygon": [[-50, -12.5], [-50, -12.5], [50, -12.5], [50, 12.5]], "mass": 100}
+        ),
+        "object.polygon",
+        "coincide",
+    ),
 ]
 
 

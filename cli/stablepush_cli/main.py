@@ -1,18 +1,17 @@
-"""`stablepush` commands. The CLI parses arguments and prints; the mechanics live in the core."""
+"""`stablepush` commands. The CLI parses arguments and prints; every rule lives in the library."""
 from __future__ import annotations
 
 import contextlib
 import json
 import math
-import sys
-
 import os
+import sys
 
 import click
 
 from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError
-from stablepush.mechanics import check_push
-from stablepush.task import load_task
+from stablepush.execution.protocol import DEFAULT_PORT
+from stablepush.task import check_push, load_task
 
 EXIT_NOT_SOLVED = 1
 EXIT_BAD_INPUT = 2
@@ -112,7 +111,9 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
               help="Plan file (JSON). Default: <TASK file name>.plan.json in the current directory.")
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None,
               help="Also write the waypoints as CSV (step,x,z,theta,pusher,...).")
-@click.option("--seed", type=click.IntRange(min=0), default=None, help="Random seed (default: the task's planner.seed).")
+@click.option(
+    "--seed", type=click.IntRange(min=0), default=None, help="Random seed (default: the task's planner.seed)."
+)
 @click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
               help="Give up after S seconds (default: the task's planner.time_limit).")
 @click.option("--max-switches", type=click.IntRange(min=0), default=None, metavar="K",
@@ -139,15 +140,10 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     Example:
       stablepush plan data/tasks/horizontal-offset-low-mu.yaml -o low-mu.plan.json --csv low-mu.csv
     """
-    from stablepush.plan_io import default_output, write_plan
-    from stablepush.planning import plan_task
+    from stablepush.outputs import default_output
+    from stablepush.plan import plan_task, write_plan
 
     task = _load(task_file)
-    tolerance = task.planner["tolerance"]
-    if all(abs(a - b) <= tol for a, b, tol in zip(task.start, task.goal, (tolerance[0], tolerance[0], tolerance[1]))):
-        raise TaskError("goal", f"the start {list(task.start)} is already within planner.tolerance {tolerance} of the "
-                                f"goal {list(task.goal)}: there is nothing to plan (a task written in metres? "
-                                f"task files use mm)", task_file)
     result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
     json_path = json_path or default_output(task_file, ".plan.json")
     write_plan(result, json_path, csv_path)
@@ -174,13 +170,21 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
 @cli.command()
 @click.argument("task_files", metavar="TASK.yaml...", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--checks", "checks_only", is_flag=True, help="Benchmark the stable-push test instead of planning.")
-@click.option("--trials", default=10, show_default=True, type=click.IntRange(min=1), help="Planning runs per task (seeds seed, seed+1, ...).")
+@click.option(
+    "--trials",
+    default=10,
+    show_default=True,
+    type=click.IntRange(min=1),
+    help="Planning runs per task (seeds seed, seed+1, ...).",
+)
 @click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0), help="First seed.")
 @click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
               help="Per-trial time limit (default: each task's planner.time_limit).")
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), default=None,
               help="Also write every trial to this file: .csv (one row per trial) or .json (trials and summary).")
-@click.option("-n", "--count", default=200_000, show_default=True, help="With --checks: checks per contact case and task.")
+@click.option(
+    "-n", "--count", default=200_000, show_default=True, help="With --checks: checks per contact case and task."
+)
 @click.option("--improve-for", type=float, default=None, metavar="S",
               help="Anytime planning: keep improving S seconds after the first plan (planner.improve_for), "
                    "and report the first and the improved plans.")
@@ -206,7 +210,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
       stablepush bench data/tasks/*.yaml --trials 10 --out results.csv
       stablepush bench --checks data/tasks/horizontal-offset-low-mu.yaml
     """
-    from stablepush import benchmark
+    from stablepush.plan import benchmark
 
     tasks = [_load(path) for path in task_files]
     if checks_only:
@@ -250,7 +254,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
 
 
 def _bench_checks(tasks, count: int, seed: int) -> None:
-    from stablepush.benchmark import bench_checks
+    from stablepush.plan.benchmark import bench_checks
 
     click.echo(f"{'task':<28} {'case':<12} {'median us':>10} {'min us':>8} {'checks':>8} {'feasible':>9} {'exact':>7}")
     for task in tasks:
@@ -266,7 +270,7 @@ def _write_bench(path: str, trials, rows) -> None:
     import dataclasses
     import io
 
-    from stablepush.plan_io import write_atomically
+    from stablepush.outputs import write_atomically
 
     records = [dataclasses.asdict(t) for t in trials]
     if path.endswith(".json"):
@@ -280,13 +284,11 @@ def _write_bench(path: str, trials, rows) -> None:
 
 
 def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = True):
-    """The task and the plan's steps, once the plan is shown to belong to the task (exit 2 if not)."""
-    from stablepush.executor import plan_steps
-    from stablepush.plan_io import read_plan
+    """The task and the plan, once the plan is shown to belong to the task (exit 2 if not)."""
+    from stablepush.plan import check_plan, load_plan
 
     task = _load(task_file)
-    plan = read_plan(plan_file)
-    return task, plan, plan_steps(task, plan, source=plan_file, require_solved=require_solved)
+    return task, check_plan(task, load_plan(plan_file), source=plan_file, require_solved=require_solved)
 
 
 @cli.command()
@@ -312,19 +314,14 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     """
     from pathlib import Path
 
-    from stablepush import figures
+    from stablepush.viz import figures
 
-    task, plan, steps = _load_plan_and_task(plan_file, task_file, require_solved=False)
+    task, plan = _load_plan_and_task(plan_file, task_file, require_solved=False)
     png_path = png_path or str(Path(plan_file).with_suffix("").with_suffix(".png"))
-    stats = plan.get("stats", {})
-    title = f"{task.name}: {len(steps) - 1} pushes, {stats.get('switches', '?')} switch-over(s), seed {stats.get('seed', '?')}"
-    if not plan["solved"]:
-        title = f"NOT SOLVED ({plan.get('outcome') or 'partial plan'}): {title}"
-    fig = figures.plan_figure(task, steps, title, reaches_goal=plan["solved"])
-    figures.save_figure(fig, png_path)
+    figures.save_figure(figures.plan_figure(task, plan), png_path)
     click.echo(f"figure written to {png_path}")
     if gif_path:
-        figures.save_plan_gif(task, steps, gif_path)
+        figures.save_plan_gif(task, plan, gif_path)
         click.echo(f"animation written to {gif_path}")
 
 
@@ -352,16 +349,16 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
       stablepush plan data/tasks/t-shaped.yaml -o t.plan.json
       stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.traj.csv
     """
-    from stablepush.plan_io import plan_from_dict, write_atomically
-    from stablepush.trajectory import timed_trajectory
+    from stablepush.execution import timed_trajectory
+    from stablepush.outputs import write_atomically
 
     if not out_path.endswith((".csv", ".json")):
         _fail(f"-o {out_path}: the file name must end in .csv or .json")
-    task, plan, steps = _load_plan_and_task(plan_file, task_file)
-    traj = timed_trajectory(task, steps, rate_hz)
+    task, plan = _load_plan_and_task(plan_file, task_file)
+    traj = timed_trajectory(task, plan, rate_hz)
     write_atomically(out_path, traj.to_json(quat) if out_path.endswith(".json") else traj.to_csv(quat))
     click.echo(f"{task.name}: {len(traj)} samples at {rate_hz:g} Hz, {traj.t[-1]:.2f} s, "
-               f"{len(steps) - 1} pushes; written to {out_path}")
+               f"{len(plan.waypoints) - 1} pushes; written to {out_path}")
 
 
 @cli.command()
@@ -380,8 +377,8 @@ def cone(task_file: str, pusher: str, png_path) -> None:
     Example:
       stablepush cone data/tasks/pivoting.yaml --pusher left -o left-cone.png
     """
-    from stablepush import figures
-    from stablepush.plan_io import default_output
+    from stablepush.outputs import default_output
+    from stablepush.viz import figures
 
     task = _load(task_file)
     task.pusher_index(pusher)
@@ -402,8 +399,8 @@ def _host_port(value: str):
 @click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
               help="The task the plan was made for (checked against the plan before anything moves).")
 @click.option("--arm", "arm", default=None, metavar="HOST:PORT",
-              help="The arm server (stablepush.arm/2 protocol, see README). Default: with --sim a simulated arm "
-                   "started in this process, else 127.0.0.1:47100.")
+              help=f"The arm server (stablepush.arm/2 protocol, see README). Default: with --sim a simulated arm "
+                   f"started in this process, else 127.0.0.1:{DEFAULT_PORT}.")
 @click.option("--sim", is_flag=True, help="Start a simulated arm (MuJoCo) here and run the plan on it.")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
               metavar="HZ", help="Waypoints per second of motion.")
@@ -454,24 +451,19 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
       stablepush sim-arm --port 47100 &     # or your robot's bridge
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
     """
-    import json as json_module
+    from stablepush.execution import execute_plan, execution_warnings
+    from stablepush.execution.stream import check_resume_from
+    from stablepush.outputs import write_atomically
 
-    from stablepush.arm_protocol import DEFAULT_PORT
-    from stablepush.executor import ExecutionFault, execute_plan
-    from stablepush.plan_io import write_atomically
-
-    task, plan, steps = _load_plan_and_task(plan_file, task_file)
-    if task.pushes == "by_moving_pusher":
-        click.echo("warning: the task's pushes are by_moving_pusher (gravity fixed in G), but the executor pushes "
-                   "against fixed features, where gravity turns in G with theta: the plan was made for another cell",
-                   err=True)
-    if resume_from >= len(steps) - 1:
-        _fail(f"--resume-from: must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} pushes)")
+    task, plan = _load_plan_and_task(plan_file, task_file)
+    for warning in execution_warnings(task):
+        click.echo(f"warning: {warning}", err=True)
+    check_resume_from(plan.waypoints, resume_from)
     if (replan_threshold or final_tolerance) and not closed_loop:
         _fail("--replan-threshold and --final-tolerance: only with --closed-loop")
     loop = None
     if closed_loop:
-        from stablepush.closed_loop import ClosedLoop
+        from stablepush.execution import ClosedLoop
 
         loop = ClosedLoop.for_task(task, replan_threshold, final_tolerance)
     deviated = mu_scale != 1.0 or any(tracker_noise)
@@ -491,7 +483,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
 
     bar = None
     if not quiet:
-        bar = click.progressbar(length=len(steps) - 1 - resume_from, label=f"{task.name}: step {resume_from}",
+        bar = click.progressbar(length=len(plan.waypoints) - 1 - resume_from, label=f"{task.name}: step {resume_from}",
                                 file=sys.stderr, show_pos=True)
         bar.__enter__()
     seen = [resume_from]
@@ -505,17 +497,19 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
             seen[0] = confirmed
 
     try:
-        report = execute_plan(task, steps, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
+        report = execute_plan(task, plan, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
                               ack_timeout=ack_timeout, closed_loop=loop, progress=progress)
-    except ExecutionFault as fault:
+    except ArmFault as fault:
         if bar is not None:
             bar.__exit__(None, None, None)
         stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
         click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
-                   f"{len(steps) - 1}", err=True)
-        click.echo(f"continue with: stablepush execute {plan_file} --task {task_file} "
-                   f"{'--arm ' + arm + ' ' if arm else ''}{'--sim ' if sim else ''}--resume-from {fault.last_confirmed_step}",
-                   err=True)
+                   f"{len(plan.waypoints) - 1}", err=True)
+        click.echo(
+            f"continue with: stablepush execute {plan_file} --task {task_file} "
+            f"{'--arm ' + arm + ' ' if arm else ''}{'--sim ' if sim else ''}--resume-from {fault.last_confirmed_step}",
+            err=True,
+        )
         sys.exit(EXIT_ARM_FAULT)
     finally:
         sim_arm.close()
@@ -523,7 +517,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
         bar.__exit__(None, None, None)
     _print_report(report)
     if json_path:
-        write_atomically(json_path, json_module.dumps(report.as_dict(), indent=1) + "\n")
+        write_atomically(json_path, json.dumps(report.as_dict(), indent=1) + "\n")
         click.echo(f"report written to {json_path}")
 
 
@@ -555,21 +549,28 @@ def _print_report(report) -> None:
             click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} slip at the pusher "
                        f"{c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
     change = report.release_change
-    if change and (math.hypot(change["x"], change["z"]) > 0.5 or abs(change["theta"]) > 0.5):
+    if report.release_moved:
         click.echo(f"note: when the last feature let go the object moved in the grasp by {math.hypot(change['x'], change['z']):.2f} mm, "
                    f"{change['theta']:+.2f} deg: the grasp alone does not hold the final pose against gravity")
 
 
 @cli.command("sim-arm")
 @click.option("--host", default="127.0.0.1", show_default=True, help="Address to listen on.")
-@click.option("--port", default=47100, show_default=True, type=click.IntRange(min=0, max=65535),
+@click.option("--port", default=DEFAULT_PORT, show_default=True, type=click.IntRange(min=0, max=65535),
               help="Port to listen on (0: any free port, printed).")
 @click.option("--exit-after", type=click.IntRange(min=1), default=None, metavar="N",
               help="Fault injection for testing executors: die abruptly after N waypoints.")
 @click.option("--mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
               metavar="S", help="The pads' and features' mu are S times each task's (a world unlike the model).")
-@click.option("--tracker-noise", "tracker_noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0),
-              metavar="MM DEG", help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).")
+@click.option(
+    "--tracker-noise",
+    "tracker_noise",
+    nargs=2,
+    type=click.FloatRange(min=0),
+    default=(0.0, 0.0),
+    metavar="MM DEG",
+    help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).",
+)
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
               help="Seed of the tracker's noise.")
 @click.option("--idle-timeout", default=30.0, show_default=True, type=click.FloatRange(min=0.1, max=3600), metavar="S",

@@ -2,22 +2,40 @@
 
     import stablepush as sp
     task = sp.load_task("data/tasks/t-shaped.yaml")
-    plan = sp.plan(task, seed=1, time_limit=2.0)       # a Plan
-    plan.save("t.plan.json"); plan = sp.Plan.load("t.plan.json")
-    plan.check(task)                                   # every push re-checked against the task
-    traj = plan.trajectory(task, rate_hz=100)          # timed gripper poses and velocities
+    plan = sp.plan(task, seed=1, time_limit=2.0)       # a Plan (plain data)
+    sp.save_plan(plan, "t.plan.json"); plan = sp.load_plan("t.plan.json")
+    sp.check_plan(task, plan)                          # every push re-checked against the task
+    traj = sp.trajectory(task, plan, rate_hz=100)      # timed gripper poses and velocities
     sp.check(task, at=(0, 0, 0), move=(1, 0, 0))       # the stable-push test, per pusher
+    fig = sp.plan_figure(task, plan)                   # a matplotlib Figure (loads matplotlib)
 
 Units at this level are the task file's: mm, degrees, grams, newtons. Every error raised on
 purpose is a `StablepushError` (TaskError, PlanError, OutputError, ArmFault).
+
+The package's layers, each importing only those below it (docs/architecture.md):
+`sim`, `viz` > `execution` > `plan` > `task` > `units`, `frames`, `errors`, `outputs`, `_core`.
 """
-from stablepush._core import ContactCase, PushResult  # noqa: F401
-from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError  # noqa: F401
-from stablepush.mechanics import check_push as check  # noqa: F401
-from stablepush.planning import Plan, Waypoint  # noqa: F401
-from stablepush.planning import plan_task as plan  # noqa: F401
-from stablepush.task import Task, load_task  # noqa: F401
+from stablepush._core import ContactCase, PlanOutcome, PushResult
+from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError
+from stablepush.execution.trajectory import Trajectory
+from stablepush.execution.trajectory import plan_trajectory as trajectory
+from stablepush.plan import Plan, PusherContact, Waypoint, check_plan, load_plan
+from stablepush.plan import plan_task as plan
+from stablepush.plan import write_plan as save_plan
+from stablepush.task import PusherSpec, Task, load_task, parse_task
+from stablepush.task import check_push as check
 
 __version__ = "0.1.0"
-__all__ = ["load_task", "plan", "check", "Plan", "Waypoint", "Task", "StablepushError", "TaskError", "PlanError",
-           "OutputError", "ArmFault", "ContactCase", "PushResult"]
+__all__ = ["load_task", "parse_task", "plan", "check", "check_plan", "save_plan", "load_plan", "trajectory",
+           "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PusherSpec", "Trajectory",
+           "StablepushError", "TaskError", "PlanError", "OutputError", "ArmFault", "ContactCase", "PlanOutcome",
+           "PushResult"]
+
+
+def __getattr__(name: str):
+    # matplotlib is loaded only when a figure is asked for (the CLI's start-up stays fast)
+    if name == "plan_figure":
+        from stablepush.viz.figures import plan_figure
+
+        return plan_figure
+    raise AttributeError(f"module 'stablepush' has no attribute {name!r}")

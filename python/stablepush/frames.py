@@ -12,7 +12,7 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from stablepush.task import MM
+from stablepush.units import MM
 
 
 def point_in_gripper(pose_mm_deg: Sequence[float], p: Sequence[float]) -> Tuple[float, float]:

@@ -1,4 +1,4 @@
-"""The friction-fidelity contract of the simulated arm (issue 9): what any engine or contact setting
+"""The friction-fidelity contract of the simulated arm: what any engine or contact setting
 that runs plans must reproduce before its results mean anything.
 
 Every experiment uses the arm's own grasp (fingers, force-capped jaw servos, pad points, contact
@@ -18,7 +18,7 @@ friction, not the arm's tracking:
   sticks; the prism must stay where it is in the world and the pose in the grasp follow the turn.
 - `pivot_on_arm`: the same pivot by the arm itself (its jaw and joint servos, IK and the executor's
   stream), the first pushes of a pivoting plan: where the hand is not infinitely stiff, the
-  sliding ring points' friction must still leave the pad centre stuck (issue 9 found 1.3 deg lost
+  sliding ring points' friction must still leave the pad centre stuck (1.3 deg was lost
   in 90 when the sliding friction was off its slip by a few degrees).
 
 Units: SI inside; results in mm, um, deg and N as their names say.
@@ -34,16 +34,20 @@ import mujoco
 import numpy as np
 import yaml
 
-from stablepush.execution import PlanStep, place_features, scene_description
+from stablepush.execution.world import place_features, scene_description
+from stablepush.plan.plan import Waypoint
+from stablepush.plan.search import plan_task
+from stablepush.plan.verify import check_plan
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.arm import SimulatedGrasp
-from stablepush.task import Task, parse_task
+from stablepush.task.model import Task
+from stablepush.task.schema import parse_task
 
 G0 = 9.81  # m/s^2
 SETTLE_TIME = 0.2  # s with the grasp closed before anything moves
 RAMP_TIME = 0.02  # s over which the hand's speed ramps up smoothly
 
-# The contract (issue 9): creep per mm of pad travel at 50% and 90% of the wall's cone, the sliding
+# The contract: creep per mm of pad travel at 50% and 90% of the wall's cone, the sliding
 # pads' friction against mu N, a still hold, and the pivot through the sticking pad centre.
 CREEP_LIMIT_UM_PER_MM = {0.5: 1.0, 0.9: 5.0}
 PAD_FRICTION_TOLERANCE = 0.03
@@ -86,7 +90,7 @@ class KinematicGrasp(SimulatedGrasp):
     features of `pushers` fixed in the world where they touch the object at the start."""
 
     def __init__(self, task: Task, pushers: Sequence[str] = ()):
-        steps = [PlanStep(task.start, None)] + [PlanStep(task.start, name) for name in pushers]
+        steps = [Waypoint(*task.start)] + [Waypoint(*task.start, pusher=name) for name in pushers]
         super().__init__(scene_description(task, place_features(task, steps), task.start), kinematic_hand=True)
         m = self.model
         self._qpos = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
@@ -230,13 +234,12 @@ class ArmPivotResult:
 
 def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1) -> ArmPivotResult:
     """Run the first `pushes` pushes of `task`'s plan (seed `seed`) on the simulated arm, open loop."""
-    from stablepush.executor import execute_plan, plan_steps  # the executor is the arm's client, not the rig's
-    from stablepush.plan_io import plan_to_dict
-    from stablepush.planning import plan_task
+    from stablepush.execution.executor import execute_plan  # the executor is the arm's client, not the rig's
     from stablepush.sim.server import running_sim_arm
 
-    steps = plan_steps(task, plan_to_dict(plan_task(task, seed=seed)))[:pushes + 1]
+    plan = check_plan(task, plan_task(task, seed=seed))
+    plan = dataclasses.replace(plan, waypoints=plan.waypoints[:pushes + 1])
     with running_sim_arm(log=lambda text: None) as server:
-        report = execute_plan(task, steps, server.host, server.port, rate_hz=100.0, pace=False)
-    return ArmPivotResult(pushes=len(steps) - 1, error_mm=report.final_error["distance"],
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
+    return ArmPivotResult(pushes=len(plan.waypoints) - 1, error_mm=report.final_error["distance"],
                           error_deg=report.final_error["theta"], steps_per_s=report.sim_steps_per_s)

@@ -8,16 +8,18 @@ with a capped force, so while the pads slide over the object they are pushed apa
 for that step by nothing, creeps along the feature that should hold it (37 um per mm pushed).
 A soft friction reference (`solreffriction` 30 ms) avoided the separation but turned a sliding
 point's friction 1.3-4.7 deg off its slip, and the pivot's twelve sliding ring points then pushed
-its sticking pad centre 1.3 deg along (issue 9). Even the stiff solver's friction on a sliding
+its sticking pad centre 1.3 deg along. Even the stiff solver's friction on a sliding
 pivot ring point is ~5 deg off the slip it produces.
 
 So a sliding pad point gets Coulomb's friction from us: mu N, opposite the slip at the end of the
 step (backward Euler, as an implicit solver would), with its contact made frictionless for that
 step (no cone, so no separation). The direction is found by trial steps on a scratch copy of the
-state: apply mu N along d, step, and compare d with the slip it produced; move d halfway toward
-the opposite of that slip and try again, until they agree within DIRECTION_TOLERANCE. Halving
-matters: explicit friction on a slow slip (one 0.25 ms step of 15 N changes a hand's speed by
-mm/s) would otherwise flip its direction every step and chatter. A sliding point whose trial slip
+state: apply mu N along d, step, and compare d with the slip it produced; move d toward the
+opposite of that slip and try again, until they agree within DIRECTION_TOLERANCE_DEG. The first
+move is halfway; later ones are Anderson steps (the secant over the last two trials, all points at
+once, `_next_directions`), since all points ride one object and one hand and a plain step
+overshoots. A damped step matters: explicit friction on a slow slip (one 0.25 ms step of 15 N
+changes a hand's speed by mm/s) would otherwise flip its direction every step and chatter. A sliding point whose trial slip
 turns against its friction or falls under STICK_SPEED sticks instead. In a steady slide the last
 step's direction passes at once, so sliding costs one trial step per step.
 

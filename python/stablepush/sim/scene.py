@@ -1,6 +1,6 @@
 """The MuJoCo scene of the simulated arm: the shipped arm (arm.xml) plus the held object, the
 multi-point finger pads and the fixed features, built from a scene description (a plain dict,
-SI units, as the executor sends it in its `hello`; see `stablepush.arm_protocol`).
+SI units, as the executor sends it in its `hello`; see `stablepush.execution.protocol`).
 
 Contact settings that keep friction honest (the simulation's results rest on them, and
 `stablepush.sim.fidelity` measures them):
@@ -177,7 +177,7 @@ def _fmt(values) -> str:
 
 
 def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
-    """The complete MJCF of a scene description (see `stablepush.arm_protocol.Scene`). With
+    """The complete MJCF of a scene description (see `stablepush.execution.protocol`). With
     `kinematic_hand` the arm is replaced by a hand at the scene's gripper pose that moves in G's
     plane through three joints (HAND_JOINTS) whose motion the caller prescribes: the same fingers,
     pads and contacts without the arm, for measuring friction alone (`fidelity.py`)."""

@@ -1,4 +1,4 @@
-"""`stablepush sim-arm`: the simulated arm (arm.py) behind the arm protocol (arm_protocol.py).
+"""`stablepush sim-arm`: the simulated arm (arm.py) behind the arm protocol (stablepush.execution.protocol).
 
 One session at a time: a second client is told the arm is busy and let go. Each session starts
 from a fresh world built from its hello's scene, unless the hello asks to `continue` and the scene
@@ -16,7 +16,7 @@ import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator, Optional
 
-from stablepush.arm_protocol import LineReader, ProtocolError, decode, encode
+from stablepush.execution.protocol import LineReader, ProtocolError, decode, encode
 from stablepush.sim.arm import SimArm, WorldDeviation
 from stablepush.sim.scene import simulated_outline
 

@@ -1,7 +1,7 @@
 """Timed trajectories: the gripper's world poses that carry out a plan, with time, linear and
 angular velocity, phase and plan step (`stablepush trajectory`, `Plan.trajectory`).
 
-They are the executor's stream (execution.arm_trajectory) for an arm that starts at the task's
+They are the executor's stream (stablepush.execution.stream.arm_trajectory) for an arm that starts at the task's
 home pose with every feature placed as the executor places it, sampled at the stream's rate.
 World frame W (x forward, y the gripping axis at home, z up), m, s. Velocities are those of G's
 origin and frame over the period that ends at each sample (backward differences), in W:
@@ -18,8 +18,11 @@ from typing import List
 
 import numpy as np
 
-from stablepush.execution import arm_trajectory, as_steps, place_features, scene_description
-from stablepush.task import Task
+from stablepush.execution.stream import arm_trajectory
+from stablepush.execution.world import place_features, scene_description
+from stablepush.plan.plan import Plan
+from stablepush.plan.verify import check_plan
+from stablepush.task.model import Task
 
 QUATERNION_ORDERS = ("xyzw", "wxyz")  # xyzw: ROS (geometry_msgs/Quaternion); wxyz: the arm protocol, MuJoCo
 
@@ -75,10 +78,10 @@ class Trajectory:
             "columns": self.columns(quat), "rows": self.rows(quat)}, indent=None) + "\n"
 
 
-def timed_trajectory(task: Task, steps, rate_hz: float = 100.0) -> Trajectory:
-    """The executor's stream for these plan steps (a checked Plan, or its steps), from G at the
-    task's home pose."""
-    steps = as_steps(steps)
+def timed_trajectory(task: Task, plan: Plan, rate_hz: float = 100.0) -> Trajectory:
+    """The executor's stream for a plan checked against the task (stablepush.plan.verify.check_plan),
+    from G at the task's home pose."""
+    steps = list(plan.waypoints)
     features = place_features(task, steps)
     start = scene_description(task, features, steps[0].pose)["gripper_pose"]
     points = arm_trajectory(task, steps, features, rate_hz, start)
@@ -102,3 +105,9 @@ def _rotation_vector(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
         w, v = -w, -v
     s = float(np.linalg.norm(v))
     return np.zeros(3) if s < 1e-15 else v / s * 2.0 * math.atan2(s, w)
+
+
+def plan_trajectory(task: Task, plan: Plan, rate_hz: float = 100.0) -> Trajectory:
+    """The timed trajectory of `plan` once it is shown to belong to `task` (check_plan; PlanError
+    names what differs)."""
+    return timed_trajectory(task, check_plan(task, plan), rate_hz)

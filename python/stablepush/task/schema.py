@@ -1,15 +1,13 @@
-"""Task files (docs/model.md section 4): load, validate, convert to SI, build the core model.
+"""Task files (docs/model.md section 4): read the YAML, validate every field, make a `Task`.
 
-Files use mm, degrees, grams and newtons; the core is SI. Every bad input is refused with a
-`TaskError` that names the field and the reason, before anything reaches the C++ core.
+Files use mm, degrees, grams and newtons. Every bad input is refused with a `TaskError` that
+names the field and the reason, before anything reaches the C++ core.
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 import re
 import reprlib
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
@@ -18,21 +16,12 @@ import yaml
 
 from stablepush import _core
 from stablepush.errors import TaskError
-
-MM = 1e-3  # m per mm
-G = 1e-3  # kg per g
+from stablepush.task.model import PUSHES, UNCERTAIN, PusherSpec, Task, make_gripper
+from stablepush.units import MM, mm2_to_si, pose_to_si
 
 DEFAULT_PAD_RADIUS_MM = 5.0
 DEFAULT_GRAVITY = (0.0, -9.81)
 DEFAULT_STEP_TIME = 0.1
-# How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
-# (README, "Gravity during a push"): against features fixed in the world, the object keeps its
-# world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
-PUSHES = ("against_fixed_features", "by_moving_pusher")
-# uncertainty: key -> the task value it widens (+- this fraction of it); a push must be stable for
-# every value in the box (Task.corner_models).
-UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers[].mu", "grip_force": "gripper.grip_force",
-             "mass": "object.mass"}
 DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
@@ -261,134 +250,6 @@ def _shown(value: Any, limit: int = 60) -> str:
 # ---------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class PusherSpec:
-    """A pusher as the task gives it, in O [mm]; `a == b` for a point pusher."""
-
-    name: str
-    a: Tuple[float, float]
-    b: Tuple[float, float]
-    mu: float
-    points: int
-
-    @property
-    def is_point(self) -> bool:
-        return self.a == self.b
-
-
-@dataclass(frozen=True)
-class Task:
-    """A validated task, in file units (mm, deg, g, N); `build_model` converts to SI."""
-
-    name: str
-    vertices: Tuple[Tuple[float, float], ...]  # cross-section in O, mm, counterclockwise
-    thickness: float  # mm along y
-    mass: float  # g
-    com: Optional[Tuple[float, float]]  # mm in O; None: the centroid
-    inertia: Optional[float]  # kg m^2 about the com; None: uniform body
-    grip_force: float  # N per pad
-    mu: float  # pad-object friction
-    pad_rings: int
-    pads: Tuple[Tuple[Tuple[float, float], float], ...]  # (centre mm in G, radius mm)
-    gravity: Tuple[float, float]  # m/s^2 in G while G's axes are the world's (at the home pose)
-    step_time: float  # s
-    friction_polygon_sides: int
-    pushers: Tuple[PusherSpec, ...]
-    start: Tuple[float, float, float]  # mm, mm, deg
-    goal: Tuple[float, float, float]
-    planner: Dict[str, Any] = field(default_factory=dict)
-    environment: Dict[str, Any] = field(default_factory=dict)  # the world around the arm, see ENVIRONMENT_DEFAULTS
-    source: Optional[str] = None
-    pushes: str = PUSHES[0]  # see PUSHES
-    uncertainty: Dict[str, float] = field(default_factory=dict)  # key -> +- fraction of nominal (UNCERTAIN)
-    # What the file says that is legal but probably not meant (each names the field); the CLI
-    # prints them as "warning:" lines.
-    warnings: Tuple[str, ...] = ()
-
-    def feature_angle(self, pusher: str) -> float:
-        """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
-        feature: environment.features gives it, else the start's (the executor places the
-        features so; stablepush.execution.place_features)."""
-        pose = self.environment.get("features", {}).get(pusher)
-        return float(pose[3]) if pose is not None else float(self.start[2])
-
-    @property
-    def pusher_names(self) -> List[str]:
-        return [p.name for p in self.pushers]
-
-    def pusher_index(self, name: str) -> int:
-        try:
-            return self.pusher_names.index(name)
-        except ValueError:
-            raise TaskError("pusher", f"no pusher named {name!r} (the task has {', '.join(self.pusher_names)})")
-
-    def section(self) -> "_core.CrossSection":
-        return _core.CrossSection([_mm2(v) for v in self.vertices])
-
-    def rigid_body(self, section: "Optional[_core.CrossSection]" = None) -> "_core.RigidBody":
-        """The object's mass [kg], com [m, in O] and moment of inertia about y at the com [kg m^2]."""
-        uniform = _core.RigidBody.uniform(section or self.section(), self.mass * G)
-        com = _mm2(self.com) if self.com is not None else tuple(uniform.com)
-        if self.inertia is not None:
-            inertia = self.inertia
-        else:  # the uniform body's inertia about the given com (parallel axes)
-            offset2 = (com[0] - uniform.com[0]) ** 2 + (com[1] - uniform.com[1]) ** 2
-            inertia = uniform.inertia + self.mass * G * offset2
-        return _core.RigidBody(self.mass * G, com, inertia)
-
-    def corner_models(self) -> List["_core.StablePushModel"]:
-        """The models every push must be stable in (docs/model.md section 7): the nominal model
-        alone, or with `uncertainty`, the 4 corners of (pad mu x grip force, mass) at the smallest
-        pusher mu. The required pusher wrench is affine in mu N and in m, the sticking polygons
-        scale with mu N and a pusher's cone shrinks with its mu, so a push stable at these corners
-        is stable for every value in the box (a convex combination of the corners' witnesses is a
-        witness). mu and N enter only as their product, so the corners scale mu alone."""
-        u = self.uncertainty
-        if not any(u.values()):
-            return [self.build_model()]
-        low_pushers = tuple(dataclasses.replace(p, mu=p.mu * (1.0 - u.get("pusher_mu", 0.0))) for p in self.pushers)
-        friction = [(1.0 - u.get("pad_mu", 0.0)) * (1.0 - u.get("grip_force", 0.0)),
-                    (1.0 + u.get("pad_mu", 0.0)) * (1.0 + u.get("grip_force", 0.0))]
-        masses = [1.0 - u.get("mass", 0.0), 1.0 + u.get("mass", 0.0)]
-        return [dataclasses.replace(self, mu=self.mu * f, mass=self.mass * m, pushers=low_pushers,
-                                    inertia=None if self.inertia is None else self.inertia * m,
-                                    uncertainty={}).build_model()
-                for f in friction for m in masses]
-
-    def build_model(self) -> "_core.StablePushModel":
-        """The core's stable-push model of this task, in SI units."""
-        section = self.section()
-        body = self.rigid_body(section)
-        gripper = _make_gripper(self.pads, self.grip_force, self.mu, self.pad_rings)
-        pushers = [
-            _core.Pusher.on_boundary(section, p.name, _mm2(p.a), _mm2(p.b), p.mu, p.points) for p in self.pushers
-        ]
-        fixed = self.pushes == "against_fixed_features"
-        return _core.StablePushModel(
-            section, body, gripper, pushers, self.gravity, self.step_time, self.friction_polygon_sides,
-            _core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
-            [math.radians(self.feature_angle(p.name)) for p in self.pushers],
-        )
-
-
-def _mm2(p: Tuple[float, float]) -> Tuple[float, float]:
-    return (p[0] * MM, p[1] * MM)
-
-
-def _make_gripper(pads, grip_force: float, mu: float, pad_rings: int) -> "_core.Gripper":
-    return _core.Gripper([_core.Pad(_mm2(c), r * MM) for c, r in pads], grip_force, mu, pad_rings)
-
-
-def pose_to_si(q: Sequence[float]) -> Tuple[float, float, float]:
-    """(x mm, z mm, theta deg) -> (x m, z m, theta rad)."""
-    return (q[0] * MM, q[1] * MM, math.radians(q[2]))
-
-
-def pose_from_si(q: Sequence[float]) -> Tuple[float, float, float]:
-    """(x m, z m, theta rad) -> (x mm, z mm, theta deg)."""
-    return (q[0] / MM, q[1] / MM, math.degrees(q[2]))
-
-
 # ---------------------------------------------------------------------------------------------
 
 
@@ -425,7 +286,7 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     name = _name("name", top["name"]) if "name" in top else _default_name(source)
     vertices, thickness, mass, com, inertia = _validate_object(top["object"], source)
 
-    vertices_m = [_mm2(v) for v in vertices]
+    vertices_m = [mm2_to_si(v) for v in vertices]
     section_defect = _core.CrossSection.defect(vertices_m)
     if section_defect:
         raise TaskError("object.polygon", section_defect)
@@ -466,7 +327,7 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     start = pose_field("start", top["start"])
     goal = pose_field("goal", top["goal"])
     for label, q in (("start", start), ("goal", goal)):
-        inside = _make_gripper(pads, grip_force, mu, pad_rings).pads_inside(section, pose_to_si(q))
+        inside = make_gripper(pads, grip_force, mu, pad_rings).pads_inside(section, pose_to_si(q))
         for i, ok in enumerate(inside):
             if not ok:
                 where = f"gripper.pads[{i}]" if "pads" in grip else "gripper (default pads)"
@@ -576,10 +437,10 @@ def _onto_edge(section: "_core.CrossSection", edge: int, p: Tuple[float, float])
 
 
 def _mesh_object(obj: dict, source: Optional[str]):
-    """shape: mesh (stablepush.mesh): the file relative to the task file's directory; `mass` g or
+    """shape: mesh (stablepush.task.mesh): the file relative to the task file's directory; `mass` g or
     `density` g/cm^3; `scale` to mm; `plane_y` mm (default: the centre of mass's); `tolerance` mm
     of the simplified section (default 0.1). com and inertia come from the solid unless given."""
-    from stablepush.mesh import load_mesh_object
+    from stablepush.task.mesh import load_mesh_object
 
     for key in ("size", "polygon", "thickness"):
         if key in obj:
@@ -630,14 +491,14 @@ def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str
         if any(s.name == name for s in specs):
             raise TaskError(f"{path}.name", f"duplicate pusher name {name!r}")
         mu = _number(f"{path}.mu", raw["mu"], LIMITS["mu"])
-        edge, distance = section.nearest_edge(_mm2(a), _mm2(b))
+        edge, distance = section.nearest_edge(mm2_to_si(a), mm2_to_si(b))
         if ON_BOUNDARY < distance / MM <= SNAP_TO_EDGE:  # a rounding slip: put it on that edge, and say so
             a, b = (_onto_edge(section, edge, a), _onto_edge(section, edge, b))
             if a == b and points > 1:
                 raise TaskError(path, "lies across a vertex; it must lie along one edge")
             notes.append(f"{path}: {distance / MM:.3g} mm off the object's edge {edge}; moved onto it")
         try:
-            _core.Pusher.on_boundary(section, name, _mm2(a), _mm2(b), mu, points)
+            _core.Pusher.on_boundary(section, name, mm2_to_si(a), mm2_to_si(b), mu, points)
         except ValueError as exc:
             raise TaskError(path, str(exc)) from None
         specs.append(PusherSpec(name=name, a=a, b=b, mu=mu, points=points))

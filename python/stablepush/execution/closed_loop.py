@@ -1,4 +1,4 @@
-"""Closed-loop execution (issue 9): with a sticking pusher the object's pose in the grasp is
+"""Closed-loop execution: with a sticking pusher the object's pose in the grasp is
 observable, so after each push the executor compares the tracker's pose (`object_in_grasp` in the
 arm protocol) with the plan's and, past a threshold, re-plans from the measured pose.
 
@@ -19,9 +19,10 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
-from stablepush.execution import PlanStep
-from stablepush.planning import PlanResult, plan_task
-from stablepush.task import Task, pose_to_si
+from stablepush.plan.plan import Plan, Waypoint
+from stablepush.plan.search import plan_task
+from stablepush.task.model import Task
+from stablepush.units import pose_to_si
 
 THRESHOLD_FRACTION = 0.5  # default threshold: this fraction of the task's goal tolerance
 FINAL_FRACTION = 0.2  # default final tolerance: this fraction of the task's goal tolerance
@@ -51,8 +52,12 @@ class ClosedLoop:
     def for_task(cls, task: Task, threshold: Optional[Sequence[float]] = None,
                  final_tolerance: Optional[Sequence[float]] = None) -> "ClosedLoop":
         tol = task.planner["tolerance"]
-        return cls(threshold=tuple(threshold) if threshold else (THRESHOLD_FRACTION * tol[0], THRESHOLD_FRACTION * tol[1]),
-                   final_tolerance=tuple(final_tolerance) if final_tolerance else (FINAL_FRACTION * tol[0], FINAL_FRACTION * tol[1]))
+        return cls(
+            threshold=tuple(threshold) if threshold else (THRESHOLD_FRACTION * tol[0], THRESHOLD_FRACTION * tol[1]),
+            final_tolerance=tuple(final_tolerance)
+            if final_tolerance
+            else (FINAL_FRACTION * tol[0], FINAL_FRACTION * tol[1]),
+        )
 
     def may_replan(self, replans: Sequence["Replan"]) -> bool:
         """Whether the run may still re-plan, given the re-plans it made."""
@@ -83,7 +88,7 @@ class Replan:
         return dataclasses.asdict(self)
 
 
-def _transits_held(task: Task, steps: Sequence[PlanStep], pusher: str) -> bool:
+def _transits_held(task: Task, steps: Sequence[Waypoint], pusher: str) -> bool:
     """Whether the pads hold TRANSIT_HOLD_RATIO times the object's weight at every pose of `steps`
     where the pusher changes (the object travels between features there), `pusher` being the one
     in contact at steps[0]. With the task's uncertainty the pads must also hold at least the
@@ -105,22 +110,25 @@ def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float,
 
 
 def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
-           after_step: int, planned: Sequence[float]) -> Tuple[Replan, List[PlanStep]]:
+           after_step: int, planned: Sequence[float]) -> Tuple[Replan, List[Waypoint]]:
     """Plan from the measured pose to the task's goal, keeping `pusher` (the one pushing now) when
     it can do it alone. Returns the record and the new plan's steps (empty when none was found);
     the first step is the measured pose."""
     tolerance = list(loop.final_tolerance)
     base = dataclasses.replace(task, start=tuple(measured),
                                planner={**task.planner, "tolerance": tolerance})
+    if base.at_goal(base.start):  # off the plan but at the goal already: nothing to correct
+        return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
+                      pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0), []
     spec = task.pushers[task.pusher_index(pusher)]
     alone = dataclasses.replace(base, pushers=(spec,),
                                 planner={**base.planner, "max_switches": 0, "time_limit": KEEP_PUSHER_TIME_LIMIT})
-    result: PlanResult = plan_task(alone)
+    result: Plan = plan_task(alone)
     elapsed = result.stats["planning_time_s"]
     if not result.solved:
         result = plan_task(base, time_limit=min(REPLAN_TIME_LIMIT, task.planner["time_limit"]))
         elapsed += result.stats["planning_time_s"]
-    steps = result.steps if result.solved else []
+    steps = list(result.waypoints) if result.solved else []
     if steps and not _transits_held(task, steps, pusher):
         steps = []
     record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=bool(steps),

@@ -12,7 +12,7 @@ the next is sent.
 
 client -> server
   {"type": "hello", "protocol": "stablepush.arm/2", "rate_hz": 100, "scene": {...}, "continue": false}
-      `scene` describes the world (stablepush.execution.scene_description); a real arm may ignore
+      `scene` describes the world (stablepush.execution.world.scene_description); a real arm may ignore
       it. A simulator builds a fresh world from it for each session, or, when `continue` is true
       and the scene is the one it has, keeps its world (so a run can resume after a fault).
   {"type": "waypoint", "seq": 0, "t": 0.01, "step": 1, "phase": "push", "pose": [...]}

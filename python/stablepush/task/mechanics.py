@@ -5,18 +5,18 @@ from typing import Dict, Optional, Sequence
 
 from stablepush import _core
 from stablepush.errors import TaskError
-from stablepush.task import Task, pose_field, pose_to_si
+from stablepush.task.model import Task
+from stablepush.task.schema import pose_field
+from stablepush.units import pose_to_si
 
 SMALLEST_MOVE = 1e-6  # mm or deg: below, the motion's velocity terms are rounding noise
-
-CASE_NAMES = {_core.ContactCase.all_sliding: "all_sliding", _core.ContactCase.sticking: "sticking"}
 
 
 def result_to_dict(result: "_core.PushResult") -> dict:
     """A PushResult as plain data: margin in N, witness (f_x N, f_z N, tau_y N m) in O."""
     return {
         "feasible": bool(result.feasible),
-        "case": CASE_NAMES[result.contact_case],
+        "case": result.contact_case.name,
         "margin": float(result.margin),
         "witness": [float(v) for v in result.witness],
         "exact": bool(result.exact),

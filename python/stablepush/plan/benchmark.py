@@ -13,8 +13,9 @@ from typing import Callable, Dict, Optional
 
 import numpy as np
 
-from stablepush.planning import plan_task
-from stablepush.task import MM, Task
+from stablepush.plan.search import plan_task
+from stablepush.task.model import Task
+from stablepush.units import MM
 
 # Paper Table II (median planning time over 10 trials, s): this paper's planner in MATLAB on an
 # i7 2.8 GHz, and the earlier complementarity-based planner (Chavan-Dafle and Rodriguez 2017).

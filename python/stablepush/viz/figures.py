@@ -1,4 +1,7 @@
-"""Figures of plans and pusher cones (matplotlib, headless): `stablepush show` and `stablepush cone`.
+"""Figures of plans and pusher cones: `stablepush show` and `stablepush cone`.
+
+Figures are `matplotlib.figure.Figure` objects made without pyplot, so drawing one neither needs
+nor changes the caller's plotting backend; `save_figure` renders PNG with Agg.
 
 `plan_figure` draws, as the paper's fig. 1 does, snapshots of the object in the grasp along the
 plan (outline, pads, the active pusher thick and coloured, switch-overs marked) above x, z and
@@ -14,20 +17,20 @@ from pathlib import Path
 from typing import List, Optional, Sequence
 
 import matplotlib
+import numpy as np
+from matplotlib import animation
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib import animation  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
-
-from stablepush.execution import PlanStep, as_steps, contacts_of  # noqa: E402
-from stablepush.frames import in_gripper  # noqa: E402
-from stablepush.plan_io import write_atomically  # noqa: E402
-from stablepush.task import Task  # noqa: E402
+from stablepush.execution.world import contacts_of
+from stablepush.frames import in_gripper
+from stablepush.outputs import write_atomically
+from stablepush.plan.plan import Plan, Waypoint
+from stablepush.task.model import Task
 
 MAX_SNAPSHOTS = 6
-PUSHER_COLOURS = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+PUSHER_COLOURS = matplotlib.rcParams["axes.prop_cycle"].by_key()["color"]
 
 
 def _colour(task: Task, pusher: str) -> str:
@@ -39,7 +42,7 @@ def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits)
     ax.fill(outline[:, 0], outline[:, 1], color="0.85", zorder=1)
     ax.plot(outline[:, 0], outline[:, 1], color="0.25", lw=1.2, zorder=2)
     for (cx, cz), r in task.pads:
-        ax.add_patch(plt.Circle((cx, cz), r, fill=False, ec="0.1", lw=1.0, ls="--", zorder=3))
+        ax.add_patch(Circle((cx, cz), r, fill=False, ec="0.1", lw=1.0, ls="--", zorder=3))
     ax.plot([0], [0], "+", color="0.1", ms=6, zorder=3)
     for spec in task.pushers:
         seg = in_gripper(pose, [spec.a, spec.b])
@@ -62,13 +65,13 @@ def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits)
     ax.tick_params(labelsize=7)
 
 
-def _limits(task: Task, steps: Sequence[PlanStep]):
+def _limits(task: Task, steps: Sequence[Waypoint]):
     pts = np.vstack([in_gripper(s.pose, task.vertices) for s in steps])
     pad = 5.0
     return ((pts[:, 0].min() - pad, pts[:, 0].max() + pad), (pts[:, 1].min() - pad, pts[:, 1].max() + pad))
 
 
-def _snapshots(steps: Sequence[PlanStep]) -> List[int]:
+def _snapshots(steps: Sequence[Waypoint]) -> List[int]:
     """The start, the first pose of every contact (where switch-overs happen), the goal, and evenly
     spread poses in between, at most MAX_SNAPSHOTS."""
     keys = [0] + [c.first for c in contacts_of(steps)[1:]] + [len(steps) - 1]
@@ -83,20 +86,27 @@ def _snapshots(steps: Sequence[PlanStep]) -> List[int]:
     return keys[:MAX_SNAPSHOTS] if len(keys) <= MAX_SNAPSHOTS else keys[:MAX_SNAPSHOTS - 1] + [keys[-1]]
 
 
-def plan_figure(task: Task, steps, title: str = "", reaches_goal: bool = True):
-    """The plan in the grasp: snapshots above, x, z, theta against step below. `steps`: a Plan,
-    its waypoints or PlanSteps. The last snapshot is labelled "goal", or "end" for a plan that
-    does not reach it."""
-    steps = as_steps(steps)
+def plan_title(task: Task, plan: Plan) -> str:
+    """The task, the pushes, switch-overs and seed; NOT SOLVED first for a partial plan."""
+    title = (f"{task.name}: {len(plan.waypoints) - 1} pushes, {plan.stats.get('switches', '?')} switch-over(s), "
+             f"seed {plan.stats.get('seed', '?')}")
+    return title if plan.solved else f"NOT SOLVED ({plan.outcome or 'partial plan'}): {title}"
+
+
+def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
+    """The plan in the grasp: snapshots above, x, z, theta against step below; `title` defaults to
+    plan_title. The last snapshot is labelled "goal", or "end" for a plan that does not reach it.
+    `plan`: checked against the task (stablepush.plan.verify.check_plan)."""
+    steps = plan.waypoints
     keys = _snapshots(steps)
     switches = {c.first for c in contacts_of(steps)[1:]}
-    fig = plt.figure(figsize=(2.3 * len(keys) + 0.5, 6.2))
+    fig = Figure(figsize=(2.3 * len(keys) + 0.5, 6.2))
     grid = fig.add_gridspec(2, len(keys), height_ratios=[1.1, 1.0], hspace=0.35)
     limits = _limits(task, steps)
     for k, i in enumerate(keys):
         ax = fig.add_subplot(grid[0, k])
         pusher = steps[i + 1].pusher if i + 1 < len(steps) else steps[i].pusher
-        label = "start" if i == 0 else (("goal" if reaches_goal else "end") if i == len(steps) - 1 else f"step {i}")
+        label = "start" if i == 0 else (("goal" if plan.solved else "end") if i == len(steps) - 1 else f"step {i}")
         if i in switches:
             label += f"\nswitch to {pusher}"
         elif pusher:
@@ -125,15 +135,16 @@ def plan_figure(task: Task, steps, title: str = "", reaches_goal: bool = True):
     lines2 = ax2.get_legend_handles_labels()
     ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="best", fontsize=8)
     ax.grid(alpha=0.3)
-    fig.suptitle(title or task.name, fontsize=11)
+    fig.suptitle(plan_title(task, plan) if title is None else title, fontsize=11)
     return fig
 
 
-def save_plan_gif(task: Task, steps, path: str, max_frames: int = 80) -> None:
-    """The plan animated, one frame per step (thinned to at most `max_frames`); `steps` as for
+def save_plan_gif(task: Task, plan: Plan, path: str, max_frames: int = 80) -> None:
+    """The plan animated, one frame per step (thinned to at most `max_frames`); `plan` as for
     plan_figure."""
-    steps = as_steps(steps)
-    fig, ax = plt.subplots(figsize=(4, 4))
+    steps = plan.waypoints
+    fig = Figure(figsize=(4, 4))
+    ax = fig.subplots()
     limits = _limits(task, steps)
     frames = sorted(set(np.linspace(0, len(steps) - 1, min(max_frames, len(steps))).round().astype(int)))
 
@@ -145,15 +156,13 @@ def save_plan_gif(task: Task, steps, path: str, max_frames: int = 80) -> None:
     anim = animation.FuncAnimation(fig, draw, frames=frames)
     with tempfile.TemporaryDirectory() as scratch:  # Pillow writes a path; the output is then written safely
         anim.save(os.path.join(scratch, "plan.gif"), writer=animation.PillowWriter(fps=10))
-        plt.close(fig)
         write_atomically(path, Path(scratch, "plan.gif").read_bytes())
 
 
 def save_figure(fig, path: str, dpi: int = 110) -> None:
-    """Write a figure as PNG the way every output is written (plan_io.write_files)."""
+    """Write a figure as PNG the way every output is written (stablepush.outputs.write_files)."""
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
-    plt.close(fig)
     write_atomically(path, buffer.getvalue())
 
 
@@ -166,7 +175,7 @@ def cone_figure(task: Task, pusher: str):
     length = cone.torque_length
     gens = np.array([[g[0], g[1], g[2] / length] for g in cone.generators], float)
     gens /= np.linalg.norm(gens, axis=1, keepdims=True)
-    fig = plt.figure(figsize=(6, 5.5))
+    fig = Figure(figsize=(6, 5.5))
     ax = fig.add_subplot(projection="3d")
     for g in gens:
         ax.plot([0, g[0]], [0, g[1]], [0, g[2]], color="0.3", lw=1)

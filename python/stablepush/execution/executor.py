@@ -1,10 +1,9 @@
-"""The executor: streams a plan's end-effector waypoints (execution.py) to an arm server over the
-arm protocol (arm_protocol.py), lock-step, and reports what the arm confirmed.
+"""The executor: streams a plan's end-effector waypoints (stream.py) to an arm server over the
+arm protocol (protocol.py), lock-step, and reports what the arm confirmed.
 
 Any fault (the server gone, a malformed or out-of-order reply, an error from the server, no reply
-in time) ends the run with `ExecutionFault`: the arm is told to stop when it can still be
-reached, and the fault names the last plan step the arm confirmed, from which `resume_from`
-continues.
+in time) ends the run with `ArmFault`: the arm is told to stop when it can still be reached, and
+the fault names the last plan step the arm confirmed, from which `resume_from` continues.
 """
 from __future__ import annotations
 
@@ -18,22 +17,29 @@ from typing import Callable, Dict, List, Optional, Sequence
 
 import numpy as np
 
-from stablepush.arm_protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
-from stablepush.closed_loop import ClosedLoop, Replan, replan
-from stablepush.execution import (ArmWaypoint, Feature, PlanStep, arm_trajectory, as_steps, place_features,
-                                  scene_description)
+from stablepush.errors import ArmFault
+from stablepush.execution.closed_loop import ClosedLoop, Replan, replan
+from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
+from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from
+from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
-from stablepush import _core
-from stablepush.errors import ArmFault, PlanError
-from stablepush.plan_io import check_plan_dict
-from stablepush.task import MM, Task, pose_to_si
+from stablepush.plan.plan import Plan, Waypoint
+from stablepush.task.model import Task
+from stablepush.units import MM
 
 DEFAULT_ACK_TIMEOUT = 5.0  # s to wait for any reply
-STEP_SLACK = 1e-6  # unit steps: rounding in a plan file's decimal poses
+# Past this change in the grasp when the last feature lets go (mm, deg), the grasp alone does not
+# hold the final pose against gravity: ExecutionReport.release_moved.
+RELEASE_MOVE = (0.5, 0.5)
 
 
-# The run stopped early (stablepush.errors.ArmFault); the name the executor has always used.
-ExecutionFault = ArmFault
+def execution_warnings(task: Task) -> List[str]:
+    """What makes a run of this task on the executor's cell differ from its model (legal, but
+    probably not meant): one line each."""
+    if task.pushes == "by_moving_pusher":
+        return ["the task's pushes are by_moving_pusher (gravity fixed in G), but the executor pushes against "
+                "fixed features, where gravity turns in G with theta: the plan was made for another cell"]
+    return []
 
 
 @dataclass
@@ -68,6 +74,7 @@ class ExecutionReport:
     # "off", "on", or "no tracker" (closed loop asked for, but the arm reports no object_in_grasp)
     closed_loop: str = "off"
     replans: List[Replan] = field(default_factory=list)
+    warnings: List[str] = field(default_factory=list)  # execution_warnings(task)
 
     @property
     def final_error(self) -> Optional[Dict[str, float]]:
@@ -95,6 +102,14 @@ class ExecutionReport:
             return None
         return {k: self.released_in_grasp[k] - self.final_in_grasp[k] for k in ("x", "z", "theta")}
 
+    @property
+    def release_moved(self) -> bool:
+        """Whether the object moved in the grasp by more than RELEASE_MOVE when the last feature let
+        go: the grasp alone does not hold the final pose against gravity."""
+        change = self.release_change
+        return change is not None and (math.hypot(change["x"], change["z"]) > RELEASE_MOVE[0]
+                                       or abs(change["theta"]) > RELEASE_MOVE[1])
+
     def as_dict(self) -> dict:
         return {
             "task": self.task, "resumed_from": self.resumed_from, "last_confirmed_step": self.last_confirmed_step,
@@ -102,58 +117,11 @@ class ExecutionReport:
             "goal": list(self.goal), "final_in_grasp": self.final_in_grasp, "final_error": self.final_error,
             "goal_error": self.goal_error,
             "released_in_grasp": self.released_in_grasp, "release_change": self.release_change,
+            "release_moved": self.release_moved, "warnings": list(self.warnings),
             "contacts": [c.__dict__ for c in self.contacts], "features": self.features,
             "wall_time_s": self.wall_time_s, "sim_steps_per_s": self.sim_steps_per_s,
             "closed_loop": self.closed_loop, "replans": [r.as_dict() for r in self.replans],
         }
-
-
-def plan_steps(task: Task, plan: dict, source: Optional[str] = None, require_solved: bool = True) -> List[PlanStep]:
-    """The plan's waypoints, once they are shown to belong to `task`: a structurally valid plan
-    (plan_io.check_plan_dict), solved, for the same task name and start, with pushers the task
-    has, no step longer than the task's unit step, and every push a stable push of this task with
-    the pads inside the object (so a plan made for another version of the file, or edited by
-    hand, is refused). PlanError names what differs. `require_solved=False` lets an unsolved
-    (partial) plan through, for drawing it."""
-    def fail(field: str, reason: str):
-        raise PlanError(field, reason, source)
-
-    check_plan_dict(plan, source)
-    if plan["task"] != task.name:
-        fail("task", f"the plan is for task {plan['task'][:100]!r}, not {task.name!r}")
-    if require_solved and not plan["solved"]:
-        fail("solved", f"the plan does not reach the goal ({str(plan.get('message', 'not solved'))[:200]})")
-    raw = plan["waypoints"]
-    if len(raw) < 2:
-        fail("waypoints", "needs the start and at least one push")
-    steps = []
-    for i, w in enumerate(raw):
-        pose, pusher = (float(w["x"]), float(w["z"]), float(w["theta"])), w.get("pusher")
-        if (pusher is None) != (i == 0):
-            fail(f"waypoints[{i}].pusher", "only the first waypoint (the start) has no pusher")
-        if pusher is not None and pusher not in task.pusher_names:
-            fail(f"waypoints[{i}].pusher", f"the task has no pusher {pusher[:100]!r}")
-        steps.append(PlanStep(pose, pusher))
-    if max(abs(a - b) for a, b in zip(steps[0].pose, task.start)) > 1e-6:
-        fail("waypoints[0]", f"the plan starts at {list(steps[0].pose)}, the task at {list(task.start)}")
-    unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
-    model = task.build_model()
-    for i in range(1, len(steps)):
-        q0, q1 = pose_to_si(steps[i - 1].pose), pose_to_si(steps[i].pose)
-        length = _core.steps_between(q0, q1, unit)
-        if length > 1.0 + STEP_SLACK:
-            fail(f"waypoints[{i}]", f"a step of {length:.3g} unit steps (planner.step {task.planner['step']}); "
-                                    f"a plan's pushes are at most one unit step")
-        dq = tuple(b - a for a, b in zip(q0, q1))
-        if max(abs(v) for v in dq) < 1e-12:
-            fail(f"waypoints[{i}]", "repeats the pose before it (a push that does not move the object)")
-        verdict = model.check(q0, dq, task.pusher_index(steps[i].pusher))
-        if not verdict.feasible:
-            fail(f"waypoints[{i}]", f"the push by {steps[i].pusher!r} is not a stable push for this task "
-                                    f"(margin {verdict.margin:+.4f} N); was the plan made for another version of it?")
-        if not model.grasp_maintained(q1):
-            fail(f"waypoints[{i}]", "the pads leave the object at this pose")
-    return steps
 
 
 class _Link:
@@ -184,7 +152,7 @@ class _Link:
 
 def execute_plan(
     task: Task,
-    steps: Sequence[PlanStep],
+    plan: Plan,
     host: str,
     port: int,
     *,
@@ -201,8 +169,10 @@ def execute_plan(
     each push is compared with the plan's and, past its threshold, the rest of the run is re-planned
     from the measured pose and spliced into the stream (`stablepush.closed_loop`); the world then
     holds a feature for every pusher of the task. `progress(waypoint, confirmed_step, total_steps)`
-    is called per ack. `steps`: checked plan steps (plan_steps, or a Plan after Plan.check)."""
-    steps = as_steps(steps)
+    is called per ack. `plan`: a plan checked against the task (stablepush.plan.verify.check_plan).
+    PlanError (field `resume_from`) before anything is sent when the plan has no push after it."""
+    steps: List[Waypoint] = list(plan.waypoints)
+    check_resume_from(steps, resume_from)
     features = place_features(task, steps, every_pusher=closed_loop is not None)
     scene = scene_description(task, features, steps[resume_from].pose)
     started = time.perf_counter()
@@ -258,7 +228,7 @@ def execute_plan(
     except (ConnectionError, TimeoutError, ProtocolError, OSError, KeyError) as exc:
         stopped = _stop(link) if link is not None else None
         reason = str(exc) if not isinstance(exc, KeyError) else f"a reply lacks {exc}"
-        raise ExecutionFault(reason, last_confirmed, stopped) from None
+        raise ArmFault(reason, last_confirmed, stopped) from None
     finally:
         if link is not None:
             link.close()
@@ -268,11 +238,11 @@ def execute_plan(
         final_in_grasp=(settled or state).get("object_in_grasp"), released_in_grasp=state.get("object_in_grasp"),
         contacts=list(contacts.values()), features=[f.as_dict() for f in features.values()],
         wall_time_s=time.perf_counter() - started, sim_steps_per_s=state.get("steps_per_s"),
-        closed_loop=loop_status, replans=replans,
+        closed_loop=loop_status, replans=replans, warnings=execution_warnings(task),
     )
 
 
-def _correct(task: Task, steps: List[PlanStep], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
+def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
              state: dict, rate_hz: float, replans: List[Replan]):
     """After plan step w.step: when the tracked pose is off the plan (or, at rest after the last
     push, off the goal) by more than the loop allows, re-plan from it and return the spliced steps and the
@@ -293,7 +263,7 @@ def _correct(task: Task, steps: List[PlanStep], features: Dict[str, Feature], lo
     pusher = steps[k].pusher
     on_feature = pose_to_matrix(state["ee_pose"]) @ grasp_transform(measured)
     features[pusher] = dataclasses.replace(features[pusher], object_pose=on_feature)
-    spliced = steps[:k] + [PlanStep(measured, pusher)] + new_steps[1:]
+    spliced = steps[:k] + [Waypoint(*measured, pusher=pusher)] + new_steps[1:]
     points = arm_trajectory(task, spliced, features, rate_hz, state["ee_pose"], resume_from=k)
     return spliced, points
 
@@ -320,7 +290,7 @@ def _stop(link: _Link, within: float = 2.0) -> Optional[bool]:
         return None
 
 
-def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[PlanStep], features: Dict[str, Feature],
+def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Waypoint], features: Dict[str, Feature],
             step: int, touch_state: Optional[dict], state: dict) -> None:
     """Update the record of the contact that plan step `step` belongs to with the object's motion in
     the world since it came to rest on the feature (when the arm reports the object)."""

@@ -1,25 +1,18 @@
 """Plan files (docs/model.md section 5): JSON, with a CSV beside it, written atomically."""
 from __future__ import annotations
 
-import contextlib
 import csv
 import io
 import json
 import math
-import os
-import re
-import signal
-import stat
-import tempfile
-import threading
 from pathlib import Path
-from typing import Mapping, Optional, Union
+from typing import Optional, Union
 
 from stablepush import strict_json
-from stablepush.errors import OutputError, PlanError
+from stablepush.errors import PlanError
+from stablepush.outputs import write_files
+from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.strict_json import is_finite_number
-
-from stablepush.planning import Plan, PlanResult, PusherContact, Waypoint
 
 FORMAT = "stablepush.plan/1"
 CSV_COLUMNS = ["step", "x", "z", "theta", "pusher", "margin", "margin_per_normal", "case",
@@ -35,7 +28,7 @@ def _waypoint_dict(w: Waypoint) -> dict:
     return out
 
 
-def plan_to_dict(plan: PlanResult) -> dict:
+def plan_to_dict(plan: Plan) -> dict:
     """The plan as the JSON document of docs/model.md section 5 (mm, deg; margins in N; the pusher's
     contact in the gripper frame G per waypoint)."""
     return {
@@ -61,118 +54,29 @@ def plan_to_dict(plan: PlanResult) -> dict:
     }
 
 
-def plan_to_csv(plan: PlanResult) -> str:
+def plan_to_csv(plan: Plan) -> str:
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
     for i, w in enumerate(plan.waypoints):
         contact = ([*w.contact.start, *w.contact.end, *w.contact.normal] if w.contact is not None else [""] * 6)
-        writer.writerow([i, repr(w.x), repr(w.z), repr(w.theta), w.pusher or "",
-                         "" if w.margin is None else repr(w.margin),
-                         "" if w.margin_per_normal is None else repr(w.margin_per_normal), w.case or "", *map(str, contact)])
+        writer.writerow(
+            [
+                i,
+                repr(w.x),
+                repr(w.z),
+                repr(w.theta),
+                w.pusher or "",
+                "" if w.margin is None else repr(w.margin),
+                "" if w.margin_per_normal is None else repr(w.margin_per_normal),
+                w.case or "",
+                *map(str, contact),
+            ]
+        )
     return buffer.getvalue()
 
 
-def default_output(input_file: Union[str, Path], suffix: str) -> str:
-    """The default output for an input file: its stem plus `suffix`, in the current directory.
-    Derived from the file's own name (never from names inside it), so it cannot point elsewhere."""
-    stem = Path(input_file).stem or "stablepush"
-    return re.sub(r"[^\w.+-]", "_", stem + suffix)
-
-
-def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
-    """Write each file so that a reader sees its old content or the whole new one, never a part,
-    and a set of files is replaced together: every new file is written and synced beside its
-    target first, then all are renamed into place with SIGINT, SIGTERM and SIGHUP held off, so
-    that only a SIGKILL or a power cut between two renames can leave old and new side by side
-    (or a temporary file behind).
-
-    A symlink is written through (its target is replaced; the link stays). A character device or
-    FIFO (/dev/null, /dev/stdout) is written to, never replaced. A directory or any other kind of
-    file is refused, as is a missing directory: OutputError naming the path. New files take the
-    umask's permissions; a replaced file keeps its own."""
-    plan = []
-    for path, content in files.items():
-        target = Path(os.path.realpath(path))
-        try:
-            mode = os.stat(target).st_mode
-        except FileNotFoundError:
-            mode = None
-        except OSError as exc:
-            raise OutputError(f"{path}: cannot write ({exc.strerror})") from None
-        if mode is not None and (stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)):
-            plan.append((path, target, content, "stream", None))
-        elif mode is not None and not stat.S_ISREG(mode):
-            raise OutputError(f"{path}: not a regular file; refusing to replace it")
-        elif not target.parent.is_dir():
-            raise OutputError(f"{path}: the directory {target.parent} does not exist")
-        else:
-            plan.append((path, target, content, "replace", stat.S_IMODE(mode) if mode is not None else None))
-    with _signals_deferred():
-        _write_and_rename(plan)
-
-
-def _write_and_rename(plan) -> None:
-    temporaries = []  # written, not yet renamed: removed on any failure
-    try:
-        for path, target, content, how, mode in plan:
-            data = content.encode() if isinstance(content, str) else content
-            if how == "stream":
-                with open(target, "wb") as handle:
-                    handle.write(data)
-                continue
-            fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-            temporaries.append((tmp, target))
-            with os.fdopen(fd, "wb") as handle:
-                handle.write(data)
-                handle.flush()
-                os.fsync(handle.fileno())
-            os.chmod(tmp, mode if mode is not None else 0o666 & ~_umask())
-        for tmp, target in temporaries:
-            os.replace(tmp, target)
-        temporaries = []
-    except OSError as exc:
-        raise OutputError(f"cannot write {exc.filename or 'the output'}: {exc.strerror or exc}") from None
-    finally:
-        for tmp, _ in temporaries:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-
-
-@contextlib.contextmanager
-def _signals_deferred():
-    """Hold SIGINT, SIGTERM and SIGHUP until the block ends, then deliver them as if they came
-    then. A handler, not a signal mask: a process-directed signal goes to any thread that does
-    not block it (numpy's BLAS threads), and its default action ends the whole process."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    pending = []
-    previous = {sig: signal.signal(sig, lambda signum, frame: pending.append(signum)) for sig in _DEFERRED}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-        for sig in dict.fromkeys(pending):
-            signal.raise_signal(sig)
-
-
-_DEFERRED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-
-
-def write_atomically(path: Union[str, Path], text: Union[str, bytes]) -> None:
-    """Write one file as `write_files` does."""
-    write_files({path: text})
-
-
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def write_plan(plan: PlanResult, json_path: Union[str, Path], csv_path: Optional[Union[str, Path]] = None) -> None:
+def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union[str, Path]] = None) -> None:
     """The plan as JSON, and as CSV beside it when `csv_path` is given, replaced together."""
     files = {json_path: json.dumps(plan_to_dict(plan), indent=1) + "\n"}
     if csv_path:
@@ -197,6 +101,11 @@ def plan_from_dict(data: dict) -> Plan:
                 uncertainty=dict(data.get("uncertainty") or {}), ends_at_goal=data.get("ends_at") == "goal")
 
 
+def load_plan(path: Union[str, Path]) -> Plan:
+    """A plan file as a Plan; PlanError naming the field if it is not a well-formed plan."""
+    return plan_from_dict(read_plan(path))
+
+
 MAX_PLAN_BYTES = 16_000_000
 MAX_WAYPOINTS = 10_000  # a plan this long streams for about 2 h at 100 waypoints/s with no retracts
 
@@ -205,7 +114,7 @@ def read_plan(path: Union[str, Path]) -> dict:
     """A plan file as a dict, once its structure is checked (PlanError naming the field): the
     format, `solved` a boolean, `stats` a mapping, at most MAX_WAYPOINTS waypoints, each with
     finite x, z, theta and a pusher name (null at the start). Whether the plan belongs to a task
-    is stablepush.executor.plan_steps's question."""
+    is stablepush.plan.verify.check_plan's question."""
     source = str(path)
     try:
         with open(path, "rb") as handle:
@@ -248,6 +157,27 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
                 fail(f"{field}.{key}", f"must be a finite number, got {str(w.get(key))[:40]}")
         if not (w.get("pusher") is None or isinstance(w.get("pusher"), str)):
             fail(f"{field}.pusher", f"must be a pusher name or null, got {_json_kind(w.get('pusher'))}")
+        for key in ("margin", "margin_per_normal"):
+            if w.get(key) is not None and not is_finite_number(w[key]):
+                fail(f"{field}.{key}", f"must be a finite number or null, got {str(w[key])[:40]}")
+        if not (w.get("case") is None or isinstance(w["case"], str)):
+            fail(f"{field}.case", f"must be a string or null, got {_json_kind(w['case'])}")
+        contact = w.get("pusher_in_gripper")
+        if contact is not None:
+            if not isinstance(contact, dict):
+                fail(f"{field}.pusher_in_gripper", f"must be a mapping or null, got {_json_kind(contact)}")
+            for key in ("from", "to", "normal"):
+                v = contact.get(key)
+                if not (isinstance(v, list) and len(v) == 2 and all(is_finite_number(c) for c in v)):
+                    fail(f"{field}.pusher_in_gripper.{key}", "must be a list of 2 finite numbers")
+    hold = data.get("final_hold")
+    if hold is not None and not (isinstance(hold, dict) and (hold.get("ratio") is None
+                                                             or is_finite_number(hold["ratio"]))):
+        fail("final_hold", "must be a mapping whose ratio is a finite number or null")
+    if data.get("uncertainty") is not None and not isinstance(data["uncertainty"], dict):
+        fail("uncertainty", f"must be a mapping, got {_json_kind(data['uncertainty'])}")
+    if data.get("ends_at") not in (None, "goal", "within_tolerance"):
+        fail("ends_at", "must be goal, within_tolerance or null")
 
 
 _KIND_NAMES = {str: "string", dict: "mapping", list: "list"}

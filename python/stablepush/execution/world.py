@@ -1,0 +1,124 @@
+"""The plan in the world: where the features that act as pushers sit, and the scene a simulated
+arm builds from them. No sockets here (`executor.py`) and no simulation (`stablepush.sim`).
+
+World frame W: x forward, z up, y along the gripping axis at the home pose, where G's axes are
+W's. A feature is fixed in W; during a push the object rests on it while the gripper moves
+(`stream.py`). Positions in W are in m.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Dict, List, Sequence
+
+import numpy as np
+
+from stablepush import _core
+from stablepush.frames import grasp_transform, matrix_to_pose, rot_y, translation
+from stablepush.plan.plan import Waypoint
+from stablepush.task.model import Task
+from stablepush.units import MM
+
+
+@dataclass(frozen=True)
+class Feature:
+    """A fixed feature of the world acting as pusher `pusher`: it touches the object along the
+    segment from-to (W, m) when the object is at `object_pose` (T_WO, 4x4); `normal` is the
+    pusher's inward normal in W (pointing into the object, away from the feature)."""
+
+    pusher: str
+    object_pose: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    normal: np.ndarray
+    mu: float
+
+    def as_dict(self) -> dict:
+        return {"pusher": self.pusher, "from": self.start.tolist(), "to": self.end.tolist(),
+                "normal": self.normal.tolist(), "mu": self.mu, "object_pose": matrix_to_pose(self.object_pose)}
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Plan pushes first+1 .. last, all by `pusher` (one stay on one feature)."""
+
+    pusher: str
+    first: int
+    last: int
+
+
+# -- the plan in the world ---------------------------------------------------------------------
+
+
+def contacts_of(steps: Sequence[Waypoint]) -> List[Contact]:
+    """The plan's pushes grouped into contacts: runs of consecutive pushes by one pusher."""
+    out: List[Contact] = []
+    for i, step in enumerate(steps[1:], start=1):
+        if out and out[-1].pusher == step.pusher and out[-1].last == i - 1:
+            out[-1] = Contact(step.pusher, out[-1].first, i)
+        else:
+            out.append(Contact(step.pusher, i - 1, i))
+    return out
+
+
+def place_features(task: Task, steps: Sequence[Waypoint], every_pusher: bool = False) -> Dict[str, Feature]:
+    """One feature per pusher the plan uses (with `every_pusher`, then one for each other pusher of
+    the task, as if its first contact began at the plan's start: a re-planned run may use it). The
+    task's `environment.features` gives the object's world pose on a feature; otherwise pusher k
+    (in order of first use) gets a station k `station_spacing` mm along +y from home, and the
+    feature is placed where the pusher touches the object at the start of its first contact with G
+    at that station, turned about y so that the object's world orientation there is the one the
+    model assumes for this feature (`Task.feature_angle`: the start's unless environment.features
+    says otherwise). Gravity in the world is the task's gravity (G's axes are W's at home)."""
+    env = task.environment
+    section = task.section()
+    home = np.asarray(env["home"], float) * MM
+    features: Dict[str, Feature] = {}
+    contacts = contacts_of(steps)
+    if every_pusher:
+        contacts += [Contact(name, 0, 0) for name in task.pusher_names]
+    for contact in contacts:
+        name = contact.pusher
+        if name in features:
+            continue
+        if name in env["features"]:
+            x, y, z, theta = env["features"][name]
+            T_WO = translation(np.array([x, y, z]) * MM)
+            T_WO[:3, :3] = rot_y(math.radians(theta))
+        else:  # G at the station, turned so that the object has the world orientation the model
+            # assumes on this feature (Task.feature_angle): G's turn plus theta is that angle
+            station = home + np.array([0.0, len(features) * env["station_spacing"] * MM, 0.0])
+            q_first = steps[contact.first].pose
+            T_WG = translation(station)
+            T_WG[:3, :3] = rot_y(math.radians(task.feature_angle(name) - q_first[2]))
+            T_WO = T_WG @ grasp_transform(q_first)
+        index = task.pusher_index(name)
+        spec = task.pushers[index]
+        pusher = _core.Pusher.on_boundary(section, name, (spec.a[0] * MM, spec.a[1] * MM), (spec.b[0] * MM, spec.b[1] * MM),
+                                          spec.mu, spec.points)  # the pusher alone: its cone is not needed here
+        n_O = np.array(pusher.inward_normal, float)
+        to_w = lambda p: (T_WO @ np.array([p[0] * MM, 0.0, p[1] * MM, 1.0]))[:3]  # noqa: E731
+        features[name] = Feature(pusher=name, object_pose=T_WO, start=to_w(spec.a), end=to_w(spec.b),
+                                 normal=T_WO[:3, :3] @ np.array([n_O[0], 0.0, n_O[1]]), mu=spec.mu)
+    return features
+
+
+def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float]) -> dict:
+    """What a simulated arm needs to build the world (SI units): the object, the gripper, gravity,
+    the features, G's home pose and the object's pose when the run starts (`in_grasp`, mm/deg)."""
+    body = task.rigid_body()
+    home = translation(np.asarray(task.environment["home"], float) * MM)
+    return {
+        "task": task.name,
+        "gravity": list(task.gravity),
+        "object": {"polygon": [[x * MM, z * MM] for x, z in task.vertices], "thickness": task.thickness * MM,
+                   "mass": body.mass, "com": list(body.com), "inertia": body.inertia},
+        "gripper": {"grip_force": task.grip_force, "mu": task.mu, "pad_rings": task.pad_rings,
+                    "pads": [{"center": [c[0] * MM, c[1] * MM], "radius": r * MM} for c, r in task.pads]},
+        "features": [f.as_dict() for f in features.values()],
+        "gripper_pose": matrix_to_pose(home),
+        "object_pose": matrix_to_pose(home @ grasp_transform(in_grasp)),
+        "object_in_grasp": list(in_grasp),
+    }
+
+

@@ -1,0 +1,145 @@
+"""Planning a task with the core's T-RRT* (docs/model.md section 3), in file units.
+
+`plan_task` turns a validated Task into a `Plan` (stablepush.plan.plan): waypoints in mm and
+degrees, the pusher of each push, the test's verdict on it, and the pusher's contact seen from
+the gripper.
+"""
+from __future__ import annotations
+
+import math
+from typing import List, Optional
+
+from stablepush import _core
+from stablepush.errors import TaskError
+from stablepush.frames import direction_in_gripper, point_in_gripper
+from stablepush.plan.plan import Plan, PusherContact, Waypoint
+from stablepush.task.model import Task
+from stablepush.task.schema import PLANNER_TUNING, planner_limit, planner_parameter
+from stablepush.units import MM, pose_from_si, pose_to_si
+
+
+def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, pose_mm_deg) -> PusherContact:
+    """Where pusher `pusher` touches the object, seen from G, when the object is at the pose."""
+    spec = task.pushers[pusher]
+    normal = direction_in_gripper(pose_mm_deg[2], model.pushers[pusher].inward_normal)
+    return PusherContact(start=point_in_gripper(pose_mm_deg, spec.a), end=point_in_gripper(pose_mm_deg, spec.b),
+                         normal=tuple(float(v) for v in normal))
+
+
+def plan_task(
+    task: Task,
+    *,
+    seed: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    max_switches: Optional[int] = None,
+    improve_for: Optional[float] = None,
+    models: "Optional[List[_core.StablePushModel]]" = None,
+) -> Plan:
+    """Plan stable pushes from the task's start to its goal. Arguments left as None take the
+    task's planner section (which has defaults for every key). `models` are the task's
+    corner_models() (built here unless given, e.g. once for many seeds): with an `uncertainty`
+    section every push must be stable at every corner, and each waypoint's margin is the least.
+    TaskError (field `goal`) when the start is already within the tolerance of the goal."""
+    if task.at_goal(task.start):
+        tolerance = task.planner["tolerance"]
+        raise TaskError("goal", f"the start {list(task.start)} is already within planner.tolerance {tolerance} of the "
+                                f"goal {list(task.goal)}: there is nothing to plan (a task written in metres? task "
+                                f"files use mm)", task.source)
+    settings = dict(task.planner)
+    if seed is not None:
+        settings["seed"] = planner_parameter("seed", "seed", seed)
+    if max_switches is not None:
+        settings["max_switches"] = planner_parameter("max_switches", "max_switches", max_switches)
+    if time_limit is not None:
+        settings["time_limit"] = planner_limit("time_limit", time_limit)
+    if improve_for is not None:
+        settings["improve_for"] = planner_parameter("improve_for", "improve_for", improve_for)
+    models = models or task.corner_models()
+    model = models[0]
+    step = (settings["step"][0] * MM, math.radians(settings["step"][1]))
+    tolerance = (settings["tolerance"][0] * MM, math.radians(settings["tolerance"][1]))
+    parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}
+    parameters.update({key: repr(settings[key]) for key in PLANNER_TUNING if key in settings})
+    raw = _core.plan(
+        models, pose_to_si(task.start), pose_to_si(task.goal), step, tolerance, float(settings["time_limit"]),
+        float(settings["min_margin"]), float(settings["sampling_margin"]), parameters,
+        float(settings["min_hold_ratio"]),
+    )
+
+    names = task.pusher_names
+    waypoints: List[Waypoint] = []
+    for k, (q, p, margin, case) in enumerate(zip(raw.poses, raw.pushers, raw.margins, raw.contact_cases)):
+        pose = tuple(float(v) for v in pose_from_si(q))
+        if p < 0:
+            waypoints.append(Waypoint(*pose))
+        else:
+            waypoints.append(Waypoint(*pose, pusher=names[p], margin=float(margin), case=case.name,
+                                      contact=contact_in_gripper(task, model, p, pose),
+                                      margin_per_normal=_margin_per_normal(models, raw.poses[k - 1], q, p)))
+
+    outcome = raw.outcome.name
+    s = raw.stats
+    stats = {
+        "planning_time_s": s.planning_time_s,
+        "iterations": int(s.iterations),
+        "nodes": int(s.nodes),
+        "feasibility_checks": int(s.feasibility_checks),
+        "switches": int(s.switches),
+        "restarts": int(s.restarts),
+        "seed": int(settings["seed"]),
+        "max_switches": int(settings["max_switches"]),
+        "time_limit_s": float(settings["time_limit"]),
+        "pushes": len(waypoints) - 1,
+        "path_length_steps": s.length,
+        "goal_distance_steps": raw.goal_distance,
+        "min_hold_ratio": float(settings["min_hold_ratio"]),
+    }
+    if "improve_for" in settings:
+        # the first plan of an anytime search (planner.improve_for), before the improvement; None: no plan
+        # (path_min_margin: the same measure for the returned path, the last push to the goal left out)
+        solved_once = math.isfinite(s.first_time_s)
+        stats["first"] = (
+            {
+                "planning_time_s": s.first_time_s,
+                "switches": int(s.first_switches),
+                "path_length_steps": s.first_length,
+                "min_margin": s.first_min_margin,
+            }
+            if solved_once
+            else None
+        )
+        stats["path_min_margin"] = s.path_min_margin if solved_once else None
+    last = waypoints[-1]
+    last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1
+    return Plan(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
+                message=_message(outcome, stats, bool(raw.ends_at_goal)), waypoints=waypoints, stats=stats,
+                final_hold_ratio=min(m.hold_ratio(last_q, last_pusher) for m in models),
+                uncertainty=dict(task.uncertainty), ends_at_goal=bool(raw.ends_at_goal))
+
+
+def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:
+    """The push's margin over the pusher's normal force (both at the least stable corner): how
+    deep inside the cone the push is, relative to how hard the pusher presses."""
+    r = _core.worst_case(models, tuple(q0), tuple(b - a for a, b in zip(q0, q1)), pusher)
+    n = models[0].pushers[pusher].inward_normal
+    normal_force = r.witness[0] * n[0] + r.witness[1] * n[1]
+    return float(r.margin / normal_force) if normal_force > 0 else None
+
+
+def _message(outcome: str, stats: dict, ends_at_goal: bool) -> str:
+    if outcome == "goal_reached":
+        end = ("ending at the goal" if ends_at_goal else
+               f"ending within tolerance, {stats['goal_distance_steps']:.2f} unit steps from the goal (a last push "
+               f"to the goal itself is not stable)")
+        return (f"solved in {stats['planning_time_s'] * 1e3:.1f} ms: {stats['pushes']} pushes, "
+                f"{stats['switches']} switch-over(s), {end}")
+    if outcome == "goal_over_switch_limit":
+        return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out with the goal reached only with "
+                f"{stats['switches']} switch-overs (max_switches {stats['max_switches']}); the plan written is that "
+                f"one; allow it with --max-switches {stats['switches']}")
+    if outcome == "invalid_start":
+        return "not solved: the pads do not hold the object at the start pose"
+    held = (f" where the pads alone hold {stats['min_hold_ratio']:g} times the weight (planner.min_hold_ratio)"
+            if stats["min_hold_ratio"] > 0 else "")
+    return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out before the goal was reached{held}; "
+            f"the best partial path ends {stats['goal_distance_steps']:.1f} unit steps from the goal")

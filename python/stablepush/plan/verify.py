@@ -1,0 +1,60 @@
+"""Does a plan belong to a task? Every push re-checked as a stable push of the task before a plan
+is drawn, turned into a trajectory or run, so that a plan made for another version of a task
+file, or edited by hand, is refused (PlanError naming the waypoint)."""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+from stablepush import _core
+from stablepush.errors import PlanError
+from stablepush.plan.plan import Plan
+from stablepush.task.model import Task
+from stablepush.units import MM, pose_to_si
+
+STEP_SLACK = 1e-6  # unit steps: rounding in a plan file's decimal poses
+START_SLACK = 1e-6  # mm or deg: the plan's start against the task's
+
+
+def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_solved: bool = True) -> Plan:
+    """`plan`, once it is shown to belong to `task`: solved, for the same task name and start, with
+    pushers the task has, no step longer than the task's unit step, and every push a stable push
+    of this task with the pads inside the object. PlanError names what differs (`source`: the
+    plan file, for the message). `require_solved=False` lets an unsolved (partial) plan through,
+    for drawing it."""
+    def fail(field: str, reason: str):
+        raise PlanError(field, reason, source)
+
+    if plan.task != task.name:
+        fail("task", f"the plan is for task {plan.task[:100]!r}, not {task.name!r}")
+    if require_solved and not plan.solved:
+        fail("solved", f"the plan does not reach the goal ({(plan.message or 'not solved')[:200]})")
+    waypoints = plan.waypoints
+    if len(waypoints) < 2:
+        fail("waypoints", "needs the start and at least one push")
+    for i, w in enumerate(waypoints):
+        if (w.pusher is None) != (i == 0):
+            fail(f"waypoints[{i}].pusher", "only the first waypoint (the start) has no pusher")
+        if w.pusher is not None and w.pusher not in task.pusher_names:
+            fail(f"waypoints[{i}].pusher", f"the task has no pusher {w.pusher[:100]!r}")
+    if max(abs(a - b) for a, b in zip(waypoints[0].pose, task.start)) > START_SLACK:
+        fail("waypoints[0]", f"the plan starts at {list(waypoints[0].pose)}, the task at {list(task.start)}")
+    unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
+    model = task.build_model()
+    for i in range(1, len(waypoints)):
+        q0, q1 = pose_to_si(waypoints[i - 1].pose), pose_to_si(waypoints[i].pose)
+        length = _core.steps_between(q0, q1, unit)
+        if length > 1.0 + STEP_SLACK:
+            fail(f"waypoints[{i}]", f"a step of {length:.3g} unit steps (planner.step {task.planner['step']}); "
+                                    f"a plan's pushes are at most one unit step")
+        dq = tuple(b - a for a, b in zip(q0, q1))
+        if max(abs(v) for v in dq) < 1e-12:
+            fail(f"waypoints[{i}]", "repeats the pose before it (a push that does not move the object)")
+        pusher = waypoints[i].pusher
+        verdict = model.check(q0, dq, task.pusher_index(pusher))
+        if not verdict.feasible:
+            fail(f"waypoints[{i}]", f"the push by {pusher!r} is not a stable push for this task "
+                                    f"(margin {verdict.margin:+.4f} N); was the plan made for another version of it?")
+        if not model.grasp_maintained(q1):
+            fail(f"waypoints[{i}]", "the pads leave the object at this pose")
+    return plan

@@ -1,0 +1,145 @@
+"""The task: the object, pads, pushers, start and goal in file units (mm, deg, g, N), and the
+core's stable-push model built from it in SI (docs/model.md sections 1-4 and 7).
+
+`stablepush.task.schema` makes a Task from a task file; this module knows nothing of files.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Tuple
+
+from stablepush import _core
+from stablepush.errors import TaskError
+from stablepush.units import MM, G, mm2_to_si
+
+# How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
+# (README, "Gravity during a push"): against features fixed in the world, the object keeps its
+# world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
+PUSHES = ("against_fixed_features", "by_moving_pusher")
+# uncertainty: key -> the task value it widens (+- this fraction of it); a push must be stable for
+# every value in the box (Task.corner_models).
+UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers[].mu", "grip_force": "gripper.grip_force",
+             "mass": "object.mass"}
+
+
+@dataclass(frozen=True)
+class PusherSpec:
+    """A pusher as the task gives it, in O [mm]; `a == b` for a point pusher."""
+
+    name: str
+    a: Tuple[float, float]
+    b: Tuple[float, float]
+    mu: float
+    points: int
+
+    @property
+    def is_point(self) -> bool:
+        return self.a == self.b
+
+
+@dataclass(frozen=True)
+class Task:
+    """A validated task, in file units (mm, deg, g, N); `build_model` converts to SI."""
+
+    name: str
+    vertices: Tuple[Tuple[float, float], ...]  # cross-section in O, mm, counterclockwise
+    thickness: float  # mm along y
+    mass: float  # g
+    com: Optional[Tuple[float, float]]  # mm in O; None: the centroid
+    inertia: Optional[float]  # kg m^2 about the com; None: uniform body
+    grip_force: float  # N per pad
+    mu: float  # pad-object friction
+    pad_rings: int
+    pads: Tuple[Tuple[Tuple[float, float], float], ...]  # (centre mm in G, radius mm)
+    gravity: Tuple[float, float]  # m/s^2 in G while G's axes are the world's (at the home pose)
+    step_time: float  # s
+    friction_polygon_sides: int
+    pushers: Tuple[PusherSpec, ...]
+    start: Tuple[float, float, float]  # mm, mm, deg
+    goal: Tuple[float, float, float]
+    planner: Dict[str, Any] = field(default_factory=dict)
+    environment: Dict[str, Any] = field(default_factory=dict)  # the world around the arm, see ENVIRONMENT_DEFAULTS
+    source: Optional[str] = None
+    pushes: str = PUSHES[0]  # see PUSHES
+    uncertainty: Dict[str, float] = field(default_factory=dict)  # key -> +- fraction of nominal (UNCERTAIN)
+    # What the file says that is legal but probably not meant (each names the field); the CLI
+    # prints them as "warning:" lines.
+    warnings: Tuple[str, ...] = ()
+
+    def feature_angle(self, pusher: str) -> float:
+        """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
+        feature: environment.features gives it, else the start's (the executor places the
+        features so; stablepush.execution.world.place_features)."""
+        pose = self.environment.get("features", {}).get(pusher)
+        return float(pose[3]) if pose is not None else float(self.start[2])
+
+    def at_goal(self, pose) -> bool:
+        """Whether `pose` (x mm, z mm, theta deg) lies within planner.tolerance of the goal, in each
+        coordinate."""
+        tol = self.planner["tolerance"]
+        return all(abs(a - b) <= t for a, b, t in zip(pose, self.goal, (tol[0], tol[0], tol[1])))
+
+    @property
+    def pusher_names(self) -> List[str]:
+        return [p.name for p in self.pushers]
+
+    def pusher_index(self, name: str) -> int:
+        try:
+            return self.pusher_names.index(name)
+        except ValueError:
+            raise TaskError("pusher", f"no pusher named {name!r} (the task has {', '.join(self.pusher_names)})")
+
+    def section(self) -> "_core.CrossSection":
+        return _core.CrossSection([mm2_to_si(v) for v in self.vertices])
+
+    def rigid_body(self, section: "Optional[_core.CrossSection]" = None) -> "_core.RigidBody":
+        """The object's mass [kg], com [m, in O] and moment of inertia about y at the com [kg m^2]."""
+        uniform = _core.RigidBody.uniform(section or self.section(), self.mass * G)
+        com = mm2_to_si(self.com) if self.com is not None else tuple(uniform.com)
+        if self.inertia is not None:
+            inertia = self.inertia
+        else:  # the uniform body's inertia about the given com (parallel axes)
+            offset2 = (com[0] - uniform.com[0]) ** 2 + (com[1] - uniform.com[1]) ** 2
+            inertia = uniform.inertia + self.mass * G * offset2
+        return _core.RigidBody(self.mass * G, com, inertia)
+
+    def corner_models(self) -> List["_core.StablePushModel"]:
+        """The models every push must be stable in (docs/model.md section 7): the nominal model
+        alone, or with `uncertainty`, the 4 corners of (pad mu x grip force, mass) at the smallest
+        pusher mu. The required pusher wrench is affine in mu N and in m, the sticking polygons
+        scale with mu N and a pusher's cone shrinks with its mu, so a push stable at these corners
+        is stable for every value in the box (a convex combination of the corners' witnesses is a
+        witness). mu and N enter only as their product, so the corners scale mu alone."""
+        u = self.uncertainty
+        if not any(u.values()):
+            return [self.build_model()]
+        low_pushers = tuple(dataclasses.replace(p, mu=p.mu * (1.0 - u.get("pusher_mu", 0.0))) for p in self.pushers)
+        friction = [(1.0 - u.get("pad_mu", 0.0)) * (1.0 - u.get("grip_force", 0.0)),
+                    (1.0 + u.get("pad_mu", 0.0)) * (1.0 + u.get("grip_force", 0.0))]
+        masses = [1.0 - u.get("mass", 0.0), 1.0 + u.get("mass", 0.0)]
+        return [dataclasses.replace(self, mu=self.mu * f, mass=self.mass * m, pushers=low_pushers,
+                                    inertia=None if self.inertia is None else self.inertia * m,
+                                    uncertainty={}).build_model()
+                for f in friction for m in masses]
+
+    def build_model(self) -> "_core.StablePushModel":
+        """The core's stable-push model of this task, in SI units."""
+        section = self.section()
+        body = self.rigid_body(section)
+        gripper = make_gripper(self.pads, self.grip_force, self.mu, self.pad_rings)
+        pushers = [
+            _core.Pusher.on_boundary(section, p.name, mm2_to_si(p.a), mm2_to_si(p.b), p.mu, p.points)
+            for p in self.pushers
+        ]
+        fixed = self.pushes == "against_fixed_features"
+        return _core.StablePushModel(
+            section, body, gripper, pushers, self.gravity, self.step_time, self.friction_polygon_sides,
+            _core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
+            [math.radians(self.feature_angle(p.name)) for p in self.pushers],
+        )
+
+
+def make_gripper(pads, grip_force: float, mu: float, pad_rings: int) -> "_core.Gripper":
+    return _core.Gripper([_core.Pad(mm2_to_si(c), r * MM) for c, r in pads], grip_force, mu, pad_rings)

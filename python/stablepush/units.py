@@ -1,0 +1,26 @@
+"""File units and SI: task and plan files use mm, degrees and grams; the core is SI (m, rad, kg).
+
+A pose in the grasp plane is q = (x, z, theta): mm, mm, deg in files, m, m, rad in the core.
+"""
+from __future__ import annotations
+
+import math
+from typing import Sequence, Tuple
+
+MM = 1e-3  # m per mm
+G = 1e-3  # kg per g
+
+
+def pose_to_si(q: Sequence[float]) -> Tuple[float, float, float]:
+    """(x mm, z mm, theta deg) -> (x m, z m, theta rad)."""
+    return (q[0] * MM, q[1] * MM, math.radians(q[2]))
+
+
+def pose_from_si(q: Sequence[float]) -> Tuple[float, float, float]:
+    """(x m, z m, theta rad) -> (x mm, z mm, theta deg)."""
+    return (q[0] / MM, q[1] / MM, math.degrees(q[2]))
+
+
+def mm2_to_si(p: Sequence[float]) -> Tuple[float, float]:
+    """A point (mm, mm) -> (m, m)."""
+    return (p[0] * MM, p[1] * MM)
