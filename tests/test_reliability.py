@@ -128,13 +128,16 @@ def test_the_core_refuses_what_python_would_never_pass_instead_of_trapping():
 def test_planner_parameters_are_refused_out_of_their_declared_range():
     task = shipped("horizontal-offset-high-mu")
     model = task.build_model()
-    args = (model, pose_to_si(task.start), pose_to_si(task.goal), (1e-3, 0.0175), (1e-3, 0.0175), 1.0, 1e-3, 5.0)
+    def settings(time_limit=1.0, **parameters):
+        return _core.PlannerSettings(start=pose_to_si(task.start), goal=pose_to_si(task.goal), step=(1e-3, 0.0175),
+                                     tolerance=(1e-3, 0.0175), time_limit=time_limit, parameters=parameters)
+
     for name, value in (("max_switches", "4294967296"), ("max_switches", "2147483648"), ("seed", "4294967296"),
                         ("seed", "-1"), ("goal_bias", "1.5"), ("rewire_radius", "nan")):
         with pytest.raises(ValueError, match=f"planner parameter '{name}'"):
-            _core.plan(*args, {name: value})
+            _core.plan([model], settings(**{name: value}))
     with pytest.raises(ValueError, match="time_limit must be > 0 and at most 1e6 s"):
-        _core.plan(model, *args[1:5], 9.3e9, *args[6:], {})
+        _core.plan([model], settings(time_limit=9.3e9))
     ranges = _core.TRRT_STAR_PARAMETER_RANGES
     assert ranges["seed"] == ("integer", 0.0, 4294967295.0) and ranges["max_switches"][2] == 100.0
 

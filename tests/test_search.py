@@ -48,20 +48,26 @@ class ConeChecker(_core.PushChecker):
         return self.alignment(a, b, pusher) - self.COS[pusher]
 
 
+def path_of(out):
+    """The path of a CheckedPlan as ((x, z, theta), pusher) pairs, start first."""
+    return [(tuple(node.pose), node.pusher) for node in out.path]
+
+
 def plan(checker, goal, time_limit=5.0, **parameters):
-    return _core.plan_with_checker(checker, (0.0, 0.0, 0.0), goal, STEP, (0.5 * MM, 0.5 * DEG), time_limit,
-                                   parameters={k: str(v) for k, v in parameters.items()})
+    settings = _core.PlannerSettings(start=(0.0, 0.0, 0.0), goal=goal, step=STEP, tolerance=(0.5 * MM, 0.5 * DEG),
+                                     time_limit=time_limit, parameters={k: str(v) for k, v in parameters.items()})
+    return _core.plan_with_checker(checker, settings)
 
 
 def test_a_goal_that_needs_both_toy_pushers_takes_one_switch_over_and_every_edge_obeys_the_toy():
     checker = ConeChecker()
     out = plan(checker, (6 * MM, 6 * MM, 0.0), max_switches=1, seed=3)
-    assert out["outcome"] == _core.PlanOutcome.goal_reached
-    path = out["path"]
+    assert out.outcome == _core.PlanOutcome.goal_reached
+    path = path_of(out)
     assert path[0] == ((0.0, 0.0, 0.0), -1)
     pushers = [p for _, p in path[1:]]
     switches = sum(1 for p, q in zip(pushers, pushers[1:]) if p != q)
-    assert switches == out["switches"] == 1 and set(pushers) == {0, 1}
+    assert switches == out.cost.switches == 1 and set(pushers) == {0, 1}
     for (a, _), (b, pusher) in zip(path, path[1:]):
         assert ConeChecker().alignment(a, b, pusher) >= ConeChecker.COS[pusher]  # the rule the search was given
     end = path[-1][0]
@@ -72,16 +78,16 @@ def test_a_goal_that_needs_both_toy_pushers_takes_one_switch_over_and_every_edge
 
 def test_with_no_switch_over_allowed_the_toy_goal_is_out_of_reach():
     out = plan(ConeChecker(), (6 * MM, 6 * MM, 0.0), time_limit=1.0, max_switches=0, seed=3)
-    assert out["outcome"] in (_core.PlanOutcome.goal_over_switch_limit, _core.PlanOutcome.time_limit)
-    assert out["outcome"] != _core.PlanOutcome.goal_reached
+    assert out.outcome in (_core.PlanOutcome.goal_over_switch_limit, _core.PlanOutcome.time_limit)
+    assert out.outcome != _core.PlanOutcome.goal_reached
 
 
 def test_a_goal_along_one_toy_pusher_takes_no_switch_over_and_the_same_seed_the_same_path():
     first = plan(ConeChecker(), (8 * MM, 1 * MM, 0.0), seed=5)
     again = plan(ConeChecker(), (8 * MM, 1 * MM, 0.0), seed=5)
-    assert first["outcome"] == _core.PlanOutcome.goal_reached and first["switches"] == 0
-    assert {p for _, p in first["path"][1:]} == {0}
-    assert first["path"] == again["path"]
+    assert first.outcome == _core.PlanOutcome.goal_reached and first.cost.switches == 0
+    assert {p for _, p in path_of(first)[1:]} == {0}
+    assert path_of(first) == path_of(again)
 
 
 def test_a_descent_asks_for_its_own_pusher_first_and_for_no_other_while_it_works():
@@ -89,7 +95,7 @@ def test_a_descent_asks_for_its_own_pusher_first_and_for_no_other_while_it_works
     where no pusher is the descent's own yet, ask for both."""
     checker = ConeChecker()
     out = plan(checker, (12 * MM, 0.0, 0.0), goal_bias=1.0, seed=2)
-    assert out["outcome"] == _core.PlanOutcome.goal_reached and {p for _, p in out["path"][1:]} == {0}
+    assert out.outcome == _core.PlanOutcome.goal_reached and {p for _, p in path_of(out)[1:]} == {0}
     assert checker.asked.count(0b01) >= 11  # each push after the first asks for pusher 0 alone
     assert 0b10 not in checker.asked and checker.asked.count(0b11) <= 3
 
@@ -111,13 +117,13 @@ def test_a_pusher_that_can_only_push_across_the_way_to_the_goal_gets_a_run_acros
     for seed in range(1, 6):
         checker = LiftDragChecker()
         out = plan(checker, (20 * MM, 0.0, 0.0), max_switches=1, seed=seed)
-        assert out["outcome"] == _core.PlanOutcome.goal_reached
-        (start, _), (first, pusher) = out["path"][:2]
+        assert out.outcome == _core.PlanOutcome.goal_reached
+        (start, _), (first, pusher) = path_of(out)[:2]
         d = unit(start, first)
         turned = math.degrees(math.acos(d[0] / math.sqrt(sum(c * c for c in d))))
         assert pusher == 0 and 45.0 < turned <= 90.0
         assert checker.calls < 1000
-        for (a, _), (b, p) in zip(out["path"], out["path"][1:]):
+        for (a, _), (b, p) in zip(path_of(out), path_of(out)[1:]):
             assert checker.alignment(a, b, p) >= checker.COS[p]
 
 
@@ -151,7 +157,7 @@ def test_descents_near_the_goal_stop_short_of_pushes_too_short_to_model():
     SHORTEST_PUSH unit steps of the goal is at it."""
     checker = AskewChecker()
     out = plan(checker, AskewChecker.GOAL, time_limit=2.0, improve_for=0.2, seed=1)
-    assert out["outcome"] == _core.PlanOutcome.goal_reached
+    assert out.outcome == _core.PlanOutcome.goal_reached
     assert checker.shortest >= _core.SHORTEST_PUSH
 
 

@@ -1,5 +1,6 @@
 // Bindings of types.hpp: Pose and Motion as value classes that a Python 3-sequence converts to,
 // and iterate as (x, z, theta) / (dx, dz, dtheta) so that `tuple(pose)` and `pose[0]` work.
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <array>
@@ -28,7 +29,13 @@ void bind_triple(py::module_& m, const char* name, const char* doc, const char* 
       .def_readwrite(b, pb)
       .def_readwrite(c, pc)
       .def("__len__", [](const T&) { return 3; })
-      .def("__getitem__", [as_tuple](const T& v, py::ssize_t i) { return as_tuple(v)[py::int_(i)]; })
+      .def("__getitem__",
+           [as_tuple](const T& v, py::ssize_t i) -> py::object {
+             if (i < 0) i += 3;
+             if (i < 0 || i >= 3) throw py::index_error("index out of range (3 coordinates)");
+             const py::tuple values = as_tuple(v);
+             return values[static_cast<std::size_t>(i)];
+           })
       .def("__iter__", [as_tuple](const T& v) { return py::iter(as_tuple(v)); })
       .def("__eq__",
            [as_tuple](const T& v, const py::object& other) {
@@ -43,6 +50,7 @@ void bind_triple(py::module_& m, const char* name, const char* doc, const char* 
       });
   py::implicitly_convertible<py::tuple, T>();
   py::implicitly_convertible<py::list, T>();
+  py::implicitly_convertible<py::array, T>();
 }
 
 }  // namespace

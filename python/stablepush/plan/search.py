@@ -56,26 +56,27 @@ def plan_task(
         settings["improve_for"] = planner_parameter("improve_for", "improve_for", improve_for)
     models = models or task.corner_models()
     model = models[0]
-    step = (settings["step"][0] * MM, math.radians(settings["step"][1]))
-    tolerance = (settings["tolerance"][0] * MM, math.radians(settings["tolerance"][1]))
     parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}
     parameters.update({key: repr(settings[key]) for key in PLANNER_TUNING if key in settings})
-    raw = _core.plan(
-        models, pose_to_si(task.start), pose_to_si(task.goal), step, tolerance, float(settings["time_limit"]),
-        float(settings["min_margin"]), float(settings["sampling_margin"]), parameters,
-        float(settings["min_hold_ratio"]),
-    )
+    raw = _core.plan(models, _core.PlannerSettings(
+        start=pose_to_si(task.start), goal=pose_to_si(task.goal),
+        step=(settings["step"][0] * MM, math.radians(settings["step"][1])),
+        tolerance=(settings["tolerance"][0] * MM, math.radians(settings["tolerance"][1])),
+        time_limit=float(settings["time_limit"]), min_margin=float(settings["min_margin"]),
+        sampling_margin=float(settings["sampling_margin"]), min_hold_ratio=float(settings["min_hold_ratio"]),
+        parameters=parameters))
 
     names = task.pusher_names
     waypoints: List[Waypoint] = []
-    for k, (q, p, margin, case) in enumerate(zip(raw.poses, raw.pushers, raw.margins, raw.contact_cases)):
-        pose = tuple(float(v) for v in pose_from_si(q))
-        if p < 0:
+    for k, w in enumerate(raw.waypoints):
+        pose = tuple(float(v) for v in pose_from_si(w.pose))
+        if w.pusher < 0:
             waypoints.append(Waypoint(*pose))
         else:
-            waypoints.append(Waypoint(*pose, pusher=names[p], margin=float(margin), case=case.name,
-                                      contact=contact_in_gripper(task, model, p, pose),
-                                      margin_per_normal=_margin_per_normal(models, raw.poses[k - 1], q, p)))
+            waypoints.append(Waypoint(*pose, pusher=names[w.pusher], margin=float(w.margin), case=w.contact_case.name,
+                                      contact=contact_in_gripper(task, model, w.pusher, pose),
+                                      margin_per_normal=_margin_per_normal(models, raw.waypoints[k - 1].pose, w.pose,
+                                                                           w.pusher)))
 
     outcome = raw.outcome.name
     s = raw.stats
@@ -120,7 +121,7 @@ def plan_task(
 def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:
     """The push's margin over the pusher's normal force (both at the least stable corner): how
     deep inside the cone the push is, relative to how hard the pusher presses."""
-    r = _core.worst_case(models, tuple(q0), tuple(b - a for a, b in zip(q0, q1)), pusher)
+    r = _core.worst_case(models, q0, tuple(b - a for a, b in zip(q0, q1)), pusher)
     n = models[0].pushers[pusher].inward_normal
     normal_force = r.witness[0] * n[0] + r.witness[1] * n[1]
     return float(r.margin / normal_force) if normal_force > 0 else None
