@@ -153,7 +153,8 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
         click.echo(f"partial plan written to {json_path}", err=True)
         sys.exit(EXIT_NOT_SOLVED)
     if not quiet:
-        click.echo(f"{task.name}: solved in {s['planning_time_s'] * 1e3:.1f} ms (seed {s['seed']}): {s['pushes']} pushes, "
+        click.echo(f"{task.name}: solved in {s['planning_time_s'] * 1e3:.1f} ms (seed {s['seed']}): "
+                   f"{s['pushes']} pushes, "
                    f"{s['switches']} switch-over(s), pushers {' -> '.join(result.pusher_sequence) or '(none)'}; "
                    f"{s['iterations']} iterations, {s['nodes']} nodes, {s['feasibility_checks']} checks")
         click.echo("ends at the goal pose" if result.ends_at_goal else
@@ -230,10 +231,12 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     def num(v, fmt):
         return "-" if v is None else format(v, fmt)
 
-    click.echo(f"{'task':<26} {'success':>7} {'median ms':>10} {'p95 ms':>8} {'min ms':>8} {'max ms':>9} {'switches':>8} "
+    click.echo(f"{'task':<26} {'success':>7} {'median ms':>10} {'p95 ms':>8} {'min ms':>8} {'max ms':>9} "
+               f"{'switches':>8} "
                f"{'length':>7} {'checks/s':>10} {'paper s':>8} {'earlier s':>9}")
     for r in rows:
-        click.echo(f"{r['task']:<26} {r['success_rate']:>7.0%} {r['median_time_s'] * 1e3:>10.2f} {r['p95_time_s'] * 1e3:>8.2f} "
+        click.echo(f"{r['task']:<26} {r['success_rate']:>7.0%} {r['median_time_s'] * 1e3:>10.2f} "
+                   f"{r['p95_time_s'] * 1e3:>8.2f} "
                    f"{r['min_time_s'] * 1e3:>8.2f} {r['max_time_s'] * 1e3:>9.2f} {num(r['median_switches'], '.0f'):>8} "
                    f"{num(r['median_path_length_steps'], '.1f'):>7} {r['checks_per_s']:>10.3g} "
                    f"{num(r['paper_time_s'], 'g'):>8} {num(r['earlier_planner_time_s'], 'g'):>9}")
@@ -474,7 +477,8 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
         from stablepush.sim.arm import WorldDeviation
         from stablepush.sim.server import running_sim_arm
 
-        deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1])
+        deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0],
+                                   tracker_noise_deg=tracker_noise[1])
         server = sim_arm.enter_context(running_sim_arm(log=(lambda text: None) if quiet else None, deviation=deviation))
         host, port = server.host, server.port
     else:
@@ -539,7 +543,8 @@ def _print_report(report) -> None:
     for r in report.replans:
         dx, dz, dth = (m - p for m, p in zip(r.measured, r.planned))
         if r.solved:
-            outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{' (same pusher)' if r.kept_pusher else ''}"
+            same = " (same pusher)" if r.kept_pusher else ""
+            outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{same}"
         else:
             outcome = "no correction found (in time, with held transits); kept the plan"
         click.echo(f"  after step {r.after_step}: off the plan by {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; "
@@ -550,7 +555,8 @@ def _print_report(report) -> None:
                        f"{c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
     change = report.release_change
     if report.release_moved:
-        click.echo(f"note: when the last feature let go the object moved in the grasp by {math.hypot(change['x'], change['z']):.2f} mm, "
+        click.echo(f"note: when the last feature let go the object moved in the grasp by "
+                   f"{math.hypot(change['x'], change['z']):.2f} mm, "
                    f"{change['theta']:+.2f} deg: the grasp alone does not hold the final pose against gravity")
 
 

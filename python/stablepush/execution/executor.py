@@ -197,7 +197,8 @@ def execute_plan(
             if pace:
                 next_time += 1.0 / rate_hz
                 time.sleep(max(0.0, next_time - time.perf_counter()))
-            link.send({"type": "waypoint", "seq": w.seq, "t": w.t, "step": w.step, "phase": w.phase, "pose": list(w.pose)})
+            link.send({"type": "waypoint", "seq": w.seq, "t": w.t, "step": w.step, "phase": w.phase,
+                       "pose": list(w.pose)})
             reply = _expect(link.receive(), "ack")
             if reply["seq"] != w.seq:
                 raise ProtocolError(f"out-of-order acknowledgement: expected seq {w.seq}, got {reply['seq']}")

@@ -101,7 +101,8 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
         if abs(math.sqrt(sum(v * v for v in message["pose"][3:])) - 1.0) > 1e-6:
             raise ProtocolError("waypoint: the quaternion in 'pose' is not of unit length")
     if kind == "hello" and not RATE_HZ[0] <= message["rate_hz"] <= RATE_HZ[1]:
-        raise ProtocolError(f"hello: rate_hz must be between {RATE_HZ[0]:g} and {RATE_HZ[1]:g}, got {message['rate_hz']}")
+        raise ProtocolError(f"hello: rate_hz must be between {RATE_HZ[0]:g} and {RATE_HZ[1]:g}, "
+                            f"got {message['rate_hz']}")
     if "state" in fields[kind]:
         _check_state(message["state"], kind)
     if kind in ("hello", "ready") and message["protocol"] not in SUPPORTED_PROTOCOLS:
@@ -118,7 +119,8 @@ def _check_state(state: dict, kind: str) -> None:
     """A server's `state`: ee_pose 7 finite numbers; object_in_grasp, when given, finite x, z, theta."""
     _check_pose(state.get("ee_pose"), f"{kind}: state.ee_pose")
     tracked = state.get("object_in_grasp")
-    if tracked is not None and not (isinstance(tracked, dict) and all(is_finite_number(tracked.get(k)) for k in ("x", "z", "theta"))):
+    well_formed = isinstance(tracked, dict) and all(is_finite_number(tracked.get(k)) for k in ("x", "z", "theta"))
+    if tracked is not None and not well_formed:
         raise ProtocolError(f"{kind}: state.object_in_grasp must hold finite numbers x, z, theta")
     if "object_pose" in state:
         _check_pose(state["object_pose"], f"{kind}: state.object_pose")

@@ -17,7 +17,7 @@ from stablepush import _core
 from stablepush.frames import grasp_transform, matrix_to_pose, rot_y, translation
 from stablepush.plan.plan import Waypoint
 from stablepush.task.model import Task
-from stablepush.units import MM
+from stablepush.units import MM, mm2_to_si
 
 
 @dataclass(frozen=True)
@@ -94,7 +94,7 @@ def place_features(task: Task, steps: Sequence[Waypoint], every_pusher: bool = F
             T_WO = T_WG @ grasp_transform(q_first)
         index = task.pusher_index(name)
         spec = task.pushers[index]
-        pusher = _core.Pusher.on_boundary(section, name, (spec.a[0] * MM, spec.a[1] * MM), (spec.b[0] * MM, spec.b[1] * MM),
+        pusher = _core.Pusher.on_boundary(section, name, mm2_to_si(spec.a), mm2_to_si(spec.b),
                                           spec.mu, spec.points)  # the pusher alone: its cone is not needed here
         n_O = np.array(pusher.inward_normal, float)
         to_w = lambda p: (T_WO @ np.array([p[0] * MM, 0.0, p[1] * MM, 1.0]))[:3]  # noqa: E731

@@ -46,7 +46,8 @@ def _queries(task: Task, rng: np.random.Generator, n: int, sticking: bool):
         arm = pad[None, :] - q[:, :2]
         dq = np.column_stack([-w * arm[:, 1], w * arm[:, 0], w])
     else:
-        dq = np.column_stack([rng.uniform(-1, 1, n) * MM, rng.uniform(-1, 1, n) * MM, np.radians(rng.uniform(-1, 1, n))])
+        dq = np.column_stack([rng.uniform(-1, 1, n) * MM, rng.uniform(-1, 1, n) * MM,
+                              np.radians(rng.uniform(-1, 1, n))])
     return q, dq
 
 

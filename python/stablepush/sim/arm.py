@@ -74,9 +74,11 @@ class SimulatedGrasp:
         self.pad_friction = CoulombPadFriction(m, scene_mod.pad_geoms(m))
         self.steps = 0
         self.step_wall_time = 0.0
-        self.data.qpos[[m.jnt_qposadr[m.joint(j).id] for j in scene_mod.FINGER_JOINTS]] = scene["object"]["thickness"] / 2
+        fingers = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.FINGER_JOINTS]
+        self.data.qpos[fingers] = scene["object"]["thickness"] / 2
         self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene["object_pose"]
-        self.data.ctrl[[m.actuator(j).id for j in scene_mod.FINGER_JOINTS]] = 0.0  # close: the servos saturate at the grip force
+        # close: the servos saturate at the grip force
+        self.data.ctrl[[m.actuator(j).id for j in scene_mod.FINGER_JOINTS]] = 0.0
         # the subclass sets its own drives, then calls mj_forward once
 
     def _run(self, n: int, before_step: Callable[[int], None]) -> None:
@@ -182,7 +184,8 @@ class SimArm(SimulatedGrasp):
             dq += null_space @ (POSTURE_GAIN * (self.home_posture - q))
             q = np.clip(q + dq, lo, hi)
         if strict and error > 1e-6:
-            raise ValueError(f"the arm cannot reach the pose {[round(float(v), 4) for v in pose]} (IK error {error:.2e})")
+            shown = [round(float(v), 4) for v in pose]
+            raise ValueError(f"the arm cannot reach the pose {shown} (IK error {error:.2e})")
         self.ik_error = error
         return q
 

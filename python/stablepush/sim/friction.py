@@ -19,9 +19,10 @@ opposite of that slip and try again, until they agree within DIRECTION_TOLERANCE
 move is halfway; later ones are Anderson steps (the secant over the last two trials, all points at
 once, `_next_directions`), since all points ride one object and one hand and a plain step
 overshoots. A damped step matters: explicit friction on a slow slip (one 0.25 ms step of 15 N
-changes a hand's speed by mm/s) would otherwise flip its direction every step and chatter. A sliding point whose trial slip
-turns against its friction or falls under STICK_SPEED sticks instead. In a steady slide the last
-step's direction passes at once, so sliding costs one trial step per step.
+changes a hand's speed by mm/s) would otherwise flip its direction every step and chatter. A
+sliding point whose trial slip turns against its friction or falls under STICK_SPEED sticks
+instead. In a steady slide the last step's direction passes at once, so sliding costs one trial
+step per step.
 
 Which points may slide is decided from their own slip, measured by the simulator from its own
 state (never told by the plan): a point that has slipped faster than SLIDE_SPEED for SLIDE_STEPS
@@ -129,7 +130,8 @@ class CoulombPadFriction:
         slipping at its end); their friction direction starts from the solver's."""
         s = self._scratch
         mu = self._point_mu[solver.slots]
-        on_cone = np.hypot(s.efc_force[solver.rows + 1], s.efc_force[solver.rows + 2]) >= ON_CONE * mu * s.efc_force[solver.rows]
+        tangential = np.hypot(s.efc_force[solver.rows + 1], s.efc_force[solver.rows + 2])
+        on_cone = tangential >= ON_CONE * mu * s.efc_force[solver.rows]
         slip = np.linalg.norm(solver.tangential(solver.end_velocity()), axis=1)
         slides = on_cone & (slip >= STICK_SPEED)
         sliding = new & (solver.count(~slides) == 0) & solver.touched

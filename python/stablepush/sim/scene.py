@@ -91,12 +91,12 @@ def convex_pieces(polygon: Sequence[Sequence[float]]) -> List[List[Tuple[float, 
     triangles = []
     while len(index) > 3:
         for k in range(len(index)):
-            i, j, l = index[k - 1], index[k], index[(k + 1) % len(index)]
-            if _cross(pts[i], pts[j], pts[l]) <= 0:
+            i, j, after = index[k - 1], index[k], index[(k + 1) % len(index)]
+            if _cross(pts[i], pts[j], pts[after]) <= 0:
                 continue
-            if any(_in_triangle(pts[m], pts[i], pts[j], pts[l]) for m in index if m not in (i, j, l)):
+            if any(_in_triangle(pts[m], pts[i], pts[j], pts[after]) for m in index if m not in (i, j, after)):
                 continue
-            triangles.append([i, j, l])
+            triangles.append([i, j, after])
             index.pop(k)
             break
         else:

@@ -407,7 +407,8 @@ def _validate_object(obj: Any, source: Optional[str]):
         if "size" not in obj:
             raise TaskError("object.size", "missing (a box needs [L along x, B along y, H along z] in mm)")
         length, thickness, height = _vector("object.size", obj["size"], 3, LIMITS["length"])
-        vertices = ((-length / 2, -height / 2), (length / 2, -height / 2), (length / 2, height / 2), (-length / 2, height / 2))
+        x, z = length / 2, height / 2
+        vertices = ((-x, -z), (x, -z), (x, z), (-x, z))
     elif shape == "polygon":
         if "size" in obj:
             raise TaskError("object.size", "only for shape: box (a polygon takes polygon and thickness)")
@@ -520,7 +521,8 @@ def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Dict[str, 
     out["features"] = {}
     for name, pose in features.items():
         if name not in pusher_names:
-            raise TaskError(f"environment.features.{name}", f"no pusher named {name!r} (the task has {', '.join(pusher_names)})")
+            raise TaskError(f"environment.features.{name}",
+                            f"no pusher named {name!r} (the task has {', '.join(pusher_names)})")
         _vector(f"environment.features.{name}", pose, 4)
         out["features"][name] = [_number(f"environment.features.{name}[{i}]", v, COORDINATE if i < 3 else ANGLE)
                                  for i, v in enumerate(pose)]

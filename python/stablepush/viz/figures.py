@@ -183,9 +183,11 @@ def cone_figure(task: Task, pusher: str):
     ring = _cone_ring(gens)
     if len(ring) >= 3:
         faces = [[np.zeros(3), ring[i], ring[(i + 1) % len(ring)]] for i in range(len(ring))]
-        ax.add_collection3d(Poly3DCollection(faces, facecolor=_colour(task, pusher), alpha=0.25, edgecolor="0.4", lw=0.5))
+        ax.add_collection3d(Poly3DCollection(faces, facecolor=_colour(task, pusher), alpha=0.25, edgecolor="0.4",
+                                             lw=0.5))
     elif len(ring) == 2:
-        ax.add_collection3d(Poly3DCollection([[np.zeros(3), ring[0], ring[1]]], facecolor=_colour(task, pusher), alpha=0.3))
+        ax.add_collection3d(Poly3DCollection([[np.zeros(3), ring[0], ring[1]]], facecolor=_colour(task, pusher),
+                                             alpha=0.3))
     ax.set_xlabel("f_x (N)")
     ax.set_ylabel("f_z (N)")
     ax.set_zlabel(f"tau_y / l (N), l = {length * 1e3:.1f} mm")
@@ -205,7 +207,8 @@ def _cone_ring(gens: np.ndarray) -> List[np.ndarray]:
     u = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
     u /= np.linalg.norm(u)
     v = np.cross(axis, u)
-    pts = [(float(np.dot(g, u) / np.dot(g, axis)), float(np.dot(g, v) / np.dot(g, axis)), i) for i, g in enumerate(gens)]
+    pts = [(float(np.dot(g, u) / np.dot(g, axis)), float(np.dot(g, v) / np.dot(g, axis)), i)
+           for i, g in enumerate(gens)]
     pts.sort()
     def half(points):
         out = []
