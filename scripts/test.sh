@@ -16,7 +16,7 @@ if [ -f cpp/tests/CMakeLists.txt ]; then
   echo "test: clang-format" >&2
   find cpp -name '*.hpp' -o -name '*.cpp' | xargs clang-format --dry-run --Werror
   echo "test: C++ unit tests (ctest)" >&2
-  cmake -S . -B build/tests -DSTABLEPUSH_TESTS=ON -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake -S . -B build/tests -DSTABLEPUSH_TESTS=ON -DSTABLEPUSH_PYTHON=OFF -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build build/tests -j2 >/dev/null
   ctest --test-dir build/tests --output-on-failure
 fi

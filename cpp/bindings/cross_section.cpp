@@ -1,9 +1,10 @@
 // Bindings of cross_section.hpp.
+#include "stablepush/cross_section.hpp"
+
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "stablepush/cross_section.hpp"
 
 namespace py = pybind11;
 

@@ -1,9 +1,10 @@
 // Bindings of friction_cone.hpp.
+#include "stablepush/friction_cone.hpp"
+
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "stablepush/friction_cone.hpp"
 
 namespace py = pybind11;
 

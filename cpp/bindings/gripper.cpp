@@ -1,9 +1,10 @@
 // Bindings of gripper.hpp.
+#include "stablepush/gripper.hpp"
+
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "stablepush/gripper.hpp"
 
 namespace py = pybind11;
 
@@ -11,8 +12,10 @@ namespace stablepush::python {
 
 void expose_gripper(py::module_& m) {
   py::class_<Pad>(m, "Pad", "A finger pad: a disc in G (centre [m], radius [m]).")
-      .def(py::init([](const Vec2& center, double radius) { return Pad{center, radius}; }), py::arg("center"),
-           py::arg("radius"))
+      .def(py::init([](const Vec2& center, double radius) {
+             return Pad{center, radius};
+           }),
+           py::arg("center"), py::arg("radius"))
       .def_readonly("center", &Pad::center)
       .def_readonly("radius", &Pad::radius);
 

@@ -3,8 +3,9 @@
 #include "bindings.hpp"
 
 PYBIND11_MODULE(_core, m) {
-  m.doc() = "stablepush C++ core: contact models, generalized friction cones, the stable-push test and the "
-            "T-RRT* planner (SI units: m, rad, kg, N, s)";
+  m.doc() =
+      "stablepush C++ core: contact models, generalized friction cones, the stable-push test and the "
+      "T-RRT* planner (SI units: m, rad, kg, N, s)";
   using namespace stablepush::python;
   expose_types(m);
   expose_cross_section(m);

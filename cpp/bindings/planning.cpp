@@ -1,5 +1,7 @@
 // Bindings of planning.hpp: PlannerSettings in, Plan out (SI units), and the search run with a
 // PushChecker written in Python (the toy checkers of the search's tests).
+#include "stablepush/planning.hpp"
+
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -8,7 +10,6 @@
 
 #include "bindings.hpp"
 #include "stablepush/grasp_space.hpp"
-#include "stablepush/planning.hpp"
 
 namespace py = pybind11;
 
@@ -55,9 +56,9 @@ void expose_planning(py::module_& m) {
       .def(py::init([](const Pose& start, const Pose& goal, const StepSize& step, const StepSize& tolerance,
                        double time_limit, double min_margin, double sampling_margin, double min_hold_ratio,
                        std::map<std::string, std::string> parameters) {
-             return PlannerSettings{start,      goal,           step,           tolerance,
-                                    time_limit, min_margin,     sampling_margin, min_hold_ratio,
-                                    std::move(parameters)};
+             return PlannerSettings{start,           goal,           step,
+                                    tolerance,       time_limit,     min_margin,
+                                    sampling_margin, min_hold_ratio, std::move(parameters)};
            }),
            py::kw_only(), py::arg("start"), py::arg("goal"), py::arg("step"), py::arg("tolerance"),
            py::arg("time_limit") = 10.0, py::arg("min_margin") = 1e-3, py::arg("sampling_margin") = 5.0,

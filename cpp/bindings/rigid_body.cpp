@@ -1,8 +1,9 @@
 // Bindings of rigid_body.hpp.
+#include "stablepush/rigid_body.hpp"
+
 #include <pybind11/eigen.h>
 
 #include "bindings.hpp"
-#include "stablepush/rigid_body.hpp"
 
 namespace py = pybind11;
 
@@ -10,7 +11,9 @@ namespace stablepush::python {
 
 void expose_rigid_body(py::module_& m) {
   py::class_<RigidBody>(m, "RigidBody", "Mass [kg], centre of mass in O [m], inertia about it [kg m^2].")
-      .def(py::init([](double mass, const Vec2& com, double inertia) { return RigidBody{mass, com, inertia}; }),
+      .def(py::init([](double mass, const Vec2& com, double inertia) {
+             return RigidBody{mass, com, inertia};
+           }),
            py::arg("mass"), py::arg("com"), py::arg("inertia"))
       .def_static("uniform", &RigidBody::uniform, py::arg("section"), py::arg("mass"))
       .def_readonly("mass", &RigidBody::mass)

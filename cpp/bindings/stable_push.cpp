@@ -1,11 +1,12 @@
 // Bindings of stable_push.hpp: the model and its test (paper section IV), in SI units. Poses and
 // motions are Pose and Motion (a Python 3-sequence converts to either).
+#include "stablepush/stable_push.hpp"
+
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "stablepush/stable_push.hpp"
 
 namespace py = pybind11;
 
@@ -27,8 +28,8 @@ void expose_stable_push(py::module_& m) {
       .def_readonly("exact", &PushResult::exact, "Decided in exact arithmetic")
       .def_readonly("sticking_points", &PushResult::sticking_points)
       .def("__repr__", [](const PushResult& r) {
-        return std::string("<PushResult feasible=") + (r.feasible ? "True" : "False") + " case=" +
-               (r.contact_case == ContactCase::Sticking ? "sticking" : "all_sliding") +
+        return std::string("<PushResult feasible=") + (r.feasible ? "True" : "False") +
+               " case=" + (r.contact_case == ContactCase::Sticking ? "sticking" : "all_sliding") +
                " margin=" + std::to_string(r.margin) + ">";
       });
 
@@ -62,19 +63,17 @@ void expose_stable_push(py::module_& m) {
           "gravity_in_gripper",
           [](const StablePushModel& m, const Pose& q, int pusher) { return m.gravity_in_gripper(q, pusher); },
           py::arg("q"), py::arg("pusher"),
-           "gravity in G [m/s^2] at q during a push by `pusher` (-1: G's axes the world's)")
+          "gravity in G [m/s^2] at q during a push by `pusher` (-1: G's axes the world's)")
       .def_property_readonly("section", &StablePushModel::section)
       .def_property_readonly("body", &StablePushModel::body)
       .def_property_readonly("gripper", &StablePushModel::gripper)
       .def_property_readonly("pushers", &StablePushModel::pushers)
       .def_property_readonly("pusher_cones", &StablePushModel::pusher_cones)
       .def_property_readonly("torque_length", &StablePushModel::torque_length)
-      .def("motion_wrench", &StablePushModel::motion_wrench, py::arg("q"), py::arg("dq"),
-           py::arg("pusher") = kNoPusher)
+      .def("motion_wrench", &StablePushModel::motion_wrench, py::arg("q"), py::arg("dq"), py::arg("pusher") = kNoPusher)
       .def(
-          "check", [](const StablePushModel& m, const Pose& q, const Motion& dq, int pusher) {
-            return m.check(q, dq, pusher);
-          },
+          "check",
+          [](const StablePushModel& m, const Pose& q, const Motion& dq, int pusher) { return m.check(q, dq, pusher); },
           py::arg("q"), py::arg("dq"), py::arg("pusher"))
       .def("check_all", &StablePushModel::check_all, py::arg("q"), py::arg("dq"))
       .def("hold_ratio", &StablePushModel::hold_ratio, py::arg("q"), py::arg("pusher") = kNoPusher,

@@ -1,5 +1,7 @@
 // Bindings of types.hpp: Pose and Motion as value classes that a Python 3-sequence converts to,
 // and iterate as (x, z, theta) / (dx, dz, dtheta) so that `tuple(pose)` and `pose[0]` work.
+#include "stablepush/types.hpp"
+
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -8,7 +10,6 @@
 
 #include "bindings.hpp"
 #include "stablepush/grasp_space.hpp"
-#include "stablepush/types.hpp"
 
 namespace py = pybind11;
 
@@ -23,8 +24,14 @@ void bind_triple(py::module_& m, const char* name, const char* doc, const char* 
   auto as_tuple = [pa, pb, pc](const T& v) { return py::make_tuple(v.*pa, v.*pb, v.*pc); };
   py::class_<T>(m, name, doc)
       .def(py::init<>())
-      .def(py::init([](double x, double y, double z) { return T{x, y, z}; }), py::arg(a), py::arg(b), py::arg(c))
-      .def(py::init([](const std::array<double, 3>& v) { return T{v[0], v[1], v[2]}; }), py::arg("values"))
+      .def(py::init([](double x, double y, double z) {
+             return T{x, y, z};
+           }),
+           py::arg(a), py::arg(b), py::arg(c))
+      .def(py::init([](const std::array<double, 3>& v) {
+             return T{v[0], v[1], v[2]};
+           }),
+           py::arg("values"))
       .def_readwrite(a, pa)
       .def_readwrite(b, pb)
       .def_readwrite(c, pc)
@@ -61,9 +68,14 @@ void expose_types(py::module_& m) {
   bind_triple<Motion>(m, "Motion", "A displacement of the object in the grasp: dx [m], dz [m], dtheta [rad], in G.",
                       "dx", "dz", "dtheta", &Motion::dx, &Motion::dz, &Motion::dtheta);
   py::class_<StepSize>(m, "StepSize", "One unit step of the planner: length [m] and angle [rad].")
-      .def(py::init([](double length, double angle) { return StepSize{length, angle}; }), py::arg("length"),
-           py::arg("angle"))
-      .def(py::init([](const std::array<double, 2>& s) { return StepSize{s[0], s[1]}; }), py::arg("values"))
+      .def(py::init([](double length, double angle) {
+             return StepSize{length, angle};
+           }),
+           py::arg("length"), py::arg("angle"))
+      .def(py::init([](const std::array<double, 2>& s) {
+             return StepSize{s[0], s[1]};
+           }),
+           py::arg("values"))
       .def_readwrite("length", &StepSize::length)
       .def_readwrite("angle", &StepSize::angle)
       .def("__iter__", [](const StepSize& s) { return py::iter(py::make_tuple(s.length, s.angle)); });

@@ -104,8 +104,7 @@ CrossSection::CrossSection(std::vector<Vec2> vertices) : vertices_(std::move(ver
     a2 += w;
     cx += (p.x() + q.x()) * w;
     cz += (p.y() + q.y()) * w;
-    j_origin += w * (p.x() * p.x() + p.x() * q.x() + q.x() * q.x() + p.y() * p.y() + p.y() * q.y() +
-                     q.y() * q.y());
+    j_origin += w * (p.x() * p.x() + p.x() * q.x() + q.x() * q.x() + p.y() * p.y() + p.y() * q.y() + q.y() * q.y());
   }
   area_ = 0.5 * a2;
   centroid_ = Vec2(cx / (3.0 * a2), cz / (3.0 * a2));
@@ -194,7 +193,8 @@ bool CrossSection::contains_capsule_exactly(const Vec2& a, const Vec2& b, double
     const Vec2& p = vertices_[i];
     const Vec2& q = vertices_[(i + 1) % vertices_.size()];
     const Epeck::Segment_2 edge(Epeck::Point_2(p.x(), p.y()), Epeck::Point_2(q.x(), q.y()));
-    const Epeck::FT d2 = is_point ? CGAL::squared_distance(ea, edge) : CGAL::squared_distance(Epeck::Segment_2(ea, eb), edge);
+    const Epeck::FT d2 =
+        is_point ? CGAL::squared_distance(ea, edge) : CGAL::squared_distance(Epeck::Segment_2(ea, eb), edge);
     if (d2 < exact_r2) return false;
   }
   return true;

@@ -15,7 +15,9 @@ bool same_direction(const ExactWrench& a, const ExactWrench& b) {
   return is_zero(CGAL::cross_product(a, b)) && CGAL::is_positive(a * b);
 }
 
-Wrench to_double(const ExactWrench& v) { return Wrench(CGAL::to_double(v.x()), CGAL::to_double(v.y()), CGAL::to_double(v.z())); }
+Wrench to_double(const ExactWrench& v) {
+  return Wrench(CGAL::to_double(v.x()), CGAL::to_double(v.y()), CGAL::to_double(v.z()));
+}
 
 }  // namespace
 
@@ -113,9 +115,12 @@ WrenchCone::WrenchCone(std::vector<Wrench> generators, double torque_length)
         any_neg |= (s == CGAL::NEGATIVE);
       }
       if (any_pos && any_neg) continue;
-      if (any_pos && !any_neg) add_facet(-n);
-      else if (any_neg && !any_pos) add_facet(n);
-      else throw std::invalid_argument("the cone is not pointed");
+      if (any_pos && !any_neg)
+        add_facet(-n);
+      else if (any_neg && !any_pos)
+        add_facet(n);
+      else
+        throw std::invalid_argument("the cone is not pointed");
     }
   if (exact_facets_.size() < 3) throw std::invalid_argument("the cone is not pointed");
 }

@@ -1,10 +1,9 @@
 #include "stablepush/grasp_space.hpp"
 
-#include <array>
-
 #include <ompl/base/SpaceInformation.h>
 #include <ompl/util/Exception.h>
 
+#include <array>
 #include <cmath>
 #include <iterator>
 
@@ -115,7 +114,7 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
   };
   // The grid in beta [deg], finer toward pure rotation, where a peg's roots crowd (a motion whose
   // translation is small against its rotation in unit steps).
-  static constexpr double kGridDeg[] = {-89.95, -89.5, -88, -85, -80, -70, -60, -50, -40, -30, -20, -10, 0,
+  static constexpr double kGridDeg[] = {-89.95, -89.5, -88, -85, -80, -70, -60, -50, -40, -30, -20,  -10,  0,
                                         10,     20,    30,  40,  50,  60,  70,  80,  85,  88,  89.5, 89.95};
   const double beta0 = std::atan2(direction[2], heading_norm);
   std::optional<double> best;
@@ -163,7 +162,7 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
 }
 
 PusherSet PushChecker::stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,
-                                                PusherSet preferred) const {
+                                                 PusherSet preferred) const {
   if ((candidates & preferred) == 0 || (candidates & ~preferred) == 0) return stable_pushers(a, b, candidates);
   const PusherSet first = stable_pushers(a, b, candidates & preferred);
   return first != 0 ? first : stable_pushers(a, b, candidates & ~preferred);
@@ -255,8 +254,8 @@ bool StablePushValidator::checkMotion(const ob::State* a, const ob::State* b,
   return false;
 }
 
-PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance,
-                   ModelSet hold, double min_hold_ratio)
+PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance, ModelSet hold,
+                   double min_hold_ratio)
     : ob::GoalSampleableRegion(si),
       space_(*si->getStateSpace()->as<GraspPoseSpace>()),
       goal_(goal),

@@ -14,7 +14,7 @@ void StablePushModel::visit_motion_terms(const Pose& q, const Rotation2& rotatio
   const double dt = step_time_;
   const Vec2 origin(q.x, q.z);
   const Vec2 v(dq.dx / dt, dq.dz / dt);  // velocity of O's origin in G [m/s]
-  const double omega = dq.dtheta / dt;  // [rad/s]
+  const double omega = dq.dtheta / dt;   // [rad/s]
   const double speed_v = v.norm();
 
   // Momentum gained over the step from rest, M xi / dt, and the weight, both at the centre of

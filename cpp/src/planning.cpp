@@ -87,8 +87,8 @@ void check_settings(const PlannerSettings& s) {
 /// Append the last, shorter push from the plan's end (within tolerance) to the goal pose itself,
 /// cut into unit pushes as every motion is, with the last pusher, when each is a stable push in
 /// every model and the goal's hold requirement holds there (Plan::ends_at_goal).
-void finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushValidator& validator,
-                    const PoseGoal& goal, const Pose& target, const ModelSet& models) {
+void finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushValidator& validator, const PoseGoal& goal,
+                    const Pose& target, const ModelSet& models) {
   const PlanStep last = plan.waypoints.back();
   const Pose& end = last.pose;
   if (space.distance(end, target) < GraspPoseSpace::kShortestPush) {  // there: no push is that short
@@ -146,22 +146,21 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   const std::vector<PathNode> nodes = planner.solution();
   if (nodes.empty()) {  // no valid start (the pads do not hold the object there): the start alone
     plan.outcome = PlanOutcome::InvalidStart;
-    plan.waypoints.push_back({settings.start, kNoPusher, std::numeric_limits<double>::quiet_NaN(),
-                              ContactCase::AllSliding});
+    plan.waypoints.push_back(
+        {settings.start, kNoPusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding});
     plan.goal_distance = space->distance(settings.start, settings.goal);
     plan.stats.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return plan;
   }
-  plan.waypoints.push_back({nodes.front().pose, kNoPusher, std::numeric_limits<double>::quiet_NaN(),
-                            ContactCase::AllSliding});
+  plan.waypoints.push_back(
+      {nodes.front().pose, kNoPusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding});
   for (std::size_t i = 1; i < nodes.size(); ++i) {
     // The same cut into unit pushes as the validator made, so each waypoint is a checked push.
     const std::vector<Pose> poses = space->unit_pushes(nodes[i - 1].pose, nodes[i].pose);
     for (std::size_t k = 1; k < poses.size(); ++k) {
       const Pose& from = poses[k - 1];
       const Pose& to = poses[k];
-      const PushResult r =
-          worst_case(models, from, to - from, nodes[i].pusher);
+      const PushResult r = worst_case(models, from, to - from, nodes[i].pusher);
       plan.waypoints.push_back({to, nodes[i].pusher, r.margin, r.contact_case});
     }
   }
@@ -172,8 +171,8 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   plan.stats.feasibility_checks = validator->feasibility_checks();
   plan.stats.switches = cost.switches;
   plan.stats.restarts = planner.restarts();
-  plan.stats.first_time_s = planner.first_solution_time() >= 0.0 ? planner.first_solution_time()
-                                                                  : std::numeric_limits<double>::quiet_NaN();
+  plan.stats.first_time_s =
+      planner.first_solution_time() >= 0.0 ? planner.first_solution_time() : std::numeric_limits<double>::quiet_NaN();
   plan.stats.first_switches = planner.first_solution_cost().switches;
   plan.stats.first_length = planner.first_solution_cost().length;
   plan.stats.first_min_margin = planner.first_solution_margin();

@@ -1,11 +1,10 @@
 #include "stablepush/stable_push.hpp"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
-
-#include <Eigen/LU>
 
 #include "motion_terms.hpp"
 #include "stablepush/small_lp.hpp"
@@ -41,15 +40,19 @@ struct DoubleLoads {
 /// origin: (R^T f, arm x f). Row r of the 3x2 matrix.
 inline Vec2 sticking_map_row(const Rotation2& R, const Vec2& arm, int r) {
   switch (r) {
-    case 0: return Vec2(R.c, -R.s);
-    case 1: return Vec2(R.s, R.c);
-    default: return Vec2(arm.y(), -arm.x());
+    case 0:
+      return Vec2(R.c, -R.s);
+    case 1:
+      return Vec2(R.s, R.c);
+    default:
+      return Vec2(arm.y(), -arm.x());
   }
 }
 
 /// w^T L for a row w (a covector on wrenches): the covector it induces on the group's force.
 inline Vec2 pull_back(const Wrench& w, const Rotation2& R, const Vec2& arm) {
-  return w.x() * sticking_map_row(R, arm, 0) + w.y() * sticking_map_row(R, arm, 1) + w.z() * sticking_map_row(R, arm, 2);
+  return w.x() * sticking_map_row(R, arm, 0) + w.y() * sticking_map_row(R, arm, 1) +
+         w.z() * sticking_map_row(R, arm, 2);
 }
 
 }  // namespace
@@ -248,8 +251,7 @@ PushResult StablePushModel::with_sticking(const WrenchCone& cone, const MotionWr
   result.sticking_points = load.sticking_points;
   auto witness_of = [&](const Eigen::VectorXd& x) {
     Wrench w = load.required;
-    for (int g = 0; g < groups; ++g)
-      w -= sticking_wrench(load.rotation, load.sticking[g].arm, x.segment<2>(2 * g));
+    for (int g = 0; g < groups; ++g) w -= sticking_wrench(load.rotation, load.sticking[g].arm, x.segment<2>(2 * g));
     return w;
   };
 
@@ -276,15 +278,17 @@ PushResult StablePushModel::with_sticking(const WrenchCone& cone, const MotionWr
     for (std::size_t a = 0; a < lp.active.size(); ++a) {
       const int r = lp.active[a];
       const double y = std::max(0.0, lp.multipliers[a]);
-      if (r < facets) lambda[r] = y; else mu[r - facets] = y;
+      if (r < facets)
+        lambda[r] = y;
+      else
+        mu[r - facets] = y;
     }
     const double lambda_sum = lambda.sum();
     if (lambda_sum > 0.0) {
       lambda /= lambda_sum;
       mu /= lambda_sum;
-      const Eigen::VectorXd residual =
-          (lambda.transpose() * A.topLeftCorner(facets, n - 1)).transpose() +
-          (mu.transpose() * A.bottomLeftCorner(rows - facets, n - 1)).transpose();
+      const Eigen::VectorXd residual = (lambda.transpose() * A.topLeftCorner(facets, n - 1)).transpose() +
+                                       (mu.transpose() * A.bottomLeftCorner(rows - facets, n - 1)).transpose();
       double radius2 = 0.0;
       for (const StickingGroup& g : load.sticking) radius2 += g.friction_limit * g.friction_limit;
       const double bound = lambda.dot(b.head(facets)) + mu.dot(b.tail(rows - facets)) +

@@ -6,7 +6,6 @@
 #include <ompl/util/Exception.h>
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,7 +13,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
-
+#include <unordered_map>
 
 namespace stablepush {
 
@@ -27,9 +26,9 @@ struct TRRTstar::Node {
   Node* parent = nullptr;
   std::vector<Node*> children;
   PathCost cost;
-  double goal_distance = 0.0;  ///< T-RRT configuration cost [unit steps]
+  double goal_distance = 0.0;     ///< T-RRT configuration cost [unit steps]
   bool extended_to_goal = false;  ///< a goal sample has already been extended from here
-  int descent = -1;  ///< the descent that made this node or started from it (index into descent_ends_)
+  int descent = -1;               ///< the descent that made this node or started from it (index into descent_ends_)
 };
 
 /// A way to connect a new pose: from `parent`, at `cost`, by any pusher of `pushers`.
@@ -41,16 +40,15 @@ struct TRRTstar::Candidate {
 
 const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges() {
   static const std::map<std::string, ParameterRange> ranges{
-      {"goal_bias", {false, 0.0, 1.0}},                  // probability of sampling the goal
-      {"rewire_radius", {false, 0.0, 100.0}},            // [unit steps]
-      {"init_temperature", {false, 1e-12, 1e6}},         // T-RRT's first temperature
-      {"temp_change_factor", {false, 1.0, 1e3}},
-      {"max_transition_failures", {true, 1.0, 1e6}},
-      {"max_switches", {true, 0.0, 100.0}},              // switch-overs a plan may make
-      {"steer_angle", {false, 0.0, 90.0}},               // [deg]
-      {"seed", {true, 0.0, 4294967295.0}},               // 0 .. 2^32 - 1
-      {"improve_for", {false, 0.0, 1e6}},                // [s] after the first plan
-      {"restart_checks", {true, 0.0, 1e12}},             // stable-push tests before a restart (0: never)
+      {"goal_bias", {false, 0.0, 1.0}},           // probability of sampling the goal
+      {"rewire_radius", {false, 0.0, 100.0}},     // [unit steps]
+      {"init_temperature", {false, 1e-12, 1e6}},  // T-RRT's first temperature
+      {"temp_change_factor", {false, 1.0, 1e3}}, {"max_transition_failures", {true, 1.0, 1e6}},
+      {"max_switches", {true, 0.0, 100.0}},   // switch-overs a plan may make
+      {"steer_angle", {false, 0.0, 90.0}},    // [deg]
+      {"seed", {true, 0.0, 4294967295.0}},    // 0 .. 2^32 - 1
+      {"improve_for", {false, 0.0, 1e6}},     // [s] after the first plan
+      {"restart_checks", {true, 0.0, 1e12}},  // stable-push tests before a restart (0: never)
   };
   return ranges;
 }
@@ -59,8 +57,8 @@ double TRRTstar::checked(const char* name, double value) {
   const ParameterRange& range = trrt_star_parameter_ranges().at(name);
   if (!(value >= range.lowest && value <= range.highest)) {  // also refuses NaN
     std::ostringstream msg;
-    msg << "planner parameter '" << name << "' must be between " << range.lowest << " and " << range.highest
-        << ", got " << value;
+    msg << "planner parameter '" << name << "' must be between " << range.lowest << " and " << range.highest << ", got "
+        << value;
     throw std::invalid_argument(msg.str());
   }
   return value;
@@ -392,7 +390,7 @@ PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob:
 }
 
 std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal, double length,
-                                                        PusherSet wedges) const {
+                                                       PusherSet wedges) const {
   const Eigen::Vector3d to_goal = space_->in_unit_steps(goal - from);
   const double heading = std::atan2(to_goal[1], to_goal[0]);
   const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
@@ -548,8 +546,7 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
       if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
     if (stable == 0) break;
-    if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state),
-                         length))
+    if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state), length))
       break;
     // Go on with the same pusher where it can (no switch-over); the nodes of the other pushers at
     // q_new stay candidates for descents of their own, which start each pusher's straight way in.
@@ -582,8 +579,7 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
     return si_->isValid(scratch) ? validator_->stable_pushers(root->pose, q, candidates) : 0;
   };
   const int within = 8 * (steering.rings() + 1), wide = 8 * (2 * Steering::kRings + 1);
-  for (int turn = 0; turn < within && across != 0; turn = turn == 0 ? 8 : turn + 1)
-    across &= ~stable_at(turn, across);
+  for (int turn = 0; turn < within && across != 0; turn = turn == 0 ? 8 : turn + 1) across &= ~stable_at(turn, across);
   // Each such pusher's first steps: every stable direction of the nearest wide ring where it has
   // one. All of them, since they tie (at 90 deg, lifting and turning the object are equally far
   // from the goal) and only the descents after them tell which leads there.
@@ -784,6 +780,15 @@ PathCost TRRTstar::solution_cost() const {
   return end ? end->cost : PathCost{};
 }
 
+std::vector<TRRTstar::TreeNode> TRRTstar::tree() const {
+  std::unordered_map<const Node*, int> index;
+  for (std::size_t i = 0; i < nodes_.size(); ++i) index[nodes_[i]] = static_cast<int>(i);
+  std::vector<TreeNode> out;
+  out.reserve(nodes_.size());
+  for (const Node* n : nodes_) out.push_back({n->pose, n->pusher, n->parent ? index.at(n->parent) : -1, n->cost});
+  return out;
+}
+
 void TRRTstar::getPlannerData(ob::PlannerData& data) const {
   ob::Planner::getPlannerData(data);
   // Vertex tags carry the pusher of the push into the vertex (kNoPusher at the start).
@@ -791,7 +796,8 @@ void TRRTstar::getPlannerData(ob::PlannerData& data) const {
     if (n->parent == nullptr)
       data.addStartVertex(ob::PlannerDataVertex(n->state, n->pusher));
     else
-      data.addEdge(ob::PlannerDataVertex(n->parent->state, n->parent->pusher), ob::PlannerDataVertex(n->state, n->pusher));
+      data.addEdge(ob::PlannerDataVertex(n->parent->state, n->parent->pusher),
+                   ob::PlannerDataVertex(n->state, n->pusher));
   }
   if (const Node* g = best_goal()) data.addGoalVertex(ob::PlannerDataVertex(g->state, g->pusher));
 }

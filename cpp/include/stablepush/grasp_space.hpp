@@ -158,9 +158,9 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   /// model. Writing the motion's elevation above the translation plane as beta, the motion is
   /// length (cos beta h, sin beta) with h the unit heading, and e . w(a, dq(beta)) = 0 for the
   /// wedge's plane normal e is a root in beta: bracketed on a grid over |beta| < 90 deg (10 deg, finer
-  /// toward pure rotation) and refined to rounding (regula falsi, Illinois), the root nearest the direction's own elevation. Empty when `pusher`'s
-  /// cone is not a wedge, the direction has no translation, or no root exists. The motion still has
-  /// to pass stable_pushers (the wedge's facets, every model, the grasp).
+  /// toward pure rotation) and refined to rounding (regula falsi, Illinois), the root nearest the direction's own
+  /// elevation. Empty when `pusher`'s cone is not a wedge, the direction has no translation, or no root exists. The
+  /// motion still has to pass stable_pushers (the wedge's facets, every model, the grasp).
   std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                          int pusher) const override;
 
@@ -191,8 +191,8 @@ class PoseGoal : public ompl::base::GoalSampleableRegion {
  public:
   /// With `hold` (a model and min_hold_ratio > 0), a node within tolerance ends a plan only when
   /// the pads alone hold the object there with that factor (`held`, StablePushModel::hold_ratio).
-  PoseGoal(const ompl::base::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance,
-           ModelSet hold = {}, double min_hold_ratio = 0.0);
+  PoseGoal(const ompl::base::SpaceInformationPtr& si, const Pose& goal, StepSize tolerance, ModelSet hold = {},
+           double min_hold_ratio = 0.0);
 
   const Pose& pose() const { return goal_; }
   bool isSatisfied(const ompl::base::State* s) const override;

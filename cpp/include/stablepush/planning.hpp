@@ -18,12 +18,12 @@ namespace stablepush {
 inline constexpr double kMaxTimeLimit = 1e6;
 
 struct PlannerSettings {
-  Pose start;                   ///< [m, m, rad]
-  Pose goal;                    ///< [m, m, rad]
-  StepSize step;                ///< one unit step
-  StepSize tolerance;           ///< per coordinate, around the goal
-  double time_limit = 10.0;     ///< [s]
-  double min_margin = 1e-3;     ///< least depth inside the pusher's cone for a push to count [N]
+  Pose start;                ///< [m, m, rad]
+  Pose goal;                 ///< [m, m, rad]
+  StepSize step;             ///< one unit step
+  StepSize tolerance;        ///< per coordinate, around the goal
+  double time_limit = 10.0;  ///< [s]
+  double min_margin = 1e-3;  ///< least depth inside the pusher's cone for a push to count [N]
   /// Samples are drawn from the box spanned by start and goal, grown by this many unit steps.
   double sampling_margin = 5.0;
   /// The plan must end where the pads alone hold the object with this factor of its weight
@@ -48,7 +48,7 @@ struct PlanStats {
   std::size_t nodes = 0;
   std::uint64_t feasibility_checks = 0;  ///< stable-push tests, one per pusher and unit push
   int switches = 0;
-  double length = 0.0;  ///< [unit steps]
+  double length = 0.0;    ///< [unit steps]
   unsigned restarts = 0;  ///< times the search started again (TRRTstar's restart_checks)
   /// The first plan the search found (TRRTstar's improve_for; the final plan's own without it):
   /// when [s into the search, NaN when none], its switch-overs, length [unit steps] and least margin [N].

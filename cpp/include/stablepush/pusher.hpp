@@ -20,8 +20,8 @@ struct Pusher {
   /// `n_points` evenly spaced points, ends included. Its normal is the inward normal of the edge
   /// holding it. Throws std::invalid_argument if it is off the boundary (tolerance 1e-9 m), or a
   /// point pusher sits on a vertex (where the normal is ambiguous).
-  static Pusher on_boundary(const CrossSection& section, std::string name, const Vec2& a, const Vec2& b,
-                            double mu, int n_points);
+  static Pusher on_boundary(const CrossSection& section, std::string name, const Vec2& a, const Vec2& b, double mu,
+                            int n_points);
 
   /// The generators of its generalized friction cone in O: for every point, the wrenches of the
   /// friction-cone edges n +- mu t (paper section IV-D, "Generalized Friction Cone for a Pusher").

@@ -11,9 +11,9 @@ namespace stablepush {
 struct SmallLpResult {
   enum class Status { Optimal, Unbounded, IterationLimit };
   Status status = Status::IterationLimit;
-  Eigen::VectorXd x;                  ///< the last iterate (optimal when status == Optimal)
-  std::vector<int> active;            ///< rows active at x
-  Eigen::VectorXd multipliers;        ///< Lagrange multipliers of `active` (>= 0 at an optimum)
+  Eigen::VectorXd x;            ///< the last iterate (optimal when status == Optimal)
+  std::vector<int> active;      ///< rows active at x
+  Eigen::VectorXd multipliers;  ///< Lagrange multipliers of `active` (>= 0 at an optimum)
   int iterations = 0;
 };
 

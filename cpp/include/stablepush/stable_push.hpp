@@ -58,7 +58,7 @@ struct MotionWrench {
   int sticking_points = 0;
   /// Sum of the magnitudes of the terms [N] (torques divided by the model's torque length).
   double scale = 0.0;
-  Rotation2 rotation;       ///< R(theta) at the pose
+  Rotation2 rotation;           ///< R(theta) at the pose
   Vec2 gravity = Vec2::Zero();  ///< the gravity in G used [m/s^2] (it depends on the pusher, see GravityFrame)
 };
 
@@ -155,7 +155,7 @@ class StablePushModel {
   std::vector<WrenchCone> cones_;
   Vec2 gravity_;
   GravityFrame gravity_frame_;
-  std::vector<double> feature_angles_;  ///< phi_p per pusher [rad]
+  std::vector<double> feature_angles_;   ///< phi_p per pusher [rad]
   std::vector<Vec2> gravity_in_object_;  ///< R(phi_p)^T g per pusher: gravity in O on p's feature
   double step_time_;
   double torque_length_;

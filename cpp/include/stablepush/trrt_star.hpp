@@ -143,6 +143,18 @@ class TRRTstar : public ompl::base::Planner {
   /// The least margin [N] over the unit pushes of the returned path (worst over the models).
   double solution_margin() const;
   std::size_t node_count() const { return nodes_.size(); }
+  /// A node of the search tree as the planner holds it: its pose, the pusher of the push into it,
+  /// its parent (an index into tree(); -1 at the root) and its cost from the root.
+  struct TreeNode {
+    Pose pose;
+    int pusher = kNoPusher;
+    int parent = -1;
+    PathCost cost;
+  };
+  /// The tree of the last solve, the root first. Choose-parent and rewire keep each node's cost
+  /// equal to its parent's plus its edge's: the edge's length in unit steps, and a switch-over when
+  /// the pusher changes after the first push.
+  std::vector<TreeNode> tree() const;
   double temperature() const { return temperature_; }
 
  private:

@@ -1,0 +1,3 @@
+// Catch2's main for the core's unit tests (ctest runs them: README, "Development").
+#define CATCH_CONFIG_MAIN
+#include <catch2/catch.hpp>

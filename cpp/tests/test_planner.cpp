@@ -1,0 +1,167 @@
+// TRRTstar against a toy PushChecker (OMPL's PlannerTest way: the search apart from the mechanics).
+// Two pushers: pusher 0 moves the object only within ~26 deg of +x, pusher 1 of +z (in unit steps).
+#include <ompl/base/ProblemDefinition.h>
+#include <ompl/base/ScopedState.h>
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/util/Console.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <memory>
+
+#include "stablepush/grasp_space.hpp"
+#include "stablepush/planning.hpp"
+#include "stablepush/trrt_star.hpp"
+
+using namespace stablepush;
+namespace ob = ompl::base;
+
+namespace {
+const StepSize kStep{1e-3, M_PI / 180.0};
+
+/// cos of the angle between the motion a -> b (in unit steps) and pusher p's axis.
+double alignment(const Pose& a, const Pose& b, int p) {
+  const Eigen::Vector3d d((b.x - a.x) / kStep.length, (b.z - a.z) / kStep.length, (b.theta - a.theta) / kStep.angle);
+  const double n = d.norm();
+  return n > 0 ? (p == 0 ? d.x() : d.y()) / n : -1.0;
+}
+
+class ConeChecker : public PushChecker {
+ public:
+  PusherSet all_pushers() const override { return 0b11; }
+  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
+    ++checks_;
+    PusherSet out = 0;
+    for (int p = 0; p < 2; ++p)
+      if (contains(candidates, p) && alignment(a, b, p) >= 0.9) out |= PusherSet{1} << p;
+    return out;
+  }
+  double push_margin(const Pose& a, const Pose& b, int p) const override { return alignment(a, b, p) - 0.9; }
+  std::uint64_t feasibility_checks() const override { return checks_; }
+  void reset_feasibility_checks() override { checks_ = 0; }
+
+ private:
+  mutable std::uint64_t checks_ = 0;
+};
+
+/// OMPL's motion validator asking the toy checker, as plan_with_checker sets it up.
+class ToyValidator : public ob::MotionValidator, public ConeChecker {
+ public:
+  explicit ToyValidator(const ob::SpaceInformationPtr& si) : ob::MotionValidator(si) {}
+  bool checkMotion(const ob::State* a, const ob::State* b) const override {
+    return stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_pushers()) != 0;
+  }
+  bool checkMotion(const ob::State* a, const ob::State* b, std::pair<ob::State*, double>& last) const override {
+    const bool ok = checkMotion(a, b);
+    if (!ok) last.second = 0.0;
+    return ok;
+  }
+};
+
+PlannerSettings settings_to(const Pose& goal) {
+  PlannerSettings s;
+  s.goal = goal;
+  s.step = kStep;
+  s.tolerance = StepSize{0.5e-3, 0.5 * M_PI / 180.0};
+  s.time_limit = 5.0;
+  s.parameters = {{"seed", "3"}, {"max_switches", "1"}};
+  return s;
+}
+}  // namespace
+
+/// The toy problem of planning from the origin to `goal` with TRRTstar, as plan_with_checker
+/// sets it up, in a box of +-20 unit steps.
+struct ToyProblem {
+  ob::SpaceInformationPtr si;
+  ob::ProblemDefinitionPtr pdef;
+  explicit ToyProblem(const Pose& goal) {
+    ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+    ob::RealVectorBounds bounds(3);
+    bounds.setLow(-0.02);
+    bounds.setHigh(0.02);
+    auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
+    si = std::make_shared<ob::SpaceInformation>(space);
+    si->setStateValidityChecker([](const ob::State*) { return true; });
+    si->setMotionValidator(std::make_shared<ToyValidator>(si));
+    si->setup();
+    pdef = std::make_shared<ob::ProblemDefinition>(si);
+    ob::ScopedState<GraspPoseSpace> start(space);
+    GraspPoseSpace::set_pose(start.get(), Pose{});
+    pdef->addStartState(start);
+    pdef->setGoal(std::make_shared<PoseGoal>(si, goal, StepSize{0.5e-3, 0.5 * M_PI / 180.0}));
+  }
+};
+
+TEST_CASE("choose-parent and rewire keep every node's cost its parent's plus its edge's", "[trrt_star]") {
+  int deep_trees = 0;
+  for (long long seed = 1; seed <= 10; ++seed) {
+    ToyProblem problem(Pose{12e-3, 12e-3, 0.0});
+    TRRTstar planner(problem.si);
+    planner.setSeed(seed);
+    planner.setImproveFor(0.05);  // keeps growing (and rewiring) after the first plan
+    planner.setProblemDefinition(problem.pdef);
+    planner.setup();
+    planner.solve(ob::timedPlannerTerminationCondition(5.0));
+    const std::vector<TRRTstar::TreeNode> tree = planner.tree();
+    REQUIRE(tree.size() > 10);
+    CHECK(tree[0].parent == -1);
+    CHECK(tree[0].cost.switches == 0);
+    CHECK(tree[0].cost.length == 0.0);
+    bool deep = false;
+    for (const TRRTstar::TreeNode& n : tree) {
+      if (n.parent < 0) continue;
+      const TRRTstar::TreeNode& p = tree[static_cast<std::size_t>(n.parent)];
+      const int switch_over = p.pusher != kNoPusher && p.pusher != n.pusher ? 1 : 0;
+      CHECK(n.cost.switches == p.cost.switches + switch_over);
+      CHECK_THAT(n.cost.length, Catch::Matchers::WithinAbs(p.cost.length + steps_between(p.pose, n.pose, kStep), 1e-9));
+      CHECK(alignment(p.pose, n.pose, n.pusher) >= 0.9);  // every edge a push the checker allowed
+      deep = deep || p.parent >= 0;
+    }
+    deep_trees += deep;
+  }
+  CHECK(deep_trees > 0);
+}
+
+TEST_CASE("the cost of the returned path is the cost of its pushes", "[trrt_star]") {
+  for (const char* seed : {"1", "2", "3", "4", "5"}) {
+    PlannerSettings settings = settings_to(Pose{6e-3, 6e-3, 0.0});
+    settings.parameters["seed"] = seed;
+    const CheckedPlan plan = plan_with_checker(std::make_shared<ConeChecker>(), settings);
+    REQUIRE(plan.outcome == PlanOutcome::GoalReached);
+    int switches = 0;
+    double length = 0.0;
+    for (std::size_t i = 1; i < plan.path.size(); ++i) {
+      length += steps_between(plan.path[i - 1].pose, plan.path[i].pose, kStep);
+      if (i > 1 && plan.path[i].pusher != plan.path[i - 1].pusher) ++switches;
+    }
+    CHECK(plan.cost.switches == switches);
+    CHECK_THAT(plan.cost.length, Catch::Matchers::WithinRel(length, 1e-9));
+    CHECK(switches == 1);  // the goal up and to the right needs both toy pushers
+  }
+}
+
+TEST_CASE("solve, clear, solve: a cleared planner plans again as a new one (OMPL's contract)", "[trrt_star]") {
+  ToyProblem problem(Pose{6e-3, 6e-3, 0.0});
+  TRRTstar planner(problem.si);
+  planner.setSeed(3);
+  planner.setProblemDefinition(problem.pdef);
+  planner.setup();
+  const ob::PlannerStatus first = planner.solve(ob::timedPlannerTerminationCondition(5.0));
+  REQUIRE(first == ob::PlannerStatus::EXACT_SOLUTION);
+  REQUIRE(planner.outcome() == PlanOutcome::GoalReached);
+  const std::vector<PathNode> path = planner.solution();
+
+  planner.clear();
+  CHECK(planner.node_count() == 0);
+  problem.pdef->clearSolutionPaths();
+  const ob::PlannerStatus again = planner.solve(ob::timedPlannerTerminationCondition(5.0));
+  REQUIRE(again == ob::PlannerStatus::EXACT_SOLUTION);
+  const std::vector<PathNode> replanned = planner.solution();
+  REQUIRE(replanned.size() == path.size());
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    CHECK(replanned[i].pusher == path[i].pusher);
+    CHECK(replanned[i].pose.x == path[i].pose.x);
+    CHECK(replanned[i].pose.z == path[i].pose.z);
+    CHECK(replanned[i].pose.theta == path[i].pose.theta);
+  }
+}
