@@ -9,7 +9,7 @@
 #include <string>
 
 #include "bindings.hpp"
-#include "stablepush/grasp_space.hpp"
+#include "stablepush/internal/grasp_space.hpp"
 
 namespace py = pybind11;
 

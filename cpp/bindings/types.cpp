@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "bindings.hpp"
-#include "stablepush/grasp_space.hpp"
+#include "stablepush/search.hpp"
 
 namespace py = pybind11;
 

@@ -1,4 +1,4 @@
-#include "stablepush/grasp_space.hpp"
+#include "stablepush/internal/grasp_space.hpp"
 
 #include <ompl/base/SpaceInformation.h>
 #include <ompl/util/Exception.h>

@@ -11,6 +11,9 @@
 #include <memory>
 #include <stdexcept>
 
+#include "stablepush/internal/grasp_space.hpp"
+#include "stablepush/internal/trrt_star.hpp"
+
 namespace stablepush {
 
 namespace ob = ompl::base;

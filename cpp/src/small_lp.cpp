@@ -1,4 +1,4 @@
-#include "stablepush/small_lp.hpp"
+#include "stablepush/internal/small_lp.hpp"
 
 #include <Eigen/Cholesky>
 #include <algorithm>

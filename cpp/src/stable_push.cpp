@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "motion_terms.hpp"
-#include "stablepush/small_lp.hpp"
+#include "stablepush/internal/small_lp.hpp"
 
 namespace stablepush {
 namespace {

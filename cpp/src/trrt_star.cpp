@@ -1,4 +1,4 @@
-#include "stablepush/trrt_star.hpp"
+#include "stablepush/internal/trrt_star.hpp"
 
 #include <ompl/base/PlannerData.h>
 #include <ompl/base/goals/GoalSampleableRegion.h>

@@ -9,9 +9,9 @@
 #include <cmath>
 #include <memory>
 
-#include "stablepush/grasp_space.hpp"
+#include "stablepush/internal/grasp_space.hpp"
 #include "stablepush/planning.hpp"
-#include "stablepush/trrt_star.hpp"
+#include "stablepush/internal/trrt_star.hpp"
 
 using namespace stablepush;
 namespace ob = ompl::base;

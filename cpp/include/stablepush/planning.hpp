@@ -8,9 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "stablepush/grasp_space.hpp"
+#include "stablepush/search.hpp"
 #include "stablepush/stable_push.hpp"
-#include "stablepush/trrt_star.hpp"
 
 namespace stablepush {
 

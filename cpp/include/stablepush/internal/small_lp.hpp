@@ -3,6 +3,10 @@
 // (a primal witness or a dual bound, evaluated directly) or falls back to CGAL's exact solver.
 #pragma once
 
+#ifndef STABLEPUSH_INTERNAL_ALLOWED
+#error "an internal header of the stablepush core: include stablepush/stable_push.hpp"
+#endif
+
 #include <Eigen/Core>
 #include <vector>
 

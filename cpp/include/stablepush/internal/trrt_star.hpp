@@ -26,6 +26,10 @@
 // margin of its unit pushes (worst over the models), then the shortest.
 #pragma once
 
+#ifndef STABLEPUSH_INTERNAL_ALLOWED
+#error "an internal header of the stablepush core: include stablepush/planning.hpp or stablepush/search.hpp"
+#endif
+
 #include <ompl/base/Planner.h>
 #include <ompl/util/RandomNumbers.h>
 
@@ -38,48 +42,10 @@
 #include <string>
 #include <vector>
 
-#include "stablepush/grasp_space.hpp"
+#include "stablepush/internal/grasp_space.hpp"
+#include "stablepush/search.hpp"
 
 namespace stablepush {
-
-/// Path cost: switch-overs first, then length [unit steps]. The first push is not a switch-over.
-struct PathCost {
-  int switches = 0;
-  double length = 0.0;
-
-  /// Lexicographic; lengths within 1e-9 unit steps count as equal.
-  bool operator<(const PathCost& other) const {
-    if (switches != other.switches) return switches < other.switches;
-    return length < other.length - 1e-9;
-  }
-  PathCost operator+(const PathCost& other) const { return {switches + other.switches, length + other.length}; }
-  PathCost operator-(const PathCost& other) const { return {switches - other.switches, length - other.length}; }
-};
-
-/// How a solve ended.
-enum class PlanOutcome {
-  GoalReached,          ///< a node within the goal tolerance with at most max_switches switch-overs
-  GoalOverSwitchLimit,  ///< time ran out; the goal was reached, but only with more switch-overs
-  TimeLimit,            ///< time ran out before the goal was reached; the path ends closest to it
-  InvalidStart,         ///< the pads do not hold the object at the start: nothing was planned
-};
-
-/// One node of a solution path: the pose and the pusher of the push into it (kNoPusher at the start).
-struct PathNode {
-  Pose pose;
-  int pusher = kNoPusher;
-};
-
-/// A declared parameter's kind and the closed range its setter accepts.
-struct ParameterRange {
-  bool integer = false;
-  double lowest = 0.0;
-  double highest = 0.0;
-};
-
-/// TRRTstar's declared parameters and their ranges: the one table the setters enforce and the
-/// task validation reads (Python: _core.TRRT_STAR_PARAMETER_RANGES).
-const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges();
 
 class TRRTstar : public ompl::base::Planner {
  public:

@@ -4,6 +4,10 @@
 // throughout) and the goal region.
 #pragma once
 
+#ifndef STABLEPUSH_INTERNAL_ALLOWED
+#error "an internal header of the stablepush core: include stablepush/planning.hpp or stablepush/search.hpp"
+#endif
+
 #include <ompl/base/MotionValidator.h>
 #include <ompl/base/StateValidityChecker.h>
 #include <ompl/base/goals/GoalSampleableRegion.h>
@@ -13,31 +17,16 @@
 #include <optional>
 #include <vector>
 
+#include "stablepush/search.hpp"
 #include "stablepush/stable_push.hpp"
 #include "stablepush/types.hpp"
 
 namespace stablepush {
 
-/// One unit step of the planner: a translation of `length` [m] or a rotation of `angle` [rad]
-/// (the task's planner.step). Distances in the planner are counted in these units.
-struct StepSize {
-  double length = 1e-3;
-  double angle = M_PI / 180.0;
-};
-
-/// Pushers as a set: bit i stands for pusher i. At most kMaxPushers pushers per task.
-using PusherSet = std::uint32_t;
-inline constexpr int kMaxPushers = 32;
-inline bool contains(PusherSet set, int pusher) { return pusher >= 0 && ((set >> pusher) & 1u); }
-
 /// The grasp poses (x [m], z [m], theta [rad]) with the metric
 ///     d(q1, q2) = sqrt((dx^2 + dz^2) / length^2 + dtheta^2 / angle^2)   [unit steps],
 /// so that a unit step is a step of length 1. theta is not wrapped: a plan turns the object
 /// through the angles it passes, and the bounds decide how far it may turn.
-/// The distance from a to b in unit steps: |(dx / length, dz / length, dtheta / angle)|. A unit
-/// push moves at most 1; the planner cuts longer motions into pushes by it (unit_pushes).
-double steps_between(const Pose& a, const Pose& b, const StepSize& step);
-
 class GraspPoseSpace : public ompl::base::RealVectorStateSpace {
  public:
   GraspPoseSpace(StepSize step, const ompl::base::RealVectorBounds& bounds);
@@ -82,15 +71,6 @@ class SeededPoseSampler : public ompl::base::RealVectorStateSampler {
   SeededPoseSampler(const ompl::base::StateSpace* space, std::uint_fast32_t seed);
 };
 
-/// The models a push must be stable in: the nominal model alone, or the corners of the task's
-/// uncertainty box (docs/model.md section 7), which share the geometry (section, pads, pushers).
-/// A push is stable when it is stable in every model; its margin is the least. Non-owning.
-using ModelSet = std::vector<const StablePushModel*>;
-
-/// The push q -> q + dq by `pusher` as the least stable model of the set sees it: the result with
-/// the least margin (an infeasible one first).
-PushResult worst_case(const ModelSet& models, const Pose& q, const Motion& dq, int pusher);
-
 /// A pose is valid when the grasp is maintained: every pad disc inside the cross-section.
 class GraspValidityChecker : public ompl::base::StateValidityChecker {
  public:
@@ -99,34 +79,6 @@ class GraspValidityChecker : public ompl::base::StateValidityChecker {
 
  private:
   const StablePushModel& model_;
-};
-
-/// What the search asks of the mechanics: which pushers make a motion a stable push, and how
-/// deep. TRRTstar is written against this alone (OMPL keeps validity apart from search the same
-/// way), so it can be tested with a toy rule; StablePushValidator answers it for the model. The
-/// search finds it as its SpaceInformation's motion validator, which must implement both.
-class PushChecker {
- public:
-  virtual ~PushChecker() = default;
-  /// Every pusher of the task as a set.
-  virtual PusherSet all_pushers() const = 0;
-  /// The pushers among `candidates` that make every unit push of a -> b stable; 0 when none.
-  virtual PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const = 0;
-  /// The same, except that when some of the `preferred` candidates are stable only they are
-  /// returned, and the others need not be tested (a descent going on with its own pusher).
-  virtual PusherSet stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,
-                                              PusherSet preferred) const;
-  /// The margin [N] of one unit push a -> b by `pusher` (the least over the models), for the
-  /// anytime choice between plans (TRRTstar's improve_for).
-  virtual double push_margin(const Pose& a, const Pose& b, int pusher) const = 0;
-  /// Point pushers, whose stable pushes are a surface (StablePushValidator::onto_wedge_surface);
-  /// by default there are none.
-  virtual PusherSet wedge_pushers() const { return 0; }
-  virtual std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
-                                                 int pusher) const;
-  /// Stable-push tests made so far (what restarts count).
-  virtual std::uint64_t feasibility_checks() const = 0;
-  virtual void reset_feasibility_checks() = 0;
 };
 
 /// A motion a -> b is valid when, for one same pusher, each of its unit pushes
