@@ -10,8 +10,8 @@
 #include <memory>
 
 #include "stablepush/internal/grasp_space.hpp"
-#include "stablepush/planning.hpp"
 #include "stablepush/internal/trrt_star.hpp"
+#include "stablepush/planning.hpp"
 
 using namespace stablepush;
 namespace ob = ompl::base;
