@@ -142,19 +142,18 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   apply_parameters(planner, settings.parameters);
   planner.setProblemDefinition(pdef);
   planner.setup();
-  planner.solve(ob::timedPlannerTerminationCondition(settings.time_limit));
+  const ob::PlannerStatus status = planner.solve(ob::timedPlannerTerminationCondition(settings.time_limit));
 
   Plan plan;
   plan.outcome = planner.outcome();
-  const std::vector<PathNode> nodes = planner.solution();
-  if (nodes.empty()) {  // no valid start (the pads do not hold the object there): the start alone
-    plan.outcome = PlanOutcome::InvalidStart;
+  if (status == ob::PlannerStatus::INVALID_START) {  // the pads do not hold the object there: the start alone
     plan.waypoints.push_back(
         {settings.start, kNoPusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding});
     plan.goal_distance = space->distance(settings.start, settings.goal);
     plan.stats.planning_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return plan;
   }
+  const std::vector<PathNode> nodes = planner.solution();
   plan.waypoints.push_back(
       {nodes.front().pose, kNoPusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding});
   for (std::size_t i = 1; i < nodes.size(); ++i) {

@@ -627,7 +627,11 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
   auto* goal = dynamic_cast<PoseGoal*>(pdef_->getGoal().get());
   if (goal == nullptr) throw ompl::Exception(getName(), "needs a PoseGoal");
   const ob::State* start = pis_.nextStart();
-  if (start == nullptr) return ob::PlannerStatus::INVALID_START;
+  if (start == nullptr) {  // no valid start: the pads do not hold the object there
+    free_tree();
+    outcome_ = PlanOutcome::InvalidStart;
+    return ob::PlannerStatus::INVALID_START;
+  }
 
   iterations_ = 0;
   restarts_ = 0;

@@ -7,6 +7,7 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <functional>
 #include <memory>
 
 #include "stablepush/internal/grasp_space.hpp"
@@ -74,14 +75,15 @@ PlannerSettings settings_to(const Pose& goal) {
 struct ToyProblem {
   ob::SpaceInformationPtr si;
   ob::ProblemDefinitionPtr pdef;
-  explicit ToyProblem(const Pose& goal) {
+  explicit ToyProblem(
+      const Pose& goal, std::function<bool(const Pose&)> valid = [](const Pose&) { return true; }) {
     ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
     ob::RealVectorBounds bounds(3);
     bounds.setLow(-0.02);
     bounds.setHigh(0.02);
     auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
     si = std::make_shared<ob::SpaceInformation>(space);
-    si->setStateValidityChecker([](const ob::State*) { return true; });
+    si->setStateValidityChecker([valid](const ob::State* s) { return valid(GraspPoseSpace::pose(s)); });
     si->setMotionValidator(std::make_shared<ToyValidator>(si));
     si->setup();
     pdef = std::make_shared<ob::ProblemDefinition>(si);
@@ -164,4 +166,14 @@ TEST_CASE("solve, clear, solve: a cleared planner plans again as a new one (OMPL
     CHECK(replanned[i].pose.z == path[i].pose.z);
     CHECK(replanned[i].pose.theta == path[i].pose.theta);
   }
+}
+
+TEST_CASE("a start where the grasp is not maintained ends the solve at once as INVALID_START", "[trrt_star]") {
+  ToyProblem problem(Pose{6e-3, 6e-3, 0.0}, [](const Pose& q) { return q.x > 1e-3; });  // the start x = 0 is not
+  TRRTstar planner(problem.si);
+  planner.setProblemDefinition(problem.pdef);
+  planner.setup();
+  CHECK(planner.solve(ob::timedPlannerTerminationCondition(5.0)) == ob::PlannerStatus::INVALID_START);
+  CHECK(planner.outcome() == PlanOutcome::InvalidStart);
+  CHECK(planner.solution().empty());
 }
