@@ -87,6 +87,17 @@ void check_settings(const PlannerSettings& s) {
     throw std::invalid_argument("min_hold_ratio must be >= 0");
 }
 
+/// Append the motion from the plan's last waypoint to `to` by `pusher`, cut into unit pushes as
+/// the validator cut it (GraspPoseSpace::unit_pushes), so that each waypoint is a checked push;
+/// each carries the test's verdict, the least over the models.
+void append_pushes(Plan& plan, const GraspPoseSpace& space, const ModelSet& models, const Pose& to, int pusher) {
+  const std::vector<Pose> poses = space.unit_pushes(plan.waypoints.back().pose, to);
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    const PushResult r = worst_case(models, poses[k - 1], poses[k] - poses[k - 1], pusher);
+    plan.waypoints.push_back({poses[k], pusher, r.margin, r.contact_case});
+  }
+}
+
 /// Append the last, shorter push from the plan's end (within tolerance) to the goal pose itself,
 /// cut into unit pushes as every motion is, with the last pusher, when each is a stable push in
 /// every model and the goal's hold requirement holds there (Plan::ends_at_goal).
@@ -101,13 +112,7 @@ void finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushVal
   }
   if (last.pusher == kNoPusher || validator.stable_pushers(end, target, PusherSet{1} << last.pusher) == 0) return;
   if (!goal.held(target, last.pusher)) return;
-  const std::vector<Pose> poses = space.unit_pushes(end, target);
-  for (std::size_t k = 1; k < poses.size(); ++k) {
-    const Pose& from = poses[k - 1];
-    const Pose& to = poses[k];
-    const PushResult r = worst_case(models, from, to - from, last.pusher);
-    plan.waypoints.push_back({to, last.pusher, r.margin, r.contact_case});
-  }
+  append_pushes(plan, space, models, target, last.pusher);
   plan.ends_at_goal = true;
 }
 
@@ -156,16 +161,7 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   const std::vector<PathNode> nodes = planner.solution();
   plan.waypoints.push_back(
       {nodes.front().pose, kNoPusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding});
-  for (std::size_t i = 1; i < nodes.size(); ++i) {
-    // The same cut into unit pushes as the validator made, so each waypoint is a checked push.
-    const std::vector<Pose> poses = space->unit_pushes(nodes[i - 1].pose, nodes[i].pose);
-    for (std::size_t k = 1; k < poses.size(); ++k) {
-      const Pose& from = poses[k - 1];
-      const Pose& to = poses[k];
-      const PushResult r = worst_case(models, from, to - from, nodes[i].pusher);
-      plan.waypoints.push_back({to, nodes[i].pusher, r.margin, r.contact_case});
-    }
-  }
+  for (std::size_t i = 1; i < nodes.size(); ++i) append_pushes(plan, *space, models, nodes[i].pose, nodes[i].pusher);
   if (plan.outcome == PlanOutcome::GoalReached) finish_at_goal(plan, *space, *validator, *goal, settings.goal, models);
   const PathCost cost = planner.solution_cost();
   plan.stats.iterations = planner.iterations();

@@ -688,7 +688,7 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
     si_->freeState(s);
   }
   const bool exact = outcome_ == PlanOutcome::GoalReached;
-  const Node* end = best_goal() ? best_goal() : closest_;
+  const Node* end = path_end();
   pdef_->addSolutionPath(path, !exact, exact ? 0.0 : end->goal_distance, getName());
   return {true, !exact};
 }
@@ -763,24 +763,25 @@ void TRRTstar::choose_improved_path() {
 
 double TRRTstar::solution_margin() const {
   if (improved_) return improved_->margin;
-  const Node* end = best_goal();
-  return path_margin(end != nullptr ? end : closest_);
+  return path_margin(path_end());
+}
+
+const TRRTstar::Node* TRRTstar::path_end() const {
+  const Node* goal = best_goal();
+  return goal != nullptr ? goal : closest_;
 }
 
 std::vector<PathNode> TRRTstar::solution() const {
   if (improved_) return improved_->nodes;
   std::vector<PathNode> path;
-  const Node* end = best_goal();
-  if (end == nullptr) end = closest_;
-  for (const Node* n = end; n != nullptr; n = n->parent) path.push_back({n->pose, n->pusher});
+  for (const Node* n = path_end(); n != nullptr; n = n->parent) path.push_back({n->pose, n->pusher});
   std::reverse(path.begin(), path.end());
   return path;
 }
 
 PathCost TRRTstar::solution_cost() const {
   if (improved_) return improved_->cost;
-  const Node* end = best_goal();
-  if (end == nullptr) end = closest_;
+  const Node* end = path_end();
   return end ? end->cost : PathCost{};
 }
 

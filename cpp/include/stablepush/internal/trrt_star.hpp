@@ -187,6 +187,9 @@ class TRRTstar : public ompl::base::Planner {
   void note_goal_candidate(Node* node);
   /// The goal node with the least cost (switch-overs, then length).
   Node* best_goal() const;
+  /// Where the returned path ends: the best goal node, else the node closest to the goal (nullptr
+  /// before the first solve).
+  const Node* path_end() const;
   /// A goal node's path as it was when noted (rewiring may shorten a path later and lower its
   /// margin, so an improvement keeps the paths it saw), its cost and least margin [N].
   struct GoalPath {
