@@ -87,6 +87,42 @@ void check_settings(const PlannerSettings& s) {
     throw std::invalid_argument("min_hold_ratio must be >= 0");
 }
 
+/// The OMPL problem TRRTstar solves: the pose space, its space information and the problem
+/// definition (start and goal).
+struct Problem {
+  std::shared_ptr<GraspPoseSpace> space;
+  ob::SpaceInformationPtr si;
+  ob::ProblemDefinitionPtr pdef;
+};
+
+/// The problem of planning from settings.start to settings.goal: samples from the start-goal box
+/// grown by settings.sampling_margin unit steps and cut to |x|, |z| <= reach [m]; poses, motions
+/// and the goal judged by what the three factories make for the space information.
+template <class PoseValidity, class MotionValidity, class Goal>
+Problem make_problem(const PlannerSettings& settings, double reach, PoseValidity pose_validity,
+                     MotionValidity motion_validity, Goal goal) {
+  Problem problem;
+  problem.space = std::make_shared<GraspPoseSpace>(settings.step, sampling_region(settings, reach));
+  problem.si = std::make_shared<ob::SpaceInformation>(problem.space);
+  problem.si->setStateValidityChecker(pose_validity(problem.si));
+  problem.si->setMotionValidator(motion_validity(problem.si));
+  problem.si->setup();
+  problem.pdef = std::make_shared<ob::ProblemDefinition>(problem.si);
+  ob::ScopedState<GraspPoseSpace> start(problem.space);
+  GraspPoseSpace::set_pose(start.get(), settings.start);
+  problem.pdef->addStartState(start);
+  problem.pdef->setGoal(goal(problem.si));
+  return problem;
+}
+
+/// TRRTstar's solve of `problem` with the settings' declared parameters, until settings.time_limit.
+ob::PlannerStatus solve(TRRTstar& planner, const Problem& problem, const PlannerSettings& settings) {
+  apply_parameters(planner, settings.parameters);
+  planner.setProblemDefinition(problem.pdef);
+  planner.setup();
+  return planner.solve(ob::timedPlannerTerminationCondition(settings.time_limit));
+}
+
 /// Append the motion from the plan's last waypoint to `to` by `pusher`, cut into unit pushes as
 /// the validator cut it (GraspPoseSpace::unit_pushes), so that each waypoint is a checked push;
 /// each carries the test's verdict, the least over the models.
@@ -129,25 +165,21 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   const StablePushModel& model = *models.front();  // the geometry, which every model shares
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 
-  auto space = std::make_shared<GraspPoseSpace>(settings.step, sampling_region(settings, pad_reach(model)));
-  auto si = std::make_shared<ob::SpaceInformation>(space);
-  si->setStateValidityChecker(std::make_shared<GraspValidityChecker>(si, model));
-  auto validator = std::make_shared<StablePushValidator>(si, models, settings.min_margin);
-  si->setMotionValidator(validator);
-  si->setup();
-
-  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
-  ob::ScopedState<GraspPoseSpace> start(space);
-  GraspPoseSpace::set_pose(start.get(), settings.start);
-  pdef->addStartState(start);
-  auto goal = std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance, models, settings.min_hold_ratio);
-  pdef->setGoal(goal);
-
-  TRRTstar planner(si);
-  apply_parameters(planner, settings.parameters);
-  planner.setProblemDefinition(pdef);
-  planner.setup();
-  const ob::PlannerStatus status = planner.solve(ob::timedPlannerTerminationCondition(settings.time_limit));
+  std::shared_ptr<StablePushValidator> validator;
+  std::shared_ptr<PoseGoal> goal;
+  const Problem problem = make_problem(
+      settings, pad_reach(model),
+      [&](const ob::SpaceInformationPtr& si) { return std::make_shared<GraspValidityChecker>(si, model); },
+      [&](const ob::SpaceInformationPtr& si) {
+        return validator = std::make_shared<StablePushValidator>(si, models, settings.min_margin);
+      },
+      [&](const ob::SpaceInformationPtr& si) {
+        return goal =
+                   std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance, models, settings.min_hold_ratio);
+      });
+  const auto& space = problem.space;
+  TRRTstar planner(problem.si);
+  const ob::PlannerStatus status = solve(planner, problem, settings);
 
   Plan plan;
   plan.outcome = planner.outcome();
@@ -225,22 +257,17 @@ CheckedPlan plan_with_checker(std::shared_ptr<PushChecker> checker, const Planne
   check_settings(settings);
   if (!checker) throw std::invalid_argument("no push checker");
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  auto space = std::make_shared<GraspPoseSpace>(settings.step,
-                                                sampling_region(settings, std::numeric_limits<double>::infinity()));
-  auto si = std::make_shared<ob::SpaceInformation>(space);
-  si->setStateValidityChecker([](const ob::State*) { return true; });
-  si->setMotionValidator(std::make_shared<CheckerMotionValidator>(si, std::move(checker)));
-  si->setup();
-  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
-  ob::ScopedState<GraspPoseSpace> start(space);
-  GraspPoseSpace::set_pose(start.get(), settings.start);
-  pdef->addStartState(start);
-  pdef->setGoal(std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance));
-  TRRTstar planner(si);
-  apply_parameters(planner, settings.parameters);
-  planner.setProblemDefinition(pdef);
-  planner.setup();
-  planner.solve(ob::timedPlannerTerminationCondition(settings.time_limit));
+  const Problem problem = make_problem(
+      settings, std::numeric_limits<double>::infinity(),
+      [](const ob::SpaceInformationPtr& si) { return std::make_shared<ob::AllValidStateValidityChecker>(si); },
+      [&](const ob::SpaceInformationPtr& si) {
+        return std::make_shared<CheckerMotionValidator>(si, std::move(checker));
+      },
+      [&](const ob::SpaceInformationPtr& si) {
+        return std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance);
+      });
+  TRRTstar planner(problem.si);
+  solve(planner, problem, settings);
   return {planner.outcome(), planner.solution(), planner.solution_cost(), planner.restarts()};
 }
 
