@@ -626,29 +626,32 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
   checkValidity();
   auto* goal = dynamic_cast<PoseGoal*>(pdef_->getGoal().get());
   if (goal == nullptr) throw ompl::Exception(getName(), "needs a PoseGoal");
+  // OMPL hands each start state out once: a second solve finds none and goes on growing the tree of
+  // the first (OMPL's contract; clear() starts anew). No start and no tree: the start is invalid.
   const ob::State* start = pis_.nextStart();
-  if (start == nullptr) {  // no valid start: the pads do not hold the object there
-    free_tree();
+  if (start == nullptr && nodes_.empty()) {  // the pads do not hold the object at the start
     outcome_ = PlanOutcome::InvalidStart;
     return ob::PlannerStatus::INVALID_START;
   }
-
-  iterations_ = 0;
-  restarts_ = 0;
+  const bool resume = start == nullptr;
+  const Pose start_pose = resume ? nodes_.front()->pose : GraspPoseSpace::pose(start);
   solve_started_ = std::chrono::steady_clock::now();
-  first_time_ = -1.0;
-  first_cost_ = PathCost{};
-  first_margin_ = std::numeric_limits<double>::quiet_NaN();
-  validator_->reset_feasibility_checks();
-  const Pose start_pose = GraspPoseSpace::pose(start);
-  begin_attempt(start_pose);
+  if (!resume) {
+    iterations_ = 0;
+    restarts_ = 0;
+    first_time_ = -1.0;
+    first_cost_ = PathCost{};
+    first_margin_ = std::numeric_limits<double>::quiet_NaN();
+    validator_->reset_feasibility_checks();
+    begin_attempt(start_pose);
+  }
 
   // Restarts against the long tail (restart_checks): a search that has made that many stable-push
   // tests without a plan starts again from the start with fresh streams and twice the budget, so
   // a seed whose first descents die where the chosen pusher cannot go on does not search there
   // for long; doubling keeps it complete. Counted in tests, not seconds, so a seed's plan is the
   // same on any machine.
-  std::uint64_t budget = restart_checks_, attempt_began = 0;
+  std::uint64_t budget = restart_checks_, attempt_began = validator_->feasibility_checks();
 
   ob::State* sample = si_->allocState();
   while (!finished(ptc)) {

@@ -177,3 +177,26 @@ TEST_CASE("a start where the grasp is not maintained ends the solve at once as I
   CHECK(planner.outcome() == PlanOutcome::InvalidStart);
   CHECK(planner.solution().empty());
 }
+
+TEST_CASE("solve, solve: a second solve goes on growing the first one's tree (OMPL's contract)", "[trrt_star]") {
+  ToyProblem problem(Pose{12e-3, 12e-3, 0.0});
+  TRRTstar planner(problem.si);
+  planner.setSeed(2);
+  planner.setProblemDefinition(problem.pdef);
+  planner.setup();
+  int polls = 0;
+  const ob::PlannerTerminationCondition soon([&polls] { return ++polls > 40; });
+  planner.solve(soon);
+  const std::vector<TRRTstar::TreeNode> before = planner.tree();
+  REQUIRE(before.size() > 1);
+  REQUIRE(planner.outcome() != PlanOutcome::GoalReached);  // stopped early
+
+  CHECK(planner.solve(ob::timedPlannerTerminationCondition(5.0)) == ob::PlannerStatus::EXACT_SOLUTION);
+  const std::vector<TRRTstar::TreeNode> after = planner.tree();
+  REQUIRE(after.size() > before.size());
+  for (std::size_t i = 0; i < before.size(); ++i) {  // the first tree is still there, node for node
+    CHECK(after[i].pose.x == before[i].pose.x);
+    CHECK(after[i].pose.z == before[i].pose.z);
+    CHECK(after[i].pose.theta == before[i].pose.theta);
+  }
+}
