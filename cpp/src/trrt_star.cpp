@@ -15,28 +15,11 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "trrt_star_parts.hpp"
+
 namespace stablepush {
 
 namespace ob = ompl::base;
-
-struct TRRTstar::Node {
-  ob::State* state = nullptr;
-  Pose pose;
-  int pusher = kNoPusher;  ///< the pusher of the push into this node
-  Node* parent = nullptr;
-  std::vector<Node*> children;
-  PathCost cost;
-  double goal_distance = 0.0;     ///< T-RRT configuration cost [unit steps]
-  bool extended_to_goal = false;  ///< a goal sample has already been extended from here
-  int descent = -1;               ///< the descent that made this node or started from it (index into descent_ends_)
-};
-
-/// A way to connect a new pose: from `parent`, at `cost`, by any pusher of `pushers`.
-struct TRRTstar::Candidate {
-  Node* parent = nullptr;
-  PathCost cost;
-  PusherSet pushers = 0;
-};
 
 const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges() {
   static const std::map<std::string, ParameterRange> ranges{
@@ -74,55 +57,7 @@ std::string range_text(const char* name) {
   return out.str();
 }
 
-/// Edges shorter than this [unit steps] are not pushes (co-located nodes differ only by pusher),
-/// and a descent this near the goal is there.
-constexpr double kMinEdge = GraspPoseSpace::kShortestPush;
-
-PusherSet single(int pusher) { return pusher < 0 ? 0u : (1u << pusher); }
 }  // namespace
-
-/// The unit steps a descent tries from `from`: turn 0 goes straight toward the goal; turn
-/// ring * 8 + k turns from it toward the k-th of eight directions square to the way to the goal,
-/// by ring / kRings of steer_angle for rings 1..kRings, and on from steer_angle evenly to 90 deg
-/// for the wide rings kRings + 1 .. 2 kRings (the start's first steps across, descend_across).
-struct TRRTstar::Steering {
-  static constexpr int kRings = 4;
-
-  Steering(const GraspPoseSpace& space, double steer_angle_deg, const Pose& from, const Pose& goal)
-      : space(space), steer_angle_deg(steer_angle_deg), from(from) {
-    const Eigen::Vector3d to_goal = space.in_unit_steps(goal - from);
-    distance = to_goal.norm();
-    length = std::min(1.0, distance);
-    if (distance < kMinEdge) return;
-    u = to_goal / distance;
-    // Two directions square to u, from the coordinate axis least aligned with it.
-    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
-    Eigen::Index least;
-    u.cwiseAbs().minCoeff(&least);
-    axis[least] = 1.0;
-    e1 = u.cross(axis).normalized();
-    e2 = u.cross(e1);
-  }
-
-  /// The last ring a descent tries: kRings (none when steer_angle is 0).
-  int rings() const { return steer_angle_deg > 0.0 ? kRings : 0; }
-
-  Pose step(int turn) const {
-    const int ring = turn / 8;
-    const double alpha_deg = ring <= kRings ? steer_angle_deg * ring / kRings
-                                            : steer_angle_deg + (90.0 - steer_angle_deg) * (ring - kRings) / kRings;
-    const double alpha = alpha_deg * M_PI / 180.0, phi = 2.0 * M_PI * (turn % 8) / 8.0;
-    const Eigen::Vector3d dir = std::cos(alpha) * u + std::sin(alpha) * (std::cos(phi) * e1 + std::sin(phi) * e2);
-    return from + space.from_unit_steps(length * dir);
-  }
-
-  const GraspPoseSpace& space;
-  double steer_angle_deg;
-  Pose from;
-  double distance = 0.0;  ///< to the goal [unit steps]
-  double length = 0.0;    ///< of a step [unit steps]: 1, or what is left
-  Eigen::Vector3d u = Eigen::Vector3d::Zero(), e1 = Eigen::Vector3d::Zero(), e2 = Eigen::Vector3d::Zero();
-};
 
 TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTstar") {
   specs_.approximateSolutions = true;
@@ -146,6 +81,18 @@ TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTsta
                        range_text("improve_for"));
   declareParam<long long>("restart_checks", this, &TRRTstar::setRestartChecks, &TRRTstar::getRestartChecks,
                           range_text("restart_checks"));
+  // What OMPL's benchmarking and planner-data tools read while a solve runs.
+  addPlannerProgressProperty("iterations INTEGER", [this] { return std::to_string(iterations_); });
+  addPlannerProgressProperty("nodes INTEGER", [this] { return std::to_string(nodes_.size()); });
+  addPlannerProgressProperty("restarts INTEGER", [this] { return std::to_string(restarts_); });
+  addPlannerProgressProperty("best switch-overs INTEGER", [this] {
+    const Node* goal = best_goal();
+    return goal ? std::to_string(goal->cost.switches) : std::string("inf");
+  });
+  addPlannerProgressProperty("best length REAL", [this] {
+    const Node* goal = best_goal();
+    return goal ? std::to_string(goal->cost.length) : std::string("inf");
+  });
 }
 
 TRRTstar::~TRRTstar() { free_tree(); }
@@ -215,52 +162,6 @@ bool TRRTstar::transition_test(double cost_from, double cost_to, double step) {
     transition_failures_ = 0;
   }
   return false;
-}
-
-// Neighbour queries scan the nodes' coordinates in unit steps, kept contiguous: exact, and
-// deterministic (ties go to the older node). Tree sizes here are thousands of nodes, where a
-// tight linear scan beats tree structures; OMPL's GNAT would also draw its pivots from OMPL's
-// global seed and make plans depend on the process's history.
-void TRRTstar::near(const Pose& q, double radius, std::vector<Node*>& out) const {
-  const Eigen::Vector3d u = space_->in_unit_steps(q);
-  const double r2 = radius * radius;
-  std::vector<std::pair<double, std::size_t>> hits;
-  for (std::size_t i = 0; i < unit_coords_.size(); ++i) {
-    const double d2 = (unit_coords_[i] - u).squaredNorm();
-    if (d2 <= r2) hits.emplace_back(d2, i);
-  }
-  std::stable_sort(hits.begin(), hits.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  out.clear();
-  for (const auto& hit : hits) out.push_back(nodes_[hit.second]);
-}
-
-TRRTstar::Node* TRRTstar::nearest_extendable(const Pose& q) const {
-  const Eigen::Vector3d u = space_->in_unit_steps(q);
-  Node* best = nullptr;
-  double best_d2 = 0.0;
-  for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    const double d2 = (unit_coords_[i] - u).squaredNorm();
-    // The coordinates are contiguous, the nodes are not: look at a node only when it would be nearer.
-    if (best != nullptr && !(d2 < best_d2)) continue;
-    if (nodes_[i]->cost.switches > max_switches_) continue;
-    best = nodes_[i];
-    best_d2 = d2;
-  }
-  return best;
-}
-
-TRRTstar::Node* TRRTstar::most_promising_toward_goal() const {
-  Node* best = nullptr;
-  PathCost best_estimate;
-  for (Node* n : nodes_) {
-    if (n->extended_to_goal || n->cost.switches > max_switches_) continue;
-    const PathCost estimate = n->cost + PathCost{0, n->goal_distance};
-    if (best == nullptr || estimate < best_estimate) {
-      best = n;
-      best_estimate = estimate;
-    }
-  }
-  return best;
 }
 
 TRRTstar::Candidate TRRTstar::choose_parent(const Pose& q_new, const std::vector<Node*>& near, Node* via,
@@ -371,82 +272,6 @@ TRRTstar::Node* TRRTstar::best_goal() const {
   return best;
 }
 
-PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob::State* scratch) const {
-  const PusherSet wedges = allowed & validator_->wedge_pushers();
-  if (wedges == 0) return 0;
-  const Eigen::Vector3d step = space_->in_unit_steps(q - from);
-  const double length = step.norm();
-  if (!(length > 0.0)) return 0;
-  for (int p = 0; p < kMaxPushers; ++p) {
-    if (!contains(wedges, p)) continue;
-    const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, step / length, length, p);
-    if (on_surface && wedge_step_valid(from, WedgeStep{0.0, *on_surface, p}, scratch)) {
-      q = *on_surface;
-      return PusherSet{1} << p;
-    }
-  }
-  GraspPoseSpace::set_pose(scratch, q);
-  return 0;
-}
-
-std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal, double length,
-                                                       PusherSet wedges) const {
-  const Eigen::Vector3d to_goal = space_->in_unit_steps(goal - from);
-  const double heading = std::atan2(to_goal[1], to_goal[0]);
-  const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
-  std::vector<WedgeStep> steps;
-  constexpr int kHeadings = 24;
-  for (int p = 0; p < kMaxPushers; ++p) {
-    if (!contains(wedges, p)) continue;
-    for (int k = 0; k < kHeadings; ++k) {
-      const double psi = heading + 2.0 * M_PI * k / kHeadings;
-      // The goal's elevation picks the root nearest to it.
-      const Eigen::Vector3d direction(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]);
-      const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, direction.normalized(), length, p);
-      if (on_surface) steps.push_back({space_->distance(*on_surface, goal), *on_surface, p});
-    }
-  }
-  std::sort(steps.begin(), steps.end(),
-            [](const WedgeStep& a, const WedgeStep& b) { return a.goal_distance < b.goal_distance; });
-  return steps;
-}
-
-bool TRRTstar::wedge_step_valid(const Pose& from, const WedgeStep& step, ob::State* scratch) const {
-  GraspPoseSpace::set_pose(scratch, step.pose);
-  return si_->isValid(scratch) && validator_->stable_pushers(from, step.pose, PusherSet{1} << step.pusher) != 0;
-}
-
-PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
-                                      ob::State* scratch, Pose& q) const {
-  const PusherSet wedges = allowed & validator_->wedge_pushers();
-  if (wedges == 0) return 0;
-  const double now = space_->distance(from, goal);
-  const std::vector<WedgeStep> steps = wedge_steps(from, goal, length, wedges);
-  const auto take = [&](const WedgeStep& step) {
-    q = step.pose;
-    GraspPoseSpace::set_pose(scratch, q);
-    return PusherSet{1} << step.pusher;
-  };
-  std::vector<const WedgeStep*> valid;
-  for (const WedgeStep& step : steps) {
-    if (!wedge_step_valid(from, step, scratch)) continue;
-    if (step.goal_distance < now) return take(step);
-    valid.push_back(&step);
-  }
-  // A local minimum of one step: one surface alone moves q in two of its three coordinates, so
-  // look two steps ahead (the second on any point pusher's surface) from the best first steps.
-  constexpr std::size_t kFirstSteps = 8;
-  for (std::size_t i = 0; i < std::min(valid.size(), kFirstSteps); ++i) {
-    const double next_length = std::min(1.0, valid[i]->goal_distance);
-    for (const WedgeStep& second : wedge_steps(valid[i]->pose, goal, next_length, validator_->wedge_pushers())) {
-      if (second.goal_distance >= now) break;
-      if (wedge_step_valid(valid[i]->pose, second, scratch)) return take(*valid[i]);
-    }
-  }
-  GraspPoseSpace::set_pose(scratch, q);
-  return 0;
-}
-
 TRRTstar::Node* TRRTstar::connect(Node* from, const Pose& q_new, PusherSet stable, int prefer) {
   near(q_new, rewire_radius_, near_);
   const Candidate best = choose_parent(q_new, near_, from, stable);
@@ -500,126 +325,6 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
     from = next;
   }
   si_->freeState(step_state);
-}
-
-void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
-  const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
-  ob::State* step_state = si_->allocState();
-  int turn = 0;  // the last step's deviation (Steering; 0: none)
-  const int descent = static_cast<int>(descent_ends_.size());
-  descent_ends_.push_back(-1.0);
-  if (from->descent < 0) from->descent = descent;
-  // Where this descent meets one that ended in a dead end well away from the goal (a node of it
-  // within half a step, with the same pusher and no more switch-overs), the rest would retrace
-  // it. Descents that ended near the goal are not cut short: there the last steps decide, and
-  // descents from nearby starts end differently.
-  const double far = 2.0 * pdef_->getGoal()->as<ob::GoalRegion>()->getThreshold();
-  const auto retraces = [&](const Node* m, const Node* next) {
-    return m != next && m->descent >= 0 && descent_ends_[m->descent] > far && m->pusher == next->pusher &&
-           m->cost.switches <= next->cost.switches && space_->distance(m->pose, next->pose) < 0.5;
-  };
-  while (!finished(ptc)) {
-    const Steering steering(*space_, steer_angle_, from->pose, goal);
-    if (steering.distance < kMinEdge) break;
-    const double length = steering.length;
-    // Pushers this node may use without exceeding the switch-over budget.
-    const PusherSet allowed = from->pusher == kNoPusher || from->cost.switches < max_switches_
-                                  ? validator_->all_pushers()
-                                  : single(from->pusher);
-    // The step toward the goal, or a deviation from it within steer_angle (Steering) that an
-    // allowed pusher makes stable, the descent's own pusher tested first (it costs no switch-over,
-    // and when it works the others need no test). After the straight step (and a point pusher's
-    // surface), the last step's deviation comes first, since a steered descent tends to keep its
-    // turn; then the rings, nearest first.
-    const PusherSet own = from->pusher == kNoPusher ? 0 : single(from->pusher);
-    const auto try_direction = [&](int turn, Pose& q) -> PusherSet {
-      q = steering.step(turn);
-      GraspPoseSpace::set_pose(step_state, q);
-      return si_->isValid(step_state) ? validator_->stable_pushers_preferring(from->pose, q, allowed, own) : 0;
-    };
-    Pose q_new;
-    int turn_taken = 0;  // ring * 8 + k of the step taken (0: straight, or onto a surface)
-    PusherSet stable = try_direction(0, q_new);
-    // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
-    if (stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
-    if (stable == 0 && turn > 0 && (stable = try_direction(turn, q_new)) != 0) turn_taken = turn;
-    for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
-      if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
-    if (stable == 0) break;
-    if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state), length))
-      break;
-    // Go on with the same pusher where it can (no switch-over); the nodes of the other pushers at
-    // q_new stay candidates for descents of their own, which start each pusher's straight way in.
-    Node* next = connect(from, q_new, stable, from->pusher);
-    next->extended_to_goal = true;  // this descent goes on from it
-    next->descent = descent;
-    if (next->cost.switches > max_switches_) break;
-    from = next;
-    // connect left q_new's near nodes in near_.
-    if (std::any_of(near_.begin(), near_.end(), [&](const Node* m) { return retraces(m, next); })) break;
-    turn = turn_taken;
-  }
-  descent_ends_[descent] = from->goal_distance;
-  si_->freeState(step_state);
-}
-
-void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition& ptc) {
-  const auto* goal = pdef_->getGoal()->as<PoseGoal>();
-  const Steering steering(*space_, steer_angle_, root->pose, goal->pose());
-  if (steering.distance < kMinEdge || steering.rings() == 0) return;
-  // A point pusher's stable pushes are a surface that no ring meets (descend_on_wedges steers
-  // onto it instead).
-  PusherSet across = validator_->all_pushers() & ~validator_->wedge_pushers();
-  for (const Node* child : root->children) across &= ~single(child->pusher);
-  // The candidates are tested together at each direction, sharing its motion wrench.
-  ob::State* scratch = si_->allocState();
-  const auto stable_at = [&](int turn, PusherSet candidates) -> PusherSet {
-    const Pose q = steering.step(turn);
-    GraspPoseSpace::set_pose(scratch, q);
-    return si_->isValid(scratch) ? validator_->stable_pushers(root->pose, q, candidates) : 0;
-  };
-  const int within = 8 * (steering.rings() + 1), wide = 8 * (2 * Steering::kRings + 1);
-  for (int turn = 0; turn < within && across != 0; turn = turn == 0 ? 8 : turn + 1) across &= ~stable_at(turn, across);
-  // Each such pusher's first steps: every stable direction of the nearest wide ring where it has
-  // one. All of them, since they tie (at 90 deg, lifting and turning the object are equally far
-  // from the goal) and only the descents after them tell which leads there.
-  std::array<std::vector<int>, kMaxPushers> first_turns;
-  for (int ring = within; ring < wide && across != 0; ring += 8) {
-    PusherSet in_ring = 0;
-    for (int turn = ring; turn < ring + 8; ++turn) {
-      const PusherSet stable = stable_at(turn, across);
-      for (int p = 0; p < kMaxPushers; ++p)
-        if (contains(stable, p)) first_turns[p].push_back(turn);
-      in_ring |= stable;
-    }
-    across &= ~in_ring;
-  }
-  // Each first step is repeated (a run across, no longer than the way to the goal), with a
-  // descent from every node of the run, while the descents end nearer the goal than the one
-  // before. The run is a deliberate climb, so the transition test does not judge it; its pusher
-  // and the grasp bound it.
-  const int longest_run = static_cast<int>(std::ceil(steering.distance));
-  for (int p = 0; p < kMaxPushers; ++p) {
-    for (const int first_turn : first_turns[p]) {
-      if (finished(ptc)) break;
-      const Pose first = steering.step(first_turn);
-      const Motion dq = first - root->pose;
-      Node* node = root;
-      double previous_end = std::numeric_limits<double>::infinity();  // [unit steps from the goal]
-      for (int k = 0; k < longest_run && !finished(ptc); ++k) {
-        const Pose q = node->pose + dq;
-        GraspPoseSpace::set_pose(scratch, q);
-        // The first step is the probe's, already tested.
-        if (k > 0 && !(si_->isValid(scratch) && validator_->stable_pushers(node->pose, q, single(p)) != 0)) break;
-        node = connect(node, q, single(p), p);
-        node->extended_to_goal = true;  // its descent is made here
-        extend_toward_goal(node, ptc);
-        if (!(descent_ends_.back() < previous_end)) break;
-        previous_end = descent_ends_.back();
-      }
-    }
-  }
-  si_->freeState(scratch);
 }
 
 ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {

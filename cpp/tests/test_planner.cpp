@@ -200,3 +200,16 @@ TEST_CASE("solve, solve: a second solve goes on growing the first one's tree (OM
     CHECK(after[i].pose.theta == before[i].pose.theta);
   }
 }
+
+TEST_CASE("statistics are OMPL progress properties", "[trrt_star]") {
+  ToyProblem problem(Pose{6e-3, 6e-3, 0.0});
+  TRRTstar planner(problem.si);
+  planner.setProblemDefinition(problem.pdef);
+  planner.setup();
+  REQUIRE(planner.solve(ob::timedPlannerTerminationCondition(5.0)) == ob::PlannerStatus::EXACT_SOLUTION);
+  const auto& properties = planner.getPlannerProgressProperties();
+  CHECK(properties.at("iterations INTEGER")() == std::to_string(planner.iterations()));
+  CHECK(properties.at("nodes INTEGER")() == std::to_string(planner.node_count()));
+  CHECK(properties.at("best switch-overs INTEGER")() == std::to_string(planner.solution_cost().switches));
+  CHECK(properties.count("restarts INTEGER") == 1);
+}

@@ -1,0 +1,213 @@
+// TRRTstar: steering toward the goal, point pushers' wedge steps, descents and runs across (extend_toward_goal,
+// descend_across).
+#include <ompl/base/goals/GoalSampleableRegion.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "stablepush/internal/trrt_star.hpp"
+#include "trrt_star_parts.hpp"
+
+namespace stablepush {
+
+PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob::State* scratch) const {
+  const PusherSet wedges = allowed & validator_->wedge_pushers();
+  if (wedges == 0) return 0;
+  const Eigen::Vector3d step = space_->in_unit_steps(q - from);
+  const double length = step.norm();
+  if (!(length > 0.0)) return 0;
+  for (int p = 0; p < kMaxPushers; ++p) {
+    if (!contains(wedges, p)) continue;
+    const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, step / length, length, p);
+    if (on_surface && wedge_step_valid(from, WedgeStep{0.0, *on_surface, p}, scratch)) {
+      q = *on_surface;
+      return PusherSet{1} << p;
+    }
+  }
+  GraspPoseSpace::set_pose(scratch, q);
+  return 0;
+}
+
+std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal, double length,
+                                                       PusherSet wedges) const {
+  const Eigen::Vector3d to_goal = space_->in_unit_steps(goal - from);
+  const double heading = std::atan2(to_goal[1], to_goal[0]);
+  const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
+  std::vector<WedgeStep> steps;
+  constexpr int kHeadings = 24;
+  for (int p = 0; p < kMaxPushers; ++p) {
+    if (!contains(wedges, p)) continue;
+    for (int k = 0; k < kHeadings; ++k) {
+      const double psi = heading + 2.0 * M_PI * k / kHeadings;
+      // The goal's elevation picks the root nearest to it.
+      const Eigen::Vector3d direction(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]);
+      const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, direction.normalized(), length, p);
+      if (on_surface) steps.push_back({space_->distance(*on_surface, goal), *on_surface, p});
+    }
+  }
+  std::sort(steps.begin(), steps.end(),
+            [](const WedgeStep& a, const WedgeStep& b) { return a.goal_distance < b.goal_distance; });
+  return steps;
+}
+
+bool TRRTstar::wedge_step_valid(const Pose& from, const WedgeStep& step, ob::State* scratch) const {
+  GraspPoseSpace::set_pose(scratch, step.pose);
+  return si_->isValid(scratch) && validator_->stable_pushers(from, step.pose, PusherSet{1} << step.pusher) != 0;
+}
+
+PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
+                                      ob::State* scratch, Pose& q) const {
+  const PusherSet wedges = allowed & validator_->wedge_pushers();
+  if (wedges == 0) return 0;
+  const double now = space_->distance(from, goal);
+  const std::vector<WedgeStep> steps = wedge_steps(from, goal, length, wedges);
+  const auto take = [&](const WedgeStep& step) {
+    q = step.pose;
+    GraspPoseSpace::set_pose(scratch, q);
+    return PusherSet{1} << step.pusher;
+  };
+  std::vector<const WedgeStep*> valid;
+  for (const WedgeStep& step : steps) {
+    if (!wedge_step_valid(from, step, scratch)) continue;
+    if (step.goal_distance < now) return take(step);
+    valid.push_back(&step);
+  }
+  // A local minimum of one step: one surface alone moves q in two of its three coordinates, so
+  // look two steps ahead (the second on any point pusher's surface) from the best first steps.
+  constexpr std::size_t kFirstSteps = 8;
+  for (std::size_t i = 0; i < std::min(valid.size(), kFirstSteps); ++i) {
+    const double next_length = std::min(1.0, valid[i]->goal_distance);
+    for (const WedgeStep& second : wedge_steps(valid[i]->pose, goal, next_length, validator_->wedge_pushers())) {
+      if (second.goal_distance >= now) break;
+      if (wedge_step_valid(valid[i]->pose, second, scratch)) return take(*valid[i]);
+    }
+  }
+  GraspPoseSpace::set_pose(scratch, q);
+  return 0;
+}
+
+void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
+  const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
+  ob::State* step_state = si_->allocState();
+  int turn = 0;  // the last step's deviation (Steering; 0: none)
+  const int descent = static_cast<int>(descent_ends_.size());
+  descent_ends_.push_back(-1.0);
+  if (from->descent < 0) from->descent = descent;
+  // Where this descent meets one that ended in a dead end well away from the goal (a node of it
+  // within half a step, with the same pusher and no more switch-overs), the rest would retrace
+  // it. Descents that ended near the goal are not cut short: there the last steps decide, and
+  // descents from nearby starts end differently.
+  const double far = 2.0 * pdef_->getGoal()->as<ob::GoalRegion>()->getThreshold();
+  const auto retraces = [&](const Node* m, const Node* next) {
+    return m != next && m->descent >= 0 && descent_ends_[m->descent] > far && m->pusher == next->pusher &&
+           m->cost.switches <= next->cost.switches && space_->distance(m->pose, next->pose) < 0.5;
+  };
+  while (!finished(ptc)) {
+    const Steering steering(*space_, steer_angle_, from->pose, goal);
+    if (steering.distance < kMinEdge) break;
+    const double length = steering.length;
+    // Pushers this node may use without exceeding the switch-over budget.
+    const PusherSet allowed = from->pusher == kNoPusher || from->cost.switches < max_switches_
+                                  ? validator_->all_pushers()
+                                  : single(from->pusher);
+    // The step toward the goal, or a deviation from it within steer_angle (Steering) that an
+    // allowed pusher makes stable, the descent's own pusher tested first (it costs no switch-over,
+    // and when it works the others need no test). After the straight step (and a point pusher's
+    // surface), the last step's deviation comes first, since a steered descent tends to keep its
+    // turn; then the rings, nearest first.
+    const PusherSet own = from->pusher == kNoPusher ? 0 : single(from->pusher);
+    const auto try_direction = [&](int turn, Pose& q) -> PusherSet {
+      q = steering.step(turn);
+      GraspPoseSpace::set_pose(step_state, q);
+      return si_->isValid(step_state) ? validator_->stable_pushers_preferring(from->pose, q, allowed, own) : 0;
+    };
+    Pose q_new;
+    int turn_taken = 0;  // ring * 8 + k of the step taken (0: straight, or onto a surface)
+    PusherSet stable = try_direction(0, q_new);
+    // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
+    if (stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
+    if (stable == 0 && turn > 0 && (stable = try_direction(turn, q_new)) != 0) turn_taken = turn;
+    for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
+      if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
+    if (stable == 0) break;
+    if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state), length))
+      break;
+    // Go on with the same pusher where it can (no switch-over); the nodes of the other pushers at
+    // q_new stay candidates for descents of their own, which start each pusher's straight way in.
+    Node* next = connect(from, q_new, stable, from->pusher);
+    next->extended_to_goal = true;  // this descent goes on from it
+    next->descent = descent;
+    if (next->cost.switches > max_switches_) break;
+    from = next;
+    // connect left q_new's near nodes in near_.
+    if (std::any_of(near_.begin(), near_.end(), [&](const Node* m) { return retraces(m, next); })) break;
+    turn = turn_taken;
+  }
+  descent_ends_[descent] = from->goal_distance;
+  si_->freeState(step_state);
+}
+
+void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition& ptc) {
+  const auto* goal = pdef_->getGoal()->as<PoseGoal>();
+  const Steering steering(*space_, steer_angle_, root->pose, goal->pose());
+  if (steering.distance < kMinEdge || steering.rings() == 0) return;
+  // A point pusher's stable pushes are a surface that no ring meets (descend_on_wedges steers
+  // onto it instead).
+  PusherSet across = validator_->all_pushers() & ~validator_->wedge_pushers();
+  for (const Node* child : root->children) across &= ~single(child->pusher);
+  // The candidates are tested together at each direction, sharing its motion wrench.
+  ob::State* scratch = si_->allocState();
+  const auto stable_at = [&](int turn, PusherSet candidates) -> PusherSet {
+    const Pose q = steering.step(turn);
+    GraspPoseSpace::set_pose(scratch, q);
+    return si_->isValid(scratch) ? validator_->stable_pushers(root->pose, q, candidates) : 0;
+  };
+  const int within = 8 * (steering.rings() + 1), wide = 8 * (2 * Steering::kRings + 1);
+  for (int turn = 0; turn < within && across != 0; turn = turn == 0 ? 8 : turn + 1) across &= ~stable_at(turn, across);
+  // Each such pusher's first steps: every stable direction of the nearest wide ring where it has
+  // one. All of them, since they tie (at 90 deg, lifting and turning the object are equally far
+  // from the goal) and only the descents after them tell which leads there.
+  std::array<std::vector<int>, kMaxPushers> first_turns;
+  for (int ring = within; ring < wide && across != 0; ring += 8) {
+    PusherSet in_ring = 0;
+    for (int turn = ring; turn < ring + 8; ++turn) {
+      const PusherSet stable = stable_at(turn, across);
+      for (int p = 0; p < kMaxPushers; ++p)
+        if (contains(stable, p)) first_turns[p].push_back(turn);
+      in_ring |= stable;
+    }
+    across &= ~in_ring;
+  }
+  // Each first step is repeated (a run across, no longer than the way to the goal), with a
+  // descent from every node of the run, while the descents end nearer the goal than the one
+  // before. The run is a deliberate climb, so the transition test does not judge it; its pusher
+  // and the grasp bound it.
+  const int longest_run = static_cast<int>(std::ceil(steering.distance));
+  for (int p = 0; p < kMaxPushers; ++p) {
+    for (const int first_turn : first_turns[p]) {
+      if (finished(ptc)) break;
+      const Pose first = steering.step(first_turn);
+      const Motion dq = first - root->pose;
+      Node* node = root;
+      double previous_end = std::numeric_limits<double>::infinity();  // [unit steps from the goal]
+      for (int k = 0; k < longest_run && !finished(ptc); ++k) {
+        const Pose q = node->pose + dq;
+        GraspPoseSpace::set_pose(scratch, q);
+        // The first step is the probe's, already tested.
+        if (k > 0 && !(si_->isValid(scratch) && validator_->stable_pushers(node->pose, q, single(p)) != 0)) break;
+        node = connect(node, q, single(p), p);
+        node->extended_to_goal = true;  // its descent is made here
+        extend_toward_goal(node, ptc);
+        if (!(descent_ends_.back() < previous_end)) break;
+        previous_end = descent_ends_.back();
+      }
+    }
+  }
+  si_->freeState(scratch);
+}
+
+}  // namespace stablepush
