@@ -53,7 +53,11 @@ class TRRTstar : public ompl::base::Planner {
   ~TRRTstar() override;
 
   void setup() override;
+  /// Grows the tree until `ptc` fires or the search is over (outcome()): EXACT_SOLUTION for
+  /// GoalReached, APPROXIMATE_SOLUTION otherwise, INVALID_START (outcome InvalidStart) when no start
+  /// is valid. A second call goes on growing the same tree; clear() starts anew.
   ompl::base::PlannerStatus solve(const ompl::base::PlannerTerminationCondition& ptc) override;
+  /// Frees the tree and the last solve's results.
   void clear() override;
   void getPlannerData(ompl::base::PlannerData& data) const override;
 
