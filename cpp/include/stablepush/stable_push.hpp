@@ -133,15 +133,15 @@ class StablePushModel {
   /// Every pad disc inside the cross-section at q.
   bool grasp_maintained(const Pose& q) const { return gripper_.grasp_maintained(section_, q); }
 
+ private:
   /// Walks the terms of the motion wrench in G: loads.force(f, arm) for a force f [N] at arm [m]
   /// from O's origin, loads.torque(t) for a pure torque [N m], loads.sticking(arm, limit, n) for a
-  /// sticking site of n pad points (Gripper::sites); `rotation` R(q.theta), computed once by the caller; `gravity` in G
-  /// [m/s^2]. Shared by the double and the exact evaluations so both see the same doubles.
+  /// sticking site of n pad points (Gripper::sites); `rotation` R(q.theta), computed once by the
+  /// caller; `gravity` in G [m/s^2]. Shared by the double and the exact evaluations so both see the
+  /// same doubles. Defined in cpp/src/motion_terms.hpp, which the core's sources include.
   template <class Loads>
   void visit_motion_terms(const Pose& q, const Rotation2& rotation, const Motion& dq, const Vec2& gravity,
                           Loads& loads) const;
-
- private:
   PushResult all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq) const;
   PushResult with_sticking(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq) const;
   PushResult exact_all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq,
