@@ -17,8 +17,6 @@ The package's layers, each importing only those below it (docs/architecture.md):
 """
 from stablepush._core import ContactCase, PlanOutcome, PushResult
 from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError
-from stablepush.execution.trajectory import Trajectory
-from stablepush.execution.trajectory import plan_trajectory as trajectory
 from stablepush.plan import Plan, PusherContact, Waypoint, check_plan, load_plan
 from stablepush.plan import plan_task as plan
 from stablepush.plan import write_plan as save_plan
@@ -32,10 +30,19 @@ __all__ = ["load_task", "parse_task", "plan", "check", "check_plan", "save_plan"
            "PushResult"]
 
 
-def __getattr__(name: str):
-    # matplotlib is loaded only when a figure is asked for (the CLI's start-up stays fast)
-    if name == "plan_figure":
-        from stablepush.viz.figures import plan_figure
+# Loaded when first used, so that `import stablepush` (and the CLI's start-up) does not pay for
+# matplotlib or the executor: name -> (module, attribute).
+_LAZY = {
+    "plan_figure": ("stablepush.viz.figures", "plan_figure"),
+    "trajectory": ("stablepush.execution.trajectory", "plan_trajectory"),
+    "Trajectory": ("stablepush.execution.trajectory", "Trajectory"),
+}
 
-        return plan_figure
-    raise AttributeError(f"module 'stablepush' has no attribute {name!r}")
+
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'stablepush' has no attribute {name!r}")
+    import importlib
+
+    module, attribute = _LAZY[name]
+    return getattr(importlib.import_module(module), attribute)

@@ -1,8 +1,24 @@
 """Execution: a checked plan in the world (features, scene), the waypoints that carry it out, the
 arm protocol, the executor that streams them, and the closed loop that corrects a run. Builds on
-`stablepush.plan` and `stablepush.task`; knows nothing of any simulator."""
-from stablepush.execution.closed_loop import ClosedLoop
-from stablepush.execution.executor import ExecutionReport, execute_plan, execution_warnings
-from stablepush.execution.trajectory import Trajectory, timed_trajectory
+`stablepush.plan` and `stablepush.task`; knows nothing of any simulator.
 
-__all__ = ["ClosedLoop", "ExecutionReport", "execute_plan", "execution_warnings", "Trajectory", "timed_trajectory"]
+The names below are loaded when first used, so that importing one module of the package (the
+arm protocol, say) does not load the executor.
+"""
+import importlib
+
+_EXPORTS = {
+    "ClosedLoop": "stablepush.execution.closed_loop",
+    "ExecutionReport": "stablepush.execution.executor",
+    "execute_plan": "stablepush.execution.executor",
+    "execution_warnings": "stablepush.execution.executor",
+    "Trajectory": "stablepush.execution.trajectory",
+    "timed_trajectory": "stablepush.execution.trajectory",
+}
+__all__ = list(_EXPORTS)
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'stablepush.execution' has no attribute {name!r}")
+    return getattr(importlib.import_module(_EXPORTS[name]), name)
