@@ -5,16 +5,17 @@
 #include <CGAL/QP_models.h>
 
 #include <limits>
+#include <vector>
 
 #include "motion_terms.hpp"
-#include "stablepush/exact.hpp"
+#include "stablepush/internal/exact.hpp"
 
 namespace stablepush {
 namespace {
 
 struct ExactLoads {
   ExactFT fx = 0, fz = 0, tau = 0;
-  boost::container::small_vector<StickingGroup, 2> groups;
+  std::vector<StickingGroup> groups;
 
   void force(const Vec2& f, const Vec2& arm) {
     const ExactFT f_x = exact(f.x()), f_z = exact(f.y());
@@ -49,7 +50,7 @@ PushResult StablePushModel::exact_all_sliding(const WrenchCone& cone, const Moti
   answer.exact = true;
   // The caller found the wrench within the certification band of the cone's span (all_sliding):
   // the facets decide, and they measure its projection onto the span.
-  answer.feasible = cone.strictly_inside_facets(required);
+  answer.feasible = strictly_inside_facets(cone.exact_rows(), required);
   return answer;
 }
 
@@ -67,9 +68,9 @@ PushResult StablePushModel::exact_sticking(const WrenchCone& cone, const MotionW
   using Program = CGAL::Quadratic_program<ExactFT>;
   Program lp(CGAL::SMALLER, false, 0, false, 0);  // free variables, rows "<=" unless set
   int row = 0;
-  for (std::size_t i = 0; i < cone.exact_facets().size(); ++i, ++row) {
+  for (std::size_t i = 0; i < cone.exact_rows().facets.size(); ++i, ++row) {
     const ExactFT k = exact(cone.facet_scales()[i]);
-    const ExactWrench a = cone.exact_facets()[i];
+    const ExactWrench a = cone.exact_rows().facets[i];
     for (int g = 0; g < groups; ++g) {
       const auto [u, v] = exact_pull_back(a, load.rotation, loads.groups[g].arm);
       lp.set_a(2 * g, row, -(k * u));
@@ -78,7 +79,7 @@ PushResult StablePushModel::exact_sticking(const WrenchCone& cone, const MotionW
     lp.set_a(t_var, row, exact(1));
     lp.set_b(row, -(k * (a * required)));
   }
-  for (const ExactWrench& e : cone.exact_equalities()) {
+  for (const ExactWrench& e : cone.exact_rows().equalities) {
     for (int g = 0; g < groups; ++g) {
       const auto [u, v] = exact_pull_back(e, load.rotation, loads.groups[g].arm);
       lp.set_a(2 * g, row, -u);

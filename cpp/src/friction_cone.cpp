@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "stablepush/internal/exact.hpp"
+
 namespace stablepush {
 namespace {
 
@@ -19,31 +21,37 @@ Wrench to_double(const ExactWrench& v) {
   return Wrench(CGAL::to_double(v.x()), CGAL::to_double(v.y()), CGAL::to_double(v.z()));
 }
 
+/// One kind of row (facets or equalities), exact and normalized: a normalized row r has
+/// sqrt(r_x^2 + r_z^2 + (torque_length r_tau)^2) = 1 (see WrenchCone).
+struct RowList {
+  std::vector<ExactWrench>& exact;
+  std::vector<double>& scales;
+  std::vector<Wrench>& rows;
+  double torque_length;
+
+  void add(const ExactWrench& row) const {
+    const Wrench r = to_double(row);
+    const double scale = 1.0 / std::sqrt(r.x() * r.x() + r.y() * r.y() + torque_length * torque_length * r.z() * r.z());
+    exact.push_back(row);
+    scales.push_back(scale);
+    rows.push_back(scale * r);
+  }
+  /// A facet row, unless a facet of the same direction is there already.
+  void add_unique(const ExactWrench& row) const {
+    for (const ExactWrench& f : exact)
+      if (same_direction(f, row)) return;
+    add(row);
+  }
+};
+
 }  // namespace
-
-double WrenchCone::row_scale(const ExactWrench& row) const {
-  const Wrench r = to_double(row);
-  return 1.0 / std::sqrt(r.x() * r.x() + r.y() * r.y() + torque_length_ * torque_length_ * r.z() * r.z());
-}
-
-void WrenchCone::add_facet(const ExactWrench& outward) {
-  for (const ExactWrench& f : exact_facets_)
-    if (same_direction(f, outward)) return;
-  const double scale = row_scale(outward);
-  exact_facets_.push_back(outward);
-  facet_scales_.push_back(scale);
-  facet_rows_.push_back(scale * to_double(outward));
-}
-
-void WrenchCone::add_equality(const ExactWrench& row) {
-  const double scale = row_scale(row);
-  exact_equalities_.push_back(row);
-  equality_scales_.push_back(scale);
-  equality_rows_.push_back(scale * to_double(row));
-}
 
 WrenchCone::WrenchCone(std::vector<Wrench> generators, double torque_length)
     : generators_(std::move(generators)), torque_length_(torque_length) {
+  auto exact_rows = std::make_shared<ExactRows>();
+  const RowList facets{exact_rows->facets, facet_scales_, facet_rows_, torque_length_};
+  const RowList equalities{exact_rows->equalities, equality_scales_, equality_rows_, torque_length_};
+  exact_rows_ = exact_rows;
   if (generators_.empty()) throw std::invalid_argument("a wrench cone needs at least one generator");
   if (!(torque_length_ > 0.0)) throw std::invalid_argument("torque_length must be > 0");
   std::vector<ExactWrench> g;
@@ -63,14 +71,14 @@ WrenchCone::WrenchCone(std::vector<Wrench> generators, double torque_length)
     for (std::size_t j = 1; j < m; ++j)
       if (!CGAL::is_positive(g[0] * g[j])) throw std::invalid_argument("the cone is not pointed");
     dimension_ = 1;
-    add_facet(-g[0]);
+    facets.add_unique(-g[0]);
     const ExactWrench axes[3] = {ExactWrench(1, 0, 0), ExactWrench(0, 1, 0), ExactWrench(0, 0, 1)};
     for (const ExactWrench& axis : axes) {
       const ExactWrench row = CGAL::cross_product(g[0], axis);
       if (is_zero(row)) continue;
-      if (!exact_equalities_.empty() && is_zero(CGAL::cross_product(exact_equalities_[0], row))) continue;
-      add_equality(row);
-      if (exact_equalities_.size() == 2) break;
+      if (!exact_rows->equalities.empty() && is_zero(CGAL::cross_product(exact_rows->equalities[0], row))) continue;
+      equalities.add(row);
+      if (exact_rows->equalities.size() == 2) break;
     }
     return;
   }
@@ -81,7 +89,7 @@ WrenchCone::WrenchCone(std::vector<Wrench> generators, double torque_length)
   if (!full) {
     // Dimension 2: a wedge in the plane with normal plane_normal, bounded by its two extreme rays.
     dimension_ = 2;
-    add_equality(plane_normal);
+    equalities.add(plane_normal);
     for (std::size_t r = 0; r < m; ++r) {
       bool any_pos = false, any_neg = false;
       for (std::size_t k = 0; k < m; ++k) {
@@ -96,7 +104,7 @@ WrenchCone::WrenchCone(std::vector<Wrench> generators, double torque_length)
           outward = -outward;
           break;
         }
-      add_facet(outward);
+      facets.add_unique(outward);
     }
     return;
   }
@@ -116,25 +124,19 @@ WrenchCone::WrenchCone(std::vector<Wrench> generators, double torque_length)
       }
       if (any_pos && any_neg) continue;
       if (any_pos && !any_neg)
-        add_facet(-n);
+        facets.add_unique(-n);
       else if (any_neg && !any_pos)
-        add_facet(n);
+        facets.add_unique(n);
       else
         throw std::invalid_argument("the cone is not pointed");
     }
-  if (exact_facets_.size() < 3) throw std::invalid_argument("the cone is not pointed");
+  if (exact_rows->facets.size() < 3) throw std::invalid_argument("the cone is not pointed");
 }
 
 double WrenchCone::distance_to_span(const Wrench& w) const {
   double distance = 0.0;
   for (const Wrench& e : equality_rows_) distance = std::max(distance, std::abs(e.dot(w)));
   return distance;
-}
-
-bool WrenchCone::strictly_inside_facets(const ExactWrench& w) const {
-  for (const ExactWrench& f : exact_facets_)
-    if (!CGAL::is_negative(f * w)) return false;
-  return true;
 }
 
 }  // namespace stablepush

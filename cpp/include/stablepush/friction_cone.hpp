@@ -2,12 +2,15 @@
 // (paper section V-A, "Feasibility Check", and ref. [Hirai91]).
 #pragma once
 
+#include <memory>
 #include <vector>
 
-#include "stablepush/exact.hpp"
 #include "stablepush/types.hpp"
 
 namespace stablepush {
+
+/// The cone's rows in exact arithmetic (CGAL), for the core's exact re-check: internal/exact.hpp.
+struct ExactRows;
 
 class WrenchCone {
  public:
@@ -26,31 +29,21 @@ class WrenchCone {
   /// Rows spanning the complement of the cone's linear span: e . w = 0 on the cone (empty for dimension 3).
   const std::vector<Wrench>& equality_rows() const { return equality_rows_; }
 
-  /// The same rows in exact arithmetic; facet_rows()[i] is exact_facets()[i] times facet_scales()[i], rounded.
-  const std::vector<ExactWrench>& exact_facets() const { return exact_facets_; }
+  /// The same rows in exact arithmetic, before their scales (internal/exact.hpp defines them).
+  const ExactRows& exact_rows() const { return *exact_rows_; }
   const std::vector<double>& facet_scales() const { return facet_scales_; }
-  const std::vector<ExactWrench>& exact_equalities() const { return exact_equalities_; }
   const std::vector<double>& equality_scales() const { return equality_scales_; }
 
   /// Distance [N] from w to the cone's linear span (largest |e . w| over the equality rows; 0 in 3-D).
   double distance_to_span(const Wrench& w) const;
 
-  /// Exact test of the facets alone (every facet row strictly negative on w): for a
-  /// lower-dimensional cone, whether w's projection onto the span is in the relative interior
-  /// (its facet rows lie in the span).
-  bool strictly_inside_facets(const ExactWrench& w) const;
-
  private:
-  void add_facet(const ExactWrench& outward);
-  void add_equality(const ExactWrench& row);
-  double row_scale(const ExactWrench& row) const;
-
   std::vector<Wrench> generators_;
   double torque_length_;
   int dimension_ = 0;
   std::vector<Wrench> facet_rows_, equality_rows_;
-  std::vector<ExactWrench> exact_facets_, exact_equalities_;
   std::vector<double> facet_scales_, equality_scales_;
+  std::shared_ptr<const ExactRows> exact_rows_;  // shared: copies of a cone share its exact rows
 };
 
 }  // namespace stablepush

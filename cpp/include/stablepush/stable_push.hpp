@@ -12,7 +12,6 @@
 // same doubles (CGAL Gmpzf sums and products, CGAL's exact LP solver for the sticking case).
 #pragma once
 
-#include <boost/container/small_vector.hpp>
 #include <string>
 #include <vector>
 
@@ -54,7 +53,7 @@ struct MotionWrench {
   /// M xi / dt - w_sliding - w_gravity in O about O's origin [N, N, N m].
   Wrench required = Wrench::Zero();
   /// Sticking pad points, grouped by location; empty in the all-sliding case.
-  boost::container::small_vector<StickingGroup, 2> sticking;
+  std::vector<StickingGroup> sticking;
   int sticking_points = 0;
   /// Sum of the magnitudes of the terms [N] (torques divided by the model's torque length).
   double scale = 0.0;

@@ -3,11 +3,16 @@
 // used are represented without error (the filtered-predicate pattern of CGAL's own kernels).
 #pragma once
 
+#ifndef STABLEPUSH_INTERNAL_ALLOWED
+#error "an internal header of the stablepush core: include stablepush/friction_cone.hpp"
+#endif
+
 #include <CGAL/Gmpzf.h>
 #include <CGAL/Simple_cartesian.h>
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace stablepush {
 
@@ -21,6 +26,20 @@ using ExactWrench = ExactKernel::Vector_3;
 inline ExactFT exact(double x) {
   if (!std::isfinite(x)) throw std::domain_error("a non-finite value reached the exact re-check (an input too large?)");
   return ExactFT(x);
+}
+
+/// A WrenchCone's rows in exact arithmetic: its facet_rows()[i] is facets[i] times facet_scales()[i],
+/// rounded, and its equality_rows()[j] is equalities[j] times equality_scales()[j], rounded.
+struct ExactRows {
+  std::vector<ExactWrench> facets, equalities;
+};
+
+/// Exact test of the facets alone (every facet row strictly negative on w): for a lower-dimensional
+/// cone, whether w's projection onto the span is in the relative interior (its facet rows lie in the span).
+inline bool strictly_inside_facets(const ExactRows& rows, const ExactWrench& w) {
+  for (const ExactWrench& f : rows.facets)
+    if (!CGAL::is_negative(f * w)) return false;
+  return true;
 }
 
 }  // namespace stablepush
