@@ -303,7 +303,7 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
   // Algorithm 1's inner loop: unit steps toward the target while each is accepted.
   const auto* goal = pdef_->getGoal()->as<ob::GoalRegion>();
   ob::State* step_state = si_->allocState();
-  while (!finished(ptc)) {
+  while (!ptc) {
     const double d = si_->distance(from->state, target);
     if (d < kMinEdge) break;
     const bool last = d <= 1.0;
@@ -351,17 +351,23 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
     begin_attempt(start_pose);
   }
 
+  // The search stops when the caller's condition fires or the anytime phase is over.
+  const ob::PlannerTerminationCondition stop = ob::plannerOrTerminationCondition(ptc, anytime_over());
+
   // Restarts against the long tail (restart_checks): a search that has made that many stable-push
   // tests without a plan starts again from the start with fresh streams and twice the budget, so
   // a seed whose first descents die where the chosen pusher cannot go on does not search there
   // for long; doubling keeps it complete. Counted in tests, not seconds, so a seed's plan is the
-  // same on any machine.
+  // same on any machine. The attempt's condition is read between iterations, never inside one.
   std::uint64_t budget = restart_checks_, attempt_began = validator_->feasibility_checks();
+  const ob::PlannerTerminationCondition attempt_over([&] {
+    return budget > 0 && outcome_ != PlanOutcome::GoalReached &&
+           validator_->feasibility_checks() - attempt_began >= budget;
+  });
 
   ob::State* sample = si_->allocState();
-  while (!finished(ptc)) {
-    if (budget > 0 && outcome_ != PlanOutcome::GoalReached &&
-        validator_->feasibility_checks() - attempt_began >= budget) {
+  while (!stop) {
+    if (attempt_over) {
       ++restarts_;
       begin_attempt(start_pose);
       attempt_began = validator_->feasibility_checks();
@@ -375,11 +381,11 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
     Node* from = nullptr;
     if (rng_->uniform01() < goal_bias_ && (from = most_promising_toward_goal()) != nullptr) {
       from->extended_to_goal = true;
-      extend_toward_goal(from, ptc);
-      if (from->parent == nullptr && !finished(ptc)) descend_across(from, ptc);
+      extend_toward_goal(from, stop);
+      if (from->parent == nullptr && !stop) descend_across(from, stop);
     } else {
       sampler_->sampleUniform(sample);
-      extend(nearest_extendable(GraspPoseSpace::pose(sample)), sample, ptc);
+      extend(nearest_extendable(GraspPoseSpace::pose(sample)), sample, stop);
     }
   }
   si_->freeState(sample);
@@ -428,12 +434,13 @@ void TRRTstar::begin_attempt(const Pose& start) {
   }
 }
 
-bool TRRTstar::finished(const ob::PlannerTerminationCondition& ptc) const {
-  if (ptc) return true;
-  if (outcome_ != PlanOutcome::GoalReached) return false;
-  return improve_for_ <= 0.0 ||
-         std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_started_).count() - first_time_ >=
-             improve_for_;
+ob::PlannerTerminationCondition TRRTstar::anytime_over() const {
+  return ob::PlannerTerminationCondition([this] {
+    if (outcome_ != PlanOutcome::GoalReached) return false;
+    return improve_for_ <= 0.0 ||
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - solve_started_).count() - first_time_ >=
+               improve_for_;
+  });
 }
 
 double TRRTstar::path_margin(const Node* node) const {

@@ -106,7 +106,7 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     return m != next && m->descent >= 0 && descent_ends_[m->descent] > far && m->pusher == next->pusher &&
            m->cost.switches <= next->cost.switches && space_->distance(m->pose, next->pose) < 0.5;
   };
-  while (!finished(ptc)) {
+  while (!ptc) {
     const Steering steering(*space_, steer_angle_, from->pose, goal);
     if (steering.distance < kMinEdge) break;
     const double length = steering.length;
@@ -189,12 +189,12 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
   const int longest_run = static_cast<int>(std::ceil(steering.distance));
   for (int p = 0; p < kMaxPushers; ++p) {
     for (const int first_turn : first_turns[p]) {
-      if (finished(ptc)) break;
+      if (ptc) break;
       const Pose first = steering.step(first_turn);
       const Motion dq = first - root->pose;
       Node* node = root;
       double previous_end = std::numeric_limits<double>::infinity();  // [unit steps from the goal]
-      for (int k = 0; k < longest_run && !finished(ptc); ++k) {
+      for (int k = 0; k < longest_run && !ptc; ++k) {
         const Pose q = node->pose + dq;
         GraspPoseSpace::set_pose(scratch, q);
         // The first step is the probe's, already tested.

@@ -208,8 +208,10 @@ class TRRTstar : public ompl::base::Planner {
   /// goal nodes now, within the budget, the one with the fewest switch-overs, then the largest
   /// least margin, then the shortest.
   void choose_improved_path();
-  /// Whether the search is over: the time is up, or a plan exists and improve_for has passed since.
-  bool finished(const ompl::base::PlannerTerminationCondition& ptc) const;
+  /// The anytime phase's end: true once a plan exists and improve_for [s] has passed since the first
+  /// (at once when improve_for is 0). solve() ORs it with the caller's condition; the helpers that
+  /// grow the tree take that combined condition as their `ptc`.
+  ompl::base::PlannerTerminationCondition anytime_over() const;
 
   PushChecker* validator_ = nullptr;  ///< the motion validator, as what the search asks of it
   const GraspPoseSpace* space_ = nullptr;
