@@ -73,11 +73,11 @@ void expose_planning(py::module_& m) {
       .def_readwrite("min_hold_ratio", &PlannerSettings::min_hold_ratio, "0: no hold requirement at the end")
       .def_readwrite("parameters", &PlannerSettings::parameters, "TRRTstar's declared parameters by name, as text");
 
-  py::class_<PlanStep>(m, "Waypoint", "The pose after a unit push, its pusher (-1 at the start) and the verdict.")
-      .def_readonly("pose", &PlanStep::pose)
-      .def_readonly("pusher", &PlanStep::pusher)
-      .def_readonly("margin", &PlanStep::margin, "[N]; NaN at the start")
-      .def_readonly("contact_case", &PlanStep::contact_case);
+  py::class_<Waypoint>(m, "Waypoint", "The pose after a unit push, its pusher (-1 at the start) and the verdict.")
+      .def_readonly("pose", &Waypoint::pose)
+      .def_readonly("pusher", &Waypoint::pusher)
+      .def_readonly("margin", &Waypoint::margin, "[N]; NaN at the start")
+      .def_readonly("contact_case", &Waypoint::contact_case);
 
   py::class_<PlanStats>(m, "PlanStats")
       .def_readonly("planning_time_s", &PlanStats::planning_time_s)

@@ -139,7 +139,7 @@ void append_pushes(Plan& plan, const GraspPoseSpace& space, const ModelSet& mode
 /// every model and the goal's hold requirement holds there (Plan::ends_at_goal).
 void finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushValidator& validator, const PoseGoal& goal,
                     const Pose& target, const ModelSet& models) {
-  const PlanStep last = plan.waypoints.back();
+  const Waypoint last = plan.waypoints.back();
   const Pose& end = last.pose;
   if (space.distance(end, target) < GraspPoseSpace::kShortestPush) {  // there: no push is that short
     plan.waypoints.back().pose = target;

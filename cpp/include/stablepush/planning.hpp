@@ -34,7 +34,7 @@ struct PlannerSettings {
 
 /// One waypoint: the pose after a unit push, the pusher that made it, and the test's verdict
 /// on that push. The first waypoint is the start: pusher kNoPusher, margin NaN.
-struct PlanStep {
+struct Waypoint {
   Pose pose;
   int pusher = kNoPusher;
   double margin = 0.0;  ///< [N]
@@ -63,7 +63,7 @@ struct PlanStats {
 
 struct Plan {
   PlanOutcome outcome = PlanOutcome::TimeLimit;
-  std::vector<PlanStep> waypoints;
+  std::vector<Waypoint> waypoints;
   PlanStats stats;
   double goal_distance = 0.0;  ///< from the last waypoint [unit steps]
   /// A solved plan ends exactly at the goal when a last, shorter push by the last pusher from the
