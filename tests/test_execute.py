@@ -51,6 +51,20 @@ def test_end_to_end_plan_execute_on_the_sim_arm(high_mu_plan, tmp_path):
     (contact,) = report["contacts"]
     assert contact["pusher"] == "left" and contact["slip_mm"] < FINAL_BOUND_MM
     assert "final pose in the grasp" in result.output
+    assert report["success"] is True and report["cause"] is None and report["engine"] == "mujoco"
+    assert report["tolerance"] == [0.5, 0.5] and "verdict: landed" in result.output
+
+
+def test_a_completed_run_that_misses_exits_5_and_names_its_cause(high_mu_plan, tmp_path):
+    plan, task = high_mu_plan
+    report_path = tmp_path / "run.json"
+    result = CliRunner().invoke(cli, ["execute", plan, "--task", task, "--sim", "--quiet", "--json", str(report_path),
+                                      "--success-tolerance", "0.001", "0.001"])
+    assert result.exit_code == 5, result.output
+    report = json.loads(report_path.read_text())
+    assert report["success"] is False and report["tolerance"] == [0.001, 0.001]
+    assert report["cause"] in ("pusher_slipped", "drift") and report["verdict"].startswith("missed the goal by")
+    assert f"[cause: {report['cause']}]" in result.output
 
 
 def test_t_shape_end_to_end_through_two_switch_overs():
@@ -99,15 +113,18 @@ def _start_sim_arm(*args):
     return process, port
 
 
-def test_server_gone_mid_plan_names_the_last_step_and_resume_finishes(high_mu_plan):
+def test_server_gone_mid_plan_names_the_last_step_and_resume_finishes(high_mu_plan, tmp_path):
     plan, task = high_mu_plan
     runner = CliRunner()
     process, port = _start_sim_arm("--exit-after", "100")
     try:
-        result = runner.invoke(cli, ["execute", plan, "--task", task, "--arm", f"127.0.0.1:{port}", "--no-pace", "--quiet"])
+        result = runner.invoke(cli, ["execute", plan, "--task", task, "--arm", f"127.0.0.1:{port}", "--no-pace", "--quiet",
+                                     "--json", str(tmp_path / "fault.json")])
     finally:
         process.wait(timeout=30)
     assert result.exit_code == 3, result.output
+    fault = json.loads((tmp_path / "fault.json").read_text())
+    assert fault["success"] is False and fault["cause"] == "arm_fault" and fault["last_confirmed_step"] == 9
     assert "closed the connection" in result.output
     assert "could not be reached to stop it" in result.output
     # 99 waypoints were acknowledged: the approach, then 10 per push: 9 pushes confirmed.
@@ -328,7 +345,7 @@ def test_a_correction_that_would_carry_an_unheld_object_between_features_is_refu
     task = shipped("horizontal-offset-high-mu")
     loop = ClosedLoop.for_task(task)
     record, steps = replan(task, (20.095, -0.223, 0.449), "left", loop, 20, (20.0, 0.0, 0.0))
-    assert not record.solved and steps == []
+    assert not record.solved and steps == [] and "less than 1.5 times its weight" in record.failure
     record, steps = replan(task, (0.1, -0.1, 0.3), "left", loop, 1, (1.0, 0.0, 0.0))
     assert record.solved and steps[0].pose == (0.1, -0.1, 0.3)
 

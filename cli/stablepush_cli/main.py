@@ -17,6 +17,7 @@ EXIT_NOT_SOLVED = 1
 EXIT_BAD_INPUT = 2
 EXIT_ARM_FAULT = 3
 EXIT_INTERNAL = 4
+EXIT_MISSED = 5  # `execute`: the run completed and the object did not land within the tolerance
 # Every error stablepush raises on purpose, and its exit status (the first class that matches).
 EXIT_STATUS = (
     (TaskError, EXIT_BAD_INPUT),
@@ -415,7 +416,12 @@ def _host_port(value: str):
 @click.option("--ack-timeout", default=5.0, show_default=True, type=click.FloatRange(min=0.01), metavar="S",
               help="Give up when the arm does not reply within S seconds.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
-              help="Write the run's report (final pose in the grasp, slip per contact, features) as JSON.")
+              help="Write the run's report as JSON: success, tolerance, cause of a miss, engine, final pose in the "
+                   "grasp, slip per contact, corrections, features (on an arm fault: the verdict and where to resume).")
+@click.option("--success-tolerance", "success_tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True),
+              default=None, metavar="MM DEG",
+              help="The run lands when the object ends within MM (x and z) and DEG of the goal in the grasp "
+                   "(default: the task's planner.tolerance).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
               metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
@@ -434,8 +440,8 @@ def _host_port(value: str):
               metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
                                      "this close to the goal (default: a fifth of the task's goal tolerance).")
 def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resume_from: int, pace,
-            ack_timeout: float, json_path, quiet: bool, mu_scale: float, tracker_noise, closed_loop: bool,
-            replan_threshold, final_tolerance) -> None:
+            ack_timeout: float, json_path, success_tolerance, quiet: bool, mu_scale: float, tracker_noise,
+            closed_loop: bool, replan_threshold, final_tolerance) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -443,6 +449,11 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
     its feature while the gripper moves; between pushes the gripper retracts, moves and approaches.
     Waypoints (G's pose in the world, m and a quaternion) go out at --rate as JSON lines over TCP and
     each is acknowledged with the arm's state.
+
+    The run ends with a verdict: it landed when the object's pose in the grasp is within the task's
+    goal tolerance (or --success-tolerance), exit 0; a completed run that missed exits 5 and names
+    its cause (grasp_lost, released_moved, correction_not_found, corrections_exhausted,
+    pusher_slipped, plan_short, drift). An arm that reports no pose in the grasp gets no verdict (exit 0).
 
     On a fault (the arm server gone, a malformed or out-of-order reply, an error from the arm) the arm
     is told to stop, the last confirmed plan step is printed, and the exit status is 3; run again with
@@ -454,7 +465,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
       stablepush sim-arm --port 47100 &     # or your robot's bridge
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
     """
-    from stablepush.execution import execute_plan, execution_warnings
+    from stablepush.execution import execute_plan, execution_warnings, fault_report
     from stablepush.execution.stream import check_resume_from
     from stablepush.outputs import write_atomically
 
@@ -502,10 +513,13 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
 
     try:
         report = execute_plan(task, plan, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
-                              ack_timeout=ack_timeout, closed_loop=loop, progress=progress)
+                              ack_timeout=ack_timeout, closed_loop=loop, success_tolerance=success_tolerance,
+                              progress=progress)
     except ArmFault as fault:
         if bar is not None:
             bar.__exit__(None, None, None)
+        if json_path:
+            write_atomically(json_path, json.dumps(fault_report(task, fault, success_tolerance), indent=1) + "\n")
         stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
         click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
                    f"{len(plan.waypoints) - 1}", err=True)
@@ -523,6 +537,8 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
     if json_path:
         write_atomically(json_path, json.dumps(report.as_dict(), indent=1) + "\n")
         click.echo(f"report written to {json_path}")
+    if report.success is False:
+        sys.exit(EXIT_MISSED)
 
 
 def _print_report(report) -> None:
@@ -541,14 +557,18 @@ def _print_report(report) -> None:
     if report.closed_loop == "no tracker":
         click.echo("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
     for r in report.replans:
-        dx, dz, dth = (m - p for m, p in zip(r.measured, r.planned))
-        if r.solved:
-            same = " (same pusher)" if r.kept_pusher else ""
-            outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{same}"
+        dx, dz, dth = (m - p for m, p in zip(r.measured, report.goal if r.trigger == "off_goal" else r.planned))
+        if r.solved and r.pushes == 0:
+            outcome = "within the final tolerance of the goal already; nothing to correct"
+        elif r.solved:
+            kept = ", starting with the pusher in contact" if r.kept_pusher and len(r.pushers) > 1 else ""
+            kept = " (the pusher in contact alone)" if r.kept_pusher and len(r.pushers) == 1 else kept
+            outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{kept}"
         else:
-            outcome = "no correction found (in time, with held transits); kept the plan"
-        click.echo(f"  after step {r.after_step}: off the plan by {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; "
-                   f"{outcome} in {r.planning_ms:.1f} ms")
+            outcome = f"no correction taken: {r.failure}; kept the plan"
+        what = "the goal" if r.trigger == "off_goal" else "the plan"
+        click.echo(f"  after step {r.after_step}: off {what} by {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; "
+                   f"{outcome} ({r.planning_ms:.1f} ms)")
     for c in report.contacts:
         if c.slip_mm is not None:
             click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} slip at the pusher "
@@ -558,6 +578,9 @@ def _print_report(report) -> None:
         click.echo(f"note: when the last feature let go the object moved in the grasp by "
                    f"{math.hypot(change['x'], change['z']):.2f} mm, "
                    f"{change['theta']:+.2f} deg: the grasp alone does not hold the final pose against gravity")
+    verdict = report.verdict
+    if verdict is not None and verdict.success is not None:
+        click.echo(f"verdict: {verdict.detail}" + (f" [cause: {verdict.cause}]" if verdict.cause else ""))
 
 
 @cli.command("sim-arm")

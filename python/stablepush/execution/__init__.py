@@ -12,6 +12,8 @@ _EXPORTS = {
     "ExecutionReport": "stablepush.execution.executor",
     "execute_plan": "stablepush.execution.executor",
     "execution_warnings": "stablepush.execution.executor",
+    "fault_report": "stablepush.execution.executor",
+    "Verdict": "stablepush.execution.verdict",
     "Trajectory": "stablepush.execution.trajectory",
     "timed_trajectory": "stablepush.execution.trajectory",
 }

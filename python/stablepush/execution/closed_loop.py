@@ -72,8 +72,9 @@ class ClosedLoop:
 @dataclass(frozen=True)
 class Replan:
     """One correction: after plan step `after_step` the object was measured at `measured` where
-    the plan had `planned`; whether a new plan from there was found and taken (`solved`), and its
-    pushers and length."""
+    the plan had `planned` (`trigger`: "off_plan" after a push, "off_goal" at rest after the last);
+    whether a new plan from there was found and taken (`solved`), its pushers and length, and, when
+    none was taken, why (`failure`)."""
 
     after_step: int
     measured: Tuple[float, float, float]
@@ -81,8 +82,10 @@ class Replan:
     solved: bool
     pushers: List[str]  # the new plan's pushers, one per contact
     pushes: int
-    kept_pusher: bool  # the new plan continues with the pusher that was pushing
+    kept_pusher: bool  # the new plan starts with the pusher that was pushing
     planning_ms: float
+    trigger: str = "off_plan"
+    failure: Optional[str] = None
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -110,7 +113,7 @@ def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float,
 
 
 def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
-           after_step: int, planned: Sequence[float]) -> Tuple[Replan, List[Waypoint]]:
+           after_step: int, planned: Sequence[float], trigger: str = "off_plan") -> Tuple[Replan, List[Waypoint]]:
     """Plan from the measured pose to the task's goal, keeping `pusher` (the one pushing now) when
     it can do it alone. Returns the record and the new plan's steps (empty when none was found);
     the first step is the measured pose."""
@@ -119,19 +122,27 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
                                planner={**task.planner, "tolerance": tolerance})
     if base.at_goal(base.start):  # off the plan but at the goal already: nothing to correct
         return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
-                      pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0), []
+                      pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
     spec = task.pushers[task.pusher_index(pusher)]
     alone = dataclasses.replace(base, pushers=(spec,),
                                 planner={**base.planner, "max_switches": 0, "time_limit": KEEP_PUSHER_TIME_LIMIT})
     result: Plan = plan_task(alone)
     elapsed = result.stats["planning_time_s"]
+    limit = min(REPLAN_TIME_LIMIT, task.planner["time_limit"])
     if not result.solved:
-        result = plan_task(base, time_limit=min(REPLAN_TIME_LIMIT, task.planner["time_limit"]))
+        result = plan_task(base, time_limit=limit)
         elapsed += result.stats["planning_time_s"]
     steps = list(result.waypoints) if result.solved else []
-    if steps and not _transits_held(task, steps, pusher):
+    failure = None
+    if not result.solved:
+        failure = (f"no plan to the final tolerance in {KEEP_PUSHER_TIME_LIMIT * 1e3:g} ms with {pusher} alone, "
+                   f"nor in {limit * 1e3:g} ms with every pusher ({result.outcome})")
+    elif not _transits_held(task, steps, pusher):
         steps = []
+        failure = (f"the plan found ({' -> '.join(result.pusher_sequence)}) carries the object between features "
+                   f"where the pads hold less than {TRANSIT_HOLD_RATIO:g} times its weight")
     record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=bool(steps),
                     pushers=result.pusher_sequence if steps else [], pushes=max(len(steps) - 1, 0),
-                    kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3)
+                    kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3,
+                    trigger=trigger, failure=failure)
     return record, steps

@@ -21,6 +21,7 @@ from stablepush.errors import ArmFault
 from stablepush.execution.closed_loop import ClosedLoop, Replan, replan
 from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from
+from stablepush.execution.verdict import Verdict, judge
 from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.plan.plan import Plan, Waypoint
@@ -75,6 +76,13 @@ class ExecutionReport:
     closed_loop: str = "off"
     replans: List[Replan] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)  # execution_warnings(task)
+    engine: Optional[str] = None  # the simulator that ran it, as the arm server says ("mujoco"); None for an arm
+    verdict: Optional[Verdict] = None  # whether it landed, and why not (stablepush.execution.verdict)
+
+    @property
+    def success(self) -> Optional[bool]:
+        """Whether the object landed at the goal within the verdict's tolerance (None: not measured)."""
+        return self.verdict.success if self.verdict is not None else None
 
     @property
     def final_error(self) -> Optional[Dict[str, float]]:
@@ -111,8 +119,11 @@ class ExecutionReport:
                                        or abs(change["theta"]) > RELEASE_MOVE[1])
 
     def as_dict(self) -> dict:
+        verdict = self.verdict.as_dict() if self.verdict is not None else {}
         return {
-            "task": self.task, "resumed_from": self.resumed_from, "last_confirmed_step": self.last_confirmed_step,
+            "task": self.task, "success": verdict.get("success"), "tolerance": verdict.get("tolerance"),
+            "cause": verdict.get("cause"), "verdict": verdict.get("detail"), "engine": self.engine,
+            "resumed_from": self.resumed_from, "last_confirmed_step": self.last_confirmed_step,
             "total_steps": self.total_steps, "waypoints": self.waypoints, "planned_final": list(self.planned_final),
             "goal": list(self.goal), "final_in_grasp": self.final_in_grasp, "final_error": self.final_error,
             "goal_error": self.goal_error,
@@ -161,6 +172,7 @@ def execute_plan(
     pace: bool = True,
     ack_timeout: float = DEFAULT_ACK_TIMEOUT,
     closed_loop: Optional[ClosedLoop] = None,
+    success_tolerance: Optional[Sequence[float]] = None,
     progress: Optional[Callable[[ArmWaypoint, int, int], None]] = None,
 ) -> ExecutionReport:
     """Stream the plan from step `resume_from` to the arm server at host:port. `pace` holds the
@@ -168,8 +180,10 @@ def execute_plan(
     acknowledged (a simulator keeps its own clock). With `closed_loop`, the tracker's pose after
     each push is compared with the plan's and, past its threshold, the rest of the run is re-planned
     from the measured pose and spliced into the stream (`stablepush.closed_loop`); the world then
-    holds a feature for every pusher of the task. `progress(waypoint, confirmed_step, total_steps)`
-    is called per ack. `plan`: a plan checked against the task (stablepush.plan.verify.check_plan).
+    holds a feature for every pusher of the task. The report's verdict judges the final pose with
+    `success_tolerance` (mm, deg; default: the task's goal tolerance). `progress(waypoint,
+    confirmed_step, total_steps)` is called per ack. `plan`: a plan checked against the task
+    (stablepush.plan.verify.check_plan).
     PlanError (field `resume_from`) before anything is sent when the plan has no push after it."""
     steps: List[Waypoint] = list(plan.waypoints)
     check_resume_from(steps, resume_from)
@@ -233,14 +247,26 @@ def execute_plan(
     finally:
         if link is not None:
             link.close()
-    return ExecutionReport(
+    report = ExecutionReport(
         task=task.name, resumed_from=resume_from, last_confirmed_step=last_confirmed, total_steps=len(steps) - 1,
         waypoints=sent, planned_final=steps[-1].pose, goal=task.goal,
         final_in_grasp=(settled or state).get("object_in_grasp"), released_in_grasp=state.get("object_in_grasp"),
         contacts=list(contacts.values()), features=[f.as_dict() for f in features.values()],
         wall_time_s=time.perf_counter() - started, sim_steps_per_s=state.get("steps_per_s"),
-        closed_loop=loop_status, replans=replans, warnings=execution_warnings(task),
+        closed_loop=loop_status, replans=replans, warnings=execution_warnings(task), engine=ready.get("engine"),
     )
+    report.verdict = judge(task, report, success_tolerance, closed_loop.max_replans if closed_loop else None)
+    return report
+
+
+def fault_report(task: Task, fault: ArmFault, success_tolerance: Optional[Sequence[float]] = None) -> dict:
+    """The report of a run that ended in an arm fault, in the fields of ExecutionReport.as_dict that
+    a script reads first: the verdict (cause "arm_fault"), the reason and where to resume."""
+    verdict = Verdict.for_fault(success_tolerance if success_tolerance is not None else task.planner["tolerance"],
+                                fault.reason)
+    return {"task": task.name, "success": verdict.success, "tolerance": list(verdict.tolerance),
+            "cause": verdict.cause, "verdict": verdict.detail, "last_confirmed_step": fault.last_confirmed_step,
+            "arm_stopped": fault.arm_stopped}
 
 
 def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
@@ -257,7 +283,8 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     if not loop.off_by(tracked, task.goal if last else steps[k].pose, loop.final_tolerance if last else loop.threshold):
         return None
     measured = (float(tracked["x"]), float(tracked["z"]), float(tracked["theta"]))
-    record, new_steps = replan(task, measured, steps[k].pusher, loop, k, steps[k].pose)
+    record, new_steps = replan(task, measured, steps[k].pusher, loop, k, steps[k].pose,
+                               trigger="off_goal" if last else "off_plan")
     replans.append(record)
     if not record.solved or record.pushes == 0:
         return None

@@ -23,6 +23,7 @@ client -> server
 
 server -> client
   {"type": "ready", "protocol": "stablepush.arm/2", "arm": "...", "state": {...}}
+      optional "engine": the simulator behind the arm ("mujoco"), reported with the run
   {"type": "ack", "seq": 0, "state": {...}}
   {"type": "stopped", "state": {...}}
   {"type": "error", "seq": 3 or null, "message": "..."}   the server has stopped the arm

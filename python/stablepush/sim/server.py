@@ -117,7 +117,7 @@ class SimArmServer:
                     greeted = True
                     expected_seq = 0
                     reply = {"type": "ready", "protocol": message["protocol"], "arm": "stablepush sim-arm (MuJoCo)",
-                             "state": self.arm.state()}
+                             "engine": "mujoco", "state": self.arm.state()}
                 elif kind == "waypoint":
                     if message["seq"] != expected_seq:
                         raise ProtocolError(f"out-of-order waypoint: expected seq {expected_seq}, got {message['seq']}")

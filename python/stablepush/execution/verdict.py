@@ -1,0 +1,112 @@
+"""The verdict on a run: did the object land at the task's goal in the grasp, and if not, why.
+
+A run lands when the object's pose in the grasp at rest after the last push (`goal_error`) is
+within the tolerance of the goal in each coordinate: |dx|, |dz| <= mm and |dtheta| <= deg, the
+rule by which the planner itself stops (`Task.at_goal`). The tolerance is the task's
+`planner.tolerance` unless the caller gives one. Whether the grasp alone then holds the object
+there when the last feature lets go is a fact of the task (its hold ratio at the goal), reported
+beside the verdict (`ExecutionReport.release_moved`), not folded into it.
+
+A miss is given one cause, the first of CAUSES that applies, so a script can act on it:
+
+- `grasp_lost`: at the final pose some pad is no longer on the object (`grasp_maintained`);
+- `correction_not_found`: the closed loop was off the plan and found no correction (each re-plan's
+  `failure` says why);
+- `corrections_exhausted`: the closed loop made as many corrections as it may and is still off;
+- `pusher_slipped`: a pusher slipped on its feature by more than SLIP_FRACTION of the tolerance;
+- `plan_short`: the plan itself ends outside the tolerance (the planner's own tolerance is wider);
+- `drift`: none of the above, the error grew without one large slip.
+
+A run that ends in an arm fault is the cause `arm_fault` (`Verdict.for_fault`); a run whose arm
+does not report the object in the grasp has no verdict (`success` None, cause `not_measured`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Dict, Optional, Sequence, Tuple
+
+from stablepush.task.model import Task
+from stablepush.units import pose_to_si
+
+CAUSES = ("grasp_lost", "correction_not_found", "corrections_exhausted", "pusher_slipped",
+          "plan_short", "drift", "arm_fault", "not_measured")
+# A contact counts as slipped past this fraction of the tolerance (mm at the pusher, deg).
+SLIP_FRACTION = 0.5
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """success: the run landed (None: the arm does not report the object, so it is not known);
+    tolerance: (mm, deg) it was judged with; cause: one of CAUSES for a miss, else None; detail:
+    one sentence for a person."""
+
+    success: Optional[bool]
+    tolerance: Tuple[float, float]
+    cause: Optional[str]
+    detail: str
+
+    @classmethod
+    def for_fault(cls, tolerance: Sequence[float], reason: str) -> "Verdict":
+        return cls(False, _pair(tolerance), "arm_fault", f"the run ended in an arm fault: {reason}")
+
+    def as_dict(self) -> dict:
+        return {"success": self.success, "tolerance": list(self.tolerance), "cause": self.cause,
+                "detail": self.detail}
+
+
+def success_tolerance(task: Task, tolerance: Optional[Sequence[float]] = None) -> Tuple[float, float]:
+    """The tolerance (mm, deg) a run of `task` is judged with: `tolerance`, else the task's own."""
+    return _pair(tolerance if tolerance is not None else task.planner["tolerance"])
+
+
+def within(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[float]) -> bool:
+    """Whether `pose` (x, z mm, theta deg) is within `tolerance` of `goal` in each coordinate."""
+    return (abs(pose["x"] - goal[0]) <= tolerance[0] and abs(pose["z"] - goal[1]) <= tolerance[0]
+            and abs(pose["theta"] - goal[2]) <= tolerance[1])
+
+
+def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
+          max_replans: Optional[int] = None) -> Verdict:
+    """The verdict on a completed run (`ExecutionReport`), judged with `tolerance` (mm, deg; default:
+    the task's). `max_replans`: the closed loop's budget, when it ran."""
+    tol = success_tolerance(task, tolerance)
+    final = report.final_in_grasp
+    if final is None:
+        return Verdict(None, tol, "not_measured", "the arm does not report the object in the grasp, so whether "
+                                                  "it landed is not known")
+    off = _describe(final, task.goal)
+    if within(final, task.goal, tol):
+        return Verdict(True, tol, None, f"landed {off} from the goal, within {tol[0]:g} mm and {tol[1]:g} deg")
+
+    def miss(cause: str, why: str) -> Verdict:
+        return Verdict(False, tol, cause, f"missed the goal by {off} (tolerance {tol[0]:g} mm, {tol[1]:g} deg): {why}")
+
+    if not task.build_model().grasp_maintained(pose_to_si((final["x"], final["z"], final["theta"]))):
+        return miss("grasp_lost", "a pad is no longer on the object at the final pose")
+    failed = [r for r in report.replans if not r.solved]
+    if failed:
+        last = failed[-1]
+        return miss("correction_not_found", f"no correction found after step {last.after_step} ({last.failure})")
+    if report.closed_loop == "on" and max_replans is not None and len(report.replans) >= max_replans:
+        return miss("corrections_exhausted", f"the closed loop made its {max_replans} corrections and is still off")
+    slipped = [c for c in report.contacts if c.slip_mm is not None
+               and (c.slip_mm > SLIP_FRACTION * tol[0] or c.slip_deg > SLIP_FRACTION * tol[1])]
+    if slipped:
+        worst = max(slipped, key=lambda c: c.slip_mm / tol[0] + c.slip_deg / tol[1])
+        return miss("pusher_slipped", f"{worst.pusher} slipped {worst.slip_mm:.2f} mm, {worst.slip_deg:.2f} deg on its "
+                                      f"feature over steps {worst.first_step}-{worst.last_step}")
+    planned = dict(zip(("x", "z", "theta"), report.planned_final))
+    if not within(planned, task.goal, tol):
+        return miss("plan_short", f"the plan itself ends {_describe(planned, task.goal)} from the goal")
+    return miss("drift", "no pusher slipped past half the tolerance; the error built up over the run")
+
+
+def _describe(pose: Dict[str, float], goal: Sequence[float]) -> str:
+    return (f"{math.hypot(pose['x'] - goal[0], pose['z'] - goal[1]):.3f} mm, "
+            f"{pose['theta'] - goal[2]:+.3f} deg")
+
+
+def _pair(values: Sequence[float]) -> Tuple[float, float]:
+    mm, deg = (float(v) for v in values)
+    return mm, deg

@@ -1,0 +1,95 @@
+"""The verdict on a run (`stablepush.execution.verdict`): hand-made reports, one per cause, and
+the order in which causes are given."""
+import dataclasses
+
+import pytest
+
+from stablepush.execution.closed_loop import Replan
+from stablepush.execution.executor import ContactRecord, ExecutionReport
+from stablepush.execution.verdict import CAUSES, Verdict, judge, success_tolerance, within
+
+from conftest import shipped
+
+TASK = shipped("horizontal-offset-high-mu")  # goal (20, 0, 0), tolerance 0.5 mm, 0.5 deg
+
+
+def _report(final, released=None, contacts=(), replans=(), closed_loop="off", planned=(20.0, 0.0, 0.0)):
+    pose = None if final is None else dict(zip(("x", "z", "theta"), final))
+    after = None if released is None else dict(zip(("x", "z", "theta"), released))
+    return ExecutionReport(task=TASK.name, resumed_from=0, last_confirmed_step=20, total_steps=20, waypoints=200,
+                           planned_final=planned, goal=TASK.goal, final_in_grasp=pose, released_in_grasp=after,
+                           contacts=list(contacts), closed_loop=closed_loop, replans=list(replans))
+
+
+def _replan(solved, failure=None):
+    return Replan(after_step=5, measured=(5.0, 0.3, 0.0), planned=(5.0, 0.0, 0.0), solved=solved, pushers=[],
+                  pushes=0, kept_pusher=False, planning_ms=1.0, failure=failure)
+
+
+def test_the_goal_tolerance_is_the_tasks_per_coordinate_unless_given():
+    assert TASK.goal == (20.0, 0.0, 0.0) and success_tolerance(TASK) == (0.5, 0.5)
+    assert success_tolerance(TASK, [0.2, 0.3]) == (0.2, 0.3)
+    # Per coordinate, as Task.at_goal: 0.45 mm in x and 0.45 mm in z is 0.64 mm away, and within.
+    assert within({"x": 20.45, "z": 0.45, "theta": -0.45}, TASK.goal, (0.5, 0.5))
+    assert not within({"x": 20.0, "z": 0.0, "theta": 0.51}, TASK.goal, (0.5, 0.5))
+
+
+def test_a_run_within_tolerance_landed():
+    v = judge(TASK, _report((20.3, -0.2, 0.4)))
+    assert v.success is True and v.cause is None and "landed" in v.detail
+    # The pose at rest on the last feature decides; what the release does is reported beside it.
+    report = _report((20.3, -0.2, 0.4), released=(28.0, -0.2, 23.0))
+    assert judge(TASK, report).success is True and report.release_moved
+
+
+def test_a_tighter_tolerance_turns_the_same_run_into_a_miss():
+    report = _report((20.3, -0.2, 0.4))
+    v = judge(TASK, report, (0.2, 0.2))
+    assert v.success is False and v.tolerance == (0.2, 0.2) and v.cause == "drift"
+
+
+def test_a_slipping_pusher_is_the_cause_and_named():
+    slips = [ContactRecord("left", 1, 10, slip_mm=0.1, slip_deg=0.1), ContactRecord("left", 11, 20, slip_mm=1.4,
+                                                                                    slip_deg=0.2)]
+    v = judge(TASK, _report((21.6, 0.0, 0.0), contacts=slips))
+    assert v.cause == "pusher_slipped" and "left slipped 1.40 mm" in v.detail and "steps 11-20" in v.detail
+    # Slips below half the tolerance (0.25 mm, 0.25 deg) are not blamed.
+    small = [dataclasses.replace(slips[1], slip_mm=0.24, slip_deg=0.24)]
+    assert judge(TASK, _report((21.6, 0.0, 0.0), contacts=small)).cause == "drift"
+
+
+def test_a_plan_that_stops_short_is_its_own_cause():
+    v = judge(TASK, _report((18.5, 0.0, 0.0), planned=(18.5, 0.0, 0.0)))
+    assert v.cause == "plan_short" and "the plan itself ends 1.500 mm" in v.detail
+
+
+def test_a_failed_correction_comes_before_the_slip_that_asked_for_it():
+    slip = [ContactRecord("left", 1, 20, slip_mm=1.5, slip_deg=0.0)]
+    replans = [_replan(True), _replan(False, failure="no plan to the final tolerance in 50 ms")]
+    v = judge(TASK, _report((21.5, 0.0, 0.0), contacts=slip, replans=replans, closed_loop="on"), max_replans=20)
+    assert v.cause == "correction_not_found" and "no plan to the final tolerance in 50 ms" in v.detail
+    v = judge(TASK, _report((21.5, 0.0, 0.0), contacts=slip, replans=[_replan(True)] * 3, closed_loop="on"),
+              max_replans=3)
+    assert v.cause == "corrections_exhausted"
+
+
+def test_a_pad_off_the_object_is_a_lost_grasp():
+    # The prism is 40 mm wide: 60 mm along x puts the pads' centre past its edge.
+    v = judge(TASK, _report((60.0, 0.0, 0.0), contacts=[ContactRecord("left", 1, 20, slip_mm=40.0, slip_deg=0.0)]))
+    assert v.cause == "grasp_lost"
+
+
+def test_an_arm_without_a_tracker_gets_no_verdict_and_a_fault_is_a_miss():
+    v = judge(TASK, _report(None))
+    assert v.success is None and v.cause == "not_measured"
+    fault = Verdict.for_fault((1, 1), "the arm server closed the connection")
+    assert fault.success is False and fault.cause == "arm_fault" and "closed the connection" in fault.detail
+    assert {v.cause, fault.cause} <= set(CAUSES)
+
+
+@pytest.mark.parametrize("key", ["success", "tolerance", "cause", "verdict", "engine"])
+def test_the_json_report_carries_the_verdict(key):
+    report = _report((20.3, -0.2, 0.4))
+    report.verdict = judge(TASK, report)
+    assert key in report.as_dict()
+    assert report.as_dict()["success"] is True and report.success is True
