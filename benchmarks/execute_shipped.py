@@ -4,6 +4,10 @@ the tasks of data/tasks/more, which nothing was tuned for.
 `--mu-scale` runs each plan again in worlds whose pads' and features' mu differ from the task's.
 
     python3 benchmarks/execute_shipped.py [TASK.yaml ...] [--seed 1] [--mu-scale 1 0.85 1.15] [--closed-loop]
+                                          [--success-tolerance MM DEG]
+
+The verdict column is the run's (stablepush.execution.verdict): landed within the task's goal
+tolerance, or --success-tolerance, or missed and why.
 """
 import argparse
 import math
@@ -26,20 +30,23 @@ def main() -> None:
     parser.add_argument("--mu-scale", type=float, nargs="+", default=[1.0], metavar="S",
                         help="world mu / task mu, one run per value (default 1)")
     parser.add_argument("--closed-loop", action="store_true", help="re-plan from the tracked pose (stablepush.closed_loop)")
+    parser.add_argument("--success-tolerance", type=float, nargs=2, default=None, metavar=("MM", "DEG"),
+                        help="judge each run with this tolerance (default: the task's goal tolerance)")
     args = parser.parse_args()
     print("| task | world mu | loop | pushes | contacts | final error mm | final error deg | goal error mm / deg "
-          "| re-plans | max slip at pusher mm (deg) | release moves it mm / deg | sim steps/s | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| re-plans | max slip at pusher mm (deg) | release moves it mm / deg | verdict | sim steps/s | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
         task = load_task(path)
         plan = check_plan(task, plan_task(task, seed=args.seed))
         for scale in args.mu_scale:
-            _run(task, plan, scale, ClosedLoop.for_task(task) if args.closed_loop else None)
+            _run(task, plan, scale, ClosedLoop.for_task(task) if args.closed_loop else None, args.success_tolerance)
 
 
-def _run(task, plan, mu_scale: float, loop) -> None:
+def _run(task, plan, mu_scale: float, loop, tolerance) -> None:
     with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=mu_scale)) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop)
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop,
+                              success_tolerance=tolerance)
     err, goal = report.final_error, report.goal_error
     replans = f"{sum(r.solved for r in report.replans)}" + (f" (+{sum(not r.solved for r in report.replans)} failed)"
                                                             if any(not r.solved for r in report.replans) else "")
@@ -50,6 +57,7 @@ def _run(task, plan, mu_scale: float, loop) -> None:
           f"| {err['distance']:.2f} | {err['theta']:+.2f} | {goal['distance']:.2f} / {goal['theta']:+.2f} | {replans} "
           f"| {slip.slip_mm:.2f} ({slip.slip_deg:.2f}) "
           f"| {math.hypot(release['x'], release['z']):.2f} / {release['theta']:+.2f} "
+          f"| {'landed' if report.success else 'missed: ' + str(report.verdict.cause)} "
           f"| {report.sim_steps_per_s:.0f} | {report.wall_time_s:.1f} |", flush=True)
 
 

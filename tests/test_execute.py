@@ -346,6 +346,7 @@ def test_a_correction_that_would_carry_an_unheld_object_between_features_is_refu
     loop = ClosedLoop.for_task(task)
     record, steps = replan(task, (20.095, -0.223, 0.449), "left", loop, 20, (20.0, 0.0, 0.0))
     assert not record.solved and steps == [] and "less than 1.5 times its weight" in record.failure
+    assert record.failure.startswith("left alone in 50 ms: ") and "every pusher in 500 ms: " in record.failure
     record, steps = replan(task, (0.1, -0.1, 0.3), "left", loop, 1, (1.0, 0.0, 0.0))
     assert record.solved and steps[0].pose == (0.1, -0.1, 0.3)
 

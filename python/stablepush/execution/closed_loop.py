@@ -6,7 +6,7 @@ The policy lives here; `executor.py` streams and splices. A re-plan
 - aims at the task's goal within the final tolerance (a run is checked again at rest after its
   last push, and corrected again while it is off by more);
 - first tries the pusher that is pushing now alone (no switch-over: the object stays on its
-  feature), then every pusher of the task within the task's switch-over budget; a switch-over
+  feature), then every pusher of the task with one switch-over more than its budget; a switch-over
   carries the object between features in the pads alone, so that plan is taken only if the pads
   hold TRANSIT_HOLD_RATIO times the object's weight (`hold_ratio`) at every pose where it changes
   pusher, the measured pose included when it starts with another pusher;
@@ -19,9 +19,10 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
-from stablepush.plan.plan import Plan, Waypoint
+from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
 from stablepush.task.model import Task
+from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import pose_to_si
 
 THRESHOLD_FRACTION = 0.5  # default threshold: this fraction of the task's goal tolerance
@@ -112,11 +113,28 @@ def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float,
     return measured["x"] - pose[0], measured["z"] - pose[1], measured["theta"] - pose[2]
 
 
+@dataclass(frozen=True)
+class _Attempt:
+    """One way to look for a correction: with the pusher in contact alone, or with every pusher and
+    one switch-over more than the task allows (a correction may need a pusher the plan did not)."""
+
+    every_pusher: bool
+    time_limit: float  # s
+
+    def describe(self, pusher: str) -> str:
+        return f"{'every pusher' if self.every_pusher else pusher + ' alone'} in {self.time_limit * 1e3:g} ms"
+
+
+# The pusher in contact first: no switch-over, the object stays on its feature.
+ATTEMPTS = (_Attempt(False, KEEP_PUSHER_TIME_LIMIT), _Attempt(True, REPLAN_TIME_LIMIT))
+
+
 def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
            after_step: int, planned: Sequence[float], trigger: str = "off_plan") -> Tuple[Replan, List[Waypoint]]:
-    """Plan from the measured pose to the task's goal, keeping `pusher` (the one pushing now) when
-    it can do it alone. Returns the record and the new plan's steps (empty when none was found);
-    the first step is the measured pose."""
+    """Plan from the measured pose to the task's goal within the loop's final tolerance, trying
+    ATTEMPTS in turn (the pusher pushing now alone first) and taking the first plan whose transits
+    are held. Returns the record and the new plan's steps (empty when none was found); the first
+    step is the measured pose."""
     tolerance = list(loop.final_tolerance)
     base = dataclasses.replace(task, start=tuple(measured),
                                planner={**task.planner, "tolerance": tolerance})
@@ -124,25 +142,27 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
     spec = task.pushers[task.pusher_index(pusher)]
-    alone = dataclasses.replace(base, pushers=(spec,),
-                                planner={**base.planner, "max_switches": 0, "time_limit": KEEP_PUSHER_TIME_LIMIT})
-    result: Plan = plan_task(alone)
-    elapsed = result.stats["planning_time_s"]
-    limit = min(REPLAN_TIME_LIMIT, task.planner["time_limit"])
-    if not result.solved:
-        result = plan_task(base, time_limit=limit)
+    elapsed, tried, steps = 0.0, [], []
+    for attempt in ATTEMPTS:
+        planner = {**base.planner, "time_limit": min(attempt.time_limit, task.planner["time_limit"])}
+        if attempt.every_pusher:
+            planner["max_switches"] = min(task.planner["max_switches"] + 1, PLANNER_PARAMETER_RANGES["max_switches"][2])
+            candidate = dataclasses.replace(base, planner=planner)
+        else:
+            candidate = dataclasses.replace(base, pushers=(spec,), planner={**planner, "max_switches": 0})
+        result = plan_task(candidate)
         elapsed += result.stats["planning_time_s"]
-    steps = list(result.waypoints) if result.solved else []
-    failure = None
-    if not result.solved:
-        failure = (f"no plan to the final tolerance in {KEEP_PUSHER_TIME_LIMIT * 1e3:g} ms with {pusher} alone, "
-                   f"nor in {limit * 1e3:g} ms with every pusher ({result.outcome})")
-    elif not _transits_held(task, steps, pusher):
-        steps = []
-        failure = (f"the plan found ({' -> '.join(result.pusher_sequence)}) carries the object between features "
-                   f"where the pads hold less than {TRANSIT_HOLD_RATIO:g} times its weight")
+        if not result.solved:
+            tried.append(f"{attempt.describe(pusher)}: {result.outcome}")
+            continue
+        if not _transits_held(task, result.waypoints, pusher):
+            tried.append(f"{attempt.describe(pusher)}: {' -> '.join(result.pusher_sequence)} carries the object "
+                         f"between features where the pads hold less than {TRANSIT_HOLD_RATIO:g} times its weight")
+            continue
+        steps = list(result.waypoints)
+        break
     record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=bool(steps),
                     pushers=result.pusher_sequence if steps else [], pushes=max(len(steps) - 1, 0),
                     kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3,
-                    trigger=trigger, failure=failure)
+                    trigger=trigger, failure=None if steps else "; ".join(tried))
     return record, steps
