@@ -407,3 +407,22 @@ def test_executing_a_moving_pusher_task_warns_that_the_arm_pushes_against_fixed_
     result = CliRunner().invoke(cli, ["execute", str(plan), "--task", str(task_file), "--sim", "--quiet"])
     assert result.exit_code == 0, result.output
     assert "by_moving_pusher" in result.output and "another cell" in result.output
+
+
+def test_closed_loop_lands_the_wedge_in_a_low_friction_world_and_says_so(tmp_path):
+    """A user's wedge (data/tasks/more/wedge-heel.yaml) whose heel stop creeps open loop: in a world
+    with 15% less mu than its task, closed loop, the run lands within 0.2 mm and 0.2 deg of the goal,
+    the report says success and lists the corrections with what triggered them."""
+    task = str(TASKS / "more" / "wedge-heel.yaml")
+    plan, report_path = tmp_path / "wedge.plan.json", tmp_path / "run.json"
+    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--quiet", "--closed-loop",
+                                      "--sim-mu-scale", "0.85", "--success-tolerance", "0.2", "0.2",
+                                      "--json", str(report_path)])
+    assert result.exit_code == 0, result.output
+    report = json.loads(report_path.read_text())
+    assert report["success"] is True and report["tolerance"] == [0.2, 0.2] and report["engine"] == "mujoco"
+    err = report["goal_error"]
+    assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
+    assert report["replans"] and all(r["trigger"] in ("off_plan", "off_goal") for r in report["replans"])
+    assert any(r["solved"] and r["pushes"] > 0 for r in report["replans"])
