@@ -55,14 +55,18 @@ void expose_planning(py::module_& m) {
   py::class_<PlannerSettings>(m, "PlannerSettings", "What to plan: start and goal, the unit step, the limits.")
       .def(py::init([](const Pose& start, const Pose& goal, const StepSize& step, const StepSize& tolerance,
                        double time_limit, double min_margin, double sampling_margin, double min_hold_ratio,
-                       std::map<std::string, std::string> parameters) {
-             return PlannerSettings{start,           goal,           step,
-                                    tolerance,       time_limit,     min_margin,
-                                    sampling_margin, min_hold_ratio, std::move(parameters)};
+                       std::map<std::string, std::string> parameters, double min_transit_hold, int start_pusher) {
+             PlannerSettings s{start,           goal,           step,
+                               tolerance,       time_limit,     min_margin,
+                               sampling_margin, min_hold_ratio, std::move(parameters)};
+             s.min_transit_hold = min_transit_hold;
+             s.start_pusher = start_pusher;
+             return s;
            }),
            py::kw_only(), py::arg("start"), py::arg("goal"), py::arg("step"), py::arg("tolerance"),
            py::arg("time_limit") = 10.0, py::arg("min_margin") = 1e-3, py::arg("sampling_margin") = 5.0,
-           py::arg("min_hold_ratio") = 0.0, py::arg("parameters") = std::map<std::string, std::string>{})
+           py::arg("min_hold_ratio") = 0.0, py::arg("parameters") = std::map<std::string, std::string>{},
+           py::arg("min_transit_hold") = 0.0, py::arg("start_pusher") = kNoPusher)
       .def_readwrite("start", &PlannerSettings::start, "[m, m, rad]")
       .def_readwrite("goal", &PlannerSettings::goal, "[m, m, rad]")
       .def_readwrite("step", &PlannerSettings::step, "one unit step [m, rad]")
@@ -71,6 +75,9 @@ void expose_planning(py::module_& m) {
       .def_readwrite("min_margin", &PlannerSettings::min_margin, "least depth inside the pusher's cone [N]")
       .def_readwrite("sampling_margin", &PlannerSettings::sampling_margin, "[unit steps] around the start-goal box")
       .def_readwrite("min_hold_ratio", &PlannerSettings::min_hold_ratio, "0: no hold requirement at the end")
+      .def_readwrite("min_transit_hold", &PlannerSettings::min_transit_hold,
+                     "switch pushers only where the pads hold this many times the weight (0: anywhere)")
+      .def_readwrite("start_pusher", &PlannerSettings::start_pusher, "the pusher in contact at the start, or -1")
       .def_readwrite("parameters", &PlannerSettings::parameters, "TRRTstar's declared parameters by name, as text");
 
   py::class_<Waypoint>(m, "Waypoint", "The pose after a unit push, its pusher (-1 at the start) and the verdict.")

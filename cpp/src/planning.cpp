@@ -85,6 +85,9 @@ void check_settings(const PlannerSettings& s) {
     throw std::invalid_argument("sampling_margin must be >= 0");
   if (!(std::isfinite(s.min_hold_ratio) && s.min_hold_ratio >= 0.0))
     throw std::invalid_argument("min_hold_ratio must be >= 0");
+  if (!(std::isfinite(s.min_transit_hold) && s.min_transit_hold >= 0.0))
+    throw std::invalid_argument("min_transit_hold must be >= 0");
+  if (s.start_pusher < kNoPusher) throw std::invalid_argument("start_pusher must be a pusher index or -1");
 }
 
 /// The OMPL problem TRRTstar solves: the pose space, its space information and the problem
@@ -178,7 +181,10 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
                    std::make_shared<PoseGoal>(si, settings.goal, settings.tolerance, models, settings.min_hold_ratio);
       });
   const auto& space = problem.space;
+  if (settings.start_pusher >= static_cast<int>(model.pushers().size()))
+    throw std::invalid_argument("start_pusher must be a pusher index or -1");
   TRRTstar planner(problem.si);
+  planner.set_transit_hold(models, settings.min_transit_hold, settings.start_pusher);
   const ob::PlannerStatus status = solve(planner, problem, settings);
 
   Plan plan;

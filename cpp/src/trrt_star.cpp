@@ -164,6 +164,26 @@ bool TRRTstar::transition_test(double cost_from, double cost_to, double step) {
   return false;
 }
 
+void TRRTstar::set_transit_hold(ModelSet models, double min_ratio, int start_pusher) {
+  transit_models_ = std::move(models);
+  min_transit_hold_ = min_ratio;
+  start_pusher_ = start_pusher;
+}
+
+PusherSet TRRTstar::transit_allowed(const Node* from, PusherSet pushers) const {
+  if (min_transit_hold_ <= 0.0) return pushers;
+  // The pusher in contact at `from`: the one that pushed into it, or at the root the start's.
+  const int leaving = from->parent != nullptr ? from->pusher : start_pusher_;
+  if (leaving == kNoPusher || (pushers & ~single(leaving)) == 0) return pushers;
+  if (from->transit_held < 0) {
+    bool held = true;
+    for (const StablePushModel* model : transit_models_)
+      held = held && model->hold_ratio(from->pose, leaving) >= min_transit_hold_;
+    from->transit_held = held ? 1 : 0;
+  }
+  return from->transit_held ? pushers : pushers & single(leaving);
+}
+
 TRRTstar::Candidate TRRTstar::choose_parent(const Pose& q_new, const std::vector<Node*>& near, Node* via,
                                             PusherSet via_pushers) const {
   // Near nodes in order of their cost if no switch-over were needed: a candidate cannot do
@@ -205,6 +225,7 @@ TRRTstar::Candidate TRRTstar::choose_parent(const Pose& q_new, const std::vector
     } else {
       stable = validator_->stable_pushers(m->pose, q_new, all);
     }
+    stable = transit_allowed(m, stable);
     if (stable == 0) continue;
     Candidate c;
     c.parent = m;
@@ -240,7 +261,7 @@ void TRRTstar::rewire(Node* node, const std::vector<Node*>& near) {
     if (d < kMinEdge) continue;
     const int switches = node->pusher != m->pusher ? 1 : 0;
     const PathCost via = node->cost + PathCost{switches, d};
-    if (!(via < m->cost)) continue;
+    if (!(via < m->cost) || transit_allowed(node, single(m->pusher)) == 0) continue;
     // m keeps its pusher, so the costs below m stay exact; only the push into m is new.
     if (validator_->stable_pushers(node->pose, m->pose, single(m->pusher)) == 0) continue;
     auto& siblings = m->parent->children;
@@ -315,8 +336,9 @@ void TRRTstar::extend(Node* from, const ob::State* target, const ob::PlannerTerm
     if (!transition_test(from->goal_distance, goal->distanceGoal(step_state), step)) break;
     if (!si_->isValid(step_state)) break;  // the grasp is lost at the new pose
     Pose q_new = GraspPoseSpace::pose(step_state);
-    PusherSet stable = validator_->stable_pushers(from->pose, q_new, validator_->all_pushers());
-    if (stable == 0 && (stable = onto_wedge(from->pose, q_new, validator_->all_pushers(), step_state)) != 0 &&
+    const PusherSet allowed = transit_allowed(from, validator_->all_pushers());
+    PusherSet stable = validator_->stable_pushers(from->pose, q_new, allowed);
+    if (stable == 0 && (stable = onto_wedge(from->pose, q_new, allowed, step_state)) != 0 &&
         !transition_test(from->goal_distance, goal->distanceGoal(step_state), step))
       break;
     if (stable == 0) break;

@@ -24,6 +24,9 @@ struct TRRTstar::Node {
   double goal_distance = 0.0;     ///< T-RRT configuration cost [unit steps]
   bool extended_to_goal = false;  ///< a goal sample has already been extended from here
   int descent = -1;               ///< the descent that made this node or started from it (index into descent_ends_)
+  /// Whether the pads hold the object here well enough for a transit (TRRTstar::transit_allowed):
+  /// 1 or 0 once known, -1 before.
+  mutable signed char transit_held = -1;
 };
 
 /// A way to connect a new pose: from `parent`, at `cost`, by any pusher of `pushers`.

@@ -111,9 +111,9 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     if (steering.distance < kMinEdge) break;
     const double length = steering.length;
     // Pushers this node may use without exceeding the switch-over budget.
-    const PusherSet allowed = from->pusher == kNoPusher || from->cost.switches < max_switches_
-                                  ? validator_->all_pushers()
-                                  : single(from->pusher);
+    const PusherSet allowed = transit_allowed(from, from->pusher == kNoPusher || from->cost.switches < max_switches_
+                                                        ? validator_->all_pushers()
+                                                        : single(from->pusher));
     // The step toward the goal, or a deviation from it within steer_angle (Steering) that an
     // allowed pusher makes stable, the descent's own pusher tested first (it costs no switch-over,
     // and when it works the others need no test). After the straight step (and a point pusher's
@@ -157,7 +157,7 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
   if (steering.distance < kMinEdge || steering.rings() == 0) return;
   // A point pusher's stable pushes are a surface that no ring meets (descend_on_wedges steers
   // onto it instead).
-  PusherSet across = validator_->all_pushers() & ~validator_->wedge_pushers();
+  PusherSet across = transit_allowed(root, validator_->all_pushers() & ~validator_->wedge_pushers());
   for (const Node* child : root->children) across &= ~single(child->pusher);
   // The candidates are tested together at each direction, sharing its motion wrench.
   ob::State* scratch = si_->allocState();

@@ -30,6 +30,13 @@ struct PlannerSettings {
   double min_hold_ratio = 0.0;
   /// TRRTstar's declared parameters by name (seed, max_switches, goal_bias, ...); values as text.
   std::map<std::string, std::string> parameters;
+  /// Switch-overs only where the pads alone hold the object with this factor of its weight in every
+  /// model (StablePushModel::hold_ratio at the pose where the pusher changes, with the gravity of
+  /// the feature being left): between two features the object is carried by the pads alone. 0: anywhere.
+  double min_transit_hold = 0.0;
+  /// The pusher in contact at the start (a re-plan from a pose on a feature), else kNoPusher. With
+  /// min_transit_hold, a plan that starts with another pusher makes a transit at the start.
+  int start_pusher = kNoPusher;
 };
 
 /// One waypoint: the pose after a unit push, the pusher that made it, and the test's verdict

@@ -7,9 +7,12 @@ The policy lives here; `executor.py` streams and splices. A re-plan
   last push, and corrected again while it is off by more);
 - first tries the pusher that is pushing now alone (no switch-over: the object stays on its
   feature), then every pusher of the task with one switch-over more than its budget; a switch-over
-  carries the object between features in the pads alone, so that plan is taken only if the pads
-  hold TRANSIT_HOLD_RATIO times the object's weight (`hold_ratio`) at every pose where it changes
-  pusher, the measured pose included when it starts with another pusher;
+  carries the object between features in the pads alone, so that search switches pushers only
+  where the pads hold TRANSIT_HOLD_RATIO times the object's weight (`hold_ratio`, the measured pose
+  included when it starts with another pusher), and its plan is checked again against that rule
+  and, for a task with `uncertainty:`, the weight at every corner of the box;
+- plans in the world the run is in: the features keep the object's world orientation they had
+  (`Task.with_start`), so gravity in O on each feature is the world's, not the measured pose's;
 - takes milliseconds (the planner's own time; limits below), between two waypoints.
 Poses are (x mm, z mm, theta deg), as in plan files.
 """
@@ -136,8 +139,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
     are held. Returns the record and the new plan's steps (empty when none was found); the first
     step is the measured pose."""
     tolerance = list(loop.final_tolerance)
-    base = dataclasses.replace(task, start=tuple(measured),
-                               planner={**task.planner, "tolerance": tolerance})
+    base = dataclasses.replace(task.with_start(measured), planner={**task.planner, "tolerance": tolerance})
     if base.at_goal(base.start):  # off the plan but at the goal already: nothing to correct
         return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
@@ -150,7 +152,12 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
             candidate = dataclasses.replace(base, planner=planner)
         else:
             candidate = dataclasses.replace(base, pushers=(spec,), planner={**planner, "max_switches": 0})
-        result = plan_task(candidate)
+        # Every pusher: the search itself switches only where the pads hold, so that a correction
+        # may detour to where a switch-over is safe. It holds every model to one factor: 1.5 with
+        # the nominal model alone, the corners' 1.0 with an uncertainty box (whose nominal 1.5
+        # _transits_held checks after).
+        transit_hold = (1.0 if task.uncertainty else TRANSIT_HOLD_RATIO) if attempt.every_pusher else 0.0
+        result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher)
         elapsed += result.stats["planning_time_s"]
         if not result.solved:
             tried.append(f"{attempt.describe(pusher)}: {result.outcome}")

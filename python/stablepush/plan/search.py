@@ -34,11 +34,16 @@ def plan_task(
     max_switches: Optional[int] = None,
     improve_for: Optional[float] = None,
     models: "Optional[List[_core.StablePushModel]]" = None,
+    min_transit_hold: float = 0.0,
+    start_pusher: Optional[str] = None,
 ) -> Plan:
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
     task's planner section (which has defaults for every key). `models` are the task's
     corner_models() (built here unless given, e.g. once for many seeds): with an `uncertainty`
     section every push must be stable at every corner, and each waypoint's margin is the least.
+    `min_transit_hold` > 0: switch pushers only where the pads alone hold the object with that
+    factor of its weight in every model; `start_pusher`, the pusher in contact at the start (a
+    re-plan from a feature), makes a plan that begins with another pusher a transit at the start.
     TaskError (field `goal`) when the start is already within the tolerance of the goal."""
     if task.at_goal(task.start):
         tolerance = task.planner["tolerance"]
@@ -64,7 +69,8 @@ def plan_task(
         tolerance=(settings["tolerance"][0] * MM, math.radians(settings["tolerance"][1])),
         time_limit=float(settings["time_limit"]), min_margin=float(settings["min_margin"]),
         sampling_margin=float(settings["sampling_margin"]), min_hold_ratio=float(settings["min_hold_ratio"]),
-        parameters=parameters))
+        parameters=parameters, min_transit_hold=float(min_transit_hold),
+        start_pusher=-1 if start_pusher is None else task.pusher_index(start_pusher)))
 
     names = task.pusher_names
     waypoints: List[Waypoint] = []

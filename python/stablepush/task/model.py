@@ -8,7 +8,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from stablepush import _core
 from stablepush.errors import TaskError
@@ -67,13 +67,25 @@ class Task:
     # What the file says that is legal but probably not meant (each names the field); the CLI
     # prints them as "warning:" lines.
     warnings: Tuple[str, ...] = ()
+    # Per pusher, the object's world orientation on its feature (deg) where environment.features
+    # does not give it; empty: the start's. with_start fills it.
+    feature_orientations: Dict[str, float] = field(default_factory=dict)
 
     def feature_angle(self, pusher: str) -> float:
         """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
         feature: environment.features gives it, else the start's (the executor places the
         features so; stablepush.execution.world.place_features)."""
         pose = self.environment.get("features", {}).get(pusher)
-        return float(pose[3]) if pose is not None else float(self.start[2])
+        if pose is not None:
+            return float(pose[3])
+        return float(self.feature_orientations.get(pusher, self.start[2]))
+
+    def with_start(self, start: Sequence[float]) -> "Task":
+        """The same task from another start (x mm, z mm, theta deg) in the same world: each feature
+        keeps the object's world orientation it had, not the new start's (a re-plan from a measured
+        pose, where gravity in O on a feature must stay the one the world has)."""
+        return dataclasses.replace(self, start=tuple(float(v) for v in start),
+                                   feature_orientations={p: self.feature_angle(p) for p in self.pusher_names})
 
     def at_goal(self, pose) -> bool:
         """Whether `pose` (x mm, z mm, theta deg) lies within planner.tolerance of the goal, in each

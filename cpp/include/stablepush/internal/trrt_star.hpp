@@ -59,6 +59,10 @@ class TRRTstar : public ompl::base::Planner {
   ompl::base::PlannerStatus solve(const ompl::base::PlannerTerminationCondition& ptc) override;
   /// Frees the tree and the last solve's results.
   void clear() override;
+  /// Switch pushers only where the pads alone hold the object with `min_ratio` times its weight in
+  /// every one of `models` (0: anywhere; PlannerSettings::min_transit_hold), `start_pusher` being
+  /// the pusher in contact at the start (kNoPusher: none). Not a declared parameter: it needs the models.
+  void set_transit_hold(ModelSet models, double min_ratio, int start_pusher);
   void getPlannerData(ompl::base::PlannerData& data) const override;
 
   // Declared parameters (Planner::params()), settable by name from the task's planner section.
@@ -213,7 +217,14 @@ class TRRTstar : public ompl::base::Planner {
   /// grow the tree take that combined condition as their `ptc`.
   ompl::base::PlannerTerminationCondition anytime_over() const;
 
+  /// Of `pushers`, those that may push from `from`: all of them, unless using one other than the
+  /// pusher in contact at `from` is a transit the pads do not hold there (set_transit_hold).
+  PusherSet transit_allowed(const Node* from, PusherSet pushers) const;
+
   PushChecker* validator_ = nullptr;  ///< the motion validator, as what the search asks of it
+  ModelSet transit_models_;           ///< set_transit_hold's models
+  double min_transit_hold_ = 0.0;
+  int start_pusher_ = kNoPusher;
   const GraspPoseSpace* space_ = nullptr;
   std::vector<Node*> nodes_;
   std::vector<Eigen::Vector3d> unit_coords_;  ///< nodes_[i]'s pose in unit steps

@@ -1,0 +1,53 @@
+"""Switch-overs only where the pads hold (`plan_task(min_transit_hold=...)`): between two features
+the object is carried by the pads alone, so the search may change pusher only at a pose where
+`hold_ratio` (with the gravity of the feature being left) reaches the given factor."""
+import pytest
+
+from stablepush.plan.search import plan_task
+from stablepush.units import pose_to_si
+
+from conftest import shipped
+
+LOW_MU = shipped("horizontal-offset-low-mu")  # bottom -> left: one switch-over, where the pads hold 4.26 times
+
+
+def _switch_holds(task, plan):
+    model, holds = task.build_model(), []
+    for before, after in zip(plan.waypoints[1:], plan.waypoints[2:]):
+        if after.pusher != before.pusher:
+            holds.append(model.hold_ratio(pose_to_si(before.pose), task.pusher_index(before.pusher)))
+    return holds
+
+
+def test_without_the_rule_the_low_mu_offset_switches_where_the_pads_hold_4_26_times():
+    plan = plan_task(LOW_MU, seed=1)
+    assert plan.pusher_sequence == ["bottom", "left"]
+    assert _switch_holds(LOW_MU, plan) == [pytest.approx(4.26, abs=0.01)]
+
+
+@pytest.mark.parametrize("factor", [1.5, 3.0, 4.0, 4.2, 4.3, 5.0, 20.0])
+def test_every_switch_over_of_a_plan_is_where_the_pads_hold_the_factor(factor):
+    plan = plan_task(LOW_MU, seed=1, min_transit_hold=factor, time_limit=0.3)
+    assert all(h >= factor for h in _switch_holds(LOW_MU, plan)), (factor, _switch_holds(LOW_MU, plan))
+    # The offset needs the bottom pusher's lift and then the left one: no switch-over, no plan.
+    assert plan.solved == (factor <= 4.2), (factor, plan.outcome, plan.pusher_sequence)
+
+
+def test_a_replan_from_a_feature_makes_a_transit_at_its_start():
+    # Started on the bottom pusher's feature where the pads hold 4.26 times: a plan that begins with
+    # the left pusher leaves that feature at the start, allowed below 4.26 and refused above.
+    plan = plan_task(LOW_MU, seed=1)
+    k = next(i for i, w in enumerate(plan.waypoints) if w.pusher == "left") - 1
+    on_bottom = LOW_MU.with_start(plan.waypoints[k].pose)
+    assert plan_task(on_bottom, seed=1, min_transit_hold=4.0, start_pusher="bottom", time_limit=0.3).solved
+    refused = plan_task(on_bottom, seed=1, min_transit_hold=4.5, start_pusher="bottom", time_limit=0.3)
+    assert not refused.solved or refused.pusher_sequence[0] == "bottom"
+
+
+def test_with_start_keeps_the_features_orientation():
+    task = shipped("large-manipulation")  # no environment.features: each feature at the start's theta
+    moved = task.with_start((14.6, -13.7, 44.0))
+    assert moved.start == (14.6, -13.7, 44.0)
+    assert [moved.feature_angle(p) for p in moved.pusher_names] == [task.start[2]] * len(task.pushers)
+    q = pose_to_si(moved.start)
+    assert moved.build_model().hold_ratio(q, 0) == pytest.approx(task.build_model().hold_ratio(q, 0))
