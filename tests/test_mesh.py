@@ -62,6 +62,7 @@ def test_a_fine_section_is_simplified_within_its_tolerance(tmp_path):
     ({"density": 1.0}, "object", "give exactly one of mass (g) and density"),
     ({"plane_y": 40.0}, "object.plane_y", "outside the mesh"),
     ({"file": "nowhere.stl"}, "object.file", "no such file"),
+    ({"file": "y" * 300}, "object.file", "cannot look up"),  # longer than a file name may be
     ({"size": [1, 2, 3]}, "object.size", "not for shape: mesh"),
 ])
 def test_mesh_mistakes_name_the_field(tmp_path, edit, field, says):

@@ -452,7 +452,11 @@ def _mesh_object(obj: dict, source: Optional[str]):
         raise TaskError("object.file", f"must be a file name, got {_shown(obj['file'])}")
     base = Path(source).parent if source else Path.cwd()
     path = base / obj["file"]
-    if not path.is_file():
+    try:
+        found = path.is_file()
+    except OSError as exc:  # is_file() lets some errors through, e.g. a name longer than the system allows
+        raise TaskError("object.file", f"cannot look up {_shown(obj['file'])}: {exc.strerror}") from None
+    if not found:
         raise TaskError("object.file", f"no such file: {path}")
     mesh = load_mesh_object(
         path, "object", scale=_number("object.scale", obj.get("scale", 1.0), (1e-6, 1e6)),
