@@ -93,3 +93,14 @@ def test_the_json_report_carries_the_verdict(key):
     report.verdict = judge(TASK, report)
     assert key in report.as_dict()
     assert report.as_dict()["success"] is True and report.success is True
+
+
+def test_angles_are_compared_within_one_turn():
+    # A tracker reports theta in (-180, 180]; a plan may end at 360 deg, the same orientation.
+    turned = dataclasses.replace(TASK, goal=(20.0, 0.0, 360.0))
+    report = _report((20.1, 0.0, -0.2), planned=(20.0, 0.0, 360.0))
+    report.goal = turned.goal
+    v = judge(turned, report)
+    assert v.success is True and "-0.200 deg" in v.detail
+    assert report.final_error["theta"] == pytest.approx(-0.2) and report.goal_error["theta"] == pytest.approx(-0.2)
+    assert within({"x": 20.0, "z": 0.0, "theta": 179.9}, (20.0, 0.0, -179.9), (0.5, 0.5))

@@ -24,3 +24,9 @@ def pose_from_si(q: Sequence[float]) -> Tuple[float, float, float]:
 def mm2_to_si(p: Sequence[float]) -> Tuple[float, float]:
     """A point (mm, mm) -> (m, m)."""
     return (p[0] * MM, p[1] * MM)
+
+
+def angle_difference_deg(a: float, b: float) -> float:
+    """a - b [deg], wrapped into [-180, 180): a tracker reports theta in one turn, while a plan's
+    theta may lie beyond it (a task at 360 deg is at 0 deg in the world)."""
+    return (a - b + 180.0) % 360.0 - 180.0

@@ -26,7 +26,7 @@ from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
 from stablepush.task.model import Task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
-from stablepush.units import pose_to_si
+from stablepush.units import angle_difference_deg, pose_to_si
 
 THRESHOLD_FRACTION = 0.5  # default threshold: this fraction of the task's goal tolerance
 FINAL_FRACTION = 0.2  # default final tolerance: this fraction of the task's goal tolerance
@@ -113,7 +113,7 @@ def _transits_held(task: Task, steps: Sequence[Waypoint], pusher: str) -> bool:
 
 def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float, float, float]:
     """The measured pose minus `pose`: x mm, z mm, theta deg."""
-    return measured["x"] - pose[0], measured["z"] - pose[1], measured["theta"] - pose[2]
+    return measured["x"] - pose[0], measured["z"] - pose[1], angle_difference_deg(measured["theta"], pose[2])
 
 
 @dataclass(frozen=True)

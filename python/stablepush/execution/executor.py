@@ -26,7 +26,7 @@ from stablepush.execution.world import Feature, place_features, scene_descriptio
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.plan.plan import Plan, Waypoint
 from stablepush.task.model import Task
-from stablepush.units import MM
+from stablepush.units import MM, angle_difference_deg
 
 DEFAULT_ACK_TIMEOUT = 5.0  # s to wait for any reply
 # Past this change in the grasp when the last feature lets go (mm, deg), the grasp alone does not
@@ -99,7 +99,7 @@ class ExecutionReport:
             return None
         dx = self.final_in_grasp["x"] - pose[0]
         dz = self.final_in_grasp["z"] - pose[1]
-        dth = self.final_in_grasp["theta"] - pose[2]
+        dth = angle_difference_deg(self.final_in_grasp["theta"], pose[2])
         return {"x": dx, "z": dz, "theta": dth, "distance": math.hypot(dx, dz)}
 
     @property
@@ -108,7 +108,8 @@ class ExecutionReport:
         when the grasp alone cannot hold the final pose against gravity."""
         if self.final_in_grasp is None or self.released_in_grasp is None:
             return None
-        return {k: self.released_in_grasp[k] - self.final_in_grasp[k] for k in ("x", "z", "theta")}
+        change = {k: self.released_in_grasp[k] - self.final_in_grasp[k] for k in ("x", "z")}
+        return {**change, "theta": angle_difference_deg(self.released_in_grasp["theta"], self.final_in_grasp["theta"])}
 
     @property
     def release_moved(self) -> bool:
@@ -282,7 +283,9 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     last = k == len(steps) - 1
     if not loop.off_by(tracked, task.goal if last else steps[k].pose, loop.final_tolerance if last else loop.threshold):
         return None
-    measured = (float(tracked["x"]), float(tracked["z"]), float(tracked["theta"]))
+    # The tracker's theta on the plan's turn (a plan may run past +-180 deg; a tracker reports one turn).
+    theta = steps[k].pose[2] + angle_difference_deg(float(tracked["theta"]), steps[k].pose[2])
+    measured = (float(tracked["x"]), float(tracked["z"]), theta)
     record, new_steps = replan(task, measured, steps[k].pusher, loop, k, steps[k].pose,
                                trigger="off_goal" if last else "off_plan")
     replans.append(record)

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import Dict, Optional, Sequence, Tuple
 
 from stablepush.task.model import Task
-from stablepush.units import pose_to_si
+from stablepush.units import angle_difference_deg, pose_to_si
 
 CAUSES = ("grasp_lost", "correction_not_found", "corrections_exhausted", "pusher_slipped",
           "plan_short", "drift", "arm_fault", "not_measured")
@@ -63,7 +63,7 @@ def success_tolerance(task: Task, tolerance: Optional[Sequence[float]] = None) -
 def within(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[float]) -> bool:
     """Whether `pose` (x, z mm, theta deg) is within `tolerance` of `goal` in each coordinate."""
     return (abs(pose["x"] - goal[0]) <= tolerance[0] and abs(pose["z"] - goal[1]) <= tolerance[0]
-            and abs(pose["theta"] - goal[2]) <= tolerance[1])
+            and abs(angle_difference_deg(pose["theta"], goal[2])) <= tolerance[1])
 
 
 def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
@@ -104,7 +104,7 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
 
 def _describe(pose: Dict[str, float], goal: Sequence[float]) -> str:
     return (f"{math.hypot(pose['x'] - goal[0], pose['z'] - goal[1]):.3f} mm, "
-            f"{pose['theta'] - goal[2]:+.3f} deg")
+            f"{angle_difference_deg(pose['theta'], goal[2]):+.3f} deg")
 
 
 def _pair(values: Sequence[float]) -> Tuple[float, float]:
