@@ -47,6 +47,10 @@ def _edited(tmp_path, old, new, name="task.yaml"):
      "size: [100, 25, 25]\n  com: [1e300, 0]", "object.com[0]: must be between -10000 and 10000, got 1e+300"),
     ("step_time: 0.1", "step_time: 1.797e308", "dynamics.step_time: must be between 0.0001 and 1000"),
     ("mu: 0.425 ", "mu: 1.797e308 ", "gripper.mu: must be between 0 and 100"),
+    # A positive mu too small to mean anything underflowed the cones' rows (exit 4 from the exact re-check).
+    ("mu: 0.2}\n  - {name: right", "mu: 5e-324}\n  - {name: right",
+     "pushers[0].mu: must be 0 (frictionless) or at least 1e-06, got 4.94066e-324"),
+    ("mu: 0.425 ", "mu: 1e-170 ", "gripper.mu: must be 0 (frictionless) or at least 1e-06, got 1e-170"),
     ("max_switches: 1", "max_switches: 2147483648", "planner.max_switches: must be an integer from 0 to 100"),
     ("max_switches: 1", "max_switches: 4294967296", "planner.max_switches: must be an integer from 0 to 100"),
     ("seed: 1", "seed: 18446744073709551616", "planner.seed: must be an integer from 0 to 4294967295"),

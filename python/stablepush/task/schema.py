@@ -205,6 +205,19 @@ def _number(path: str, value: Any, within: Optional[Tuple[float, float]] = None)
     return x
 
 
+# The least positive friction coefficient: below it the cones' rows underflow (a mu of 1e-170
+# reached the exact re-check as infinity), and no material is that slippery without being 0.
+MIN_POSITIVE_MU = 1e-6
+
+
+def _friction(path: str, value: Any) -> float:
+    """A friction coefficient: 0 (frictionless) or MIN_POSITIVE_MU to LIMITS["mu"]'s top."""
+    mu = _number(path, value, LIMITS["mu"])
+    if 0.0 < mu < MIN_POSITIVE_MU:
+        raise TaskError(path, f"must be 0 (frictionless) or at least {MIN_POSITIVE_MU:g}, got {mu:g}")
+    return mu
+
+
 def _integer(path: str, value: Any, lowest: int, highest: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
         raise TaskError(path, f"must be an integer, got {_shown(value)}")
@@ -294,7 +307,7 @@ def _validate(data: Any, source: Optional[str]) -> Task:
 
     grip = _mapping("gripper", top["gripper"], ["grip_force", "mu"], ["pad_rings", "pads"])
     grip_force = _number("gripper.grip_force", grip["grip_force"], LIMITS["force"])
-    mu = _number("gripper.mu", grip["mu"], LIMITS["mu"])
+    mu = _friction("gripper.mu", grip["mu"])
     pad_rings = _integer("gripper.pad_rings", grip.get("pad_rings", 1), 0, MAX_PAD_RINGS)
     if "pads" in grip:
         if not isinstance(grip["pads"], list) or not 1 <= len(grip["pads"]) <= MAX_PADS:
@@ -495,7 +508,7 @@ def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str
         name = _name(f"{path}.name", raw["name"])
         if any(s.name == name for s in specs):
             raise TaskError(f"{path}.name", f"duplicate pusher name {name!r}")
-        mu = _number(f"{path}.mu", raw["mu"], LIMITS["mu"])
+        mu = _friction(f"{path}.mu", raw["mu"])
         edge, distance = section.nearest_edge(mm2_to_si(a), mm2_to_si(b))
         if ON_BOUNDARY < distance / MM <= SNAP_TO_EDGE:  # a rounding slip: put it on that edge, and say so
             a, b = (_onto_edge(section, edge, a), _onto_edge(section, edge, b))
