@@ -101,6 +101,13 @@ def test_check_refuses_non_finite_and_vanishing_motions(move, says):
     assert result.exit_code == 2 and says in result.stderr
 
 
+def test_check_refuses_a_pose_where_the_pads_miss_the_object():
+    result = CliRunner().invoke(cli, ["check", str(LOW_MU), "--move", "1", "0", "0", "--at", "1000", "0", "0"])
+    assert result.exit_code == 2 and "at: the pads are not all on the object at [1000.0, 0.0, 0.0]" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert CliRunner().invoke(cli, ["check", str(LOW_MU), "--move", "1", "0", "0", "--at", "10", "0", "0"]).exit_code == 0
+
+
 def test_check_refuses_a_non_finite_pose():
     result = CliRunner().invoke(cli, ["check", str(LOW_MU), "--at", "nan", "0", "0", "--move", "1", "0", "0"])
     assert result.exit_code == 2 and "at[0]: must be finite" in result.stderr

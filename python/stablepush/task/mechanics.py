@@ -41,10 +41,15 @@ def check_push(
                                 f"give a unit motion (dx, dz, dtheta)")
     q, dq = pose_to_si(at), pose_to_si(move)
     names = [pusher] if pusher is not None else task.pusher_names
-    if task.uncertainty and model is None:  # robust: the least stable corner of the box decides
+    robust = task.uncertainty and model is None
+    model = model or task.build_model()
+    # The model answers for any pose, but a push means something only where the pads hold the object.
+    if not model.grasp_maintained(q):
+        raise TaskError("at", f"the pads are not all on the object at {list(at)} (x mm, z mm, theta deg): "
+                              f"there is no grasp to push in")
+    if robust:  # the least stable corner of the box decides
         corners = task.corner_models()
         return {name: result_to_dict(_core.worst_case(corners, q, dq, task.pusher_index(name))) for name in names}
-    model = model or task.build_model()
     if pusher is not None:
         return {pusher: result_to_dict(model.check(q, dq, task.pusher_index(pusher)))}
     return {name: result_to_dict(r) for name, r in zip(task.pusher_names, model.check_all(q, dq))}
