@@ -115,3 +115,14 @@ def test_trajectory_command_writes_csv_and_json_in_either_quaternion_order(tmp_p
     assert doc["columns"][4:8] == ["qw", "qx", "qy", "qz"] and doc["rate_hz"] == 50
     bad = CliRunner().invoke(cli, ["trajectory", str(plan_file), "--task", str(task), "-o", str(tmp_path / "t.txt")])
     assert bad.exit_code == 2 and "must end in .csv or .json" in bad.stderr
+
+
+def test_plan_refuses_models_that_are_not_the_tasks():
+    import stablepush as sp
+
+    task, other = sp.load_task(TASKS / "t-shaped.yaml"), sp.load_task(TASKS / "pivoting.yaml")
+    with pytest.raises(TypeError, match=r"models\[0\]: expected a StablePushModel"):
+        sp.plan(task, models=[None])  # was a segmentation fault
+    with pytest.raises(ValueError, match="not a model of task 't-shaped'"):
+        sp.plan(task, models=other.corner_models())
+    assert sp.plan(task, models=task.corner_models()).solved

@@ -165,6 +165,8 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   const auto started = std::chrono::steady_clock::now();
   check_settings(settings);
   if (models.empty()) throw std::invalid_argument("no model to plan in");
+  for (const StablePushModel* m : models)
+    if (m == nullptr) throw std::invalid_argument("a model to plan in is None");
   const StablePushModel& model = *models.front();  // the geometry, which every model shares
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 

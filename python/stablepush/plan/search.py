@@ -60,6 +60,7 @@ def plan_task(
     if improve_for is not None:
         settings["improve_for"] = planner_parameter("improve_for", "improve_for", improve_for)
     models = models or task.corner_models()
+    _check_models(task, models)
     model = models[0]
     parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}
     parameters.update({key: repr(settings[key]) for key in PLANNER_TUNING if key in settings})
@@ -150,3 +151,16 @@ def _message(outcome: str, stats: dict, ends_at_goal: bool) -> str:
             if stats["min_hold_ratio"] > 0 else "")
     return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out before the goal was reached{held}; "
             f"the best partial path ends {stats['goal_distance_steps']:.1f} unit steps from the goal")
+
+
+def _check_models(task: Task, models) -> None:
+    """The models given to plan_task must be this task's (its corner_models() or build_model()): a
+    model of another object would plan pushes this task's object does not make."""
+    for k, m in enumerate(models):
+        if not isinstance(m, _core.StablePushModel):
+            raise TypeError(f"models[{k}]: expected a StablePushModel (task.corner_models()), got {type(m).__name__}")
+        vertices = m.section.vertices
+        same = len(m.pushers) == len(task.pushers) and len(vertices) == len(task.vertices) and all(
+            abs(a[0] - b[0] * MM) <= 1e-9 and abs(a[1] - b[1] * MM) <= 1e-9 for a, b in zip(vertices, task.vertices))
+        if not same:
+            raise ValueError(f"models[{k}]: not a model of task {task.name!r} (another object, or other pushers)")
