@@ -357,3 +357,38 @@ def test_a_task_error_is_a_stablepush_error_with_exit_status_2():
 
     assert issubclass(TaskError, StablepushError) and issubclass(PlanError, StablepushError)
     assert dict(EXIT_STATUS)[TaskError] == 2 and dict(EXIT_STATUS)[ArmFault] == 3
+
+
+# -- the files a user names ----------------------------------------------------------------------
+
+@pytest.mark.parametrize("kind", ["fifo", "device", "sparse"])
+def test_task_and_plan_files_are_read_bounded_and_regular_only(tmp_path, kind):
+    """A FIFO used to hang, /dev/zero and a 3 GB sparse file were read whole (MemoryError, exit 4)."""
+    path = tmp_path / "input"
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "device":
+        path = Path("/dev/zero")
+    else:
+        with open(path, "wb") as handle:
+            handle.truncate(3 * 2**30)
+    says = "larger than" if kind == "sparse" else "not a regular file"
+    task = CliRunner().invoke(cli, ["plan", str(path), "-o", str(tmp_path / "p.json")])
+    assert task.exit_code == 2 and says in task.stderr and len(task.stderr.strip().splitlines()) == 1, task.stderr
+    plan = CliRunner().invoke(cli, ["show", str(path), "--task", str(LOW_MU), "-o", str(tmp_path / "x.png")])
+    assert plan.exit_code == 2 and says in plan.stderr, plan.stderr
+
+
+@pytest.mark.parametrize("name, says", [("part.3mf", "a mesh file is one of stl, obj, ply, off"),
+                                        ("part.stl", "not a regular file")])
+def test_mesh_files_are_read_bounded_in_known_formats(tmp_path, name, says):
+    mesh = tmp_path / name
+    if name.endswith(".stl"):
+        os.mkfifo(mesh)
+    else:
+        mesh.write_bytes(b"PK\x03\x04")
+    task = tmp_path / "task.yaml"
+    task.write_text("object: {shape: mesh, file: " + name + ", mass: 10}\ngripper: {grip_force: 10, mu: 0.5}\n"
+                    "pushers: [{name: left, at: [-20, 0], mu: 0.5}]\nstart: [0, 0, 0]\ngoal: [1, 0, 0]\n")
+    result = CliRunner().invoke(cli, ["plan", str(task)])
+    assert result.exit_code == 2 and "object.file" in result.stderr and says in result.stderr, result.stderr

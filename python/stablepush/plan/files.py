@@ -10,6 +10,7 @@ from typing import Optional, Union
 
 from stablepush import strict_json
 from stablepush.errors import PlanError
+from stablepush.inputs import read_capped
 from stablepush.outputs import write_files
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.strict_json import is_finite_number
@@ -117,12 +118,11 @@ def read_plan(path: Union[str, Path]) -> dict:
     is stablepush.plan.verify.check_plan's question."""
     source = str(path)
     try:
-        with open(path, "rb") as handle:
-            raw = handle.read(MAX_PLAN_BYTES + 1)
+        raw = read_capped(path, MAX_PLAN_BYTES)
+    except ValueError as exc:  # not a regular file, or too large
+        raise PlanError("", f"{exc}; not a plan this tool wrote", source) from None
     except OSError as exc:
         raise PlanError("", f"cannot read the plan file ({exc.strerror or exc})", source) from None
-    if len(raw) > MAX_PLAN_BYTES:
-        raise PlanError("", f"larger than {MAX_PLAN_BYTES} bytes; not a plan this tool wrote", source)
     try:
         data = strict_json.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, ValueError) as exc:

@@ -7,6 +7,7 @@ times `scale`, must give mm.
 """
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional, Tuple
@@ -14,8 +15,13 @@ from typing import Optional, Tuple
 import numpy as np
 
 from stablepush.errors import TaskError
+from stablepush.inputs import read_capped
 
 G_PER_CM3 = 1e-3  # g/mm^3 per g/cm^3
+# Read by trimesh from bytes capped here (a binary STL of 1.3 million triangles), in these formats
+# only: others pull in optional readers (3MF needs lxml) or archives that expand past any cap.
+MAX_MESH_BYTES = 64_000_000
+MESH_FORMATS = ("stl", "obj", "ply", "off")
 
 
 @dataclass(frozen=True)
@@ -42,8 +48,16 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
         from shapely.geometry.polygon import orient
     except ImportError as exc:  # pragma: no cover - both are dependencies
         raise TaskError(field, f"mesh objects need trimesh and shapely ({exc})") from None
+    file_type = path.suffix.lstrip(".").lower()
+    if file_type not in MESH_FORMATS:
+        raise TaskError(f"{field}.file", f"{path.name}: a mesh file is one of {', '.join(MESH_FORMATS)} "
+                                         f"(by its extension)")
     try:
-        mesh = trimesh.load_mesh(str(path), force="mesh")
+        data = read_capped(path, MAX_MESH_BYTES)
+    except (OSError, ValueError) as exc:
+        raise TaskError(f"{field}.file", f"cannot read {path}: {exc}") from None
+    try:
+        mesh = trimesh.load_mesh(io.BytesIO(data), file_type=file_type, force="mesh")
     except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds on a bad file
         raise TaskError(f"{field}.file", f"cannot read {path} as a mesh ({type(exc).__name__}: "
                                          f"{' '.join(str(exc).split())[:120]})") from None

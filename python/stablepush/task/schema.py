@@ -16,6 +16,7 @@ import yaml
 
 from stablepush import _core
 from stablepush.errors import TaskError
+from stablepush.inputs import read_capped
 from stablepush.task.model import PUSHES, UNCERTAIN, PusherSpec, Task, make_gripper
 from stablepush.units import MM, mm2_to_si, pose_to_si
 
@@ -270,8 +271,10 @@ def load_task(path: "str | Path") -> Task:
     """Read and validate a task file; raises TaskError naming the field on any problem."""
     source = str(path)
     try:
-        text = Path(path).read_text()
-    except (OSError, UnicodeDecodeError) as exc:
+        text = read_capped(path, MAX_TASK_BYTES).decode("utf-8")
+    except ValueError as exc:  # not a regular file, too large, or not UTF-8
+        raise TaskError("", f"cannot read the task file: {exc}", source) from None
+    except OSError as exc:
         raise TaskError("", f"cannot read the task file ({exc.__class__.__name__}: {exc})", source) from None
     try:
         return parse_task(text, source)
@@ -470,7 +473,8 @@ def _mesh_object(obj: dict, source: Optional[str]):
     except OSError as exc:  # is_file() lets some errors through, e.g. a name longer than the system allows
         raise TaskError("object.file", f"cannot look up {_shown(obj['file'])}: {exc.strerror}") from None
     if not found:
-        raise TaskError("object.file", f"no such file: {path}")
+        what = "not a regular file (a device, a FIFO or a directory)" if path.exists() else "no such file"
+        raise TaskError("object.file", f"{what}: {path}")
     mesh = load_mesh_object(
         path, "object", scale=_number("object.scale", obj.get("scale", 1.0), (1e-6, 1e6)),
         plane_y=_number("object.plane_y", obj["plane_y"], COORDINATE) if "plane_y" in obj else None,
