@@ -47,6 +47,8 @@ def test_a_task_written_in_metres_is_warned_about_and_refused_plainly(tmp_path):
     ("grip_force: 10 ", "grip_force: 1000 ", "gripper.grip_force: 1000 N per pad (over 500 N)"),
     ("mu: 0.425 ", "mu: 42.5 ", "gripper.mu: 42.5; a friction coefficient over 3 is unusual"),
     ("gravity: [0, -9.81]", "gravity: [0, -98.1]", "gravity: |g| = 98.1 m/s^2, neither 0"),
+    # A mass written in kg (0.045 for a 45 g part) in the 62.5 cm^3 prism: 0.00072 g/cm^3.
+    ("mass: 202 ", "mass: 0.045 ", "object.mass: 0.045 g in 62.5 cm^3 is 0.00072 g/cm^3, lighter than air; written in kg?"),
 ])
 def test_implausible_magnitudes_are_warned_about_naming_the_field(old, new, says):
     text = task_text("horizontal-offset-low-mu")

@@ -378,6 +378,9 @@ def _default_name(source: Optional[str]) -> str:
     return stem if stem and stem.isprintable() and len(stem) <= 100 else "task"
 
 
+AIR_DENSITY = 1.2e-3  # g/cm^3: a solid lighter than this is a unit slip
+
+
 def _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity) -> List[str]:
     """Warnings for magnitudes no cell has, each naming the field and the likely unit slip."""
     out = []
@@ -389,6 +392,12 @@ def _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity) ->
         out.append(f"object: {size:g} mm across (over 2 m); written in micrometres, or meant in mm?")
     if mass > 50_000.0:
         out.append(f"object.mass: {mass:g} g (over 50 kg); task files use grams")
+    # Shoelace area [mm^2] times thickness: the prism's volume, and its density in g/cm^3.
+    area = abs(sum(x0 * z1 - x1 * z0 for (x0, z0), (x1, z1) in zip(vertices, vertices[1:] + vertices[:1]))) / 2
+    density = mass / (area * thickness) * 1e3
+    if density < AIR_DENSITY:
+        out.append(f"object.mass: {mass:g} g in {area * thickness / 1e3:.3g} cm^3 is {density:.2g} g/cm^3, lighter "
+                   f"than air; written in kg? Task files use grams")
     if grip_force > 500.0:
         out.append(f"gripper.grip_force: {grip_force:g} N per pad (over 500 N); task files use newtons")
     for path, value in [("gripper.mu", mu)] + [(f"pushers[{i}].mu", p.mu) for i, p in enumerate(pushers)]:
