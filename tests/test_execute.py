@@ -152,7 +152,8 @@ def test_nothing_listening_is_a_clear_fault(high_mu_plan):
         port = s.getsockname()[1]  # closed again when the block ends: nothing listens there
     result = CliRunner().invoke(cli, ["execute", plan, "--task", task, "--arm", f"127.0.0.1:{port}", "--quiet"])
     assert result.exit_code == 3
-    assert "cannot reach the arm server" in result.output and "last confirmed step: 0 of 20" in result.output
+    assert "cannot reach the arm server" in result.output and "nothing was sent" in result.output
+    assert "stablepush sim-arm" in result.output and "--sim" in result.output and "--resume-from" not in result.output
 
 
 class FakeArm:

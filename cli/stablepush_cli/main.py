@@ -520,6 +520,10 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
             bar.__exit__(None, None, None)
         if json_path:
             write_atomically(json_path, json.dumps(fault_report(task, fault, success_tolerance), indent=1) + "\n")
+        if not fault.connected:
+            click.echo(f"error: {fault.reason}; nothing was sent. Is the arm server running? "
+                       f"(`stablepush sim-arm` serves a simulated arm, or run with --sim)", err=True)
+            sys.exit(EXIT_ARM_FAULT)
         stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
         click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
                    f"{len(plan.waypoints) - 1}", err=True)

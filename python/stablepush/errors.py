@@ -40,10 +40,12 @@ class OutputError(StablepushError, OSError):
 class ArmFault(StablepushError, RuntimeError):
     """Execution stopped on the arm's side or on its link: the arm was told to stop when it could
     be (`arm_stopped`: True, or None when the arm could not be reached), and
-    `last_confirmed_step` is the last plan step the arm confirmed (resume after it)."""
+    `last_confirmed_step` is the last plan step the arm confirmed (resume after it). `connected`:
+    False when the arm server was never reached, so nothing was sent."""
 
-    def __init__(self, reason: str, last_confirmed_step: int, arm_stopped: Optional[bool]):
+    def __init__(self, reason: str, last_confirmed_step: int, arm_stopped: Optional[bool], connected: bool = True):
         super().__init__(reason)
         self.reason = reason
         self.last_confirmed_step = last_confirmed_step
         self.arm_stopped = arm_stopped
+        self.connected = connected

@@ -244,7 +244,7 @@ def execute_plan(
     except (ConnectionError, TimeoutError, ProtocolError, OSError, KeyError) as exc:
         stopped = _stop(link) if link is not None else None
         reason = str(exc) if not isinstance(exc, KeyError) else f"a reply lacks {exc}"
-        raise ArmFault(reason, last_confirmed, stopped) from None
+        raise ArmFault(reason, last_confirmed, stopped, connected=link is not None) from None
     finally:
         if link is not None:
             link.close()
