@@ -267,7 +267,7 @@ def fault_report(task: Task, fault: ArmFault, success_tolerance: Optional[Sequen
                                 fault.reason)
     return {"task": task.name, "success": verdict.success, "tolerance": list(verdict.tolerance),
             "cause": verdict.cause, "verdict": verdict.detail, "last_confirmed_step": fault.last_confirmed_step,
-            "arm_stopped": fault.arm_stopped}
+            "arm_stopped": fault.arm_stopped, "connected": fault.connected}
 
 
 def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
