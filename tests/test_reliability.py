@@ -328,6 +328,13 @@ def test_the_executor_holds_its_ack_deadline_against_a_trickling_arm(high_mu_run
     ({"ee_pose": [0, 0, 0, 1, 0, 0]}, "state.ee_pose must be 7 finite numbers"),
     ({"ee_pose": [0, 0, float("nan"), 1, 0, 0, 0]}, "not a JSON line"),
     ({"ee_pose": [0, 0, 0, 1, 0, 0, 0], "object_in_grasp": {"x": "1"}}, "object_in_grasp must hold finite numbers"),
+    # Finite but absurd: 1e200 overflowed (exit 4), 100 m streamed 88,000 waypoints of approach, a
+    # tracked theta of 1e17 reached the re-planner as a zero motion (exit 4, the arm never stopped).
+    ({"ee_pose": [1e200, 0, 0, 1, 0, 0, 0]}, "state.ee_pose is more than 10 m from the arm's base"),
+    ({"ee_pose": [100, 0, 0, 1, 0, 0, 0]}, "state.ee_pose is more than 10 m from the arm's base"),
+    ({"ee_pose": [0.4, 0, 0.3, 2, 0, 0, 0]}, "state.ee_pose: the quaternion is not of unit length"),
+    ({"ee_pose": [0.4, 0, 0.3, 1, 0, 0, 0], "object_in_grasp": {"x": 0, "z": 0, "theta": 1e17}},
+     "object_in_grasp must have"),
 ])
 def test_bad_arm_states_end_in_an_arm_fault_and_a_stop(high_mu_run, state, says):
     task, plan, _ = high_mu_run

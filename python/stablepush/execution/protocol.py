@@ -72,6 +72,12 @@ _SERVER_FIELDS = {
 }
 
 
+# Bounds on what a server reports: no arm reaches farther, and the task files' own limits.
+ARM_REACH_M = 10.0
+GRASP_REACH_MM = 10_000.0
+GRASP_TURN_DEG = 3_600.0
+
+
 class ProtocolError(ValueError):
     """A message that breaks the protocol: not JSON, not an object, an unknown type, or a field
     missing or of the wrong kind."""
@@ -117,14 +123,29 @@ def _check_pose(pose: Any, what: str) -> None:
 
 
 def _check_state(state: dict, kind: str) -> None:
-    """A server's `state`: ee_pose 7 finite numbers; object_in_grasp, when given, finite x, z, theta."""
+    """A server's `state`: ee_pose 7 finite numbers within ARM_REACH_M of the base with a unit
+    quaternion; object_in_grasp, when given, x, z within GRASP_REACH_MM and theta within
+    GRASP_TURN_DEG. Values past these are a broken arm or tracker, not a pose to plan from."""
     _check_pose(state.get("ee_pose"), f"{kind}: state.ee_pose")
+    _check_placed(state["ee_pose"], f"{kind}: state.ee_pose")
     tracked = state.get("object_in_grasp")
     well_formed = isinstance(tracked, dict) and all(is_finite_number(tracked.get(k)) for k in ("x", "z", "theta"))
     if tracked is not None and not well_formed:
         raise ProtocolError(f"{kind}: state.object_in_grasp must hold finite numbers x, z, theta")
+    if tracked is not None and not (abs(tracked["x"]) <= GRASP_REACH_MM and abs(tracked["z"]) <= GRASP_REACH_MM
+                                    and abs(tracked["theta"]) <= GRASP_TURN_DEG):
+        raise ProtocolError(f"{kind}: state.object_in_grasp must have |x|, |z| <= {GRASP_REACH_MM:g} mm and "
+                            f"|theta| <= {GRASP_TURN_DEG:g} deg")
     if "object_pose" in state:
         _check_pose(state["object_pose"], f"{kind}: state.object_pose")
+        _check_placed(state["object_pose"], f"{kind}: state.object_pose")
+
+
+def _check_placed(pose: list, what: str) -> None:
+    if math.sqrt(sum(v * v for v in pose[:3])) > ARM_REACH_M:
+        raise ProtocolError(f"{what} is more than {ARM_REACH_M:g} m from the arm's base")
+    if abs(math.sqrt(sum(v * v for v in pose[3:])) - 1.0) > 1e-3:
+        raise ProtocolError(f"{what}: the quaternion is not of unit length")
 
 
 class LineReader:
