@@ -176,6 +176,9 @@ def low_mu_plan():
     (lambda p: p["waypoints"][2].update(x=p["waypoints"][2]["x"] + 50), "waypoints[2]: a step of 5"),
     (lambda p: p["waypoints"][3].update(x=10 ** 400), "waypoints[3].x: must be a finite number"),
     (lambda p: p["waypoints"].extend([p["waypoints"][-1]] * 10_001), "a plan has at most 10000"),
+    # "Solved" plans that do not end at this task's goal used to run with exit 0.
+    (lambda p: p.update(waypoints=p["waypoints"][:6]), "not within planner.tolerance [0.5, 0.5] of the task's goal"),
+    (lambda p: p.update(waypoints=p["waypoints"][:-1]), "made for another goal, or cut short?"),
 ])
 def test_bad_plan_files_are_refused_before_anything_moves(tmp_path, low_mu_plan, edit, says):
     plan = json.loads(json.dumps(low_mu_plan))
@@ -187,6 +190,16 @@ def test_bad_plan_files_are_refused_before_anything_moves(tmp_path, low_mu_plan,
     assert says in str(error.value)
     result = CliRunner().invoke(cli, ["execute", str(path), "--task", str(LOW_MU), "--arm", "127.0.0.1:9"])
     assert result.exit_code == 2 and says in result.stderr
+
+
+def test_a_nominal_plan_is_refused_for_the_same_task_with_an_uncertainty_box():
+    """Every push is re-checked at each corner of the box: a plan made without it has pushes that
+    are stable for the nominal model only (its margins are 0.1 N)."""
+    nominal = plan_task(shipped("horizontal-offset-low-mu"), seed=1)
+    uncertain = parse_task(task_text("horizontal-offset-low-mu") + "uncertainty: {pusher_mu: 0.15}\n")
+    with pytest.raises(PlanError, match="is not a stable push for this task"):
+        check_plan(uncertain, nominal)
+    check_plan(uncertain, plan_task(uncertain, seed=1))
 
 
 def test_deeply_nested_plan_json_is_refused(tmp_path):

@@ -17,9 +17,10 @@ START_SLACK = 1e-6  # mm or deg: the plan's start against the task's
 
 
 def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_solved: bool = True) -> Plan:
-    """`plan`, once it is shown to belong to `task`: solved, for the same task name and start, with
-    pushers the task has, no step longer than the task's unit step, and every push a stable push
-    of this task with the pads inside the object. PlanError names what differs (`source`: the
+    """`plan`, once it is shown to belong to `task`: solved and ending within the task's tolerance of
+    its goal, for the same task name and start, with pushers the task has, no step longer than the
+    task's unit step, and every push a stable push of this task (at every corner of its uncertainty
+    box, when it has one) with the pads inside the object. PlanError names what differs (`source`: the
     plan file, for the message). `require_solved=False` lets an unsolved (partial) plan through,
     for drawing it."""
     def fail(field: str, reason: str):
@@ -39,8 +40,15 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
             fail(f"waypoints[{i}].pusher", f"the task has no pusher {w.pusher[:100]!r}")
     if max(abs(a - b) for a, b in zip(waypoints[0].pose, task.start)) > START_SLACK:
         fail("waypoints[0]", f"the plan starts at {list(waypoints[0].pose)}, the task at {list(task.start)}")
+    end = waypoints[-1].pose
+    if require_solved and not task.at_goal(end):
+        fail(f"waypoints[{len(waypoints) - 1}]",
+             f"the plan ends at {[round(v, 3) for v in end]}, not within planner.tolerance "
+             f"{task.planner['tolerance']} of the task's goal {list(task.goal)}: made for another goal, or cut short?")
     unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
     model = task.build_model()
+    # With an uncertainty box every push must be stable at each corner, as the planner made it.
+    corners = task.corner_models() if task.uncertainty else None
     for i in range(1, len(waypoints)):
         q0, q1 = pose_to_si(waypoints[i - 1].pose), pose_to_si(waypoints[i].pose)
         length = _core.steps_between(q0, q1, unit)
@@ -51,7 +59,8 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
         if max(abs(v) for v in dq) < 1e-12:
             fail(f"waypoints[{i}]", "repeats the pose before it (a push that does not move the object)")
         pusher = waypoints[i].pusher
-        verdict = model.check(q0, dq, task.pusher_index(pusher))
+        index = task.pusher_index(pusher)
+        verdict = _core.worst_case(corners, q0, dq, index) if corners else model.check(q0, dq, index)
         if not verdict.feasible:
             fail(f"waypoints[{i}]", f"the push by {pusher!r} is not a stable push for this task "
                                     f"(margin {verdict.margin:+.4f} N); was the plan made for another version of it?")
