@@ -82,3 +82,14 @@ def test_an_open_surface_is_refused(tmp_path):
     box.export(tmp_path / "open.stl")
     with pytest.raises(TaskError, match="not a closed surface"):
         load_mesh_object(tmp_path / "open.stl", "object", mass=10.0)
+
+
+def test_a_mesh_in_metres_is_named_as_such(tmp_path):
+    """An STL in metres used to be refused only for its pads, with no word of units or scale."""
+    solid = trimesh.creation.cylinder(radius=0.020, height=0.025, sections=64)
+    solid.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))
+    solid.export(tmp_path / "disc_m.stl")
+    text = ("object: {shape: mesh, file: disc_m.stl, mass: 100}\ngripper: {grip_force: 10, mu: 0.5}\n"
+            "pushers: [{name: left, at: [-0.0199, 0.0005], mu: 0.5}]\nstart: [0, 0, 0]\ngoal: [0.001, 0, 0]\n")
+    with pytest.raises(TaskError, match=r"only 0.04 mm across: written in metres\? \(object.scale: 1000"):
+        parse_task(text, source=str(tmp_path / "task.yaml"))

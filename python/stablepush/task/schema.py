@@ -347,7 +347,8 @@ def _validate(data: Any, source: Optional[str]) -> Task:
         for i, ok in enumerate(inside):
             if not ok:
                 where = f"gripper.pads[{i}]" if "pads" in grip else "gripper (default pads)"
-                raise TaskError(label, f"{where} does not lie inside the object at the {label} pose {list(q)}")
+                raise TaskError(label, f"{where} does not lie inside the object at the {label} pose {list(q)}"
+                                + _units_hint(vertices, thickness, top["object"]))
 
     planner = _validate_planner(top.get("planner", {}))
     uncertain = _mapping("uncertainty", top.get("uncertainty", {}), [], list(UNCERTAIN))
@@ -376,6 +377,16 @@ def _default_name(source: Optional[str]) -> str:
     """A task without `name:` is named after its file (its stem), else "task"."""
     stem = Path(source).stem if source else ""
     return stem if stem and stem.isprintable() and len(stem) <= 100 else "task"
+
+
+def _units_hint(vertices, thickness, obj: dict) -> str:
+    """For an error that a unit slip explains: an object under 2 mm across was written in metres."""
+    size = max(max(x for x, _ in vertices) - min(x for x, _ in vertices),
+               max(z for _, z in vertices) - min(z for _, z in vertices), thickness)
+    if size >= 2.0:
+        return ""
+    fix = "object.scale: 1000 reads a mesh in metres" if obj.get("shape") == "mesh" else "task files use mm"
+    return f"; the object is only {size:.3g} mm across: written in metres? ({fix})"
 
 
 AIR_DENSITY = 1.2e-3  # g/cm^3: a solid lighter than this is a unit slip
