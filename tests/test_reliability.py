@@ -163,6 +163,11 @@ def test_seeds_above_2_31_are_their_own_seeds():
 
 # -- plan files -----------------------------------------------------------------------------------
 
+def _alternate_pushers(waypoints):
+    for i, w in enumerate(waypoints):
+        w["pusher"] = "left" if i % 2 else "bottom"
+
+
 @pytest.fixture(scope="module")
 def low_mu_plan():
     return plan_to_dict(plan_task(shipped("horizontal-offset-low-mu"), seed=1))
@@ -179,6 +184,9 @@ def low_mu_plan():
     # "Solved" plans that do not end at this task's goal used to run with exit 0.
     (lambda p: p.update(waypoints=p["waypoints"][:6]), "not within planner.tolerance [0.5, 0.5] of the task's goal"),
     (lambda p: p.update(waypoints=p["waypoints"][:-1]), "made for another goal, or cut short?"),
+    # bottom -> left -> bottom -> left: 3 switch-overs where the plan's budget is 1 (10,000 waypoints
+    # alternating pushers took minutes to turn into a trajectory).
+    (lambda p: _alternate_pushers(p["waypoints"][1:5]), "switch-overs, more than the plan's max_switches (1)"),
 ])
 def test_bad_plan_files_are_refused_before_anything_moves(tmp_path, low_mu_plan, edit, says):
     plan = json.loads(json.dumps(low_mu_plan))

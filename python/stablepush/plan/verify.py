@@ -10,10 +10,14 @@ from stablepush import _core
 from stablepush.errors import PlanError
 from stablepush.plan.plan import Plan
 from stablepush.task.model import Task
+from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import MM, pose_to_si
 
 STEP_SLACK = 1e-6  # unit steps: rounding in a plan file's decimal poses
 START_SLACK = 1e-6  # mm or deg: the plan's start against the task's
+
+
+MAX_SWITCHES = int(PLANNER_PARAMETER_RANGES["max_switches"][2])
 
 
 def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_solved: bool = True) -> Plan:
@@ -38,6 +42,14 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
             fail(f"waypoints[{i}].pusher", "only the first waypoint (the start) has no pusher")
         if w.pusher is not None and w.pusher not in task.pusher_names:
             fail(f"waypoints[{i}].pusher", f"the task has no pusher {w.pusher[:100]!r}")
+    # Each switch-over is a transit between features (hundreds of trajectory samples): no more than
+    # the plan's own budget, itself within the planner's range.
+    switches = sum(1 for a, b in zip(waypoints[1:], waypoints[2:]) if a.pusher != b.pusher)
+    recorded = plan.stats.get("max_switches")
+    budget = int(recorded) if isinstance(recorded, int) and 0 <= recorded < MAX_SWITCHES else MAX_SWITCHES
+    if switches > budget:
+        fail("waypoints", f"{switches} switch-overs, more than the plan's max_switches ({budget}); "
+                          f"not a plan this tool made")
     if max(abs(a - b) for a, b in zip(waypoints[0].pose, task.start)) > START_SLACK:
         fail("waypoints[0]", f"the plan starts at {list(waypoints[0].pose)}, the task at {list(task.start)}")
     end = waypoints[-1].pose
