@@ -310,6 +310,13 @@ def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu
         assert replies[-1]["type"] == "error" and "nested too deeply" in replies[-1]["message"]
         replies = exchange(_hello(scene, rate_hz=0))
         assert "rate_hz must be between 1 and 1000" in replies[-1]["message"]
+        # 826 bytes asking for 1e9 pad rings kept the server busy 31 s, until MemoryError.
+        huge = json.loads(json.dumps(scene))
+        huge["gripper"]["pad_rings"] = 10 ** 9
+        started = time.monotonic()
+        replies = exchange(_hello(huge))
+        assert "scene.gripper.pad_rings must be an integer from 0 to 6" in replies[-1]["message"]
+        assert time.monotonic() - started < 2.0
         replies = exchange(b'{"type": "hello", "prot')  # half a line, then silence: dropped
         assert "no complete message from the client within 3 s" in replies[-1]["message"]
         # A session in progress: a second client is told the arm is busy.
