@@ -427,3 +427,22 @@ def test_mesh_files_are_read_bounded_in_known_formats(tmp_path, name, says):
                     "pushers: [{name: left, at: [-20, 0], mu: 0.5}]\nstart: [0, 0, 0]\ngoal: [1, 0, 0]\n")
     result = CliRunner().invoke(cli, ["plan", str(task)])
     assert result.exit_code == 2 and "object.file" in result.stderr and says in result.stderr, result.stderr
+
+
+def test_ctrl_c_ends_a_long_search_at_once_and_writes_nothing(tmp_path):
+    """SIGINT 2 s into a search that cannot succeed (the pegs robust to 1% pad mu: no stable push)
+    with a 20 s limit used to return only at the limit (18.8 s); it now stops within a flag check."""
+    task = tmp_path / "stuck.yaml"
+    task.write_text(task_text("more/cube-pegs").replace("time_limit: 10", "time_limit: 20")
+                    + "uncertainty: {pad_mu: 0.01}\n")
+    assert "time_limit: 20" in task.read_text()
+    out = tmp_path / "stuck.plan.json"
+    process = subprocess.Popen([sys.executable, "-c", "from stablepush_cli.main import cli; cli()", "plan", str(task),
+                                "-o", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(2.0)
+    assert process.poll() is None  # still searching
+    process.send_signal(signal.SIGINT)
+    interrupted = time.monotonic()
+    _, stderr = process.communicate(timeout=15)
+    assert time.monotonic() - interrupted < 1.5, stderr
+    assert process.returncode == 1 and "Aborted!" in stderr and not out.exists()

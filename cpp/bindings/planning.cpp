@@ -5,7 +5,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
+#include <csignal>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "bindings.hpp"
@@ -15,6 +18,37 @@ namespace py = pybind11;
 
 namespace stablepush::python {
 namespace {
+
+// Ctrl-C during a search: the core plans with the GIL released, so Python's own SIGINT handler
+// cannot run until it returns; for the search's length a C handler sets its stop flag instead, and
+// the KeyboardInterrupt is raised once the search has returned. Only one search at a time (the main
+// thread's, where Python delivers signals) installs it.
+std::atomic<StopFlag*> interrupted_search{nullptr};
+
+extern "C" void stop_search_on_sigint(int) {
+  if (StopFlag* flag = interrupted_search.load()) flag->set();
+}
+
+/// Installs stop_search_on_sigint for `flag` while it lives; restores the previous handler after.
+class SigintStopsSearch {
+ public:
+  explicit SigintStopsSearch(StopFlag* flag) {
+    interrupted_search.store(flag);
+    struct sigaction action {};
+    action.sa_handler = stop_search_on_sigint;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &previous_);
+  }
+  ~SigintStopsSearch() {
+    sigaction(SIGINT, &previous_, nullptr);
+    interrupted_search.store(nullptr);
+  }
+  SigintStopsSearch(const SigintStopsSearch&) = delete;
+  SigintStopsSearch& operator=(const SigintStopsSearch&) = delete;
+
+ private:
+  struct sigaction previous_ {};
+};
 
 /// A PushChecker written in Python: subclass _core.PushChecker and define all_pushers(),
 /// stable_pushers(a, b, candidates) and push_margin(a, b, pusher); a and b are Poses, pusher sets
@@ -52,6 +86,11 @@ void expose_planning(py::module_& m) {
       .value("time_limit", PlanOutcome::TimeLimit)
       .value("invalid_start", PlanOutcome::InvalidStart);
 
+  py::class_<StopFlag, std::shared_ptr<StopFlag>>(m, "StopFlag", "Set from another thread to end a search early.")
+      .def(py::init<>())
+      .def("set", &StopFlag::set)
+      .def_property_readonly("is_set", &StopFlag::is_set);
+
   py::class_<PlannerSettings>(m, "PlannerSettings", "What to plan: start and goal, the unit step, the limits.")
       .def(py::init([](const Pose& start, const Pose& goal, const StepSize& step, const StepSize& tolerance,
                        double time_limit, double min_margin, double sampling_margin, double min_hold_ratio,
@@ -78,6 +117,7 @@ void expose_planning(py::module_& m) {
       .def_readwrite("min_transit_hold", &PlannerSettings::min_transit_hold,
                      "switch pushers only where the pads hold this many times the weight (0: anywhere)")
       .def_readwrite("start_pusher", &PlannerSettings::start_pusher, "the pusher in contact at the start, or -1")
+      .def_readwrite("stop", &PlannerSettings::stop, "a StopFlag that ends the search early when set, or None")
       .def_readwrite("parameters", &PlannerSettings::parameters, "TRRTstar's declared parameters by name, as text");
 
   py::class_<Waypoint>(m, "Waypoint", "The pose after a unit push, its pusher (-1 at the start) and the verdict.")
@@ -124,14 +164,29 @@ void expose_planning(py::module_& m) {
 
   m.def(
       "plan",
-      [](const ModelSet& models, const PlannerSettings& settings) {
-        py::gil_scoped_release release;
-        return plan_stable_pushes(models, settings);
+      [](const ModelSet& models, PlannerSettings settings, bool interruptible) {
+        if (!interruptible) {
+          py::gil_scoped_release release;
+          return plan_stable_pushes(models, settings);
+        }
+        if (!settings.stop) settings.stop = std::make_shared<StopFlag>();
+        Plan plan;
+        {
+          SigintStopsSearch sigint(settings.stop.get());
+          py::gil_scoped_release release;
+          plan = plan_stable_pushes(models, settings);
+        }
+        if (settings.stop->is_set()) {
+          PyErr_SetNone(PyExc_KeyboardInterrupt);
+          throw py::error_already_set();
+        }
+        return plan;
       },
-      py::arg("models"), py::arg("settings"),
+      py::arg("models"), py::arg("settings"), py::arg("interruptible") = false,
       "Plan stable pushes with TRRTstar. models: StablePushModels sharing the geometry (the corners of an\n"
       "uncertainty box, or the nominal model alone): a push counts when it is stable in all, its margin the\n"
-      "least. Throws ValueError for a parameter TRRTstar does not declare or cannot take.");
+      "least. Throws ValueError for a parameter TRRTstar does not declare or cannot take. interruptible (only from\n"
+      "the main thread): SIGINT stops the search at once and raises KeyboardInterrupt.");
 
   py::class_<PathNode>(m, "PathNode", "A node of the search's path: the pose and the pusher of the push into it.")
       .def_readonly("pose", &PathNode::pose)

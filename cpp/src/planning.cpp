@@ -123,7 +123,12 @@ ob::PlannerStatus solve(TRRTstar& planner, const Problem& problem, const Planner
   apply_parameters(planner, settings.parameters);
   planner.setProblemDefinition(problem.pdef);
   planner.setup();
-  return planner.solve(ob::timedPlannerTerminationCondition(settings.time_limit));
+  ob::PlannerTerminationCondition ptc = ob::timedPlannerTerminationCondition(settings.time_limit);
+  if (settings.stop) {
+    const std::shared_ptr<StopFlag> stop = settings.stop;
+    ptc = ob::plannerOrTerminationCondition(ptc, ob::PlannerTerminationCondition([stop] { return stop->is_set(); }));
+  }
+  return planner.solve(ptc);
 }
 
 /// Append the motion from the plan's last waypoint to `to` by `pusher`, cut into unit pushes as

@@ -2,6 +2,7 @@
 // TRRTstar, solved, and the tree path cut into the unit pushes a robot executes.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -15,6 +16,16 @@ namespace stablepush {
 
 /// The longest time limit a plan accepts [s] (OMPL's timed termination counts in integer ns).
 inline constexpr double kMaxTimeLimit = 1e6;
+
+/// Set from another thread to end a search early (Ctrl-C): the plan returns as at its time limit.
+class StopFlag {
+ public:
+  void set() { set_.store(true); }
+  bool is_set() const { return set_.load(); }
+
+ private:
+  std::atomic<bool> set_{false};
+};
 
 struct PlannerSettings {
   Pose start;                ///< [m, m, rad]
@@ -37,6 +48,8 @@ struct PlannerSettings {
   /// The pusher in contact at the start (a re-plan from a pose on a feature), else kNoPusher. With
   /// min_transit_hold, a plan that starts with another pusher makes a transit at the start.
   int start_pusher = kNoPusher;
+  /// When given and set, the search stops at once (checked as often as the time limit).
+  std::shared_ptr<StopFlag> stop;
 };
 
 /// One waypoint: the pose after a unit push, the pusher that made it, and the test's verdict

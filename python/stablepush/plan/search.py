@@ -7,6 +7,7 @@ the gripper.
 from __future__ import annotations
 
 import math
+import threading
 from typing import List, Optional
 
 from stablepush import _core
@@ -59,11 +60,13 @@ def plan_task(
         settings["time_limit"] = planner_limit("time_limit", time_limit)
     if improve_for is not None:
         settings["improve_for"] = planner_parameter("improve_for", "improve_for", improve_for)
+    if models:  # the caller's: they must be this task's
+        _check_models(task, models)
     models = models or task.corner_models()
-    _check_models(task, models)
     model = models[0]
     parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}
     parameters.update({key: repr(settings[key]) for key in PLANNER_TUNING if key in settings})
+    # Ctrl-C stops the search at once (KeyboardInterrupt); signals reach the main thread only.
     raw = _core.plan(models, _core.PlannerSettings(
         start=pose_to_si(task.start), goal=pose_to_si(task.goal),
         step=(settings["step"][0] * MM, math.radians(settings["step"][1])),
@@ -71,7 +74,8 @@ def plan_task(
         time_limit=float(settings["time_limit"]), min_margin=float(settings["min_margin"]),
         sampling_margin=float(settings["sampling_margin"]), min_hold_ratio=float(settings["min_hold_ratio"]),
         parameters=parameters, min_transit_hold=float(min_transit_hold),
-        start_pusher=-1 if start_pusher is None else task.pusher_index(start_pusher)))
+        start_pusher=-1 if start_pusher is None else task.pusher_index(start_pusher)),
+        interruptible=threading.current_thread() is threading.main_thread())
 
     names = task.pusher_names
     waypoints: List[Waypoint] = []
