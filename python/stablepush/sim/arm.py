@@ -15,15 +15,11 @@ from typing import Callable, Dict, Optional, Sequence
 import mujoco
 import numpy as np
 
-from stablepush.frames import matrix_to_pose, pose_to_matrix
+from stablepush.frames import matrix_to_pose
+from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.friction import CoulombPadFriction
 
-IK_DAMPING = 1e-4  # DLS damping lambda^2 [m^2]
-IK_ITERATIONS = 50
-IK_TOLERANCE = 1e-9  # m (and rad) of pose error
-POSTURE_GAIN = 0.05  # null-space pull toward the home posture per IK iteration
-HOME_GUESS = np.array([0.0, 0.35, 0.0, 1.9, 0.0, 0.89, 0.0])  # rad, hand pointing down in front of the base
 SETTLE_TIME = 0.3  # s of simulation after the grasp closes, before the first waypoint
 
 
@@ -141,10 +137,14 @@ class SimArm(SimulatedGrasp):
         self._arm_dof = np.array([m.jnt_dofadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
         self._arm_act = np.array([m.actuator(j).id for j in scene_mod.ARM_JOINTS])
         self._scratch = mujoco.MjData(m)
+        joints = [m.joint(j).id for j in scene_mod.ARM_JOINTS]
+        self._lower, self._upper = m.jnt_range[joints, 0], m.jnt_range[joints, 1]
+        self._jacp = np.zeros((3, m.nv))
+        self._jacr = np.zeros((3, m.nv))
 
         home = np.asarray(scene["gripper_pose"], float)
-        self.home_posture = HOME_GUESS.copy()
-        self.home_posture = self.solve_ik(home, HOME_GUESS, strict=True, iterations=1000)
+        self.home_posture = ik.HOME_GUESS.copy()
+        self.home_posture = self.solve_ik(home, ik.HOME_GUESS, strict=True, iterations=1000)
         self.target = self.home_posture.copy()
         self.data.qpos[self._arm_qpos] = self.home_posture
         self.data.ctrl[self._arm_act] = self.home_posture
@@ -154,40 +154,24 @@ class SimArm(SimulatedGrasp):
     # -- kinematics ---------------------------------------------------------------------------
 
     def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, strict: bool = False,
-                 iterations: int = IK_ITERATIONS) -> np.ndarray:
-        """Joint angles [rad] that put G at `pose`, by damped least squares from `q_start`, with a
-        null-space pull toward the home posture (the arm has one joint more than the pose needs)."""
-        d = self._scratch
-        target = pose_to_matrix(pose)
-        q = np.array(q_start, float)
-        lo = self.model.jnt_range[[self.model.joint(j).id for j in scene_mod.ARM_JOINTS], 0]
-        hi = self.model.jnt_range[[self.model.joint(j).id for j in scene_mod.ARM_JOINTS], 1]
-        jacp = np.zeros((3, self.model.nv))
-        jacr = np.zeros((3, self.model.nv))
-        error = np.inf
-        for _ in range(iterations):
-            d.qpos[self._arm_qpos] = q
-            mujoco.mj_kinematics(self.model, d)
-            mujoco.mj_comPos(self.model, d)
-            R = d.site_xmat[self._site].reshape(3, 3)
-            e_pos = target[:3, 3] - d.site_xpos[self._site]
-            e_rot = _rotation_vector(target[:3, :3] @ R.T)
-            e = np.concatenate([e_pos, e_rot])
-            error = float(np.linalg.norm(e))
-            if error < IK_TOLERANCE:
-                break
-            mujoco.mj_jacSite(self.model, d, jacp, jacr, self._site)
-            J = np.vstack([jacp, jacr])[:, self._arm_dof]
-            JJt = J @ J.T + IK_DAMPING * np.eye(6)
-            dq = J.T @ np.linalg.solve(JJt, e)
-            null_space = np.eye(7) - np.linalg.pinv(J, rcond=1e-6) @ J
-            dq += null_space @ (POSTURE_GAIN * (self.home_posture - q))
-            q = np.clip(q + dq, lo, hi)
+                 iterations: int = ik.IK_ITERATIONS) -> np.ndarray:
+        """Joint angles [rad] that put G at `pose`, from `q_start` (`ik.solve_ik` on MuJoCo's
+        kinematics of the arm)."""
+        q, error = ik.solve_ik(self._kinematics, pose, q_start, self.home_posture, self._lower, self._upper,
+                               iterations)
         if strict and error > 1e-6:
-            shown = [round(float(v), 4) for v in pose]
-            raise ValueError(f"the arm cannot reach the pose {shown} (IK error {error:.2e})")
+            raise ik.unreachable(pose, error)
         self.ik_error = error
         return q
+
+    def _kinematics(self, q: np.ndarray):
+        d = self._scratch
+        d.qpos[self._arm_qpos] = q
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_comPos(self.model, d)
+        mujoco.mj_jacSite(self.model, d, self._jacp, self._jacr, self._site)
+        J = np.vstack([self._jacp, self._jacr])[:, self._arm_dof]
+        return d.site_xmat[self._site].reshape(3, 3), d.site_xpos[self._site].copy(), J
 
     # -- simulation ---------------------------------------------------------------------------
 
@@ -233,12 +217,3 @@ class SimArm(SimulatedGrasp):
             "object_in_grasp": tracked,
             "steps_per_s": round(self.steps_per_second, 1),
         }
-
-def _rotation_vector(R: np.ndarray) -> np.ndarray:
-    quat = np.zeros(4)
-    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(R).ravel())
-    if quat[0] < 0:
-        quat = -quat
-    v = np.zeros(3)
-    mujoco.mju_quat2Vel(v, quat, 1.0)
-    return v

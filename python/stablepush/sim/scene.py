@@ -45,6 +45,7 @@ NOSLIP_TOLERANCE = 1e-6  # MuJoCo's default
 PAD_POINT_RADIUS = 0.0005  # m, radius of each pad contact sphere
 FEATURE_DEPTH = 0.01  # m, how far a feature extends behind its contact face
 FEATURE_CLEARANCE = 0.002  # m, a feature is this much narrower than the object along y on each side
+FEATURE_ROD_RADIUS = 0.001  # m, the rod of a point pusher's feature
 
 
 def pad_points(center: Sequence[float], radius: float, rings: int) -> List[Tuple[float, float]]:
@@ -176,14 +177,73 @@ def _fmt(values) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
-def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
-    """The complete MJCF of a scene description (see `stablepush.execution.protocol`). With
-    `kinematic_hand` the arm is replaced by a hand at the scene's gripper pose that moves in G's
-    plane through three joints (HAND_JOINTS) whose motion the caller prescribes: the same fingers,
-    pads and contacts without the arm, for measuring friction alone (`fidelity.py`)."""
+def arm_tree(scene: dict, kinematic_hand: bool = False) -> ET.Element:
+    """The shipped arm (arm.xml) as an MJCF element tree, its finger servos capped at the scene's
+    grip force; with `kinematic_hand` the arm is replaced by a hand at the scene's gripper pose that
+    moves in G's plane through three joints (HAND_JOINTS) whose motion the caller prescribes: the
+    same fingers, pads and contacts without the arm, for measuring friction alone (`fidelity.py`).
+    Both engines read the arm from this tree (MuJoCo whole, Drake through its MJCF parser)."""
     root = ET.parse(ARM_XML).getroot()
     if kinematic_hand:
         _replace_arm_by_kinematic_hand(root, scene["gripper_pose"])
+    # The finger servos close toward y = 0 and press with at most the grip force.
+    grip_force = scene["gripper"]["grip_force"]
+    for finger in FINGER_JOINTS:
+        act = root.find(f".//actuator/position[@name='{finger}']")
+        act.set("forcerange", _fmt((-grip_force, grip_force)))
+        act.set("forcelimited", "true")
+    return root
+
+
+def pad_layout(scene: dict) -> List[Tuple[str, str, float, Tuple[float, float]]]:
+    """Every pad contact point as (name, finger body, side, (x, z) in G [m]): pad i sits on finger
+    i mod 2 (the task lists the opposed pads in pairs), `side` is the finger's inner face (+1 on
+    finger_pos, -1 on finger_neg), the points as `pad_points` lays them out."""
+    gripper = scene["gripper"]
+    out = []
+    for f, (finger, side) in enumerate(zip(FINGER_JOINTS, (1.0, -1.0))):
+        for p, pad in list(enumerate(gripper["pads"]))[f::2]:
+            for k, point in enumerate(pad_points(pad["center"], pad["radius"], gripper["pad_rings"])):
+                out.append((f"{PAD_PREFIX}{finger}_{p}_{k}", finger, side, point))
+    return out
+
+
+def object_inertia(obj: dict) -> np.ndarray:
+    """The object's inertia tensor [kg m^2] about its centre of mass, axes of O: a uniform prism of
+    its outline, with the task's own moment about y (docs/model.md section 4)."""
+    inertia = _prism_inertia(obj["polygon"], obj["thickness"], obj["mass"], obj["com"])
+    inertia[1, 1] = obj["inertia"]
+    return inertia
+
+
+def object_pieces(obj: dict) -> List[Tuple[str, list, bool]]:
+    """The object's collision pieces: (name, convex ccw outline in O's xz [m], whether the piece
+    is an axis-aligned rectangle, built as a box)."""
+    pieces = convex_pieces(simulated_outline(obj["polygon"])[0])
+    return [(f"object_piece{i}", piece, _axis_aligned_rectangle(piece)) for i, piece in enumerate(pieces)]
+
+
+def feature_solid(feature: dict, thickness: float) -> dict:
+    """A feature's fixed solid in W: a box whose contact face is the pusher's segment, extending
+    FEATURE_DEPTH behind it (`center`, `angle` about y, `half_size`), or for a point pusher a rod
+    along y (`center`, `radius`, `half_length`). It is FEATURE_CLEARANCE narrower than the object
+    on each side along y, so that it touches the object's face and never a pad."""
+    a = np.asarray(feature["from"], float)
+    b = np.asarray(feature["to"], float)
+    n = np.asarray(feature["normal"], float)
+    half_y = max(thickness / 2 - FEATURE_CLEARANCE, 0.001)
+    length = float(np.linalg.norm(b - a))
+    if length > 0:
+        t = (b - a) / length
+        return {"kind": "box", "center": (a + b) / 2 - n * FEATURE_DEPTH / 2, "angle": math.atan2(-t[2], t[0]),
+                "half_size": (length / 2, half_y, FEATURE_DEPTH / 2)}
+    return {"kind": "rod", "center": a - n * FEATURE_ROD_RADIUS, "radius": FEATURE_ROD_RADIUS, "half_length": half_y}
+
+
+def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
+    """The complete MJCF of a scene description (see `stablepush.execution.protocol`): `arm_tree`
+    plus the solver options, the pad points, the held object, the features and the contact pairs."""
+    root = arm_tree(scene, kinematic_hand)
     gx, gz = scene["gravity"]
     ET.SubElement(root, "option", timestep=repr(TIMESTEP), gravity=_fmt((gx, 0.0, gz)), cone="elliptic",
                   impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS),
@@ -196,32 +256,26 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
 
     # The pads: point spheres on the inner side of each finger, in G's xz-plane.
     pad_names = []
-    # Pad i sits on finger i mod 2 (the task lists the opposed pads in pairs).
-    for f, (finger, side) in enumerate(zip(FINGER_JOINTS, (1.0, -1.0))):
+    for name, finger, side, (px, pz) in pad_layout(scene):
         body = root.find(f".//body[@name='{finger}']")
-        for p, pad in list(enumerate(gripper["pads"]))[f::2]:
-            for k, (px, pz) in enumerate(pad_points(pad["center"], pad["radius"], gripper["pad_rings"])):
-                name = f"{PAD_PREFIX}{finger}_{p}_{k}"
-                ET.SubElement(body, "geom", name=name, type="sphere", size=repr(PAD_POINT_RADIUS),
-                              pos=_fmt((px, side * PAD_POINT_RADIUS, pz)), mass="0.0001", rgba="0.2 0.2 0.2 1")
-                pad_names.append(name)
+        ET.SubElement(body, "geom", name=name, type="sphere", size=repr(PAD_POINT_RADIUS),
+                      pos=_fmt((px, side * PAD_POINT_RADIUS, pz)), mass="0.0001", rgba="0.2 0.2 0.2 1")
+        pad_names.append(name)
 
     # The held object: a free body of convex prisms in O.
     x, y, z, w, qx, qy, qz = scene["object_pose"]
     body = ET.SubElement(worldbody, "body", name=OBJECT_BODY, pos=_fmt((x, y, z)), quat=_fmt((w, qx, qy, qz)))
     ET.SubElement(body, "freejoint", name=OBJECT_BODY)
     com = obj["com"]
-    inertia = _prism_inertia(obj["polygon"], obj["thickness"], obj["mass"], com)
-    inertia[1, 1] = obj["inertia"]  # the task's moment about y (docs/model.md section 4)
+    inertia = object_inertia(obj)
     ET.SubElement(body, "inertial", pos=_fmt((com[0], 0.0, com[1])), mass=repr(obj["mass"]),
                   fullinertia=_fmt((inertia[0, 0], inertia[1, 1], inertia[2, 2], 0.0, inertia[0, 2], 0.0)))
     piece_names = []
     assets = root.find("asset")
     if assets is None:
         assets = ET.SubElement(root, "asset")
-    for i, piece in enumerate(convex_pieces(simulated_outline(obj["polygon"])[0])):
-        name = f"object_piece{i}"
-        if _axis_aligned_rectangle(piece):
+    for name, piece, rectangle in object_pieces(obj):
+        if rectangle:
             xs = [p[0] for p in piece]
             zs = [p[1] for p in piece]
             ET.SubElement(body, "geom", name=name, type="box", mass="0",
@@ -234,38 +288,23 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
             ET.SubElement(body, "geom", name=name, type="mesh", mesh=name, mass="0", rgba="0.85 0.55 0.25 1")
         piece_names.append(name)
 
-    # The features: fixed boxes whose contact face is the pusher's segment (a thin rod for a point).
-    feature_half_y = max(half_thickness - FEATURE_CLEARANCE, 0.001)
+    # The features: fixed solids whose contact face is the pusher's segment.
     contact = ET.SubElement(root, "contact")
     for feature in scene["features"]:
-        a = np.asarray(feature["from"], float)
-        b = np.asarray(feature["to"], float)
-        n = np.asarray(feature["normal"], float)
         name = feature_geom(feature["pusher"])
-        length = float(np.linalg.norm(b - a))
-        if length > 0:
-            t = (b - a) / length
-            angle = math.atan2(-t[2], t[0])
-            center = (a + b) / 2 - n * FEATURE_DEPTH / 2
-            ET.SubElement(worldbody, "geom", name=name, type="box", pos=_fmt(center), quat=_fmt(quat_about_y(angle)),
-                          size=_fmt((length / 2, feature_half_y, FEATURE_DEPTH / 2)), rgba="0.3 0.5 0.8 1")
+        solid = feature_solid(feature, obj["thickness"])
+        if solid["kind"] == "box":
+            ET.SubElement(worldbody, "geom", name=name, type="box", pos=_fmt(solid["center"]),
+                          quat=_fmt(quat_about_y(solid["angle"])), size=_fmt(solid["half_size"]), rgba="0.3 0.5 0.8 1")
         else:
-            rod = 0.001
-            center = a - n * rod
-            ET.SubElement(worldbody, "geom", name=name, type="capsule", size=repr(rod),
-                          fromto=_fmt((*(center - [0, feature_half_y, 0]), *(center + [0, feature_half_y, 0]))),
-                          rgba="0.3 0.5 0.8 1")
+            c, h = solid["center"], solid["half_length"]
+            ET.SubElement(worldbody, "geom", name=name, type="capsule", size=repr(solid["radius"]),
+                          fromto=_fmt((*(c - [0, h, 0]), *(c + [0, h, 0]))), rgba="0.3 0.5 0.8 1")
         for piece in piece_names:
             _pair(contact, name, piece, feature["mu"])
     for pad in pad_names:
         for piece in piece_names:
             _pair(contact, pad, piece, gripper["mu"])
-
-    # The finger servos close toward y = 0 and press with at most the grip force.
-    for finger in FINGER_JOINTS:
-        act = root.find(f".//actuator/position[@name='{finger}']")
-        act.set("forcerange", _fmt((-gripper["grip_force"], gripper["grip_force"])))
-        act.set("forcelimited", "true")
     return ET.tostring(root, encoding="unicode")
 
 
