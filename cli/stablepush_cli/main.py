@@ -11,6 +11,7 @@ import click
 
 from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError
 from stablepush.execution.protocol import DEFAULT_PORT
+from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import check_push, load_task
 
 EXIT_NOT_SOLVED = 1
@@ -405,7 +406,10 @@ def _host_port(value: str):
 @click.option("--arm", "arm", default=None, metavar="HOST:PORT",
               help=f"The arm server (stablepush.arm/2 protocol, see README). Default: with --sim a simulated arm "
                    f"started in this process, else 127.0.0.1:{DEFAULT_PORT}.")
-@click.option("--sim", is_flag=True, help="Start a simulated arm (MuJoCo) here and run the plan on it.")
+@click.option("--sim", is_flag=True, help="Start a simulated arm here and run the plan on it (see --engine).")
+@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+              help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with stablepush's own "
+                   "Coulomb friction; drake: Drake's contact solver alone decides stick and slip.")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
               metavar="HZ", help="Waypoints per second of motion.")
 @click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
@@ -439,7 +443,7 @@ def _host_port(value: str):
 @click.option("--final-tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
                                      "this close to the goal (default: a fifth of the task's goal tolerance).")
-def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resume_from: int, pace,
+def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
             ack_timeout: float, json_path, success_tolerance, quiet: bool, mu_scale: float, tracker_noise,
             closed_loop: bool, replan_threshold, final_tolerance) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
@@ -480,9 +484,9 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
         from stablepush.execution import ClosedLoop
 
         loop = ClosedLoop.for_task(task, replan_threshold, final_tolerance)
-    deviated = mu_scale != 1.0 or any(tracker_noise)
+    deviated = mu_scale != 1.0 or any(tracker_noise) or engine != DEFAULT_ENGINE
     if deviated and not (sim and arm is None):
-        _fail("--sim-mu-scale and --tracker-noise: only with --sim (a simulated arm started here)")
+        _fail("--engine, --sim-mu-scale and --tracker-noise: only with --sim (a simulated arm started here)")
     sim_arm = contextlib.ExitStack()
     if sim and arm is None:
         from stablepush.sim.arm import WorldDeviation
@@ -490,7 +494,8 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, rate_hz: float, resu
 
         deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0],
                                    tracker_noise_deg=tracker_noise[1])
-        server = sim_arm.enter_context(running_sim_arm(log=(lambda text: None) if quiet else None, deviation=deviation))
+        server = sim_arm.enter_context(running_sim_arm(log=(lambda text: None) if quiet else None, deviation=deviation,
+                                                       engine=engine))
         host, port = server.host, server.port
     else:
         host, port = _host_port(arm) if arm else ("127.0.0.1", DEFAULT_PORT)
@@ -608,8 +613,12 @@ def _print_report(report) -> None:
               help="Seed of the tracker's noise.")
 @click.option("--idle-timeout", default=30.0, show_default=True, type=click.FloatRange(min=0.1, max=3600), metavar="S",
               help="Drop a client that sends no complete message for S seconds (the arm is stopped).")
-def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, seed: int, idle_timeout: float) -> None:
-    """Serve a simulated arm (MuJoCo) over the arm protocol, until interrupted.
+@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+              help="The physics engine. mujoco: pads slide with stablepush's own Coulomb friction; drake: Drake's "
+                   "contact solver alone decides stick and slip (about half MuJoCo's speed).")
+def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, seed: int, idle_timeout: float,
+            engine: str) -> None:
+    """Serve a simulated arm (MuJoCo or Drake) over the arm protocol, until interrupted.
 
     A 7-joint arm of simple shapes (shipped MJCF) with a parallel-jaw gripper whose pads press with
     the task's grip force; the executor's hello carries the object, the features and the friction.
@@ -625,8 +634,9 @@ def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, se
 
     deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1],
                                seed=seed)
-    server = SimArmServer(host, port, exit_after=exit_after, deviation=deviation, idle_timeout=idle_timeout)
-    click.echo(f"sim-arm: listening on {server.host}:{server.port}", err=True)
+    server = SimArmServer(host, port, exit_after=exit_after, deviation=deviation, idle_timeout=idle_timeout,
+                          engine=engine)
+    click.echo(f"sim-arm: listening on {server.host}:{server.port} ({engine})", err=True)
     try:
         server.serve_forever()
     except KeyboardInterrupt:

@@ -1,2 +1,3 @@
-"""The simulated arm (MuJoCo): scene building (scene.py), the arm and its IK (arm.py), and the
-arm-protocol server (server.py) behind `stablepush sim-arm`."""
+"""The simulated arm on two physics engines (engines.py): MuJoCo (scene.py, arm.py, friction.py)
+and Drake (drake_arm.py); the arm's IK (ik.py), the friction-fidelity contract both must pass
+(fidelity.py), and the arm-protocol server (server.py) behind `stablepush sim-arm`."""

@@ -45,7 +45,8 @@ class WorldDeviation:
     seed: int = 0
 
 
-def _scaled_friction(scene: dict, scale: float) -> dict:
+def scaled_friction(scene: dict, scale: float) -> dict:
+    """`scene` with every pad's and feature's mu times `scale` (a world that differs from the model)."""
     if scale == 1.0:
         return scene
     scene = copy.deepcopy(scene)
@@ -75,7 +76,37 @@ class SimulatedGrasp:
         self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene["object_pose"]
         # close: the servos saturate at the grip force
         self.data.ctrl[[m.actuator(j).id for j in scene_mod.FINGER_JOINTS]] = 0.0
-        # the subclass sets its own drives, then calls mj_forward once
+        self._pad_geoms = set(scene_mod.pad_geoms(m))
+        if kinematic_hand:
+            self._hand_qpos = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
+            self._hand_dof = [m.jnt_dofadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
+            mujoco.mj_forward(m, self.data)
+        # the arm sets its own drives, then calls mj_forward once
+
+    engine = "mujoco"
+
+    @property
+    def timestep(self) -> float:
+        return float(self.model.opt.timestep)
+
+    def step_hand(self, motion: Sequence[float], velocity: Sequence[float]) -> None:
+        """With a kinematic hand: one time step with the hand at `motion` (x m, z m, theta rad about
+        y, from its start) moving at `velocity` (m/s, m/s, rad/s)."""
+
+        def drive_hand(_: int) -> None:
+            self.data.qpos[self._hand_qpos] = motion
+            self.data.qvel[self._hand_dof] = velocity
+
+        self._run(1, drive_hand)
+
+    def pad_contacts(self) -> int:
+        """How many pad points touch the object now."""
+        return sum(1 for i in range(self.data.ncon)
+                   if self.data.contact[i].geom1 in self._pad_geoms or self.data.contact[i].geom2 in self._pad_geoms)
+
+    def describe(self) -> str:
+        return (f"MuJoCo {self.model.nbody} bodies, {self.model.npair} contact pairs, "
+                f"{self.timestep * 1e3:g} ms step")
 
     def _run(self, n: int, before_step: Callable[[int], None]) -> None:
         """n time steps; `before_step(i)` (i = 1..n) sets the drives of step i."""
@@ -128,7 +159,7 @@ class SimArm(SimulatedGrasp):
     """The arm, the grasp and the world of one scene description (as `deviation` alters it)."""
 
     def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(_scaled_friction(scene, deviation.mu_scale))
+        super().__init__(scaled_friction(scene, deviation.mu_scale))
         self.scene = scene
         self.deviation = deviation
         self._tracker_rng = np.random.default_rng(deviation.seed)
@@ -203,17 +234,23 @@ class SimArm(SimulatedGrasp):
     def state(self) -> dict:
         """What the arm reports: G's pose and the joints; the tracker's `object_in_grasp` (with the
         deviation's noise); and, as a simulation, the object's true world pose."""
-        T_g, T_o = self.gripper_matrix(), self.object_matrix()
-        tracked = in_grasp(T_g, T_o)  # the truth; a noisy tracker below
-        d = self.deviation
-        if d.tracker_noise_mm > 0 or d.tracker_noise_deg > 0:
-            nx, nz, nth = self._tracker_rng.normal(0.0, [d.tracker_noise_mm, d.tracker_noise_mm, d.tracker_noise_deg])
-            tracked.update(x=tracked["x"] + nx, z=tracked["z"] + nz, theta=tracked["theta"] + nth)
-        return {
-            "time": float(self.data.time),
-            "ee_pose": matrix_to_pose(T_g),
-            "joints": [float(v) for v in self.data.qpos[self._arm_qpos]],
-            "object_pose": matrix_to_pose(T_o),
-            "object_in_grasp": tracked,
-            "steps_per_s": round(self.steps_per_second, 1),
-        }
+        return arm_state(self, float(self.data.time), self.data.qpos[self._arm_qpos])
+
+
+def arm_state(arm, time_s: float, joints) -> dict:
+    """A simulated arm's report (either engine's): G's pose and the joints [rad]; the tracker's
+    `object_in_grasp`, the truth plus the deviation's noise; the object's true world pose."""
+    T_g, T_o = arm.gripper_matrix(), arm.object_matrix()
+    tracked = in_grasp(T_g, T_o)
+    d = arm.deviation
+    if d.tracker_noise_mm > 0 or d.tracker_noise_deg > 0:
+        nx, nz, nth = arm._tracker_rng.normal(0.0, [d.tracker_noise_mm, d.tracker_noise_mm, d.tracker_noise_deg])
+        tracked.update(x=tracked["x"] + nx, z=tracked["z"] + nz, theta=tracked["theta"] + nth)
+    return {
+        "time": time_s,
+        "ee_pose": matrix_to_pose(T_g),
+        "joints": [float(v) for v in joints],
+        "object_pose": matrix_to_pose(T_o),
+        "object_in_grasp": tracked,
+        "steps_per_s": round(arm.steps_per_second, 1),
+    }

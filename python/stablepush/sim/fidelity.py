@@ -30,7 +30,6 @@ import math
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
-import mujoco
 import numpy as np
 import yaml
 
@@ -38,8 +37,7 @@ from stablepush.execution.world import place_features, scene_description
 from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
 from stablepush.plan.verify import check_plan
-from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import SimulatedGrasp
+from stablepush.sim.engines import DEFAULT_ENGINE, make_grasp
 from stablepush.task.model import Task
 from stablepush.task.schema import parse_task
 
@@ -85,44 +83,32 @@ def with_pusher_mu(task: Task, pusher: str, mu: float) -> Task:
     return dataclasses.replace(task, pushers=tuple(pushers))
 
 
-class KinematicGrasp(SimulatedGrasp):
+class KinematicGrasp:
     """The arm's grasp of `task`'s object on a hand whose planar motion is prescribed, with the
-    features of `pushers` fixed in the world where they touch the object at the start."""
+    features of `pushers` fixed in the world where they touch the object at the start, on
+    `engine` (`engines.make_grasp`)."""
 
-    def __init__(self, task: Task, pushers: Sequence[str] = ()):
+    def __init__(self, task: Task, pushers: Sequence[str] = (), engine: str = DEFAULT_ENGINE):
         steps = [Waypoint(*task.start)] + [Waypoint(*task.start, pusher=name) for name in pushers]
-        super().__init__(scene_description(task, place_features(task, steps), task.start), kinematic_hand=True)
-        m = self.model
-        self._qpos = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
-        self._dof = [m.jnt_dofadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
-        self._pad_geoms = set(scene_mod.pad_geoms(m))
-        mujoco.mj_forward(m, self.data)
+        self.world = make_grasp(engine, scene_description(task, place_features(task, steps), task.start))
+        self.timestep = self.world.timestep
 
     def step(self, motion: Sequence[float], velocity: Sequence[float]) -> None:
         """One time step with the hand at `motion` (x m, z m, theta rad about y, from its start)
         moving at `velocity` (m/s, m/s, rad/s)."""
-
-        def drive_hand(_: int) -> None:
-            self.data.qpos[self._qpos] = motion
-            self.data.qvel[self._dof] = velocity
-
-        self._run(1, drive_hand)
+        self.world.step_hand(motion, velocity)
 
     def hold(self, duration: float) -> None:
-        for _ in range(int(round(duration / self.model.opt.timestep))):
+        for _ in range(int(round(duration / self.timestep))):
             self.step((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
     def object_position(self) -> np.ndarray:
-        return self.data.xpos[self._object].copy()
+        return self.world.object_matrix()[:3, 3].copy()
 
     def object_angle(self) -> float:
         """The object's rotation about the world's y axis, rad."""
-        R = self.data.xmat[self._object].reshape(3, 3)
+        R = self.world.object_matrix()[:3, :3]
         return math.atan2(R[0, 2], R[0, 0])
-
-    def pad_contacts(self) -> int:
-        return sum(1 for i in range(self.data.ncon)
-                   if self.data.contact[i].geom1 in self._pad_geoms or self.data.contact[i].geom2 in self._pad_geoms)
 
 
 def _ramp(t: float, speed: float) -> tuple:
@@ -146,14 +132,15 @@ class CreepResult:
     steps_per_s: float
 
 
-def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None) -> CreepResult:
+def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None,
+               engine: str = DEFAULT_ENGINE) -> CreepResult:
     """Slide the pads at `pad_speed` m/s over a box that a wall holds at `load` of its cone."""
     task = _box_task(load)
-    rig = KinematicGrasp(task, ["wall"])
+    rig = KinematicGrasp(task, ["wall"], engine)
     travel = travel if travel is not None else min(0.004, pad_speed * 0.5)
     rig.hold(SETTLE_TIME)
-    full_contact = rig.pad_contacts()
-    h = rig.model.opt.timestep
+    full_contact = rig.world.pad_contacts()
+    h = rig.timestep
     duration = travel / pad_speed + RAMP_TIME / 2
     samples = []
     forces = []
@@ -161,11 +148,11 @@ def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None) ->
     for i in range(1, int(round(duration / h)) + 1):
         s, v = _ramp(i * h, pad_speed)
         rig.step((-s, 0.0, 0.0), (-v, 0.0, 0.0))  # the pads slide toward the wall
-        drops += rig.pad_contacts() < full_contact
+        drops += rig.world.pad_contacts() < full_contact
         if s >= travel / 2:
             samples.append((s, rig.object_position()[2]))
             if i % 10 == 0:
-                forces.append(rig.contact_force_on_object("wall"))
+                forces.append(rig.world.contact_force_on_object("wall"))
     (s0, z0), (s1, z1) = samples[0], samples[-1]
     fx, _, fz = np.mean(forces, axis=0)  # the wall's normal is +x, its tangent z
     fn, ft = fx, abs(fz)
@@ -173,7 +160,7 @@ def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None) ->
     return CreepResult(load=load, pad_speed_mm_s=pad_speed * 1e3,
                        creep_um_per_mm=abs(z1 - z0) * 1e6 / ((s1 - s0) * 1e3),
                        pad_friction_ratio=fn / (2 * task.mu * task.grip_force), wall_cone_use=ft / (mu_wall * fn),
-                       pad_dropout_steps=drops, steps_per_s=rig.steps_per_second)
+                       pad_dropout_steps=drops, steps_per_s=rig.world.steps_per_second)
 
 
 @dataclass(frozen=True)
@@ -183,11 +170,11 @@ class HoldResult:
     duration_s: float
 
 
-def static_hold(load: float, duration: float = 1.0) -> HoldResult:
+def static_hold(load: float, duration: float = 1.0, engine: str = DEFAULT_ENGINE) -> HoldResult:
     """The box hanging in the pads, its weight at `load` of their friction 2 mu N, the hand still."""
     mu, mass_g = 0.45, 200.0
     task = _box_task(None, grip_force=mass_g * 1e-3 * G0 / (load * 2 * mu), mu=mu, mass_g=mass_g)
-    rig = KinematicGrasp(task)
+    rig = KinematicGrasp(task, engine=engine)
     rig.hold(SETTLE_TIME)
     before = rig.object_position()
     rig.hold(duration)
@@ -204,20 +191,21 @@ class PivotResult:
     grasp_error_deg: float  # theta in the grasp - the turn
 
 
-def pivot(task: Task, pusher: str = "left", turn_deg: float = 30.0, rate_deg_s: float = 10.0) -> PivotResult:
+def pivot(task: Task, pusher: str = "left", turn_deg: float = 30.0, rate_deg_s: float = 10.0,
+          engine: str = DEFAULT_ENGINE) -> PivotResult:
     """Turn the hand by -`turn_deg` about the pad centre at `rate_deg_s` while feature `pusher`
     holds the object: the object turns by +`turn_deg` in the grasp about the pad centre."""
-    rig = KinematicGrasp(task, [pusher])
+    rig = KinematicGrasp(task, [pusher], engine)
     rig.hold(SETTLE_TIME)
     p0, a0 = rig.object_position(), rig.object_angle()
-    h = rig.model.opt.timestep
+    h = rig.timestep
     rate = math.radians(rate_deg_s)
     duration = math.radians(turn_deg) / rate + RAMP_TIME / 2
     for i in range(1, int(round(duration / h)) + 1):
         a, w = _ramp(i * h, rate)
         rig.step((0.0, 0.0, -a), (0.0, 0.0, -w))
     turned = math.degrees(_ramp(int(round(duration / h)) * h, rate)[0])
-    pose = rig.in_grasp()
+    pose = rig.world.in_grasp()
     return PivotResult(turned_deg=turned, moved_mm=float(np.linalg.norm(rig.object_position() - p0)) * 1e3,
                        rotated_deg=math.degrees(rig.object_angle() - a0),
                        grasp_error_mm=math.hypot(pose["x"] - task.start[0], pose["z"] - task.start[1]),
@@ -232,14 +220,15 @@ class ArmPivotResult:
     steps_per_s: float
 
 
-def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1) -> ArmPivotResult:
+def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1,
+                 engine: str = DEFAULT_ENGINE) -> ArmPivotResult:
     """Run the first `pushes` pushes of `task`'s plan (seed `seed`) on the simulated arm, open loop."""
     from stablepush.execution.executor import execute_plan  # the executor is the arm's client, not the rig's
     from stablepush.sim.server import running_sim_arm
 
     plan = check_plan(task, plan_task(task, seed=seed))
     plan = dataclasses.replace(plan, waypoints=plan.waypoints[:pushes + 1])
-    with running_sim_arm(log=lambda text: None) as server:
+    with running_sim_arm(log=lambda text: None, engine=engine) as server:
         report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
     return ArmPivotResult(pushes=len(plan.waypoints) - 1, error_mm=report.final_error["distance"],
                           error_deg=report.final_error["theta"], steps_per_s=report.sim_steps_per_s)

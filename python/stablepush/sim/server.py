@@ -17,7 +17,8 @@ from contextlib import contextmanager
 from typing import Any, Callable, Iterator, Optional
 
 from stablepush.execution.protocol import LineReader, ProtocolError, decode, encode
-from stablepush.sim.arm import SimArm, WorldDeviation
+from stablepush.sim.arm import WorldDeviation
+from stablepush.sim.engines import DEFAULT_ENGINE, check_engine, make_arm
 from stablepush.sim.scene import simulated_outline
 from stablepush.task.schema import MAX_PAD_RINGS, MAX_PADS, MAX_PUSHERS, MAX_VERTICES
 
@@ -58,12 +59,13 @@ class SimArmServer:
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, log: Callable[[str], None] = None,
                  exit_after: Optional[int] = None, deviation: WorldDeviation = WorldDeviation(),
-                 idle_timeout: float = DEFAULT_IDLE_TIMEOUT):
+                 idle_timeout: float = DEFAULT_IDLE_TIMEOUT, engine: str = DEFAULT_ENGINE):
         self.log = log or (lambda text: print(f"sim-arm: {text}", file=sys.stderr, flush=True))
         self.exit_after = exit_after  # fault injection: die abruptly after this many waypoints
         self.deviation = deviation  # how the simulated world departs from each task's model
         self.idle_timeout = idle_timeout
-        self.arm: Optional[SimArm] = None
+        self.engine = check_engine(engine)  # the physics engine every session's world is built on
+        self.arm = None
         self._scene: Optional[dict] = None
         self._waypoints = 0
         self._session = threading.Lock()
@@ -139,8 +141,9 @@ class SimArmServer:
                     self._hello(message)
                     greeted = True
                     expected_seq = 0
-                    reply = {"type": "ready", "protocol": message["protocol"], "arm": "stablepush sim-arm (MuJoCo)",
-                             "engine": "mujoco", "state": self.arm.state()}
+                    reply = {"type": "ready", "protocol": message["protocol"],
+                             "arm": f"stablepush sim-arm ({self.engine})", "engine": self.engine,
+                             "state": self.arm.state()}
                 elif kind == "waypoint":
                     if message["seq"] != expected_seq:
                         raise ProtocolError(f"out-of-order waypoint: expected seq {expected_seq}, got {message['seq']}")
@@ -185,15 +188,14 @@ class SimArmServer:
             return
         check_scene_size(scene)
         try:
-            arm = SimArm(scene, self.deviation)
+            arm = make_arm(self.engine, scene, self.deviation)
         except Exception as exc:  # noqa: BLE001 - any malformed scene is the client's error
             raise ProtocolError(f"hello: cannot build a world from this scene ({type(exc).__name__}: "
                                 f"{' '.join(str(exc).split())[:200]})") from None
         self.arm, self._scene = arm, scene
         _, tolerance = simulated_outline(scene["object"]["polygon"])
         simplified = f"; outline simplified within {tolerance * 1e3:g} mm" if tolerance else ""
-        self.log(f"world built for {scene.get('task', 'a task')} ({self.arm.model.nbody} bodies, "
-                 f"{self.arm.model.npair} contact pairs{simplified})")
+        self.log(f"world built for {scene.get('task', 'a task')} ({self.arm.describe()}{simplified})")
 
 
 def _send_quietly(connection: socket.socket, message: dict) -> None:
@@ -206,11 +208,11 @@ def _send_quietly(connection: socket.socket, message: dict) -> None:
 
 
 @contextmanager
-def running_sim_arm(log: Optional[Callable[[str], None]] = None,
-                    deviation: WorldDeviation = WorldDeviation()) -> Iterator[SimArmServer]:
-    """A simulated arm served from a thread of this process on a free localhost port, for the
-    length of the `with` block (`execute --sim`, the tests, the benchmark)."""
-    server = SimArmServer(log=log, deviation=deviation)
+def running_sim_arm(log: Optional[Callable[[str], None]] = None, deviation: WorldDeviation = WorldDeviation(),
+                    engine: str = DEFAULT_ENGINE) -> Iterator[SimArmServer]:
+    """A simulated arm on `engine` served from a thread of this process on a free localhost port,
+    for the length of the `with` block (`execute --sim`, the tests, the benchmark)."""
+    server = SimArmServer(log=log, deviation=deviation, engine=engine)
     server.start_in_thread()
     try:
         yield server

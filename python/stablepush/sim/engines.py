@@ -1,0 +1,40 @@
+"""The physics engines a simulated arm can run on, by name: MuJoCo (`arm.py`, whose sliding pad
+friction is stablepush's own Coulomb law, `friction.py`) and Drake (`drake_arm.py`, whose contact
+solver alone decides stick and slip). Both build the same arm, grasp and world from a scene
+description and answer to the same calls, so the server, the executor and the fidelity contract
+never ask which one they have. Importing this module loads neither engine.
+"""
+from __future__ import annotations
+
+ENGINES = ("mujoco", "drake")
+DEFAULT_ENGINE = "mujoco"
+
+
+def check_engine(engine: str) -> str:
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+    return engine
+
+
+def make_arm(engine: str, scene: dict, deviation=None):
+    """The simulated arm of `scene` on `engine` (SimArm or DrakeArm), in the world `deviation`
+    (an `arm.WorldDeviation`; None: the task's own)."""
+    from stablepush.sim.arm import SimArm, WorldDeviation
+
+    deviation = deviation or WorldDeviation()
+    if check_engine(engine) == "drake":
+        from stablepush.sim.drake_arm import DrakeArm
+
+        return DrakeArm(scene, deviation)
+    return SimArm(scene, deviation)
+
+
+def make_grasp(engine: str, scene: dict):
+    """The grasp of `scene` on a kinematic hand (no arm), on `engine`: the friction rig's world."""
+    if check_engine(engine) == "drake":
+        from stablepush.sim.drake_arm import DrakeGrasp
+
+        return DrakeGrasp(scene, kinematic_hand=True)
+    from stablepush.sim.arm import SimulatedGrasp
+
+    return SimulatedGrasp(scene, kinematic_hand=True)
