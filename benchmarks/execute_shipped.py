@@ -4,7 +4,7 @@ the tasks of data/tasks/more, which nothing was tuned for.
 `--mu-scale` runs each plan again in worlds whose pads' and features' mu differ from the task's.
 
     python3 benchmarks/execute_shipped.py [TASK.yaml ...] [--seed 1] [--mu-scale 1 0.85 1.15] [--closed-loop]
-                                          [--success-tolerance MM DEG]
+                                          [--success-tolerance MM DEG] [--engine mujoco drake]
 
 The verdict column is the run's (stablepush.execution.verdict): landed within the task's goal
 tolerance, or --success-tolerance, or missed and why.
@@ -17,6 +17,7 @@ from stablepush.execution import execute_plan
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.plan import check_plan, plan_task
 from stablepush.sim.arm import WorldDeviation
+from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.sim.server import running_sim_arm
 from stablepush.task import load_task
 
@@ -32,19 +33,23 @@ def main() -> None:
     parser.add_argument("--closed-loop", action="store_true", help="re-plan from the tracked pose (stablepush.closed_loop)")
     parser.add_argument("--success-tolerance", type=float, nargs=2, default=None, metavar=("MM", "DEG"),
                         help="judge each run with this tolerance (default: the task's goal tolerance)")
+    parser.add_argument("--engine", nargs="+", choices=ENGINES, default=[DEFAULT_ENGINE],
+                        help="the simulated arm's physics engine, one run per engine (default mujoco)")
     args = parser.parse_args()
-    print("| task | world mu | loop | pushes | contacts | final error mm | final error deg | goal error mm / deg "
+    print("| task | engine | world mu | loop | pushes | contacts | final error mm | final error deg | goal error mm / deg "
           "| re-plans | max slip at pusher mm (deg) | release moves it mm / deg | verdict | sim steps/s | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
         task = load_task(path)
         plan = check_plan(task, plan_task(task, seed=args.seed))
         for scale in args.mu_scale:
-            _run(task, plan, scale, ClosedLoop.for_task(task) if args.closed_loop else None, args.success_tolerance)
+            for engine in args.engine:
+                _run(task, plan, scale, ClosedLoop.for_task(task) if args.closed_loop else None, args.success_tolerance,
+                     engine)
 
 
-def _run(task, plan, mu_scale: float, loop, tolerance) -> None:
-    with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=mu_scale)) as server:
+def _run(task, plan, mu_scale: float, loop, tolerance, engine: str) -> None:
+    with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=mu_scale), engine=engine) as server:
         report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop,
                               success_tolerance=tolerance)
     err, goal = report.final_error, report.goal_error
@@ -52,7 +57,7 @@ def _run(task, plan, mu_scale: float, loop, tolerance) -> None:
                                                             if any(not r.solved for r in report.replans) else "")
     slip = max(report.contacts, key=lambda c: c.slip_mm)
     release = report.release_change
-    print(f"| {task.name} | x{mu_scale:g} | {'closed' if loop else 'open'} | {report.total_steps} "
+    print(f"| {task.name} | {engine} | x{mu_scale:g} | {'closed' if loop else 'open'} | {report.total_steps} "
           f"| {' → '.join(c.pusher for c in report.contacts)} "
           f"| {err['distance']:.2f} | {err['theta']:+.2f} | {goal['distance']:.2f} / {goal['theta']:+.2f} | {replans} "
           f"| {slip.slip_mm:.2f} ({slip.slip_deg:.2f}) "

@@ -2,13 +2,14 @@
 the arm's contact setting against the contract's limits, and, with --stiff, the setting it
 replaced (the solver's stiff friction on every pad point, sliding or not).
 
-    python3 benchmarks/friction_fidelity.py [--stiff]
+    python3 benchmarks/friction_fidelity.py [--engine mujoco|drake] [--stiff]
 """
 import argparse
 import time
 from pathlib import Path
 
 from stablepush.sim import fidelity, friction
+from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import check_push, load_task
 
 TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
@@ -17,22 +18,27 @@ TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--stiff", action="store_true", help="measure the solver's stiff pad friction alone (no pad point ever slides with explicit friction)")
+    parser.add_argument("--engine", choices=ENGINES, default=DEFAULT_ENGINE, help="the physics engine (default mujoco)")
     args = parser.parse_args()
+    engine = args.engine
+    if args.stiff and engine != "mujoco":
+        parser.error("--stiff is MuJoCo's setting: the pads' friction is Drake's own")
     if args.stiff:
         friction.SLIDE_SPEED = float("inf")
     started = time.perf_counter()
+    print(f"engine: {engine}\n")
     print("| wall load | pad speed mm/s | creep um per mm (limit) | pad friction / mu N | pad drop-out steps | steps/s |")
     print("|---:|---:|---:|---:|---:|---:|")
     for load in (0.5, 0.9):
         for speed in (0.001, 0.005, 0.02):
-            r = fidelity.wall_creep(load, speed)
+            r = fidelity.wall_creep(load, speed, engine=engine)
             print(f"| {load:.0%} | {r.pad_speed_mm_s:g} | {r.creep_um_per_mm:.3f} ({fidelity.CREEP_LIMIT_UM_PER_MM[load]:g}) "
                   f"| {r.pad_friction_ratio:.4f} | {r.pad_dropout_steps} | {r.steps_per_s:.0f} |", flush=True)
     print()
     print("| static hold, weight / 2 mu N | moved in 1 s, um (limit) |")
     print("|---:|---:|")
     for load in (0.5, 0.9):
-        r = fidelity.static_hold(load)
+        r = fidelity.static_hold(load, engine=engine)
         print(f"| {load:.0%} | {r.moved_um:.2f} ({fidelity.HOLD_LIMIT_UM:g}) |", flush=True)
     print()
     print("| pivot about the pad centre, 30 deg | model | prism moved in the world mm | rotated deg |")
@@ -41,11 +47,11 @@ def main() -> None:
     for mu in (0.6, 0.2):
         task = fidelity.with_pusher_mu(pivoting, "left", mu)
         stable = check_push(task, (0, 0, 0), (0, 0, 1), "left")["left"]["feasible"]
-        r = fidelity.pivot(task, "left", turn_deg=30)
+        r = fidelity.pivot(task, "left", turn_deg=30, engine=engine)
         print(f"| pivoting, left pusher mu {mu} | {'stable' if stable else 'not stable'} | {r.moved_mm:.3f} "
               f"| {r.rotated_deg:+.3f} |", flush=True)
     print()
-    r = fidelity.pivot_on_arm(pivoting)
+    r = fidelity.pivot_on_arm(pivoting, engine=engine)
     print(
         f"Pivot on the arm, first {r.pushes} pushes of the pivoting plan: {r.error_mm:.3f} mm, {r.error_deg:+.3f} deg "
         f"from the plan (limits {fidelity.ARM_PIVOT_LIMIT_MM} mm, {fidelity.ARM_PIVOT_LIMIT_DEG} deg), {r.steps_per_s:.0f} steps/s"

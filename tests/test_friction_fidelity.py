@@ -1,6 +1,8 @@
 """The friction-fidelity contract (`stablepush.sim.fidelity`): the simulated arm's contacts
 must stick where Coulomb's law sticks and slide with mu N where it slides, or no plan measured on
-it means anything. `python3 benchmarks/friction_fidelity.py` prints the same numbers as a table.
+it means anything. Every engine that runs plans passes it (MuJoCo with the pad friction of
+friction.py, Drake with its own contact solver). `python3 benchmarks/friction_fidelity.py
+[--engine drake]` prints the same numbers as a table.
 """
 import pytest
 
@@ -10,10 +12,14 @@ from stablepush.task import check_push
 from conftest import shipped
 
 
+ENGINES = ["mujoco", "drake"]
+
+
+@pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("load", [0.5, 0.9])
 @pytest.mark.parametrize("pad_speed", [0.001, 0.005, 0.02])
-def test_a_wall_holds_the_box_while_the_pads_slide_over_it(load, pad_speed):
-    result = fidelity.wall_creep(load, pad_speed)
+def test_a_wall_holds_the_box_while_the_pads_slide_over_it(load, pad_speed, engine):
+    result = fidelity.wall_creep(load, pad_speed, engine=engine)
     assert result.wall_cone_use == pytest.approx(load, abs=0.06)  # the scene loads the wall as asked
     assert result.creep_um_per_mm <= fidelity.CREEP_LIMIT_UM_PER_MM[load], result
     assert result.pad_friction_ratio == pytest.approx(1.0, abs=fidelity.PAD_FRICTION_TOLERANCE), result
@@ -29,36 +35,64 @@ def test_stiff_pad_friction_alone_fails_the_contract(monkeypatch):
     assert result.pad_dropout_steps > 0
 
 
+@pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("load", [0.5, 0.9])
-def test_a_box_held_by_friction_alone_stays_put(load):
-    result = fidelity.static_hold(load)
+def test_a_box_held_by_friction_alone_stays_put(load, engine):
+    result = fidelity.static_hold(load, engine=engine)
     assert result.moved_um <= fidelity.HOLD_LIMIT_UM, result
 
 
-def test_a_pivot_through_the_sticking_pad_centre_holds_where_the_model_says_it_does():
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_pivot_through_the_sticking_pad_centre_holds_where_the_model_says_it_does(engine):
     task = shipped("pivoting")
     verdict = check_push(task, (0, 0, 0), (0, 0, 1), "left")["left"]
     assert verdict["feasible"] and verdict["case"] == "sticking"
-    result = fidelity.pivot(task, "left", turn_deg=30)
+    result = fidelity.pivot(task, "left", turn_deg=30, engine=engine)
     assert result.moved_mm <= fidelity.PIVOT_LIMIT_MM, result
     assert abs(result.rotated_deg) <= fidelity.PIVOT_LIMIT_DEG, result
     assert abs(result.grasp_error_deg) <= fidelity.PIVOT_LIMIT_DEG, result
 
 
-def test_a_pivot_the_model_calls_unstable_slips_at_the_pusher():
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_pivot_the_model_calls_unstable_slips_at_the_pusher(engine):
     """The other direction of the same cross-check: with the side pusher's mu at 0.2 the model
     says the pivot is not a stable push, and the simulated pusher indeed slips."""
     task = fidelity.with_pusher_mu(shipped("pivoting"), "left", 0.2)
     assert not check_push(task, (0, 0, 0), (0, 0, 1), "left")["left"]["feasible"]
-    result = fidelity.pivot(task, "left", turn_deg=30)
+    result = fidelity.pivot(task, "left", turn_deg=30, engine=engine)
     assert abs(result.rotated_deg) > 5 * fidelity.PIVOT_LIMIT_DEG, result
 
 
-def test_a_pivot_by_the_servo_driven_arm_follows_its_plan():
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_pivot_by_the_servo_driven_arm_follows_its_plan(engine):
     """The rig's hand is infinitely stiff; the arm's is not. On the arm, with its servos, IK and the
     executor's stream, the first 30 degrees of the pivoting plan must still turn about the stuck pad
     centre (with the sliding ring points' friction a few degrees off their slip it lost 0.5 deg here)."""
-    result = fidelity.pivot_on_arm(shipped("pivoting"))
+    result = fidelity.pivot_on_arm(shipped("pivoting"), engine=engine)
     assert result.pushes == fidelity.ARM_PIVOT_PUSHES
     assert result.error_mm <= fidelity.ARM_PIVOT_LIMIT_MM, result
     assert abs(result.error_deg) <= fidelity.ARM_PIVOT_LIMIT_DEG, result
+
+
+def test_drakes_coarser_step_fails_the_contract(monkeypatch):
+    """Drake's convex friction is regularized: a sticking contact slips at a rate proportional to
+    the time step. At 0.4 ms (not the arm's 0.125 ms) the stable pivot turns about 0.2 deg in the
+    world, past the contract's 0.1 deg, so the contract decides the step."""
+    from stablepush.sim import drake_arm
+
+    monkeypatch.setattr(drake_arm, "DRAKE_TIMESTEP", 0.0004)
+    result = fidelity.pivot(shipped("pivoting"), "left", turn_deg=30, engine="drake")
+    assert abs(result.rotated_deg) > fidelity.PIVOT_LIMIT_DEG, result
+
+
+def test_each_drake_contact_pair_has_the_tasks_mu():
+    """Drake combines two surfaces' mu as 2 a b / (a + b); each pad and feature carries the partner
+    value that gives its pair with the object the task's (or the deviated world's) mu."""
+    from stablepush.sim import drake_arm
+
+    for mu in (0.0, 1e-6, 0.1, 0.35, 0.6, 1.0, 3.0, 100.0):
+        b = drake_arm.partner_mu(mu)
+        a = drake_arm.OBJECT_MU
+        assert 2 * a * b / (a + b) == pytest.approx(mu, rel=1e-12, abs=1e-15)
+    with pytest.raises(ValueError, match="mu"):
+        drake_arm.partner_mu(2 * drake_arm.OBJECT_MU)

@@ -40,9 +40,9 @@ STICTION_TOLERANCE = 1e-7  # m/s: the regularized friction's slip at the edge of
 NEAR_RIGID_THRESHOLD = 1.0  # SAP: contacts stiffer than this (relative to the step) are regularized as near rigid
 POINT_STIFFNESS = 1e5  # N/m per pad point and per feature contact
 HUNT_CROSSLEY_DISSIPATION = 1.0  # s/m
-HYDROELASTIC_MODULUS = 1e8  # Pa
+HYDROELASTIC_MODULUS = 1e10  # Pa: the object's contact with a feature; softer lets the pusher roll (docstring)
 HYDRO_RESOLUTION = 0.002  # m
-OBJECT_MU = 10.0
+OBJECT_MU = 1000.0  # the object's own friction; each partner's is set to give the pair's mu (partner_mu)
 KINEMATIC_HAND_BODY = "hand"
 KINEMATIC_HAND_MASS = 1e4  # kg  # the object's own friction; each partner's is set to give the pair's mu
 
