@@ -428,3 +428,27 @@ def test_closed_loop_lands_the_wedge_in_a_low_friction_world_and_says_so(tmp_pat
     assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
     assert report["replans"] and all(r["trigger"] in ("off_plan", "off_goal") for r in report["replans"])
     assert any(r["solved"] and r["pushes"] > 0 for r in report["replans"])
+
+
+def test_closed_loop_on_drake_lands_the_t_shape_in_a_low_friction_world(tmp_path):
+    """The second engine end to end: the T through two switch-overs on the Drake arm (whose contact
+    solver alone decides stick and slip), mu x0.85, closed loop: it lands within 0.2 mm and
+    0.2 deg, and the report says so, names the engine and lists its corrections (none were needed)."""
+    task = str(TASKS / "t-shaped.yaml")
+    plan, report_path = tmp_path / "t.plan.json", tmp_path / "run.json"
+    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--engine", "drake", "--quiet",
+                                      "--closed-loop", "--sim-mu-scale", "0.85", "--success-tolerance", "0.2", "0.2",
+                                      "--json", str(report_path)])
+    assert result.exit_code == 0, result.output
+    report = json.loads(report_path.read_text())
+    assert report["success"] is True and report["engine"] == "drake" and report["closed_loop"] == "on"
+    err = report["goal_error"]
+    assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
+    assert isinstance(report["replans"], list)
+
+
+def test_engine_needs_the_simulated_arm(high_mu_plan):
+    plan, task = high_mu_plan
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", str(task), "--engine", "drake"])
+    assert result.exit_code == 2 and "--engine" in result.output

@@ -11,7 +11,6 @@ from stablepush.task import check_push
 
 from conftest import shipped
 
-
 ENGINES = ["mujoco", "drake"]
 
 

@@ -13,6 +13,7 @@ from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.plan import Waypoint
 from stablepush.sim.arm import SimArm
+from stablepush.sim.engines import ENGINES, make_arm
 from stablepush.sim.scene import convex_pieces
 
 from conftest import shipped, task_with
@@ -20,13 +21,13 @@ from conftest import shipped, task_with
 G0 = 9.81
 
 
-def _ledge_force(task, speed=0.01, duration=1.0):
+def _ledge_force(task, speed=0.01, duration=1.0, engine="mujoco"):
     """Hold the object above the task's bottom pusher, made a ledge, and lower the gripper onto it at
     `speed` m/s: the mean ledge force on the object (N, world z) once the pads slide steadily."""
     start = task.start
     steps = [Waypoint(*start), Waypoint(*start, pusher="bottom")]
     features = place_features(task, steps)
-    arm = SimArm(scene_description(task, features, start))
+    arm = make_arm(engine, scene_description(task, features, start))
     pose = list(arm.state()["ee_pose"])
     z0 = pose[2]
     period = 0.01
@@ -40,35 +41,38 @@ def _ledge_force(task, speed=0.01, duration=1.0):
     return float(np.mean(forces)), slid
 
 
+@pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("grip_force, mu", [
     (10.0, 0.425), (10.0, 0.6), (5.0, 0.3),
     (20.0, 0.8),  # chattered (16% high) before sliding pad points got Coulomb friction (sim/friction.py)
 ])
-def test_ledge_force_to_slide_the_held_object_is_coulombs(grip_force, mu):
+def test_ledge_force_to_slide_the_held_object_is_coulombs(grip_force, mu, engine):
     def edit(data):
         data["gripper"]["grip_force"] = grip_force
         data["gripper"]["mu"] = mu
 
     task = task_with("horizontal-offset-low-mu", edit)
-    force, slid = _ledge_force(task)
+    force, slid = _ledge_force(task, engine=engine)
     expected = 2 * mu * grip_force + task.mass * 1e-3 * G0
     assert force == pytest.approx(expected, rel=0.05), (force, expected)
     assert slid > 5.0  # mm: the object really slid up between the pads while the force was measured
 
 
-def test_a_held_object_stays_put_under_gravity_alone():
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_held_object_stays_put_under_gravity_alone(engine):
     """Static friction: 2 mu N = 8.5 N holds the 2 N prism; it must not creep over a second."""
     task = shipped("horizontal-offset-low-mu")
-    arm = SimArm(scene_description(task, {}, task.start))
+    arm = make_arm(engine, scene_description(task, {}, task.start))
     before = arm.state()["object_in_grasp"]
     arm.advance(1.0)
     after = arm.state()["object_in_grasp"]
     assert abs(after["z"] - before["z"]) < 0.02 and abs(after["x"] - before["x"]) < 0.02
 
 
-def test_ik_tracks_a_rotation_about_the_pads():
+@pytest.mark.parametrize("engine", ENGINES)
+def test_ik_tracks_a_rotation_about_the_pads(engine):
     task = shipped("pivoting")
-    arm = SimArm(scene_description(task, {}, task.start))
+    arm = make_arm(engine, scene_description(task, {}, task.start))
     home = pose_to_matrix(arm.state()["ee_pose"])
     for deg in range(0, 91, 10):
         target = home.copy()
