@@ -592,6 +592,135 @@ def _print_report(report) -> None:
         click.echo(f"verdict: {verdict.detail}" + (f" [cause: {verdict.cause}]" if verdict.cause else ""))
 
 
+def _vary(_ctx, _param, values):
+    """--vary KEY=FRACTION, repeated, as a dict (the keys and ranges are checked by Spreads)."""
+    out = {}
+    for value in values:
+        key, sep, fraction = value.partition("=")
+        try:
+            out[key.strip()] = float(fraction)
+        except ValueError:
+            sep = ""
+        if not sep:
+            raise click.BadParameter(f"expected KEY=FRACTION (e.g. pad_mu=0.15), got {value!r}")
+    return out
+
+
+@cli.command()
+@click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
+@click.option("--plan", "plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False), default=None,
+              help="The plan to evaluate (checked against the task). Default: plan once from the task.")
+@click.option("--trials", default=100, show_default=True, type=click.IntRange(min=1, max=1_000_000),
+              help="Number of trials (worlds).")
+@click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
+              help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and outcomes, "
+                   "serially, on workers or on Ray.")
+@click.option("--vary", "vary", multiple=True, callback=_vary, metavar="KEY=FRACTION",
+              help="Multiply the task's KEY (pad_mu, pusher_mu, grip_force or mass) in each world by a factor drawn "
+                   "uniformly within 1 +- FRACTION. Repeatable.")
+@click.option("--feature-error", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0), metavar="MM DEG",
+              help="Place each feature off by up to MM in x and z and DEG about y (uniform).")
+@click.option("--tracker-noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0), metavar="MM DEG",
+              help="Standard deviations of the tracker's noise on the pose in the grasp.")
+@click.option("--closed-loop", is_flag=True, help="Run each trial closed loop (re-plan from the tracked pose).")
+@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+              help="The simulated arm's physics engine.")
+@click.option("--success-tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True), default=(0.5, 0.5),
+              show_default=True, metavar="MM DEG", help="A trial succeeds when it ends within MM (x and z) and DEG "
+                                                        "of the goal in the grasp.")
+@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+              help="Run the trials on K local processes (default: the number of CPUs).")
+@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              help="Run the trials on Ray: a local instance, or the cluster at ADDRESS (e.g. 10.0.0.5:6379; see "
+                   "README, 'Evaluating a plan').")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+              help="Write the summary and every trial as JSON.")
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row.")
+@click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
+              help="Draw the goal error's CDF against the tolerance, and success over the varied parameters (PNG).")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_error, tracker_noise, closed_loop: bool,
+             engine: str, success_tolerance, workers, ray_address, json_path, csv_path, png_path, quiet: bool) -> None:
+    """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
+
+    Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
+    given spreads, moves each feature by up to --feature-error and adds --tracker-noise; the plan
+    runs there on the simulated arm (open loop, or --closed-loop) and lands when it ends within
+    --success-tolerance of the goal. The summary gives the success rate with its Wilson 95%
+    interval, the goal error's percentiles and the causes of the misses. A trial that crashes is
+    recorded (cause `crash`) and the batch goes on; Ctrl-C stops it and keeps the trials done.
+
+    \b
+    Exit status: 0 done (whatever the success rate), 2 bad input.
+
+    \b
+    Examples:
+      stablepush evaluate data/tasks/pivoting.yaml --trials 200 --vary pad_mu=0.15 --vary pusher_mu=0.15 \\
+          --vary grip_force=0.1 --vary mass=0.05 --feature-error 0.5 0.5 --json piv.eval.json --plot piv.png
+      stablepush evaluate data/tasks/t-shaped.yaml --trials 1000 --closed-loop --vary pad_mu=0.15 --ray
+    """
+    from stablepush.evaluation import Batch, Runner, Spreads, default_workers, write_evaluation
+    from stablepush.evaluation import evaluate as run_evaluation
+    from stablepush.plan import check_plan, plan_task
+
+    if ray_address is not None and workers is not None:
+        _fail("--workers and --ray: choose one")
+    try:
+        spreads = Spreads(vary=vary, feature_error=tuple(feature_error), tracker_noise=tuple(tracker_noise))
+    except ValueError as exc:
+        _fail(f"--vary: {exc}")
+    if plan_file:
+        task, plan = _load_plan_and_task(plan_file, task_file)
+    else:
+        task = _load(task_file)
+        plan = plan_task(task)
+        if not plan.solved:
+            click.echo(f"{task.name}: {plan.message}", err=True)
+            sys.exit(EXIT_NOT_SOLVED)
+        plan = check_plan(task, plan)
+    runner = Runner(workers=workers or default_workers(), ray=ray_address is not None,
+                    ray_address=ray_address or None)
+    batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, engine=engine,
+                  tolerance=tuple(success_tolerance))
+    if not quiet:
+        click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop on {engine}, "
+                   f"on {runner.describe()}", err=True)
+    bar = None if quiet else click.progressbar(length=trials, label="trials", file=sys.stderr, show_pos=True)
+
+    def progress(record, done) -> None:
+        if bar is not None:
+            landed = sum(1 for r in done if r["success"])
+            bar.label = f"landed {landed}/{len(done)} ({landed / len(done):.0%})"
+            bar.update(1)
+
+    try:
+        result = run_evaluation(batch, trials, runner, progress)
+    finally:
+        if bar is not None:
+            bar.render_finish()
+    write_evaluation(result, json_path, csv_path, png_path)
+    s = result.summary()
+    if not s["trials"]:
+        click.echo("no trial finished", err=True)
+        sys.exit(EXIT_NOT_SOLVED)
+    low, high = s["ci95"]
+    click.echo(f"{task.name}: landed {s['successes']} of {s['trials']} trials within {success_tolerance[0]:g} mm / "
+               f"{success_tolerance[1]:g} deg: {s['success_rate']:.1%} (95% CI {low:.1%}-{high:.1%})"
+               + (f"; interrupted after {s['trials']} of {trials}" if s["interrupted"] else ""))
+    if s["goal_error_mm"]:
+        click.echo(f"goal error: median {s['goal_error_mm']['p50']:.3f} mm / {s['goal_error_deg']['p50']:.3f} deg, "
+                   f"p95 {s['goal_error_mm']['p95']:.3f} mm / {s['goal_error_deg']['p95']:.3f} deg")
+    if s["causes"]:
+        click.echo("misses: " + ", ".join(f"{cause} {count}" for cause, count in sorted(s["causes"].items())))
+    click.echo(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
+               f"{s['real_time_factor']:.2f}x real time")
+    written = [p for p in (json_path, csv_path, png_path) if p]
+    if written:
+        click.echo(f"written: {', '.join(written)}")
+    if s["interrupted"]:
+        sys.exit(130)
+
+
 @cli.command("sim-arm")
 @click.option("--host", default="127.0.0.1", show_default=True, help="Address to listen on.")
 @click.option("--port", default=DEFAULT_PORT, show_default=True, type=click.IntRange(min=0, max=65535),

@@ -10,12 +10,12 @@ import copy
 import math
 import time
 from dataclasses import dataclass
-from typing import Callable, Dict, Optional, Sequence
+from typing import Callable, Dict, Optional, Sequence, Tuple
 
 import mujoco
 import numpy as np
 
-from stablepush.frames import matrix_to_pose
+from stablepush.frames import matrix_to_pose, rot_y
 from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.friction import CoulombPadFriction
@@ -36,24 +36,48 @@ def in_grasp(T_world_gripper: np.ndarray, T_world_object: np.ndarray) -> Dict[st
 @dataclass(frozen=True)
 class WorldDeviation:
     """How the simulated world departs from the task it is given, to test plans against a world that
-    differs from their model: every pad's and feature's mu times `mu_scale`, and a tracker whose
-    `object_in_grasp` carries Gaussian noise (standard deviations in mm and deg, drawn from `seed`)."""
+    differs from their model: every pad's and feature's mu times `mu_scale`, the pads' mu also times
+    `pad_mu_scale` and the features' times `pusher_mu_scale`, the grip force times `grip_scale`, the
+    object's mass (and inertia) times `mass_scale`, each feature `feature_offsets` off where the
+    plan puts it ((pusher, dx mm, dz mm, dtheta deg) in the world's x, z and about y through the
+    middle of its segment), and a tracker whose `object_in_grasp` carries Gaussian noise (standard
+    deviations in mm and deg, drawn from `seed`)."""
 
     mu_scale: float = 1.0
     tracker_noise_mm: float = 0.0
     tracker_noise_deg: float = 0.0
     seed: int = 0
+    pad_mu_scale: float = 1.0
+    pusher_mu_scale: float = 1.0
+    grip_scale: float = 1.0
+    mass_scale: float = 1.0
+    feature_offsets: Tuple[Tuple[str, float, float, float], ...] = ()
 
-
-def scaled_friction(scene: dict, scale: float) -> dict:
-    """`scene` with every pad's and feature's mu times `scale` (a world that differs from the model)."""
-    if scale == 1.0:
+    def apply(self, scene: dict) -> dict:
+        """`scene` (a scene description, SI units) as this world has it; the scene itself unchanged."""
+        scene = copy.deepcopy(scene)
+        scene["gripper"]["mu"] *= self.mu_scale * self.pad_mu_scale
+        scene["gripper"]["grip_force"] *= self.grip_scale
+        obj = scene["object"]
+        obj["mass"] *= self.mass_scale
+        obj["inertia"] *= self.mass_scale
+        offsets = {name: (dx, dz, dth) for name, dx, dz, dth in self.feature_offsets}
+        for feature in scene["features"]:
+            feature["mu"] *= self.mu_scale * self.pusher_mu_scale
+            if feature["pusher"] in offsets:
+                _move_feature(feature, *offsets[feature["pusher"]])
         return scene
-    scene = copy.deepcopy(scene)
-    scene["gripper"]["mu"] *= scale
-    for feature in scene["features"]:
-        feature["mu"] *= scale
-    return scene
+
+
+def _move_feature(feature: dict, dx_mm: float, dz_mm: float, dtheta_deg: float) -> None:
+    """Turn a feature by dtheta about the world's y through the middle of its segment, then shift it."""
+    a, b = np.asarray(feature["from"], float), np.asarray(feature["to"], float)
+    middle = (a + b) / 2
+    R = rot_y(math.radians(dtheta_deg))
+    shift = np.array([dx_mm * 1e-3, 0.0, dz_mm * 1e-3])
+    feature["from"] = (middle + R @ (a - middle) + shift).tolist()
+    feature["to"] = (middle + R @ (b - middle) + shift).tolist()
+    feature["normal"] = (R @ np.asarray(feature["normal"], float)).tolist()
 
 
 class SimulatedGrasp:
@@ -159,7 +183,7 @@ class SimArm(SimulatedGrasp):
     """The arm, the grasp and the world of one scene description (as `deviation` alters it)."""
 
     def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(scaled_friction(scene, deviation.mu_scale))
+        super().__init__(deviation.apply(scene))
         self.scene = scene
         self.deviation = deviation
         self._tracker_rng = np.random.default_rng(deviation.seed)

@@ -32,7 +32,7 @@ import numpy as np
 from stablepush.frames import pose_to_matrix
 from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import SETTLE_TIME, WorldDeviation, arm_state, in_grasp, scaled_friction
+from stablepush.sim.arm import SETTLE_TIME, WorldDeviation, arm_state, in_grasp
 
 DRAKE_TIMESTEP = 0.000125  # s (the friction-fidelity contract fails at 0.2 ms: module docstring)
 DRAKE_APPROXIMATION = "lagged"  # DiscreteContactApproximation: sap, similar or lagged
@@ -322,7 +322,7 @@ class DrakeArm(DrakeGrasp):
     Drake; the same interface as `arm.SimArm` (move_to, advance, stop, state, solve_ik)."""
 
     def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(scaled_friction(scene, deviation.mu_scale))
+        super().__init__(deviation.apply(scene))
         self.scene = scene
         self.deviation = deviation
         self._tracker_rng = np.random.default_rng(deviation.seed)

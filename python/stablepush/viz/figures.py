@@ -221,3 +221,41 @@ def _cone_ring(gens: np.ndarray) -> List[np.ndarray]:
     lower, upper = half(pts), half(pts[::-1])
     hull = lower[:-1] + upper[:-1]
     return [gens[p[2]] for p in hull]
+
+
+def evaluation_figure(summary: dict, trials: Sequence[dict]) -> Figure:
+    """An evaluation (`stablepush.evaluation`) at a glance: left, the goal error's distribution
+    (CDF of max(|x|, |z|) / tolerance mm and |theta| / tolerance deg, so 1 is the success line);
+    right, success (green) and misses (red) over the two varied parameters that vary most."""
+    fig = Figure(figsize=(11, 4.4))
+    cdf, scatter = fig.subplots(1, 2)
+    tol_mm, tol_deg = summary["tolerance"]
+    ran = [t for t in trials if t["goal_error"] is not None]
+    position = [max(abs(t["goal_error"]["x"]), abs(t["goal_error"]["z"])) / tol_mm for t in ran]
+    angle = [abs(t["goal_error"]["theta"]) / tol_deg for t in ran]
+    for label, values in ((f"position: max(|x|, |z|) / {tol_mm:g} mm", position),
+                          (f"angle: |theta| / {tol_deg:g} deg", angle)):
+        if values:
+            x = np.sort(values)
+            cdf.step(x, np.arange(1, len(x) + 1) / len(x), where="post", label=label)
+    cdf.axvline(1.0, color="k", linestyle="--", linewidth=1)
+    cdf.set_xlabel("goal error / tolerance")
+    cdf.set_ylabel("fraction of trials")
+    cdf.set_ylim(0, 1.02)
+    rate, (low, high) = summary["success_rate"], summary["ci95"]
+    cdf.set_title(f"{summary['task']}: {summary['successes']}/{summary['trials']} landed "
+                  f"({rate:.1%}, 95% CI {low:.1%}-{high:.1%})", fontsize=10)
+    cdf.legend(fontsize=8, loc="lower right")
+    spreads = sorted(summary["vary"], key=lambda k: -summary["vary"][k])[:2]
+    if spreads:
+        xs = [t["world"][spreads[0]] for t in trials]
+        ys = [t["world"][spreads[1]] for t in trials] if len(spreads) > 1 else [0.0] * len(trials)
+        colours = ["tab:green" if t["success"] else "tab:red" for t in trials]
+        scatter.scatter(xs, ys, c=colours, s=14)
+        scatter.set_xlabel(f"{spreads[0]} x task's")
+        scatter.set_ylabel(f"{spreads[1]} x task's" if len(spreads) > 1 else "")
+        scatter.set_title("landed (green) and missed (red) over the world", fontsize=10)
+    else:
+        scatter.text(0.5, 0.5, "no parameter varied (--vary)", ha="center", va="center")
+        scatter.set_axis_off()
+    return fig

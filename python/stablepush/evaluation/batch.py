@@ -1,0 +1,298 @@
+"""A plan's success rate over many perturbed worlds (`stablepush evaluate`).
+
+Each trial runs the plan on a simulated arm of its own (`stablepush.sim`, in the worker's process,
+over the arm protocol on a loopback port) in the world `worlds.draw_world(seed, i)` draws, and
+records where the object ended against the goal. Trials are independent: they run one after the
+other, on local worker processes, or on Ray (a local instance or a cluster), and a trial's outcome
+depends on (seed, i) alone, so all three give the same trials.
+
+The summary's `ci95` is the Wilson score interval of the success rate (scipy's `binomtest`).
+Units: mm and deg as in plan files; times in s.
+"""
+from __future__ import annotations
+
+import os
+import time
+import traceback
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from typing import Callable, Dict, Iterator, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
+from stablepush.execution.closed_loop import ClosedLoop
+from stablepush.execution.executor import execute_plan
+from stablepush.plan.plan import Plan
+from stablepush.sim.arm import WorldDeviation
+from stablepush.sim.server import running_sim_arm
+from stablepush.task.model import Task
+
+DEFAULT_TOLERANCE = (0.5, 0.5)  # mm, deg: a trial succeeds within this of the goal, per coordinate
+RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
+PERCENTILES = (50, 90, 95, 99)
+
+
+@dataclass(frozen=True)
+class Batch:
+    """What every trial shares: the task, its plan, the spreads of the worlds, open or closed
+    loop, the engine and the success tolerance (mm, deg)."""
+
+    task: Task
+    plan: Plan
+    spreads: Spreads
+    seed: int = 1
+    closed_loop: bool = False
+    engine: str = "mujoco"
+    tolerance: Tuple[float, float] = DEFAULT_TOLERANCE
+
+    def world(self, trial: int) -> TrialWorld:
+        return draw_world(self.seed, trial, self.spreads, self.task.pusher_names)
+
+
+def deviation_of(batch: Batch, world: TrialWorld) -> WorldDeviation:
+    """The simulated arm's deviation for one trial's world."""
+    m = world.multipliers
+    return WorldDeviation(pad_mu_scale=m["pad_mu"], pusher_mu_scale=m["pusher_mu"], grip_scale=m["grip_force"],
+                          mass_scale=m["mass"], tracker_noise_mm=batch.spreads.tracker_noise[0],
+                          tracker_noise_deg=batch.spreads.tracker_noise[1], seed=world.tracker_seed,
+                          feature_offsets=tuple((k, *v) for k, v in world.feature_offsets.items()))
+
+
+def run_trial(batch: Batch, trial: int) -> dict:
+    """Run trial `trial` and return its record. A trial that raises is recorded as crashed (its
+    `cause` is `crash`, `error` the exception); it never ends the batch."""
+    world = batch.world(trial)
+    started = time.perf_counter()
+    record = {"trial": trial, "world": world.as_dict()}
+    try:
+        loop = ClosedLoop.for_task(batch.task) if batch.closed_loop else None
+        with running_sim_arm(log=lambda text: None, deviation=deviation_of(batch, world),
+                             engine=batch.engine) as server:
+            report = execute_plan(batch.task, batch.plan, server.host, server.port, rate_hz=RATE_HZ, pace=False,
+                                  closed_loop=loop, success_tolerance=batch.tolerance)
+        record.update(final_error=report.final_error, goal_error=report.goal_error,
+                      replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
+                      cause=report.verdict.cause if report.verdict else None,
+                      sim_time_s=report.waypoints / RATE_HZ, error=None)
+    except Exception as exc:  # noqa: BLE001 - a crashed trial is a result, not the end of the batch
+        last = traceback.extract_tb(exc.__traceback__)[-1]
+        record.update(final_error=None, goal_error=None, replans=0, success=False, cause="crash", sim_time_s=0.0,
+                      error=f"{type(exc).__name__}: {exc} ({os.path.basename(last.filename)}:{last.lineno})")
+    record["wall_s"] = time.perf_counter() - started
+    return record
+
+
+# -- where the trials run ---------------------------------------------------------------------
+
+
+def _serial(batch: Batch, trials: Sequence[int]) -> Iterator[dict]:
+    for i in trials:
+        yield run_trial(batch, i)
+
+
+def _processes(batch: Batch, trials: Sequence[int], workers: int) -> Iterator[dict]:
+    """Local worker processes (the standard library's pool). A worker that dies takes its trial
+    with it: the trial is recorded as crashed and the rest go on in a new pool."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    pending = list(trials)
+    while pending:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            futures = {pool.submit(run_trial, batch, i): i for i in pending}
+            try:
+                while futures:
+                    done, _ = wait(futures, return_when=FIRST_COMPLETED)
+                    for future in done:
+                        i = futures.pop(future)
+                        pending.remove(i)
+                        try:
+                            yield future.result()
+                        except BrokenProcessPool:
+                            yield _crashed(batch, i, "the worker process died")
+                            raise
+            except BrokenProcessPool:
+                continue  # the trials still pending start again in a new pool
+            except BaseException:
+                for future in futures:
+                    future.cancel()
+                raise
+
+
+def _ray(batch: Batch, trials: Sequence[int], address: Optional[str]) -> Iterator[dict]:
+    """Ray tasks, one per trial: a local instance (address None) or the cluster at `address`."""
+    import ray
+
+    started_here = not ray.is_initialized()
+    if started_here:
+        ray.init(address=address, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
+    try:
+        remote = ray.remote(max_retries=0)(run_trial)
+        shared = ray.put(batch)
+        refs = {remote.remote(shared, i): i for i in trials}
+        try:
+            while refs:
+                done, _ = ray.wait(list(refs), num_returns=1)
+                for ref in done:
+                    i = refs.pop(ref)
+                    try:
+                        yield ray.get(ref)
+                    except ray.exceptions.RayError as exc:  # the worker died, or Ray lost the task
+                        yield _crashed(batch, i, f"{type(exc).__name__}: {str(exc)[:200]}")
+        except BaseException:
+            for ref in refs:
+                ray.cancel(ref, force=True)
+            raise
+    finally:
+        if started_here:
+            ray.shutdown()
+
+
+def _crashed(batch: Batch, trial: int, why: str) -> dict:
+    return {"trial": trial, "world": batch.world(trial).as_dict(), "final_error": None, "goal_error": None,
+            "replans": 0, "success": False, "cause": "crash", "sim_time_s": 0.0, "error": why, "wall_s": 0.0}
+
+
+@dataclass(frozen=True)
+class Runner:
+    """Where the trials run: `workers` local processes (1: in this process), or Ray when `ray` is
+    set (`ray_address` None: a local instance)."""
+
+    workers: int = 1
+    ray: bool = False
+    ray_address: Optional[str] = None
+
+    def describe(self) -> str:
+        if self.ray:
+            return f"Ray ({self.ray_address or 'local instance'})"
+        return "this process" if self.workers <= 1 else f"{self.workers} local processes"
+
+
+def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
+             progress: Optional[Callable[[dict, List[dict]], None]] = None) -> "Evaluation":
+    """Run trials 0 .. trials-1 of `batch` on `runner`; `progress(record, done)` after each. Ctrl-C
+    (KeyboardInterrupt) stops the batch and keeps the trials done (`interrupted`)."""
+    indices = list(range(trials))
+    if runner.ray:
+        source = _ray(batch, indices, runner.ray_address)
+    elif runner.workers > 1 and trials > 1:
+        source = _processes(batch, indices, runner.workers)
+    else:
+        source = _serial(batch, indices)
+    started = time.perf_counter()
+    done: List[dict] = []
+    interrupted = False
+    try:
+        for record in source:
+            done.append(record)
+            if progress is not None:
+                progress(record, done)
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        close = getattr(source, "close", None)
+        if close is not None:
+            close()
+    done.sort(key=lambda r: r["trial"])
+    return Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started, runner=runner.describe(),
+                      requested=trials, interrupted=interrupted)
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    batch: Batch
+    trials: List[dict]
+    wall_s: float
+    runner: str
+    requested: int
+    interrupted: bool = False
+
+    def summary(self) -> dict:
+        """Counts, the success rate with its Wilson 95% interval, goal-error percentiles (mm and
+        |deg|, over the trials that ran to the end), the causes of the misses, and the speed:
+        robot time simulated per wall second."""
+        n = len(self.trials)
+        successes = sum(1 for t in self.trials if t["success"])
+        ran = [t for t in self.trials if t["goal_error"] is not None]
+        distance = np.array([t["goal_error"]["distance"] for t in ran])
+        angle = np.array([abs(t["goal_error"]["theta"]) for t in ran])
+        causes: Dict[str, int] = {}
+        for t in self.trials:
+            if not t["success"]:
+                causes[str(t["cause"])] = causes.get(str(t["cause"]), 0) + 1
+        robot_time = sum(t["sim_time_s"] for t in self.trials)
+        return {
+            "task": self.batch.task.name, "trials": n, "requested": self.requested, "interrupted": self.interrupted,
+            "successes": successes, "success_rate": successes / n if n else None,
+            "ci95": list(wilson_interval(successes, n)) if n else None,
+            "tolerance": list(self.batch.tolerance), "closed_loop": self.batch.closed_loop,
+            "engine": self.batch.engine, "seed": self.batch.seed,
+            "vary": dict(self.batch.spreads.vary), "feature_error": list(self.batch.spreads.feature_error),
+            "tracker_noise": list(self.batch.spreads.tracker_noise),
+            "goal_error_mm": _percentiles(distance), "goal_error_deg": _percentiles(angle),
+            "causes": causes, "crashed": causes.get("crash", 0),
+            "wall_s": self.wall_s, "runner": self.runner,
+            "robot_time_s": robot_time, "real_time_factor": robot_time / self.wall_s if self.wall_s > 0 else None,
+        }
+
+    def as_dict(self) -> dict:
+        return {"summary": self.summary(), "trials": self.trials}
+
+    def rows(self) -> Tuple[List[str], List[list]]:
+        """The trials as CSV columns and rows (one trial a row)."""
+        offsets = sorted({k for t in self.trials for k in t["world"]["feature_offsets"]})
+        header = (["trial", "success", "cause"] + list(VARY_KEYS)
+                  + [f"{name}_{c}" for name in offsets for c in ("dx_mm", "dz_mm", "dtheta_deg")]
+                  + ["goal_x_mm", "goal_z_mm", "goal_theta_deg", "goal_distance_mm", "replans", "sim_time_s",
+                     "wall_s", "error"])
+        rows = []
+        for t in self.trials:
+            w, g = t["world"], t["goal_error"] or {}
+            rows.append([t["trial"], t["success"], t["cause"] or ""] + [w[k] for k in VARY_KEYS]
+                        + [v for name in offsets for v in w["feature_offsets"].get(name, ("", "", ""))]
+                        + [g.get("x", ""), g.get("z", ""), g.get("theta", ""), g.get("distance", ""), t["replans"],
+                           t["sim_time_s"], t["wall_s"], t["error"] or ""])
+        return header, rows
+
+
+def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> Tuple[float, float]:
+    """The Wilson score interval of a success rate (scipy)."""
+    from scipy.stats import binomtest
+
+    ci = binomtest(successes, n).proportion_ci(confidence_level=confidence, method="wilson")
+    return float(ci.low), float(ci.high)
+
+
+def _percentiles(values: np.ndarray) -> Optional[Dict[str, float]]:
+    if values.size == 0:
+        return None
+    return {f"p{p}": float(np.percentile(values, p)) for p in PERCENTILES} | {"max": float(values.max())}
+
+
+def default_workers() -> int:
+    return max(1, os.cpu_count() or 1)
+
+
+def write_evaluation(evaluation: Evaluation, json_path: Optional[str] = None, csv_path: Optional[str] = None,
+                     png_path: Optional[str] = None) -> None:
+    """Write the evaluation: JSON (`summary` and `trials`), CSV (one trial a row), the figure as PNG
+    (`stablepush.viz.figures.evaluation_figure`); each file atomically."""
+    import csv
+    import io
+    import json
+
+    from stablepush.outputs import write_atomically
+
+    if json_path:
+        write_atomically(json_path, json.dumps(evaluation.as_dict(), indent=1) + "\n")
+    if csv_path:
+        header, rows = evaluation.rows()
+        buffer = io.StringIO()
+        writer = csv.writer(buffer, lineterminator="\n")
+        writer.writerow(header)
+        writer.writerows(rows)
+        write_atomically(csv_path, buffer.getvalue())
+    if png_path:
+        from stablepush.viz.figures import evaluation_figure, save_figure
+
+        save_figure(evaluation_figure(evaluation.summary(), evaluation.trials), png_path)

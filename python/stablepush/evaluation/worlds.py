@@ -1,0 +1,63 @@
+"""The worlds of an evaluation: trial i of a batch with seed S runs in a world drawn from
+numpy's generator seeded with (S, i) alone, so a trial's world, and so its outcome, is the same
+whichever worker runs it, in whatever order.
+
+A world multiplies the task's pad mu, pusher mu, grip force and mass by factors drawn uniformly
+within +-FRACTION (`Spreads.vary`), places each feature off by up to (mm, deg) in x, z and theta
+(uniform), and seeds the tracker's noise.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Dict, Sequence, Tuple
+
+import numpy as np
+
+VARY_KEYS = ("pad_mu", "pusher_mu", "grip_force", "mass")
+MAX_FRACTION = 0.9  # a spread of +-90% at most: every multiplier stays positive
+
+
+@dataclass(frozen=True)
+class Spreads:
+    """How far the worlds of a batch may differ from the task: `vary` maps VARY_KEYS to a fraction
+    (a multiplier within 1 +- fraction); `feature_error` (mm, deg) bounds each feature's offset;
+    `tracker_noise` (mm, deg) is the tracker's standard deviation."""
+
+    vary: Dict[str, float] = field(default_factory=dict)
+    feature_error: Tuple[float, float] = (0.0, 0.0)
+    tracker_noise: Tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self):
+        for key, fraction in self.vary.items():
+            if key not in VARY_KEYS:
+                raise ValueError(f"vary: unknown key {key!r} (one of {', '.join(VARY_KEYS)})")
+            if not 0.0 <= fraction <= MAX_FRACTION:
+                raise ValueError(f"vary: {key} must be a fraction from 0 to {MAX_FRACTION:g}, got {fraction:g}")
+        if min(self.feature_error) < 0 or min(self.tracker_noise) < 0:
+            raise ValueError("feature error and tracker noise must not be negative")
+
+
+@dataclass(frozen=True)
+class TrialWorld:
+    """One trial's world: the multipliers under VARY_KEYS' names, each feature's offset (pusher ->
+    (dx mm, dz mm, dtheta deg)), and the tracker's seed."""
+
+    trial: int
+    multipliers: Dict[str, float]
+    feature_offsets: Dict[str, Tuple[float, float, float]]
+    tracker_seed: int
+
+    def as_dict(self) -> dict:
+        return {**self.multipliers, "feature_offsets": {k: list(v) for k, v in self.feature_offsets.items()}}
+
+
+def draw_world(seed: int, trial: int, spreads: Spreads, pushers: Sequence[str]) -> TrialWorld:
+    """Trial `trial`'s world: a function of (seed, trial) and the spreads alone."""
+    rng = np.random.default_rng([seed, trial])
+    multipliers = {key: float(1.0 + rng.uniform(-spreads.vary.get(key, 0.0), spreads.vary.get(key, 0.0)))
+                   for key in VARY_KEYS}
+    mm, deg = spreads.feature_error
+    offsets = {name: (float(rng.uniform(-mm, mm)), float(rng.uniform(-mm, mm)), float(rng.uniform(-deg, deg)))
+               for name in pushers}
+    return TrialWorld(trial=trial, multipliers=multipliers, feature_offsets=offsets,
+                      tracker_seed=int(rng.integers(2**31)))

@@ -1,0 +1,146 @@
+"""`stablepush evaluate` (stablepush.evaluation): a plan's success rate over perturbed worlds.
+Each trial's world depends on (seed, i) alone, so the same batch gives the same trials serially,
+on local processes and on Ray; the worlds stay inside the spreads asked for; the summary's rate
+and Wilson interval follow from the trials; a crashing trial is a result, not the end."""
+import json
+import math
+
+import pytest
+from click.testing import CliRunner
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from stablepush.evaluation import Batch, Evaluation, Runner, Spreads, draw_world, evaluate, wilson_interval
+from stablepush.evaluation import batch as batch_mod
+from stablepush.execution.world import place_features, scene_description
+from stablepush.plan import check_plan, plan_task
+from stablepush.sim.arm import WorldDeviation
+from stablepush_cli.main import cli
+
+from conftest import TASKS, shipped
+
+SPREADS = Spreads(vary={"pad_mu": 0.15, "pusher_mu": 0.15, "grip_force": 0.1, "mass": 0.05},
+                  feature_error=(0.5, 0.5))
+
+
+def _batch(name="more/tilted-gravity", **kw) -> Batch:
+    from stablepush.task import load_task
+
+    task = load_task(TASKS / f"{name}.yaml")
+    return Batch(task=task, plan=check_plan(task, plan_task(task, seed=1)), spreads=SPREADS, seed=7, **kw)
+
+
+@settings(max_examples=200, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), trial=st.integers(0, 10**6),
+       fractions=st.lists(st.floats(0, 0.9), min_size=4, max_size=4), mm=st.floats(0, 5), deg=st.floats(0, 5))
+def test_worlds_stay_inside_the_spreads_and_depend_on_seed_and_trial_alone(seed, trial, fractions, mm, deg):
+    spreads = Spreads(vary=dict(zip(("pad_mu", "pusher_mu", "grip_force", "mass"), fractions)), feature_error=(mm, deg))
+    world = draw_world(seed, trial, spreads, ["a", "b"])
+    for key, fraction in spreads.vary.items():
+        assert 1 - fraction <= world.multipliers[key] <= 1 + fraction
+    for dx, dz, dth in world.feature_offsets.values():
+        assert abs(dx) <= mm and abs(dz) <= mm and abs(dth) <= deg
+    assert draw_world(seed, trial, spreads, ["a", "b"]) == world  # no hidden state
+    other = draw_world(seed, trial + 1, spreads, ["a", "b"])
+    assert other != world or all(f == 0 for f in fractions) and mm == 0 and deg == 0
+
+
+def test_bad_spreads_are_refused_naming_the_key():
+    with pytest.raises(ValueError, match="friction"):
+        Spreads(vary={"friction": 0.1})
+    with pytest.raises(ValueError, match="pad_mu"):
+        Spreads(vary={"pad_mu": 1.5})
+
+
+def test_a_world_deviation_changes_the_scene_as_asked():
+    """Hand-derived: multipliers on mu, grip and mass (and inertia); a feature turned 90 deg about y
+    through its middle and shifted by (1, 2) mm."""
+    task = shipped("horizontal-offset-high-mu")
+    scene = scene_description(task, place_features(task, check_plan(task, plan_task(task, seed=1)).waypoints),
+                              task.start)
+    deviation = WorldDeviation(mu_scale=1.1, pad_mu_scale=0.9, pusher_mu_scale=1.2, grip_scale=0.8, mass_scale=1.05,
+                               feature_offsets=(("left", 1.0, 2.0, 90.0),))
+    world = deviation.apply(scene)
+    assert world["gripper"]["mu"] == pytest.approx(scene["gripper"]["mu"] * 1.1 * 0.9)
+    assert world["gripper"]["grip_force"] == pytest.approx(scene["gripper"]["grip_force"] * 0.8)
+    assert world["object"]["mass"] == pytest.approx(scene["object"]["mass"] * 1.05)
+    assert world["object"]["inertia"] == pytest.approx(scene["object"]["inertia"] * 1.05)
+    (before,), (after,) = scene["features"], world["features"]
+    assert after["mu"] == pytest.approx(before["mu"] * 1.1 * 1.2)
+    mid = [(a + b) / 2 for a, b in zip(before["from"], before["to"])]
+    rel = [a - m for a, m in zip(before["from"], mid)]
+    # rot_y(90 deg): x' = z, z' = -x
+    expected = [mid[0] + rel[2] + 1e-3, mid[1] + rel[1], mid[2] - rel[0] + 2e-3]
+    assert after["from"] == pytest.approx(expected, abs=1e-12)
+    assert after["normal"] == pytest.approx([before["normal"][2], before["normal"][1], -before["normal"][0]], abs=1e-12)
+    assert scene["features"][0] is before and before["mu"] == task.pushers[0].mu  # the scene itself unchanged
+
+
+def test_the_summary_follows_from_the_trials():
+    """success_rate = successes / trials; ci95 is Wilson's interval (checked against its formula)."""
+    trials = [{"trial": i, "success": i % 4 != 0, "cause": None if i % 4 else "pusher_slipped",
+               "goal_error": {"x": 0.1 * i, "z": 0.0, "theta": -0.01 * i, "distance": 0.1 * i}, "sim_time_s": 2.0,
+               "world": {}} for i in range(40)]
+    evaluation = Evaluation(batch=_batch(), trials=trials, wall_s=4.0, runner="this process", requested=40)
+    s = evaluation.summary()
+    assert (s["trials"], s["successes"]) == (40, 30) and s["success_rate"] == 0.75
+    assert s["causes"] == {"pusher_slipped": 10} and s["real_time_factor"] == pytest.approx(20.0)
+    z, n, p = 1.959963984540054, 40, 0.75
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    assert s["ci95"] == pytest.approx([centre - half, centre + half], abs=1e-9)
+    assert s["goal_error_mm"]["max"] == pytest.approx(3.9)
+    assert wilson_interval(0, 10)[0] == 0.0 and wilson_interval(10, 10)[1] == 1.0
+
+
+def test_a_crashing_trial_is_recorded_and_the_batch_goes_on(monkeypatch):
+    real = batch_mod.execute_plan
+
+    calls = []
+
+    def crash_on_trial_one(task, plan, host, port, **kw):  # the serial runner runs trials 0, 1, 2 in turn
+        calls.append(1)
+        if len(calls) == 2:
+            raise RuntimeError("the simulator blew up")
+        return real(task, plan, host, port, **kw)
+
+    monkeypatch.setattr(batch_mod, "execute_plan", crash_on_trial_one)
+    result = evaluate(_batch(), 3, Runner(workers=1))
+    assert [t["trial"] for t in result.trials] == [0, 1, 2]
+    crashed = result.trials[1]
+    assert crashed["cause"] == "crash" and not crashed["success"] and "the simulator blew up" in crashed["error"]
+    assert result.trials[0]["cause"] != "crash" and result.trials[2]["cause"] != "crash"
+    assert result.summary()["crashed"] == 1
+
+
+def _outcomes(evaluation):
+    return [(t["trial"], t["world"], t["goal_error"], t["success"], t["cause"]) for t in evaluation.trials]
+
+
+def test_the_same_seed_gives_the_same_trials_serially_on_workers_and_on_ray():
+    batch = _batch()
+    serial = evaluate(batch, 3, Runner(workers=1))
+    workers = evaluate(batch, 3, Runner(workers=2))
+    on_ray = evaluate(batch, 3, Runner(ray=True))
+    assert _outcomes(serial) == _outcomes(workers) == _outcomes(on_ray)
+    assert len({json.dumps(t["world"], sort_keys=True) for t in serial.trials}) == 3  # three different worlds
+    assert on_ray.runner.startswith("Ray")
+
+
+def test_evaluate_cli_writes_its_files_and_refuses_bad_options(tmp_path):
+    task = str(TASKS / "more" / "tilted-gravity.yaml")
+    out = tmp_path / "e.json"
+    result = CliRunner().invoke(cli, ["evaluate", task, "--trials", "2", "--workers", "1", "--vary", "pad_mu=0.1",
+                                      "--json", str(out), "--csv", str(tmp_path / "e.csv"),
+                                      "--plot", str(tmp_path / "e.png"), "--quiet"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(out.read_text())
+    assert data["summary"]["trials"] == 2 and len(data["trials"]) == 2
+    assert (tmp_path / "e.png").read_bytes()[:4] == b"\x89PNG"
+    assert len((tmp_path / "e.csv").read_text().splitlines()) == 3
+    bad = CliRunner().invoke(cli, ["evaluate", task, "--vary", "friction=0.1"])
+    assert bad.exit_code == 2 and "friction" in bad.output
+    bad = CliRunner().invoke(cli, ["evaluate", task, "--vary", "pad_mu"])
+    assert bad.exit_code == 2 and "KEY=FRACTION" in bad.output
+    bad = CliRunner().invoke(cli, ["evaluate", task, "--workers", "2", "--ray"])
+    assert bad.exit_code == 2 and "--ray" in bad.output
