@@ -144,3 +144,18 @@ def test_evaluate_cli_writes_its_files_and_refuses_bad_options(tmp_path):
     assert bad.exit_code == 2 and "KEY=FRACTION" in bad.output
     bad = CliRunner().invoke(cli, ["evaluate", task, "--workers", "2", "--ray"])
     assert bad.exit_code == 2 and "--ray" in bad.output
+
+
+def test_bench_plans_the_same_on_workers_as_here(tmp_path):
+    """`stablepush bench --workers` runs the same seeds to the same plans; only the times differ."""
+    task = str(TASKS / "t-shaped.yaml")
+    outs = []
+    for extra in ([], ["--workers", "2"]):
+        out = tmp_path / f"b{len(outs)}.json"
+        result = CliRunner().invoke(cli, ["bench", task, "--trials", "4", "--out", str(out)] + extra)
+        assert result.exit_code == 0, result.output
+        keep = ("seed", "solved", "switches", "pushes", "path_length_steps", "nodes", "pusher_sequence", "min_margin")
+        outs.append([{k: t[k] for k in keep} for t in json.loads(out.read_text())["trials"]])
+    assert outs[0] == outs[1] and [t["seed"] for t in outs[0]] == [1, 2, 3, 4]
+    bad = CliRunner().invoke(cli, ["bench", task, "--workers", "2", "--ray"])
+    assert bad.exit_code == 2 and "--ray" in bad.output

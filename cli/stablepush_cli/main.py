@@ -191,8 +191,13 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
 @click.option("--improve-for", type=float, default=None, metavar="S",
               help="Anytime planning: keep improving S seconds after the first plan (planner.improve_for), "
                    "and report the first and the improved plans.")
+@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+              help="Run the planning trials on K local processes (default: one after the other, here). "
+                   "Times are each search's own, so they compare across runners; parallel runs share the CPUs.")
+@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              help="Run the planning trials on Ray: a local instance, or the cluster at ADDRESS.")
 def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out_path, count: int,
-          improve_for) -> None:
+          improve_for, workers, ray_address) -> None:
     """Benchmark planning over seeds, in the shape of the paper's Table II.
 
     For each task: success rate, median / p95 / min / max planning time, median switch-overs and path
@@ -222,11 +227,17 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     if out_path and not out_path.endswith((".csv", ".json")):
         _fail(f"--out {out_path}: the file name must end in .csv or .json")
 
+    if ray_address is not None and workers is not None:
+        _fail("--workers and --ray: choose one")
     every, rows = [], []
     with click.progressbar(length=trials * len(tasks), label="planning", file=sys.stderr) as bar:
         for task in tasks:
-            runs = benchmark.bench_planning(task, trials, seed=seed, time_limit=time_limit, progress=bar.update,
-                                            improve_for=improve_for)
+            if workers is None and ray_address is None:
+                runs = benchmark.bench_planning(task, trials, seed=seed, time_limit=time_limit, progress=bar.update,
+                                                improve_for=improve_for)
+            else:
+                runs = _bench_on_runner(benchmark.PlanningJob(task, seed, time_limit, improve_for), trials,
+                                        workers, ray_address, bar.update)
             every.extend(runs)
             rows.append(benchmark.summarize_planning(runs))
 
@@ -256,6 +267,21 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     if out_path:
         _write_bench(out_path, every, rows)
         click.echo(f"trials written to {out_path}")
+
+
+def _bench_on_runner(job, trials: int, workers, ray_address, progress) -> list:
+    """A task's planning trials on local processes or Ray (stablepush.evaluation.run_all), in seed order."""
+    from stablepush.evaluation import Runner, WorkerLost, run_all
+    from stablepush.plan.benchmark import run_planning_job
+
+    runner = Runner(workers=workers or 1, ray=ray_address is not None, ray_address=ray_address or None)
+    done = {}
+    for k, trial in run_all(run_planning_job, job, range(trials), runner):
+        if isinstance(trial, WorkerLost):
+            raise click.ClickException(f"{job.task.name}: planning trial {k} lost its worker ({trial.why})")
+        done[k] = trial
+        progress(1)
+    return [done[k] for k in sorted(done)]
 
 
 def _bench_checks(tasks, count: int, seed: int) -> None:

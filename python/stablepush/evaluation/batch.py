@@ -3,8 +3,8 @@
 Each trial runs the plan on a simulated arm of its own (`stablepush.sim`, in the worker's process,
 over the arm protocol on a loopback port) in the world `worlds.draw_world(seed, i)` draws, and
 records where the object ended against the goal. Trials are independent: they run one after the
-other, on local worker processes, or on Ray (a local instance or a cluster), and a trial's outcome
-depends on (seed, i) alone, so all three give the same trials.
+other, on local worker processes, or on Ray (`runners.py`), and a trial's outcome depends on
+(seed, i) alone, so all three give the same trials.
 
 The summary's `ci95` is the Wilson score interval of the success rate (scipy's `binomtest`).
 Units: mm and deg as in plan files; times in s.
@@ -14,12 +14,12 @@ from __future__ import annotations
 import os
 import time
 import traceback
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
-from typing import Callable, Dict, Iterator, List, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
+from stablepush.evaluation.runners import Runner, WorkerLost, run_all
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.executor import execute_plan
@@ -83,107 +83,23 @@ def run_trial(batch: Batch, trial: int) -> dict:
     return record
 
 
-# -- where the trials run ---------------------------------------------------------------------
-
-
-def _serial(batch: Batch, trials: Sequence[int]) -> Iterator[dict]:
-    for i in trials:
-        yield run_trial(batch, i)
-
-
-def _processes(batch: Batch, trials: Sequence[int], workers: int) -> Iterator[dict]:
-    """Local worker processes (the standard library's pool). A worker that dies takes its trial
-    with it: the trial is recorded as crashed and the rest go on in a new pool."""
-    from concurrent.futures.process import BrokenProcessPool
-
-    pending = list(trials)
-    while pending:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            futures = {pool.submit(run_trial, batch, i): i for i in pending}
-            try:
-                while futures:
-                    done, _ = wait(futures, return_when=FIRST_COMPLETED)
-                    for future in done:
-                        i = futures.pop(future)
-                        pending.remove(i)
-                        try:
-                            yield future.result()
-                        except BrokenProcessPool:
-                            yield _crashed(batch, i, "the worker process died")
-                            raise
-            except BrokenProcessPool:
-                continue  # the trials still pending start again in a new pool
-            except BaseException:
-                for future in futures:
-                    future.cancel()
-                raise
-
-
-def _ray(batch: Batch, trials: Sequence[int], address: Optional[str]) -> Iterator[dict]:
-    """Ray tasks, one per trial: a local instance (address None) or the cluster at `address`."""
-    import ray
-
-    started_here = not ray.is_initialized()
-    if started_here:
-        ray.init(address=address, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
-    try:
-        remote = ray.remote(max_retries=0)(run_trial)
-        shared = ray.put(batch)
-        refs = {remote.remote(shared, i): i for i in trials}
-        try:
-            while refs:
-                done, _ = ray.wait(list(refs), num_returns=1)
-                for ref in done:
-                    i = refs.pop(ref)
-                    try:
-                        yield ray.get(ref)
-                    except ray.exceptions.RayError as exc:  # the worker died, or Ray lost the task
-                        yield _crashed(batch, i, f"{type(exc).__name__}: {str(exc)[:200]}")
-        except BaseException:
-            for ref in refs:
-                ray.cancel(ref, force=True)
-            raise
-    finally:
-        if started_here:
-            ray.shutdown()
-
-
 def _crashed(batch: Batch, trial: int, why: str) -> dict:
     return {"trial": trial, "world": batch.world(trial).as_dict(), "final_error": None, "goal_error": None,
             "replans": 0, "success": False, "cause": "crash", "sim_time_s": 0.0, "error": why, "wall_s": 0.0}
-
-
-@dataclass(frozen=True)
-class Runner:
-    """Where the trials run: `workers` local processes (1: in this process), or Ray when `ray` is
-    set (`ray_address` None: a local instance)."""
-
-    workers: int = 1
-    ray: bool = False
-    ray_address: Optional[str] = None
-
-    def describe(self) -> str:
-        if self.ray:
-            return f"Ray ({self.ray_address or 'local instance'})"
-        return "this process" if self.workers <= 1 else f"{self.workers} local processes"
 
 
 def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
              progress: Optional[Callable[[dict, List[dict]], None]] = None) -> "Evaluation":
     """Run trials 0 .. trials-1 of `batch` on `runner`; `progress(record, done)` after each. Ctrl-C
     (KeyboardInterrupt) stops the batch and keeps the trials done (`interrupted`)."""
-    indices = list(range(trials))
-    if runner.ray:
-        source = _ray(batch, indices, runner.ray_address)
-    elif runner.workers > 1 and trials > 1:
-        source = _processes(batch, indices, runner.workers)
-    else:
-        source = _serial(batch, indices)
+    source = run_all(run_trial, batch, range(trials), runner)
     started = time.perf_counter()
     done: List[dict] = []
     interrupted = False
     try:
-        for record in source:
+        for i, record in source:
+            if isinstance(record, WorkerLost):
+                record = _crashed(batch, i, record.why)
             done.append(record)
             if progress is not None:
                 progress(record, done)

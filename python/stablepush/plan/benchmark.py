@@ -108,6 +108,24 @@ class PlanningTrial:
     first_min_margin: Optional[float] = None
 
 
+def planning_trial(task: Task, seed: int, time_limit: Optional[float] = None, improve_for: Optional[float] = None,
+                   models=None) -> PlanningTrial:
+    """One planning run of `task` with `seed` (`models`: the task's corner models, built once by the
+    caller when it runs many)."""
+    plan = plan_task(task, seed=seed, time_limit=time_limit, models=models, improve_for=improve_for)
+    s = plan.stats
+    first = s.get("first") or {}
+    return PlanningTrial(
+        task=task.name, seed=seed, solved=plan.solved, outcome=plan.outcome,
+        planning_time_s=s["planning_time_s"], switches=s["switches"], pushes=s["pushes"],
+        path_length_steps=s["path_length_steps"], feasibility_checks=s["feasibility_checks"], nodes=s["nodes"],
+        pusher_sequence="-".join(plan.pusher_sequence),
+        min_margin=min((w.margin for w in plan.waypoints[1:]), default=None),
+        first_time_s=first.get("planning_time_s"), first_switches=first.get("switches"),
+        first_path_length_steps=first.get("path_length_steps"), first_min_margin=first.get("min_margin"),
+    )
+
+
 def bench_planning(task: Task, trials: int, seed: int = 1, time_limit: Optional[float] = None,
                    progress: Optional[Callable[[int], None]] = None,
                    improve_for: Optional[float] = None) -> "list[PlanningTrial]":
@@ -116,21 +134,25 @@ def bench_planning(task: Task, trials: int, seed: int = 1, time_limit: Optional[
     models = task.corner_models()
     out = []
     for k in range(trials):
-        plan = plan_task(task, seed=seed + k, time_limit=time_limit, models=models, improve_for=improve_for)
-        s = plan.stats
-        first = s.get("first") or {}
-        out.append(PlanningTrial(
-            task=task.name, seed=seed + k, solved=plan.solved, outcome=plan.outcome,
-            planning_time_s=s["planning_time_s"], switches=s["switches"], pushes=s["pushes"],
-            path_length_steps=s["path_length_steps"], feasibility_checks=s["feasibility_checks"], nodes=s["nodes"],
-            pusher_sequence="-".join(plan.pusher_sequence),
-            min_margin=min((w.margin for w in plan.waypoints[1:]), default=None),
-            first_time_s=first.get("planning_time_s"), first_switches=first.get("switches"),
-            first_path_length_steps=first.get("path_length_steps"), first_min_margin=first.get("min_margin"),
-        ))
+        out.append(planning_trial(task, seed + k, time_limit, improve_for, models))
         if progress is not None:
             progress(1)
     return out
+
+
+@dataclass(frozen=True)
+class PlanningJob:
+    """A bench's planning runs of one task, as jobs for a batch runner (`stablepush.evaluation.run_all`):
+    run k plans with seed `seed` + k."""
+
+    task: Task
+    seed: int = 1
+    time_limit: Optional[float] = None
+    improve_for: Optional[float] = None
+
+
+def run_planning_job(job: PlanningJob, k: int) -> PlanningTrial:
+    return planning_trial(job.task, job.seed + k, job.time_limit, job.improve_for)
 
 
 def summarize_planning(trials: "list[PlanningTrial]") -> dict:
