@@ -179,7 +179,36 @@ class SimulatedGrasp:
         return self.steps / self.step_wall_time if self.step_wall_time > 0 else 0.0
 
 
-class SimArm(SimulatedGrasp):
+class TrackingArm:
+    """What the arm does the same on every engine: IK on the engine's kinematics (`_kinematics(q)`
+    -> R_WG, p_WG, J; `ik.solve_ik`), and servo set-points moved linearly from one streamed
+    waypoint's joint angles to the next's over the waypoint period (`_set_servos`, `_run`)."""
+
+    def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, strict: bool = False,
+                 iterations: int = ik.IK_ITERATIONS) -> np.ndarray:
+        """Joint angles [rad] that put G at `pose`, from `q_start`."""
+        q, error = ik.solve_ik(self._kinematics, pose, q_start, self.home_posture, self._lower, self._upper,
+                               iterations)
+        if strict and error > 1e-6:
+            raise ik.unreachable(pose, error)
+        self.ik_error = error
+        return q
+
+    def advance(self, duration: float, target: Optional[np.ndarray] = None) -> None:
+        """Step the physics for `duration` s while the joint servo set-points move linearly from the
+        current target to `target` (the servos interpolate between streamed waypoints)."""
+        n = max(1, int(round(duration / self.timestep)))
+        start = self.target.copy()
+        end = start if target is None else np.asarray(target, float)
+        self._run(n, lambda i: self._set_servos(start + (end - start) * (i / n)))
+        self.target = end.copy()
+
+    def move_to(self, pose: Sequence[float], duration: float) -> None:
+        """Track G toward `pose` over `duration` s (one streamed waypoint period)."""
+        self.advance(duration, self.solve_ik(pose, self.target))
+
+
+class SimArm(TrackingArm, SimulatedGrasp):
     """The arm, the grasp and the world of one scene description (as `deviation` alters it)."""
 
     def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
@@ -202,22 +231,11 @@ class SimArm(SimulatedGrasp):
         self.home_posture = self.solve_ik(home, ik.HOME_GUESS, strict=True, iterations=1000)
         self.target = self.home_posture.copy()
         self.data.qpos[self._arm_qpos] = self.home_posture
-        self.data.ctrl[self._arm_act] = self.home_posture
+        self._set_servos(self.home_posture)
         mujoco.mj_forward(m, self.data)
         self.advance(SETTLE_TIME)
 
     # -- kinematics ---------------------------------------------------------------------------
-
-    def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, strict: bool = False,
-                 iterations: int = ik.IK_ITERATIONS) -> np.ndarray:
-        """Joint angles [rad] that put G at `pose`, from `q_start` (`ik.solve_ik` on MuJoCo's
-        kinematics of the arm)."""
-        q, error = ik.solve_ik(self._kinematics, pose, q_start, self.home_posture, self._lower, self._upper,
-                               iterations)
-        if strict and error > 1e-6:
-            raise ik.unreachable(pose, error)
-        self.ik_error = error
-        return q
 
     def _kinematics(self, q: np.ndarray):
         d = self._scratch
@@ -230,27 +248,13 @@ class SimArm(SimulatedGrasp):
 
     # -- simulation ---------------------------------------------------------------------------
 
-    def advance(self, duration: float, target: Optional[np.ndarray] = None) -> None:
-        """Step the physics for `duration` s while the joint servo set-points move linearly from the
-        current target to `target` (the servos interpolate between streamed waypoints)."""
-        n = max(1, int(round(duration / self.model.opt.timestep)))
-        start = self.target.copy()
-        end = start if target is None else np.asarray(target, float)
-
-        def servo_setpoints(i: int) -> None:
-            self.data.ctrl[self._arm_act] = start + (end - start) * (i / n)
-
-        self._run(n, servo_setpoints)
-        self.target = end.copy()
-
-    def move_to(self, pose: Sequence[float], duration: float) -> None:
-        """Track G toward `pose` over `duration` s (one streamed waypoint period)."""
-        self.advance(duration, self.solve_ik(pose, self.target))
+    def _set_servos(self, q_arm: np.ndarray) -> None:
+        self.data.ctrl[self._arm_act] = q_arm
 
     def stop(self) -> None:
         """Hold the joints where they are now."""
         self.target = self.data.qpos[self._arm_qpos].copy()
-        self.data.ctrl[self._arm_act] = self.target
+        self._set_servos(self.target)
         self.data.qvel[self._arm_dof] = 0.0
 
     # -- state --------------------------------------------------------------------------------

@@ -32,7 +32,7 @@ import numpy as np
 from stablepush.frames import pose_to_matrix
 from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import SETTLE_TIME, WorldDeviation, arm_state, in_grasp
+from stablepush.sim.arm import SETTLE_TIME, TrackingArm, WorldDeviation, arm_state, in_grasp
 
 DRAKE_TIMESTEP = 0.000125  # s (the friction-fidelity contract fails at 0.2 ms: module docstring)
 DRAKE_APPROXIMATION = "lagged"  # DiscreteContactApproximation: sap, similar or lagged
@@ -317,7 +317,7 @@ class DrakeGrasp:
                 f"{DRAKE_APPROXIMATION} contact, {self.timestep * 1e3:g} ms step")
 
 
-class DrakeArm(DrakeGrasp):
+class DrakeArm(TrackingArm, DrakeGrasp):
     """The arm, the grasp and the world of one scene description (as `deviation` alters it), in
     Drake; the same interface as `arm.SimArm` (move_to, advance, stop, state, solve_ik)."""
 
@@ -346,17 +346,6 @@ class DrakeArm(DrakeGrasp):
 
     # -- kinematics ---------------------------------------------------------------------------
 
-    def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, strict: bool = False,
-                 iterations: int = ik.IK_ITERATIONS) -> np.ndarray:
-        """Joint angles [rad] that put G at `pose`, from `q_start` (`ik.solve_ik` on Drake's
-        kinematics of the arm)."""
-        q, error = ik.solve_ik(self._kinematics, pose, q_start, self.home_posture, self._lower, self._upper,
-                               iterations)
-        if strict and error > 1e-6:
-            raise ik.unreachable(pose, error)
-        self.ik_error = error
-        return q
-
     def _kinematics(self, q: np.ndarray):
         plant, ctx = self.plant, self._scratch
         full = plant.GetPositions(ctx)
@@ -377,22 +366,8 @@ class DrakeArm(DrakeGrasp):
         self._desired[self._finger_servos] = 0.0  # the jaws close toward y = 0, capped at the grip force
 
     def advance(self, duration: float, target=None) -> None:
-        """Step the physics for `duration` s while the joint servo set-points move linearly from the
-        current target to `target`."""
-        n = max(1, int(round(duration / self.timestep)))
-        start = self.target.copy()
-        end = start if target is None else np.asarray(target, float)
-        self._gravity_compensation()
-
-        def servo_setpoints(i: int) -> None:
-            self._set_servos(start + (end - start) * (i / n))
-
-        self._run(n, servo_setpoints)
-        self.target = end.copy()
-
-    def move_to(self, pose: Sequence[float], duration: float) -> None:
-        """Track G toward `pose` over `duration` s (one streamed waypoint period)."""
-        self.advance(duration, self.solve_ik(pose, self.target))
+        self._gravity_compensation()  # gravcomp's torques, held over the waypoint period
+        super().advance(duration, target)
 
     def stop(self) -> None:
         """Hold the joints where they are now."""
