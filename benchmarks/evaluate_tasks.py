@@ -11,8 +11,9 @@ import json
 import sys
 from pathlib import Path
 
-from stablepush.evaluation import Batch, Runner, Spreads, default_workers, evaluate
+from stablepush.evaluation import Batch, Spreads, evaluate
 from stablepush.plan import check_plan, plan_task
+from stablepush.runners import Runner, default_workers
 from stablepush.sim.engines import ENGINES
 from stablepush.task import load_task
 

@@ -10,10 +10,11 @@ from click.testing import CliRunner
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from stablepush.evaluation import Batch, Evaluation, Runner, Spreads, draw_world, evaluate, wilson_interval
+from stablepush.evaluation import Batch, Evaluation, Spreads, draw_world, evaluate, wilson_interval
 from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.world import place_features, scene_description
 from stablepush.plan import check_plan, plan_task
+from stablepush.runners import Runner
 from stablepush.sim.arm import WorldDeviation
 from stablepush_cli.main import cli
 

@@ -270,9 +270,9 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
 
 
 def _bench_on_runner(job, trials: int, workers, ray_address, progress) -> list:
-    """A task's planning trials on local processes or Ray (stablepush.evaluation.run_all), in seed order."""
-    from stablepush.evaluation import Runner, WorkerLost, run_all
+    """A task's planning trials on local processes or Ray (stablepush.runners.run_all), in seed order."""
     from stablepush.plan.benchmark import run_planning_job
+    from stablepush.runners import Runner, WorkerLost, run_all
 
     runner = Runner(workers=workers or 1, ray=ray_address is not None, ray_address=ray_address or None)
     done = {}
@@ -685,9 +685,10 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
           --vary grip_force=0.1 --vary mass=0.05 --feature-error 0.5 0.5 --json piv.eval.json --plot piv.png
       stablepush evaluate data/tasks/t-shaped.yaml --trials 1000 --closed-loop --vary pad_mu=0.15 --ray
     """
-    from stablepush.evaluation import Batch, Runner, Spreads, default_workers, write_evaluation
+    from stablepush.evaluation import Batch, Spreads, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
     from stablepush.plan import check_plan, plan_task
+    from stablepush.runners import Runner, default_workers
 
     if ray_address is not None and workers is not None:
         _fail("--workers and --ray: choose one")

@@ -3,7 +3,7 @@
 Each trial runs the plan on a simulated arm of its own (`stablepush.sim`, in the worker's process,
 over the arm protocol on a loopback port) in the world `worlds.draw_world(seed, i)` draws, and
 records where the object ended against the goal. Trials are independent: they run one after the
-other, on local worker processes, or on Ray (`runners.py`), and a trial's outcome depends on
+other, on local worker processes, or on Ray (`stablepush.runners`), and a trial's outcome depends on
 (seed, i) alone, so all three give the same trials.
 
 The summary's `ci95` is the Wilson score interval of the success rate (scipy's `binomtest`).
@@ -19,11 +19,11 @@ from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
-from stablepush.evaluation.runners import Runner, WorkerLost, run_all
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.executor import execute_plan
 from stablepush.plan.plan import Plan
+from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.sim.arm import WorldDeviation
 from stablepush.sim.server import running_sim_arm
 from stablepush.task.model import Task
@@ -183,10 +183,6 @@ def _percentiles(values: np.ndarray) -> Optional[Dict[str, float]]:
     if values.size == 0:
         return None
     return {f"p{p}": float(np.percentile(values, p)) for p in PERCENTILES} | {"max": float(values.max())}
-
-
-def default_workers() -> int:
-    return max(1, os.cpu_count() or 1)
 
 
 def write_evaluation(evaluation: Evaluation, json_path: Optional[str] = None, csv_path: Optional[str] = None,

@@ -142,7 +142,7 @@ def bench_planning(task: Task, trials: int, seed: int = 1, time_limit: Optional[
 
 @dataclass(frozen=True)
 class PlanningJob:
-    """A bench's planning runs of one task, as jobs for a batch runner (`stablepush.evaluation.run_all`):
+    """A bench's planning runs of one task, as jobs for a batch runner (`stablepush.runners.run_all`):
     run k plans with seed `seed` + k."""
 
     task: Task

@@ -1,6 +1,7 @@
 """Where a batch of independent jobs runs: in this process, on local worker processes (the standard
 library's pool), or on Ray (a local instance, or a cluster by address). `stablepush evaluate` runs
-its trials here and `stablepush bench --workers/--ray` its planning runs.
+its trials here, `stablepush reach` its cells and `stablepush bench --workers/--ray` its planning
+runs.
 
 A job is `job(shared, i)` for i in the batch's indices: a module-level function (so that workers
 can import it), `shared` picklable and sent once per worker (Ray: once per cluster, `ray.put`).
@@ -8,6 +9,7 @@ Results arrive as they finish, as (i, result); a job whose worker died arrives a
 """
 from __future__ import annotations
 
+import os
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from typing import Any, Callable, Iterable, Iterator, Optional, Tuple
@@ -28,6 +30,11 @@ class Runner:
         if self.ray:
             return f"Ray ({self.ray_address or 'local instance'})"
         return "this process" if self.workers <= 1 else f"{self.workers} local processes"
+
+
+def default_workers() -> int:
+    """The machine's CPU count."""
+    return max(1, os.cpu_count() or 1)
 
 
 @dataclass(frozen=True)
