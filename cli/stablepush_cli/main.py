@@ -748,6 +748,88 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
         sys.exit(130)
 
 
+def _axis(_ctx, param, value):
+    """A grid axis A:B:N (N values from A to B; N = 1: A alone)."""
+    if value is None:
+        return None
+    parts = value.split(":")
+    try:
+        start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
+        if len(parts) != 3 or not 1 <= count <= 1000:
+            raise ValueError
+    except (ValueError, IndexError):
+        raise click.BadParameter(f"expected FROM:TO:COUNT with COUNT from 1 to 1000 (e.g. -10:10:11), got {value!r}")
+    return start, stop, count
+
+
+@cli.command()
+@click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
+@click.option("--x", "x_axis", callback=_axis, default=None, metavar="A:B:N",
+              help="Goal x values, mm: N from A to B (default: the task's goal x alone).")
+@click.option("--z", "z_axis", callback=_axis, default=None, metavar="A:B:N", help="Goal z values, mm (likewise).")
+@click.option("--theta", "theta_axis", callback=_axis, default=None, metavar="A:B:N",
+              help="Goal theta values, deg (likewise).")
+@click.option("--time-limit", default=1.0, show_default=True, type=click.FloatRange(min=0, min_open=True),
+              metavar="S", help="Each cell's search time.")
+@click.option("--seed", default=None, type=click.IntRange(min=0), help="Planner seed (default: the task's).")
+@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+              help="Plan the cells on K local processes (default: the number of CPUs).")
+@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              help="Plan the cells on Ray: a local instance, or the cluster at ADDRESS.")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+              help="Write the map: its cells (goal, verdict, reason, solved, seed, planning time, switch-overs).")
+@click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
+              help="Draw the map in slices of theta, beside the grasp at the start (PNG).")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, workers, ray_address, json_path,
+          png_path, quiet: bool) -> None:
+    """Map where the pushers can take the object: plan from the task's start to every goal of a grid.
+
+    Each cell is the task with its goal replaced, planned on its own. Its verdict: `reached`,
+    `unreachable` with the reason (decided exactly before any search: no grasp at the goal, or
+    none at the start), or `not found` within --time-limit. The same seed gives the same map,
+    whichever runner plans it.
+
+    \b
+    Example:
+      stablepush reach data/tasks/t-shaped.yaml --x -20:20:9 --z -10:10:5 --theta 0:0:1 \\
+          --json t.reach.json --plot t.reach.png
+    """
+    from stablepush.outputs import write_atomically
+    from stablepush.plan.reach import reach_map
+    from stablepush.runners import Runner, default_workers
+
+    if ray_address is not None and workers is not None:
+        _fail("--workers and --ray: choose one")
+    task = _load(task_file)
+    gx, gz, gth = task.goal
+    axes = [a if a is not None else (g, g, 1) for a, g in ((x_axis, gx), (z_axis, gz), (theta_axis, gth))]
+    count = axes[0][2] * axes[1][2] * axes[2][2]
+    if count > 100_000:
+        _fail(f"--x, --z, --theta: {count} cells; at most 100000")
+    runner = Runner(workers=workers or default_workers(), ray=ray_address is not None, ray_address=ray_address or None)
+    bar = None if quiet else click.progressbar(length=count, label=f"{count} cells", file=sys.stderr, show_pos=True)
+    try:
+        result = reach_map(task, *axes, seed=task.planner["seed"] if seed is None else seed, time_limit=time_limit,
+                           runner=runner, progress=(lambda cell: bar.update(1)) if bar else None)
+    finally:
+        if bar is not None:
+            bar.render_finish()
+    data = result.as_dict()
+    if json_path:
+        write_atomically(json_path, json.dumps(data, indent=1) + "\n")
+    if png_path:
+        from stablepush.viz.figures import reach_figure, save_figure
+
+        save_figure(reach_figure(task, data), png_path)
+    c = data["counts"]
+    click.echo(f"{task.name}: {c['reached']} of {count} goals reached, {c['not found']} not found in {time_limit:g} s, "
+               f"{c['unreachable']} unreachable ({result.wall_s:.1f} s on {result.runner})")
+    written = [p for p in (json_path, png_path) if p]
+    if written:
+        click.echo(f"written: {', '.join(written)}")
+
+
 @cli.command("sim-arm")
 @click.option("--host", default="127.0.0.1", show_default=True, help="Address to listen on.")
 @click.option("--port", default=DEFAULT_PORT, show_default=True, type=click.IntRange(min=0, max=65535),

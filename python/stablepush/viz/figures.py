@@ -259,3 +259,41 @@ def evaluation_figure(summary: dict, trials: Sequence[dict]) -> Figure:
         scatter.text(0.5, 0.5, "no parameter varied (--vary)", ha="center", va="center")
         scatter.set_axis_off()
     return fig
+
+
+REACH_STYLE = {"reached": ("tab:green", "o"), "not found": ("tab:orange", "s"), "unreachable": ("0.55", "x")}
+
+
+def reach_figure(task: Task, reach: dict) -> Figure:
+    """A reach map (`stablepush.plan.reach`): first the grasp at the start with its pads and
+    pushers (the fixtures); then one panel per slice of theta (at most six, evenly chosen), each
+    goal (x, z) marked by its verdict, the start's (x, z) a star."""
+    thetas = sorted({c["goal"][2] for c in reach["cells"]})
+    if len(thetas) > 6:
+        thetas = [thetas[int(round(k))] for k in np.linspace(0, len(thetas) - 1, 6)]
+    fig = Figure(figsize=(3.3 * (len(thetas) + 1), 3.6))
+    axes = np.atleast_1d(fig.subplots(1, len(thetas) + 1))
+    start = list(reach["start"])
+    _draw_grasp(axes[0], task, start, None, "the start in the grasp, pushers grey", _limits(task, [Waypoint(*start)]))
+    xs = [c["goal"][0] for c in reach["cells"]]
+    zs = [c["goal"][1] for c in reach["cells"]]
+    margin = max(1.0, 0.05 * max(max(xs) - min(xs), max(zs) - min(zs)))
+    for ax, theta in zip(axes[1:], thetas):
+        for verdict, (colour, marker) in REACH_STYLE.items():
+            cells = [c for c in reach["cells"] if c["goal"][2] == theta and c["verdict"] == verdict]
+            ax.scatter([c["goal"][0] for c in cells], [c["goal"][1] for c in cells], c=colour, marker=marker, s=28,
+                       label=f"{verdict} ({len(cells)})")
+        ax.plot([start[0]], [start[1]], "*", color="k", ms=12, label=f"start (theta {start[2]:g})")
+        ax.set_xlim(min(xs) - margin, max(xs) + margin)
+        ax.set_ylim(min(zs) - margin, max(zs) + margin)
+        ax.set_aspect("equal")
+        ax.set_title(f"goal theta {theta:g} deg", fontsize=9)
+        ax.set_xlabel("x mm", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2)
+    axes[1].set_ylabel("z mm", fontsize=8)
+    counts = reach["counts"]
+    fig.suptitle(f"{reach['task']}: {counts['reached']} reached, {counts['not found']} not found in "
+                 f"{reach['time_limit_s']:g} s, {counts['unreachable']} unreachable (seed {reach['seed']})",
+                 fontsize=10)
+    return fig

@@ -1,0 +1,129 @@
+"""Where the pushers can take the object (`stablepush reach`): the task's start planned to every
+goal of a grid of poses in the grasp, the task otherwise unchanged, each cell on its own, where
+`stablepush.runners` says (here, local processes or Ray). A cell's plan depends on the task, the
+goal and the seed alone, so the same seed gives the same map on every runner.
+
+Each cell ends with a verdict:
+- `reached`: a plan reaches the goal within the task's tolerance and switch-over budget;
+- `unreachable`: no plan can, for a reason decided exactly before any search (`reason`): the pads
+  are not all on the object at the goal (no grasp there, so no push can end there), or the pads
+  do not hold the object at the start (the planner's `invalid_start`);
+- `not found`: the search ran out of time (`outcome` says how: `time_limit`, or
+  `goal_over_switch_limit` when the goal was reached with more switch-overs than allowed).
+
+Poses are (x mm, z mm, theta deg), as in task files.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from stablepush.plan.search import plan_task
+from stablepush.task.model import Task, make_gripper
+from stablepush.units import pose_to_si
+
+Axis = Tuple[float, float, int]  # from, to, count (count 1: `from` alone)
+
+
+def axis_values(axis: Axis) -> List[float]:
+    start, stop, count = axis
+    return [float(v) for v in np.linspace(start, stop, int(count))] if count > 1 else [float(start)]
+
+
+@dataclass(frozen=True)
+class ReachJob:
+    """A reach map's shared part: the task, the goals of the grid (x fastest, then z, then
+    theta), the seed and each cell's time limit [s]."""
+
+    task: Task
+    goals: Tuple[Tuple[float, float, float], ...]
+    seed: int
+    time_limit: float
+
+    @classmethod
+    def grid(cls, task: Task, x: Axis, z: Axis, theta: Axis, seed: int, time_limit: float) -> "ReachJob":
+        goals = tuple((gx, gz, gth) for gth in axis_values(theta) for gz in axis_values(z) for gx in axis_values(x))
+        return cls(task=task, goals=goals, seed=seed, time_limit=time_limit)
+
+
+def pads_off_object(task: Task, pose: Sequence[float]) -> List[int]:
+    """The indices of the pads that are not all on the object at `pose`."""
+    inside = make_gripper(task.pads, task.grip_force, task.mu, task.pad_rings).pads_inside(task.section(),
+                                                                                           pose_to_si(pose))
+    return [i for i, ok in enumerate(inside) if not ok]
+
+
+def reach_cell(job: ReachJob, i: int) -> dict:
+    """Plan cell i of the map and give its verdict (module docstring)."""
+    goal = job.goals[i]
+    cell = {"goal": list(goal), "seed": job.seed, "solved": False, "planning_time_s": 0.0, "switches": None,
+            "pushes": None, "outcome": None, "verdict": None, "reason": None}
+    task = dataclasses.replace(job.task, goal=tuple(goal))
+    off = pads_off_object(task, goal)
+    if off:
+        return {**cell, "verdict": "unreachable",
+                "reason": f"gripper.pads{off} would not lie on the object at the goal: no grasp there"}
+    if task.at_goal(task.start):
+        return {**cell, "solved": True, "switches": 0, "pushes": 0, "outcome": "at_start", "verdict": "reached"}
+    plan = plan_task(task, seed=job.seed, time_limit=job.time_limit)
+    s = plan.stats
+    cell.update(solved=plan.solved, planning_time_s=s["planning_time_s"], switches=s["switches"],
+                pushes=s["pushes"], outcome=plan.outcome)
+    if plan.solved:
+        cell["verdict"] = "reached"
+    elif plan.outcome == "invalid_start":
+        cell.update(verdict="unreachable", reason=plan.message)
+    else:
+        cell.update(verdict="not found", reason=plan.message)
+    return cell
+
+
+@dataclass(frozen=True)
+class ReachMap:
+    task: str
+    start: Tuple[float, float, float]
+    axes: dict  # "x", "z", "theta" -> [from, to, count]
+    seed: int
+    time_limit: float
+    cells: List[dict]
+    wall_s: float
+    runner: str
+
+    def counts(self) -> dict:
+        out = {"reached": 0, "unreachable": 0, "not found": 0}
+        for c in self.cells:
+            out[c["verdict"]] += 1
+        return out
+
+    def as_dict(self) -> dict:
+        return {"task": self.task, "start": list(self.start), "axes": self.axes, "seed": self.seed,
+                "time_limit_s": self.time_limit, "counts": self.counts(), "wall_s": self.wall_s,
+                "runner": self.runner, "cells": self.cells}
+
+
+def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_limit: float = 1.0,
+              runner=None, progress=None) -> ReachMap:
+    """The reach map of `task` over the grid x by z by theta (each (from, to, count)); `runner` a
+    `stablepush.runners.Runner` (None: here); `progress(cell)` after each cell."""
+    import time
+
+    from stablepush.runners import Runner, WorkerLost, run_all
+
+    runner = runner or Runner()
+    job = ReachJob.grid(task, x, z, theta, seed, time_limit)
+    started = time.perf_counter()
+    cells: List[Optional[dict]] = [None] * len(job.goals)
+    for i, cell in run_all(reach_cell, job, range(len(job.goals)), runner):
+        if isinstance(cell, WorkerLost):
+            cell = {"goal": list(job.goals[i]), "seed": seed, "solved": False, "planning_time_s": 0.0,
+                    "switches": None, "pushes": None, "outcome": "worker_lost", "verdict": "not found",
+                    "reason": cell.why}
+        cells[i] = cell
+        if progress is not None:
+            progress(cell)
+    return ReachMap(task=task.name, start=tuple(task.start), axes={"x": list(x), "z": list(z), "theta": list(theta)},
+                    seed=seed, time_limit=time_limit, cells=cells, wall_s=time.perf_counter() - started,
+                    runner=runner.describe())

@@ -1,0 +1,62 @@
+"""`stablepush reach` (stablepush.plan.reach): a map of the goals the pushers can reach from the
+start. The same seed gives the same map on every runner; an `unreachable` verdict is never given
+to a goal that a plan reaches (each one is planned again with a long limit), and every `reached`
+cell's plan passes the task's own check."""
+import dataclasses
+import json
+
+from click.testing import CliRunner
+
+from stablepush.plan import check_plan, plan_task
+from stablepush.plan.reach import ReachJob, reach_cell, reach_map
+from stablepush.runners import Runner
+from stablepush_cli.main import cli
+
+from conftest import TASKS, shipped
+
+GRID = dict(x=(-30.0, 30.0, 5), z=(-15.0, 15.0, 3), theta=(-20.0, 20.0, 2))
+
+
+def _verdicts(result):
+    return [(c["goal"], c["verdict"], c["solved"], c["switches"], c["pushes"], c["outcome"]) for c in result.cells]
+
+
+def test_the_same_seed_gives_the_same_map_here_and_on_workers():
+    task = shipped("t-shaped")
+    here = reach_map(task, **GRID, seed=3, time_limit=0.3)
+    workers = reach_map(task, **GRID, seed=3, time_limit=0.3, runner=Runner(workers=2))
+    assert _verdicts(here) == _verdicts(workers)
+    assert len(here.cells) == 30 and {c["verdict"] for c in here.cells} >= {"reached", "unreachable"}
+
+
+def test_unreachable_verdicts_are_sound_and_reached_plans_check():
+    task = shipped("t-shaped")
+    result = reach_map(task, **GRID, seed=1, time_limit=0.3)
+    for cell in result.cells:
+        cell_task = dataclasses.replace(task, goal=tuple(cell["goal"]))
+        if cell["verdict"] == "unreachable":
+            assert "no grasp" in cell["reason"]
+            long = plan_task(cell_task, seed=1, time_limit=1.0)
+            assert not long.solved, cell
+        elif cell["verdict"] == "reached" and cell["pushes"]:
+            check_plan(cell_task, plan_task(cell_task, seed=1, time_limit=0.3))
+
+
+def test_a_goal_at_the_start_is_reached_with_no_push():
+    task = shipped("pivoting")
+    job = ReachJob(task=task, goals=(tuple(task.start),), seed=1, time_limit=0.1)
+    cell = reach_cell(job, 0)
+    assert cell["verdict"] == "reached" and cell["pushes"] == 0 and cell["outcome"] == "at_start"
+
+
+def test_reach_cli_writes_the_map_and_refuses_a_bad_axis(tmp_path):
+    out, png = tmp_path / "r.json", tmp_path / "r.png"
+    task = str(TASKS / "pivoting.yaml")
+    result = CliRunner().invoke(cli, ["reach", task, "--theta", "0:90:4", "--time-limit", "0.2", "--workers", "1",
+                                      "--json", str(out), "--plot", str(png), "--quiet"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(out.read_text())
+    assert len(data["cells"]) == 4 and data["counts"]["reached"] >= 1
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    bad = CliRunner().invoke(cli, ["reach", task, "--x", "1:2"])
+    assert bad.exit_code == 2 and "FROM:TO:COUNT" in bad.output
