@@ -60,3 +60,21 @@ def test_reach_cli_writes_the_map_and_refuses_a_bad_axis(tmp_path):
     assert png.read_bytes()[:4] == b"\x89PNG"
     bad = CliRunner().invoke(cli, ["reach", task, "--x", "1:2"])
     assert bad.exit_code == 2 and "FROM:TO:COUNT" in bad.output
+
+
+def test_show_draws_a_plan_that_found_no_push_and_marks_the_goal(tmp_path):
+    """An unsolved plan with the start alone (a goal no push leads toward) is drawn, not refused."""
+    from stablepush import save_plan
+
+    task = shipped("horizontal-offset-low-mu")
+    plan = plan_task(task, seed=1)
+    start_only = dataclasses.replace(plan, waypoints=plan.waypoints[:1], solved=False, outcome="time_limit")
+    path, png = tmp_path / "none.plan.json", tmp_path / "none.png"
+    save_plan(start_only, str(path))
+    result = CliRunner().invoke(cli, ["show", str(path), "--task", str(TASKS / "horizontal-offset-low-mu.yaml"),
+                                      "-o", str(png)])
+    assert result.exit_code == 0, result.output
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    with_push = CliRunner().invoke(cli, ["execute", str(path), "--task", str(TASKS / "horizontal-offset-low-mu.yaml"),
+                                         "--sim"])
+    assert with_push.exit_code == 2 and "solved" in with_push.output  # running it is still refused

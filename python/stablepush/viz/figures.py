@@ -11,6 +11,7 @@ theta against the step. `cone_figure` draws a pusher's generalized friction cone
 from __future__ import annotations
 
 import io
+import math
 import os
 import tempfile
 from pathlib import Path
@@ -86,6 +87,11 @@ def _snapshots(steps: Sequence[Waypoint]) -> List[int]:
     return keys[:MAX_SNAPSHOTS] if len(keys) <= MAX_SNAPSHOTS else keys[:MAX_SNAPSHOTS - 1] + [keys[-1]]
 
 
+def _short_of_goal(task: Task, pose) -> str:
+    dx, dz, dth = (a - b for a, b in zip(pose, task.goal))
+    return f"end: {math.hypot(dx, dz):.2f} mm, {dth:+.2f} deg\nshort of the goal (red)"
+
+
 def plan_title(task: Task, plan: Plan) -> str:
     """The task, the pushes, switch-overs and seed; NOT SOLVED first for a partial plan."""
     title = (f"{task.name}: {len(plan.waypoints) - 1} pushes, {plan.stats.get('switches', '?')} switch-over(s), "
@@ -102,26 +108,35 @@ def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
     switches = {c.first for c in contacts_of(steps)[1:]}
     fig = Figure(figsize=(2.3 * len(keys) + 0.5, 6.2))
     grid = fig.add_gridspec(2, len(keys), height_ratios=[1.1, 1.0], hspace=0.35)
-    limits = _limits(task, steps)
+    # A plan that stops short also shows the goal it did not reach (in red, at its end).
+    limits = _limits(task, list(steps) + ([] if plan.solved else [Waypoint(*task.goal)]))
     for k, i in enumerate(keys):
         ax = fig.add_subplot(grid[0, k])
         pusher = steps[i + 1].pusher if i + 1 < len(steps) else steps[i].pusher
-        label = "start" if i == 0 else (("goal" if plan.solved else "end") if i == len(steps) - 1 else f"step {i}")
-        if i in switches:
+        last = i == len(steps) - 1
+        label = "start" if i == 0 else (("goal" if plan.solved else "end") if last else f"step {i}")
+        if last and not plan.solved:
+            label = _short_of_goal(task, steps[i].pose) if i > 0 else "start, no push found\n" + \
+                _short_of_goal(task, steps[i].pose)
+        elif i in switches:
             label += f"\nswitch to {pusher}"
         elif pusher:
             label += f"\n{pusher}"
         _draw_grasp(ax, task, steps[i].pose, pusher, label, limits)
+        if last and not plan.solved:
+            goal = in_gripper(task.goal, list(task.vertices) + [task.vertices[0]])
+            ax.plot(goal[:, 0], goal[:, 1], color="tab:red", lw=1.2, ls="--", zorder=6)
         if k == 0:
             ax.set_ylabel("z in G (mm)", fontsize=8)
         ax.set_xlabel("x in G (mm)", fontsize=8)
     ax = fig.add_subplot(grid[1, :])
     n = np.arange(len(steps))
     poses = np.array([s.pose for s in steps])
-    ax.plot(n, poses[:, 0], label="x (mm)")
-    ax.plot(n, poses[:, 1], label="z (mm)")
+    marker = "o" if len(steps) == 1 else None  # a plan that found no push: its start alone
+    ax.plot(n, poses[:, 0], label="x (mm)", marker=marker)
+    ax.plot(n, poses[:, 1], label="z (mm)", marker=marker)
     ax2 = ax.twinx()
-    ax2.plot(n, poses[:, 2], color="C3", label="theta (deg)")
+    ax2.plot(n, poses[:, 2], color="C3", label="theta (deg)", marker=marker)
     ax2.set_ylabel("theta (deg)", color="C3")
     for c in contacts_of(steps):
         ax.axvspan(c.first, c.last, color=_colour(task, c.pusher), alpha=0.12, lw=0)
