@@ -446,3 +446,19 @@ def test_ctrl_c_ends_a_long_search_at_once_and_writes_nothing(tmp_path):
     _, stderr = process.communicate(timeout=15)
     assert time.monotonic() - interrupted < 1.5, stderr
     assert process.returncode == 1 and "Aborted!" in stderr and not out.exists()
+
+
+def test_a_trajectory_past_the_sample_cap_is_refused_in_bounded_time(monkeypatch, tmp_path):
+    """A valid plan whose trajectory would pass the samples cap (issue 24, item 8) is refused with
+    one line naming the cap and the rate, before it takes minutes and gigabytes."""
+    from stablepush.execution import stream
+
+    monkeypatch.setattr(stream, "MAX_TRAJECTORY_SAMPLES", 2000)
+    task = str(TASKS / "pivoting.yaml")
+    plan = tmp_path / "p.plan.json"
+    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan), "--quiet"]).exit_code == 0
+    result = CliRunner().invoke(cli, ["trajectory", str(plan), "--task", task, "-o", str(tmp_path / "t.csv"),
+                                      "--rate", "1000"])
+    assert result.exit_code == 2, result.output
+    assert "2000 samples" in result.output and "1000 Hz" in result.output and "lower rate" in result.output
+    assert not (tmp_path / "t.csv").exists()

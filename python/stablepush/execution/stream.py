@@ -30,6 +30,9 @@ MOVE_SPEED = 0.1  # m/s of G between contacts
 TURN_SPEED = math.radians(60)  # rad/s of G between contacts
 SETTLE_TIME = 0.2  # s held still at the end of the last push, before the final retract
 LIFT_MARGIN = 0.02  # m above every feature when the object changes lanes
+# Samples a trajectory may hold: 50 min of motion at 100 Hz. Each costs tens of microseconds to make
+# and hundreds of bytes to keep, so a longer one is refused before it takes minutes and gigabytes.
+MAX_TRAJECTORY_SAMPLES = 300_000
 
 
 @dataclass(frozen=True)
@@ -56,6 +59,11 @@ class _Stream:
         self.step = step
 
     def _emit(self, T: np.ndarray, phase: str, step: int, completes: bool = False) -> None:
+        if len(self.points) >= MAX_TRAJECTORY_SAMPLES:
+            raise PlanError("waypoints", f"the trajectory passes {MAX_TRAJECTORY_SAMPLES} samples "
+                                         f"({MAX_TRAJECTORY_SAMPLES * self.period / 60:.0f} min of motion at "
+                                         f"{1 / self.period:g} Hz) by plan step {step}: a lower rate, or a "
+                                         f"shorter plan")
         self.points.append(ArmWaypoint(seq=len(self.points), t=(len(self.points) + 1) * self.period, step=step,
                                        completes=completes, phase=phase, pose=tuple(matrix_to_pose(T))))
         self.pose = T
