@@ -93,3 +93,55 @@ def test_a_mesh_in_metres_is_named_as_such(tmp_path):
             "pushers: [{name: left, at: [-0.0199, 0.0005], mu: 0.5}]\nstart: [0, 0, 0]\ngoal: [0.001, 0, 0]\n")
     with pytest.raises(TaskError, match=r"only 0.04 mm across: written in metres\? \(object.scale: 1000"):
         parse_task(text, source=str(tmp_path / "task.yaml"))
+
+
+def _washer(tmp_path):
+    ring = trimesh.creation.annulus(r_min=8.0, r_max=20.0, height=10.0, sections=64)  # axis z
+    ring.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))  # axis y
+    ring.export(tmp_path / "washer.stl")
+    return tmp_path / "washer.stl"
+
+
+def test_a_section_with_a_hole_is_refused(tmp_path):
+    """A washer used to be planned on its outer outline alone, with the pads over its hole."""
+    with pytest.raises(TaskError, match=r"1 hole\(s\)") as error:
+        load_mesh_object(_washer(tmp_path), "object", mass=10.0)
+    assert error.value.field == "object.plane_y"
+
+
+def test_several_bodies_are_refused(tmp_path):
+    """Two boxes 500 mm apart used to give one box's section with both boxes' mass."""
+    a, b = trimesh.creation.box([40, 25, 40]), trimesh.creation.box([40, 25, 40])
+    b.apply_translation([500, 0, 0])
+    trimesh.util.concatenate([a, b]).export(tmp_path / "two.stl")
+    with pytest.raises(TaskError, match="2 separate bodies") as error:
+        load_mesh_object(tmp_path / "two.stl", "object", mass=10.0)
+    assert error.value.field == "object.file"
+
+
+def test_a_section_in_two_pieces_is_refused(tmp_path):
+    """One body (a U) cut across both its arms: the model would keep one arm's outline."""
+    u = [(-30, -5), (30, -5), (30, 35), (20, 35), (20, 5), (-20, 5), (-20, 35), (-30, 35)]  # in x, y
+    cap = [(0, 1, 4), (0, 4, 5), (1, 2, 3), (1, 3, 4), (0, 5, 6), (0, 6, 7)]  # the U in triangles, by hand
+    n = len(u)
+    vertices = [(x, y, 0.0) for x, y in u] + [(x, y, 40.0) for x, y in u]  # extruded along z
+    faces = [(a, c, b) for a, b, c in cap] + [(a + n, b + n, c + n) for a, b, c in cap]
+    for i in range(n):
+        j = (i + 1) % n
+        faces += [(i, j, j + n), (i, j + n, i + n)]
+    solid = trimesh.Trimesh(vertices, faces)
+    solid.fix_normals()
+    assert solid.is_watertight and solid.body_count == 1
+    solid.export(tmp_path / "u.stl")
+    with pytest.raises(TaskError, match="2 separate pieces") as error:
+        load_mesh_object(tmp_path / "u.stl", "object", mass=10.0, plane_y=25.0)
+    assert error.value.field == "object.plane_y"
+
+
+@pytest.mark.parametrize("thickness", [0.001, 1_000_000.0])
+def test_a_mesh_of_an_implausible_thickness_is_refused(tmp_path, thickness):
+    box = trimesh.creation.box([40, thickness, 40])
+    box.export(tmp_path / "slab.stl")
+    with pytest.raises(TaskError, match="thick along y") as error:
+        load_mesh_object(tmp_path / "slab.stl", "object", mass=10.0)
+    assert error.value.field == "object.file" and "scale" in error.value.reason

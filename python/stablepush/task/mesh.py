@@ -38,10 +38,11 @@ class MeshObject:
 
 def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Optional[float] = None,
                      tolerance: float = 0.1, mass: Optional[float] = None, density: Optional[float] = None,
-                     max_vertices: int = 1000) -> MeshObject:
+                     max_vertices: int = 1000, thickness_range: Tuple[float, float] = (1e-2, 1e4)) -> MeshObject:
     """The object of a mesh file. `mass` [g] or `density` [g/cm^3] (exactly one); `plane_y` [mm,
     after scaling] defaults to the centre of mass's y; `tolerance` [mm] bounds how far the
-    simplified section departs from the true one. TaskError naming `field` on any problem."""
+    simplified section departs from the true one; `thickness_range` [mm] bounds the solid's extent
+    along y. One body, cut into one outline without holes. TaskError naming `field` on any problem."""
     try:
         import trimesh
         from shapely.geometry import Polygon
@@ -65,7 +66,16 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
         raise TaskError(f"{field}.file", f"{path} holds no triangles")
     if not mesh.is_watertight:
         raise TaskError(f"{field}.file", f"{path} is not a closed surface (watertight), so it has no volume")
+    bodies = mesh.body_count
+    if bodies > 1:
+        raise TaskError(f"{field}.file", f"{path} holds {bodies} separate bodies; the grasp holds one "
+                                         f"(one body per file)")
     mesh.apply_scale(scale)
+    thickness = float(mesh.extents[1])
+    if not thickness_range[0] <= thickness <= thickness_range[1]:
+        raise TaskError(f"{field}.file", f"{path} is {thickness:g} mm thick along y (the gripping axis), outside "
+                                         f"{thickness_range[0]:g} to {thickness_range[1]:g} mm: its units? "
+                                         f"({field}.scale multiplies them into mm)")
     volume = float(mesh.volume)  # mm^3
     if not volume > 0:
         raise TaskError(f"{field}.file", f"{path} encloses no volume (inside out?)")
@@ -85,7 +95,16 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
     polygons = list(planar.polygons_full)
     if not polygons:
         raise TaskError(f"{field}.plane_y", f"the section at y = {y:g} mm is not a closed outline")
-    outline = max(polygons, key=lambda p: p.area)
+    # The model's object is one outline without holes: a pad over a hole, or between two pieces of
+    # the section, would press on nothing.
+    if len(polygons) > 1:
+        raise TaskError(f"{field}.plane_y", f"the section at y = {y:g} mm falls into {len(polygons)} separate "
+                                            f"pieces; the model takes one outline (another plane_y?)")
+    outline = polygons[0]
+    if outline.interiors:
+        raise TaskError(f"{field}.plane_y", f"the section at y = {y:g} mm has {len(outline.interiors)} hole(s); "
+                                            f"the model takes an outline without holes, and a pad over a hole would "
+                                            f"hold nothing (another plane_y?)")
     raw = len(outline.exterior.coords) - 1
     simple = orient(Polygon(outline.exterior).simplify(tolerance, preserve_topology=True), 1.0)
     vertices = tuple((float(x), float(z)) for x, z in list(simple.exterior.coords)[:-1])
@@ -94,5 +113,5 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
                                               f"at most {max_vertices} (a larger tolerance)")
     mesh.density = grams / volume  # g/mm^3, so moment_inertia is in g mm^2
     inertia = float(mesh.moment_inertia[1, 1]) * 1e-9  # g mm^2 -> kg m^2
-    return MeshObject(vertices=vertices, thickness=float(high - low), mass=float(grams),
+    return MeshObject(vertices=vertices, thickness=thickness, mass=float(grams),
                       com=(float(com[0]), float(com[2])), inertia=inertia, section_vertices=raw)

@@ -501,7 +501,7 @@ def _mesh_object(obj: dict, source: Optional[str]):
         tolerance=_number("object.tolerance", obj.get("tolerance", 0.1), (1e-4, 100.0)),
         mass=_number("object.mass", obj["mass"], LIMITS["mass"]) if "mass" in obj else None,
         density=_number("object.density", obj["density"], (1e-3, 100.0)) if "density" in obj else None,
-        max_vertices=MAX_VERTICES)
+        max_vertices=MAX_VERTICES, thickness_range=LIMITS["length"])
     com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else mesh.com
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else mesh.inertia
     _number("object.mass", mesh.mass, LIMITS["mass"])
