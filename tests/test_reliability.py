@@ -23,7 +23,7 @@ from stablepush.outputs import write_files
 from stablepush.plan import check_plan, load_plan, plan_task
 from stablepush.plan.files import plan_to_dict, read_plan
 from stablepush.sim.server import SimArmServer
-from stablepush.task import parse_task
+from stablepush.task import load_task, parse_task
 from stablepush.units import pose_to_si
 from stablepush_cli.main import cli
 
@@ -462,3 +462,49 @@ def test_a_trajectory_past_the_sample_cap_is_refused_in_bounded_time(monkeypatch
     assert result.exit_code == 2, result.output
     assert "2000 samples" in result.output and "1000 Hz" in result.output and "lower rate" in result.output
     assert not (tmp_path / "t.csv").exists()
+
+
+def _plan_then_edit(tmp_path, edit):
+    """A plan of the high-mu offset, and its task file edited afterwards by `edit` (text -> text)."""
+    source = (TASKS / "horizontal-offset-high-mu.yaml").read_text()
+    task = tmp_path / "task.yaml"
+    task.write_text(source)
+    plan = tmp_path / "task.plan.json"
+    assert CliRunner().invoke(cli, ["plan", str(task), "-o", str(plan), "--quiet"]).exit_code == 0
+    task.write_text(edit(source))
+    return str(plan), str(task)
+
+
+@pytest.mark.parametrize("edit, changed", [
+    (lambda t: t.replace("goal: [20, 0, 0]", "goal: [19.5, 0, 0]"), "goal"),  # still within tolerance of the end
+    (lambda t: t.replace("grip_force: 10 ", "grip_force: 10.5 "), "gripper.grip_force"),
+])
+def test_execute_refuses_a_plan_whose_task_changed_and_names_what(tmp_path, edit, changed):
+    """Issue 24, item 4: a user edited the goal after planning, and show and trajectory took the old
+    plan without a word. Now execute refuses and names the field; show and trajectory warn."""
+    plan, task = _plan_then_edit(tmp_path, edit)
+    result = CliRunner().invoke(cli, ["execute", plan, "--task", task, "--sim", "--quiet"])
+    assert result.exit_code == 2 and "changed since the plan was made" in result.output and changed in result.output
+    shown = CliRunner().invoke(cli, ["show", plan, "--task", task, "-o", str(tmp_path / "p.png")])
+    assert shown.exit_code == 0 and "warning:" in shown.output and changed in shown.output
+
+
+def test_a_pusher_edited_after_planning_is_named(tmp_path):
+    from stablepush.plan.verify import changes_since_planned
+
+    plan, task = _plan_then_edit(tmp_path, lambda t: t.replace("mu: 0.6", "mu: 0.61", 1))
+    changes = changes_since_planned(load_task(task), load_plan(plan))
+    assert changes and all(c.startswith("pushers.") and c.endswith(".mu") for c in changes), changes
+
+
+def test_a_hand_edited_task_record_and_an_old_plan_file(tmp_path):
+    plan, task = _plan_then_edit(tmp_path, lambda t: t)
+    data = json.loads(Path(plan).read_text())
+    data["task_identity"]["fields"]["goal"] = [0, 0, 0]
+    Path(plan).write_text(json.dumps(data))
+    with pytest.raises(PlanError, match="digest"):
+        load_plan(plan)
+    del data["task_identity"]  # a plan file from before the record: read as before, nothing to compare
+    Path(plan).write_text(json.dumps(data))
+    result = CliRunner().invoke(cli, ["show", plan, "--task", task, "-o", str(tmp_path / "p.png")])
+    assert result.exit_code == 0 and "changed since" not in result.output

@@ -314,12 +314,23 @@ def _write_bench(path: str, trials, rows) -> None:
     write_atomically(path, buffer.getvalue())
 
 
-def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = True):
-    """The task and the plan, once the plan is shown to belong to the task (exit 2 if not)."""
+def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = True, changed: str = "warn"):
+    """The task and the plan, once the plan is shown to belong to the task (exit 2 if not). A task
+    that changed since the plan was made is warned about (`changed="warn"`) or refused ("refuse")."""
+    from stablepush.errors import PlanError
     from stablepush.plan import check_plan, load_plan
+    from stablepush.plan.verify import changes_since_planned
 
     task = _load(task_file)
-    return task, check_plan(task, load_plan(plan_file), source=plan_file, require_solved=require_solved)
+    plan = load_plan(plan_file)
+    changes = changes_since_planned(task, plan)
+    if changes:
+        what = f"{task_file} changed since the plan was made ({', '.join(changes[:6])}" + \
+            (f" and {len(changes) - 6} more" if len(changes) > 6 else "") + ")"
+        if changed == "refuse":
+            raise PlanError("task_identity", what + ": plan it again", plan_file)
+        click.echo(f"warning: {what}", err=True)
+    return task, check_plan(task, plan, source=plan_file, require_solved=require_solved)
 
 
 @cli.command()
@@ -499,7 +510,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     from stablepush.execution.stream import check_resume_from
     from stablepush.outputs import write_atomically
 
-    task, plan = _load_plan_and_task(plan_file, task_file)
+    task, plan = _load_plan_and_task(plan_file, task_file, changed="refuse")
     for warning in execution_warnings(task):
         click.echo(f"warning: {warning}", err=True)
     check_resume_from(plan.waypoints, resume_from)

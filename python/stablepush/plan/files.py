@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
 import math
@@ -51,8 +52,17 @@ def plan_to_dict(plan: Plan) -> dict:
                        "holds": plan.final_hold_ratio >= 1.0},
         "units": {"x": "mm", "z": "mm", "theta": "deg", "margin": "N", "margin_per_normal": "1 (N per N)",
                   "pusher_in_gripper": "mm in G"},
+        # The task it was planned for, whole, and its digest: a plan whose task changed since says what.
+        "task_identity": None if plan.task_identity is None else {"digest": task_digest(plan.task_identity),
+                                                                  "fields": plan.task_identity},
         "waypoints": [_waypoint_dict(w) for w in plan.waypoints],
     }
+
+
+def task_digest(identity: dict) -> str:
+    """SHA-256 of a task's identity (Task.identity) as canonical JSON."""
+    text = json.dumps(identity, sort_keys=True, separators=(",", ":"), allow_nan=True)
+    return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
 
 
 def plan_to_csv(plan: Plan) -> str:
@@ -99,7 +109,8 @@ def plan_from_dict(data: dict) -> Plan:
     return Plan(task=data["task"], solved=data["solved"], outcome=data.get("outcome", ""),
                 message=data.get("message", ""), waypoints=waypoints, stats=dict(data["stats"]),
                 final_hold_ratio=math.inf if hold is None else float(hold),
-                uncertainty=dict(data.get("uncertainty") or {}), ends_at_goal=data.get("ends_at") == "goal")
+                uncertainty=dict(data.get("uncertainty") or {}), ends_at_goal=data.get("ends_at") == "goal",
+                task_identity=(data.get("task_identity") or {}).get("fields"))
 
 
 def load_plan(path: Union[str, Path]) -> Plan:
@@ -176,6 +187,12 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
         fail("final_hold", "must be a mapping whose ratio is a finite number or null")
     if data.get("uncertainty") is not None and not isinstance(data["uncertainty"], dict):
         fail("uncertainty", f"must be a mapping, got {_json_kind(data['uncertainty'])}")
+    identity = data.get("task_identity")
+    if identity is not None:
+        if not isinstance(identity, dict) or not isinstance(identity.get("fields"), dict):
+            fail("task_identity", "must be a mapping with the task's fields (or null)")
+        if identity.get("digest") != task_digest(identity["fields"]):
+            fail("task_identity.digest", "does not match its fields: the file was edited by hand")
     if data.get("ends_at") not in (None, "goal", "within_tolerance"):
         fail("ends_at", "must be goal, within_tolerance or null")
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
@@ -64,6 +64,8 @@ class Plan:
     # A solved plan's last push reaches the goal pose itself; False: it ends within the tolerance
     # (the last, shorter push to the goal was not a stable push).
     ends_at_goal: bool = False
+    # The task it was planned for (Task.identity); None for a plan file older than this field.
+    task_identity: Optional[Dict[str, Any]] = None
 
     @property
     def pusher_sequence(self) -> List[str]:

@@ -126,7 +126,8 @@ def plan_task(
     return Plan(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
                 message=_message(outcome, stats, bool(raw.ends_at_goal)), waypoints=waypoints, stats=stats,
                 final_hold_ratio=min(m.hold_ratio(last_q, last_pusher) for m in models),
-                uncertainty=dict(task.uncertainty), ends_at_goal=bool(raw.ends_at_goal))
+                uncertainty=dict(task.uncertainty), ends_at_goal=bool(raw.ends_at_goal),
+                task_identity=task.identity())
 
 
 def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:

@@ -4,7 +4,7 @@ file, or edited by hand, is refused (PlanError naming the waypoint)."""
 from __future__ import annotations
 
 import math
-from typing import Optional
+from typing import List, Optional
 
 from stablepush import _core
 from stablepush.errors import PlanError
@@ -79,3 +79,25 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
         if not model.grasp_maintained(q1):
             fail(f"waypoints[{i}]", "the pads leave the object at this pose")
     return plan
+
+
+def changes_since_planned(task: Task, plan: Plan) -> List[str]:
+    """What of `task` differs from the task `plan` was planned for (its recorded Task.identity),
+    as dotted field names (`goal`, `gripper.mu`, `pushers.left.mu`, `object.vertices`); empty when
+    nothing did, or when the plan file predates the record."""
+    if plan.task_identity is None:
+        return []
+    return _differences(plan.task_identity, task.identity(), "")
+
+
+def _differences(then, now, path: str) -> List[str]:
+    if isinstance(then, dict) and isinstance(now, dict):
+        out: List[str] = []
+        for key in sorted(set(then) | set(now)):
+            where = f"{path}.{key}" if path else key
+            if key not in then or key not in now:
+                out.append(where)
+            else:
+                out.extend(_differences(then[key], now[key], where))
+        return out
+    return [] if then == now else [path]

@@ -87,6 +87,26 @@ class Task:
         return dataclasses.replace(self, start=tuple(float(v) for v in start),
                                    feature_orientations={p: self.feature_angle(p) for p in self.pusher_names})
 
+    def identity(self) -> Dict[str, Any]:
+        """What a plan of this task rests on, as plain JSON values (file units): the object, the
+        pads, gravity and pushes, the pushers, the start and goal, the planner settings that bound
+        a plan (not its seed or time limit), the uncertainty box and where environment.features
+        hold the object. A plan file keeps it (docs/model.md section 5), so a plan whose task
+        changed since can say what changed (`stablepush.plan.verify.changes_since_planned`)."""
+        planner = {k: self.planner[k] for k in ("step", "tolerance", "max_switches", "min_margin", "min_hold_ratio")
+                   if k in self.planner}
+        return json_values({
+            "name": self.name,
+            "object": {"vertices": self.vertices, "thickness": self.thickness, "mass": self.mass, "com": self.com,
+                       "inertia": self.inertia},
+            "gripper": {"grip_force": self.grip_force, "mu": self.mu, "pad_rings": self.pad_rings, "pads": self.pads},
+            "gravity": self.gravity, "step_time": self.step_time, "pushes": self.pushes,
+            "friction_polygon_sides": self.friction_polygon_sides,
+            "pushers": {p.name: {"from": p.a, "to": p.b, "mu": p.mu} for p in self.pushers},
+            "start": self.start, "goal": self.goal, "planner": planner, "uncertainty": self.uncertainty,
+            "features": {name: self.feature_angle(name) for name in self.pusher_names},
+        })
+
     def at_goal(self, pose) -> bool:
         """Whether `pose` (x mm, z mm, theta deg) lies within planner.tolerance of the goal, in each
         coordinate."""
@@ -151,6 +171,19 @@ class Task:
             _core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
             [math.radians(self.feature_angle(p.name)) for p in self.pushers],
         )
+
+
+def json_values(value):
+    """`value` with tuples as lists and numbers as floats or ints, as JSON reads it back."""
+    if isinstance(value, dict):
+        return {str(k): json_values(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_values(v) for v in value]
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return value
+    if isinstance(value, int):
+        return int(value)
+    return float(value)
 
 
 def make_gripper(pads, grip_force: float, mu: float, pad_rings: int) -> "_core.Gripper":
