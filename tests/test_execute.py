@@ -160,8 +160,8 @@ class FakeArm:
     """An arm server that misbehaves after `good` acknowledgements, and records whether it was
     told to stop."""
 
-    def __init__(self, good: int, bad_reply):
-        self.good, self.bad_reply = good, bad_reply
+    def __init__(self, good: int, bad_reply, frozen: bool = False):
+        self.good, self.bad_reply, self.frozen = good, bad_reply, frozen  # frozen: always reports the home pose
         self.stopped = False
         self.sock = socket.create_server(("127.0.0.1", 0))
         self.port = self.sock.getsockname()[1]
@@ -178,7 +178,7 @@ class FakeArm:
                     state = {"ee_pose": msg["scene"]["gripper_pose"], "joints": [0.0] * 7}
                     conn.sendall(encode({"type": "ready", "protocol": PROTOCOL, "arm": "fake", "state": state}))
                 elif msg["type"] == "waypoint":
-                    state = {"ee_pose": msg["pose"], "joints": [0.0] * 7}
+                    state = state if self.frozen else {"ee_pose": msg["pose"], "joints": [0.0] * 7}
                     if msg["seq"] < self.good:
                         conn.sendall(encode({"type": "ack", "seq": msg["seq"], "state": state}))
                     else:
@@ -452,3 +452,14 @@ def test_engine_needs_the_simulated_arm(high_mu_plan):
     plan, task = high_mu_plan
     result = CliRunner().invoke(cli, ["execute", str(plan), "--task", str(task), "--engine", "drake"])
     assert result.exit_code == 2 and "--engine" in result.output
+
+
+def test_an_arm_that_never_moves_ends_the_run_in_a_fault_and_is_stopped():
+    """Issue 24, item 5: a fake arm whose acks always report the home pose got "steps 1-20 of 20
+    confirmed", exit 0. The executor now sees that it does not follow and stops it."""
+    task = shipped("horizontal-offset-high-mu")
+    arm = FakeArm(good=10**9, bad_reply=None, frozen=True)
+    with pytest.raises(ArmFault, match="not following") as fault:
+        execute_plan(task, check_plan(task, plan_task(task, seed=1)), "127.0.0.1", arm.port, rate_hz=100.0,
+                     pace=False)
+    assert arm.stopped and fault.value.last_confirmed_step < 20

@@ -32,6 +32,10 @@ DEFAULT_ACK_TIMEOUT = 5.0  # s to wait for any reply
 # Past this change in the grasp when the last feature lets go (mm, deg), the grasp alone does not
 # hold the final pose against gravity: ExecutionReport.release_moved.
 RELEASE_MOVE = (0.5, 0.5)
+# An arm whose reported pose stays this far from the commanded one (m, rad) for this many acks in
+# a row is not following the stream (a real arm lags by a fraction of a mm): the run ends in a fault.
+FOLLOW_LIMIT = (0.01, math.radians(5.0))
+FOLLOW_ACKS = 50
 
 
 def execution_warnings(task: Task) -> List[str]:
@@ -136,6 +140,13 @@ class ExecutionReport:
         }
 
 
+def _off_command(reported: Sequence[float], commanded: Sequence[float]) -> bool:
+    """Whether a reported pose of G is farther than FOLLOW_LIMIT from the commanded one."""
+    a, b = pose_to_matrix(reported), pose_to_matrix(commanded)
+    cos = max(-1.0, min(1.0, (np.trace(a[:3, :3].T @ b[:3, :3]) - 1) / 2))
+    return bool(np.linalg.norm(a[:3, 3] - b[:3, 3]) > FOLLOW_LIMIT[0] or math.acos(cos) > FOLLOW_LIMIT[1])
+
+
 class _Link:
     """The socket to the arm server: one JSON line at a time, each within the ack timeout."""
 
@@ -206,6 +217,7 @@ def execute_plan(
         state = ready["state"]
         settled: Optional[dict] = None
         sent = 0
+        lagging = 0  # acks in a row whose reported pose is off the commanded one
         next_time = time.perf_counter()
         while pending:
             w = pending.popleft()
@@ -221,6 +233,11 @@ def execute_plan(
             if w.phase == "push" and state is not None and touch_state is None:
                 touch_state = state  # the object as it came to rest on the feature
             state = reply["state"]
+            lagging = lagging + 1 if _off_command(state["ee_pose"], w.pose) else 0
+            if lagging >= FOLLOW_ACKS:
+                raise ProtocolError(f"the arm is not following: its reported pose stayed over "
+                                    f"{FOLLOW_LIMIT[0] * 1e3:g} mm or {math.degrees(FOLLOW_LIMIT[1]):g} deg from the "
+                                    f"commanded one for {FOLLOW_ACKS} waypoints (up to seq {w.seq})")
             if w.completes:
                 last_confirmed = w.step
                 _record(contacts, task, steps, features, w.step, touch_state, state)
