@@ -324,6 +324,20 @@ def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu
             first.sendall(_hello(scene))
             assert decode(first.makefile("rb").readline(), "server")["type"] == "ready"
             assert "busy" in exchange(b"")[-1]["message"]
+        # A client that half-closes after 20 waypoints (it kept the arm busy for about 28 s): the
+        # server ends its session at the end of what it sent, so the good client below is served.
+        from stablepush.execution.stream import arm_trajectory
+        from stablepush.execution.world import place_features
+
+        points = arm_trajectory(task, plan.waypoints, place_features(task, plan.waypoints), 100.0,
+                                scene["gripper_pose"])[:20]
+        with socket.create_connection((server.host, server.port), timeout=30) as half:
+            half.sendall(_hello(scene) + b"".join(
+                encode({"type": "waypoint", "seq": w.seq, "t": w.t, "step": w.step, "phase": w.phase,
+                        "pose": list(w.pose)}) for w in points))
+            half.shutdown(socket.SHUT_WR)
+            replies = [decode(line, "server") for line in half.makefile("rb")]
+            assert replies[0]["type"] == "ready" and [r["seq"] for r in replies[1:]] == list(range(20))
         time.sleep(0.2)
         report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
         assert report.last_confirmed_step == len(plan.waypoints) - 1 and report.final_error["distance"] < 0.5
