@@ -3,6 +3,10 @@ crash by signal fails the test instead of killing pytest).
 
     python3 tests/fuzz_cli.py tasks N SEED SCRATCH    # N mutated task files: plan, and check every 4th
     python3 tests/fuzz_cli.py plans N SEED SCRATCH    # N mutated plan files of the shipped tasks: show
+    python3 tests/fuzz_cli.py meshes N SEED SCRATCH   # N generated meshes (holes, two bodies, flat, huge,
+                                                      # damaged; STL, OBJ, PLY, OFF): plan
+    python3 tests/fuzz_cli.py semantics N SEED SCRATCH  # N valid plans that do not fit their task
+                                                        # (short, reversed, other goal or model): trajectory
 
 Each case runs the CLI in this process (click's CliRunner) and must end with exit status 0, 1 or
 2; a refusal (2) is one line on stderr starting "error:" (besides "warning:" lines); no
@@ -15,6 +19,7 @@ from __future__ import annotations
 import collections
 import copy
 import json
+import math
 import random
 import sys
 import time
@@ -141,9 +146,107 @@ def run_plans(count: int, seed: int, scratch: Path):
         yield f"plan {case} of {path.name}", ["show", str(plan_file), "--task", str(path), "-o", str(scratch / "out.png")], text
 
 
+def _mesh(rng: random.Random):
+    """A generated solid, good or hostile: a box, a cylinder or a washer (a hole), two bodies, a
+    flat or a huge one, or a solid with faces missing; with the x of its left side at z = 0 (mm)."""
+    import numpy as np
+    import trimesh
+
+    kind = rng.choice(["box", "cylinder", "washer", "two", "flat", "huge", "open"])
+    turn = trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0])
+    if kind == "cylinder":
+        radius = rng.uniform(5, 40)
+        solid = trimesh.creation.cylinder(radius=radius, height=rng.uniform(5, 40), sections=32)
+        solid.apply_transform(turn)
+        return kind, solid, -radius
+    if kind == "washer":
+        radius = rng.uniform(12, 40)
+        solid = trimesh.creation.annulus(r_min=rng.uniform(2, 10), r_max=radius, height=10.0, sections=32)
+        solid.apply_transform(turn)
+        return kind, solid, -radius
+    if kind == "two":
+        a, b = trimesh.creation.box([40, 25, 40]), trimesh.creation.box([40, 25, 40])
+        b.apply_translation([rng.choice([45, 500]), 0, 0])
+        return kind, trimesh.util.concatenate([a, b]), -20.0
+    else:
+        size = {"box": [rng.uniform(10, 80), rng.uniform(5, 40), rng.uniform(10, 80)], "flat": [40, 1e-4, 40],
+                "huge": [4e6, 25, 40], "open": [60, 25, 40]}[kind]
+        solid = trimesh.creation.box(size)
+        if kind == "open":
+            solid.update_faces(np.arange(len(solid.faces)) != 0)
+    return kind, solid, -size[0] / 2
+
+
+def run_meshes(count: int, seed: int, scratch: Path):
+    """Generated meshes in every format the task files take (and garbage bytes), planned."""
+    rng = random.Random(seed)
+    for case in range(count):
+        kind, solid, left = _mesh(rng)
+        fmt = rng.choice(["stl", "obj", "ply", "off"])
+        mesh_file = scratch / f"case.{fmt}"
+        data = solid.export(file_type=fmt)
+        data = data.encode() if isinstance(data, str) else data
+        if rng.random() < 0.15:  # truncated or garbage
+            data = data[: rng.randrange(len(data) + 1)] if rng.random() < 0.5 else bytes(rng.randrange(256)
+                                                                                           for _ in range(200))
+            kind += " damaged"
+        mesh_file.write_bytes(data)
+        obj = {"shape": "mesh", "file": mesh_file.name, rng.choice(["mass", "density"]): rng.choice([100, 2.7, 1e-3])}
+        if rng.random() < 0.3:
+            obj["scale"] = rng.choice([1e-3, 1.0, 1000.0, 1e-6])
+        if rng.random() < 0.3:
+            obj["plane_y"] = rng.choice([0.0, 5.0, -100.0, 1e9])
+        task = {"name": "fuzz-mesh", "object": obj, "gripper": {"grip_force": 10, "mu": 0.5},
+                "pushers": [{"name": "left", "from": [left, -1.0], "to": [left, 1.0], "mu": 0.5}],
+                "start": [0, 0, 0], "goal": [3, 0, 0]}
+        text = yaml.safe_dump(task)
+        path = scratch / "case.yaml"
+        path.write_text(text)
+        yield f"mesh {case} ({kind}, {fmt})", ["plan", str(path), "--time-limit", "0.02", "-o",
+                                                str(scratch / "out.plan.json"), "--quiet"], text
+
+
+def run_semantics(count: int, seed: int, scratch: Path):
+    """Valid plan files that do not fit their task: cut short, reversed, made for another goal or
+    another model, with alternating pushers; given to trajectory (the arm's stream)."""
+    import dataclasses
+
+    from stablepush.plan import plan_task
+    from stablepush.plan.files import plan_to_dict
+    from stablepush.task import load_task
+
+    rng = random.Random(seed)
+    made = [(path, load_task(path)) for path in TASKS[:5]]
+    made = [(path, task, plan_task(task, seed=1)) for path, task in made]
+    for case in range(count):
+        path, task, plan = rng.choice(made)
+        how = rng.choice(["short", "reversed", "other-goal", "other-model", "alternating"])
+        steps = list(plan.waypoints)
+        if how == "short":
+            steps = steps[: rng.randrange(1, len(steps))]
+        elif how == "reversed":
+            steps = steps[::-1]
+        elif how == "alternating" and len(task.pushers) > 1:
+            names = task.pusher_names
+            steps = steps[:1] + [dataclasses.replace(w, pusher=names[i % 2]) for i, w in enumerate(steps[1:])]
+        edited = plan
+        if how == "other-goal":
+            edited = plan_task(dataclasses.replace(task, goal=(task.goal[0] - 3, task.goal[1], task.goal[2])), seed=1)
+            steps = list(edited.waypoints)
+        if how == "other-model":
+            edited = plan_task(dataclasses.replace(task, mu=task.mu * 2), seed=1)
+            steps = list(edited.waypoints)
+        text = json.dumps(plan_to_dict(dataclasses.replace(edited, waypoints=steps)))
+        plan_file = scratch / "case.plan.json"
+        plan_file.write_text(text)
+        yield (f"plan {case} of {path.name} ({how})",
+               ["trajectory", str(plan_file), "--task", str(path), "-o", str(scratch / "out.csv")], text[:2000])
+
+
 def main() -> None:
     kind, count, seed, scratch = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), Path(sys.argv[4])
-    cases = run_tasks(count, seed, scratch) if kind == "tasks" else run_plans(count, seed, scratch)
+    cases = {"tasks": run_tasks, "plans": run_plans, "meshes": run_meshes, "semantics": run_semantics}[kind](
+        count, seed, scratch)
     runner = CliRunner()
     statuses, failures, slowest = collections.Counter(), [], (0.0, "")
     for label, args, content in cases:

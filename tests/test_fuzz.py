@@ -1,6 +1,7 @@
-"""Hostile inputs, fuzzed: 2,000 mutated task files and 200 mutated plan files per run, each given
-to the CLI (tests/fuzz_cli.py), in child processes with a memory cap, so that a crash by signal or
-a runaway allocation fails here instead of taking pytest down."""
+"""Hostile inputs, fuzzed: 2,000 mutated task files, 200 mutated plan files, 120 generated meshes
+and 80 plans that do not fit their task per run, each given to the CLI (tests/fuzz_cli.py), in
+child processes with a memory cap, so that a crash by signal or a runaway allocation fails here
+instead of taking pytest down."""
 import json
 import resource
 import subprocess
@@ -33,3 +34,19 @@ def test_mutated_task_and_plan_files_get_exit_0_1_or_2_with_one_line(tmp_path):
         assert set(summary["exit_statuses"]) <= {"0", "1", "2"}
         # Bounded time per case (a hang guard, not a speed target): planning is limited to 0.02 s.
         assert summary["slowest_s"] < 20.0, summary
+
+
+def test_generated_meshes_and_plans_that_do_not_fit_their_task_get_one_line(tmp_path):
+    """The campaign's new surfaces (issue 24): generated meshes (holes, two bodies, flat, huge,
+    damaged bytes; STL, OBJ, PLY, OFF) planned, and valid plan files cut short, reversed or made for
+    another goal or model, given to trajectory."""
+    for kind, count in (("meshes", 120), ("semantics", 80)):
+        scratch = tmp_path / kind
+        scratch.mkdir()
+        worker = subprocess.run([sys.executable, str(FUZZ), kind, str(count), "2026", str(scratch)],
+                                capture_output=True, text=True, preexec_fn=_cap_memory, timeout=900)
+        assert worker.returncode == 0, f"{kind} worker died ({worker.returncode}): {worker.stderr[-2000:]}"
+        summary = json.loads(worker.stdout.strip().splitlines()[-1])
+        assert summary["failure_count"] == 0, summary["failures"]
+        assert summary["cases"] == count and set(summary["exit_statuses"]) <= {"0", "1", "2"}
+        assert summary["exit_statuses"].get("2", 0) > 0  # the hostile ones were refused
