@@ -371,8 +371,11 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
 @click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
 @click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
               help="The task the plan was made for (checked against the plan).")
-@click.option("-o", "--output", "out_path", required=True, type=click.Path(dir_okay=False), metavar="TRAJ.csv|.json",
-              help="Where to write the trajectory: CSV (a header, one row per sample) or JSON (columns and rows).")
+@click.option("-o", "--output", "out_path", required=True, type=click.Path(dir_okay=False),
+              metavar="TRAJ.csv|.json|.mcap",
+              help="Where to write the trajectory: CSV (a header, one row per sample), JSON (columns and rows), or a "
+                   "ROS 2 bag in one MCAP file (/tf, the gripper's pose and twist, phase, step and the scene as "
+                   "markers; README, 'ROS 2 bags').")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
               metavar="HZ", help="Samples per second (the executor streams at this rate).")
 @click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default="xyzw", show_default=True,
@@ -390,15 +393,21 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
     Example:
       stablepush plan data/tasks/t-shaped.yaml -o t.plan.json
       stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.traj.csv
+      stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.mcap   # ros2 bag play, Foxglove
     """
     from stablepush.execution import timed_trajectory
     from stablepush.outputs import write_atomically
 
-    if not out_path.endswith((".csv", ".json")):
-        _fail(f"-o {out_path}: the file name must end in .csv or .json")
+    if not out_path.endswith((".csv", ".json", ".mcap")):
+        _fail(f"-o {out_path}: the file name must end in .csv, .json or .mcap")
     task, plan = _load_plan_and_task(plan_file, task_file)
     traj = timed_trajectory(task, plan, rate_hz)
-    write_atomically(out_path, traj.to_json(quat) if out_path.endswith(".json") else traj.to_csv(quat))
+    if out_path.endswith(".mcap"):
+        from stablepush.execution.bags import write_bag
+
+        write_bag(out_path, task, plan, traj)
+    else:
+        write_atomically(out_path, traj.to_json(quat) if out_path.endswith(".json") else traj.to_csv(quat))
     click.echo(f"{task.name}: {len(traj)} samples at {rate_hz:g} Hz, {traj.t[-1]:.2f} s, "
                f"{len(plan.waypoints) - 1} pushes; written to {out_path}")
 

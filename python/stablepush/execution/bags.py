@@ -1,0 +1,175 @@
+"""A plan's trajectory as a ROS 2 bag (rosbag2, MCAP storage; written by the `rosbags` library),
+for robot stacks, `ros2 bag play` and Foxglove (`stablepush trajectory PLAN --task TASK -o X.mcap`).
+
+Frames: `world` (W: x forward, y the gripping axis at home, z up), `gripper` (G, between the
+pads), `object` (O, the task's object frame). Each message is stamped with its trajectory time t
+(s from the start of the stream), as the executor streams it. Topics, one message per trajectory
+sample unless said:
+- `/tf` (tf2_msgs/msg/TFMessage): world -> gripper, and gripper -> object: the object's pose in
+  the grasp (the plan's pose at the last step reached; during a push, where the feature holds it);
+- `/stablepush/gripper_pose` (geometry_msgs/msg/PoseStamped, in world): the CSV's row;
+- `/stablepush/gripper_twist` (geometry_msgs/msg/TwistStamped, in world): its velocity;
+- `/stablepush/phase` (std_msgs/msg/String): push, settle, retract, move or approach;
+- `/stablepush/step` (std_msgs/msg/Int32): the plan step (the one a push heads for);
+- `/stablepush/scene` (visualization_msgs/msg/MarkerArray), once at t = 0: the object's outline
+  extruded to its thickness (in object), the pads (in gripper) and each feature's contact segment
+  at its world pose (in world).
+Units: m, s, rad; quaternions x, y, z, w.
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Sequence, Union
+
+import numpy as np
+
+from stablepush.errors import OutputError
+from stablepush.execution.trajectory import Trajectory
+from stablepush.execution.world import place_features
+from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix
+from stablepush.plan.plan import Plan
+from stablepush.task.model import Task
+from stablepush.units import MM
+
+WORLD, GRIPPER, OBJECT = "world", "gripper", "object"
+TOPICS = {
+    "/tf": "tf2_msgs/msg/TFMessage",
+    "/stablepush/gripper_pose": "geometry_msgs/msg/PoseStamped",
+    "/stablepush/gripper_twist": "geometry_msgs/msg/TwistStamped",
+    "/stablepush/phase": "std_msgs/msg/String",
+    "/stablepush/step": "std_msgs/msg/Int32",
+    "/stablepush/scene": "visualization_msgs/msg/MarkerArray",
+}
+
+
+def object_in_gripper(task: Task, plan: Plan, trajectory: Trajectory) -> np.ndarray:
+    """T_GO (n x 4 x 4, m) at each sample: during a push the object rests on its feature (T_WO
+    fixed), elsewhere it is held at the pose of the last plan step reached."""
+    steps = list(plan.waypoints)
+    features = place_features(task, steps)
+    out = np.empty((len(trajectory), 4, 4))
+    for i in range(len(trajectory)):
+        step = int(trajectory.step[i])
+        if trajectory.phase[i] == "push":
+            T_WG = pose_to_matrix([*trajectory.position[i], *trajectory.quaternion_wxyz[i]])
+            out[i] = np.linalg.inv(T_WG) @ features[steps[step].pusher].object_pose
+        else:
+            out[i] = grasp_transform(steps[step].pose)
+    return out
+
+
+def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajectory) -> None:
+    """Write the trajectory of `plan` (checked against `task`) as one MCAP file at `path`."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    T = store.types
+    path = Path(path)
+    T_GO = object_in_gripper(task, plan, trajectory)
+    with tempfile.TemporaryDirectory(dir=path.parent if path.parent.exists() else None) as scratch:
+        bag = Path(scratch) / "bag"
+        with Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
+            connections = {topic: writer.add_connection(topic, kind, typestore=store) for topic, kind in TOPICS.items()}
+
+            def write(topic: str, stamp_ns: int, message) -> None:
+                writer.write(connections[topic], stamp_ns, store.serialize_cdr(message, TOPICS[topic]))
+
+            write("/stablepush/scene", 0, T["visualization_msgs/msg/MarkerArray"](
+                markers=_scene_markers(T, task, plan)))
+            for i in range(len(trajectory)):
+                ns = int(round(float(trajectory.t[i]) * 1e9))
+                stamp = _time(T, ns)
+                pose = _pose(T, trajectory.position[i], trajectory.quaternion_wxyz[i])
+                held = matrix_to_pose(T_GO[i])
+                write("/tf", ns, T["tf2_msgs/msg/TFMessage"](transforms=[
+                    _transform(T, stamp, WORLD, GRIPPER, trajectory.position[i], trajectory.quaternion_wxyz[i]),
+                    _transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:])]))
+                write("/stablepush/gripper_pose", ns, T["geometry_msgs/msg/PoseStamped"](
+                    header=_header(T, stamp, WORLD), pose=pose))
+                write("/stablepush/gripper_twist", ns, T["geometry_msgs/msg/TwistStamped"](
+                    header=_header(T, stamp, WORLD), twist=T["geometry_msgs/msg/Twist"](
+                        linear=_vector3(T, trajectory.linear_velocity[i]),
+                        angular=_vector3(T, trajectory.angular_velocity[i]))))
+                write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=trajectory.phase[i]))
+                write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(trajectory.step[i])))
+        try:
+            os.replace(bag / "bag.mcap", path)
+        except OSError as exc:
+            raise OutputError(str(path), f"cannot write the bag ({exc.strerror or exc})") from None
+
+
+# -- messages ---------------------------------------------------------------------------------
+
+
+def _time(T, ns: int):
+    return T["builtin_interfaces/msg/Time"](sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+
+
+def _header(T, stamp, frame: str):
+    return T["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
+
+
+def _vector3(T, v: Sequence[float]):
+    return T["geometry_msgs/msg/Vector3"](x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+
+def _quaternion(T, q_wxyz: Sequence[float]):
+    return T["geometry_msgs/msg/Quaternion"](x=float(q_wxyz[1]), y=float(q_wxyz[2]), z=float(q_wxyz[3]),
+                                             w=float(q_wxyz[0]))
+
+
+def _pose(T, p: Sequence[float], q_wxyz: Sequence[float]):
+    return T["geometry_msgs/msg/Pose"](position=T["geometry_msgs/msg/Point"](x=float(p[0]), y=float(p[1]),
+                                                                             z=float(p[2])),
+                                       orientation=_quaternion(T, q_wxyz))
+
+
+def _transform(T, stamp, parent: str, child: str, p, q_wxyz):
+    return T["geometry_msgs/msg/TransformStamped"](
+        header=_header(T, stamp, parent), child_frame_id=child,
+        transform=T["geometry_msgs/msg/Transform"](translation=_vector3(T, p), rotation=_quaternion(T, q_wxyz)))
+
+
+def _marker(T, ident: int, frame: str, kind: int, points, scale, colour, pose=None):
+    Marker = T["visualization_msgs/msg/Marker"]
+    return Marker(
+        header=_header(T, _time(T, 0), frame), ns="stablepush", id=ident, type=kind, action=Marker.ADD,
+        pose=pose or _pose(T, (0, 0, 0), (1, 0, 0, 0)), scale=_vector3(T, scale),
+        color=T["std_msgs/msg/ColorRGBA"](r=colour[0], g=colour[1], b=colour[2], a=1.0),
+        lifetime=T["builtin_interfaces/msg/Duration"](sec=0, nanosec=0), frame_locked=True,
+        points=[T["geometry_msgs/msg/Point"](x=float(x), y=float(y), z=float(z)) for x, y, z in points],
+        colors=[], texture_resource="", texture=T["sensor_msgs/msg/CompressedImage"](
+            header=_header(T, _time(T, 0), ""), format="", data=np.zeros(0, np.uint8)),
+        uv_coordinates=[], text="", mesh_resource="",
+        mesh_file=T["visualization_msgs/msg/MeshFile"](filename="", data=np.zeros(0, np.uint8)),
+        mesh_use_embedded_materials=False)
+
+
+def _scene_markers(T, task: Task, plan: Plan) -> list:
+    """The object's outline extruded to its thickness (LINE_LIST in object), the pads (CYLINDER
+    in gripper, axis along y) and each feature's contact segment (LINE_LIST in world)."""
+    Marker = T["visualization_msgs/msg/Marker"]
+    half = task.thickness * MM / 2
+    outline = [(x * MM, z * MM) for x, z in task.vertices]
+    edges = []
+    for (x0, z0), (x1, z1) in zip(outline, outline[1:] + outline[:1]):
+        for y in (-half, half):
+            edges += [(x0, y, z0), (x1, y, z1)]
+        edges += [(x0, -half, z0), (x0, half, z0)]
+    markers = [_marker(T, 0, OBJECT, Marker.LINE_LIST, edges, (0.0005, 0, 0), (0.85, 0.55, 0.25))]
+    along_y = (np.sqrt(0.5), np.sqrt(0.5), 0.0, 0.0)  # the cylinder's z axis turned onto y
+    for k, ((cx, cz), r) in enumerate(task.pads):  # pad k on the finger at +y when k is even
+        y = half if k % 2 == 0 else -half
+        markers.append(_marker(T, 1 + k, GRIPPER, Marker.CYLINDER, [], (2 * r * MM, 2 * r * MM, 0.002),
+                               (0.2, 0.2, 0.2), pose=_pose(T, (cx * MM, y, cz * MM), along_y)))
+    for k, feature in enumerate(place_features(task, list(plan.waypoints)).values()):
+        if np.allclose(feature.start, feature.end):  # a point pusher: a peg
+            markers.append(_marker(T, 100 + k, WORLD, Marker.SPHERE, [], (0.004, 0.004, 0.004), (0.3, 0.5, 0.8),
+                                   pose=_pose(T, feature.start, (1, 0, 0, 0))))
+        else:
+            markers.append(_marker(T, 100 + k, WORLD, Marker.LINE_LIST, [feature.start, feature.end],
+                                   (0.003, 0, 0), (0.3, 0.5, 0.8)))
+    return markers

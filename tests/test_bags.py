@@ -1,0 +1,99 @@
+"""ROS 2 bags of a plan's trajectory (stablepush.execution.bags), read back with rosbags' own
+reader: every topic with its message type, one message per trajectory sample stamped with its
+time, the gripper's pose equal to the CSV's row, and /tf putting the object where the plan has it
+(in the grasp between pushes, fixed on its feature during one)."""
+import csv
+import io
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_typestore
+
+from stablepush.execution import timed_trajectory
+from stablepush.execution.bags import TOPICS
+from stablepush.execution.world import place_features
+from stablepush.frames import grasp_transform, pose_to_matrix
+from stablepush.plan import check_plan, plan_task
+from stablepush_cli.main import cli
+
+from conftest import TASKS, shipped
+
+STORE = get_typestore(Stores.ROS2_HUMBLE)
+
+
+def _matrix(transform) -> np.ndarray:
+    t, q = transform.translation, transform.rotation
+    return pose_to_matrix([t.x, t.y, t.z, q.w, q.x, q.y, q.z])
+
+
+@pytest.fixture(scope="module")
+def t_bag(tmp_path_factory):
+    scratch = tmp_path_factory.mktemp("bag")
+    task_file = str(TASKS / "t-shaped.yaml")
+    plan, bag, table = scratch / "t.plan.json", scratch / "t.mcap", scratch / "t.csv"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["plan", task_file, "-o", str(plan), "--quiet"]).exit_code == 0
+    for out in (bag, table):
+        result = runner.invoke(cli, ["trajectory", str(plan), "--task", task_file, "-o", str(out)])
+        assert result.exit_code == 0, result.output
+    messages = {}
+    with Reader(bag) as reader:
+        kinds = {c.topic: c.msgtype for c in reader.connections}
+        for connection, stamp, raw in reader.messages():
+            messages.setdefault(connection.topic, []).append((stamp, STORE.deserialize_cdr(raw, connection.msgtype)))
+    rows = list(csv.DictReader(io.StringIO(table.read_text())))
+    return kinds, messages, rows
+
+
+def test_every_topic_is_there_with_its_type_and_a_message_per_sample(t_bag):
+    kinds, messages, rows = t_bag
+    assert kinds == TOPICS
+    for topic in TOPICS:
+        assert len(messages[topic]) == (1 if topic == "/stablepush/scene" else len(rows)), topic
+    stamps = [stamp for stamp, _ in messages["/stablepush/gripper_pose"]]
+    assert stamps == [round(float(r["t"]) * 1e9) for r in rows]
+    assert [m.data for _, m in messages["/stablepush/phase"]] == [r["phase"] for r in rows]
+    assert [m.data for _, m in messages["/stablepush/step"]] == [int(r["step"]) for r in rows]
+    markers = messages["/stablepush/scene"][0][1].markers
+    frames = {m.header.frame_id for m in markers}
+    task = shipped("t-shaped")
+    assert frames == {"object", "gripper", "world"}
+    assert len(markers) == 1 + len(task.pads) + 2  # the outline, each pad, the features of left and under-web
+
+
+def test_the_gripper_pose_is_the_csv_row(t_bag):
+    _, messages, rows = t_bag
+    for (_, msg), row in zip(messages["/stablepush/gripper_pose"], rows):
+        p, q = msg.pose.position, msg.pose.orientation
+        assert [p.x, p.y, p.z, q.x, q.y, q.z, q.w] == pytest.approx(
+            [float(row[k]) for k in ("x", "y", "z", "qx", "qy", "qz", "qw")], abs=1e-12)
+        assert msg.header.frame_id == "world"
+
+
+def test_tf_puts_the_object_in_the_grasp_and_on_its_feature(t_bag):
+    """Between pushes the object's pose in the grasp is the plan's at the last step; during a
+    push the object stays where its feature holds it in the world."""
+    _, messages, rows = t_bag
+    task = shipped("t-shaped")
+    plan = check_plan(task, plan_task(task, seed=1))
+    features = place_features(task, list(plan.waypoints))
+    for (_, tf), row in zip(messages["/tf"], rows):
+        (to_gripper, to_object) = tf.transforms
+        assert (to_gripper.header.frame_id, to_gripper.child_frame_id) == ("world", "gripper")
+        assert (to_object.header.frame_id, to_object.child_frame_id) == ("gripper", "object")
+        step = plan.waypoints[int(row["step"])]
+        if row["phase"] == "push":
+            T_WO = _matrix(to_gripper.transform) @ _matrix(to_object.transform)
+            assert np.allclose(T_WO, features[step.pusher].object_pose, atol=1e-9)
+        else:
+            assert np.allclose(_matrix(to_object.transform), grasp_transform(step.pose), atol=1e-9)
+
+
+def test_a_bag_needs_a_checked_plan(tmp_path):
+    result = CliRunner().invoke(cli, ["trajectory", str(tmp_path / "none.json"), "--task",
+                                      str(TASKS / "t-shaped.yaml"), "-o", str(tmp_path / "x.mcap")])
+    assert result.exit_code == 2 and not (tmp_path / "x.mcap").exists()
+    assert len(timed_trajectory(shipped("t-shaped"), check_plan(shipped("t-shaped"),
+                                                                plan_task(shipped("t-shaped"), seed=1)))) > 0
