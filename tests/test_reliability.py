@@ -522,3 +522,17 @@ def test_a_hand_edited_task_record_and_an_old_plan_file(tmp_path):
     Path(plan).write_text(json.dumps(data))
     result = CliRunner().invoke(cli, ["show", plan, "--task", task, "-o", str(tmp_path / "p.png")])
     assert result.exit_code == 0 and "changed since" not in result.output
+
+
+@pytest.mark.parametrize("key, value, says", [("min_margin", 1.0, "planner.min_margin"),
+                                              ("min_hold_ratio", 5.0, "planner.min_hold_ratio")])
+def test_check_plan_holds_a_plan_to_the_tasks_min_margin_and_min_hold_ratio(key, value, says):
+    """Issue 24, item 4: min_margin and min_hold_ratio were not checked against a plan."""
+    import dataclasses
+
+    task = shipped("horizontal-offset-high-mu")
+    plan = plan_task(task, seed=1)
+    check_plan(task, plan)
+    stricter = dataclasses.replace(task, planner={**task.planner, key: value})
+    with pytest.raises(PlanError, match=says):
+        check_plan(stricter, plan)

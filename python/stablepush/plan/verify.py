@@ -18,15 +18,17 @@ START_SLACK = 1e-6  # mm or deg: the plan's start against the task's
 
 
 MAX_SWITCHES = int(PLANNER_PARAMETER_RANGES["max_switches"][2])
+MARGIN_SLACK = 1e-9  # N (and weights): the re-check's rounding against the planner's own test
 
 
 def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_solved: bool = True) -> Plan:
     """`plan`, once it is shown to belong to `task`: solved and ending within the task's tolerance of
     its goal, for the same task name and start, with pushers the task has, no step longer than the
     task's unit step, and every push a stable push of this task (at every corner of its uncertainty
-    box, when it has one) with the pads inside the object. PlanError names what differs (`source`: the
-    plan file, for the message). `require_solved=False` lets an unsolved (partial) plan through,
-    for drawing it."""
+    box, when it has one) with the pads inside the object, each push's margin at least the task's
+    min_margin and, solved, the pads holding min_hold_ratio times the weight at its end. PlanError
+    names what differs (`source`: the plan file, for the message). `require_solved=False` lets an
+    unsolved (partial) plan through, for drawing it."""
     def fail(field: str, reason: str):
         raise PlanError(field, reason, source)
 
@@ -58,6 +60,7 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
              f"the plan ends at {[round(v, 3) for v in end]}, not within planner.tolerance "
              f"{task.planner['tolerance']} of the task's goal {list(task.goal)}: made for another goal, or cut short?")
     unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
+    min_margin = float(task.planner.get("min_margin", 0.0))
     model = task.build_model()
     # With an uncertainty box every push must be stable at each corner, as the planner made it.
     corners = task.corner_models() if task.uncertainty else None
@@ -76,8 +79,19 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
         if not verdict.feasible:
             fail(f"waypoints[{i}]", f"the push by {pusher!r} is not a stable push for this task "
                                     f"(margin {verdict.margin:+.4f} N); was the plan made for another version of it?")
+        if verdict.margin < min_margin - MARGIN_SLACK:
+            fail(f"waypoints[{i}]", f"the push by {pusher!r} has a margin of {verdict.margin:.4f} N, under the "
+                                    f"task's planner.min_margin {min_margin:g} N")
         if not model.grasp_maintained(q1):
             fail(f"waypoints[{i}]", "the pads leave the object at this pose")
+    min_hold = float(task.planner.get("min_hold_ratio", 0.0))
+    if require_solved and min_hold > 0 and len(waypoints) > 1:
+        q, last = pose_to_si(waypoints[-1].pose), task.pusher_index(waypoints[-1].pusher)
+        held = min(m.hold_ratio(q, last) for m in (corners or [model]))
+        if held < min_hold - MARGIN_SLACK:
+            fail(f"waypoints[{len(waypoints) - 1}]",
+                 f"the pads hold {held:.3f} times the object's weight at the plan's end, under the task's "
+                 f"planner.min_hold_ratio {min_hold:g}")
     return plan
 
 
