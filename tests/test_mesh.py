@@ -119,12 +119,10 @@ def test_several_bodies_are_refused(tmp_path):
     assert error.value.field == "object.file"
 
 
-def test_a_section_in_two_pieces_is_refused(tmp_path):
-    """One body (a U) cut across both its arms: the model would keep one arm's outline."""
-    u = [(-30, -5), (30, -5), (30, 35), (20, 35), (20, 5), (-20, 5), (-20, 35), (-30, 35)]  # in x, y
-    cap = [(0, 1, 4), (0, 4, 5), (1, 2, 3), (1, 3, 4), (0, 5, 6), (0, 6, 7)]  # the U in triangles, by hand
-    n = len(u)
-    vertices = [(x, y, 0.0) for x, y in u] + [(x, y, 40.0) for x, y in u]  # extruded along z
+def _extruded(outline, cap, height):
+    """A polygon in x, y (its triangles given) extruded along z: one closed body."""
+    n = len(outline)
+    vertices = [(x, y, 0.0) for x, y in outline] + [(x, y, height) for x, y in outline]
     faces = [(a, c, b) for a, b, c in cap] + [(a + n, b + n, c + n) for a, b, c in cap]
     for i in range(n):
         j = (i + 1) % n
@@ -132,6 +130,27 @@ def test_a_section_in_two_pieces_is_refused(tmp_path):
     solid = trimesh.Trimesh(vertices, faces)
     solid.fix_normals()
     assert solid.is_watertight and solid.body_count == 1
+    return solid
+
+
+def test_a_flanged_part_gripped_on_its_shaft_is_warned_about(tmp_path):
+    """A flanged bushing gripped across its 20 mm shaft was modelled, silently, as a slab of the
+    flange's 36 mm."""
+    profile = [(-20, -10), (20, -10), (20, -18), (26, -18), (26, 18), (20, 18), (20, 10), (-20, 10)]  # x, y
+    cap = [(0, 1, 6), (0, 6, 7), (1, 2, 3), (1, 3, 4), (1, 4, 6), (6, 4, 5)]
+    _extruded(profile, cap, 20.0).export(tmp_path / "bushing.stl")
+    obj = load_mesh_object(tmp_path / "bushing.stl", "object", mass=50.0)
+    assert obj.thickness == pytest.approx(36.0)
+    (note,) = obj.notes
+    assert "20 mm thick across the grasp" in note and "slab of 36 mm" in note
+    assert not load_mesh_object(_cylinder(tmp_path), "object", mass=10.0).notes  # a disc: the same everywhere
+
+
+def test_a_section_in_two_pieces_is_refused(tmp_path):
+    """One body (a U) cut across both its arms: the model would keep one arm's outline."""
+    u = [(-30, -5), (30, -5), (30, 35), (20, 35), (20, 5), (-20, 5), (-20, 35), (-30, 35)]  # in x, y
+    cap = [(0, 1, 4), (0, 4, 5), (1, 2, 3), (1, 3, 4), (0, 5, 6), (0, 6, 7)]  # the U in triangles, by hand
+    solid = _extruded(u, cap, 40.0)
     solid.export(tmp_path / "u.stl")
     with pytest.raises(TaskError, match="2 separate pieces") as error:
         load_mesh_object(tmp_path / "u.stl", "object", mass=10.0, plane_y=25.0)

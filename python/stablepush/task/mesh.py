@@ -22,6 +22,8 @@ G_PER_CM3 = 1e-3  # g/mm^3 per g/cm^3
 # only: others pull in optional readers (3MF needs lxml) or archives that expand past any cap.
 MAX_MESH_BYTES = 64_000_000
 MESH_FORMATS = ("stl", "obj", "ply", "off")
+# A solid thinner than this fraction under its full extent somewhere across the grasp is noted.
+THICKNESS_VARIATION = 0.1
 
 
 @dataclass(frozen=True)
@@ -34,6 +36,7 @@ class MeshObject:
     com: Tuple[float, float]  # mm: the solid's centre of mass (x, z)
     inertia: float  # kg m^2: the solid's moment about y through its centre of mass
     section_vertices: int  # before simplification
+    notes: Tuple[str, ...] = ()  # legal but probably not meant (each names its field)
 
 
 def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Optional[float] = None,
@@ -113,5 +116,34 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
                                               f"at most {max_vertices} (a larger tolerance)")
     mesh.density = grams / volume  # g/mm^3, so moment_inertia is in g mm^2
     inertia = float(mesh.moment_inertia[1, 1]) * 1e-9  # g mm^2 -> kg m^2
+    notes = []
+    thinnest = _thinnest_across(mesh, simple, low, high)
+    if thinnest is not None and thinnest[0] < (1 - THICKNESS_VARIATION) * thickness:
+        t, (x, z) = thinnest
+        notes.append(f"{field}.file: the solid is {t:.3g} mm thick across the grasp at (x, z) = ({x:.3g}, {z:.3g}) "
+                     f"mm but {thickness:.3g} mm overall; the model takes a slab of {thickness:.3g} mm (the pads "
+                     f"press on its two faces)")
     return MeshObject(vertices=vertices, thickness=thickness, mass=float(grams),
-                      com=(float(com[0]), float(com[2])), inertia=inertia, section_vertices=raw)
+                      com=(float(com[0]), float(com[2])), inertia=inertia, section_vertices=raw, notes=tuple(notes))
+
+
+def _thinnest_across(mesh, section, low: float, high: float, grid: int = 9):
+    """The least extent along y (mm) of the solid over a grid of points inside the section, and
+    where: rays along +y through the solid (trimesh, with rtree)."""
+    from shapely.geometry import Point
+
+    x0, z0, x1, z1 = section.bounds
+    points = [(x, z) for x in np.linspace(x0, x1, grid + 2)[1:-1] for z in np.linspace(z0, z1, grid + 2)[1:-1]
+              if section.contains(Point(x, z))]
+    if not points:
+        return None
+    origins = np.array([(x, low - 1.0, z) for x, z in points])
+    hits, rays, _ = mesh.ray.intersects_location(origins, np.tile([0.0, 1.0, 0.0], (len(points), 1)))
+    best = None
+    for k, (x, z) in enumerate(points):
+        ys = hits[rays == k][:, 1]
+        if len(ys) >= 2:
+            extent = float(ys.max() - ys.min())
+            if best is None or extent < best[0]:
+                best = (extent, (x, z))
+    return best

@@ -300,7 +300,8 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     top = _mapping("", data, ["object", "gripper", "pushers", "start", "goal"],
                    ["name", "gravity", "dynamics", "planner", "environment", "uncertainty"])
     name = _name("name", top["name"]) if "name" in top else _default_name(source)
-    vertices, thickness, mass, com, inertia = _validate_object(top["object"], source)
+    notes: List[str] = []
+    vertices, thickness, mass, com, inertia = _validate_object(top["object"], source, notes)
 
     vertices_m = [mm2_to_si(v) for v in vertices]
     section_defect = _core.CrossSection.defect(vertices_m)
@@ -338,7 +339,6 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     sides = _integer("dynamics.friction_polygon_sides", dyn.get("friction_polygon_sides", DEFAULT_POLYGON_SIDES), 3,
                      MAX_POLYGON_SIDES)
 
-    notes: List[str] = []
     pushers = _validate_pushers(top["pushers"], section, notes)
     start = pose_field("start", top["start"])
     goal = pose_field("goal", top["goal"])
@@ -424,7 +424,7 @@ def _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity) ->
 MESH_KEYS = ["file", "scale", "plane_y", "tolerance", "density"]
 
 
-def _validate_object(obj: Any, source: Optional[str]):
+def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
     obj = _mapping("object", obj, ["shape"], ["mass", "size", "polygon", "thickness", "com", "inertia"] + MESH_KEYS)
     shape = obj["shape"]
     if shape != "mesh":
@@ -434,7 +434,7 @@ def _validate_object(obj: Any, source: Optional[str]):
         if "mass" not in obj:
             raise TaskError("object.mass", "missing")
     if shape == "mesh":
-        return _mesh_object(obj, source)
+        return _mesh_object(obj, source, notes)
     if shape == "box":
         if "polygon" in obj:
             raise TaskError("object.polygon", "only for shape: polygon (a box takes size)")
@@ -473,7 +473,7 @@ def _onto_edge(section: "_core.CrossSection", edge: int, p: Tuple[float, float])
     return tuple(float(c) for c in u + t * (v - u))
 
 
-def _mesh_object(obj: dict, source: Optional[str]):
+def _mesh_object(obj: dict, source: Optional[str], notes: List[str]):
     """shape: mesh (stablepush.task.mesh): the file relative to the task file's directory; `mass` g or
     `density` g/cm^3; `scale` to mm; `plane_y` mm (default: the centre of mass's); `tolerance` mm
     of the simplified section (default 0.1). com and inertia come from the solid unless given."""
@@ -505,6 +505,7 @@ def _mesh_object(obj: dict, source: Optional[str]):
     com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else mesh.com
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else mesh.inertia
     _number("object.mass", mesh.mass, LIMITS["mass"])
+    notes.extend(mesh.notes)
     return mesh.vertices, mesh.thickness, mesh.mass, com, inertia
 
 
