@@ -536,3 +536,67 @@ def test_check_plan_holds_a_plan_to_the_tasks_min_margin_and_min_hold_ratio(key,
     stricter = dataclasses.replace(task, planner={**task.planner, key: value})
     with pytest.raises(PlanError, match=says):
         check_plan(stricter, plan)
+
+
+HOSTILE_VALUES = [1e308, -1e308, 1e17, -1e17, 1e-300, 0.0, 50.0, "x", None, [], {}, True, float("nan")]
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_generated_hostile_arm_states_end_in_a_report_or_a_fault_with_a_stop(high_mu_run, seed):
+    """Issue 24's arm surface, generated: an arm that answers one ack (or its ready) with a hostile
+    value in ee_pose or object_in_grasp, or with a key missing, closed loop on. The run ends in a
+    report or an ArmFault, and in a fault the arm is told to stop."""
+    import random
+
+    from stablepush.execution.closed_loop import ClosedLoop
+
+    task, plan, _ = high_mu_run
+    rng = random.Random(seed)
+    bad_at = rng.randrange(0, 60)  # 0: the ready
+    listener = socket.create_server(("127.0.0.1", 0))
+    stops = []
+
+    def state(pose, in_grasp, hostile: bool) -> dict:
+        out = {"ee_pose": list(pose), "joints": [0.0] * 7, "object_in_grasp": dict(in_grasp)}
+        if hostile:
+            where = rng.choice(["ee_pose", "object_in_grasp", "missing"])
+            if where == "ee_pose":
+                out["ee_pose"][rng.randrange(7)] = rng.choice(HOSTILE_VALUES)
+            elif where == "object_in_grasp":
+                out["object_in_grasp"][rng.choice(["x", "z", "theta"])] = rng.choice(HOSTILE_VALUES)
+            else:
+                del out[rng.choice(["ee_pose", "object_in_grasp"])]
+        return out
+
+    def arm():
+        conn, _ = listener.accept()
+        with conn:
+            reader = conn.makefile("rb")
+            hello = json.loads(reader.readline())
+            pose = hello["scene"]["gripper_pose"]
+            x, z, theta = hello["scene"]["object_in_grasp"]
+            in_grasp = {"x": x, "z": z, "theta": theta}
+            conn.sendall(json.dumps({"type": "ready", "protocol": PROTOCOL, "arm": "x",
+                                     "state": state(pose, in_grasp, bad_at == 0)}).encode() + b"\n")
+            for line in reader:
+                msg = json.loads(line)
+                if msg["type"] == "stop":
+                    stops.append(msg)
+                    conn.sendall(json.dumps({"type": "stopped", "state": state(pose, in_grasp, False)}).encode() + b"\n")
+                    return
+                if msg["type"] == "bye":
+                    return
+                pose = msg["pose"]
+                conn.sendall(json.dumps({"type": "ack", "seq": msg["seq"],
+                                         "state": state(pose, in_grasp, msg["seq"] + 1 == bad_at)}).encode() + b"\n")
+
+    threading.Thread(target=arm, daemon=True).start()
+    try:
+        report = execute_plan(task, plan, "127.0.0.1", listener.getsockname()[1], rate_hz=100.0, pace=False,
+                              ack_timeout=2.0, closed_loop=ClosedLoop.for_task(task))
+        assert report.last_confirmed_step >= 0
+    except ArmFault:
+        time.sleep(0.1)
+        assert stops, "the arm was not told to stop"
+    finally:
+        listener.close()
