@@ -19,6 +19,7 @@ from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
+from stablepush.errors import ArmFault
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.executor import execute_plan
@@ -60,8 +61,9 @@ def deviation_of(batch: Batch, world: TrialWorld) -> WorldDeviation:
 
 
 def run_trial(batch: Batch, trial: int) -> dict:
-    """Run trial `trial` and return its record. A trial that raises is recorded as crashed (its
-    `cause` is `crash`, `error` the exception); it never ends the batch."""
+    """Run trial `trial` and return its record. A trial whose arm faults is recorded with cause
+    `arm_fault`, one that raises anything else as `crash` (`error` says what); neither ends the
+    batch."""
     world = batch.world(trial)
     started = time.perf_counter()
     record = {"trial": trial, "world": world.as_dict()}
@@ -75,6 +77,9 @@ def run_trial(batch: Batch, trial: int) -> dict:
                       replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
                       cause=report.verdict.cause if report.verdict else None,
                       sim_time_s=report.waypoints / RATE_HZ, error=None)
+    except ArmFault as fault:  # the simulated arm failed (a simulator blow-up, a protocol error): stopped
+        record.update(final_error=None, goal_error=None, replans=0, success=False, cause="arm_fault",
+                      sim_time_s=0.0, error=str(fault))
     except Exception as exc:  # noqa: BLE001 - a crashed trial is a result, not the end of the batch
         last = traceback.extract_tb(exc.__traceback__)[-1]
         record.update(final_error=None, goal_error=None, replans=0, success=False, cause="crash", sim_time_s=0.0,
