@@ -1,5 +1,5 @@
 """Plan every shipped task (seed 1) and run it on the simulated arm over the socket: the final
-pose in the grasp against the plan's, and the slip at the pusher per contact (README table); then
+pose in the grasp against the plan's, and the slip at the pusher per contact (docs/execution.md and docs/engines.md); then
 the tasks of data/tasks/more, which nothing was tuned for.
 `--mu-scale` runs each plan again in worlds whose pads' and features' mu differ from the task's.
 

@@ -1,4 +1,4 @@
-"""The friction-fidelity contract of the simulated arm as a table (README, "Friction fidelity"):
+"""The friction-fidelity contract of the simulated arm as a table (docs/execution.md, "Friction fidelity"):
 the arm's contact setting against the contract's limits, and, with --stiff, the setting it
 replaced (the solver's stiff friction on every pad point, sliding or not).
 

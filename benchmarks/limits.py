@@ -1,7 +1,7 @@
 """The resource caps at work: a task at every cap at once (1,000 vertices, 32 pushers of 20
 points, 2 pads of 4 rings = 122 pad points, a 64-sided friction polygon), planned with a 2 s time
 limit, and a 1,000-vertex object's simulated world built. Prints where the time goes and the peak
-memory (README, "Limits and hostile inputs").
+memory (docs/limits.md, "Limits and hostile inputs").
 
     python3 benchmarks/limits.py
 """

@@ -1,7 +1,7 @@
 """Nominal against robust plans on the simulated arm: every shipped task (and data/tasks/more),
 planned once with the task's nominal friction and once with `uncertainty: {pad_mu: 0.15,
 pusher_mu: 0.15}` (seed 1, the task's own switch budget, 20 s), each run open loop in worlds whose
-pad and feature mu are 0.85, 1 and 1.15 times the task's. Prints the README's "Robust pushes" table.
+pad and feature mu are 0.85, 1 and 1.15 times the task's. Prints the "Robust pushes" table of docs/planner.md.
 
     python3 benchmarks/robust_execution.py      # about 4 minutes
 """

@@ -22,7 +22,7 @@ from conftest import TASKS, shipped
 
 # The bound the end-to-end test holds the simulated run to (the paper's robot: 0.5 mm, 0.5 deg).
 # The paper's robot ended within 0.5 mm and 0.5 deg; the simulated arm does better on these plans
-# (0.04 mm / 0.05 deg and 0.02 mm / 0.03 deg, README), so the tests hold it to 0.2.
+# (0.04 mm / 0.05 deg and 0.02 mm / 0.03 deg, docs/execution.md), so the tests hold it to 0.2.
 FINAL_BOUND_MM = 0.2
 FINAL_BOUND_DEG = 0.2
 
@@ -292,7 +292,7 @@ def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     """The low-mu offset in a world whose pads and features have 15% less mu than the task says:
     open loop its pusher slips and it ends about 1 mm from the goal; closed loop it re-plans from
     the tracked pose and ends within the loop's threshold (half the goal tolerance). Whether it
-    also ends within the final tolerance depends on the plan (README, "Closed loop"): drift that
+    also ends within the final tolerance depends on the plan (docs/execution.md, "Closed loop"): drift that
     shows after the prism has passed the bottom pusher can no longer be lifted out."""
     from stablepush.execution.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation

@@ -232,7 +232,7 @@ def test_released_at_the_offsets_goal_the_prism_is_not_held_and_the_planner_can_
 
     task = shipped("horizontal-offset-high-mu")
     free = plan_task(task)
-    assert free.solved and free.final_hold_ratio < 1.0  # the sim turns it 15 deg on release (README)
+    assert free.solved and free.final_hold_ratio < 1.0  # the sim turns it 15 deg on release (docs/execution.md)
     held = plan_task(task_with("horizontal-offset-high-mu", lambda d: d["planner"].update(min_hold_ratio=1.0)),
                      time_limit=0.5)
     assert not held.solved and "min_hold_ratio" in held.message  # no pose within 0.5 mm of x = 20 holds it
@@ -241,7 +241,7 @@ def test_released_at_the_offsets_goal_the_prism_is_not_held_and_the_planner_can_
 
 
 def test_against_fixed_features_gravity_turns_in_g_and_stays_fixed_in_o():
-    """Hand-derived (README, "Gravity during a push"): on a feature the object keeps its world
+    """Hand-derived (docs/planner.md, "Gravity during a push"): on a feature the object keeps its world
     orientation phi_p, so G turns by phi_p - theta and gravity in G is R(theta - phi_p) g; pushed
     by a moving pusher, gravity stays g in G."""
     g = np.array([0.0, -9.81])

@@ -72,7 +72,7 @@ def cli() -> None:
     """In-hand manipulation planning by stable prehensile pushing.
 
     A task file (YAML; mm, degrees, grams, newtons) describes the object, the gripper pads, the
-    pushers and the goal; see data/tasks/ for the paper's examples and README.md for the format.
+    pushers and the goal; see data/tasks/ for the paper's examples and docs/task-files.md for the format.
     """
 
 
@@ -375,7 +375,7 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
               metavar="TRAJ.csv|.json|.mcap",
               help="Where to write the trajectory: CSV (a header, one row per sample), JSON (columns and rows), or a "
                    "ROS 2 bag in one MCAP file (/tf, the gripper's pose and twist, phase, step and the scene as "
-                   "markers; README, 'ROS 2 bags').")
+                   "markers; docs/execution.md, 'ROS 2 bags').")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
               metavar="HZ", help="Samples per second (the executor streams at this rate).")
 @click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default="xyzw", show_default=True,
@@ -450,8 +450,8 @@ def _host_port(value: str):
 @click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
               help="The task the plan was made for (checked against the plan before anything moves).")
 @click.option("--arm", "arm", default=None, metavar="HOST:PORT",
-              help=f"The arm server (stablepush.arm/2 protocol, see README). Default: with --sim a simulated arm "
-                   f"started in this process, else 127.0.0.1:{DEFAULT_PORT}.")
+              help=f"The arm server (stablepush.arm/2 protocol, see docs/execution.md). Default: with --sim a "
+                   f"simulated arm started in this process, else 127.0.0.1:{DEFAULT_PORT}.")
 @click.option("--sim", is_flag=True, help="Start a simulated arm here and run the plan on it (see --engine).")
 @click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
               help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with stablepush's own "
@@ -678,7 +678,7 @@ def _vary(_ctx, _param, values):
               help="Run the trials on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
               help="Run the trials on Ray: a local instance, or the cluster at ADDRESS (e.g. 10.0.0.5:6379; see "
-                   "README, 'Evaluating a plan').")
+                   "docs/evaluate.md, 'Evaluating a plan').")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the summary and every trial as JSON.")
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row.")

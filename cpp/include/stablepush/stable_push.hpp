@@ -35,7 +35,7 @@ inline constexpr double kStickingSpeedRatio = 1e-9;
 
 enum class ContactCase { AllSliding, Sticking };
 
-/// The frame in which gravity is fixed during a push (docs: README, "Gravity during a push").
+/// The frame in which gravity is fixed during a push (docs: docs/planner.md, "Gravity during a push").
 /// Gripper: the pusher moves and the gripper stays (the paper's assumption): gravity is fixed in G.
 /// Object: the pusher is a feature fixed in the world and sticks, so on pusher p's feature the
 /// object keeps its world orientation phi_p and G turns by phi_p - theta: gravity is fixed in O,

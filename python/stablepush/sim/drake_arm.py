@@ -9,7 +9,7 @@ feed-forward torque) and the site G (a fixed frame). The pads' point spheres, th
 prisms and the features come from the same scene parts as MuJoCo's (`scene.pad_layout`,
 `scene.object_pieces`, `scene.feature_solid`).
 
-Contact (chosen by the friction-fidelity contract, `fidelity.py`; README, "Friction fidelity"):
+Contact (chosen by the friction-fidelity contract, `fidelity.py`; docs/execution.md, "Friction fidelity"):
 - point contact, discrete time step DRAKE_TIMESTEP, Drake's DRAKE_APPROXIMATION model of
   contact (a convex approximation solved by SAP; the PD servos, their effort limits and the
   coupler are implicit in it);

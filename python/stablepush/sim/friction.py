@@ -1,4 +1,4 @@
-"""Pad friction in MuJoCo that sticks and slides as Coulomb's law says (README, "Friction
+"""Pad friction in MuJoCo that sticks and slides as Coulomb's law says (docs/execution.md, "Friction
 fidelity").
 
 Why the pads need this. MuJoCo's contact model is convex: a contact that slides with its friction

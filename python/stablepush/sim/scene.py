@@ -11,7 +11,7 @@ Contact settings that keep friction honest (the simulation's results rest on the
   while it sticks, explicit Coulomb friction (mu N opposite its slip) while it slides, which
   removes the pads' drop-outs while they slide;
 - each pad is a disc of point contacts laid out as the task's `pad_rings` says, so the simulated
-  pad's force acts where the model's does (README, "The mechanics");
+  pad's force acts where the model's does (docs/planner.md, "The mechanics");
 - multi-point convex collisions by libccd (`multiccd`, native CCD off), so a face on a face
   touches at several points;
 - only the object touches pads and features (explicit contact pairs with the task's friction);

@@ -15,7 +15,7 @@ from stablepush.errors import TaskError
 from stablepush.units import MM, G, mm2_to_si
 
 # How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
-# (README, "Gravity during a push"): against features fixed in the world, the object keeps its
+# (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
 # world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
 PUSHES = ("against_fixed_features", "by_moving_pusher")
 # uncertainty: key -> the task value it widens (+- this fraction of it); a push must be stable for

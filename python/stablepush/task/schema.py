@@ -29,7 +29,7 @@ MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
 SNAP_TO_EDGE = 0.05  # mm: a pusher this close to an edge is put on it (a warning says so)
 ON_BOUNDARY = 1e-6  # mm: closer than this, a pusher is on its edge (the core's tolerance)
 # Resource caps: each bounds the model's size (and so the time and memory to build it and to
-# test a push) before anything reaches the core. README, "Limits".
+# test a push) before anything reaches the core. docs/limits.md, "Limits".
 MAX_TASK_BYTES = 1_000_000
 MAX_VERTICES = 1000  # of the cross-section
 MAX_PAD_RINGS = 6  # 1 + 3 r (r + 1) points per pad: 127 at the cap
