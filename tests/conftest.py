@@ -13,7 +13,7 @@ from stablepush.task import load_task, parse_task  # noqa: E402
 # tests of several seconds: `-m "not slow"` leaves them out, so the rest (the mechanics, the
 # planner, files, the CLI) runs in about a minute.
 SLOW_MODULES = {"test_fuzz", "test_execute", "test_sim_arm", "test_friction_fidelity", "test_reliability",
-                "test_robust", "test_point_pushers", "test_cross_check", "test_evaluate", "test_reach", "test_readme"}
+                "test_robust", "test_point_pushers", "test_cross_check", "test_evaluate", "test_reach", "test_readme", "test_bags"}
 SLOW_TESTS = {
     "test_h_representation_matches_generators",
     "test_large_manipulation_reaches_a_zero_switch_plan_for_nine_of_ten_seeds",

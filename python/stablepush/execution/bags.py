@@ -13,11 +13,15 @@ sample unless said:
 - `/stablepush/step` (std_msgs/msg/Int32): the plan step (the one a push heads for);
 - `/stablepush/scene` (visualization_msgs/msg/MarkerArray), once at t = 0: the object's outline
   extruded to its thickness (in object), the pads (in gripper) and each feature's contact segment
-  at its world pose (in world).
+  at its world pose (in world);
+- `/stablepush/arm_scene` (std_msgs/msg/String), once at t = 0: the world as the arm protocol's
+  hello describes it (JSON, SI units; `stablepush.execution.world.scene_description`), so that a
+  bridge can replay the bag to an arm server (examples/bag_to_arm.py).
 Units: m, s, rad; quaternions x, y, z, w.
 """
 from __future__ import annotations
 
+import json
 import os
 import tempfile
 from pathlib import Path
@@ -27,7 +31,7 @@ import numpy as np
 
 from stablepush.errors import OutputError
 from stablepush.execution.trajectory import Trajectory
-from stablepush.execution.world import place_features
+from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix
 from stablepush.plan.plan import Plan
 from stablepush.task.model import Task
@@ -41,6 +45,7 @@ TOPICS = {
     "/stablepush/phase": "std_msgs/msg/String",
     "/stablepush/step": "std_msgs/msg/Int32",
     "/stablepush/scene": "visualization_msgs/msg/MarkerArray",
+    "/stablepush/arm_scene": "std_msgs/msg/String",
 }
 
 
@@ -79,6 +84,9 @@ def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajec
 
             write("/stablepush/scene", 0, T["visualization_msgs/msg/MarkerArray"](
                 markers=_scene_markers(T, task, plan)))
+            steps = list(plan.waypoints)
+            scene = scene_description(task, place_features(task, steps), steps[0].pose)
+            write("/stablepush/arm_scene", 0, T["std_msgs/msg/String"](data=json.dumps(scene)))
             for i in range(len(trajectory)):
                 ns = int(round(float(trajectory.t[i]) * 1e9))
                 stamp = _time(T, ns)
