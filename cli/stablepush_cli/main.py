@@ -495,8 +495,9 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
-    places them, else one station per pusher 150 mm apart along y). During a push the object rests on
-    its feature while the gripper moves; between pushes the gripper retracts, moves and approaches.
+    places them, else one station per pusher along y, 150 mm apart and alternating about home).
+    During a push the object rests on its feature while the gripper moves; between pushes the
+    gripper retracts, moves and approaches.
     Waypoints (G's pose in the world, m and a quaternion) go out at --rate as JSON lines over TCP and
     each is acknowledged with the arm's state.
 

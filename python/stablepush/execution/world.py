@@ -65,7 +65,8 @@ def place_features(task: Task, steps: Sequence[Waypoint], every_pusher: bool = F
     """One feature per pusher the plan uses (with `every_pusher`, then one for each other pusher of
     the task, as if its first contact began at the plan's start: a re-planned run may use it). The
     task's `environment.features` gives the object's world pose on a feature; otherwise pusher k
-    (in order of first use) gets a station k `station_spacing` mm along +y from home, and the
+    (in order of first use) gets a station `station_offset(k)` times `station_spacing` mm along y
+    from home (0, +1, -1, +2, -2, ...: the stations stay within the arm's reach), and the
     feature is placed where the pusher touches the object at the start of its first contact with G
     at that station, turned about y so that the object's world orientation there is the one the
     model assumes for this feature (`Task.feature_angle`: the start's unless environment.features
@@ -87,7 +88,7 @@ def place_features(task: Task, steps: Sequence[Waypoint], every_pusher: bool = F
             T_WO[:3, :3] = rot_y(math.radians(theta))
         else:  # G at the station, turned so that the object has the world orientation the model
             # assumes on this feature (Task.feature_angle): G's turn plus theta is that angle
-            station = home + np.array([0.0, len(features) * env["station_spacing"] * MM, 0.0])
+            station = home + np.array([0.0, station_offset(len(features)) * env["station_spacing"] * MM, 0.0])
             q_first = steps[contact.first].pose
             T_WG = translation(station)
             T_WG[:3, :3] = rot_y(math.radians(task.feature_angle(name) - q_first[2]))
@@ -101,6 +102,12 @@ def place_features(task: Task, steps: Sequence[Waypoint], every_pusher: bool = F
         features[name] = Feature(pusher=name, object_pose=T_WO, start=to_w(spec.a), end=to_w(spec.b),
                                  normal=T_WO[:3, :3] @ np.array([n_O[0], 0.0, n_O[1]]), mu=spec.mu)
     return features
+
+
+def station_offset(k: int) -> int:
+    """The k-th default station's place along y, in station spacings: 0, +1, -1, +2, -2, ...,
+    alternating about home so that six pushers span five spacings, not ten to one side."""
+    return (k + 1) // 2 if k % 2 else -(k // 2)
 
 
 def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float]) -> dict:

@@ -204,8 +204,15 @@ class TrackingArm:
         self.target = end.copy()
 
     def move_to(self, pose: Sequence[float], duration: float) -> None:
-        """Track G toward `pose` over `duration` s (one streamed waypoint period)."""
-        self.advance(duration, self.solve_ik(pose, self.target))
+        """Track G toward `pose` over `duration` s (one streamed waypoint period). ValueError, the
+        arm held where it is, when no joint angles within the limits put G there (IK_REACH):
+        driven there anyway, the servos fight the limits and the arm leaves the stream."""
+        q = self.solve_ik(pose, self.target)
+        if self.ik_error > ik.IK_REACH:  # slow to converge near the edge of reach: look harder first
+            q = self.solve_ik(pose, self.target, iterations=10 * ik.IK_ITERATIONS)
+        if self.ik_error > ik.IK_REACH:
+            raise ik.unreachable(pose, self.ik_error)
+        self.advance(duration, q)
 
 
 class SimArm(TrackingArm, SimulatedGrasp):

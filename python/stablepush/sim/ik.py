@@ -16,6 +16,7 @@ from stablepush.frames import pose_to_matrix
 IK_DAMPING = 1e-4  # DLS damping lambda^2 [m^2]
 IK_ITERATIONS = 50
 IK_TOLERANCE = 1e-9  # m (and rad) of pose error
+IK_REACH = 1e-3  # m (and rad): a waypoint whose IK ends farther off than this is out of the arm's reach
 POSTURE_GAIN = 0.05  # null-space pull toward the home posture per IK iteration
 HOME_GUESS = np.array([0.0, 0.35, 0.0, 1.9, 0.0, 0.89, 0.0])  # rad, hand pointing down in front of the base
 
