@@ -7,6 +7,7 @@ crash by signal fails the test instead of killing pytest).
                                                       # damaged; STL, OBJ, PLY, OFF): plan
     python3 tests/fuzz_cli.py semantics N SEED SCRATCH  # N valid plans that do not fit their task
                                                         # (short, reversed, other goal or model): trajectory
+    python3 tests/fuzz_cli.py api N SEED SCRATCH      # N calls of the Python API with hostile arguments
 
 Each case runs the CLI in this process (click's CliRunner) and must end with exit status 0, 1 or
 2; a refusal (2) is one line on stderr starting "error:" (besides "warning:" lines); no
@@ -243,8 +244,70 @@ def run_semantics(count: int, seed: int, scratch: Path):
                ["trajectory", str(plan_file), "--task", str(path), "-o", str(scratch / "out.csv")], text[:2000])
 
 
+API_ERRORS = ("StablepushError", "TypeError", "ValueError", "KeyboardInterrupt")
+
+
+def run_api(count: int, seed: int, scratch: Path) -> None:
+    """The Python API misused: sp.plan, sp.check, sp.check_plan, sp.trajectory and sp.save_plan with
+    hostile arguments. Each call returns or raises a StablepushError, TypeError or ValueError;
+    anything else (or a crash by signal, which kills this process) is a failure. Prints the summary."""
+    import dataclasses
+
+    import stablepush as sp
+
+    rng = random.Random(seed)
+    tasks = [sp.load_task(path) for path in TASKS[:5]]
+    plans = [sp.plan(task, seed=1) for task in tasks]
+    outcomes, failures, slowest = collections.Counter(), [], (0.0, "")
+
+    def hostile():
+        return rng.choice(HOSTILE + [(1, 2), (float("nan"),) * 3, (0, 0, 0), (1e308, 0, 0), "left", -5, 3.5])
+
+    for case in range(count):
+        k = rng.randrange(len(tasks))
+        task, plan = tasks[k], plans[k]
+        what = rng.choice(["plan", "check", "check_plan", "trajectory", "save_plan", "plan-models", "plan-edited"])
+        if what == "plan":
+            key = rng.choice(["seed", "time_limit", "max_switches", "improve_for", "min_transit_hold", "start_pusher"])
+            call = lambda: sp.plan(task, **{key: hostile()}, **({} if key == "time_limit" else {"time_limit": 0.02}))  # noqa: E731
+        elif what == "plan-models":
+            call = lambda: sp.plan(task, models=rng.choice([[None], [], "x", [task], tasks[k - 1].corner_models()]),  # noqa: E731
+                                   time_limit=0.02)
+        elif what == "plan-edited":  # a Task edited past its loader's checks
+            field = rng.choice(["mu", "grip_force", "mass", "start", "goal", "pads", "pushers", "gravity"])
+            call = lambda: sp.plan(dataclasses.replace(task, **{field: hostile()}), time_limit=0.02)  # noqa: E731
+        elif what == "check":
+            call = lambda: sp.check(task, at=hostile(), move=hostile(), pusher=rng.choice([None, "left", hostile()]))  # noqa: E731
+        elif what == "check_plan":
+            steps = list(plan.waypoints)
+            steps[rng.randrange(len(steps))] = rng.choice([None, "x", hostile()])
+            call = lambda: sp.check_plan(task, dataclasses.replace(plan, waypoints=steps))  # noqa: E731
+        elif what == "trajectory":
+            call = lambda: sp.trajectory(task, plan, rate_hz=hostile())  # noqa: E731
+        else:
+            call = lambda: sp.save_plan(dataclasses.replace(plan, stats=hostile()), str(scratch / "api.plan.json"))  # noqa: E731
+        label = f"api {case} {what} on {task.name}"
+        (scratch / "current").write_text(label)
+        started = time.perf_counter()
+        try:
+            call()
+            outcomes["returned"] += 1
+        except BaseException as exc:  # noqa: BLE001 - sorting what escaped is the point
+            kinds = [c.__name__ for c in type(exc).__mro__]
+            if any(kind in API_ERRORS for kind in kinds):
+                outcomes["refused"] += 1
+            else:
+                failures.append({"case": label, "problem": f"{type(exc).__name__}: {str(exc)[:200]}"})
+        slowest = max(slowest, (time.perf_counter() - started, label))
+    print(json.dumps({"cases": count, "exit_statuses": dict(outcomes), "failures": failures[:20],
+                      "failure_count": len(failures), "slowest_s": round(slowest[0], 3), "slowest": slowest[1]}))
+
+
 def main() -> None:
     kind, count, seed, scratch = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), Path(sys.argv[4])
+    if kind == "api":
+        run_api(count, seed, scratch)
+        return
     cases = {"tasks": run_tasks, "plans": run_plans, "meshes": run_meshes, "semantics": run_semantics}[kind](
         count, seed, scratch)
     runner = CliRunner()

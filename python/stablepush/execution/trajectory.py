@@ -18,6 +18,7 @@ from typing import List
 
 import numpy as np
 
+from stablepush.execution.protocol import RATE_HZ
 from stablepush.execution.stream import arm_trajectory
 from stablepush.execution.world import place_features, scene_description
 from stablepush.plan.plan import Plan
@@ -80,7 +81,9 @@ class Trajectory:
 
 def timed_trajectory(task: Task, plan: Plan, rate_hz: float = 100.0) -> Trajectory:
     """The executor's stream for a plan checked against the task (stablepush.plan.verify.check_plan),
-    from G at the task's home pose."""
+    from G at the task's home pose. ValueError unless `rate_hz` lies in the arm protocol's RATE_HZ."""
+    if isinstance(rate_hz, bool) or not isinstance(rate_hz, (int, float)) or not RATE_HZ[0] <= rate_hz <= RATE_HZ[1]:
+        raise ValueError(f"rate_hz must be a number from {RATE_HZ[0]:g} to {RATE_HZ[1]:g}, got {rate_hz!r:.40}")
     steps = list(plan.waypoints)
     features = place_features(task, steps)
     start = scene_description(task, features, steps[0].pose)["gripper_pose"]

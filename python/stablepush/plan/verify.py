@@ -8,7 +8,7 @@ from typing import List, Optional
 
 from stablepush import _core
 from stablepush.errors import PlanError
-from stablepush.plan.plan import Plan
+from stablepush.plan.plan import Plan, Waypoint
 from stablepush.task.model import Task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import MM, pose_to_si
@@ -37,6 +37,11 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     if require_solved and not plan.solved:
         fail("solved", f"the plan does not reach the goal ({(plan.message or 'not solved')[:200]})")
     waypoints = plan.waypoints
+    for i, w in enumerate(waypoints):
+        if not isinstance(w, Waypoint):
+            fail(f"waypoints[{i}]", f"must be a Waypoint (x, z, theta, pusher, ...), got {type(w).__name__}")
+        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in w.pose):
+            fail(f"waypoints[{i}]", f"must be a pose of 3 finite numbers, got {w.pose!r:.80}")
     if len(waypoints) < (2 if require_solved else 1):  # a partial plan may have found no push at all
         fail("waypoints", "needs the start and at least one push" if require_solved else "needs the start")
     for i, w in enumerate(waypoints):

@@ -71,6 +71,30 @@ class Task:
     # does not give it; empty: the start's. with_start fills it.
     feature_orientations: Dict[str, float] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        """The shape of the fields (TypeError or ValueError naming the field): a Task made by
+        `load_task`/`parse_task` always has it; one edited in code (dataclasses.replace) must too,
+        before anything reaches the core."""
+        if not isinstance(self.name, str):
+            raise TypeError(f"Task.name must be a string, got {type(self.name).__name__}")
+        for name in ("thickness", "mass", "grip_force", "mu", "step_time"):
+            _finite(f"Task.{name}", getattr(self, name))
+        for name, size in (("gravity", 2), ("start", 3), ("goal", 3)):
+            _finite_vector(f"Task.{name}", getattr(self, name), size)
+        if not isinstance(self.vertices, (tuple, list)) or len(self.vertices) < 3:
+            raise TypeError("Task.vertices must be a sequence of at least 3 (x, z) pairs")
+        for i, v in enumerate(self.vertices):
+            _finite_vector(f"Task.vertices[{i}]", v, 2)
+        if not isinstance(self.pads, (tuple, list)) or not self.pads:
+            raise TypeError("Task.pads must be a sequence of ((x, z), radius)")
+        for i, pad in enumerate(self.pads):
+            if not isinstance(pad, (tuple, list)) or len(pad) != 2:
+                raise TypeError(f"Task.pads[{i}] must be ((x, z), radius)")
+            _finite_vector(f"Task.pads[{i}] centre", pad[0], 2)
+            _finite(f"Task.pads[{i}] radius", pad[1])
+        if not isinstance(self.pushers, (tuple, list)) or not all(isinstance(p, PusherSpec) for p in self.pushers):
+            raise TypeError("Task.pushers must be a sequence of PusherSpec")
+
     def feature_angle(self, pusher: str) -> float:
         """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
         feature: environment.features gives it, else the start's (the executor places the
@@ -171,6 +195,24 @@ class Task:
             _core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
             [math.radians(self.feature_angle(p.name)) for p in self.pushers],
         )
+
+
+def _finite(field: str, value) -> None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise TypeError(f"{field} must be a number, got {type(value).__name__}")
+    try:
+        ok = math.isfinite(float(value))
+    except OverflowError:
+        ok = False
+    if not ok:
+        raise ValueError(f"{field} must be finite, got {value!r:.40}")
+
+
+def _finite_vector(field: str, value, size: int) -> None:
+    if not isinstance(value, (tuple, list)) or len(value) != size:
+        raise TypeError(f"{field} must be {size} numbers, got {value!r:.60}")
+    for v in value:
+        _finite(field, v)
 
 
 def json_values(value):
