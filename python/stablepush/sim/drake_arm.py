@@ -9,10 +9,14 @@ feed-forward torque) and the site G (a fixed frame). The pads' point spheres, th
 prisms and the features come from the same scene parts as MuJoCo's (`scene.pad_layout`,
 `scene.object_pieces`, `scene.feature_solid`).
 
-Contact (chosen by the friction-fidelity contract, `fidelity.py`; docs/execution.md, "Friction fidelity"):
-- point contact, discrete time step DRAKE_TIMESTEP, Drake's DRAKE_APPROXIMATION model of
-  contact (a convex approximation solved by SAP; the PD servos, their effort limits and the
-  coupler are implicit in it);
+Contact (chosen by the friction-fidelity contract, `fidelity.py`; docs/engines.md says how):
+- Drake's DRAKE_APPROXIMATION discrete model (a convex approximation solved by SAP; the PD servos,
+  their effort limits and the coupler are implicit in it), at DRAKE_TIMESTEP: its friction is
+  regularized, and a sticking contact slips at about 1e-3 w f h (w the contact's inverse mass, f
+  its friction, h the step), so the step is the contract's to choose (0.2 ms fails it);
+- the pads are point contacts (spheres); each feature is rigid hydroelastic against the object,
+  compliant at HYDROELASTIC_MODULUS (a box on a box has one point contact, which chatters; a
+  softer patch lets the object roll on the pusher where the rigid model says it sticks);
 - only pads and features touch the object (collision filters);
 - Drake combines two surfaces' friction as mu = 2 mu1 mu2 / (mu1 + mu2); the object carries
   OBJECT_MU and every pad and feature the partner value that makes the pair's mu the task's
@@ -36,15 +40,14 @@ from stablepush.sim.arm import SETTLE_TIME, TrackingArm, WorldDeviation, arm_sta
 
 DRAKE_TIMESTEP = 0.000125  # s (the friction-fidelity contract fails at 0.2 ms: module docstring)
 DRAKE_APPROXIMATION = "lagged"  # DiscreteContactApproximation: sap, similar or lagged
-STICTION_TOLERANCE = 1e-7  # m/s: the regularized friction's slip at the edge of sticking
-NEAR_RIGID_THRESHOLD = 1.0  # SAP: contacts stiffer than this (relative to the step) are regularized as near rigid
-POINT_STIFFNESS = 1e5  # N/m per pad point and per feature contact
+STICTION_TOLERANCE = 1e-7  # m/s: under the regularization's own floor (1e-6 to 1e-9 give the same creep)
+POINT_STIFFNESS = 1e5  # N/m per pad point
 HUNT_CROSSLEY_DISSIPATION = 1.0  # s/m
 HYDROELASTIC_MODULUS = 1e10  # Pa: the object's contact with a feature; softer lets the pusher roll (docstring)
 HYDRO_RESOLUTION = 0.002  # m
 OBJECT_MU = 1000.0  # the object's own friction; each partner's is set to give the pair's mu (partner_mu)
 KINEMATIC_HAND_BODY = "hand"
-KINEMATIC_HAND_MASS = 1e4  # kg  # the object's own friction; each partner's is set to give the pair's mu
+KINEMATIC_HAND_MASS = 1e4  # kg
 
 
 def partner_mu(mu: float, object_mu: float = OBJECT_MU) -> float:
@@ -88,7 +91,6 @@ class DrakeGrasp:
         plant.set_discrete_contact_approximation(getattr(d.DiscreteContactApproximation, "k" + approximation.title()))
         plant.set_contact_model(d.ContactModel.kHydroelasticWithFallback)
         plant.set_stiction_tolerance(STICTION_TOLERANCE)
-        plant.set_sap_near_rigid_threshold(NEAR_RIGID_THRESHOLD)
         parser = d.Parser(plant)
         parser.SetAutoRenaming(False)
         (self._arm,) = _quietly(lambda: parser.AddModelsFromString(ET.tostring(tree, encoding="unicode"), "xml"))
