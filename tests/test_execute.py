@@ -10,7 +10,7 @@ import threading
 import pytest
 from click.testing import CliRunner
 
-from stablepush.errors import ArmFault
+from stablepush.errors import ArmFault, PlanError
 from stablepush.execution import execute_plan
 from stablepush.execution.protocol import PROTOCOL, ProtocolError, decode, encode
 from stablepush.plan import check_plan, plan_task
@@ -97,8 +97,13 @@ def test_a_plan_for_another_version_of_the_task_is_refused(high_mu_plan, tmp_pat
     edited = tmp_path / "edited.yaml"
     edited.write_text(yaml.safe_dump(data))
     result = CliRunner().invoke(cli, ["execute", plan, "--task", str(edited), "--sim"])
-    assert result.exit_code == 2
-    assert "plan.json: waypoints[1]: " in result.output and "not a stable push" in result.output
+    assert result.exit_code == 2  # named by the plan's record of its task, before any push is re-checked
+    assert "changed since the plan was made (pushers.bottom.mu, pushers.left.mu, pushers.right.mu)" in result.output
+    from stablepush.plan import check_plan, load_plan
+    from stablepush.task import load_task
+
+    with pytest.raises(PlanError, match=r"waypoints\[1\]: .*not a stable push"):  # and check_plan itself
+        check_plan(load_task(edited), load_plan(plan))
 
 
 # -- faults -------------------------------------------------------------------------------------

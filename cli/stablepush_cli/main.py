@@ -323,7 +323,8 @@ def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = T
 
     task = _load(task_file)
     plan = load_plan(plan_file)
-    changes = changes_since_planned(task, plan)
+    # A plan for another task (its name) is check_plan's to name; for this one, what changed since.
+    changes = changes_since_planned(task, plan) if plan.task == task.name else []
     if changes:
         what = f"{task_file} changed since the plan was made ({', '.join(changes[:6])}" + \
             (f" and {len(changes) - 6} more" if len(changes) > 6 else "") + ")"
