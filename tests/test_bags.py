@@ -122,3 +122,37 @@ def test_the_bridge_example_replays_a_bag_to_the_sim_arm(tmp_path):
     assert abs(where["x"] - end[0]) < 0.3 and abs(where["z"] - end[1]) < 0.3 and abs(where["theta"] - end[2]) < 0.3
     with pytest.raises(ValueError, match="cannot read it as a ROS 2 bag"):
         bridge.read_bag(tmp_path / "p.plan.json")
+
+
+def test_a_recorded_run_reads_back_with_its_corrections_and_verdict(tmp_path):
+    """`execute --record` (issue 22, item 2): the low-mu offset closed loop in a world with 15% less
+    mu, recorded and read back: a sample per acknowledged waypoint on every per-sample topic, each
+    correction the report lists, the verdict, and the tracker's last pose in the grasp."""
+    import json
+
+    from stablepush.execution.bags import RUN_TOPICS
+
+    task = str(TASKS / "horizontal-offset-low-mu.yaml")
+    plan, bag, report = tmp_path / "p.plan.json", tmp_path / "run.mcap", tmp_path / "run.json"
+    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan), "--quiet"]).exit_code == 0
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--quiet", "--closed-loop",
+                                      "--sim-mu-scale", "0.85", "--record", str(bag), "--json", str(report)])
+    assert result.exit_code in (0, 5), result.output
+    run = json.loads(report.read_text())
+    messages = {}
+    with Reader(bag) as reader:
+        assert {c.topic: c.msgtype for c in reader.connections} == RUN_TOPICS
+        for connection, stamp, raw in reader.messages():
+            messages.setdefault(connection.topic, []).append(STORE.deserialize_cdr(raw, connection.msgtype))
+    for topic in ("/tf", "/stablepush/commanded_pose", "/stablepush/gripper_pose", "/stablepush/object_pose",
+                  "/stablepush/object_in_grasp", "/stablepush/pusher", "/stablepush/phase", "/stablepush/step"):
+        assert len(messages[topic]) == run["waypoints"], topic
+    corrections = [json.loads(m.data) for m in messages.get("/stablepush/correction", [])]
+    assert run["replans"] and corrections == run["replans"]
+    (verdict,) = [json.loads(m.data) for m in messages["/stablepush/verdict"]]
+    assert verdict["success"] == run["success"] and verdict["cause"] == run["cause"]
+    assert {m.data for m in messages["/stablepush/pusher"]} >= {"", "bottom", "left"}
+    last = messages["/stablepush/object_in_grasp"][-1].pose.position
+    assert last.x * 1e3 == pytest.approx(run["released_in_grasp"]["x"], abs=1e-6)
+    bad = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--record", str(tmp_path / "x.bag")])
+    assert bad.exit_code == 2 and "--record" in bad.output

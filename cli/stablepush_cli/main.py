@@ -473,6 +473,10 @@ def _host_port(value: str):
               default=None, metavar="MM DEG",
               help="The run lands when the object ends within MM (x and z) and DEG of the goal in the grasp "
                    "(default: the task's planner.tolerance).")
+@click.option("--record", "record_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mcap",
+              help="Record the run as a ROS 2 bag (one MCAP file): the commanded and measured gripper pose, the "
+                   "object in the world and in the grasp, /tf, the pusher in contact, each correction and the "
+                   "verdict (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
               metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
@@ -491,7 +495,7 @@ def _host_port(value: str):
               metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
                                      "this close to the goal (default: a fifth of the task's goal tolerance).")
 def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
-            ack_timeout: float, json_path, success_tolerance, quiet: bool, mu_scale: float, tracker_noise,
+            ack_timeout: float, json_path, success_tolerance, record_path, quiet: bool, mu_scale: float, tracker_noise,
             closed_loop: bool, replan_threshold, final_tolerance) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
@@ -564,15 +568,24 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
             bar.update(confirmed - seen[0])
             seen[0] = confirmed
 
+    if record_path and not record_path.endswith(".mcap"):
+        _fail(f"--record {record_path}: the file name must end in .mcap")
+    recording = None
+    if record_path:
+        from stablepush.execution.bags import RunRecording
+
+        recording = RunRecording()
     try:
         report = execute_plan(task, plan, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
                               ack_timeout=ack_timeout, closed_loop=loop, success_tolerance=success_tolerance,
-                              progress=progress)
+                              progress=progress, record=recording)
     except ArmFault as fault:
         if bar is not None:
             bar.__exit__(None, None, None)
         if json_path:
             write_atomically(json_path, json.dumps(fault_report(task, fault, success_tolerance), indent=1) + "\n")
+        if recording is not None:
+            recording.write(record_path, fault_report(task, fault, success_tolerance))
         if not fault.connected:
             click.echo(f"error: {fault.reason}; nothing was sent. Is the arm server running? "
                        f"(`stablepush sim-arm` serves a simulated arm, or run with --sim)", err=True)
@@ -594,6 +607,9 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     if json_path:
         write_atomically(json_path, json.dumps(report.as_dict(), indent=1) + "\n")
         click.echo(f"report written to {json_path}")
+    if recording is not None:
+        recording.write(record_path, report.as_dict())
+        click.echo(f"run recorded to {record_path}")
     if report.success is False:
         sys.exit(EXIT_MISSED)
 

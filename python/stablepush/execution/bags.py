@@ -1,5 +1,6 @@
 """A plan's trajectory as a ROS 2 bag (rosbag2, MCAP storage; written by the `rosbags` library),
-for robot stacks, `ros2 bag play` and Foxglove (`stablepush trajectory PLAN --task TASK -o X.mcap`).
+for robot stacks, `ros2 bag play` and Foxglove (`stablepush trajectory PLAN --task TASK -o X.mcap`);
+and a run as the executor saw it, in the same form (`RunRecording`, `execute --record run.mcap`).
 
 Frames: `world` (W: x forward, y the gripping axis at home, z up), `gripper` (G, between the
 pads), `object` (O, the task's object frame). Each message is stamped with its trajectory time t
@@ -181,3 +182,85 @@ def _scene_markers(T, task: Task, plan: Plan) -> list:
             markers.append(_marker(T, 100 + k, WORLD, Marker.LINE_LIST, [feature.start, feature.end],
                                    (0.003, 0, 0), (0.3, 0.5, 0.8)))
     return markers
+
+
+# -- a run, recorded ----------------------------------------------------------------------------
+
+RUN_TOPICS = {
+    "/tf": "tf2_msgs/msg/TFMessage",
+    "/stablepush/commanded_pose": "geometry_msgs/msg/PoseStamped",
+    "/stablepush/gripper_pose": "geometry_msgs/msg/PoseStamped",
+    "/stablepush/object_pose": "geometry_msgs/msg/PoseStamped",
+    "/stablepush/object_in_grasp": "geometry_msgs/msg/PoseStamped",
+    "/stablepush/pusher": "std_msgs/msg/String",
+    "/stablepush/phase": "std_msgs/msg/String",
+    "/stablepush/step": "std_msgs/msg/Int32",
+    "/stablepush/correction": "std_msgs/msg/String",
+    "/stablepush/verdict": "std_msgs/msg/String",
+}
+
+
+class RunRecording:
+    """A run as the executor saw it (`execute --record run.mcap`), one sample per acknowledged
+    waypoint, stamped with the stream's time: the commanded and the reported gripper pose (world),
+    the object's pose in the world (`/stablepush/object_pose`, a simulator's truth) and in the grasp
+    (`/stablepush/object_in_grasp`, the tracker's, in gripper), `/tf` world -> gripper -> object,
+    the pusher in contact ("" between contacts), phase and step; each correction of the closed loop
+    (`/stablepush/correction`, JSON, at the step after which it was made) and the run's report
+    (`/stablepush/verdict`, JSON, at the end). Pass it to `execute_plan(record=...)`."""
+
+    def __init__(self):
+        self.samples = []
+
+    def __call__(self, waypoint, state: dict, pusher) -> None:
+        self.samples.append((waypoint.t, list(waypoint.pose), list(state["ee_pose"]), state.get("object_pose"),
+                             state.get("object_in_grasp"), pusher or "", waypoint.phase, waypoint.step))
+
+    def write(self, path: Union[str, Path], report: dict) -> None:
+        """Write the recording and `report` (ExecutionReport.as_dict, or a fault's report) as one
+        MCAP file at `path`."""
+        from rosbags.rosbag2 import StoragePlugin, Writer
+        from rosbags.typesys import Stores, get_typestore
+
+        store = get_typestore(Stores.ROS2_HUMBLE)
+        T = store.types
+        path = Path(path)
+        with tempfile.TemporaryDirectory(dir=path.parent if path.parent.exists() else None) as scratch:
+            bag = Path(scratch) / "bag"
+            with Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
+                connections = {topic: writer.add_connection(topic, kind, typestore=store)
+                               for topic, kind in RUN_TOPICS.items()}
+
+                def write(topic: str, ns: int, message) -> None:
+                    writer.write(connections[topic], ns, store.serialize_cdr(message, RUN_TOPICS[topic]))
+
+                last_ns, end_of_step = 0, {}
+                for t, commanded, reported, in_world, in_grasp, pusher, phase, step in self.samples:
+                    ns = last_ns = int(round(t * 1e9))
+                    end_of_step[step] = ns
+                    stamp = _time(T, ns)
+                    write("/stablepush/commanded_pose", ns, T["geometry_msgs/msg/PoseStamped"](
+                        header=_header(T, stamp, WORLD), pose=_pose(T, commanded[:3], commanded[3:])))
+                    write("/stablepush/gripper_pose", ns, T["geometry_msgs/msg/PoseStamped"](
+                        header=_header(T, stamp, WORLD), pose=_pose(T, reported[:3], reported[3:])))
+                    transforms = [_transform(T, stamp, WORLD, GRIPPER, reported[:3], reported[3:])]
+                    if in_world is not None:
+                        write("/stablepush/object_pose", ns, T["geometry_msgs/msg/PoseStamped"](
+                            header=_header(T, stamp, WORLD), pose=_pose(T, in_world[:3], in_world[3:])))
+                    if in_grasp is not None:
+                        held = matrix_to_pose(grasp_transform((in_grasp["x"], in_grasp["z"], in_grasp["theta"])))
+                        write("/stablepush/object_in_grasp", ns, T["geometry_msgs/msg/PoseStamped"](
+                            header=_header(T, stamp, GRIPPER), pose=_pose(T, held[:3], held[3:])))
+                        transforms.append(_transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:]))
+                    write("/tf", ns, T["tf2_msgs/msg/TFMessage"](transforms=transforms))
+                    write("/stablepush/pusher", ns, T["std_msgs/msg/String"](data=pusher))
+                    write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=phase))
+                    write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(step)))
+                for correction in report.get("replans") or []:
+                    ns = end_of_step.get(correction["after_step"], last_ns)
+                    write("/stablepush/correction", ns, T["std_msgs/msg/String"](data=json.dumps(correction)))
+                write("/stablepush/verdict", last_ns, T["std_msgs/msg/String"](data=json.dumps(report)))
+            try:
+                os.replace(bag / "bag.mcap", path)
+            except OSError as exc:
+                raise OutputError(str(path), f"cannot write the bag ({exc.strerror or exc})") from None

@@ -186,6 +186,7 @@ def execute_plan(
     closed_loop: Optional[ClosedLoop] = None,
     success_tolerance: Optional[Sequence[float]] = None,
     progress: Optional[Callable[[ArmWaypoint, int, int], None]] = None,
+    record: Optional[Callable[[ArmWaypoint, dict, Optional[str]], None]] = None,
 ) -> ExecutionReport:
     """Stream the plan from step `resume_from` to the arm server at host:port. `pace` holds the
     stream to rate_hz in wall-clock time (a real arm); without it waypoints go as fast as they are
@@ -194,8 +195,9 @@ def execute_plan(
     from the measured pose and spliced into the stream (`stablepush.closed_loop`); the world then
     holds a feature for every pusher of the task. The report's verdict judges the final pose with
     `success_tolerance` (mm, deg; default: the task's goal tolerance). `progress(waypoint,
-    confirmed_step, total_steps)` is called per ack. `plan`: a plan checked against the task
-    (stablepush.plan.verify.check_plan).
+    confirmed_step, total_steps)` is called per ack, and `record(waypoint, state, pusher)` with the
+    arm's state and the pusher in contact (None between contacts; `bags.RunRecording`). `plan`: a
+    plan checked against the task (stablepush.plan.verify.check_plan).
     PlanError (field `resume_from`) before anything is sent when the plan has no push after it."""
     steps: List[Waypoint] = list(plan.waypoints)
     check_resume_from(steps, resume_from)
@@ -238,6 +240,8 @@ def execute_plan(
                 raise ProtocolError(f"the arm is not following: its reported pose stayed over "
                                     f"{FOLLOW_LIMIT[0] * 1e3:g} mm or {math.degrees(FOLLOW_LIMIT[1]):g} deg from the "
                                     f"commanded one for {FOLLOW_ACKS} waypoints (up to seq {w.seq})")
+            if record is not None:
+                record(w, state, steps[w.step].pusher if w.phase == "push" else None)
             if w.completes:
                 last_confirmed = w.step
                 _record(contacts, task, steps, features, w.step, touch_state, state)
