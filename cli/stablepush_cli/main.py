@@ -715,7 +715,8 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
     recorded (cause `crash`) and the batch goes on; Ctrl-C stops it and keeps the trials done.
 
     \b
-    Exit status: 0 done (whatever the success rate), 2 bad input.
+    Exit status: 0 done (whatever the success rate), 1 no plan found, 2 bad input, 130 stopped by
+    Ctrl-C (the trials done are summarized and written).
 
     \b
     Examples:
