@@ -227,8 +227,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     if out_path and not out_path.endswith((".csv", ".json")):
         _fail(f"--out {out_path}: the file name must end in .csv or .json")
 
-    if ray_address is not None and workers is not None:
-        _fail("--workers and --ray: choose one")
+    runner = _runner(workers, ray_address, default=1)
     every, rows = [], []
     with click.progressbar(length=trials * len(tasks), label="planning", file=sys.stderr) as bar:
         for task in tasks:
@@ -236,8 +235,8 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
                 runs = benchmark.bench_planning(task, trials, seed=seed, time_limit=time_limit, progress=bar.update,
                                                 improve_for=improve_for)
             else:
-                runs = _bench_on_runner(benchmark.PlanningJob(task, seed, time_limit, improve_for), trials,
-                                        workers, ray_address, bar.update)
+                runs = _bench_on_runner(benchmark.PlanningJob(task, seed, time_limit, improve_for), trials, runner,
+                                        bar.update)
             every.extend(runs)
             rows.append(benchmark.summarize_planning(runs))
 
@@ -269,12 +268,21 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
         click.echo(f"trials written to {out_path}")
 
 
-def _bench_on_runner(job, trials: int, workers, ray_address, progress) -> list:
+def _runner(workers, ray_address, default: int):
+    """--workers K | --ray [ADDRESS] as a stablepush.runners.Runner (`default` workers when neither
+    is given); both at once exit 2."""
+    from stablepush.runners import Runner
+
+    if ray_address is not None and workers is not None:
+        _fail("--workers and --ray: choose one")
+    return Runner(workers=workers or default, ray=ray_address is not None, ray_address=ray_address or None)
+
+
+def _bench_on_runner(job, trials: int, runner, progress) -> list:
     """A task's planning trials on local processes or Ray (stablepush.runners.run_all), in seed order."""
     from stablepush.plan.benchmark import run_planning_job
-    from stablepush.runners import Runner, WorkerLost, run_all
+    from stablepush.runners import WorkerLost, run_all
 
-    runner = Runner(workers=workers or 1, ray=ray_address is not None, ray_address=ray_address or None)
     done = {}
     for k, trial in run_all(run_planning_job, job, range(trials), runner):
         if isinstance(trial, WorkerLost):
@@ -727,10 +735,9 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
     from stablepush.evaluation import Batch, Spreads, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
     from stablepush.plan import check_plan, plan_task
-    from stablepush.runners import Runner, default_workers
+    from stablepush.runners import default_workers
 
-    if ray_address is not None and workers is not None:
-        _fail("--workers and --ray: choose one")
+    runner = _runner(workers, ray_address, default=default_workers())
     try:
         spreads = Spreads(vary=vary, feature_error=tuple(feature_error), tracker_noise=tuple(tracker_noise))
     except ValueError as exc:
@@ -744,8 +751,6 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
             click.echo(f"{task.name}: {plan.message}", err=True)
             sys.exit(EXIT_NOT_SOLVED)
         plan = check_plan(task, plan)
-    runner = Runner(workers=workers or default_workers(), ray=ray_address is not None,
-                    ray_address=ray_address or None)
     batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, engine=engine,
                   tolerance=tuple(success_tolerance))
     if not quiet:
@@ -836,17 +841,15 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
     """
     from stablepush.outputs import write_atomically
     from stablepush.plan.reach import reach_map
-    from stablepush.runners import Runner, default_workers
+    from stablepush.runners import default_workers
 
-    if ray_address is not None and workers is not None:
-        _fail("--workers and --ray: choose one")
+    runner = _runner(workers, ray_address, default=default_workers())
     task = _load(task_file)
     gx, gz, gth = task.goal
     axes = [a if a is not None else (g, g, 1) for a, g in ((x_axis, gx), (z_axis, gz), (theta_axis, gth))]
     count = axes[0][2] * axes[1][2] * axes[2][2]
     if count > 100_000:
         _fail(f"--x, --z, --theta: {count} cells; at most 100000")
-    runner = Runner(workers=workers or default_workers(), ray=ray_address is not None, ray_address=ray_address or None)
     bar = None if quiet else click.progressbar(length=count, label=f"{count} cells", file=sys.stderr, show_pos=True)
     try:
         result = reach_map(task, *axes, seed=task.planner["seed"] if seed is None else seed, time_limit=time_limit,

@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Sequence, Union
 
@@ -68,42 +69,50 @@ def object_in_gripper(task: Task, plan: Plan, trajectory: Trajectory) -> np.ndar
 
 def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajectory) -> None:
     """Write the trajectory of `plan` (checked against `task`) as one MCAP file at `path`."""
+    T_GO = object_in_gripper(task, plan, trajectory)
+    with _mcap(path, TOPICS) as (T, write):
+        write("/stablepush/scene", 0, T["visualization_msgs/msg/MarkerArray"](
+            markers=_scene_markers(T, task, plan)))
+        steps = list(plan.waypoints)
+        scene = scene_description(task, place_features(task, steps), steps[0].pose)
+        write("/stablepush/arm_scene", 0, T["std_msgs/msg/String"](data=json.dumps(scene)))
+        for i in range(len(trajectory)):
+            ns = int(round(float(trajectory.t[i]) * 1e9))
+            stamp = _time(T, ns)
+            pose = _pose(T, trajectory.position[i], trajectory.quaternion_wxyz[i])
+            held = matrix_to_pose(T_GO[i])
+            write("/tf", ns, T["tf2_msgs/msg/TFMessage"](transforms=[
+                _transform(T, stamp, WORLD, GRIPPER, trajectory.position[i], trajectory.quaternion_wxyz[i]),
+                _transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:])]))
+            write("/stablepush/gripper_pose", ns, T["geometry_msgs/msg/PoseStamped"](
+                header=_header(T, stamp, WORLD), pose=pose))
+            write("/stablepush/gripper_twist", ns, T["geometry_msgs/msg/TwistStamped"](
+                header=_header(T, stamp, WORLD), twist=T["geometry_msgs/msg/Twist"](
+                    linear=_vector3(T, trajectory.linear_velocity[i]),
+                    angular=_vector3(T, trajectory.angular_velocity[i]))))
+            write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=trajectory.phase[i]))
+            write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(trajectory.step[i])))
+
+
+@contextmanager
+def _mcap(path: Union[str, Path], topics: dict):
+    """A ROS 2 bag of `topics` (name -> message type) being written: yields the message types
+    (Humble's) and write(topic, stamp ns, message); on leaving, the bag's MCAP file is moved to
+    `path` whole (rosbag2 writes a directory; its metadata lives in the MCAP file too)."""
     from rosbags.rosbag2 import StoragePlugin, Writer
     from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE)
-    T = store.types
     path = Path(path)
-    T_GO = object_in_gripper(task, plan, trajectory)
     with tempfile.TemporaryDirectory(dir=path.parent if path.parent.exists() else None) as scratch:
         bag = Path(scratch) / "bag"
         with Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
-            connections = {topic: writer.add_connection(topic, kind, typestore=store) for topic, kind in TOPICS.items()}
+            connections = {topic: writer.add_connection(topic, kind, typestore=store) for topic, kind in topics.items()}
 
             def write(topic: str, stamp_ns: int, message) -> None:
-                writer.write(connections[topic], stamp_ns, store.serialize_cdr(message, TOPICS[topic]))
+                writer.write(connections[topic], stamp_ns, store.serialize_cdr(message, topics[topic]))
 
-            write("/stablepush/scene", 0, T["visualization_msgs/msg/MarkerArray"](
-                markers=_scene_markers(T, task, plan)))
-            steps = list(plan.waypoints)
-            scene = scene_description(task, place_features(task, steps), steps[0].pose)
-            write("/stablepush/arm_scene", 0, T["std_msgs/msg/String"](data=json.dumps(scene)))
-            for i in range(len(trajectory)):
-                ns = int(round(float(trajectory.t[i]) * 1e9))
-                stamp = _time(T, ns)
-                pose = _pose(T, trajectory.position[i], trajectory.quaternion_wxyz[i])
-                held = matrix_to_pose(T_GO[i])
-                write("/tf", ns, T["tf2_msgs/msg/TFMessage"](transforms=[
-                    _transform(T, stamp, WORLD, GRIPPER, trajectory.position[i], trajectory.quaternion_wxyz[i]),
-                    _transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:])]))
-                write("/stablepush/gripper_pose", ns, T["geometry_msgs/msg/PoseStamped"](
-                    header=_header(T, stamp, WORLD), pose=pose))
-                write("/stablepush/gripper_twist", ns, T["geometry_msgs/msg/TwistStamped"](
-                    header=_header(T, stamp, WORLD), twist=T["geometry_msgs/msg/Twist"](
-                        linear=_vector3(T, trajectory.linear_velocity[i]),
-                        angular=_vector3(T, trajectory.angular_velocity[i]))))
-                write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=trajectory.phase[i]))
-                write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(trajectory.step[i])))
+            yield store.types, write
         try:
             os.replace(bag / "bag.mcap", path)
         except OSError as exc:
@@ -219,48 +228,30 @@ class RunRecording:
     def write(self, path: Union[str, Path], report: dict) -> None:
         """Write the recording and `report` (ExecutionReport.as_dict, or a fault's report) as one
         MCAP file at `path`."""
-        from rosbags.rosbag2 import StoragePlugin, Writer
-        from rosbags.typesys import Stores, get_typestore
-
-        store = get_typestore(Stores.ROS2_HUMBLE)
-        T = store.types
-        path = Path(path)
-        with tempfile.TemporaryDirectory(dir=path.parent if path.parent.exists() else None) as scratch:
-            bag = Path(scratch) / "bag"
-            with Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
-                connections = {topic: writer.add_connection(topic, kind, typestore=store)
-                               for topic, kind in RUN_TOPICS.items()}
-
-                def write(topic: str, ns: int, message) -> None:
-                    writer.write(connections[topic], ns, store.serialize_cdr(message, RUN_TOPICS[topic]))
-
-                last_ns, end_of_step = 0, {}
-                for t, commanded, reported, in_world, in_grasp, pusher, phase, step in self.samples:
-                    ns = last_ns = int(round(t * 1e9))
-                    end_of_step[step] = ns
-                    stamp = _time(T, ns)
-                    write("/stablepush/commanded_pose", ns, T["geometry_msgs/msg/PoseStamped"](
-                        header=_header(T, stamp, WORLD), pose=_pose(T, commanded[:3], commanded[3:])))
-                    write("/stablepush/gripper_pose", ns, T["geometry_msgs/msg/PoseStamped"](
-                        header=_header(T, stamp, WORLD), pose=_pose(T, reported[:3], reported[3:])))
-                    transforms = [_transform(T, stamp, WORLD, GRIPPER, reported[:3], reported[3:])]
-                    if in_world is not None:
-                        write("/stablepush/object_pose", ns, T["geometry_msgs/msg/PoseStamped"](
-                            header=_header(T, stamp, WORLD), pose=_pose(T, in_world[:3], in_world[3:])))
-                    if in_grasp is not None:
-                        held = matrix_to_pose(grasp_transform((in_grasp["x"], in_grasp["z"], in_grasp["theta"])))
-                        write("/stablepush/object_in_grasp", ns, T["geometry_msgs/msg/PoseStamped"](
-                            header=_header(T, stamp, GRIPPER), pose=_pose(T, held[:3], held[3:])))
-                        transforms.append(_transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:]))
-                    write("/tf", ns, T["tf2_msgs/msg/TFMessage"](transforms=transforms))
-                    write("/stablepush/pusher", ns, T["std_msgs/msg/String"](data=pusher))
-                    write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=phase))
-                    write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(step)))
-                for correction in report.get("replans") or []:
-                    ns = end_of_step.get(correction["after_step"], last_ns)
-                    write("/stablepush/correction", ns, T["std_msgs/msg/String"](data=json.dumps(correction)))
-                write("/stablepush/verdict", last_ns, T["std_msgs/msg/String"](data=json.dumps(report)))
-            try:
-                os.replace(bag / "bag.mcap", path)
-            except OSError as exc:
-                raise OutputError(str(path), f"cannot write the bag ({exc.strerror or exc})") from None
+        with _mcap(path, RUN_TOPICS) as (T, write):
+            last_ns, end_of_step = 0, {}
+            for t, commanded, reported, in_world, in_grasp, pusher, phase, step in self.samples:
+                ns = last_ns = int(round(t * 1e9))
+                end_of_step[step] = ns
+                stamp = _time(T, ns)
+                write("/stablepush/commanded_pose", ns, T["geometry_msgs/msg/PoseStamped"](
+                    header=_header(T, stamp, WORLD), pose=_pose(T, commanded[:3], commanded[3:])))
+                write("/stablepush/gripper_pose", ns, T["geometry_msgs/msg/PoseStamped"](
+                    header=_header(T, stamp, WORLD), pose=_pose(T, reported[:3], reported[3:])))
+                transforms = [_transform(T, stamp, WORLD, GRIPPER, reported[:3], reported[3:])]
+                if in_world is not None:
+                    write("/stablepush/object_pose", ns, T["geometry_msgs/msg/PoseStamped"](
+                        header=_header(T, stamp, WORLD), pose=_pose(T, in_world[:3], in_world[3:])))
+                if in_grasp is not None:
+                    held = matrix_to_pose(grasp_transform((in_grasp["x"], in_grasp["z"], in_grasp["theta"])))
+                    write("/stablepush/object_in_grasp", ns, T["geometry_msgs/msg/PoseStamped"](
+                        header=_header(T, stamp, GRIPPER), pose=_pose(T, held[:3], held[3:])))
+                    transforms.append(_transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:]))
+                write("/tf", ns, T["tf2_msgs/msg/TFMessage"](transforms=transforms))
+                write("/stablepush/pusher", ns, T["std_msgs/msg/String"](data=pusher))
+                write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=phase))
+                write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(step)))
+            for correction in report.get("replans") or []:
+                ns = end_of_step.get(correction["after_step"], last_ns)
+                write("/stablepush/correction", ns, T["std_msgs/msg/String"](data=json.dumps(correction)))
+            write("/stablepush/verdict", last_ns, T["std_msgs/msg/String"](data=json.dumps(report)))

@@ -180,9 +180,25 @@ class SimulatedGrasp:
 
 
 class TrackingArm:
-    """What the arm does the same on every engine: IK on the engine's kinematics (`_kinematics(q)`
-    -> R_WG, p_WG, J; `ik.solve_ik`), and servo set-points moved linearly from one streamed
-    waypoint's joint angles to the next's over the waypoint period (`_set_servos`, `_run`)."""
+    """What the arm does the same on every engine: the world `deviation` makes of the scene, IK on
+    the engine's kinematics (`_kinematics(q)` -> R_WG, p_WG, J; `ik.solve_ik`) from the home
+    posture, servo set-points moved linearly from one streamed waypoint's joint angles to the
+    next's over the waypoint period (`_set_servos`, `_run`), and the report with the tracker's
+    noise. Mixed in before the engine's grasp class, whose constructor takes the altered scene."""
+
+    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
+        super().__init__(deviation.apply(scene))
+        self.scene = scene
+        self.deviation = deviation
+        self._tracker_rng = np.random.default_rng(deviation.seed)
+
+    def _find_home(self) -> np.ndarray:
+        """The joint angles [rad] that put G at the scene's gripper pose: the posture IK's
+        null space pulls toward, and the servos' first target."""
+        self.home_posture = ik.HOME_GUESS.copy()
+        self.home_posture = self.solve_ik(self.scene["gripper_pose"], ik.HOME_GUESS, strict=True, iterations=1000)
+        self.target = self.home_posture.copy()
+        return self.home_posture
 
     def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, strict: bool = False,
                  iterations: int = ik.IK_ITERATIONS) -> np.ndarray:
@@ -214,15 +230,30 @@ class TrackingArm:
             raise ik.unreachable(pose, self.ik_error)
         self.advance(duration, q)
 
+    def _report(self, time_s: float, joints) -> dict:
+        """The arm's state message: G's pose and the joints [rad]; the tracker's `object_in_grasp`,
+        the truth plus the deviation's noise; the object's true world pose."""
+        T_g, T_o = self.gripper_matrix(), self.object_matrix()
+        tracked = in_grasp(T_g, T_o)
+        d = self.deviation
+        if d.tracker_noise_mm > 0 or d.tracker_noise_deg > 0:
+            nx, nz, nth = self._tracker_rng.normal(0.0, [d.tracker_noise_mm, d.tracker_noise_mm, d.tracker_noise_deg])
+            tracked.update(x=tracked["x"] + nx, z=tracked["z"] + nz, theta=tracked["theta"] + nth)
+        return {
+            "time": time_s,
+            "ee_pose": matrix_to_pose(T_g),
+            "joints": [float(v) for v in joints],
+            "object_pose": matrix_to_pose(T_o),
+            "object_in_grasp": tracked,
+            "steps_per_s": round(self.steps_per_second, 1),
+        }
+
 
 class SimArm(TrackingArm, SimulatedGrasp):
     """The arm, the grasp and the world of one scene description (as `deviation` alters it)."""
 
     def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(deviation.apply(scene))
-        self.scene = scene
-        self.deviation = deviation
-        self._tracker_rng = np.random.default_rng(deviation.seed)
+        super().__init__(scene, deviation)
         m = self.model
         self._arm_qpos = np.array([m.jnt_qposadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
         self._arm_dof = np.array([m.jnt_dofadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
@@ -233,12 +264,9 @@ class SimArm(TrackingArm, SimulatedGrasp):
         self._jacp = np.zeros((3, m.nv))
         self._jacr = np.zeros((3, m.nv))
 
-        home = np.asarray(scene["gripper_pose"], float)
-        self.home_posture = ik.HOME_GUESS.copy()
-        self.home_posture = self.solve_ik(home, ik.HOME_GUESS, strict=True, iterations=1000)
-        self.target = self.home_posture.copy()
-        self.data.qpos[self._arm_qpos] = self.home_posture
-        self._set_servos(self.home_posture)
+        home = self._find_home()
+        self.data.qpos[self._arm_qpos] = home
+        self._set_servos(home)
         mujoco.mj_forward(m, self.data)
         self.advance(SETTLE_TIME)
 
@@ -269,23 +297,4 @@ class SimArm(TrackingArm, SimulatedGrasp):
     def state(self) -> dict:
         """What the arm reports: G's pose and the joints; the tracker's `object_in_grasp` (with the
         deviation's noise); and, as a simulation, the object's true world pose."""
-        return arm_state(self, float(self.data.time), self.data.qpos[self._arm_qpos])
-
-
-def arm_state(arm, time_s: float, joints) -> dict:
-    """A simulated arm's report (either engine's): G's pose and the joints [rad]; the tracker's
-    `object_in_grasp`, the truth plus the deviation's noise; the object's true world pose."""
-    T_g, T_o = arm.gripper_matrix(), arm.object_matrix()
-    tracked = in_grasp(T_g, T_o)
-    d = arm.deviation
-    if d.tracker_noise_mm > 0 or d.tracker_noise_deg > 0:
-        nx, nz, nth = arm._tracker_rng.normal(0.0, [d.tracker_noise_mm, d.tracker_noise_mm, d.tracker_noise_deg])
-        tracked.update(x=tracked["x"] + nx, z=tracked["z"] + nz, theta=tracked["theta"] + nth)
-    return {
-        "time": time_s,
-        "ee_pose": matrix_to_pose(T_g),
-        "joints": [float(v) for v in joints],
-        "object_pose": matrix_to_pose(T_o),
-        "object_in_grasp": tracked,
-        "steps_per_s": round(arm.steps_per_second, 1),
-    }
+        return self._report(float(self.data.time), self.data.qpos[self._arm_qpos])

@@ -34,9 +34,8 @@ from typing import Callable, Dict, Sequence
 import numpy as np
 
 from stablepush.frames import pose_to_matrix
-from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import SETTLE_TIME, TrackingArm, WorldDeviation, arm_state, in_grasp
+from stablepush.sim.arm import SETTLE_TIME, TrackingArm, WorldDeviation, in_grasp
 
 DRAKE_TIMESTEP = 0.000125  # s (the friction-fidelity contract fails at 0.2 ms: module docstring)
 DRAKE_APPROXIMATION = "lagged"  # DiscreteContactApproximation: sap, similar or lagged
@@ -324,10 +323,7 @@ class DrakeArm(TrackingArm, DrakeGrasp):
     Drake; the same interface as `arm.SimArm` (move_to, advance, stop, state, solve_ik)."""
 
     def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(deviation.apply(scene))
-        self.scene = scene
-        self.deviation = deviation
-        self._tracker_rng = np.random.default_rng(deviation.seed)
+        super().__init__(scene, deviation)
         plant = self.plant
         joints = [plant.GetJointByName(j, self._arm) for j in scene_mod.ARM_JOINTS]
         self._arm_q = np.array([j.position_start() for j in joints])
@@ -336,13 +332,11 @@ class DrakeArm(TrackingArm, DrakeGrasp):
         self._upper = np.array([j.position_upper_limits()[0] for j in joints])
         self._scratch = plant.CreateDefaultContext()
 
-        self.home_posture = ik.HOME_GUESS.copy()
-        self.home_posture = self.solve_ik(scene["gripper_pose"], ik.HOME_GUESS, strict=True, iterations=1000)
-        self.target = self.home_posture.copy()
+        home = self._find_home()
         q = plant.GetPositions(self.plant_context)
-        q[self._arm_q] = self.home_posture
+        q[self._arm_q] = home
         plant.SetPositions(self.plant_context, q)
-        self._set_servos(self.home_posture)
+        self._set_servos(home)
         self.simulator.Initialize()
         self.advance(SETTLE_TIME)
 
@@ -384,7 +378,7 @@ class DrakeArm(TrackingArm, DrakeGrasp):
 
     def state(self) -> dict:
         """What the arm reports, as `arm.SimArm.state` does."""
-        return arm_state(self, float(self.time), self.plant.GetPositions(self.plant_context)[self._arm_q])
+        return self._report(float(self.time), self.plant.GetPositions(self.plant_context)[self._arm_q])
 
 
 def _quietly(build):
