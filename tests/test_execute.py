@@ -296,9 +296,9 @@ def test_world_deviations_need_the_simulated_arm(tmp_path):
 def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     """The low-mu offset in a world whose pads and features have 15% less mu than the task says:
     open loop its pusher slips and it ends about 1 mm from the goal; closed loop it re-plans from
-    the tracked pose and ends within the loop's threshold (half the goal tolerance). Whether it
-    also ends within the final tolerance depends on the plan (docs/execution.md, "Closed loop"): drift that
-    shows after the prism has passed the bottom pusher can no longer be lifted out."""
+    the tracked pose, robust to pushers with 15% less mu (a correction with the model's mu slipped
+    as the plan did and ended 0.22 mm low, where no pusher can lift it), and lands within the
+    final tolerance, a fifth of the goal tolerance."""
     from stablepush.execution.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
 
@@ -312,9 +312,10 @@ def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     assert open_loop.goal_error["distance"] > 0.5, open_loop.goal_error
     assert report.closed_loop == "on"
     assert any(r.solved and r.pushes > 0 for r in report.replans), report.replans
-    assert report.goal_error["distance"] <= min(loop.threshold[0], open_loop.goal_error["distance"] / 4), \
-        (report.goal_error, open_loop.goal_error)
-    assert abs(report.goal_error["theta"]) <= loop.final_tolerance[1], report.goal_error
+    err = report.goal_error
+    assert max(abs(err["x"]), abs(err["z"])) <= loop.final_tolerance[0], (err, open_loop.goal_error)
+    assert abs(err["theta"]) <= loop.final_tolerance[1], err
+    assert report.success is True
     assert report.last_confirmed_step == report.total_steps  # the spliced plan ran to its end
     assert report.as_dict()["replans"][0]["after_step"] >= 1
 
@@ -352,8 +353,8 @@ def test_a_correction_that_would_carry_an_unheld_object_between_features_is_refu
     loop = ClosedLoop.for_task(task)
     record, steps = replan(task, (20.095, -0.223, 0.449), "left", loop, 20, (20.0, 0.0, 0.0))
     # The search switches pushers only where the pads hold 1.5 times the weight, and finds none.
-    assert not record.solved and steps == [] and record.failure.startswith("left alone in 50 ms: ")
-    assert "every pusher in 500 ms: " in record.failure
+    assert not record.solved and steps == [] and record.failure.startswith("left alone, pusher mu -15% in 50 ms: ")
+    assert "every pusher, pusher mu -15% in 500 ms: " in record.failure and "; every pusher in 500 ms: " in record.failure
     record, steps = replan(task, (0.1, -0.1, 0.3), "left", loop, 1, (1.0, 0.0, 0.0))
     assert record.solved and steps[0].pose == (0.1, -0.1, 0.3)
 
@@ -431,8 +432,29 @@ def test_closed_loop_lands_the_wedge_in_a_low_friction_world_and_says_so(tmp_pat
     assert report["success"] is True and report["tolerance"] == [0.2, 0.2] and report["engine"] == "mujoco"
     err = report["goal_error"]
     assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
-    assert report["replans"] and all(r["trigger"] in ("off_plan", "off_goal") for r in report["replans"])
+    assert report["replans"] and all(r["trigger"] in ("plan_short", "off_plan", "off_goal") for r in report["replans"])
     assert any(r["solved"] and r["pushes"] > 0 for r in report["replans"])
+
+
+def test_closed_loop_plans_a_short_plan_again_to_the_goal_before_the_first_push(tmp_path):
+    """The large manipulation's plan stops 1.28 unit steps short of the goal (inside the task's
+    1 mm / 1 deg) where its one pusher cannot push the rest: closed loop, in a world with 15% less
+    mu, the loop plans it again to 0.2 mm / 0.2 deg before the first push and the run lands there;
+    the report and the printed lines say so."""
+    task = str(TASKS / "large-manipulation.yaml")
+    plan, report_path = tmp_path / "lm.plan.json", tmp_path / "run.json"
+    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--quiet", "--closed-loop",
+                                      "--sim-mu-scale", "0.85", "--success-tolerance", "0.2", "0.2",
+                                      "--json", str(report_path)])
+    assert result.exit_code == 0, result.output
+    report = json.loads(report_path.read_text())
+    first = report["replans"][0]
+    assert first["trigger"] == "plan_short" and first["solved"] and first["after_step"] == 0
+    assert "before the first push: the plan ends off the goal by" in result.output
+    assert report["success"] is True and report["total_steps"] == first["pushes"]
+    err = report["goal_error"]
+    assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
 
 
 def test_closed_loop_on_drake_lands_the_t_shape_in_a_low_friction_world(tmp_path):

@@ -63,6 +63,16 @@ def test_a_plan_that_stops_short_is_its_own_cause():
     assert v.cause == "plan_short" and "the plan itself ends 1.500 mm" in v.detail
 
 
+def test_a_short_plan_that_the_loop_could_not_aim_again_is_plan_short_and_says_why():
+    # The aim before the first push is no correction: its failure leaves the cause to the plan.
+    aimed = dataclasses.replace(_replan(False, failure="every pusher in 500 ms: time_limit"), after_step=0,
+                                trigger="plan_short")
+    v = judge(TASK, _report((18.5, 0.0, 0.0), planned=(18.5, 0.0, 0.0), replans=[aimed], closed_loop="on"),
+              max_replans=20)
+    assert v.cause == "plan_short" and "no plan to the goal was found before the first push (every pusher in " \
+        "500 ms: time_limit)" in v.detail, v.detail
+
+
 def test_a_failed_correction_comes_before_the_slip_that_asked_for_it():
     slip = [ContactRecord("left", 1, 20, slip_mm=1.5, slip_deg=0.0)]
     replans = [_replan(True), _replan(False, failure="no plan to the final tolerance in 50 ms")]

@@ -638,7 +638,9 @@ def _print_report(report) -> None:
     if report.closed_loop == "no tracker":
         click.echo("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
     for r in report.replans:
-        dx, dz, dth = (m - p for m, p in zip(r.measured, report.goal if r.trigger == "off_goal" else r.planned))
+        off, ref = {"off_goal": (r.measured, report.goal), "plan_short": (r.planned, report.goal)}.get(
+            r.trigger, (r.measured, r.planned))
+        dx, dz, dth = (m - p for m, p in zip(off, ref))
         if r.solved and r.pushes == 0:
             outcome = "within the final tolerance of the goal already; nothing to correct"
         elif r.solved:
@@ -647,9 +649,10 @@ def _print_report(report) -> None:
             outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{kept}"
         else:
             outcome = f"no correction taken: {r.failure}; kept the plan"
-        what = "the goal" if r.trigger == "off_goal" else "the plan"
-        click.echo(f"  after step {r.after_step}: off {what} by {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; "
-                   f"{outcome} ({r.planning_ms:.1f} ms)")
+        when = {"off_goal": f"after step {r.after_step}: off the goal by",
+                "plan_short": "before the first push: the plan ends off the goal by"}.get(
+            r.trigger, f"after step {r.after_step}: off the plan by")
+        click.echo(f"  {when} {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; {outcome} ({r.planning_ms:.1f} ms)")
     for c in report.contacts:
         if c.slip_mm is not None:
             click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} slip at the pusher "

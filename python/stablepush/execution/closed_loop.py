@@ -4,7 +4,15 @@ arm protocol) with the plan's and, past a threshold, re-plans from the measured 
 
 The policy lives here; `executor.py` streams and splices. A re-plan
 - aims at the task's goal within the final tolerance (a run is checked again at rest after its
-  last push, and corrected again while it is off by more);
+  last push, and corrected again while it is off by more); a plan that itself ends outside it (a
+  plan stops anywhere within the task's wider tolerance) is planned again to it before the first
+  push (`aim`), where every push of the task is still ahead: at its end the pusher in contact may
+  not be able to push the rest;
+- is planned first robust to pushers whose mu is CORRECTION_PUSHER_MU lower than the task's (as
+  `uncertainty: {pusher_mu: ...}`): a run that needs a correction is in a world whose friction is
+  not the model's, and a correction planned with the model's slips as the plan did (the low-mu
+  offset at x0.85: 0.22 mm low with nominal corrections, 0.08 mm with robust ones); then with the
+  task's own model (a task with `uncertainty:` keeps its box for both);
 - first tries the pusher that is pushing now alone (no switch-over: the object stays on its
   feature), then every pusher of the task with one switch-over more than its budget; a switch-over
   carries the object between features in the pads alone, so that search switches pushers only
@@ -39,6 +47,9 @@ MAX_FAILED_REPLANS = 3  # per run: past this, a pose the planner cannot leave is
 # for worlds that differ from the model; with 1.0, a world with 15% less mu dropped the low-mu
 # prism in transit, 13.8 mm / 45 deg off).
 TRANSIT_HOLD_RATIO = 1.5
+# Corrections are planned first robust to pushers' mu this fraction below the task's: the spread of
+# worlds (x0.85) the loop is rated for.
+CORRECTION_PUSHER_MU = 0.15
 
 
 @dataclass(frozen=True)
@@ -65,7 +76,7 @@ class ClosedLoop:
 
     def may_replan(self, replans: Sequence["Replan"]) -> bool:
         """Whether the run may still re-plan, given the re-plans it made."""
-        failed = sum(1 for r in replans if not r.solved)
+        failed = sum(1 for r in replans if not r.solved and r.trigger != "plan_short")  # aim's: not a correction
         return len(replans) < self.max_replans and failed < self.max_failed_replans
 
     def off_by(self, measured: Dict[str, float], pose: Sequence[float], limit: Tuple[float, float]) -> bool:
@@ -111,6 +122,42 @@ def _transits_held(task: Task, steps: Sequence[Waypoint], pusher: str) -> bool:
     return True
 
 
+def aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tuple[Replan, List[Waypoint]]]:
+    """Before the first push: when the plan `steps` ends off the goal by more than the loop's final
+    tolerance, plan again from its start to the goal within it, with the task's pushers, as few
+    switch-overs as the plan makes first and then one more at a time up to the task's budget (a plan
+    like the one that was checked is preferred), and the transit rule of corrections (a switch-over
+    only where the pads hold TRANSIT_HOLD_RATIO times the weight). None when the plan ends within
+    it; else the record (trigger "plan_short") and the new steps (empty when none was found: the
+    plan runs as it is)."""
+    start, end = steps[0].pose, steps[-1].pose
+    at = lambda pose: not loop.off_by(dict(zip(("x", "z", "theta"), pose)), task.goal, loop.final_tolerance)  # noqa: E731
+    if at(end) or at(start):
+        return None
+    switches = sum(1 for a, b in zip(steps[1:], steps[2:]) if a.pusher != b.pusher)
+    time_limit = min(REPLAN_TIME_LIMIT, task.planner["time_limit"])
+    elapsed, tried, found = 0.0, [], []
+    for budget in range(min(switches, task.planner["max_switches"]), task.planner["max_switches"] + 1):
+        planner = {**task.planner, "tolerance": list(loop.final_tolerance), "time_limit": time_limit,
+                   "max_switches": budget}
+        result = plan_task(dataclasses.replace(task.with_start(start), planner=planner),
+                           min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO)
+        elapsed += result.stats["planning_time_s"]
+        if not result.solved:
+            tried.append(f"{budget} switch-over(s) in {time_limit * 1e3:g} ms: {result.outcome}")
+        elif not _transits_held(task, result.waypoints, result.waypoints[1].pusher):
+            tried.append(f"{' -> '.join(result.pusher_sequence)} carries the object between features where the pads "
+                         f"hold less than {TRANSIT_HOLD_RATIO:g} times its weight")
+        else:
+            found = list(result.waypoints)
+            break
+    record = Replan(after_step=0, measured=tuple(start), planned=tuple(end), solved=bool(found),
+                    pushers=result.pusher_sequence if found else [], pushes=max(len(found) - 1, 0),
+                    kept_pusher=False, planning_ms=elapsed * 1e3, trigger="plan_short",
+                    failure=None if found else "; ".join(tried))
+    return record, found
+
+
 def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float, float, float]:
     """The measured pose minus `pose`: x mm, z mm, theta deg."""
     return measured["x"] - pose[0], measured["z"] - pose[1], angle_difference_deg(measured["theta"], pose[2])
@@ -119,24 +166,29 @@ def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float,
 @dataclass(frozen=True)
 class _Attempt:
     """One way to look for a correction: with the pusher in contact alone, or with every pusher and
-    one switch-over more than the task allows (a correction may need a pusher the plan did not)."""
+    one switch-over more than the task allows (a correction may need a pusher the plan did not);
+    robust to the pushers' mu CORRECTION_PUSHER_MU lower, or with the task's model."""
 
     every_pusher: bool
     time_limit: float  # s
+    robust: bool
 
     def describe(self, pusher: str) -> str:
-        return f"{'every pusher' if self.every_pusher else pusher + ' alone'} in {self.time_limit * 1e3:g} ms"
+        who = "every pusher" if self.every_pusher else pusher + " alone"
+        robust = f", pusher mu -{CORRECTION_PUSHER_MU:.0%}" if self.robust else ""
+        return f"{who}{robust} in {self.time_limit * 1e3:g} ms"
 
 
-# The pusher in contact first: no switch-over, the object stays on its feature.
-ATTEMPTS = (_Attempt(False, KEEP_PUSHER_TIME_LIMIT), _Attempt(True, REPLAN_TIME_LIMIT))
+# Robust first, and the pusher in contact first: no switch-over, the object stays on its feature.
+ATTEMPTS = tuple(_Attempt(every, limit, robust) for robust in (True, False)
+                 for every, limit in ((False, KEEP_PUSHER_TIME_LIMIT), (True, REPLAN_TIME_LIMIT)))
 
 
 def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
            after_step: int, planned: Sequence[float], trigger: str = "off_plan") -> Tuple[Replan, List[Waypoint]]:
     """Plan from the measured pose to the task's goal within the loop's final tolerance, trying
-    ATTEMPTS in turn (the pusher pushing now alone first) and taking the first plan whose transits
-    are held. Returns the record and the new plan's steps (empty when none was found); the first
+    ATTEMPTS in turn (robust first, the pusher pushing now alone first) and taking the first plan
+    whose transits are held. Returns the record and the new plan's steps (empty when none was found); the first
     step is the measured pose."""
     tolerance = list(loop.final_tolerance)
     base = dataclasses.replace(task.with_start(measured), planner={**task.planner, "tolerance": tolerance})
@@ -145,17 +197,21 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
     spec = task.pushers[task.pusher_index(pusher)]
     elapsed, tried, steps = 0.0, [], []
+    robust = dataclasses.replace(base, uncertainty={"pusher_mu": CORRECTION_PUSHER_MU})
     for attempt in ATTEMPTS:
+        if attempt.robust and task.uncertainty:
+            continue  # the task's own box is the model for every attempt
         planner = {**base.planner, "time_limit": min(attempt.time_limit, task.planner["time_limit"])}
+        start = robust if attempt.robust else base
         if attempt.every_pusher:
             planner["max_switches"] = min(task.planner["max_switches"] + 1, PLANNER_PARAMETER_RANGES["max_switches"][2])
-            candidate = dataclasses.replace(base, planner=planner)
+            candidate = dataclasses.replace(start, planner=planner)
         else:
-            candidate = dataclasses.replace(base, pushers=(spec,), planner={**planner, "max_switches": 0})
+            candidate = dataclasses.replace(start, pushers=(spec,), planner={**planner, "max_switches": 0})
         # Every pusher: the search itself switches only where the pads hold, so that a correction
         # may detour to where a switch-over is safe. It holds every model to one factor: 1.5 with
-        # the nominal model alone, the corners' 1.0 with an uncertainty box (whose nominal 1.5
-        # _transits_held checks after).
+        # the nominal model alone, the corners' 1.0 with the task's uncertainty box (whose nominal
+        # 1.5 _transits_held checks after); the robust attempts' box leaves the pads as they are.
         transit_hold = (1.0 if task.uncertainty else TRANSIT_HOLD_RATIO) if attempt.every_pusher else 0.0
         result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher)
         elapsed += result.stats["planning_time_s"]

@@ -18,7 +18,7 @@ from typing import Callable, Dict, List, Optional, Sequence
 import numpy as np
 
 from stablepush.errors import ArmFault
-from stablepush.execution.closed_loop import ClosedLoop, Replan, replan
+from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan
 from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from
 from stablepush.execution.verdict import Verdict, judge
@@ -192,8 +192,9 @@ def execute_plan(
     stream to rate_hz in wall-clock time (a real arm); without it waypoints go as fast as they are
     acknowledged (a simulator keeps its own clock). With `closed_loop`, the tracker's pose after
     each push is compared with the plan's and, past its threshold, the rest of the run is re-planned
-    from the measured pose and spliced into the stream (`stablepush.closed_loop`); the world then
-    holds a feature for every pusher of the task. The report's verdict judges the final pose with
+    from the measured pose and spliced into the stream (`stablepush.closed_loop`), and a plan that
+    ends outside the loop's final tolerance is planned again to it first (`closed_loop.aim`); the
+    world then holds a feature for every pusher of the task. The report's verdict judges the final pose with
     `success_tolerance` (mm, deg; default: the task's goal tolerance). `progress(waypoint,
     confirmed_step, total_steps)` is called per ack, and `record(waypoint, state, pusher)` with the
     arm's state and the pusher in contact (None between contacts; `bags.RunRecording`). `plan`: a
@@ -201,11 +202,15 @@ def execute_plan(
     PlanError (field `resume_from`) before anything is sent when the plan has no push after it."""
     steps: List[Waypoint] = list(plan.waypoints)
     check_resume_from(steps, resume_from)
+    started = time.perf_counter()
+    replans: List[Replan] = []
+    aimed = aim(task, steps, closed_loop) if closed_loop is not None and resume_from == 0 else None
+    if aimed is not None:
+        replans.append(aimed[0])
+        steps = aimed[1] or steps
     features = place_features(task, steps, every_pusher=closed_loop is not None)
     scene = scene_description(task, features, steps[resume_from].pose)
-    started = time.perf_counter()
     last_confirmed = resume_from
-    replans: List[Replan] = []
     loop_status = "off" if closed_loop is None else "on"
     link = None
     try:

@@ -11,7 +11,7 @@ A miss is given one cause, the first of CAUSES that applies, so a script can act
 
 - `grasp_lost`: at the final pose some pad is no longer on the object (`grasp_maintained`);
 - `correction_not_found`: the closed loop was off the plan and found no correction (each re-plan's
-  `failure` says why);
+  `failure` says why; the plan's own shortfall, found before the first push, is `plan_short`);
 - `corrections_exhausted`: the closed loop made as many corrections as it may and is still off;
 - `pusher_slipped`: a pusher slipped on its feature by more than SLIP_FRACTION of the tolerance;
 - `plan_short`: the plan itself ends outside the tolerance (the planner's own tolerance is wider);
@@ -84,7 +84,7 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
 
     if not task.build_model().grasp_maintained(pose_to_si((final["x"], final["z"], final["theta"]))):
         return miss("grasp_lost", "a pad is no longer on the object at the final pose")
-    failed = [r for r in report.replans if not r.solved]
+    failed = [r for r in report.replans if not r.solved and r.trigger != "plan_short"]
     if failed:
         last = failed[-1]
         return miss("correction_not_found", f"no correction found after step {last.after_step} ({last.failure})")
@@ -98,7 +98,9 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
                                       f"feature over steps {worst.first_step}-{worst.last_step}")
     planned = dict(zip(("x", "z", "theta"), report.planned_final))
     if not within(planned, task.goal, tol):
-        return miss("plan_short", f"the plan itself ends {_describe(planned, task.goal)} from the goal")
+        aimed = [r for r in report.replans if r.trigger == "plan_short"]
+        why = f" and no plan to the goal was found before the first push ({aimed[0].failure})" if aimed else ""
+        return miss("plan_short", f"the plan itself ends {_describe(planned, task.goal)} from the goal{why}")
     return miss("drift", "no pusher slipped past half the tolerance; the error built up over the run")
 
 

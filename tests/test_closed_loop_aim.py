@@ -1,0 +1,64 @@
+"""The closed loop's aim before the first push (`closed_loop.aim`): a plan may stop anywhere
+within the task's tolerance, but the loop lands within its final tolerance, so a plan that ends
+outside that is planned again to it while every push is still ahead."""
+from stablepush.execution.closed_loop import ClosedLoop, aim
+from stablepush.plan.search import plan_task
+
+from conftest import shipped
+
+
+def _within(pose, goal, tolerance):
+    return max(abs(pose[0] - goal[0]), abs(pose[1] - goal[1])) <= tolerance[0] and abs(pose[2] - goal[2]) <= tolerance[1]
+
+
+def test_a_plan_that_ends_short_of_the_final_tolerance_is_planned_again_to_it():
+    # The large manipulation's plan (seed 1) stops 1.28 unit steps from the goal, inside its 1 mm /
+    # 1 deg but not the loop's 0.2 / 0.2; its left pusher alone cannot push the rest from there.
+    task = shipped("large-manipulation")
+    plan = plan_task(task, seed=1)
+    loop = ClosedLoop.for_task(task)
+    assert not _within(plan.waypoints[-1].pose, task.goal, loop.final_tolerance)
+    record, steps = aim(task, plan.waypoints, loop)
+    assert record.solved and record.trigger == "plan_short" and record.after_step == 0
+    assert record.planned == plan.waypoints[-1].pose and record.measured == plan.waypoints[0].pose
+    assert steps[0].pose == plan.waypoints[0].pose and record.pushes == len(steps) - 1
+    assert _within(steps[-1].pose, task.goal, loop.final_tolerance), steps[-1].pose
+    assert record.pushers == ["left"]  # the task's switch-over budget (0) is kept
+
+
+def test_a_plan_that_ends_within_the_final_tolerance_is_run_as_it_is():
+    task = shipped("pivoting")  # its plan ends at the goal pose
+    plan = plan_task(task, seed=1)
+    assert aim(task, plan.waypoints, ClosedLoop.for_task(task)) is None
+
+
+def test_when_no_plan_reaches_the_final_tolerance_the_plan_runs_and_the_record_says_why():
+    # The pegs' plan ends a unit step short; in 0.5 s no plan of the two pegs reaches 0.2 mm / 0.2 deg.
+    task = shipped("more/cube-pegs")
+    plan = plan_task(task, seed=1)
+    record, steps = aim(task, plan.waypoints, ClosedLoop.for_task(task))
+    assert not record.solved and steps == [] and record.pushes == 0 and record.pushers == []
+    assert record.failure == "0 switch-over(s) in 500 ms: time_limit; 1 switch-over(s) in 500 ms: time_limit; " \
+        "2 switch-over(s) in 500 ms: time_limit", record.failure
+
+
+def test_aimed_plans_switch_over_only_where_corrections_may_and_no_more_than_needed():
+    # The wedge's plan uses its heel stop alone and ends short; no plan of the heel stop alone
+    # reaches 0.2 mm / 0.2 deg in 0.5 s, so the aimed plan switches once (its budget is 2), by the
+    # rule of every correction: only where the pads hold 1.5 times the weight.
+    from stablepush.execution.closed_loop import TRANSIT_HOLD_RATIO
+    from stablepush.units import pose_to_si
+
+    task = shipped("more/wedge-heel")
+    plan = plan_task(task, seed=1)
+    record, steps = aim(task, plan.waypoints, ClosedLoop.for_task(task))
+    assert plan.pusher_sequence == ["heel-stop"] and task.planner["max_switches"] == 2
+    assert record.solved and record.pushers == ["heel-stop", "floor-block"], record
+    model = task.build_model()
+    holds = [model.hold_ratio(pose_to_si(before.pose), task.pusher_index(before.pusher))
+             for before, after in zip(steps[1:], steps[2:]) if after.pusher != before.pusher]
+    assert len(holds) == 1 and holds[0] >= TRANSIT_HOLD_RATIO, holds
+    # The L bracket's plan (its left pusher alone) is aimed with the left pusher alone.
+    task = shipped("more/l-bracket-mesh")
+    record, steps = aim(task, plan_task(task, seed=1).waypoints, ClosedLoop.for_task(task))
+    assert record.solved and record.pushers == ["left"], record
