@@ -136,7 +136,12 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     best partial path).
 
     \b
-    Exit status: 0 solved, 1 not solved (time limit), 2 bad input.
+    A goal that no plan can reach for a reason decided before the search (every pusher excluded by
+    the uncertainty box, no stable push out of the start, a hold requirement the goal cannot meet
+    within its tolerance) returns at once, "unreachable: " and the reason.
+
+    \b
+    Exit status: 0 solved, 1 not solved (time limit, or unreachable), 2 bad input.
 
     \b
     Example:

@@ -53,7 +53,7 @@ class Plan:
 
     task: str
     solved: bool  # the goal is reached within tolerance with at most max_switches switch-overs
-    outcome: str  # goal_reached | goal_over_switch_limit | time_limit | invalid_start
+    outcome: str  # goal_reached | goal_over_switch_limit | time_limit | invalid_start | unreachable
     message: str
     waypoints: List[Waypoint]
     stats: Dict[str, float] = field(default_factory=dict)

@@ -6,8 +6,10 @@ goal and the seed alone, so the same seed gives the same map on every runner.
 Each cell ends with a verdict:
 - `reached`: a plan reaches the goal within the task's tolerance and switch-over budget;
 - `unreachable`: no plan can, for a reason decided exactly before any search (`reason`): the pads
-  are not all on the object at the goal (no grasp there, so no push can end there), or the pads
-  do not hold the object at the start (the planner's `invalid_start`);
+  are not all on the object at the goal (no grasp there, so no push can end there), the pads are
+  not on the object at the start (the planner's `invalid_start`), or the planner's own verdict
+  before its search (`stablepush.plan.unreachable`: every pusher excluded by the uncertainty box,
+  no stable push out of the start, the goal not held well enough anywhere in its tolerance);
 - `not found`: the search ran out of time (`outcome` says how: `time_limit`, or
   `goal_over_switch_limit` when the goal was reached with more switch-overs than allowed).
 
@@ -74,7 +76,7 @@ def reach_cell(job: ReachJob, i: int) -> dict:
                 pushes=s["pushes"], outcome=plan.outcome)
     if plan.solved:
         cell["verdict"] = "reached"
-    elif plan.outcome == "invalid_start":
+    elif plan.outcome in ("invalid_start", "unreachable"):
         cell.update(verdict="unreachable", reason=plan.message)
     else:
         cell.update(verdict="not found", reason=plan.message)

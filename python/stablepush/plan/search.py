@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from typing import List, Optional
 
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
+from stablepush.plan.unreachable import why_unreachable
 from stablepush.task.model import Task
 from stablepush.task.schema import PLANNER_TUNING, planner_limit, planner_parameter
 from stablepush.units import MM, pose_from_si, pose_to_si
@@ -45,6 +47,8 @@ def plan_task(
     `min_transit_hold` > 0: switch pushers only where the pads alone hold the object with that
     factor of its weight in every model; `start_pusher`, the pusher in contact at the start (a
     re-plan from a feature), makes a plan that begins with another pusher a transit at the start.
+    A goal that no plan can reach for a reason decided before the search (plan.unreachable) returns
+    at once: outcome `unreachable`, the start alone, the reason in the message.
     TaskError (field `goal`) when the start is already within the tolerance of the goal."""
     if task.at_goal(task.start):
         tolerance = task.planner["tolerance"]
@@ -64,6 +68,10 @@ def plan_task(
         _check_models(task, models)
     models = models or task.corner_models()
     model = models[0]
+    began = time.perf_counter()
+    reason = why_unreachable(task, models)
+    if reason is not None:
+        return _unreachable(task, models, settings, reason, time.perf_counter() - began)
     parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}
     parameters.update({key: repr(settings[key]) for key in PLANNER_TUNING if key in settings})
     # Ctrl-C stops the search at once (KeyboardInterrupt); signals reach the main thread only.
@@ -128,6 +136,22 @@ def plan_task(
                 final_hold_ratio=min(m.hold_ratio(last_q, last_pusher) for m in models),
                 uncertainty=dict(task.uncertainty), ends_at_goal=bool(raw.ends_at_goal),
                 task_identity=task.identity())
+
+
+def _unreachable(task: Task, models, settings: dict, reason: str, seconds: float) -> Plan:
+    """The plan of a goal found unreachable before the search: the start alone."""
+    step = settings["step"]
+    d = [(g - s) / k for g, s, k in zip(task.goal, task.start, (step[0], step[0], step[1]))]
+    stats = {"planning_time_s": seconds, "iterations": 0, "nodes": 0, "feasibility_checks": 0, "switches": 0,
+             "restarts": 0, "seed": int(settings["seed"]), "max_switches": int(settings["max_switches"]),
+             "time_limit_s": float(settings["time_limit"]), "pushes": 0, "path_length_steps": 0.0,
+             "goal_distance_steps": math.sqrt(sum(v * v for v in d)),
+             "min_hold_ratio": float(settings["min_hold_ratio"])}
+    start = pose_to_si(task.start)
+    return Plan(task=task.name, solved=False, outcome="unreachable", message=f"unreachable: {reason}",
+                waypoints=[Waypoint(*task.start)], stats=stats,
+                final_hold_ratio=min(m.hold_ratio(start, -1) for m in models), uncertainty=dict(task.uncertainty),
+                ends_at_goal=False, task_identity=task.identity())
 
 
 def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:

@@ -1,0 +1,258 @@
+"""Goals no plan can reach, decided before the search (docs/planner.md, "Unreachable goals").
+
+`why_unreachable(task)` returns a reason when one of these holds, else None:
+
+1. every pusher is excluded by the uncertainty box (a point pusher makes no push robust to pad mu,
+   grip force or mass: docs/model.md, "Point pushers and the box");
+2. no pusher that may push has a stable push out of the start, in any direction, in every model
+   the plan must hold in (the corners of an uncertainty box);
+3. with `planner.min_hold_ratio` > 0, the pads cannot hold the object with that factor of its
+   weight anywhere in the goal's tolerance box, whichever pusher pushes last.
+
+Each is a linear program over an outer approximation of the model, so that its infeasibility (2)
+or an upper bound under the requirement (3) holds for the model itself:
+- every pad point's force lies in its friction disc (a sliding point's on its rim, a sticking
+  point's in the polygon inscribed in it), so in the polygon circumscribed about it;
+- the momentum term M xi / dt of a push of at most one unit step lies in a box;
+- over the tolerance box, the weight in G moves by at most m |g| |dtheta| (gravity fixed in O)
+  and its moment about G's origin, cross_y(o + R(theta) r_cm, W), within an interval bounded on
+  a grid in theta with the derivative's bound for the gaps;
+- a pusher's wrench lies in its closed cone (the model asks for the relative interior).
+For a held start, 2 never fires: the ray from the gravity wrench into a pusher's cone leaves the
+pads' limit surface somewhere, and there a motion is a stable push; it decides the starts the
+pads alone do not hold.
+
+HiGHS (scipy) solves each LP in doubles; the verdict rests on a bound computed from its dual
+solution in exact rational arithmetic (weak duality with the variables' bounds, Neumaier and
+Shcherbina 2004), so a rounding in the solver cannot call a reachable goal unreachable.
+Wrenches are (f_x, f_z [N], torque [N m]); forces in G unless said; poses in SI (units.pose_to_si).
+"""
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from typing import List, Optional, Sequence
+
+import numpy as np
+from scipy.optimize import linprog
+
+from stablepush.task.model import Task
+from stablepush.units import MM, pose_to_si
+
+POLYGON_SIDES = 16  # of the polygon circumscribed about each pad point's friction disc
+THETA_GRID = 65  # poses in theta at which the moment of the weight is bounded over the tolerance box
+HOLD_CAP = 1e3  # hold factors are bounded by this in the LP (as in StablePushModel::hold_ratio)
+
+
+def why_unreachable(task: Task, models=None) -> Optional[str]:
+    """The reason no plan of `task` can reach its goal, or None when none is found (module
+    docstring). `models`: task.corner_models(), built here unless given."""
+    models = models or task.corner_models()
+    usable = [i for i, p in enumerate(task.pushers) if not _excluded_by_box(task, p)]
+    if not usable:
+        return ("every pusher is a point pusher, and a point pusher makes no push robust to the uncertainty "
+                f"box's {', '.join(k for k in ('pad_mu', 'grip_force', 'mass') if task.uncertainty.get(k))}")
+    start = pose_to_si(task.start)
+    # Where the pads hold the object (in pusher i's gravity) the LP is feasible with no pusher force:
+    # only the starts they do not hold need it.
+    stuck = [i for i in usable
+             if any(m.hold_ratio(start, i) < 1.0 and not _may_push(task, m, start, i) for m in models)]
+    if len(stuck) == len(usable):
+        return ("no pusher has a stable push out of the start in any direction (" + ", ".join(
+            task.pushers[i].name for i in stuck) + "): the pads do not hold the object there, and no pusher's "
+            "friction cone can carry what they leave")
+    need = float(task.planner.get("min_hold_ratio", 0.0))
+    goal = pose_to_si(task.goal)
+    # The bound is at least the hold at the goal itself: only goals held too little by every pusher need it.
+    if need > 0.0 and all(min(m.hold_ratio(goal, i) for m in models) < need for i in usable):
+        bounds = {i: min(_hold_bound(task, m, i) for m in models) for i in usable}
+        if all(b < need for b in bounds.values()):
+            best = max(bounds.values())
+            return (f"the pads hold at most {float(best):.3g} times the object's weight anywhere within planner."
+                    f"tolerance of the goal, whichever pusher pushes last, and planner.min_hold_ratio asks for "
+                    f"{need:g}")
+    return None
+
+
+def _excluded_by_box(task: Task, pusher) -> bool:
+    return pusher.is_point and any(task.uncertainty.get(k, 0.0) > 0.0 for k in ("pad_mu", "grip_force", "mass"))
+
+
+def _polygon_rows(n_points: int, limits: Sequence[float], offset: int, n_vars: int):
+    """n_k . f_i <= limit_i for the POLYGON_SIDES normals n_k: each pad force f_i (columns offset + 2i,
+    offset + 2i + 1) in the polygon circumscribed about its disc."""
+    rows, rhs = [], []
+    for i in range(n_points):
+        for k in range(POLYGON_SIDES):
+            a = 2.0 * math.pi * k / POLYGON_SIDES
+            row = np.zeros(n_vars)
+            row[offset + 2 * i], row[offset + 2 * i + 1] = math.cos(a), math.sin(a)
+            rows.append(row)
+            rhs.append(limits[i])
+    return rows, rhs
+
+
+def _rot(theta: float) -> np.ndarray:
+    """R(theta): p_G = o + R p_O (the core's Rotation2)."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, s], [-s, c]])
+
+
+def _cross_y(a, f) -> float:
+    return float(a[1] * f[0] - a[0] * f[1])
+
+
+def _may_push(task: Task, model, q: Sequence[float], pusher: int) -> bool:
+    """False only when no motion from q is a stable push of `pusher` in `model` (module docstring, 2):
+    the LP  sum_j l_j g_j - sum_i W(f_i) - e = w_g,  l >= 0, f_i in the circumscribed polygons,
+    e in the momentum box, is infeasible (in O about O's origin; w_g the weight's wrench that
+    the pusher and pads must carry). Decided as: the least t with |residual| <= t is positive."""
+    gens = [np.asarray(g, float) for g in model.pusher_cones[pusher].generators]
+    positions = [np.asarray(p, float) for p in model.gripper.point_positions]
+    limits = list(model.gripper.point_friction_limits)
+    R = _rot(q[2])
+    o = np.array(q[:2])
+    body = model.body
+    r_cm = R @ np.asarray(body.com, float)
+    weight = body.mass * np.asarray(model.gravity_in_gripper(q, pusher), float)  # in G
+    # The wrench the weight asks of pusher and pads (w_motion's gravity part, docs/model.md section 2).
+    w_g = np.array([*(R.T @ -weight), _cross_y(r_cm, -weight)])
+    # M xi / dt for a push of at most one unit step (|dx|, |dz| <= L, |dtheta| <= A): a box in O.
+    L, A = task.planner["step"][0] * MM, math.radians(task.planner["step"][1])
+    dt2 = task.step_time ** 2
+    arm = float(np.linalg.norm(r_cm))
+    force = body.mass * (math.sqrt(2.0) * L + A * arm) / dt2
+    momentum = np.array([force, force, arm * force + body.inertia * A / dt2])
+    n_g, n_p = len(gens), len(positions)
+    # Columns: l (n_g), f (2 n_p), e (3), t.
+    n = n_g + 2 * n_p + 3 + 1
+    eq = np.zeros((3, n))
+    for j, g in enumerate(gens):
+        eq[:, j] = g
+    for i, (p, _) in enumerate(zip(positions, limits)):
+        for k, unit in enumerate(np.eye(2)):
+            eq[:2, n_g + 2 * i + k] = -(R.T @ unit)
+            eq[2, n_g + 2 * i + k] = -_cross_y(p - o, unit)
+    eq[:, n_g + 2 * n_p:n_g + 2 * n_p + 3] = -np.eye(3)
+    # |eq x - w_g| <= t, row by row.
+    ub_rows, ub_rhs = _polygon_rows(n_p, limits, n_g, n)
+    for r in range(3):
+        for sign in (1.0, -1.0):
+            row = sign * eq[r].copy()
+            row[-1] = -1.0
+            ub_rows.append(row)
+            ub_rhs.append(sign * w_g[r])
+    scale = float(np.abs(w_g).sum() + sum(limits) + momentum.sum())
+    lam_cap = 1e3 * scale
+    bounds = ([(0.0, lam_cap)] * n_g + [(-2.0 * lim, 2.0 * lim) for lim in limits for _ in range(2)]
+              + [(-m, m) for m in momentum] + [(0.0, 10.0 * scale)])
+    c = np.zeros(n)
+    c[-1] = -1.0  # maximize -t
+    bound = _certified_max(c, np.array(ub_rows), np.array(ub_rhs), None, None, bounds)
+    return not (bound < 0)
+
+
+def _hold_bound(task: Task, model, pusher: int):
+    """An upper bound on StablePushModel.hold_ratio(q, pusher) over every q in the goal's tolerance
+    box (module docstring, 3): maximize lam subject to, in G about G's origin,
+        sum f_i + lam W0 in lam [-d, d],   sum cross_y(p_i, f_i) + u = 0,   lam tau_lo <= u <= lam tau_hi,
+    f_i in the circumscribed polygons, with W0 the weight at the goal, d its largest change over
+    the box and [tau_lo, tau_hi] the range of the weight's moment about G's origin. A Fraction, or
+    inf without gravity."""
+    positions = [np.asarray(p, float) for p in model.gripper.point_positions]
+    limits = list(model.gripper.point_friction_limits)
+    goal = pose_to_si(task.goal)
+    tol = task.planner["tolerance"]
+    a, b = tol[0] * MM, math.radians(tol[1])
+    body = model.body
+    W0 = body.mass * np.asarray(model.gravity_in_gripper(goal, pusher), float)
+    gmag = float(np.linalg.norm(W0))
+    if gmag == 0.0:
+        return math.inf  # no weight: held at any factor (hold_ratio's inf)
+    turns = str(model.gravity_frame).endswith("object")  # gravity fixed in O turns in G with theta
+    d = gmag * b if turns else 0.0
+    tau_lo, tau_hi = _moment_range(model, goal, a, b, pusher, turns)
+    n_p = len(positions)
+    n = 2 * n_p + 2  # f, lam, u
+    LAM, U = 2 * n_p, 2 * n_p + 1
+    ub_rows, ub_rhs = _polygon_rows(n_p, limits, 0, n)
+    for r in range(2):  # |sum f_r + lam W0_r| <= lam d
+        for sign in (1.0, -1.0):
+            row = np.zeros(n)
+            row[r:2 * n_p:2] = sign
+            row[LAM] = sign * W0[r] - d
+            ub_rows.append(row)
+            ub_rhs.append(0.0)
+    row = np.zeros(n)  # lam tau_lo - u <= 0 and u - lam tau_hi <= 0
+    row[LAM], row[U] = tau_lo, -1.0
+    ub_rows.append(row)
+    ub_rhs.append(0.0)
+    row = np.zeros(n)
+    row[LAM], row[U] = -tau_hi, 1.0
+    ub_rows.append(row)
+    ub_rhs.append(0.0)
+    eq = np.zeros((1, n))
+    for i, p in enumerate(positions):
+        eq[0, 2 * i], eq[0, 2 * i + 1] = p[1], -p[0]  # cross_y(p, f) = p_z f_x - p_x f_z
+    eq[0, U] = 1.0
+    u_big = HOLD_CAP * max(abs(tau_lo), abs(tau_hi))
+    bounds = ([(-2.0 * lim, 2.0 * lim) for lim in limits for _ in range(2)] + [(0.0, HOLD_CAP), (-u_big, u_big)])
+    c = np.zeros(n)
+    c[LAM] = 1.0
+    return _certified_max(c, np.array(ub_rows), np.array(ub_rhs), eq, np.zeros(1), bounds)
+
+
+def _moment_range(model, goal, a: float, b: float, pusher: int, turns: bool):
+    """[lo, hi] containing cross_y(o + R(theta) r_cm, W(theta)) for |x - gx|, |z - gz| <= a and
+    |theta - gtheta| <= b [N m]: linear in o, so at the corners of the square for each theta of a
+    grid, widened by the derivative's bound times half the grid's spacing."""
+    body = model.body
+    com = np.asarray(body.com, float)
+    values = []
+    thetas = np.linspace(goal[2] - b, goal[2] + b, THETA_GRID)
+    for theta in thetas:
+        W = body.mass * np.asarray(model.gravity_in_gripper((goal[0], goal[1], theta), pusher), float)
+        r_cm = _rot(theta) @ com
+        for dx in (-a, a):
+            for dz in (-a, a):
+                values.append(_cross_y(np.array([goal[0] + dx, goal[1] + dz]) + r_cm, W))
+    wmag = body.mass * float(np.linalg.norm(model.gravity_in_gripper(goal, pusher)))
+    reach = math.hypot(abs(goal[0]) + a, abs(goal[1]) + a) + float(np.linalg.norm(com))
+    # d/dtheta: |o| |W'| + |r_cm'| |W| + |r_cm| |W'| <= (|o| + 2 |r_cm|) |W| (|W'| = |W| when it turns).
+    slope = ((reach + float(np.linalg.norm(com))) if turns else float(np.linalg.norm(com))) * wmag
+    slack = slope * (thetas[1] - thetas[0]) / 2.0 if b > 0 else 0.0
+    pad = 1e-9 * (reach * wmag + 1e-30)  # the rounding of the sums above, many times over
+    return min(values) - slack - pad, max(values) + slack + pad
+
+
+def _certified_max(c, A_ub, b_ub, A_eq, b_eq, bounds) -> Fraction:
+    """A rigorous upper bound on max c.x subject to A_ub x <= b_ub, A_eq x = b_eq and the (finite)
+    bounds: HiGHS's dual (y >= 0 for the rows, z for the equalities), then in exact arithmetic
+    c.x = y.A_ub x + z.A_eq x + r.x <= y.b_ub + z.b_eq + sum_j max(r_j l_j, r_j u_j), r = c - A_ub^T y - A_eq^T z.
+    A problem HiGHS cannot solve gets the bound of its box alone (y = z = 0)."""
+    res = linprog(-c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=b_eq, bounds=bounds, method="highs")
+    y = np.zeros(len(b_ub))
+    z = np.zeros(0 if b_eq is None else len(b_eq))
+    if res.status == 0:
+        y = np.maximum(0.0, -np.asarray(res.ineqlin.marginals, float))
+        if b_eq is not None:
+            z = -np.asarray(res.eqlin.marginals, float)
+    return _weak_duality_bound(c, A_ub, b_ub, A_eq, b_eq, bounds, y, z)
+
+
+def _weak_duality_bound(c, A_ub, b_ub, A_eq, b_eq, bounds, y, z) -> Fraction:
+    F = Fraction
+    ys = [F(float(v)) for v in y]
+    zs = [F(float(v)) for v in z]
+    total = sum((yi * F(float(bi)) for yi, bi in zip(ys, b_ub) if yi), F(0))
+    total += sum((zi * F(float(bi)) for zi, bi in zip(zs, b_eq if b_eq is not None else ()) if zi), F(0))
+    rows: List = [(yi, A_ub[k]) for k, yi in enumerate(ys) if yi]
+    rows += [(zi, A_eq[k]) for k, zi in enumerate(zs) if zi]
+    for j, (lo, hi) in enumerate(bounds):
+        r = F(float(c[j]))
+        for weight, row in rows:
+            if row[j]:
+                r -= weight * F(float(row[j]))
+        if r:
+            total += max(r * F(float(lo)), r * F(float(hi)))
+    return total

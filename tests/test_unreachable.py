@@ -1,0 +1,177 @@
+"""Goals decided unreachable before the search (`stablepush.plan.unreachable`): hand-made cases that
+are, the bounds' soundness as properties over random poses (never below what the core computes),
+the certificate's weak duality, and grids on which every goal called unreachable is also planned,
+with the verdict switched off, and never reached."""
+import dataclasses
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+import yaml
+from scipy.optimize import linprog
+
+from stablepush import _core
+from stablepush.plan import search
+from stablepush.plan import unreachable as U
+from stablepush.plan.search import plan_task
+from stablepush.task import parse_task
+from stablepush.units import pose_to_si
+
+from conftest import shipped, task_with
+
+SHIPPED = ["horizontal-offset-high-mu", "horizontal-offset-low-mu", "large-manipulation", "pivoting", "t-shaped",
+           "more/cube-pegs", "more/hexagon-offset", "more/l-bracket-mesh", "more/tilted-gravity", "more/wedge-heel"]
+
+# A 1 kg block held by pads of mu 0.1 at 2 N (0.4 N of friction against 9.8 N of weight), with one
+# pusher on its top face: the pusher can only press down, so nothing carries the weight.
+UNHELD = """
+name: unheld-block
+object: {shape: box, size: [40, 20, 40], mass: 1000}
+gripper: {grip_force: 2, mu: 0.1, pad_rings: 1}
+gravity: [0, -9.81]
+pushers:
+  - {name: top, from: [-20, 20], to: [20, 20], mu: 0.5}
+start: [0, 0, 0]
+goal: [0, -5, 0]
+planner: {time_limit: 5}
+"""
+
+
+def test_a_goal_the_pads_cannot_hold_within_its_tolerance_is_unreachable_at_once():
+    # The high-mu offset's goal: the pads hold 0.908 of the prism's weight there; in the whole
+    # 0.5 mm / 0.5 deg box around it, at most 0.942 (the bound). It searched its full time limit.
+    task = task_with("horizontal-offset-high-mu", lambda d: d["planner"].update(min_hold_ratio=1.0))
+    plan = plan_task(task, time_limit=5)
+    assert plan.outcome == "unreachable" and not plan.solved and len(plan.waypoints) == 1
+    assert "at most 0.942 times" in plan.message and "min_hold_ratio asks for 1" in plan.message
+    assert plan.stats["planning_time_s"] < 1.0 and plan.waypoints[0].pose == task.start
+    # Asking for 0.9 leaves it reachable, and the search finds it.
+    task = task_with("horizontal-offset-high-mu", lambda d: d["planner"].update(min_hold_ratio=0.9))
+    assert plan_task(task).solved
+
+
+def test_a_start_no_pusher_can_carry_is_unreachable():
+    task = parse_task(UNHELD)
+    plan = plan_task(task)
+    assert plan.outcome == "unreachable", plan.message
+    assert "no pusher has a stable push out of the start" in plan.message and "(top)" in plan.message
+    # With a pusher under the block, which lifts, the start is no dead end.
+    data = yaml.safe_load(UNHELD)
+    data["pushers"].append({"name": "floor", "from": [-20, -20], "to": [20, -20], "mu": 0.5})
+    assert U.why_unreachable(parse_task(yaml.safe_dump(data))) is None
+
+
+def test_point_pushers_all_excluded_by_the_box_are_unreachable_and_a_width_in_pusher_mu_is_not():
+    task = task_with("more/cube-pegs", lambda d: d.update(uncertainty={"pad_mu": 0.1}))
+    plan = plan_task(task)
+    assert plan.outcome == "unreachable" and "uncertainty box's pad_mu" in plan.message
+    assert U.why_unreachable(task_with("more/cube-pegs", lambda d: d.update(uncertainty={"pusher_mu": 0.1}))) is None
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_the_shipped_tasks_are_not_called_unreachable(name):
+    assert U.why_unreachable(shipped(name)) is None
+
+
+def _random_in_box(rng, goal, tol, n):
+    g = np.array(goal, float)
+    offsets = rng.uniform(-1.0, 1.0, size=(n, 3)) * np.array([tol[0], tol[0], tol[1]])
+    corners = np.array([[sx * tol[0], sz * tol[0], st * tol[1]] for sx in (-1, 1) for sz in (-1, 1) for st in (-1, 1)])
+    return g + np.vstack([offsets, corners])
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_the_hold_bound_is_never_below_the_cores_hold_ratio_in_the_box(name):
+    """A property over random goals near the task's and random poses in their boxes, every pusher's
+    gravity, every corner model: the bound is an upper bound of the core's own hold_ratio."""
+    rng = np.random.default_rng(abs(hash(name)) % 2**32)
+    task = shipped(name)
+    for trial in range(4):
+        tol = (float(rng.uniform(0.1, 3.0)), float(rng.uniform(0.1, 5.0)))
+        goal = tuple(np.array(task.goal) + rng.normal(0.0, [2.0, 2.0, 10.0]))
+        t = dataclasses.replace(task, goal=goal, planner={**task.planner, "tolerance": list(tol)})
+        for model in t.corner_models():
+            for pusher in range(len(t.pushers)):
+                bound = U._hold_bound(t, model, pusher)
+                worst = max(model.hold_ratio(pose_to_si(q), pusher) for q in _random_in_box(rng, goal, tol, 40))
+                assert bound >= worst, (name, trial, pusher, float(bound), worst)  # exact: Fraction vs float
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_a_start_with_a_stable_push_is_never_called_stuck(name):
+    """A property: at random poses (most of them not held by the pads alone), wherever the core
+    finds a stable push of a pusher in some random direction, and at the start of every push of
+    the task's plan (a point pusher's stable pushes are a surface random directions miss), the LP
+    says the pusher may push."""
+    rng = np.random.default_rng(7 + len(name))
+    task = shipped(name)
+    model = task.build_model()
+    step = task.planner["step"]
+    found = 0
+    for _ in range(30):
+        q = pose_to_si(tuple(np.array(task.start) + rng.normal(0.0, [3.0, 3.0, 15.0])))
+        if not model.grasp_maintained(q):
+            continue
+        for pusher in range(len(task.pushers)):
+            for _ in range(20):
+                d = rng.normal(size=3)
+                d /= np.linalg.norm(d)
+                dq = _core.Motion(d[0] * step[0] * 1e-3, d[1] * step[0] * 1e-3, math.radians(d[2] * step[1]))
+                if model.check(q, dq, pusher).feasible:
+                    found += 1
+                    assert U._may_push(task, model, q, pusher), (name, q, pusher)
+                    break
+    plan = plan_task(task, seed=1)
+    for before, push in zip(plan.waypoints, plan.waypoints[1:]):
+        found += 1
+        assert U._may_push(task, model, pose_to_si(before.pose), task.pusher_index(push.pusher)), (name, before)
+    assert found > len(plan.waypoints) - 1 or any(p.is_point for p in task.pushers)
+
+
+def test_the_certificate_is_an_upper_bound_for_any_dual_and_tight_for_highs_own():
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        n, m = 6, 12
+        A = rng.normal(size=(m, n))
+        b = rng.uniform(0.5, 2.0, size=m)
+        c = rng.normal(size=n)
+        bounds = [(-3.0, 3.0)] * n
+        res = linprog(-c, A_ub=A, b_ub=b, bounds=bounds, method="highs")
+        optimum = -res.fun
+        bound = U._certified_max(c, A, b, None, None, bounds)
+        assert float(bound) >= optimum - 1e-12 and float(bound) <= optimum + 1e-6
+        for _ in range(5):  # any y >= 0 bounds it, however poor
+            y = rng.uniform(0.0, 1.0, size=m)
+            assert U._weak_duality_bound(c, A, b, None, None, bounds, y, np.zeros(0)) >= Fraction(optimum) - Fraction(
+                1, 10**9)
+
+
+GRID_TASKS = [("horizontal-offset-high-mu", 1.0), ("horizontal-offset-low-mu", 1.0), ("more/hexagon-offset", 4.0),
+              ("more/tilted-gravity", 1.5), ("t-shaped", 2.2)]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, hold", GRID_TASKS)
+def test_no_goal_called_unreachable_on_a_grid_is_reached_by_a_long_search(name, hold, monkeypatch):
+    """Goals across a grid around the task's, with a hold requirement: each goal the verdict calls
+    unreachable is planned again with the verdict switched off for 1.5 s and 2 seeds, and none is
+    reached; some cells of each grid are unreachable and some are reached, so the test decides both."""
+    task = task_with(name, lambda d: d["planner"].update(min_hold_ratio=hold))
+    g = np.array(task.goal)
+    verdicts = {}
+    for dx in (-8.0, 0.0, 8.0):
+        for dth in (-20.0, 0.0, 20.0):
+            goal = (g[0] + dx, g[1], g[2] + dth)
+            t = dataclasses.replace(task, goal=goal)
+            if t.at_goal(t.start):
+                continue
+            verdicts[goal] = U.why_unreachable(t)
+    unreachable = [goal for goal, why in verdicts.items() if why is not None]
+    assert unreachable and len(unreachable) < len(verdicts), verdicts
+    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None: None)
+    for goal in unreachable:
+        t = dataclasses.replace(task, goal=goal)
+        for seed in (1, 2):
+            plan = plan_task(t, seed=seed, time_limit=1.5)
+            assert not plan.solved, (goal, verdicts[goal], plan.message)
