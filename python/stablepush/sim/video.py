@@ -261,6 +261,9 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
     obj, gripper = scene["object"], scene["gripper"]
     half = obj["thickness"] / 2
     width, height = size
+    x0, z0, x1, z1 = box
+    # 6% of the height above and below for the caption and the legend
+    extent_z = max(z1 - z0, (x1 - x0) * height / width) / (1 - 2 * 0.06)
     root = ET.Element("mujoco", model="stablepush-video")
     ET.SubElement(root, "compiler", angle="radian")
     visual = ET.SubElement(root, "visual")
@@ -293,13 +296,13 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
 
     # The ghost's fill is a little thinner than the object, so the object hides it where the two
     # agree and it shows where the object is not where the plan has it; its outline lies in front
-    # of the object's face and of the pads, so it is always seen.
+    # of the object's face and of the pads, so it is always seen, 3 pixels wide.
     ghost = ET.SubElement(world, "body", name="ghost", mocap="true")
     _prism(ghost, assets, "ghost", obj, max(half - 0.001, half / 2), _GHOST_RGBA)
     outline = simulated_outline(obj["polygon"])[0]
     front = -(half + 0.0015)
     for k, (a, b) in enumerate(zip(outline, outline[1:] + outline[:1])):
-        ET.SubElement(ghost, "geom", name=f"ghost_edge{k}", type="capsule", size="0.0004",
+        ET.SubElement(ghost, "geom", name=f"ghost_edge{k}", type="capsule", size=_fmt([1.5 * extent_z / height]),
                       fromto=_fmt((a[0], front, a[1], b[0], front, b[1])), rgba=_fmt(_GHOST_EDGE_RGBA))
 
     hand = ET.SubElement(world, "body", name="gripper", mocap="true")
@@ -316,9 +319,6 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
                       pos=_fmt((0.0, side * (half + 0.0045), 0.045)), rgba=_fmt(_FINGER_RGBA))
     ET.SubElement(hand, "geom", name="backdrop", type="box", size="2 0.0005 2",
                   pos=_fmt((0.0, half + _SLAB - 0.002, 0.0)), rgba=_fmt(_BACKDROP_RGBA))
-    x0, z0, x1, z1 = box
-    # 6% of the height above and below for the caption and the legend
-    extent_z = max(z1 - z0, (x1 - x0) * height / width) / (1 - 2 * 0.06)
     # xyaxes: the image's x along G's x, its y along G's z, so the camera looks along G's +y.
     ET.SubElement(hand, "camera", name="view", orthographic="true", fovy=_fmt([extent_z]),
                   pos=_fmt(((x0 + x1) / 2, -_CAMERA_DISTANCE, (z0 + z1) / 2)), xyaxes="1 0 0 0 0 1")
@@ -430,7 +430,7 @@ class _Caption:
         pen.text((8 * s, 6 * s), f"{task}   t {sample.t:6.2f} s   step {sample.step}   {sample.phase}{contact}",
                  fill=(20, 20, 20), font=self.font)
         x, y = 8 * s, image.height - 20 * s
-        for rgba, label in ((_OBJECT_RGBA, "object"), ((0.1, 0.75, 0.3, 1.0), "plan at this step"),
+        for rgba, label in ((_OBJECT_RGBA, "object"), (_GHOST_EDGE_RGBA, "plan at this step"),
                             (_ACTIVE_FEATURE_RGBA, "pusher in contact"), (_PAD_RGBA, "pads")):
             colour = tuple(round(255 * c) for c in rgba[:3])
             pen.rectangle((x, y + 2 * s, x + 11 * s, y + 13 * s), fill=colour)
