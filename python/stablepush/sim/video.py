@@ -121,13 +121,14 @@ def check_size(size: Sequence[int]) -> None:
 
 
 def video_directory(path: Union[str, Path]) -> str:
-    """`path` as a directory for videos, made (with its parents) when missing; OutputError when it
-    is a file or cannot be made."""
+    """`path` as a directory for videos, made (with its parents) when missing, as an absolute path
+    (workers, Ray's among them, need not share the caller's working directory); OutputError when
+    it is a file or cannot be made."""
     try:
         os.makedirs(path, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{path}: cannot make the directory for videos ({exc.strerror or exc})") from None
-    return str(path)
+    return os.path.abspath(path)
 
 
 def run_scene(task: Task, plan: Plan, closed_loop: bool = False, resume_from: int = 0) -> dict:
