@@ -59,6 +59,17 @@ def test_a_bad_video_suffix_or_size_is_refused_before_anything_runs(tmp_path):
     assert result.exit_code == 2 and "--video-failed" in result.output
 
 
+def test_a_missing_encoder_is_refused_before_the_run_naming_the_option(tmp_path, monkeypatch):
+    import sys
+
+    task, plan = _plan_file(tmp_path)
+    monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)  # as if it were not installed
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--video",
+                                      str(tmp_path / "run.mp4")])
+    assert result.exit_code == 2 and "--video" in result.output and "imageio-ffmpeg" in result.output
+    assert "waypoints" not in result.output
+
+
 def test_frames_are_taken_every_1_over_fps_of_the_stream():
     times = [(k + 1) / 100 for k in range(192)]  # 100 Hz, as `execute` streams
     chosen = video.frame_samples(times, 25)
