@@ -57,6 +57,10 @@ def test_a_bad_video_suffix_or_size_is_refused_before_anything_runs(tmp_path):
     result = CliRunner().invoke(cli, ["evaluate", task, "--plan", str(plan), "--trials", "1",
                                       "--video-failed", str(plan)])  # a file, not a directory
     assert result.exit_code == 2 and "--video-failed" in result.output
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--video-fps", "10"])
+    assert result.exit_code == 2 and "--video-fps: only with --video" in result.output
+    result = CliRunner().invoke(cli, ["evaluate", task, "--plan", str(plan), "--video-size", "320x240"])
+    assert result.exit_code == 2 and "--video-size: only with --video-failed" in result.output
 
 
 def test_a_missing_encoder_is_refused_before_the_run_naming_the_option(tmp_path, monkeypatch):

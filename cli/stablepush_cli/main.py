@@ -468,6 +468,15 @@ def _video_options(which: str):
     return decorate
 
 
+def _video_settings_need(option: str) -> None:
+    """Exit 2 when --video-fps or --video-size is given without `option` (they would do nothing)."""
+    ctx = click.get_current_context()
+    given = [f"--video-{name}" for name in ("fps", "size")
+             if ctx.get_parameter_source(f"video_{name}") is click.core.ParameterSource.COMMANDLINE]
+    if given:
+        _fail(f"{' and '.join(given)}: only with {option}")
+
+
 def _check_video(option: str, path: str, fps: float, size) -> None:
     """Refuse, before anything runs, a video that could not be written (exit 2 naming the option).
     Loads MuJoCo for headless rendering (MUJOCO_GL=osmesa), so call it before the simulated arm
@@ -622,6 +631,8 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
         _fail(f"--record {record_path}: the file name must end in .mcap")
     if video_path:  # before the simulated arm loads MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
         _check_video("--video", video_path, video_fps, video_size)
+    else:
+        _video_settings_need("--video")
     sim_arm = contextlib.ExitStack()
     if sim and arm is None:
         from stablepush.sim.arm import WorldDeviation
@@ -822,13 +833,9 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
       stablepush evaluate data/tasks/t-shaped.yaml --trials 20 --vary pad_mu=0.3 --video-failed t-failed
     """
     if video_dir:  # before the trials load MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
-        from stablepush.sim.video import video_directory
-
         _check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video_fps, video_size)
-        try:
-            video_dir = video_directory(video_dir)
-        except OutputError as exc:
-            _fail(f"--video-failed {exc}")
+    else:
+        _video_settings_need("--video-failed")
     from stablepush.evaluation import Batch, Spreads, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
     from stablepush.plan import check_plan, plan_task
@@ -848,6 +855,13 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
             click.echo(f"{task.name}: {plan.message}", err=True)
             sys.exit(EXIT_NOT_SOLVED)
         plan = check_plan(task, plan)
+    if video_dir:
+        from stablepush.sim.video import video_directory
+
+        try:
+            video_dir = video_directory(video_dir)
+        except OutputError as exc:
+            _fail(f"--video-failed {exc}")
     batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, engine=engine,
                   tolerance=tuple(success_tolerance), video_dir=video_dir, video_fps=video_fps,
                   video_size=tuple(video_size))
