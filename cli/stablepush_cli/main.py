@@ -464,7 +464,7 @@ def _video_options(which: str):
         return click.option(
             "--video-fps", "video_fps", default=25.0, show_default=True, type=click.FloatRange(min=0, min_open=True),
             metavar="FPS", help=f"With {which}: frames per second of the run's time, played at that rate (real "
-                                f"time); at most the waypoint rate (100 at --rate 100).")(command)
+                                f"time); at most 100, a frame per waypoint at 100 Hz.")(command)
     return decorate
 
 
