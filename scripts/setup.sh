@@ -12,7 +12,9 @@ test_extras=false
 [ "${1:-}" = "--test" ] && test_extras=true
 venv="${STABLEPUSH_VENV:-.venv}"
 
-packages=(g++ cmake libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev libompl-dev libboost-filesystem-dev python3-venv)
+# libosmesa6: MuJoCo's headless renderer (execute --video draws with MUJOCO_GL=osmesa)
+packages=(g++ cmake libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev libompl-dev libboost-filesystem-dev python3-venv
+  libosmesa6)
 $test_extras && packages+=(catch2 clang-format)
 missing=()
 for p in "${packages[@]}"; do

@@ -26,6 +26,6 @@ def test_the_walkthrough_runs_as_written(tmp_path, monkeypatch):
     for args in commands:
         result = CliRunner().invoke(cli, args)
         assert result.exit_code == 0, (args, result.output)
-        outputs = [a for a, option in zip(args[1:], args) if option in ("-o", "--json", "--plot")]
+        outputs = [a for a, option in zip(args[1:], args) if option in ("-o", "--json", "--plot", "--video")]
         for name in outputs:
             assert (tmp_path / name).stat().st_size > 0, (args, name)

@@ -452,6 +452,79 @@ def cone(task_file: str, pusher: str, png_path) -> None:
     click.echo(f"figure written to {png_path}")
 
 
+def _video_size(_ctx, _param, value: str):
+    """--video-size WxH as (width, height) pixels (the library checks the numbers)."""
+    width, sep, height = value.lower().partition("x")
+    if not sep or not width.strip().isdigit() or not height.strip().isdigit():
+        raise click.BadParameter(f"expected WIDTHxHEIGHT in pixels (e.g. 640x480), got {value!r}")
+    return int(width), int(height)
+
+
+def _video_options(which: str):
+    """--video-fps and --video-size, for the videos that `which` asks for."""
+    def decorate(command):
+        command = click.option(
+            "--video-size", "video_size", default="640x480", show_default=True, callback=_video_size,
+            metavar="WxH", help=f"With {which}: the video's width and height in pixels (even).")(command)
+        return click.option(
+            "--video-fps", "video_fps", default=25.0, show_default=True, type=click.FloatRange(min=0, min_open=True),
+            metavar="FPS", help=f"With {which}: frames per second of the run's time, played at that rate (real "
+                                f"time); at most 100, a frame per waypoint at 100 Hz.")(command)
+    return decorate
+
+
+def _video_settings_need(option: str) -> None:
+    """Exit 2 when --video-fps or --video-size is given without `option` (they would do nothing)."""
+    ctx = click.get_current_context()
+    given = [f"--video-{name}" for name in ("fps", "size")
+             if ctx.get_parameter_source(f"video_{name}") is click.core.ParameterSource.COMMANDLINE]
+    if given:
+        _fail(f"{' and '.join(given)}: only with {option}")
+
+
+def _check_video(option: str, path: str, fps: float, size) -> None:
+    """Refuse, before anything runs, a video that could not be written (exit 2 naming the option).
+    Loads MuJoCo for headless rendering (MUJOCO_GL=osmesa), so call it before the simulated arm
+    starts."""
+    from stablepush.sim.video import check_fps, check_size, check_video_path
+
+    for name, check, value in (("--video-fps", check_fps, fps), ("--video-size", check_size, size)):
+        try:
+            check(value)
+        except ValueError as exc:
+            _fail(f"{name}: {exc}")
+    try:
+        check_video_path(path)
+    except OutputError as exc:
+        _fail(f"{option} {exc}")
+
+
+def _write_video(path: str, task, scene: dict, recording, fps: float, size, quiet: bool) -> None:
+    """Draw a recorded run into `path` (stablepush.sim.video), with a progress bar on stderr."""
+    from stablepush.sim.video import render_run
+
+    bar = None
+
+    def progress(done: int, frames: int) -> None:
+        nonlocal bar
+        if quiet:
+            return
+        if bar is None:
+            bar = click.progressbar(length=frames, label=f"video {path}", file=sys.stderr, show_pos=True)
+            bar.__enter__()
+        bar.update(1)
+
+    try:
+        info = render_run(path, task, scene, recording.samples, fps=fps, size=size, progress=progress)
+    except OutputError as exc:
+        _fail(f"--video {exc}")
+    finally:
+        if bar is not None:
+            bar.__exit__(None, None, None)
+    click.echo(f"video written to {path}: {info.frames} frames, {info.width}x{info.height} at {info.fps:g} fps, "
+               f"drawn in {info.render_s:.1f} s ({info.ms_per_frame:.0f} ms a frame)")
+
+
 def _host_port(value: str):
     host, sep, port = value.rpartition(":")
     if not sep or not port.isdigit():
@@ -490,6 +563,12 @@ def _host_port(value: str):
               help="Record the run as a ROS 2 bag (one MCAP file): the commanded and measured gripper pose, the "
                    "object in the world and in the grasp, /tf, the pusher in contact, each correction and the "
                    "verdict (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
+@click.option("--video", "video_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mp4",
+              help="Draw the run as a video (H.264 MP4, headless): seen along the gripping axis as the plan figures "
+                   "are, the object, the pads, the features (the pusher in contact highlighted) and the plan's pose "
+                   "at each step as a green ghost (docs/execution.md, 'Video of a run'); needs the object's pose, "
+                   "which a simulated arm reports; drawn on a fault too.")
+@_video_options("--video")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
               metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
@@ -508,8 +587,8 @@ def _host_port(value: str):
               metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
                                      "this close to the goal (default: a fifth of the task's goal tolerance).")
 def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
-            ack_timeout: float, json_path, success_tolerance, record_path, quiet: bool, mu_scale: float, tracker_noise,
-            closed_loop: bool, replan_threshold, final_tolerance) -> None:
+            ack_timeout: float, json_path, success_tolerance, record_path, video_path, video_fps: float, video_size,
+            quiet: bool, mu_scale: float, tracker_noise, closed_loop: bool, replan_threshold, final_tolerance) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -531,6 +610,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     \b
     Examples:
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --sim
+      stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --sim --video low-mu.mp4
       stablepush sim-arm --port 47100 &     # or your robot's bridge
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
     """
@@ -552,6 +632,12 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     deviated = mu_scale != 1.0 or any(tracker_noise) or engine != DEFAULT_ENGINE
     if deviated and not (sim and arm is None):
         _fail("--engine, --sim-mu-scale and --tracker-noise: only with --sim (a simulated arm started here)")
+    if record_path and not record_path.endswith(".mcap"):
+        _fail(f"--record {record_path}: the file name must end in .mcap")
+    if video_path:  # before the simulated arm loads MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
+        _check_video("--video", video_path, video_fps, video_size)
+    else:
+        _video_settings_need("--video")
     sim_arm = contextlib.ExitStack()
     if sim and arm is None:
         from stablepush.sim.arm import WorldDeviation
@@ -581,13 +667,18 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
             bar.update(confirmed - seen[0])
             seen[0] = confirmed
 
-    if record_path and not record_path.endswith(".mcap"):
-        _fail(f"--record {record_path}: the file name must end in .mcap")
     recording = None
-    if record_path:
+    if record_path or video_path:
         from stablepush.execution.bags import RunRecording
 
         recording = RunRecording()
+
+    def video() -> None:
+        if video_path:
+            from stablepush.sim.video import run_scene
+
+            _write_video(video_path, task, run_scene(task, plan, closed_loop, resume_from), recording, video_fps,
+                         video_size, quiet)
     try:
         report = execute_plan(task, plan, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
                               ack_timeout=ack_timeout, closed_loop=loop, success_tolerance=success_tolerance,
@@ -597,8 +688,10 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
             bar.__exit__(None, None, None)
         if json_path:
             write_atomically(json_path, json.dumps(fault_report(task, fault, success_tolerance), indent=1) + "\n")
-        if recording is not None:
+        if record_path:
             recording.write(record_path, fault_report(task, fault, success_tolerance))
+        if recording is not None and recording.samples:
+            video()
         if not fault.connected:
             click.echo(f"error: {fault.reason}; nothing was sent. Is the arm server running? "
                        f"(`stablepush sim-arm` serves a simulated arm, or run with --sim)", err=True)
@@ -620,9 +713,10 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     if json_path:
         write_atomically(json_path, json.dumps(report.as_dict(), indent=1) + "\n")
         click.echo(f"report written to {json_path}")
-    if recording is not None:
+    if record_path:
         recording.write(record_path, report.as_dict())
         click.echo(f"run recorded to {record_path}")
+    video()
     if report.success is False:
         sys.exit(EXIT_MISSED)
 
@@ -718,9 +812,14 @@ def _vary(_ctx, _param, values):
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row.")
 @click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
               help="Draw the goal error's CDF against the tolerance, and success over the varied parameters (PNG).")
+@click.option("--video-failed", "video_dir", type=click.Path(file_okay=False), default=None, metavar="DIR",
+              help="Draw each failed trial's run as a video, DIR/trial-<i>.mp4 (made if missing; as `execute "
+                   "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv).")
+@_video_options("--video-failed")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_error, tracker_noise, closed_loop: bool,
-             engine: str, success_tolerance, workers, ray_address, json_path, csv_path, png_path, quiet: bool) -> None:
+             engine: str, success_tolerance, workers, ray_address, json_path, csv_path, png_path, video_dir,
+             video_fps: float, video_size, quiet: bool) -> None:
     """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
 
     Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
@@ -739,7 +838,12 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
       stablepush evaluate data/tasks/pivoting.yaml --trials 200 --vary pad_mu=0.15 --vary pusher_mu=0.15 \\
           --vary grip_force=0.1 --vary mass=0.05 --feature-error 0.5 0.5 --json piv.eval.json --plot piv.png
       stablepush evaluate data/tasks/t-shaped.yaml --trials 1000 --closed-loop --vary pad_mu=0.15 --ray
+      stablepush evaluate data/tasks/t-shaped.yaml --trials 20 --vary pad_mu=0.3 --video-failed t-failed
     """
+    if video_dir:  # before the trials load MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
+        _check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video_fps, video_size)
+    else:
+        _video_settings_need("--video-failed")
     from stablepush.evaluation import Batch, Spreads, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
     from stablepush.plan import check_plan, plan_task
@@ -759,8 +863,16 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
             click.echo(f"{task.name}: {plan.message}", err=True)
             sys.exit(EXIT_NOT_SOLVED)
         plan = check_plan(task, plan)
+    if video_dir:
+        from stablepush.sim.video import video_directory
+
+        try:
+            video_dir = video_directory(video_dir)
+        except OutputError as exc:
+            _fail(f"--video-failed {exc}")
     batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, engine=engine,
-                  tolerance=tuple(success_tolerance))
+                  tolerance=tuple(success_tolerance), video_dir=video_dir, video_fps=video_fps,
+                  video_size=tuple(video_size))
     if not quiet:
         click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop on {engine}, "
                    f"on {runner.describe()}", err=True)
@@ -796,6 +908,12 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
     written = [p for p in (json_path, csv_path, png_path) if p]
     if written:
         click.echo(f"written: {', '.join(written)}")
+    if video_dir:
+        videos = sum(1 for t in result.trials if t.get("video"))
+        failed = sum(1 for t in result.trials if not t["success"])
+        click.echo(f"videos of {videos} of the {failed} failed trial(s) written to {video_dir}"
+                   + "".join(f"\n  trial {t['trial']}: no video ({t['video_error']})"
+                             for t in result.trials if t.get("video_error")))
     if s["interrupted"]:
         sys.exit(130)
 

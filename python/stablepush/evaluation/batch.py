@@ -4,7 +4,9 @@ Each trial runs the plan on a simulated arm of its own (`stablepush.sim`, in the
 over the arm protocol on a loopback port) in the world `worlds.draw_world(seed, i)` draws, and
 records where the object ended against the goal. Trials are independent: they run one after the
 other, on local worker processes, or on Ray (`stablepush.runners`), and a trial's outcome depends on
-(seed, i) alone, so all three give the same trials.
+(seed, i) alone, so all three give the same trials. With `Batch.video_dir`, a failed trial's run,
+kept in memory while it runs, is drawn into a video in the worker after its verdict
+(`stablepush.sim.video`), which changes no outcome.
 
 The summary's `ci95` is the Wilson score interval of the success rate (scipy's `binomtest`).
 Units: mm and deg as in plan files; times in s.
@@ -21,6 +23,7 @@ import numpy as np
 
 from stablepush.errors import ArmFault
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
+from stablepush.execution.bags import RunRecording
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.executor import execute_plan
 from stablepush.plan.plan import Plan
@@ -46,6 +49,11 @@ class Batch:
     closed_loop: bool = False
     engine: str = "mujoco"
     tolerance: Tuple[float, float] = DEFAULT_TOLERANCE
+    # Where each failed trial's video goes (`trial-<i>.mp4`; None: no videos), and how it is drawn
+    # (stablepush.sim.video). Drawn after the trial's verdict, so the outcomes do not depend on them.
+    video_dir: Optional[str] = None
+    video_fps: float = 25.0
+    video_size: Tuple[int, int] = (640, 480)
 
     def world(self, trial: int) -> TrialWorld:
         return draw_world(self.seed, trial, self.spreads, self.task.pusher_names)
@@ -63,16 +71,19 @@ def deviation_of(batch: Batch, world: TrialWorld) -> WorldDeviation:
 def run_trial(batch: Batch, trial: int) -> dict:
     """Run trial `trial` and return its record. A trial whose arm faults is recorded with cause
     `arm_fault`, one that raises anything else as `crash` (`error` says what); neither ends the
-    batch."""
+    batch. With `batch.video_dir`, the run is recorded in memory and, when the trial failed, drawn
+    into video_dir/trial-<i>.mp4 (`video`: its path; None for a trial that landed, or when it could
+    not be drawn, `video_error` then says why)."""
     world = batch.world(trial)
     started = time.perf_counter()
     record = {"trial": trial, "world": world.as_dict()}
+    recording = RunRecording() if batch.video_dir else None
     try:
         loop = ClosedLoop.for_task(batch.task) if batch.closed_loop else None
         with running_sim_arm(log=lambda text: None, deviation=deviation_of(batch, world),
                              engine=batch.engine) as server:
             report = execute_plan(batch.task, batch.plan, server.host, server.port, rate_hz=RATE_HZ, pace=False,
-                                  closed_loop=loop, success_tolerance=batch.tolerance)
+                                  closed_loop=loop, success_tolerance=batch.tolerance, record=recording)
         record.update(final_error=report.final_error, goal_error=report.goal_error,
                       replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
                       cause=report.verdict.cause if report.verdict else None,
@@ -85,7 +96,25 @@ def run_trial(batch: Batch, trial: int) -> dict:
         record.update(final_error=None, goal_error=None, replans=0, success=False, cause="crash", sim_time_s=0.0,
                       error=f"{type(exc).__name__}: {exc} ({os.path.basename(last.filename)}:{last.lineno})")
     record["wall_s"] = time.perf_counter() - started
+    if recording is not None:
+        record["video"] = None if record["success"] else _failed_trial_video(batch, trial, world, recording, record)
     return record
+
+
+def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: RunRecording, record: dict):
+    """Draw a failed trial's recorded run in its own world (features where this trial put them)
+    into video_dir/trial-<i>.mp4 and return the path; None, with `video_error` in the record, when
+    it cannot be drawn (no waypoint was acknowledged, say). Never raises: the trial's record stands."""
+    from stablepush.sim.video import render_run, run_scene
+
+    path = os.path.join(batch.video_dir, f"trial-{trial}.mp4")
+    try:
+        scene = deviation_of(batch, world).apply(run_scene(batch.task, batch.plan, batch.closed_loop))
+        render_run(path, batch.task, scene, recording.samples, fps=batch.video_fps, size=batch.video_size)
+    except Exception as exc:  # noqa: BLE001 - a video that cannot be drawn does not change the trial
+        record["video_error"] = f"{type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
+        return None
+    return path
 
 
 def _crashed(batch: Batch, trial: int, why: str) -> dict:
@@ -165,14 +194,15 @@ class Evaluation:
         header = (["trial", "success", "cause"] + list(VARY_KEYS)
                   + [f"{name}_{c}" for name in offsets for c in ("dx_mm", "dz_mm", "dtheta_deg")]
                   + ["goal_x_mm", "goal_z_mm", "goal_theta_deg", "goal_distance_mm", "replans", "sim_time_s",
-                     "wall_s", "error"])
+                     "wall_s", "error"] + (["video"] if self.batch.video_dir else []))
         rows = []
         for t in self.trials:
             w, g = t["world"], t["goal_error"] or {}
             rows.append([t["trial"], t["success"], t["cause"] or ""] + [w[k] for k in VARY_KEYS]
                         + [v for name in offsets for v in w["feature_offsets"].get(name, ("", "", ""))]
                         + [g.get("x", ""), g.get("z", ""), g.get("theta", ""), g.get("distance", ""), t["replans"],
-                           t["sim_time_s"], t["wall_s"], t["error"] or ""])
+                           t["sim_time_s"], t["wall_s"], t["error"] or ""]
+                        + ([t.get("video") or ""] if self.batch.video_dir else []))
         return header, rows
 
 

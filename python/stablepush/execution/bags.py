@@ -27,7 +27,7 @@ import os
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Sequence, Union
+from typing import Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -209,28 +209,47 @@ RUN_TOPICS = {
 }
 
 
+class RunSample(NamedTuple):
+    """One acknowledged waypoint of a recorded run. Poses are [x, y, z, qw, qx, qy, qz] in W (m);
+    `object_pose` is None when the arm does not report it (a real arm), `object_in_grasp`
+    ({x, z mm, theta deg}) when it has no tracker; `planned` is the plan's pose in the grasp at
+    `step` (x mm, z mm, theta deg), in the plan being followed (re-planned after a correction)."""
+
+    t: float  # s, the stream's time
+    commanded: List[float]
+    reported: List[float]  # G as the arm reports it (`ee_pose`)
+    object_pose: Optional[List[float]]
+    object_in_grasp: Optional[Dict[str, float]]
+    pusher: str  # the pusher in contact, "" between contacts
+    phase: str
+    step: int
+    planned: Optional[Tuple[float, float, float]]
+
+
 class RunRecording:
-    """A run as the executor saw it (`execute --record run.mcap`), one sample per acknowledged
-    waypoint, stamped with the stream's time: the commanded and the reported gripper pose (world),
-    the object's pose in the world (`/stablepush/object_pose`, a simulator's truth) and in the grasp
-    (`/stablepush/object_in_grasp`, the tracker's, in gripper), `/tf` world -> gripper -> object,
-    the pusher in contact ("" between contacts), phase and step; each correction of the closed loop
-    (`/stablepush/correction`, JSON, at the step after which it was made) and the run's report
-    (`/stablepush/verdict`, JSON, at the end). Pass it to `execute_plan(record=...)`."""
+    """A run as the executor saw it (`execute --record run.mcap`, `--video run.mp4`), one
+    `RunSample` per acknowledged waypoint, stamped with the stream's time. As a bag: the commanded
+    and the reported gripper pose (world), the object's pose in the world
+    (`/stablepush/object_pose`, a simulator's truth) and in the grasp (`/stablepush/object_in_grasp`,
+    the tracker's, in gripper), `/tf` world -> gripper -> object, the pusher in contact ("" between
+    contacts), phase and step; each correction of the closed loop (`/stablepush/correction`, JSON,
+    at the step after which it was made) and the run's report (`/stablepush/verdict`, JSON, at the
+    end). Pass it to `execute_plan(record=...)`."""
 
     def __init__(self):
-        self.samples = []
+        self.samples: List[RunSample] = []
 
     def __call__(self, waypoint, state: dict, pusher) -> None:
-        self.samples.append((waypoint.t, list(waypoint.pose), list(state["ee_pose"]), state.get("object_pose"),
-                             state.get("object_in_grasp"), pusher or "", waypoint.phase, waypoint.step))
+        self.samples.append(RunSample(waypoint.t, list(waypoint.pose), list(state["ee_pose"]), state.get("object_pose"),
+                                      state.get("object_in_grasp"), pusher or "", waypoint.phase, waypoint.step,
+                                      waypoint.planned))
 
     def write(self, path: Union[str, Path], report: dict) -> None:
         """Write the recording and `report` (ExecutionReport.as_dict, or a fault's report) as one
         MCAP file at `path`."""
         with _mcap(path, RUN_TOPICS) as (T, write):
             last_ns, end_of_step = 0, {}
-            for t, commanded, reported, in_world, in_grasp, pusher, phase, step in self.samples:
+            for t, commanded, reported, in_world, in_grasp, pusher, phase, step, _ in self.samples:
                 ns = last_ns = int(round(t * 1e9))
                 end_of_step[step] = ns
                 stamp = _time(T, ns)

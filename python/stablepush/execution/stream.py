@@ -39,7 +39,9 @@ MAX_TRAJECTORY_SAMPLES = 300_000
 class ArmWaypoint:
     """One streamed end-effector set-point. `step` is the plan step the motion is heading for
     (during a push) or the last one reached (otherwise); when `completes` is set, the arm's
-    acknowledgement of this waypoint confirms that plan step."""
+    acknowledgement of this waypoint confirms that plan step. `planned` is that step's pose in the
+    grasp (x mm, z mm, theta deg) in the plan being streamed, a re-planned one after a correction
+    (so a recording can show the plan the arm was following, `stablepush.sim.video`)."""
 
     seq: int
     t: float  # s from the start of the stream
@@ -47,16 +49,18 @@ class ArmWaypoint:
     completes: bool
     phase: str  # push | settle | retract | move | approach
     pose: Tuple[float, ...]
+    planned: Optional[Tuple[float, float, float]] = None
 
 
 class _Stream:
     """Accumulates waypoints at a fixed rate."""
 
-    def __init__(self, rate_hz: float, start_pose: np.ndarray, step: int):
+    def __init__(self, rate_hz: float, start_pose: np.ndarray, step: int, planned: Sequence[Sequence[float]]):
         self.period = 1.0 / rate_hz
         self.points: List[ArmWaypoint] = []
         self.pose = start_pose
         self.step = step
+        self.planned = [tuple(float(v) for v in pose) for pose in planned]  # each plan step's pose in the grasp
 
     def _emit(self, T: np.ndarray, phase: str, step: int, completes: bool = False) -> None:
         if len(self.points) >= MAX_TRAJECTORY_SAMPLES:
@@ -65,7 +69,8 @@ class _Stream:
                                          f"{1 / self.period:g} Hz) by plan step {step}: a lower rate, or a "
                                          f"shorter plan")
         self.points.append(ArmWaypoint(seq=len(self.points), t=(len(self.points) + 1) * self.period, step=step,
-                                       completes=completes, phase=phase, pose=tuple(matrix_to_pose(T))))
+                                       completes=completes, phase=phase, pose=tuple(matrix_to_pose(T)),
+                                       planned=self.planned[step]))
         self.pose = T
 
     def move(self, target: np.ndarray, phase: str) -> None:
@@ -129,7 +134,7 @@ def arm_trajectory(
     reach = max(math.hypot(x, z) for x, z in task.vertices) * MM
     top = max(max(f.start[2], f.end[2]) for f in features.values())
 
-    stream = _Stream(rate_hz, pose_to_matrix(start_pose), resume_from)
+    stream = _Stream(rate_hz, pose_to_matrix(start_pose), resume_from, [s.pose for s in steps])
     # On a resume the object may still rest on the feature of the last confirmed push: back off first.
     current: Optional[Feature] = features.get(steps[resume_from].pusher) if resume_from > 0 else None
     lane = home[1] + env["lane_offset"] * MM

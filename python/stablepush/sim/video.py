@@ -1,0 +1,440 @@
+"""Videos of runs (`stablepush execute --video run.mp4`, `evaluate --video-failed DIR`): a run
+recorded by the executor (`stablepush.execution.bags.RunRecording`, one sample per acknowledged
+waypoint) drawn after the run by MuJoCo's renderer, headless (OSMesa), and encoded as H.264 MP4 by
+the ffmpeg that the imageio-ffmpeg wheel ships.
+
+The drawing is a render-only MuJoCo model built from the run's scene description (the one the
+executor sends in its hello, `stablepush.execution.world.scene_description`): the features, the
+object, the pads and the plan's ghost are mocap bodies or fixed geoms whose poses are set from
+the recorded states frame by frame, and nothing is simulated. So a run on Drake, or on an arm that
+reports the object, is drawn the same way as one on MuJoCo.
+
+What a frame shows (poses [x, y, z, qw, qx, qy, qz] in W, m, as recorded):
+- the camera: fixed in the gripper frame G, on the gripping axis (G's -y side) looking along +y,
+  orthographic, with G's x to the right and z up: the view of the plan figures
+  (`stablepush show`), so the pads stay put and the object slides between them. Only a slab
+  a few centimetres deep about G's xz-plane is drawn, so that the features of other stations
+  (150 mm away along y) never hide the object;
+- the object (orange) where the arm reports it (`object_pose`, a simulator's truth; else G's
+  pose times the tracker's `object_in_grasp`);
+- the pads (dark, translucent discs) and the fingers (faint) at G's reported pose;
+- every feature (blue-grey), the one the pusher in contact belongs to in bright blue;
+- the ghost (translucent green with a green outline): the plan's pose in the grasp at the sample's
+  step (`RunSample.planned`: the step a push heads for, or the last one reached), in the plan being
+  followed, a re-planned one after a closed-loop correction;
+- a caption: the task, the stream's time, the step, the phase and the pusher in contact.
+
+Frames are taken from the samples every 1/fps s of the stream's time (100 Hz at `execute`'s default
+rate) and played at fps, so the video runs at the robot's speed.
+
+MuJoCo picks its GL back-end when it is first imported (`mujoco.gl_context`, from MUJOCO_GL): this
+module sets MUJOCO_GL=osmesa when it is unset and mujoco is not imported yet. A process that
+imported mujoco first without MUJOCO_GL (the simulated arm does) got GLFW, which needs a display;
+without one, the renderer here is switched to OSMesa, as MUJOCO_GL=osmesa would have chosen.
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+import tempfile
+import time
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from stablepush.errors import OutputError
+from stablepush.execution.bags import RunSample
+from stablepush.execution.world import place_features, scene_description
+from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, quat_about_y
+from stablepush.plan.plan import Plan
+from stablepush.sim.scene import feature_geom, feature_solid, object_pieces, simulated_outline
+from stablepush.task.model import Task
+
+SUFFIX = ".mp4"  # H.264 in MP4: plays in browsers, on GitHub and in every player
+DEFAULT_FPS = 25.0  # frames per second of the stream's time: 2.5 frames per 0.1 s push
+MAX_FPS = 100.0  # the executor's default rate: one frame per sample
+DEFAULT_SIZE = (640, 480)  # width, height in pixels
+SIZE_RANGE = (64, 3840)  # each side, pixels; even, as H.264's 4:2:0 colour needs
+CRF = 20  # x264's constant rate factor: flat shaded scenes stay sharp at about 1 MB a minute
+
+_CAMERA_DISTANCE = 0.5  # m from G along -y; orthographic, so only the clipping slab depends on it
+_SLAB = 0.03  # m drawn beyond each face of the object along y (the pads, fingers and backdrop)
+_MARGIN = (0.015, 0.2)  # around the plan's outlines and the pads: m, and a fraction of their size
+_OBJECT_RGBA = (0.85, 0.55, 0.25, 1.0)
+_GHOST_RGBA = (0.1, 0.75, 0.3, 0.35)
+_GHOST_EDGE_RGBA = (0.0, 0.5, 0.15, 0.9)
+_FEATURE_RGBA = (0.62, 0.66, 0.74, 1.0)
+_ACTIVE_FEATURE_RGBA = (0.12, 0.42, 0.9, 1.0)
+_PAD_RGBA = (0.15, 0.15, 0.15, 0.55)
+_FINGER_RGBA = (0.5, 0.52, 0.56, 0.12)
+_BACKDROP_RGBA = (0.97, 0.97, 0.97, 1.0)
+
+
+@dataclass(frozen=True)
+class VideoInfo:
+    """A written video: its frames, their size (pixels), fps, and the time spent drawing and
+    encoding them (s)."""
+
+    path: str
+    frames: int
+    width: int
+    height: int
+    fps: float
+    render_s: float
+
+    @property
+    def ms_per_frame(self) -> float:
+        return 1e3 * self.render_s / self.frames if self.frames else 0.0
+
+
+# -- options, checked before a run ----------------------------------------------------------------
+
+
+def check_video_path(path: Union[str, Path]) -> None:
+    """Refuse a video that cannot be written, before anything runs (OutputError naming the path):
+    a file name not ending in .mp4, the encoder (imageio-ffmpeg) or the renderer (MuJoCo with
+    OSMesa) missing. Loads mujoco with MUJOCO_GL=osmesa when it is not loaded yet: call it before
+    the simulated arm starts."""
+    if not str(path).lower().endswith(SUFFIX):
+        raise OutputError(f"{path}: a video's file name must end in {SUFFIX} (H.264 in MP4)")
+    _encoder()
+    _mujoco()
+
+
+def check_fps(fps: float) -> None:
+    """ValueError unless 0 < fps <= MAX_FPS."""
+    if not (isinstance(fps, (int, float)) and 0 < fps <= MAX_FPS):
+        raise ValueError(f"frames per second must be above 0 and at most {MAX_FPS:g} (one frame per waypoint at "
+                         f"100 Hz), got {fps}")
+
+
+def check_size(size: Sequence[int]) -> None:
+    """ValueError unless `size` is (width, height), both even and within SIZE_RANGE pixels."""
+    low, high = SIZE_RANGE
+    if len(size) != 2 or not all(isinstance(n, int) and low <= n <= high and n % 2 == 0 for n in size):
+        raise ValueError(f"width and height must be even numbers of pixels from {low} to {high} "
+                         f"(H.264's colour is sampled in 2 x 2 blocks), got {'x'.join(map(str, size))}")
+
+
+def video_directory(path: Union[str, Path]) -> str:
+    """`path` as a directory for videos, made (with its parents) when missing, as an absolute path
+    (workers, Ray's among them, need not share the caller's working directory); OutputError when
+    it is a file or cannot be made."""
+    try:
+        os.makedirs(path, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot make the directory for videos ({exc.strerror or exc})") from None
+    return os.path.abspath(path)
+
+
+def run_scene(task: Task, plan: Plan, closed_loop: bool = False, resume_from: int = 0) -> dict:
+    """The scene description `execute_plan` sends for this run (the features it places: every
+    pusher's with a closed loop), in the task's own world; a simulated world that departs from it
+    is `WorldDeviation.apply` of this."""
+    steps = list(plan.waypoints)
+    return scene_description(task, place_features(task, steps, every_pusher=closed_loop), steps[resume_from].pose)
+
+
+def _mujoco():
+    """mujoco, imported with MUJOCO_GL=osmesa unless the caller chose a back-end or mujoco is
+    loaded already (mujoco reads MUJOCO_GL once, at its import); OutputError when OSMesa is missing."""
+    if "mujoco" not in sys.modules:
+        os.environ.setdefault("MUJOCO_GL", "osmesa")
+    try:
+        import mujoco
+    except (ImportError, AttributeError, OSError) as exc:  # PyOpenGL cannot load libOSMesa
+        raise OutputError(f"cannot load MuJoCo's headless renderer with MUJOCO_GL={os.environ.get('MUJOCO_GL')} "
+                          f"({type(exc).__name__}: {exc}); videos need the Debian package libosmesa6 "
+                          f"(apt-get install libosmesa6, or bash scripts/setup.sh)") from None
+    return mujoco
+
+
+def _encoder():
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        raise OutputError("videos need the Python package imageio-ffmpeg (pip install imageio-ffmpeg; "
+                          "a dependency of stablepush)") from None
+    return imageio_ffmpeg
+
+
+def _headless_gl(mujoco) -> None:
+    """With mujoco imported before this module without MUJOCO_GL (the simulated arm imports it),
+    mujoco.Renderer would open a GLFW context, which needs a display. Without one, give it the
+    OSMesa context that MUJOCO_GL=osmesa would have chosen at mujoco's import."""
+    from mujoco import gl_context
+
+    chosen = getattr(gl_context, "GLContext", None)
+    display = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    if chosen is not None and chosen.__module__.startswith("mujoco.glfw") and not display:
+        try:
+            from mujoco.osmesa import GLContext
+        except (ImportError, AttributeError, OSError) as exc:
+            raise OutputError(f"cannot load MuJoCo's headless renderer ({type(exc).__name__}: {exc}); videos need "
+                              f"the Debian package libosmesa6 (apt-get install libosmesa6)") from None
+        gl_context.GLContext = GLContext
+
+
+# -- which samples become frames ------------------------------------------------------------------
+
+
+def frame_samples(times: Sequence[float], fps: float) -> List[int]:
+    """The samples drawn: for frame k, the last sample at or before times[0] + k / fps, for every k
+    up to the last sample's time (so floor((times[-1] - times[0]) fps) + 1 frames, about)."""
+    if not times:
+        return []
+    out, i = [], 0
+    count = int(math.floor((times[-1] - times[0]) * fps + 1e-9)) + 1
+    for k in range(count):
+        due = times[0] + k / fps + 1e-9
+        while i + 1 < len(times) and times[i + 1] <= due:
+            i += 1
+        out.append(i)
+    return out
+
+
+def object_in_world(sample: RunSample) -> Optional[np.ndarray]:
+    """T_WO (4x4, m) of a sample: the reported object pose, else G's reported pose times the
+    tracked pose in the grasp, else None (the arm reports neither)."""
+    if sample.object_pose is not None:
+        return pose_to_matrix(sample.object_pose)
+    if sample.object_in_grasp is not None:
+        q = sample.object_in_grasp
+        return pose_to_matrix(sample.reported) @ grasp_transform((q["x"], q["z"], q["theta"]))
+    return None
+
+
+# -- the render-only model ------------------------------------------------------------------------
+
+
+def _fmt(values) -> str:
+    return " ".join(repr(float(v)) for v in values)
+
+
+def _prism(body: ET.Element, assets: ET.Element, prefix: str, obj: dict, half_y: float, rgba) -> None:
+    """The object's outline as convex prisms (the simulated arm's pieces) in `body`, `half_y` m
+    either side of the xz-plane."""
+    for name, piece, rectangle in object_pieces(obj):
+        name = f"{prefix}_{name}"
+        if rectangle:
+            xs, zs = [p[0] for p in piece], [p[1] for p in piece]
+            ET.SubElement(body, "geom", name=name, type="box", rgba=_fmt(rgba),
+                          pos=_fmt(((min(xs) + max(xs)) / 2, 0.0, (min(zs) + max(zs)) / 2)),
+                          size=_fmt(((max(xs) - min(xs)) / 2, half_y, (max(zs) - min(zs)) / 2)))
+        else:
+            ET.SubElement(assets, "mesh", name=name,
+                          vertex=_fmt(np.ravel([(px, sy * half_y, pz) for sy in (-1, 1) for px, pz in piece])))
+            ET.SubElement(body, "geom", name=name, type="mesh", mesh=name, rgba=_fmt(rgba))
+
+
+def _frame_box(scene: dict, samples: Sequence[RunSample], chosen: Sequence[int]) -> Tuple[float, float, float, float]:
+    """The region of G's xz-plane the camera shows (x0, z0, x1, z1, m): the plan's outline at
+    every drawn step, the object at the start and the pads, with a margin for the features. An
+    object dropped from the grasp leaves the picture rather than shrinking it."""
+    outline = np.asarray(simulated_outline(scene["object"]["polygon"])[0])
+    points = []
+    poses = {samples[i].planned for i in chosen if samples[i].planned is not None}
+    for q in poses:
+        T = grasp_transform(q)
+        points.append(outline @ T[[0, 2]][:, [0, 2]].T + T[[0, 2], 3])
+    first = object_in_world(samples[chosen[0]])
+    if first is not None:
+        T = np.linalg.inv(pose_to_matrix(samples[chosen[0]].reported)) @ first
+        points.append(outline @ T[[0, 2]][:, [0, 2]].T + T[[0, 2], 3])
+    for pad in scene["gripper"]["pads"]:
+        (cx, cz), r = pad["center"], pad["radius"]
+        points.append(np.array([[cx - r, cz - r], [cx + r, cz + r]]))
+    allp = np.vstack(points)
+    low, high = allp.min(axis=0), allp.max(axis=0)
+    margin = max(_MARGIN[0], _MARGIN[1] * float(max(high - low)))
+    return low[0] - margin, low[1] - margin, high[0] + margin, high[1] + margin
+
+
+def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: Tuple[int, int]) -> str:
+    """The render-only MJCF of a scene description (SI units): the features as fixed geoms named as
+    the simulated arm names them (`scene.feature_geom`), the object, the plan's ghost and the
+    gripper (pads, fingers, backdrop and the camera `view`) as mocap bodies; no joints, no contacts.
+    The camera frames `box` (G's xz-plane, m) at the aspect of `size` (width, height)."""
+    obj, gripper = scene["object"], scene["gripper"]
+    half = obj["thickness"] / 2
+    width, height = size
+    x0, z0, x1, z1 = box
+    # 6% of the height above and below for the caption and the legend
+    extent_z = max(z1 - z0, (x1 - x0) * height / width) / (1 - 2 * 0.06)
+    root = ET.Element("mujoco", model="stablepush-video")
+    ET.SubElement(root, "compiler", angle="radian")
+    visual = ET.SubElement(root, "visual")
+    ET.SubElement(visual, "global", offwidth=str(width), offheight=str(height))
+    ET.SubElement(visual, "headlight", ambient="0.45 0.45 0.45", diffuse="0.55 0.55 0.55", specular="0 0 0")
+    ET.SubElement(visual, "quality", shadowsize="0")
+    # The camera sees only a slab about G's xz-plane (mjVisual.map.znear/zfar are fractions of the
+    # extent, set to 1 m): features of other stations, along y, stay out of the picture.
+    ET.SubElement(visual, "map", znear=repr(_CAMERA_DISTANCE - half - _SLAB),
+                  zfar=repr(_CAMERA_DISTANCE + half + _SLAB))
+    ET.SubElement(root, "statistic", extent="1", center="0 0 0")
+    ET.SubElement(root, "default").append(ET.Element("geom", contype="0", conaffinity="0"))
+    assets = ET.SubElement(root, "asset")
+    world = ET.SubElement(root, "worldbody")
+
+    for feature in scene["features"]:
+        solid = feature_solid(feature, obj["thickness"])
+        name = feature_geom(feature["pusher"])
+        if solid["kind"] == "box":
+            ET.SubElement(world, "geom", name=name, type="box", pos=_fmt(solid["center"]),
+                          quat=_fmt(quat_about_y(solid["angle"])), size=_fmt(solid["half_size"]),
+                          rgba=_fmt(_FEATURE_RGBA))
+        else:
+            c, h = np.asarray(solid["center"]), solid["half_length"]
+            ET.SubElement(world, "geom", name=name, type="capsule", size=repr(solid["radius"]),
+                          fromto=_fmt((*(c - [0, h, 0]), *(c + [0, h, 0]))), rgba=_fmt(_FEATURE_RGBA))
+
+    body = ET.SubElement(world, "body", name="object", mocap="true")
+    _prism(body, assets, "object", obj, half, _OBJECT_RGBA)
+
+    # The ghost's fill is a little thinner than the object, so the object hides it where the two
+    # agree and it shows where the object is not where the plan has it; its outline lies in front
+    # of the object's face and of the pads, so it is always seen, 3 pixels wide.
+    ghost = ET.SubElement(world, "body", name="ghost", mocap="true")
+    _prism(ghost, assets, "ghost", obj, max(half - 0.001, half / 2), _GHOST_RGBA)
+    outline = simulated_outline(obj["polygon"])[0]
+    front = -(half + 0.0015)
+    for k, (a, b) in enumerate(zip(outline, outline[1:] + outline[:1])):
+        ET.SubElement(ghost, "geom", name=f"ghost_edge{k}", type="capsule", size=_fmt([1.5 * extent_z / height]),
+                      fromto=_fmt((a[0], front, a[1], b[0], front, b[1])), rgba=_fmt(_GHOST_EDGE_RGBA))
+
+    hand = ET.SubElement(world, "body", name="gripper", mocap="true")
+    for k, pad in enumerate(gripper["pads"]):  # pad k on the finger at +y when k is even (scene.pad_layout)
+        side = 1.0 if k % 2 == 0 else -1.0
+        (cx, cz), r = pad["center"], pad["radius"]
+        ET.SubElement(hand, "geom", name=f"pad{k}", type="cylinder", size=_fmt((r, 0.0005)),
+                      pos=_fmt((cx, side * (half + 0.0006), cz)), quat=_fmt((math.sqrt(0.5), math.sqrt(0.5), 0, 0)),
+                      rgba=_fmt(_PAD_RGBA))
+    # The fingers as the shipped arm's (arm.xml: 16 mm wide, 90 mm from G toward the palm, +z),
+    # just outside the pads.
+    for side in (1.0, -1.0):
+        ET.SubElement(hand, "geom", type="box", size="0.008 0.003 0.045",
+                      pos=_fmt((0.0, side * (half + 0.0045), 0.045)), rgba=_fmt(_FINGER_RGBA))
+    ET.SubElement(hand, "geom", name="backdrop", type="box", size="2 0.0005 2",
+                  pos=_fmt((0.0, half + _SLAB - 0.002, 0.0)), rgba=_fmt(_BACKDROP_RGBA))
+    # xyaxes: the image's x along G's x, its y along G's z, so the camera looks along G's +y.
+    ET.SubElement(hand, "camera", name="view", orthographic="true", fovy=_fmt([extent_z]),
+                  pos=_fmt(((x0 + x1) / 2, -_CAMERA_DISTANCE, (z0 + z1) / 2)), xyaxes="1 0 0 0 0 1")
+    return ET.tostring(root, encoding="unicode")
+
+
+# -- drawing and encoding ------------------------------------------------------------------------
+
+
+def render_run(path: Union[str, Path], task: Task, scene: dict, samples: Sequence[RunSample], *,
+               fps: float = DEFAULT_FPS, size: Tuple[int, int] = DEFAULT_SIZE,
+               progress: Optional[Callable[[int, int], None]] = None) -> VideoInfo:
+    """Draw the recorded run `samples` (RunRecording.samples) of `task` in the world `scene` (the
+    scene description the run's arm built; the features are drawn where it has them) and write
+    it to `path` (.mp4) atomically. `progress(frames done, frames)` after each frame.
+    OutputError (naming the path) for a bad file name or setting, a run without samples or without
+    the object's pose (a real arm without a tracker), or a missing renderer or encoder."""
+    from stablepush.outputs import write_files
+
+    try:
+        check_fps(fps)
+        check_size(tuple(size))
+    except ValueError as exc:
+        raise OutputError(f"{path}: {exc}") from None
+    if not str(path).lower().endswith(SUFFIX):
+        raise OutputError(f"{path}: a video's file name must end in {SUFFIX} (H.264 in MP4)")
+    if not samples:
+        raise OutputError(f"{path}: the run has no acknowledged waypoint to draw")
+    if all(object_in_world(s) is None for s in samples):
+        raise OutputError(f"{path}: the arm reported no pose of the object (neither object_pose nor a tracker's "
+                          f"object_in_grasp), so there is nothing to draw; a simulated arm (--sim) reports it")
+    width, height = (int(n) for n in size)
+    imageio_ffmpeg = _encoder()
+    mujoco = _mujoco()
+    _headless_gl(mujoco)
+    started = time.perf_counter()
+    chosen = frame_samples([s.t for s in samples], fps)
+    model = mujoco.MjModel.from_xml_string(render_model_xml(scene, _frame_box(scene, samples, chosen), (width, height)))
+    data = mujoco.MjData(model)
+    mocap = {name: model.body(name).mocapid[0] for name in ("object", "ghost", "gripper")}
+    features = {f["pusher"]: model.geom(feature_geom(f["pusher"])).id for f in scene["features"]}
+    try:
+        renderer = mujoco.Renderer(model, height=height, width=width)
+    except Exception as exc:  # noqa: BLE001 - whatever the GL back-end raises, said in one line
+        raise OutputError(f"{path}: cannot open MuJoCo's renderer with MUJOCO_GL={os.environ.get('MUJOCO_GL')} "
+                          f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); headless rendering needs "
+                          f"MUJOCO_GL=osmesa and the Debian package libosmesa6") from None
+    caption = _Caption(width, height)
+    with tempfile.TemporaryDirectory(prefix="stablepush-video-") as scratch:
+        encoded = Path(scratch) / f"video{SUFFIX}"
+        writer = imageio_ffmpeg.write_frames(str(encoded), (width, height), fps=fps, codec="libx264", quality=None,
+                                             macro_block_size=2, ffmpeg_log_level="error",
+                                             output_params=["-crf", str(CRF)])
+        writer.send(None)  # starts ffmpeg
+        try:
+            last = next(T for T in map(object_in_world, samples) if T is not None)  # until the arm reports one
+            for n, i in enumerate(chosen):
+                sample = samples[i]
+                T_WG = pose_to_matrix(sample.reported)
+                T_WO = object_in_world(sample)
+                last = T_WO if T_WO is not None else last  # a tracker may miss a sample: keep the last pose
+                _place(data, mocap["gripper"], T_WG)
+                _place(data, mocap["object"], last)
+                if sample.planned is not None:
+                    _place(data, mocap["ghost"], T_WG @ grasp_transform(sample.planned))
+                for pusher, geom in features.items():
+                    model.geom_rgba[geom] = _ACTIVE_FEATURE_RGBA if pusher == sample.pusher else _FEATURE_RGBA
+                mujoco.mj_kinematics(model, data)
+                mujoco.mj_camlight(model, data)  # the camera rides on the gripper's mocap body
+                renderer.update_scene(data, camera="view")
+                frame = caption.draw(renderer.render(), task.name, sample)
+                writer.send(np.ascontiguousarray(frame))
+                if progress is not None:
+                    progress(n + 1, len(chosen))
+        finally:
+            writer.close()
+            renderer.close()
+        write_files({path: encoded.read_bytes()})
+    return VideoInfo(path=str(path), frames=len(chosen), width=width, height=height, fps=float(fps),
+                     render_s=time.perf_counter() - started)
+
+
+def _place(data, mocap_id: int, T: np.ndarray) -> None:
+    pose = matrix_to_pose(T)
+    data.mocap_pos[mocap_id] = pose[:3]
+    data.mocap_quat[mocap_id] = pose[3:]
+
+
+class _Caption:
+    """The caption and legend drawn on each frame (Pillow)."""
+
+    def __init__(self, width: int, height: int):
+        from PIL import ImageFont
+
+        self.scale = max(0.5, height / 480)
+        try:
+            self.font = ImageFont.load_default(size=round(15 * self.scale))
+            self.small = ImageFont.load_default(size=round(12 * self.scale))
+        except TypeError:  # Pillow before 10.1: one bitmap size
+            self.font = self.small = ImageFont.load_default()
+
+    def draw(self, pixels: np.ndarray, task: str, sample: RunSample) -> np.ndarray:
+        from PIL import Image, ImageDraw
+
+        image = Image.fromarray(pixels)
+        pen = ImageDraw.Draw(image)
+        s = self.scale
+        contact = f" on {sample.pusher}" if sample.pusher else ""
+        pen.text((8 * s, 6 * s), f"{task}   t {sample.t:6.2f} s   step {sample.step}   {sample.phase}{contact}",
+                 fill=(20, 20, 20), font=self.font)
+        x, y = 8 * s, image.height - 20 * s
+        for rgba, label in ((_OBJECT_RGBA, "object"), (_GHOST_EDGE_RGBA, "plan at this step"),
+                            (_ACTIVE_FEATURE_RGBA, "pusher in contact"), (_PAD_RGBA, "pads")):
+            colour = tuple(round(255 * c) for c in rgba[:3])
+            pen.rectangle((x, y + 2 * s, x + 11 * s, y + 13 * s), fill=colour)
+            pen.text((x + 15 * s, y), label, fill=(40, 40, 40), font=self.small)
+            x += 15 * s + pen.textlength(label, font=self.small) + 14 * s
+        return np.asarray(image)
