@@ -1,0 +1,158 @@
+"""Point pushers on parts nothing was tuned for: a generator of tasks (boxes and convex polygons of
+other sizes and masses, two or three pins at other places and friction, with and without gravity
+in the grasp plane), goals the pins can reach, and the planning time over seeds.
+
+    python3 benchmarks/point_pusher_tasks.py [--tasks 10] [--seeds 30] [--seed 1] [--time-limit 5]
+                                             [--goals random|paths] [--json OUT.json]
+
+Task i depends only on (--seed, i). Its goal (`goal_for`) is reachable: a random pose near the
+start that a long search with other seeds reaches (as a user picks a goal), or the end of a
+partial path toward a random target (spread over the part of the grasp the pins reach, as
+`stablepush reach` finds it, without a grid). Each task is then planned from its start to that goal
+with every seed 1..--seeds; the table gives the solved count and the planning time's median and
+95th percentile per task, and the line under it the same over all runs (issue 21's target:
+median <= 100 ms, p95 <= 500 ms).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+import yaml
+
+from stablepush.errors import TaskError
+from stablepush.plan import plan_task
+from stablepush.task import parse_task
+
+# The far targets the goals are drawn toward, and how far (unit steps) a goal must be from the start.
+TARGET_SPAN = (12.0, 12.0, 25.0)  # mm, mm, deg
+MIN_GOAL_STEPS = 3.0
+VERIFY_SEED = 10_000  # seeds that find goals, never used to time them
+VERIFY_LIMIT = 3.0  # s a random goal's search may take to show it is reachable
+
+
+def _convex_polygon(rng: np.random.Generator) -> list:
+    """5 to 7 vertices on an ellipse of semi-axes 15-40 mm, counterclockwise (convex)."""
+    n = int(rng.integers(5, 8))
+    # Keep the vertices apart, so that no edge is too short to hold a pin away from its ends.
+    angles = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False) + rng.uniform(-0.25, 0.25, n) * (2 * math.pi / n)
+    a, b = rng.uniform(15.0, 40.0, 2)
+    return [[round(float(a * math.cos(t)), 2), round(float(b * math.sin(t)), 2)] for t in angles]
+
+
+def _pins(rng: np.random.Generator, polygon: list, count: int) -> list:
+    """`count` pins on distinct edges, each between 20% and 80% along its edge."""
+    edges = rng.choice(len(polygon), size=count, replace=False)
+    pins = []
+    for k, e in enumerate(sorted(int(i) for i in edges)):
+        a, b = np.array(polygon[e]), np.array(polygon[(e + 1) % len(polygon)])
+        at = a + rng.uniform(0.2, 0.8) * (b - a)
+        pins.append({"name": f"pin-{k}", "at": [round(float(at[0]), 3), round(float(at[1]), 3)],
+                     "mu": round(float(rng.uniform(0.3, 0.8)), 2)})
+    return pins
+
+
+def generate_task(seed: int, index: int) -> dict:
+    """Task `index` of the set `seed`, as a task file's mapping (no goal yet: `goal_for`)."""
+    rng = np.random.default_rng([seed, index])
+    if rng.uniform() < 0.5:
+        w, h = rng.uniform(25.0, 80.0), rng.uniform(20.0, 60.0)
+        polygon = [[-w / 2, -h / 2], [w / 2, -h / 2], [w / 2, h / 2], [-w / 2, h / 2]]
+        polygon = [[round(float(x), 2), round(float(z), 2)] for x, z in polygon]
+    else:
+        polygon = _convex_polygon(rng)
+    gravity = [0.0, -9.81] if rng.uniform() < 0.7 else [0.0, 0.0]
+    return {
+        "name": f"pins-{seed}-{index}",
+        "object": {"shape": "polygon", "polygon": polygon, "thickness": round(float(rng.uniform(10.0, 40.0)), 1),
+                   "mass": round(float(rng.uniform(30.0, 300.0)), 1)},
+        "gripper": {"grip_force": round(float(rng.uniform(5.0, 20.0)), 1),
+                    "mu": round(float(rng.uniform(0.3, 0.7)), 2), "pad_rings": 1},
+        "gravity": gravity,
+        "pushers": _pins(rng, polygon, int(rng.integers(2, 4))),
+        "start": [0.0, 0.0, 0.0],
+        "goal": [0.0, 0.0, 0.0],
+        "planner": {"time_limit": 5.0, "seed": 1, "max_switches": 2},
+    }
+
+
+def goal_for(data: dict, seed: int, index: int, kind: str = "random", tries: int = 8) -> Optional[list]:
+    """A reachable goal for the task, None when no try gives one. `kind`:
+    - "random": a random pose within TARGET_SPAN of the start (as a user picks one) that a search of
+      VERIFY_LIMIT s with seed VERIFY_SEED or VERIFY_SEED + 1 reaches (seeds the timing never uses);
+    - "paths": the end of the best partial path toward a random far target (0.5 s, seed VERIFY_SEED),
+      a pose some sequence of stable pushes reaches, spread over the part of the grasp the pins reach.
+    Either is at least MIN_GOAL_STEPS unit steps from the start."""
+    rng = np.random.default_rng([seed, index, 1])
+    for _ in range(tries):
+        target = [round(float(v), 3) for v in rng.uniform(-1.0, 1.0, 3) * TARGET_SPAN]
+        try:
+            task = parse_task(yaml.safe_dump({**data, "goal": target}), source=data["name"])
+        except TaskError:  # no grasp at the target (a pad off the object)
+            continue
+        step = task.planner["step"]
+        far = lambda pose: math.sqrt((pose[0] / step[0]) ** 2 + (pose[1] / step[0]) ** 2  # noqa: E731
+                                     + (pose[2] / step[1]) ** 2) >= MIN_GOAL_STEPS
+        if kind == "paths":
+            end = plan_task(task, seed=VERIFY_SEED, time_limit=0.5).waypoints[-1].pose
+            if far(end):
+                return [round(v, 4) for v in end]
+        elif far(target) and any(plan_task(task, seed=s, time_limit=VERIFY_LIMIT).solved
+                                 for s in (VERIFY_SEED, VERIFY_SEED + 1)):
+            return target
+    return None
+
+
+def generated_tasks(seed: int, count: int, kind: str = "random"):
+    """(task, its mapping) for tasks 0..count-1 of the set `seed` that have a reachable goal."""
+    for index in range(count):
+        data = generate_task(seed, index)
+        goal = goal_for(data, seed, index, kind)
+        if goal is None:
+            continue
+        data = {**data, "goal": goal}
+        yield parse_task(yaml.safe_dump(data), source=data["name"]), data
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--tasks", type=int, default=10)
+    parser.add_argument("--seeds", type=int, default=30)
+    parser.add_argument("--seed", type=int, default=1, help="the task set's seed")
+    parser.add_argument("--time-limit", type=float, default=5.0, help="s per plan")
+    parser.add_argument("--goals", choices=("random", "paths"), default="random",
+                        help="random poses a long search reaches, or ends of partial paths (goal_for)")
+    parser.add_argument("--json", default=None, help="write every run here")
+    args = parser.parse_args()
+    print("| task | shape | pins | gravity | goal | solved | median ms | p95 ms |")
+    print("|---|---|---:|---|---|---:|---:|---:|")
+    runs, everything = [], []
+    for task, data in generated_tasks(args.seed, args.tasks, args.goals):
+        times, solved = [], 0
+        for s in range(1, args.seeds + 1):
+            plan = plan_task(task, seed=s, time_limit=args.time_limit)
+            times.append(plan.stats["planning_time_s"] * 1e3)
+            solved += plan.solved
+            runs.append({"task": task.name, "seed": s, "solved": plan.solved, "ms": times[-1],
+                         "ends_at_goal": plan.ends_at_goal})
+        everything += times
+        shape = "box" if len(data["object"]["polygon"]) == 4 else f"{len(data['object']['polygon'])}-gon"
+        print(f"| {task.name} | {shape} | {len(task.pushers)} | {'yes' if any(task.gravity) else 'no'} "
+              f"| {data['goal']} | {solved}/{args.seeds} | {np.median(times):.1f} | {np.percentile(times, 95):.1f} |",
+              flush=True)
+    t = np.array(everything)
+    solved = sum(r["solved"] for r in runs)
+    print(f"\nall {len(runs)} runs: solved {solved}, median {np.median(t):.1f} ms, p95 {np.percentile(t, 95):.1f} ms, "
+          f"max {t.max():.1f} ms (target: median <= 100 ms, p95 <= 500 ms)")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"runs": runs, "args": vars(args)}, indent=1) + "\n")
+    sys.exit(0)
+
+
+if __name__ == "__main__":
+    main()
