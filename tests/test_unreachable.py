@@ -19,6 +19,7 @@ from stablepush.task import parse_task
 from stablepush.units import pose_to_si
 
 from conftest import shipped, task_with
+from independent_lp import IndependentModel
 
 SHIPPED = ["horizontal-offset-high-mu", "horizontal-offset-low-mu", "large-manipulation", "pivoting", "t-shaped",
            "more/cube-pegs", "more/hexagon-offset", "more/l-bracket-mesh", "more/tilted-gravity", "more/wedge-heel"]
@@ -96,6 +97,12 @@ def test_the_hold_bound_is_never_below_the_cores_hold_ratio_in_the_box(name):
                 bound = U._hold_bound(t, model, pusher)
                 worst = max(model.hold_ratio(pose_to_si(q), pusher) for q in _random_in_box(rng, goal, tol, 40))
                 assert bound >= worst, (name, trial, pusher, float(bound), worst)  # exact: Fraction vs float
+        # And above the independent LP's (tests/independent_lp.py, HiGHS on polygon vertices).
+        independent = IndependentModel(t)
+        for pusher in range(len(t.pushers)):
+            bound = U._hold_bound(t, t.build_model(), pusher)
+            for q in _random_in_box(rng, goal, tol, 5):
+                assert bound >= independent.hold_ratio(pose_to_si(q), pusher) - 1e-9, (name, trial, pusher, q)
 
 
 @pytest.mark.parametrize("name", SHIPPED)
