@@ -94,6 +94,14 @@ std::optional<Pose> PushChecker::onto_wedge_surface(const Pose&, const Eigen::Ve
   return std::nullopt;
 }
 
+std::vector<Vec2> StablePushValidator::pivot_points() const {
+  std::vector<Vec2> points;
+  for (const Pad& pad : models_.front()->gripper().pads())
+    if (std::none_of(points.begin(), points.end(), [&](const Vec2& p) { return p == pad.center; }))
+      points.push_back(pad.center);
+  return points;
+}
+
 double StablePushValidator::push_margin(const Pose& a, const Pose& b, int pusher) const {
   return worst_case(models_, a, b - a, pusher).margin;
 }

@@ -32,6 +32,7 @@ const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges() {
       {"seed", {true, 0.0, 4294967295.0}},    // 0 .. 2^32 - 1
       {"improve_for", {false, 0.0, 1e6}},     // [s] after the first plan
       {"restart_checks", {true, 0.0, 1e12}},  // stable-push tests before a restart (0: never)
+      {"pivot_steps", {true, 0.0, 1.0}},      // 1: descents turn about the pads' centres
   };
   return ranges;
 }
@@ -77,6 +78,8 @@ TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTsta
   declareParam<double>("steer_angle", this, &TRRTstar::setSteerAngle, &TRRTstar::getSteerAngle,
                        range_text("steer_angle"));
   declareParam<long long>("seed", this, &TRRTstar::setSeed, &TRRTstar::getSeed, range_text("seed"));
+  declareParam<long long>("pivot_steps", this, &TRRTstar::setPivotSteps, &TRRTstar::getPivotSteps,
+                          range_text("pivot_steps"));
   declareParam<double>("improve_for", this, &TRRTstar::setImproveFor, &TRRTstar::getImproveFor,
                        range_text("improve_for"));
   declareParam<long long>("restart_checks", this, &TRRTstar::setRestartChecks, &TRRTstar::getRestartChecks,

@@ -90,6 +90,30 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
   return 0;
 }
 
+PusherSet TRRTstar::pivot_toward_goal(const Pose& from, const Pose& goal, PusherSet allowed, PusherSet own,
+                                      ob::State* scratch, Pose& q) const {
+  const double turn = goal.theta - from.theta;
+  if (!(std::abs(turn) > kMinEdge * space_->step().angle)) return 0;
+  const Vec2 origin(from.x, from.z);
+  for (const Vec2& pivot : validator_->pivot_points()) {
+    // At most one unit step: (dtheta |P - o| / length)^2 + (dtheta / angle)^2 <= 1.
+    const double radius = (pivot - origin).norm() / space_->step().length;
+    const double largest = 1.0 / std::hypot(radius, 1.0 / space_->step().angle);
+    const double dtheta = std::copysign(std::min(std::abs(turn), largest), turn);
+    const Vec2 d = -omega_cross(dtheta, pivot - origin);
+    const Pose candidate = from + Motion{d.x(), d.y(), dtheta};
+    GraspPoseSpace::set_pose(scratch, candidate);
+    if (!si_->isValid(scratch)) continue;
+    const PusherSet stable = validator_->stable_pushers_preferring(from, candidate, allowed, own);
+    if (stable != 0) {
+      q = candidate;
+      return stable;
+    }
+  }
+  GraspPoseSpace::set_pose(scratch, q);
+  return 0;
+}
+
 void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondition& ptc) {
   const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
   ob::State* step_state = si_->allocState();
@@ -130,6 +154,8 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     PusherSet stable = try_direction(0, q_new);
     // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
     if (stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
+    // A turn about a pad's centre before the steered steps: they drift the object across the grasp.
+    if (stable == 0 && pivot_steps_) stable = pivot_toward_goal(from->pose, goal, allowed, own, step_state, q_new);
     if (stable == 0 && turn > 0 && (stable = try_direction(turn, q_new)) != 0) turn_taken = turn;
     for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
       if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;

@@ -213,3 +213,75 @@ TEST_CASE("statistics are OMPL progress properties", "[trrt_star]") {
   CHECK(properties.at("best switch-overs INTEGER")() == std::to_string(planner.solution_cost().switches));
   CHECK(properties.count("restarts INTEGER") == 1);
 }
+
+namespace {
+/// Stable only as a turn toward +theta about kPivot (fixed in G), the sticking case: the point of the
+/// object at kPivot does not slip, v + omega_cross(omega, kPivot - o) = 0.
+const Vec2 kPivot(2e-3, 0.0);
+
+class PivotValidator : public ob::MotionValidator, public PushChecker {
+ public:
+  explicit PivotValidator(const ob::SpaceInformationPtr& si) : ob::MotionValidator(si) {}
+  PusherSet all_pushers() const override { return 0b1; }
+  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
+    ++checks_;
+    const Vec2 v(b.x - a.x, b.z - a.z);
+    const double omega = b.theta - a.theta;
+    const Vec2 slip = v + omega_cross(omega, kPivot - Vec2(a.x, a.z));
+    const bool turns = omega > 0.0 && slip.norm() <= 1e-9 * (v.norm() + omega * (kPivot - Vec2(a.x, a.z)).norm());
+    return turns ? (candidates & 0b1) : 0;
+  }
+  double push_margin(const Pose&, const Pose&, int) const override { return 1.0; }
+  std::vector<Vec2> pivot_points() const override { return {kPivot}; }
+  std::uint64_t feasibility_checks() const override { return checks_; }
+  void reset_feasibility_checks() override { checks_ = 0; }
+  bool checkMotion(const ob::State* a, const ob::State* b) const override {
+    return stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_pushers()) != 0;
+  }
+  bool checkMotion(const ob::State* a, const ob::State* b, std::pair<ob::State*, double>& last) const override {
+    const bool ok = checkMotion(a, b);
+    if (!ok) last.second = 0.0;
+    return ok;
+  }
+
+ private:
+  mutable std::uint64_t checks_ = 0;
+};
+
+/// From the origin, 2 mm off the pivot, to the origin turned 30 deg about it.
+ob::PlannerStatus solve_pivot(long long pivot_steps, std::vector<PathNode>* path) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  ob::RealVectorBounds bounds(3);
+  bounds.setLow(-0.02);
+  bounds.setHigh(0.02);
+  bounds.setHigh(2, 1.0);
+  auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  si->setStateValidityChecker([](const ob::State*) { return true; });
+  si->setMotionValidator(std::make_shared<PivotValidator>(si));
+  si->setup();
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  ob::ScopedState<GraspPoseSpace> start(space);
+  GraspPoseSpace::set_pose(start.get(), Pose{});
+  pdef->addStartState(start);
+  const double turn = 30.0 * M_PI / 180.0;
+  const Vec2 end = kPivot + Rotation2(turn).apply(-kPivot);
+  pdef->setGoal(std::make_shared<PoseGoal>(si, Pose{end.x(), end.y(), turn}, StepSize{0.5e-3, 0.5 * M_PI / 180.0}));
+  TRRTstar planner(si);
+  planner.params().setParam("pivot_steps", std::to_string(pivot_steps));
+  planner.params().setParam("seed", "1");
+  planner.setProblemDefinition(pdef);
+  planner.setup();
+  const ob::PlannerStatus status = planner.solve(ob::timedPlannerTerminationCondition(1.0));
+  *path = planner.solution();
+  return status;
+}
+}  // namespace
+
+TEST_CASE("pivot_steps: a turn about a pad's centre reaches what straight and steered steps cannot", "[trrt_star]") {
+  std::vector<PathNode> path;
+  REQUIRE(solve_pivot(1, &path) == ob::PlannerStatus::EXACT_SOLUTION);
+  CHECK(path.size() >= 31);  // one unit step of turn at most per push
+  for (std::size_t i = 1; i < path.size(); ++i) CHECK(path[i].pose.theta > path[i - 1].pose.theta);
+  CHECK(solve_pivot(0, &path) == ob::PlannerStatus::APPROXIMATE_SOLUTION);  // the default: none found
+}

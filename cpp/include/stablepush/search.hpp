@@ -65,6 +65,10 @@ class PushChecker {
   virtual PusherSet wedge_pushers() const { return 0; }
   virtual std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                                  int pusher) const;
+  /// Points fixed in G [m] about which a turn keeps a pad point sticking (the pads' centres): such a
+  /// turn is the sticking case, one line of motions the straight and steered steps meet only by
+  /// chance once the object is off the point it was planned to turn about. By default none.
+  virtual std::vector<Vec2> pivot_points() const { return {}; }
   /// Stable-push tests made so far (what restarts count).
   virtual std::uint64_t feasibility_checks() const = 0;
   virtual void reset_feasibility_checks() = 0;

@@ -115,6 +115,8 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   /// motion still has to pass stable_pushers (the wedge's facets, every model, the grasp).
   std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                          int pusher) const override;
+  /// The centres of the first model's pads, each once.
+  std::vector<Vec2> pivot_points() const override;
 
   bool checkMotion(const ompl::base::State* a, const ompl::base::State* b) const override;
   bool checkMotion(const ompl::base::State* a, const ompl::base::State* b,

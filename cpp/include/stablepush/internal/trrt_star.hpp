@@ -89,6 +89,10 @@ class TRRTstar : public ompl::base::Planner {
   double getSteerAngle() const { return steer_angle_; }
   void setSeed(long long seed) { seed_ = static_cast<std::uint32_t>(checked("seed", seed)); }
   long long getSeed() const { return seed_; }
+  /// 1: a descent whose straight step is not stable tries a turn about a pad's centre before the
+  /// steered steps (pivot_toward_goal); 0 (the default): never.
+  void setPivotSteps(long long on) { pivot_steps_ = checked("pivot_steps", static_cast<double>(on)) > 0.0; }
+  long long getPivotSteps() const { return pivot_steps_ ? 1 : 0; }
   /// How long to keep improving after the first plan [s] (0: stop at the first).
   void setImproveFor(double seconds) { improve_for_ = checked("improve_for", seconds); }
   double getImproveFor() const { return improve_for_; }
@@ -178,6 +182,15 @@ class TRRTstar : public ompl::base::Planner {
   /// ends closer. Sets q (and `scratch`) and returns that pusher; 0, q unchanged, when neither.
   PusherSet descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
                               ompl::base::State* scratch, Pose& q) const;
+  /// Toward the goal when no straight, steered or wedge step is stable: a turn about a pad's centre
+  /// (PushChecker::pivot_points), the sticking case, by the rest of the goal's theta or as much of
+  /// it as a unit step holds, its translation dq = -omega_cross(dtheta, P - o) so that the pad point
+  /// at P does not slip. Sets q (and `scratch`) and returns the pushers that make it stable, the
+  /// descent's own first; 0, q unchanged, when none does. A plan made to turn about a pad centre
+  /// (the pivot) needs it once the object is off that centre: 0.01 mm off, no plan was found.
+  /// Only with pivot_steps: tried before the steered steps, it changes plans that do not need it.
+  PusherSet pivot_toward_goal(const Pose& from, const Pose& goal, PusherSet allowed, PusherSet own,
+                              ompl::base::State* scratch, Pose& q) const;
   Node* add_node(const Pose& q, int pusher, Node* parent, const PathCost& cost);
   /// optimEdge: the cheapest stable connection to q_new among the near nodes; `via` is the node
   /// the extension came from, `via_pushers` the pushers stable along via -> q_new.
@@ -248,6 +261,7 @@ class TRRTstar : public ompl::base::Planner {
   int max_switches_ = 1;
   std::uint32_t seed_ = 1;
   double improve_for_ = 0.0;
+  bool pivot_steps_ = false;
   std::uint64_t restart_checks_ = 5000;
   unsigned restarts_ = 0;
 
