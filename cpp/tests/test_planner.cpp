@@ -45,10 +45,13 @@ class ConeChecker : public PushChecker {
   mutable std::uint64_t checks_ = 0;
 };
 
-/// OMPL's motion validator asking the toy checker, as plan_with_checker sets it up.
-class ToyValidator : public ob::MotionValidator, public ConeChecker {
+/// OMPL's motion validator asking a toy checker, as plan_with_checker sets it up.
+template <class Checker>
+class ToyValidator : public ob::MotionValidator, public Checker {
  public:
   explicit ToyValidator(const ob::SpaceInformationPtr& si) : ob::MotionValidator(si) {}
+  using Checker::all_pushers;
+  using Checker::stable_pushers;
   bool checkMotion(const ob::State* a, const ob::State* b) const override {
     return stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_pushers()) != 0;
   }
@@ -84,7 +87,7 @@ struct ToyProblem {
     auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
     si = std::make_shared<ob::SpaceInformation>(space);
     si->setStateValidityChecker([valid](const ob::State* s) { return valid(GraspPoseSpace::pose(s)); });
-    si->setMotionValidator(std::make_shared<ToyValidator>(si));
+    si->setMotionValidator(std::make_shared<ToyValidator<ConeChecker>>(si));
     si->setup();
     pdef = std::make_shared<ob::ProblemDefinition>(si);
     ob::ScopedState<GraspPoseSpace> start(space);
@@ -219,9 +222,8 @@ namespace {
 /// object at kPivot does not slip, v + omega_cross(omega, kPivot - o) = 0.
 const Vec2 kPivot(2e-3, 0.0);
 
-class PivotValidator : public ob::MotionValidator, public PushChecker {
+class PivotChecker : public PushChecker {
  public:
-  explicit PivotValidator(const ob::SpaceInformationPtr& si) : ob::MotionValidator(si) {}
   PusherSet all_pushers() const override { return 0b1; }
   PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
     ++checks_;
@@ -235,14 +237,6 @@ class PivotValidator : public ob::MotionValidator, public PushChecker {
   std::vector<Vec2> pivot_points() const override { return {kPivot}; }
   std::uint64_t feasibility_checks() const override { return checks_; }
   void reset_feasibility_checks() override { checks_ = 0; }
-  bool checkMotion(const ob::State* a, const ob::State* b) const override {
-    return stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_pushers()) != 0;
-  }
-  bool checkMotion(const ob::State* a, const ob::State* b, std::pair<ob::State*, double>& last) const override {
-    const bool ok = checkMotion(a, b);
-    if (!ok) last.second = 0.0;
-    return ok;
-  }
 
  private:
   mutable std::uint64_t checks_ = 0;
@@ -258,7 +252,7 @@ ob::PlannerStatus solve_pivot(long long pivot_steps, std::vector<PathNode>* path
   auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
   auto si = std::make_shared<ob::SpaceInformation>(space);
   si->setStateValidityChecker([](const ob::State*) { return true; });
-  si->setMotionValidator(std::make_shared<PivotValidator>(si));
+  si->setMotionValidator(std::make_shared<ToyValidator<PivotChecker>>(si));
   si->setup();
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
   ob::ScopedState<GraspPoseSpace> start(space);
