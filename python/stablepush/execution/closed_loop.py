@@ -11,7 +11,7 @@ The policy lives here; `executor.py` streams and splices. A re-plan
 - is planned first robust to pushers whose mu is CORRECTION_PUSHER_MU lower than the task's (as
   `uncertainty: {pusher_mu: ...}`): a run that needs a correction is in a world whose friction is
   not the model's, and a correction planned with the model's slips as the plan did (the low-mu
-  offset at x0.85: 0.22 mm low with nominal corrections, 0.08 mm with robust ones); then with the
+  offset at x0.85: 0.22 mm low with nominal corrections, 0.09 mm with robust ones); then with the
   task's own model (a task with `uncertainty:` keeps its box for both);
 - first tries the pusher that is pushing now alone (no switch-over: the object stays on its
   feature), then every pusher of the task with one switch-over more than its budget; a switch-over
@@ -201,12 +201,11 @@ ATTEMPTS = tuple(_Attempt(every, limit, robust, pivot) for pivot in (False, True
 def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
            after_step: int, planned: Sequence[float], trigger: str = "off_plan") -> Tuple[Replan, List[Waypoint]]:
     """Plan from the measured pose to the task's goal within the loop's final tolerance, trying
-    ATTEMPTS in turn (robust first, the pusher pushing now alone first) and taking the first plan
-    whose transits are held. Returns the record and the new plan's steps (empty when none was found); the first
-    step is the measured pose."""
+    ATTEMPTS in turn (robust first, the pusher pushing now alone first, pivot steps last) and taking
+    the first plan whose transits are held. Returns the record and the new plan's steps (empty when
+    none was found); the first step is the measured pose."""
     tolerance = list(loop.final_tolerance)
-    base = dataclasses.replace(task.with_start(measured),
-                               planner={**task.planner, "tolerance": tolerance})
+    base = dataclasses.replace(task.with_start(measured), planner={**task.planner, "tolerance": tolerance})
     if base.at_goal(base.start):  # off the plan but at the goal already: nothing to correct
         return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
