@@ -62,3 +62,23 @@ def test_aimed_plans_switch_over_only_where_corrections_may_and_no_more_than_nee
     task = shipped("more/l-bracket-mesh")
     record, steps = aim(task, plan_task(task, seed=1).waypoints, ClosedLoop.for_task(task))
     assert record.solved and record.pushers == ["left"], record
+
+
+def test_the_same_plan_is_aimed_once_per_process(monkeypatch):
+    # evaluate runs one plan in many worlds: the pegs' failed aim (its whole time limit) is made once.
+    from stablepush.execution import closed_loop
+
+    calls = []
+    real = closed_loop._aim
+    monkeypatch.setattr(closed_loop, "_aim", lambda *args: calls.append(args) or real(*args))
+    monkeypatch.setattr(closed_loop, "_AIMED", type(closed_loop._AIMED)())
+    task = shipped("large-manipulation")
+    plan = plan_task(task, seed=1)
+    loop = ClosedLoop.for_task(task)
+    first = aim(task, plan.waypoints, loop)
+    assert aim(task, plan.waypoints, loop) == first and len(calls) == 1
+    tighter = ClosedLoop.for_task(task, final_tolerance=(0.1, 0.1))  # another tolerance: aimed anew
+    assert aim(task, plan.waypoints, tighter)[0].solved and len(calls) == 2
+    other = plan_task(task, seed=2)  # another plan: aimed anew
+    aim(task, other.waypoints, loop)
+    assert len(calls) == 3
