@@ -34,7 +34,6 @@ from fractions import Fraction
 from typing import List, Optional, Sequence
 
 import numpy as np
-from scipy.optimize import linprog
 
 from stablepush.task.model import Task
 from stablepush.units import MM, pose_to_si
@@ -230,6 +229,8 @@ def _certified_max(c, A_ub, b_ub, A_eq, b_eq, bounds) -> Fraction:
     bounds: HiGHS's dual (y >= 0 for the rows, z for the equalities), then in exact arithmetic
     c.x = y.A_ub x + z.A_eq x + r.x <= y.b_ub + z.b_eq + sum_j max(r_j l_j, r_j u_j), r = c - A_ub^T y - A_eq^T z.
     A problem HiGHS cannot solve gets the bound of its box alone (y = z = 0)."""
+    from scipy.optimize import linprog  # here: importing it costs every plan ~0.3 s, and few plans need an LP
+
     res = linprog(-c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=b_eq, bounds=bounds, method="highs")
     y = np.zeros(len(b_ub))
     z = np.zeros(0 if b_eq is None else len(b_eq))
