@@ -25,9 +25,11 @@ from typing import Optional
 import numpy as np
 import yaml
 
+from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.plan import plan_task
 from stablepush.task import parse_task
+from stablepush.units import MM, pose_to_si
 
 # The far targets the goals are drawn toward, and how far (unit steps) a goal must be from the start.
 TARGET_SPAN = (12.0, 12.0, 25.0)  # mm, mm, deg
@@ -95,9 +97,8 @@ def goal_for(data: dict, seed: int, index: int, kind: str = "random", tries: int
             task = parse_task(yaml.safe_dump({**data, "goal": target}), source=data["name"])
         except TaskError:  # no grasp at the target (a pad off the object)
             continue
-        step = task.planner["step"]
-        far = lambda pose: math.sqrt((pose[0] / step[0]) ** 2 + (pose[1] / step[0]) ** 2  # noqa: E731
-                                     + (pose[2] / step[1]) ** 2) >= MIN_GOAL_STEPS
+        unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
+        far = lambda pose: _core.steps_between(pose_to_si(task.start), pose_to_si(pose), unit) >= MIN_GOAL_STEPS  # noqa: E731
         if kind == "paths":
             end = plan_task(task, seed=VERIFY_SEED, time_limit=0.5).waypoints[-1].pose
             if far(end):

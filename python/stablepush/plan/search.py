@@ -140,12 +140,11 @@ def plan_task(
 
 def _unreachable(task: Task, models, settings: dict, reason: str, seconds: float) -> Plan:
     """The plan of a goal found unreachable before the search: the start alone."""
-    step = settings["step"]
-    d = [(g - s) / k for g, s, k in zip(task.goal, task.start, (step[0], step[0], step[1]))]
+    unit = (settings["step"][0] * MM, math.radians(settings["step"][1]))
     stats = {"planning_time_s": seconds, "iterations": 0, "nodes": 0, "feasibility_checks": 0, "switches": 0,
              "restarts": 0, "seed": int(settings["seed"]), "max_switches": int(settings["max_switches"]),
              "time_limit_s": float(settings["time_limit"]), "pushes": 0, "path_length_steps": 0.0,
-             "goal_distance_steps": math.sqrt(sum(v * v for v in d)),
+             "goal_distance_steps": _core.steps_between(pose_to_si(task.start), pose_to_si(task.goal), unit),
              "min_hold_ratio": float(settings["min_hold_ratio"])}
     start = pose_to_si(task.start)
     return Plan(task=task.name, solved=False, outcome="unreachable", message=f"unreachable: {reason}",

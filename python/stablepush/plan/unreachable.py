@@ -35,6 +35,7 @@ from typing import List, Optional, Sequence
 
 import numpy as np
 
+from stablepush.frames import direction_in_gripper
 from stablepush.task.model import Task
 from stablepush.units import MM, pose_to_si
 
@@ -91,10 +92,9 @@ def _polygon_rows(n_points: int, limits: Sequence[float], offset: int, n_vars: i
     return rows, rhs
 
 
-def _rot(theta: float) -> np.ndarray:
-    """R(theta): p_G = o + R p_O (the core's Rotation2)."""
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, s], [-s, c]])
+def _in_gripper(theta: float, v) -> np.ndarray:
+    """R(theta) v [theta in rad]: a vector of O seen from G (the core's Rotation2)."""
+    return np.array(direction_in_gripper(math.degrees(theta), v))
 
 
 def _cross_y(a, f) -> float:
@@ -109,13 +109,12 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int) -> bool:
     gens = [np.asarray(g, float) for g in model.pusher_cones[pusher].generators]
     positions = [np.asarray(p, float) for p in model.gripper.point_positions]
     limits = list(model.gripper.point_friction_limits)
-    R = _rot(q[2])
     o = np.array(q[:2])
     body = model.body
-    r_cm = R @ np.asarray(body.com, float)
+    r_cm = _in_gripper(q[2], body.com)
     weight = body.mass * np.asarray(model.gravity_in_gripper(q, pusher), float)  # in G
     # The wrench the weight asks of pusher and pads (w_motion's gravity part, docs/model.md section 2).
-    w_g = np.array([*(R.T @ -weight), _cross_y(r_cm, -weight)])
+    w_g = np.array([*_in_gripper(-q[2], -weight), _cross_y(r_cm, -weight)])
     # M xi / dt for a push of at most one unit step (|dx|, |dz| <= L, |dtheta| <= A): a box in O.
     L, A = task.planner["step"][0] * MM, math.radians(task.planner["step"][1])
     dt2 = task.step_time ** 2
@@ -128,9 +127,9 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int) -> bool:
     eq = np.zeros((3, n))
     for j, g in enumerate(gens):
         eq[:, j] = g
-    for i, (p, _) in enumerate(zip(positions, limits)):
+    for i, p in enumerate(positions):
         for k, unit in enumerate(np.eye(2)):
-            eq[:2, n_g + 2 * i + k] = -(R.T @ unit)
+            eq[:2, n_g + 2 * i + k] = -_in_gripper(-q[2], unit)
             eq[2, n_g + 2 * i + k] = -_cross_y(p - o, unit)
     eq[:, n_g + 2 * n_p:n_g + 2 * n_p + 3] = -np.eye(3)
     # |eq x - w_g| <= t, row by row.
@@ -211,7 +210,7 @@ def _moment_range(model, goal, a: float, b: float, pusher: int, turns: bool):
     thetas = np.linspace(goal[2] - b, goal[2] + b, THETA_GRID)
     for theta in thetas:
         W = body.mass * np.asarray(model.gravity_in_gripper((goal[0], goal[1], theta), pusher), float)
-        r_cm = _rot(theta) @ com
+        r_cm = _in_gripper(theta, com)
         for dx in (-a, a):
             for dz in (-a, a):
                 values.append(_cross_y(np.array([goal[0] + dx, goal[1] + dz]) + r_cm, W))
