@@ -417,21 +417,29 @@ def test_executing_a_moving_pusher_task_warns_that_the_arm_pushes_against_fixed_
     assert "by_moving_pusher" in result.output and "another cell" in result.output
 
 
+def _closed_loop_within_0_2_at_0_85(tmp_path, task: str, *options: str):
+    """Plan `task` (its path under data/tasks) and run it closed loop on the simulated arm in a world
+    with 15% less mu, judged within 0.2 mm / 0.2 deg: the printed output and the JSON report, once
+    the run exited 0 and its goal error is within 0.2 mm and 0.2 deg."""
+    task_file = str(TASKS / task)
+    plan, report_path = tmp_path / "task.plan.json", tmp_path / "run.json"
+    assert CliRunner().invoke(cli, ["plan", task_file, "-o", str(plan)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task_file, "--sim", *options, "--quiet",
+                                      "--closed-loop", "--sim-mu-scale", "0.85", "--success-tolerance", "0.2", "0.2",
+                                      "--json", str(report_path)])
+    assert result.exit_code == 0, result.output
+    report = json.loads(report_path.read_text())
+    err = report["goal_error"]
+    assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
+    return result.output, report
+
+
 def test_closed_loop_lands_the_wedge_in_a_low_friction_world_and_says_so(tmp_path):
     """A user's wedge (data/tasks/more/wedge-heel.yaml) whose heel stop creeps open loop: in a world
     with 15% less mu than its task, closed loop, the run lands within 0.2 mm and 0.2 deg of the goal,
     the report says success and lists the corrections with what triggered them."""
-    task = str(TASKS / "more" / "wedge-heel.yaml")
-    plan, report_path = tmp_path / "wedge.plan.json", tmp_path / "run.json"
-    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
-    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--quiet", "--closed-loop",
-                                      "--sim-mu-scale", "0.85", "--success-tolerance", "0.2", "0.2",
-                                      "--json", str(report_path)])
-    assert result.exit_code == 0, result.output
-    report = json.loads(report_path.read_text())
+    _, report = _closed_loop_within_0_2_at_0_85(tmp_path, "more/wedge-heel.yaml")
     assert report["success"] is True and report["tolerance"] == [0.2, 0.2] and report["engine"] == "mujoco"
-    err = report["goal_error"]
-    assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
     assert report["replans"] and all(r["trigger"] in ("plan_short", "off_plan", "off_goal") for r in report["replans"])
     assert any(r["solved"] and r["pushes"] > 0 for r in report["replans"])
 
@@ -441,20 +449,11 @@ def test_closed_loop_plans_a_short_plan_again_to_the_goal_before_the_first_push(
     1 mm / 1 deg) where its one pusher cannot push the rest: closed loop, in a world with 15% less
     mu, the loop plans it again to 0.2 mm / 0.2 deg before the first push and the run lands there;
     the report and the printed lines say so."""
-    task = str(TASKS / "large-manipulation.yaml")
-    plan, report_path = tmp_path / "lm.plan.json", tmp_path / "run.json"
-    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
-    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--quiet", "--closed-loop",
-                                      "--sim-mu-scale", "0.85", "--success-tolerance", "0.2", "0.2",
-                                      "--json", str(report_path)])
-    assert result.exit_code == 0, result.output
-    report = json.loads(report_path.read_text())
+    output, report = _closed_loop_within_0_2_at_0_85(tmp_path, "large-manipulation.yaml")
     first = report["replans"][0]
     assert first["trigger"] == "plan_short" and first["solved"] and first["after_step"] == 0
-    assert "before the first push: the plan ends off the goal by" in result.output
+    assert "before the first push: the plan ends off the goal by" in output
     assert report["success"] is True and report["total_steps"] == first["pushes"]
-    err = report["goal_error"]
-    assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
 
 
 def test_closed_loop_lands_the_pivot_with_its_feature_off_its_place():
@@ -480,17 +479,8 @@ def test_closed_loop_on_drake_lands_the_t_shape_in_a_low_friction_world(tmp_path
     """The second engine end to end: the T through two switch-overs on the Drake arm (whose contact
     solver alone decides stick and slip), mu x0.85, closed loop: it lands within 0.2 mm and
     0.2 deg, and the report says so, names the engine and lists its corrections (none were needed)."""
-    task = str(TASKS / "t-shaped.yaml")
-    plan, report_path = tmp_path / "t.plan.json", tmp_path / "run.json"
-    assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
-    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--engine", "drake", "--quiet",
-                                      "--closed-loop", "--sim-mu-scale", "0.85", "--success-tolerance", "0.2", "0.2",
-                                      "--json", str(report_path)])
-    assert result.exit_code == 0, result.output
-    report = json.loads(report_path.read_text())
+    _, report = _closed_loop_within_0_2_at_0_85(tmp_path, "t-shaped.yaml", "--engine", "drake")
     assert report["success"] is True and report["engine"] == "drake" and report["closed_loop"] == "on"
-    err = report["goal_error"]
-    assert max(abs(err["x"]), abs(err["z"])) <= 0.2 and abs(err["theta"]) <= 0.2, err
     assert isinstance(report["replans"], list)
 
 
