@@ -175,7 +175,8 @@ def _prism_inertia(polygon, thickness: float, mass: float, com) -> np.ndarray:
     return np.array([[my + mz, 0.0, -mxz], [0.0, mx + mz, 0.0], [-mxz, 0.0, mx + my]])
 
 
-def _fmt(values) -> str:
+def mjcf_numbers(values) -> str:
+    """Numbers as an MJCF attribute: space-separated, each exact (repr)."""
     return " ".join(repr(float(v)) for v in values)
 
 
@@ -192,7 +193,7 @@ def arm_tree(scene: dict, kinematic_hand: bool = False) -> ET.Element:
     grip_force = scene["gripper"]["grip_force"]
     for finger in FINGER_JOINTS:
         act = root.find(f".//actuator/position[@name='{finger}']")
-        act.set("forcerange", _fmt((-grip_force, grip_force)))
+        act.set("forcerange", mjcf_numbers((-grip_force, grip_force)))
         act.set("forcelimited", "true")
     return root
 
@@ -225,6 +226,28 @@ def object_pieces(obj: dict) -> List[Tuple[str, list, bool]]:
     return [(f"object_piece{i}", piece, _axis_aligned_rectangle(piece)) for i, piece in enumerate(pieces)]
 
 
+def add_object_geoms(body: ET.Element, assets: ET.Element, obj: dict, half_y: float, rgba: str, prefix: str = "",
+                     **attributes: str) -> List[str]:
+    """The object's pieces (object_pieces) as geoms of `body`, `half_y` m either side of the
+    xz-plane: a rectangle as a box, any other piece as a mesh prism in `assets`; `attributes` go on
+    every geom (e.g. mass), names start with `prefix`. Returns the geoms' names."""
+    names = []
+    for name, piece, rectangle in object_pieces(obj):
+        name = prefix + name
+        if rectangle:
+            xs = [p[0] for p in piece]
+            zs = [p[1] for p in piece]
+            ET.SubElement(body, "geom", name=name, type="box", **attributes,
+                          pos=mjcf_numbers(((min(xs) + max(xs)) / 2, 0.0, (min(zs) + max(zs)) / 2)),
+                          size=mjcf_numbers(((max(xs) - min(xs)) / 2, half_y, (max(zs) - min(zs)) / 2)), rgba=rgba)
+        else:
+            vertices = [(px, sy * half_y, pz) for sy in (-1, 1) for px, pz in piece]
+            ET.SubElement(assets, "mesh", name=name, vertex=mjcf_numbers(np.ravel(vertices)))
+            ET.SubElement(body, "geom", name=name, type="mesh", mesh=name, **attributes, rgba=rgba)
+        names.append(name)
+    return names
+
+
 def feature_solid(feature: dict, thickness: float) -> dict:
     """A feature's fixed solid in W: a box whose contact face is the pusher's segment, extending
     FEATURE_DEPTH behind it (`center`, `angle` about y, `half_size`), or for a point pusher a rod
@@ -247,7 +270,7 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
     plus the solver options, the pad points, the held object, the features and the contact pairs."""
     root = arm_tree(scene, kinematic_hand)
     gx, gz = scene["gravity"]
-    ET.SubElement(root, "option", timestep=repr(TIMESTEP), gravity=_fmt((gx, 0.0, gz)), cone="elliptic",
+    ET.SubElement(root, "option", timestep=repr(TIMESTEP), gravity=mjcf_numbers((gx, 0.0, gz)), cone="elliptic",
                   impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS),
                   noslip_tolerance=repr(NOSLIP_TOLERANCE), integrator="implicitfast")
     # libccd, not MuJoCo's native CCD: with native CCD the wedge's convex mesh slid 0.6 mm along
@@ -263,34 +286,22 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
     for name, finger, side, (px, pz) in pad_layout(scene):
         body = root.find(f".//body[@name='{finger}']")
         ET.SubElement(body, "geom", name=name, type="sphere", size=repr(PAD_POINT_RADIUS),
-                      pos=_fmt((px, side * PAD_POINT_RADIUS, pz)), mass="0.0001", rgba="0.2 0.2 0.2 1")
+                      pos=mjcf_numbers((px, side * PAD_POINT_RADIUS, pz)), mass="0.0001", rgba="0.2 0.2 0.2 1")
         pad_names.append(name)
 
     # The held object: a free body of convex prisms in O.
     x, y, z, w, qx, qy, qz = scene["object_pose"]
-    body = ET.SubElement(worldbody, "body", name=OBJECT_BODY, pos=_fmt((x, y, z)), quat=_fmt((w, qx, qy, qz)))
+    body = ET.SubElement(worldbody, "body", name=OBJECT_BODY, pos=mjcf_numbers((x, y, z)),
+                         quat=mjcf_numbers((w, qx, qy, qz)))
     ET.SubElement(body, "freejoint", name=OBJECT_BODY)
     com = obj["com"]
     inertia = object_inertia(obj)
-    ET.SubElement(body, "inertial", pos=_fmt((com[0], 0.0, com[1])), mass=repr(obj["mass"]),
-                  fullinertia=_fmt((inertia[0, 0], inertia[1, 1], inertia[2, 2], 0.0, inertia[0, 2], 0.0)))
-    piece_names = []
+    ET.SubElement(body, "inertial", pos=mjcf_numbers((com[0], 0.0, com[1])), mass=repr(obj["mass"]),
+                  fullinertia=mjcf_numbers((inertia[0, 0], inertia[1, 1], inertia[2, 2], 0.0, inertia[0, 2], 0.0)))
     assets = root.find("asset")
     if assets is None:
         assets = ET.SubElement(root, "asset")
-    for name, piece, rectangle in object_pieces(obj):
-        if rectangle:
-            xs = [p[0] for p in piece]
-            zs = [p[1] for p in piece]
-            ET.SubElement(body, "geom", name=name, type="box", mass="0",
-                          pos=_fmt(((min(xs) + max(xs)) / 2, 0.0, (min(zs) + max(zs)) / 2)),
-                          size=_fmt(((max(xs) - min(xs)) / 2, half_thickness, (max(zs) - min(zs)) / 2)),
-                          rgba="0.85 0.55 0.25 1")
-        else:
-            vertices = [(px, sy * half_thickness, pz) for sy in (-1, 1) for px, pz in piece]
-            ET.SubElement(assets, "mesh", name=name, vertex=_fmt(np.ravel(vertices)))
-            ET.SubElement(body, "geom", name=name, type="mesh", mesh=name, mass="0", rgba="0.85 0.55 0.25 1")
-        piece_names.append(name)
+    piece_names = add_object_geoms(body, assets, obj, half_thickness, "0.85 0.55 0.25 1", mass="0")
 
     # The features: fixed solids whose contact face is the pusher's segment.
     contact = ET.SubElement(root, "contact")
@@ -298,12 +309,13 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
         name = feature_geom(feature["pusher"])
         solid = feature_solid(feature, obj["thickness"])
         if solid["kind"] == "box":
-            ET.SubElement(worldbody, "geom", name=name, type="box", pos=_fmt(solid["center"]),
-                          quat=_fmt(quat_about_y(solid["angle"])), size=_fmt(solid["half_size"]), rgba="0.3 0.5 0.8 1")
+            ET.SubElement(worldbody, "geom", name=name, type="box", pos=mjcf_numbers(solid["center"]),
+                          quat=mjcf_numbers(quat_about_y(solid["angle"])), size=mjcf_numbers(solid["half_size"]),
+                          rgba="0.3 0.5 0.8 1")
         else:
             c, h = solid["center"], solid["half_length"]
             ET.SubElement(worldbody, "geom", name=name, type="capsule", size=repr(solid["radius"]),
-                          fromto=_fmt((*(c - [0, h, 0]), *(c + [0, h, 0]))), rgba="0.3 0.5 0.8 1")
+                          fromto=mjcf_numbers((*(c - [0, h, 0]), *(c + [0, h, 0]))), rgba="0.3 0.5 0.8 1")
         for piece in piece_names:
             _pair(contact, name, piece, feature["mu"])
     for pad in pad_names:
@@ -330,9 +342,10 @@ def _replace_arm_by_kinematic_hand(root: ET.Element, gripper_pose: Sequence[floa
     fingers = [root.find(f".//body[@name='{f}']") for f in FINGER_JOINTS]
     worldbody.remove(arm_base)
     x, y, z, w, qx, qy, qz = gripper_pose
-    hand = ET.SubElement(worldbody, "body", name="hand", pos=_fmt((x, y, z)), quat=_fmt((w, qx, qy, qz)))
+    hand = ET.SubElement(worldbody, "body", name="hand", pos=mjcf_numbers((x, y, z)),
+                         quat=mjcf_numbers((w, qx, qy, qz)))
     for name, kind, axis in zip(HAND_JOINTS, ("slide", "slide", "hinge"), ((1, 0, 0), (0, 0, 1), (0, 1, 0))):
-        ET.SubElement(hand, "joint", name=name, type=kind, axis=_fmt(axis), armature="1e4", damping="0")
+        ET.SubElement(hand, "joint", name=name, type=kind, axis=mjcf_numbers(axis), armature="1e4", damping="0")
     ET.SubElement(hand, "geom", type="box", size="0.01 0.01 0.01", pos="0 0 -0.1", mass="1")
     ET.SubElement(hand, "site", name=GRIPPER_SITE, size="0.004")
     for finger in fingers:  # in the arm they sit at G's pose in the hand; here the hand is G
@@ -347,4 +360,5 @@ def _replace_arm_by_kinematic_hand(root: ET.Element, gripper_pose: Sequence[floa
 
 def _pair(contact: ET.Element, geom1: str, geom2: str, mu: float) -> None:
     ET.SubElement(contact, "pair", geom1=geom1, geom2=geom2, condim="3",
-                  friction=_fmt((mu, mu, 0.0, 0.0, 0.0)), solref=_fmt(CONTACT_SOLREF), solimp=_fmt(CONTACT_SOLIMP))
+                  friction=mjcf_numbers((mu, mu, 0.0, 0.0, 0.0)), solref=mjcf_numbers(CONTACT_SOLREF),
+                  solimp=mjcf_numbers(CONTACT_SOLIMP))

@@ -51,7 +51,7 @@ from stablepush.execution.bags import RunSample
 from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, quat_about_y
 from stablepush.plan.plan import Plan
-from stablepush.sim.scene import feature_geom, feature_solid, object_pieces, simulated_outline
+from stablepush.sim.scene import add_object_geoms, feature_geom, feature_solid, mjcf_numbers, simulated_outline
 from stablepush.task.model import Task
 
 SUFFIX = ".mp4"  # H.264 in MP4: plays in browsers, on GitHub and in every player
@@ -211,26 +211,6 @@ def object_in_world(sample: RunSample) -> Optional[np.ndarray]:
 # -- the render-only model ------------------------------------------------------------------------
 
 
-def _fmt(values) -> str:
-    return " ".join(repr(float(v)) for v in values)
-
-
-def _prism(body: ET.Element, assets: ET.Element, prefix: str, obj: dict, half_y: float, rgba) -> None:
-    """The object's outline as convex prisms (the simulated arm's pieces) in `body`, `half_y` m
-    either side of the xz-plane."""
-    for name, piece, rectangle in object_pieces(obj):
-        name = f"{prefix}_{name}"
-        if rectangle:
-            xs, zs = [p[0] for p in piece], [p[1] for p in piece]
-            ET.SubElement(body, "geom", name=name, type="box", rgba=_fmt(rgba),
-                          pos=_fmt(((min(xs) + max(xs)) / 2, 0.0, (min(zs) + max(zs)) / 2)),
-                          size=_fmt(((max(xs) - min(xs)) / 2, half_y, (max(zs) - min(zs)) / 2)))
-        else:
-            ET.SubElement(assets, "mesh", name=name,
-                          vertex=_fmt(np.ravel([(px, sy * half_y, pz) for sy in (-1, 1) for px, pz in piece])))
-            ET.SubElement(body, "geom", name=name, type="mesh", mesh=name, rgba=_fmt(rgba))
-
-
 def _frame_box(scene: dict, samples: Sequence[RunSample], chosen: Sequence[int]) -> Tuple[float, float, float, float]:
     """The region of G's xz-plane the camera shows (x0, z0, x1, z1, m): the plan's outline at
     every drawn step, the object at the start and the pads, with a margin for the features. An
@@ -284,45 +264,47 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
         solid = feature_solid(feature, obj["thickness"])
         name = feature_geom(feature["pusher"])
         if solid["kind"] == "box":
-            ET.SubElement(world, "geom", name=name, type="box", pos=_fmt(solid["center"]),
-                          quat=_fmt(quat_about_y(solid["angle"])), size=_fmt(solid["half_size"]),
-                          rgba=_fmt(_FEATURE_RGBA))
+            ET.SubElement(world, "geom", name=name, type="box", pos=mjcf_numbers(solid["center"]),
+                          quat=mjcf_numbers(quat_about_y(solid["angle"])), size=mjcf_numbers(solid["half_size"]),
+                          rgba=mjcf_numbers(_FEATURE_RGBA))
         else:
             c, h = np.asarray(solid["center"]), solid["half_length"]
             ET.SubElement(world, "geom", name=name, type="capsule", size=repr(solid["radius"]),
-                          fromto=_fmt((*(c - [0, h, 0]), *(c + [0, h, 0]))), rgba=_fmt(_FEATURE_RGBA))
+                          fromto=mjcf_numbers((*(c - [0, h, 0]), *(c + [0, h, 0]))), rgba=mjcf_numbers(_FEATURE_RGBA))
 
     body = ET.SubElement(world, "body", name="object", mocap="true")
-    _prism(body, assets, "object", obj, half, _OBJECT_RGBA)
+    add_object_geoms(body, assets, obj, half, mjcf_numbers(_OBJECT_RGBA), prefix="object_")
 
     # The ghost's fill is a little thinner than the object, so the object hides it where the two
     # agree and it shows where the object is not where the plan has it; its outline lies in front
     # of the object's face and of the pads, so it is always seen, 3 pixels wide.
     ghost = ET.SubElement(world, "body", name="ghost", mocap="true")
-    _prism(ghost, assets, "ghost", obj, max(half - 0.001, half / 2), _GHOST_RGBA)
+    add_object_geoms(ghost, assets, obj, max(half - 0.001, half / 2), mjcf_numbers(_GHOST_RGBA), prefix="ghost_")
     outline = simulated_outline(obj["polygon"])[0]
     front = -(half + 0.0015)
     for k, (a, b) in enumerate(zip(outline, outline[1:] + outline[:1])):
-        ET.SubElement(ghost, "geom", name=f"ghost_edge{k}", type="capsule", size=_fmt([1.5 * extent_z / height]),
-                      fromto=_fmt((a[0], front, a[1], b[0], front, b[1])), rgba=_fmt(_GHOST_EDGE_RGBA))
+        ET.SubElement(ghost, "geom", name=f"ghost_edge{k}", type="capsule",
+                      size=mjcf_numbers([1.5 * extent_z / height]),
+                      fromto=mjcf_numbers((a[0], front, a[1], b[0], front, b[1])), rgba=mjcf_numbers(_GHOST_EDGE_RGBA))
 
     hand = ET.SubElement(world, "body", name="gripper", mocap="true")
     for k, pad in enumerate(gripper["pads"]):  # pad k on the finger at +y when k is even (scene.pad_layout)
         side = 1.0 if k % 2 == 0 else -1.0
         (cx, cz), r = pad["center"], pad["radius"]
-        ET.SubElement(hand, "geom", name=f"pad{k}", type="cylinder", size=_fmt((r, 0.0005)),
-                      pos=_fmt((cx, side * (half + 0.0006), cz)), quat=_fmt((math.sqrt(0.5), math.sqrt(0.5), 0, 0)),
-                      rgba=_fmt(_PAD_RGBA))
+        ET.SubElement(hand, "geom", name=f"pad{k}", type="cylinder", size=mjcf_numbers((r, 0.0005)),
+                      pos=mjcf_numbers((cx, side * (half + 0.0006), cz)),
+                      quat=mjcf_numbers((math.sqrt(0.5), math.sqrt(0.5), 0, 0)),
+                      rgba=mjcf_numbers(_PAD_RGBA))
     # The fingers as the shipped arm's (arm.xml: 16 mm wide, 90 mm from G toward the palm, +z),
     # just outside the pads.
     for side in (1.0, -1.0):
         ET.SubElement(hand, "geom", type="box", size="0.008 0.003 0.045",
-                      pos=_fmt((0.0, side * (half + 0.0045), 0.045)), rgba=_fmt(_FINGER_RGBA))
+                      pos=mjcf_numbers((0.0, side * (half + 0.0045), 0.045)), rgba=mjcf_numbers(_FINGER_RGBA))
     ET.SubElement(hand, "geom", name="backdrop", type="box", size="2 0.0005 2",
-                  pos=_fmt((0.0, half + _SLAB - 0.002, 0.0)), rgba=_fmt(_BACKDROP_RGBA))
+                  pos=mjcf_numbers((0.0, half + _SLAB - 0.002, 0.0)), rgba=mjcf_numbers(_BACKDROP_RGBA))
     # xyaxes: the image's x along G's x, its y along G's z, so the camera looks along G's +y.
-    ET.SubElement(hand, "camera", name="view", orthographic="true", fovy=_fmt([extent_z]),
-                  pos=_fmt(((x0 + x1) / 2, -_CAMERA_DISTANCE, (z0 + z1) / 2)), xyaxes="1 0 0 0 0 1")
+    ET.SubElement(hand, "camera", name="view", orthographic="true", fovy=mjcf_numbers([extent_z]),
+                  pos=mjcf_numbers(((x0 + x1) / 2, -_CAMERA_DISTANCE, (z0 + z1) / 2)), xyaxes="1 0 0 0 0 1")
     return ET.tostring(root, encoding="unicode")
 
 
