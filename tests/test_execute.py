@@ -434,12 +434,15 @@ def _closed_loop_within_0_2_at_0_85(tmp_path, task: str, *options: str):
     return result.output, report
 
 
-def test_closed_loop_lands_the_wedge_in_a_low_friction_world_and_says_so(tmp_path):
+@pytest.mark.parametrize("engine", ["mujoco", "drake"])
+def test_closed_loop_lands_the_wedge_in_a_low_friction_world_and_says_so(tmp_path, engine):
     """A user's wedge (data/tasks/more/wedge-heel.yaml) whose heel stop creeps open loop: in a world
     with 15% less mu than its task, closed loop, the run lands within 0.2 mm and 0.2 deg of the goal,
-    the report says success and lists the corrections with what triggered them."""
-    _, report = _closed_loop_within_0_2_at_0_85(tmp_path, "more/wedge-heel.yaml")
-    assert report["success"] is True and report["tolerance"] == [0.2, 0.2] and report["engine"] == "mujoco"
+    the report says success and lists the corrections with what triggered them. On Drake its goal
+    puts a pad point 0.15 mm inside the heel face, where Drake's sphere-vs-convex query answered
+    through that face and pushed the wedge 0.4 mm out of the grasp (drake_arm._add_pad_faces)."""
+    _, report = _closed_loop_within_0_2_at_0_85(tmp_path, "more/wedge-heel.yaml", "--engine", engine)
+    assert report["success"] is True and report["tolerance"] == [0.2, 0.2] and report["engine"] == engine
     assert report["replans"] and all(r["trigger"] in ("plan_short", "off_plan", "off_goal") for r in report["replans"])
     assert any(r["solved"] and r["pushes"] > 0 for r in report["replans"])
 

@@ -17,7 +17,9 @@ Contact (chosen by the friction-fidelity contract, `fidelity.py`; docs/engines.m
 - the pads are point contacts (spheres); each feature is rigid hydroelastic against the object,
   compliant at HYDROELASTIC_MODULUS (a box on a box has one point contact, which chatters; a
   softer patch lets the object roll on the pusher where the rigid model says it sticks);
-- only pads and features touch the object (collision filters);
+- only pads and features touch the object (collision filters); a pad touches a prism piece
+  through a deep copy of it (`_add_pad_faces`: Drake's sphere-vs-convex query misplaces a contact
+  near a thin prism's side face);
 - Drake combines two surfaces' friction as mu = 2 mu1 mu2 / (mu1 + mu2); the object carries
   OBJECT_MU and every pad and feature the partner value that makes the pair's mu the task's
   (`partner_mu`), since each pair in the task has its own mu.
@@ -44,6 +46,7 @@ POINT_STIFFNESS = 1e5  # N/m per pad point
 HUNT_CROSSLEY_DISSIPATION = 1.0  # s/m
 HYDROELASTIC_MODULUS = 1e10  # Pa: the object's contact with a feature; softer lets the pusher roll (docstring)
 HYDRO_RESOLUTION = 0.002  # m
+PAD_FACE_DEPTH = 1.0  # m: how deep the prisms the pads touch reach into the object (_add_pad_faces)
 OBJECT_MU = 1000.0  # the object's own friction; each partner's is set to give the pair's mu (partner_mu)
 KINEMATIC_HAND_BODY = "hand"
 KINEMATIC_HAND_MASS = 1e4  # kg
@@ -119,15 +122,23 @@ class DrakeGrasp:
         arm_geometry += plant.GetCollisionGeometriesForBody(plant.world_body())  # the floor
         self._pads = self._add_pads(scene)
         self._object_body, self._pieces = self._add_object(scene["object"])
+        pad_faces = self._add_pad_faces(scene["object"])
         self._features = self._add_features(scene)
         plant.Finalize()
 
-        # Only pads and features touch the object.
-        everything = d.GeometrySet(arm_geometry + self._pads + self._pieces + list(self._features.values()))
-        touching = d.GeometrySet(self._pads + list(self._features.values()))
-        pieces = d.GeometrySet(self._pieces)
-        scene_graph.collision_filter_manager().Apply(
-            d.CollisionFilterDeclaration().ExcludeWithin(everything).AllowBetween(touching, pieces))
+        # Only pads and features touch the object; a pad touches a box piece, or the deep copy of a
+        # prism piece on its own side (_add_pad_faces).
+        sides = [side for _, _, side, _ in scene_mod.pad_layout(scene)]
+        pads_on = {s: d.GeometrySet([g for g, side in zip(self._pads, sides) if side == s]) for s in (1.0, -1.0)}
+        deep = [g for faces in pad_faces.values() for g in faces]
+        boxes = [g for g, (_, _, rectangle) in zip(self._pieces, scene_mod.object_pieces(scene["object"])) if rectangle]
+        everything = d.GeometrySet(arm_geometry + self._pads + self._pieces + deep + list(self._features.values()))
+        declaration = (d.CollisionFilterDeclaration().ExcludeWithin(everything)
+                       .AllowBetween(d.GeometrySet(list(self._features.values())), d.GeometrySet(self._pieces))
+                       .AllowBetween(d.GeometrySet(self._pads), d.GeometrySet(boxes)))
+        for side, faces in pad_faces.items():
+            declaration.AllowBetween(pads_on[side], d.GeometrySet(faces))
+        scene_graph.collision_filter_manager().Apply(declaration)
 
         self.diagram = builder.Build()
         self.simulator = d.Simulator(self.diagram)
@@ -210,6 +221,30 @@ class DrakeGrasp:
                 shape = d.Convex(d.InMemoryMesh(mesh_file=d.MemoryFile(vertices, ".obj", name)))
             pieces.append(plant.RegisterCollisionGeometry(body, X, shape, name, props))
         return body, pieces
+
+    def _add_pad_faces(self, obj: dict) -> Dict[float, list]:
+        """What the pads on each side (+1, -1: the object's +y and -y faces) touch of every piece that
+        is not a box: the piece's outline as a prism from that face PAD_FACE_DEPTH deep into the
+        object, without mass. Drake's sphere-vs-convex query answers a pad point within about 5.5
+        times its penetration of a prism's side face with a contact through that side (the normal
+        from the prism's centre): on the wedge, a pad point 0.3 mm inside its heel face was pushed
+        out along x with 7.5 N where it pressed only on the face, and the object jumped 0.4 mm out
+        of the grasp. The side faces of a deep prism are that far from its centre, so the query
+        answers with the face the pad presses on."""
+        d, plant = self._d, self.plant
+        props = self._properties(OBJECT_MU)  # point contact, as the pads': no hydroelastic mesh
+        half = obj["thickness"] / 2
+        faces: Dict[float, list] = {1.0: [], -1.0: []}
+        for name, piece, rectangle in scene_mod.object_pieces(obj):
+            if rectangle:
+                continue  # the sphere-vs-box query is exact
+            for side in faces:
+                ys = (side * half, side * (half - PAD_FACE_DEPTH))
+                vertices = "".join(f"v {x!r} {y!r} {z!r}\n" for y in ys for x, z in piece)
+                shape = d.Convex(d.InMemoryMesh(mesh_file=d.MemoryFile(vertices, ".obj", f"{name}_pad_face{side:+g}")))
+                faces[side].append(plant.RegisterCollisionGeometry(self._object_body, d.RigidTransform(), shape,
+                                                                   f"{name}_pad_face{side:+g}", props))
+        return faces
 
     def _add_features(self, scene: dict) -> Dict[str, int]:
         d, plant = self._d, self.plant
