@@ -87,6 +87,7 @@ class CoulombPadFriction:
         self._fast_steps = np.zeros(n_points, dtype=int)
         self.solver_steps = 0  # scratch steps with the solver's friction, deciding new sliders
         self.trial_steps = 0  # scratch steps finding the friction's direction
+        self._frictionless = None  # which pad pairs model.pair_friction makes frictionless now
         self._set_frictionless(self.sliding)
 
     def update(self, data) -> None:
@@ -202,9 +203,13 @@ class CoulombPadFriction:
         return (self._point_mu[points] * normal(at, take))[:, None] * at.in_tangent_plane(take, self._direction[points])
 
     def _set_frictionless(self, sliding: np.ndarray) -> None:
+        frictionless = sliding[self._pair_slots]
+        if self._frictionless is not None and np.array_equal(frictionless, self._frictionless):
+            return  # the pairs hold these values already (every write comes through here)
         mu = self._mu.copy()
-        mu[sliding[self._pair_slots]] = FRICTIONLESS_MU
+        mu[frictionless] = FRICTIONLESS_MU
         self.model.pair_friction[self._pairs, :2] = mu
+        self._frictionless = frictionless
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -222,16 +227,17 @@ class _PadContacts:
     def __init__(self, friction: CoulombPadFriction, data):
         self.model, self.data = friction.model, data
         n = data.ncon
-        geoms = data.contact.geom[:n]
+        contact = data.contact  # MuJoCo builds this view at each access: once per step, not per field
+        geoms = contact.geom[:n]
         slots = np.maximum(friction._slot_of_geom[geoms[:, 0]], friction._slot_of_geom[geoms[:, 1]])
-        rows = data.contact.efc_address[:n]
+        rows = contact.efc_address[:n]
         index = np.nonzero((slots >= 0) & (rows >= 0))[0]
         self.slots, self.rows = slots[index], rows[index]
         self.keys = geoms[index, 0] * self.model.ngeom + geoms[index, 1]
-        frames = data.contact.frame[index].reshape(-1, 3, 3)
+        frames = contact.frame[index].reshape(-1, 3, 3)
         self._t1, self._t2 = frames[:, 1], frames[:, 2]
         self._n_points = len(friction.slipping)
-        self.touched = self.count(np.ones(len(self.slots))) > 0
+        self.touched = np.bincount(self.slots, minlength=self._n_points) > 0
 
     def count(self, flags: np.ndarray) -> np.ndarray:
         """How many of each pad point's contacts have `flags`."""
