@@ -296,9 +296,9 @@ def test_world_deviations_need_the_simulated_arm(tmp_path):
 def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     """The low-mu offset in a world whose pads and features have 15% less mu than the task says:
     open loop its pusher slips and it ends about 1 mm from the goal; closed loop it re-plans from
-    the tracked pose, robust to pushers with 15% less mu (a correction with the model's mu slipped
-    as the plan did and ended 0.22 mm low, where no pusher can lift it), and lands within the
-    final tolerance, a fifth of the goal tolerance."""
+    the tracked pose, robust to pushers with 15% less mu and pads with 15% more or less (a
+    correction with the model's mu slipped as the plan did and ended 0.22 mm low, where no pusher
+    can lift it), and lands within the final tolerance, a fifth of the goal tolerance."""
     from stablepush.execution.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
 
@@ -353,8 +353,8 @@ def test_a_correction_that_would_carry_an_unheld_object_between_features_is_refu
     loop = ClosedLoop.for_task(task)
     record, steps = replan(task, (20.095, -0.223, 0.449), "left", loop, 20, (20.0, 0.0, 0.0))
     # The search switches pushers only where the pads hold 1.5 times the weight, and finds none.
-    assert not record.solved and steps == [] and record.failure.startswith("left alone, pusher mu -15% in 50 ms: ")
-    assert "every pusher, pusher mu -15% in 500 ms: " in record.failure and "; every pusher in 500 ms: " in record.failure
+    assert not record.solved and steps == [] and record.failure.startswith("left alone, pusher mu -15%, pad mu +-15% in 50 ms: ")
+    assert "every pusher, pusher mu -15%, pad mu +-15% in 500 ms: " in record.failure and "; every pusher in 500 ms: " in record.failure
     record, steps = replan(task, (0.1, -0.1, 0.3), "left", loop, 1, (1.0, 0.0, 0.0))
     assert record.solved and steps[0].pose == (0.1, -0.1, 0.3)
 
@@ -445,6 +445,16 @@ def test_closed_loop_lands_the_wedge_in_a_low_friction_world_and_says_so(tmp_pat
     assert report["success"] is True and report["tolerance"] == [0.2, 0.2] and report["engine"] == engine
     assert report["replans"] and all(r["trigger"] in ("plan_short", "off_plan", "off_goal") for r in report["replans"])
     assert any(r["solved"] and r["pushes"] > 0 for r in report["replans"])
+
+
+def test_closed_loop_lands_the_high_mu_offset_whose_pusher_slips_with_pads_of_less_friction(tmp_path):
+    """The high-mu offset at x0.85: its left pusher slips and turns the prism 0.9 deg (the pads'
+    15% less mu, not the pusher's, makes it: a plan robust to the pusher's mu alone is the nominal
+    plan). Corrections robust to the pads' mu too switch to the bottom pusher where the pads hold,
+    and the run lands within 0.2 mm / 0.2 deg; robust to the pushers' mu alone, every correction
+    after the first slipped or was refused and it ended 0.85 mm / +0.94 deg off."""
+    _, report = _closed_loop_within_0_2_at_0_85(tmp_path, "horizontal-offset-high-mu.yaml")
+    assert report["success"] is True and any(r["solved"] and r["pushes"] > 0 for r in report["replans"])
 
 
 def test_closed_loop_plans_a_short_plan_again_to_the_goal_before_the_first_push(tmp_path):

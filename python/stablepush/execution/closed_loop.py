@@ -8,11 +8,14 @@ The policy lives here; `executor.py` streams and splices. A re-plan
   plan stops anywhere within the task's wider tolerance) is planned again to it before the first
   push (`aim`), where every push of the task is still ahead: at its end the pusher in contact may
   not be able to push the rest;
-- is planned first robust to pushers whose mu is CORRECTION_PUSHER_MU lower than the task's (as
-  `uncertainty: {pusher_mu: ...}`): a run that needs a correction is in a world whose friction is
-  not the model's, and a correction planned with the model's slips as the plan did (the low-mu
-  offset at x0.85: 0.22 mm low with nominal corrections, 0.09 mm with robust ones); then with the
-  task's own model (a task with `uncertainty:` keeps its box for both);
+- is planned first robust to the worlds the loop is rated for: pushers whose mu is
+  CORRECTION_MU_SPREAD lower than the task's and pads whose mu is that fraction either side of it
+  (as `uncertainty: {pusher_mu: ..., pad_mu: ...}`): a run that needs a correction is in a world
+  whose friction is not the model's, and a correction planned with the model's slips as the plan
+  did (the low-mu offset at x0.85: 0.22 mm low with nominal corrections, 0.09 mm with robust
+  ones; the high-mu offset at x0.85, whose left pusher slipped with pads of 15% less mu, 0.85 mm
+  off with corrections robust to the pushers' mu alone, 0.06 mm with the pads' too); then with
+  the task's own model (a task with `uncertainty:` keeps its box for both);
 - first tries the pusher that is pushing now alone (no switch-over: the object stays on its
   feature), then every pusher of the task with one switch-over more than its budget; a switch-over
   carries the object between features in the pads alone, so that search switches pushers only
@@ -58,9 +61,9 @@ MAX_FAILED_REPLANS = 3  # per run: past this, a pose the planner cannot leave is
 # for worlds that differ from the model; with 1.0, a world with 15% less mu dropped the low-mu
 # prism in transit, 13.8 mm / 45 deg off).
 TRANSIT_HOLD_RATIO = 1.5
-# Corrections are planned first robust to pushers' mu this fraction below the task's: the spread of
-# worlds (x0.85) the loop is rated for.
-CORRECTION_PUSHER_MU = 0.15
+# Corrections are planned first robust to pushers' mu this fraction below the task's and pads' mu this
+# fraction either side of it: the spread of worlds (x0.85 to x1.15) the loop is rated for.
+CORRECTION_MU_SPREAD = 0.15
 
 
 @dataclass(frozen=True)
@@ -196,7 +199,8 @@ def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float,
 class _Attempt:
     """One way to look for a correction: with the pusher in contact alone, or with every pusher and
     one switch-over more than the task allows (a correction may need a pusher the plan did not);
-    robust to the pushers' mu CORRECTION_PUSHER_MU lower, or with the task's model; with the
+    robust to the pushers' mu CORRECTION_MU_SPREAD lower and the pads' that much either way, or
+    with the task's model; with the
     planner's pivot steps, or without."""
 
     every_pusher: bool
@@ -206,7 +210,7 @@ class _Attempt:
 
     def describe(self, pusher: str) -> str:
         who = "every pusher" if self.every_pusher else pusher + " alone"
-        robust = f", pusher mu -{CORRECTION_PUSHER_MU:.0%}" if self.robust else ""
+        robust = f", pusher mu -{CORRECTION_MU_SPREAD:.0%}, pad mu +-{CORRECTION_MU_SPREAD:.0%}" if self.robust else ""
         pivot = ", pivot steps" if self.pivot_steps else ""
         return f"{who}{robust}{pivot} in {self.time_limit * 1e3:g} ms"
 
@@ -230,7 +234,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
     spec = task.pushers[task.pusher_index(pusher)]
     elapsed, tried, steps = 0.0, [], []
-    robust = dataclasses.replace(base, uncertainty={"pusher_mu": CORRECTION_PUSHER_MU})
+    robust = dataclasses.replace(base, uncertainty={"pusher_mu": CORRECTION_MU_SPREAD, "pad_mu": CORRECTION_MU_SPREAD})
     for attempt in ATTEMPTS:
         if (attempt.robust and task.uncertainty) or (attempt.pivot_steps and task.planner.get("pivot_steps")):
             continue  # the task's own box is the model for every attempt; its own pivot steps are in all
@@ -246,7 +250,8 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         # Every pusher: the search itself switches only where the pads hold, so that a correction
         # may detour to where a switch-over is safe. It holds every model to one factor: 1.5 with
         # the nominal model alone, the corners' 1.0 with the task's uncertainty box (whose nominal
-        # 1.5 _transits_held checks after); the robust attempts' box leaves the pads as they are.
+        # 1.5 _transits_held checks after), and 1.5 at every corner of the robust attempts' box too
+        # (its pads' mu is 15% lower at two of them: the stricter rule, as measured).
         transit_hold = (1.0 if task.uncertainty else TRANSIT_HOLD_RATIO) if attempt.every_pusher else 0.0
         result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher)
         elapsed += result.stats["planning_time_s"]
