@@ -200,8 +200,7 @@ class _Attempt:
     """One way to look for a correction: with the pusher in contact alone, or with every pusher and
     one switch-over more than the task allows (a correction may need a pusher the plan did not);
     robust to the pushers' mu CORRECTION_MU_SPREAD lower and the pads' that much either way, or
-    with the task's model; with the
-    planner's pivot steps, or without."""
+    with the task's model; with the planner's pivot steps, or without."""
 
     every_pusher: bool
     time_limit: float  # s

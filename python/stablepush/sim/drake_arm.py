@@ -226,11 +226,10 @@ class DrakeGrasp:
         """What the pads on each side (+1, -1: the object's +y and -y faces) touch of every piece that
         is not a box: the piece's outline as a prism from that face PAD_FACE_DEPTH deep into the
         object, without mass. Drake's sphere-vs-convex query answers a pad point within about 5.5
-        times its penetration of a prism's side face with a contact through that side (the normal
-        from the prism's centre): on the wedge, a pad point 0.3 mm inside its heel face was pushed
-        out along x with 7.5 N where it pressed only on the face, and the object jumped 0.4 mm out
-        of the grasp. The side faces of a deep prism are that far from its centre, so the query
-        answers with the face the pad presses on."""
+        times its penetration of a prism's side face through that side, along the direction from
+        the prism's centre (the wedge's pad point 0.3 mm inside its heel face pushed the wedge out of
+        the grasp with 7.5 N along x; docs/engines.md). A deep prism's side faces are far from its
+        centre, so the query answers with the face the pad presses on."""
         d, plant = self._d, self.plant
         props = self._properties(OBJECT_MU)  # point contact, as the pads': no hydroelastic mesh
         half = obj["thickness"] / 2
