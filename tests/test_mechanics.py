@@ -268,3 +268,34 @@ def test_against_fixed_features_gravity_turns_in_g_and_stays_fixed_in_o():
         np.testing.assert_allclose(w_fixed[:2] - w_moving[:2], -m * (g - R.T @ g), atol=1e-12)
     with pytest.raises(Exception, match="dynamics.pushes"):
         task_with("large-manipulation", lambda d: d["dynamics"].update(pushes="sideways"))
+
+
+def test_stable_directions_of_line_pushers_are_stable_by_the_independent_lp():
+    """stable_directions over 3-D cones (the high-mu offset's three line pushers, at its start): a
+    sample of the pushes it lists is stable by the independent LP, a sample of those it leaves out
+    at the same headings is not, and the largest components are those of the pushes listed."""
+    from stablepush.task import stable_directions
+
+    from independent_lp import IndependentModel
+
+    task = shipped("horizontal-offset-high-mu")
+    found = stable_directions(task, task.start, heading_step=30.0)
+    reference, q = IndependentModel(task), np.array(pose_to_si(task.start))
+    rng = np.random.default_rng(3)
+    for pusher, (name, pushes) in enumerate(found["pushers"].items()):
+        assert pushes, name
+        listed = {(p["heading"], round(p["elevation"])) for p in pushes}
+        for p in rng.choice(pushes, size=min(15, len(pushes)), replace=False):
+            assert reference.stable(q, np.array(pose_to_si(p["move"])), pusher)[0], (name, p)
+        for heading in sorted({h for h, _ in listed})[:4]:
+            for elevation in range(-89, 90, 7):
+                if (heading, elevation) in listed:
+                    continue
+                h, b = math.radians(heading), math.radians(elevation)
+                move = (math.cos(b) * math.cos(h), math.cos(b) * math.sin(h), math.sin(b))
+                stable, _ = reference.stable(q, np.array(pose_to_si(move)), pusher)
+                assert not stable or not task.build_model().grasp_maintained(list(q + pose_to_si(move))), \
+                    (name, heading, elevation)
+    moves = [p["move"] for pushes in found["pushers"].values() for p in pushes]
+    assert found["largest"]["+x"] == pytest.approx(max(m[0] for m in moves))
+    assert found["largest"]["-theta"] == pytest.approx(max(-m[2] for m in moves))

@@ -84,3 +84,25 @@ def test_bench_prints_table_ii_and_writes_trials(tmp_path):
     js = tmp_path / "bench.json"
     assert run("bench", LOW_MU, "--trials", "1", "--out", str(js)).returncode == 0
     assert json.loads(js.read_text())["summary"][0]["task"] == "horizontal-offset-low-mu"
+
+
+def test_check_directions_lists_stable_pushes_and_their_reach(tmp_path):
+    """`check --directions`: each pusher's stable unit pushes (a point pusher: one elevation per
+    heading) and the largest component along each sense; --json holds the same; exactly one of
+    --move and --directions."""
+    pegs = str(TASKS / "more" / "cube-pegs.yaml")
+    result = run("check", pegs, "--at", "7.2445", "-6.1356", "19.543", "--directions")
+    assert result.returncode == 0, result.stderr
+    assert "peg-left: 12" in result.stdout and "peg-bottom: 3" in result.stdout
+    assert "-x +0.051" in result.stdout
+    result = run("check", pegs, "--directions", "--json", "--pusher", "peg-bottom", "--heading-step", "5")
+    found = json.loads(result.stdout)
+    assert list(found["pushers"]) == ["peg-bottom"] and found["unit_step"] == [1.0, 1.0]
+    assert set(found["largest"]) == {"+x", "-x", "+z", "-z", "+theta", "-theta"}
+    headings = [p["heading"] for p in found["pushers"]["peg-bottom"]]
+    assert headings and all(h % 5 == 0 for h in headings) and len(set(headings)) == len(headings)
+    for args in ((), ("--move", "1", "0", "0", "--directions")):
+        result = run("check", LOW_MU, *args)
+        assert result.returncode == 2 and "--move DX DZ DTH, or --directions" in result.stderr
+    result = run("check", LOW_MU, "--directions", "--heading-step", "0")
+    assert result.returncode == 2 and "--heading-step" in result.stderr

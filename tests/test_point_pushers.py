@@ -67,46 +67,38 @@ def test_a_cube_with_two_pegs_is_solved_on_every_seed_and_every_push_passes_the_
         assert {w.pusher for w in plan.waypoints[1:]} <= {"peg-left", "peg-bottom"}
 
 
-def _benchmark(name: str):
-    """A script of benchmarks/ as a module."""
+def _generator():
+    """benchmarks/point_pusher_tasks.py, the generator of point-pusher tasks nothing was tuned on."""
     import importlib.util
 
-    path = TASKS.parent.parent / "benchmarks" / f"{name}.py"
-    spec = importlib.util.spec_from_file_location(name, path)
+    path = TASKS.parent.parent / "benchmarks" / "point_pusher_tasks.py"
+    spec = importlib.util.spec_from_file_location("point_pusher_tasks", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
-def _generator():
-    """benchmarks/point_pusher_tasks.py, the generator of point-pusher tasks nothing was tuned on."""
-    return _benchmark("point_pusher_tasks")
-
-
 def test_at_the_pegs_plan_end_no_stable_push_moves_the_cube_back_along_x(cube_pegs):
-    """benchmarks/stable_directions.py: every direction it finds is stable by the independent LP,
-    and at the end of the pegs' plan (seed 1, 0.245 unit steps past the goal in x) neither peg
-    moves the cube along -x by more than a twentieth of a unit step, and only while turning it
-    (+0.99 in theta): an overshoot in x there is beyond any correction (docs/engines.md)."""
-    directions = _benchmark("stable_directions")
-    model, reference = cube_pegs.build_model(), IndependentModel(cube_pegs)
+    """stable_directions (`stablepush check --directions`): every push it lists is stable by the
+    independent LP, and at the end of the pegs' plan (seed 1, 0.245 unit steps past the goal in x)
+    neither peg moves the cube along -x by more than a twentieth of a unit step, and only while
+    turning it (+0.99 in theta): an overshoot in x there is beyond any correction (docs/engines.md)."""
+    from stablepush.task import stable_directions
+
+    reference = IndependentModel(cube_pegs)
     end = plan_task(cube_pegs, seed=1).waypoints[-1].pose
-    q = np.array([end[0] * MM, end[1] * MM, math.radians(end[2])])
     assert end[0] > cube_pegs.goal[0]
-    scale = np.array([MM, MM, math.radians(1)])  # the task's unit step: 1 mm, 1 deg
-    headings = np.radians(np.arange(0.0, 360.0, 10.0))
-    units = []
-    for pusher in (0, 1):
-        found = directions.stable_directions(model, q, pusher, scale, headings)
-        assert found, pusher
-        for h, b, _ in found:
-            u = np.array([math.cos(math.radians(b)) * math.cos(math.radians(h)),
-                          math.cos(math.radians(b)) * math.sin(math.radians(h)), math.sin(math.radians(b))])
-            assert reference.stable(q, u * scale, pusher)[0], (pusher, h, b)
-            units.append(u)
-    units = np.array(units)
-    assert units[:, 0].max() > 0.5 and (-units[:, 0]).max() < 0.06
-    assert units[np.argmin(units[:, 0]), 2] > 0.95  # the one push with -x turns the cube
+    found = stable_directions(cube_pegs, end)
+    q = np.array([end[0] * MM, end[1] * MM, math.radians(end[2])])
+    assert found["unit_step"] == [1.0, 1.0] and all(found["pushers"].values())
+    for pusher, pushes in enumerate(found["pushers"].values()):
+        for push in pushes:
+            dq = np.array([push["move"][0] * MM, push["move"][1] * MM, math.radians(push["move"][2])])
+            assert reference.stable(q, dq, pusher)[0], (pusher, push)
+    largest = found["largest"]
+    assert largest["+x"] > 0.5 and largest["-x"] < 0.06
+    back = min((p for pushes in found["pushers"].values() for p in pushes), key=lambda p: p["move"][0])
+    assert back["move"][2] > 0.95  # the one push with -x turns the cube
 
 
 def test_generated_point_pusher_tasks_are_solved_and_every_push_passes_the_independent_lp():

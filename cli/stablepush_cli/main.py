@@ -12,7 +12,7 @@ import click
 from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
-from stablepush.task import check_push, load_task
+from stablepush.task import check_push, load_task, stable_directions
 
 EXIT_NOT_SOLVED = 1
 EXIT_BAD_INPUT = 2
@@ -80,11 +80,16 @@ def cli() -> None:
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
 @click.option("--at", "at", nargs=3, type=float, default=None, metavar="X Z TH",
               help="Object pose in the grasp: x mm, z mm, theta deg. Default: the task's start.")
-@click.option("--move", nargs=3, type=float, required=True, metavar="DX DZ DTH",
+@click.option("--move", nargs=3, type=float, default=None, metavar="DX DZ DTH",
               help="Unit motion of the object over one step: dx mm, dz mm, dtheta deg.")
+@click.option("--directions", is_flag=True,
+              help="Instead of --move: every direction in which a pusher can push the object one unit step "
+                   "(planner.step) from --at, and how far any of them moves it along +-x, +-z and +-theta.")
+@click.option("--heading-step", type=click.FloatRange(min=0, max=90, min_open=True), default=10.0, metavar="DEG",
+              show_default=True, help="With --directions: degrees between the headings tried in the (x, z) plane.")
 @click.option("--pusher", default=None, metavar="NAME", help="Test only this pusher (default: every pusher).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object keyed by pusher name.")
-def check(task_file: str, at, move, pusher, as_json: bool) -> None:
+def check(task_file: str, at, move, directions: bool, heading_step: float, pusher, as_json: bool) -> None:
     """Is moving the object by --move from --at a stable push, pusher by pusher?
 
     For each pusher: feasible or not, the contact case at the pads (all_sliding, or sticking when
@@ -92,11 +97,23 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
     pusher's generalized friction cone; negative outside). Decisions within rounding of the cone's
     boundary are re-made in exact arithmetic ("exact" in --json).
 
+    With --directions instead: each pusher's stable unit pushes from --at, by heading h in the (x, z)
+    plane and elevation toward +theta (a point pusher's lie on a surface: one elevation a heading),
+    then the largest component any of them has along each of +-x, +-z, +-theta in unit steps. A
+    sense no push moves the object in (0 or less) cannot be corrected from there: an overshoot that
+    way stays.
+
     \b
-    Example:
+    Examples:
       stablepush check data/tasks/horizontal-offset-low-mu.yaml --at 0 0 0 --move 1 0 0
+      stablepush check data/tasks/more/cube-pegs.yaml --at 7.24 -6.14 19.54 --directions
     """
+    if (move is None) == (not directions):
+        raise click.UsageError("give --move DX DZ DTH, or --directions (one of the two)")
     task = _load(task_file)
+    if directions:
+        _print_directions(stable_directions(task, at if at else task.start, pusher, heading_step), as_json)
+        return
     results = check_push(task, at if at else task.start, move, pusher)
     if as_json:
         click.echo(json.dumps(results))
@@ -105,6 +122,28 @@ def check(task_file: str, at, move, pusher, as_json: bool) -> None:
     for name, r in results.items():
         verdict = "stable" if r["feasible"] else "not stable"
         click.echo(f"{name:<{width}}  {verdict:<10}  {r['case']:<11}  margin {r['margin']:+.4f} N")
+
+
+def _print_directions(found: dict, as_json: bool) -> None:
+    if as_json:
+        click.echo(json.dumps(found))
+        return
+    step_mm, step_deg = found["unit_step"]
+    click.echo(f"stable unit pushes (one unit step: {step_mm:g} mm, {step_deg:g} deg), by heading in the (x, z) plane "
+               f"and elevation toward +theta:")
+    for name, pushes in found["pushers"].items():
+        click.echo(f"{name}: {len(pushes)}")
+        by_heading: dict = {}
+        for p in pushes:
+            by_heading.setdefault(p["heading"], []).append(p["elevation"])
+        for heading, elevations in by_heading.items():
+            shown = (f"elevation {elevations[0]:+6.1f}" if len(elevations) == 1
+                     else f"{len(elevations)} elevations from {min(elevations):+.1f} to {max(elevations):+.1f}")
+            click.echo(f"  heading {heading:5.1f}  {shown}")
+    click.echo("largest component of a stable unit push along each sense, in unit steps (none or <= 0: no push "
+               "moves the object that way):")
+    click.echo("  " + "  ".join(f"{sense} {'none' if v is None else f'{v:+.3f}'}"
+                                for sense, v in found["largest"].items()))
 
 
 @cli.command()

@@ -1,6 +1,7 @@
 """The stable-push test in file units: the Python face of the core's feasibility test."""
 from __future__ import annotations
 
+import math
 from typing import Dict, Optional, Sequence
 
 from stablepush import _core
@@ -53,3 +54,90 @@ def check_push(
     if pusher is not None:
         return {pusher: result_to_dict(model.check(q, dq, task.pusher_index(pusher)))}
     return {name: result_to_dict(r) for name, r in zip(task.pusher_names, model.check_all(q, dq))}
+
+
+ELEVATION_GRID_DEG = 1.0  # deg between the elevations tested at each heading (stable_directions)
+ROOT_BISECTIONS = 50  # a point pusher's surface, to rounding of the elevation
+
+
+def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = None,
+                      heading_step: float = 10.0) -> dict:
+    """Which ways the pushers can move the object from pose `at` (x mm, z mm, theta deg): the stable
+    unit pushes, one unit step (planner.step) long, at headings every `heading_step` deg.
+
+    A unit push is written in unit steps as (cos b cos h, cos b sin h, sin b): heading h in the
+    (x, z) plane, elevation b toward +theta. A pusher whose cone is 3-D is tested at every
+    ELEVATION_GRID_DEG of elevation; a point pusher's stable pushes lie on its surface
+    e . w_required(motion) = 0 (docs/model.md, sections 2 and 3), so its elevations are the roots
+    of that equation on the grid, refined by bisection, then tested. Every push returned passed the
+    stable-push test (with `uncertainty:`, at every corner of the box) and keeps the grasp.
+
+    Returns {"unit_step": [mm, deg], "pushers": {name: [{"heading", "elevation" (deg), "move"
+    (dx mm, dz mm, dtheta deg), "margin" (N)}, ...]}, "largest": {"+x", "-x", "+z", "-z",
+    "+theta", "-theta": the largest component along that sense of any push returned, in unit
+    steps (<= 0 or None: no stable push moves the object that way)}}."""
+    import numpy as np
+
+    at = pose_field("at", list(at))
+    if not 0.0 < heading_step <= 90.0:
+        raise TaskError("heading_step", f"must be in (0, 90] degrees, got {heading_step:g}")
+    names = [pusher] if pusher is not None else task.pusher_names
+    indices = [task.pusher_index(name) for name in names]
+    model = task.build_model()
+    q = np.array(pose_to_si(at))
+    if not model.grasp_maintained(q.tolist()):
+        raise TaskError("at", f"the pads are not all on the object at {list(at)} (x mm, z mm, theta deg): "
+                              f"there is no grasp to push in")
+    corners = task.corner_models() if task.uncertainty else [model]
+    step_mm, step_deg = task.planner["step"]
+    scale = np.array(pose_to_si((step_mm, step_mm, step_deg)))
+    headings = [heading_step * i for i in range(math.ceil(360.0 / heading_step - 1e-9))]  # deg
+    elevations = np.radians(np.arange(-90.0 + ELEVATION_GRID_DEG, 90.0, ELEVATION_GRID_DEG))
+
+    def unit(h: float, b: float) -> np.ndarray:
+        return np.array([math.cos(b) * math.cos(h), math.cos(b) * math.sin(h), math.sin(b)])
+
+    def verdict(dq: np.ndarray, index: int):
+        result = _core.worst_case(corners, q.tolist(), dq.tolist(), index)
+        return result.feasible and model.grasp_maintained((q + dq).tolist()), result.margin
+
+    out, units = {}, []
+    for name, index in zip(names, indices):
+        found = []
+        rows = model.pusher_cones[index].equality_rows
+        for heading in headings:
+            h = math.radians(heading)
+            if not rows:  # a 3-D cone: every elevation of the grid, each its own candidate
+                candidates = [(b,) for b in elevations]
+            else:
+                e = np.asarray(rows[0])
+
+                def off(b: float) -> float:  # e . w_required / its scale: 0 on the surface
+                    w = model.motion_wrench(q.tolist(), (unit(h, b) * scale).tolist(), index)
+                    return float(e @ np.asarray(w.required)) / w.scale
+
+                values = [off(b) for b in elevations]
+                candidates = []
+                for lo, hi, f_lo, f_hi in zip(elevations, elevations[1:], values, values[1:]):
+                    if f_lo * f_hi >= 0:
+                        continue
+                    for _ in range(ROOT_BISECTIONS):
+                        mid = 0.5 * (lo + hi)
+                        lo, hi = (lo, mid) if off(mid) * f_lo < 0 else (mid, hi)
+                    candidates.append((lo, hi))  # the side of the root the test accepts, if either
+            for sides in candidates:
+                for b in sides:
+                    stable, margin = verdict(unit(h, b) * scale, index)
+                    if stable:
+                        found.append({"heading": heading, "elevation": math.degrees(b),
+                                      "move": [float(v) for v in unit(h, b) * (step_mm, step_mm, step_deg)],
+                                      "margin": float(margin)})
+                        units.append(unit(h, b))
+                        break
+        out[name] = found
+    largest = {}
+    for axis, label in enumerate(("x", "z", "theta")):
+        for sign, s in ((1.0, "+"), (-1.0, "-")):
+            best = max((sign * u[axis] for u in units), default=None)
+            largest[s + label] = None if best is None else float(best)
+    return {"unit_step": [step_mm, step_deg], "pushers": out, "largest": largest}
