@@ -125,6 +125,11 @@ def run_tasks(count: int, seed: int, scratch: Path):
         if case % 4 == 0:
             move = [rng.choice([1.0, 0.0, -1.0, 1e-160, float("nan"), 1e308, 0.5]) for _ in range(3)]
             yield (f"task {case} check", ["check", str(task), "--move", *map(repr, move)], mutated)
+        if case % 8 == 0:
+            at = [rng.choice([0.0, -1.0, 1e-160, float("nan"), 1e308, 5.0, -40.0]) for _ in range(3)]
+            step = rng.choice(["10", "90", "0.7"])  # click refuses the rest itself, with its usage text
+            yield (f"task {case} check --directions",
+                   ["check", str(task), "--directions", "--at", *map(repr, at), "--heading-step", step], mutated)
 
 
 def run_plans(count: int, seed: int, scratch: Path):
