@@ -38,8 +38,25 @@ def test_when_no_plan_reaches_the_final_tolerance_the_plan_runs_and_the_record_s
     plan = plan_task(task, seed=1)
     record, steps = aim(task, plan.waypoints, ClosedLoop.for_task(task))
     assert not record.solved and steps == [] and record.pushes == 0 and record.pushers == []
+    # The plan ends 0.245 mm past the goal in x, where neither peg moves the cube back along -x.
     assert record.failure == "0 switch-over(s) in 2000 ms: time_limit; 1 switch-over(s) in 2000 ms: time_limit; " \
-        "2 switch-over(s) in 2000 ms: time_limit", record.failure
+        "2 switch-over(s) in 2000 ms: time_limit; from the plan's end no stable push moves the object toward the " \
+        "goal along -x (at most 0.05 of a unit step)", record.failure
+
+
+def test_no_way_back_names_the_senses_no_pusher_moves_the_object_in():
+    """closed_loop.no_way_back: the senses of x, z, theta toward the goal, beyond the tolerance, in
+    which no stable push moves the object by more than a tenth of a unit step; None where the
+    pushers can move it every way the goal lies (the T at its start), or off the grasp."""
+    from stablepush.execution.closed_loop import no_way_back
+
+    pegs = shipped("more/cube-pegs")
+    end = plan_task(pegs, seed=1).waypoints[-1].pose
+    assert no_way_back(pegs, end, (0.2, 0.2)) == "-x (at most 0.05 of a unit step)"
+    assert no_way_back(pegs, end, (0.3, 0.5)) is None  # the x gap (0.245 mm) is within 0.3 mm
+    t = shipped("t-shaped")
+    assert no_way_back(t, t.start, (0.2, 0.2)) is None
+    assert no_way_back(t, (500.0, 0.0, 0.0), (0.2, 0.2)) is None  # no grasp there
 
 
 def test_aimed_plans_switch_over_only_where_corrections_may_and_no_more_than_needed():

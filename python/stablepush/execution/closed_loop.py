@@ -40,8 +40,10 @@ from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
+from stablepush.errors import TaskError
 from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
+from stablepush.task.mechanics import stable_directions
 from stablepush.task.model import Task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import angle_difference_deg, pose_to_si
@@ -61,6 +63,9 @@ MAX_FAILED_REPLANS = 3  # per run: past this, a pose the planner cannot leave is
 # for worlds that differ from the model; with 1.0, a world with 15% less mu dropped the low-mu
 # prism in transit, 13.8 mm / 45 deg off).
 TRANSIT_HOLD_RATIO = 1.5
+# A sense of x, z or theta in which no stable push moves the object by more than this fraction of a
+# unit step counts as one the pushers cannot push it in (the pegs' -x: 0.05, and only while turning).
+NO_WAY_BACK = 0.1
 # Corrections are planned first robust to pushers' mu this fraction below the task's and pads' mu this
 # fraction either side of it: the spread of worlds (x0.85 to x1.15) the loop is rated for.
 CORRECTION_MU_SPREAD = 0.15
@@ -183,6 +188,10 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
         else:
             found = list(result.waypoints)
             break
+    if not found:
+        blocked = no_way_back(task, end, loop.final_tolerance)  # where the plan, run as it is, ends
+        tried += [f"from the plan's end no stable push moves the object toward the goal along {blocked}"] \
+            if blocked else []
     record = Replan(after_step=0, measured=tuple(start), planned=tuple(end), solved=bool(found),
                     pushers=result.pusher_sequence if found else [], pushes=max(len(found) - 1, 0),
                     kept_pusher=False, planning_ms=elapsed * 1e3, trigger="plan_short",
@@ -193,6 +202,26 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
 def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float, float, float]:
     """The measured pose minus `pose`: x mm, z mm, theta deg."""
     return measured["x"] - pose[0], measured["z"] - pose[1], angle_difference_deg(measured["theta"], pose[2])
+
+
+def no_way_back(task: Task, pose: Sequence[float], tolerance: Tuple[float, float]) -> Optional[str]:
+    """When the goal lies, from `pose` (x mm, z mm, theta deg, in the task's world), beyond
+    `tolerance` (mm, deg) in a sense of x, z or theta in which no stable unit push of the task's
+    pushers moves the object by more than NO_WAY_BACK of a unit step (`stable_directions`, headings
+    every 10 deg): those senses, each with the largest such push ("-x (at most 0.05 of a unit
+    step)"), else None. Why a correction cannot exist from there."""
+    try:
+        largest = stable_directions(task.with_start(pose), pose)["largest"]
+    except TaskError:  # no grasp at the pose: the planner's own refusal says so
+        return None
+    gap = (task.goal[0] - pose[0], task.goal[1] - pose[1], angle_difference_deg(task.goal[2], pose[2]))
+    blocked = []
+    for axis, (name, limit) in enumerate(zip(("x", "z", "theta"), (tolerance[0], tolerance[0], tolerance[1]))):
+        sense = ("+" if gap[axis] > 0 else "-") + name
+        if abs(gap[axis]) > limit and (largest[sense] is None or largest[sense] < NO_WAY_BACK):
+            most = "none" if largest[sense] is None else f"at most {max(largest[sense], 0.0):.2f} of a unit step"
+            blocked.append(f"{sense} ({most})")
+    return ", ".join(blocked) if blocked else None
 
 
 @dataclass(frozen=True)
@@ -263,6 +292,9 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
             continue
         steps = list(result.waypoints)
         break
+    if not steps:
+        blocked = no_way_back(task, measured, loop.final_tolerance)
+        tried += [f"from here no stable push moves the object toward the goal along {blocked}"] if blocked else []
     record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=bool(steps),
                     pushers=result.pusher_sequence if steps else [], pushes=max(len(steps) - 1, 0),
                     kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3,
