@@ -284,7 +284,8 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher)
         elapsed += result.stats["planning_time_s"]
         if not result.solved:
-            tried.append(f"{attempt.describe(pusher)}: {result.outcome}")
+            why = result.message if result.outcome == "unreachable" else result.outcome  # the reason, decided at once
+            tried.append(f"{attempt.describe(pusher)}: {why}")
             continue
         if not _transits_held(task, result.waypoints, pusher):
             tried.append(f"{attempt.describe(pusher)}: {' -> '.join(result.pusher_sequence)} carries the object "
