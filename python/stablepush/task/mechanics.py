@@ -4,6 +4,8 @@ from __future__ import annotations
 import math
 from typing import Dict, Optional, Sequence
 
+import numpy as np
+
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.task.model import Task
@@ -76,8 +78,6 @@ def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = N
     (dx mm, dz mm, dtheta deg), "margin" (N)}, ...]}, "largest": {"+x", "-x", "+z", "-z",
     "+theta", "-theta": the largest component along that sense of any push returned, in unit
     steps (<= 0 or None: no stable push moves the object that way)}}."""
-    import numpy as np
-
     at = pose_field("at", list(at))
     if not 0.0 < heading_step <= 90.0:
         raise TaskError("heading_step", f"must be in (0, 90] degrees, got {heading_step:g}")
