@@ -132,11 +132,15 @@ def test_execute_video_draws_the_run_and_the_object_moves_in_it(tmp_path, engine
 
 @pytest.mark.slow
 def test_the_ghost_follows_the_re_planned_steps(tmp_path):
-    """With the closed loop, the waypoints after a correction carry the new plan's poses: the step
-    where the correction starts carries the measured pose (the spliced plan's first pose)."""
+    """With the closed loop, the waypoints after a correction carry the new plan's poses. The new
+    plan starts at the measured pose, so the step after the correction shows a pose one unit push
+    from the measured one, not the old plan's; a transit at the step where the correction starts
+    (a new plan that starts with another pusher) shows the measured pose itself."""
+    from stablepush import _core
     from stablepush.execution import ClosedLoop, execute_plan
     from stablepush.sim.arm import WorldDeviation
     from stablepush.sim.server import running_sim_arm
+    from stablepush.units import pose_to_si
 
     task = shipped("horizontal-offset-low-mu")
     plan = check_plan(task, plan_task(task, seed=1))
@@ -146,9 +150,15 @@ def test_the_ghost_follows_the_re_planned_steps(tmp_path):
                               closed_loop=ClosedLoop.for_task(task), record=recording)
     taken = [r for r in report.replans if r.solved and r.pushes]
     assert taken
+    unit = (task.planner["step"][0] * 1e-3, np.radians(task.planner["step"][1]))
     for r in taken:
-        after = [s.planned for s in recording.samples if s.step == r.after_step and s.phase != "push"]
-        assert any(p == pytest.approx(r.measured, abs=1e-9) for p in after)
+        heading = [s.planned for s in recording.samples if s.step == r.after_step + 1]
+        assert heading and all(_core.steps_between(pose_to_si(r.measured), pose_to_si(p), unit) <= 1.0 + 1e-6
+                               for p in heading), (r.measured, heading[:1])
+        transit = [s.planned for s in recording.samples if s.step == r.after_step and s.phase not in ("push", "settle")]
+        assert all(p == pytest.approx(r.measured, abs=1e-9) for p in transit)
+    k = taken[0].after_step + 1  # the old plan's pose there is not shown any more
+    assert all(s.planned != pytest.approx(plan.waypoints[k].pose, abs=1e-6) for s in recording.samples if s.step == k)
     assert recording.samples[-1].planned == pytest.approx(report.planned_final)
 
 
