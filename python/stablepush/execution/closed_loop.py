@@ -30,7 +30,9 @@ The policy lives here; `executor.py` streams and splices. A re-plan
   are not needed for (the low-mu offset's lifted less and ended 0.35 mm low);
 - plans in the world the run is in: the features keep the object's world orientation they had
   (`Task.with_start`), so gravity in O on each feature is the world's, not the measured pose's;
-- takes milliseconds (the planner's own time; limits below), between two waypoints.
+- takes milliseconds (the planner's own time; limits below), between two waypoints;
+- when none is found, says so with what each attempt ended with and, where the goal lies in a
+  sense of x, z or theta no stable push moves the object in (`no_way_back`), that sense.
 Poses are (x mm, z mm, theta deg), as in plan files.
 """
 from __future__ import annotations
