@@ -121,8 +121,9 @@ class DrakeGrasp:
                         for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))]
         arm_geometry += plant.GetCollisionGeometriesForBody(plant.world_body())  # the floor
         self._pads = self._add_pads(scene)
-        self._object_body, self._pieces = self._add_object(scene["object"])
-        pad_faces = self._add_pad_faces(scene["object"])
+        pieces = scene_mod.object_pieces(scene["object"])  # (name, outline, whether a box), once
+        self._object_body, self._pieces = self._add_object(scene["object"], pieces)
+        pad_faces = self._add_pad_faces(scene["object"], pieces)
         self._features = self._add_features(scene)
         plant.Finalize()
 
@@ -131,7 +132,7 @@ class DrakeGrasp:
         sides = [side for _, _, side, _ in scene_mod.pad_layout(scene)]
         pads_on = {s: d.GeometrySet([g for g, side in zip(self._pads, sides) if side == s]) for s in (1.0, -1.0)}
         deep = [g for faces in pad_faces.values() for g in faces]
-        boxes = [g for g, (_, _, rectangle) in zip(self._pieces, scene_mod.object_pieces(scene["object"])) if rectangle]
+        boxes = [g for g, (_, _, rectangle) in zip(self._pieces, pieces) if rectangle]
         everything = d.GeometrySet(arm_geometry + self._pads + self._pieces + deep + list(self._features.values()))
         declaration = (d.CollisionFilterDeclaration().ExcludeWithin(everything)
                        .AllowBetween(d.GeometrySet(list(self._features.values())), d.GeometrySet(self._pieces))
@@ -199,7 +200,7 @@ class DrakeGrasp:
             pads.append(plant.RegisterCollisionGeometry(body, X, d.Sphere(scene_mod.PAD_POINT_RADIUS), name, props))
         return pads
 
-    def _add_object(self, obj: dict):
+    def _add_object(self, obj: dict, pieces: list):
         d, plant = self._d, self.plant
         instance = plant.AddModelInstance(scene_mod.OBJECT_BODY)
         J = scene_mod.object_inertia(obj)
@@ -209,8 +210,8 @@ class DrakeGrasp:
         body = plant.AddRigidBody(scene_mod.OBJECT_BODY, instance, inertia)
         props = self._properties(OBJECT_MU, "compliant")
         half = obj["thickness"] / 2
-        pieces = []
-        for name, piece, rectangle in scene_mod.object_pieces(obj):
+        geometries = []
+        for name, piece, rectangle in pieces:
             if rectangle:
                 xs, zs = [p[0] for p in piece], [p[1] for p in piece]
                 X = d.RigidTransform([(min(xs) + max(xs)) / 2, 0.0, (min(zs) + max(zs)) / 2])
@@ -219,10 +220,10 @@ class DrakeGrasp:
                 X = d.RigidTransform()
                 vertices = "".join(f"v {x!r} {sy * half!r} {z!r}\n" for sy in (-1, 1) for x, z in piece)
                 shape = d.Convex(d.InMemoryMesh(mesh_file=d.MemoryFile(vertices, ".obj", name)))
-            pieces.append(plant.RegisterCollisionGeometry(body, X, shape, name, props))
-        return body, pieces
+            geometries.append(plant.RegisterCollisionGeometry(body, X, shape, name, props))
+        return body, geometries
 
-    def _add_pad_faces(self, obj: dict) -> Dict[float, list]:
+    def _add_pad_faces(self, obj: dict, pieces: list) -> Dict[float, list]:
         """What the pads on each side (+1, -1: the object's +y and -y faces) touch of every piece that
         is not a box: the piece's outline as a prism from that face PAD_FACE_DEPTH deep into the
         object, without mass. Drake's sphere-vs-convex query answers a pad point within about 5.5
@@ -234,7 +235,7 @@ class DrakeGrasp:
         props = self._properties(OBJECT_MU)  # point contact, as the pads': no hydroelastic mesh
         half = obj["thickness"] / 2
         faces: Dict[float, list] = {1.0: [], -1.0: []}
-        for name, piece, rectangle in scene_mod.object_pieces(obj):
+        for name, piece, rectangle in pieces:
             if rectangle:
                 continue  # the sphere-vs-box query is exact
             for side in faces:
