@@ -111,10 +111,11 @@ def check(task_file: str, at, move, directions: bool, heading_step: float, pushe
     if (move is None) == (not directions):
         raise click.UsageError("give --move DX DZ DTH, or --directions (one of the two)")
     task = _load(task_file)
+    at = at if at else task.start
     if directions:
-        _print_directions(stable_directions(task, at if at else task.start, pusher, heading_step), as_json)
+        _print_directions(stable_directions(task, at, pusher, heading_step), as_json)
         return
-    results = check_push(task, at if at else task.start, move, pusher)
+    results = check_push(task, at, move, pusher)
     if as_json:
         click.echo(json.dumps(results))
         return

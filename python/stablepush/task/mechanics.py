@@ -27,6 +27,14 @@ def result_to_dict(result: "_core.PushResult") -> dict:
     }
 
 
+def _require_grasp(model: "_core.StablePushModel", q: Sequence[float], at: Sequence[float]) -> None:
+    """TaskError (field `at`) unless the pads are all on the object at q: the model answers for any
+    pose, but a push means something only where the pads hold the object."""
+    if not model.grasp_maintained(q):
+        raise TaskError("at", f"the pads are not all on the object at {list(at)} (x mm, z mm, theta deg): "
+                              f"there is no grasp to push in")
+
+
 def check_push(
     task: Task,
     at: Sequence[float],
@@ -46,10 +54,7 @@ def check_push(
     names = [pusher] if pusher is not None else task.pusher_names
     robust = task.uncertainty and model is None
     model = model or task.build_model()
-    # The model answers for any pose, but a push means something only where the pads hold the object.
-    if not model.grasp_maintained(q):
-        raise TaskError("at", f"the pads are not all on the object at {list(at)} (x mm, z mm, theta deg): "
-                              f"there is no grasp to push in")
+    _require_grasp(model, q, at)
     if robust:  # the least stable corner of the box decides
         corners = task.corner_models()
         return {name: result_to_dict(_core.worst_case(corners, q, dq, task.pusher_index(name))) for name in names}
@@ -85,9 +90,7 @@ def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = N
     indices = [task.pusher_index(name) for name in names]
     model = task.build_model()
     q = np.array(pose_to_si(at))
-    if not model.grasp_maintained(q.tolist()):
-        raise TaskError("at", f"the pads are not all on the object at {list(at)} (x mm, z mm, theta deg): "
-                              f"there is no grasp to push in")
+    _require_grasp(model, q.tolist(), at)
     corners = task.corner_models() if task.uncertainty else [model]
     step_mm, step_deg = task.planner["step"]
     scale = np.array(pose_to_si((step_mm, step_mm, step_deg)))
