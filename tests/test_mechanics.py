@@ -227,6 +227,19 @@ def test_hold_ratio_agrees_with_an_independent_lp_and_is_infinite_without_gravit
     assert math.isinf(shipped("pivoting").build_model().hold_ratio((0.0, 0.0, 0.0)))
 
 
+def test_hold_ratio_answers_where_the_fast_lp_stalls_at_a_degenerate_vertex():
+    """The hexagon, held with its centre of mass on the pads' axis, at two poses (found by a random
+    search) where the fast active-set LP stalls: the exact LP answers, as the independent LP does."""
+    from independent_lp import IndependentModel
+
+    task = shipped("more/hexagon-offset")
+    model, reference = task.build_model(), IndependentModel(task)
+    for q, pusher in (((6.595234876716923, 2.8980005094153807, 22.666233343058526), 0),
+                      ((7.837396483733109, 6.12360638911497, 22.783082226508174), 1)):
+        q = pose_to_si(q)
+        assert model.hold_ratio(q, pusher) == pytest.approx(reference.hold_ratio(q, pusher), rel=1e-6)
+
+
 def test_released_at_the_offsets_goal_the_prism_is_not_held_and_the_planner_can_require_a_held_goal():
     from stablepush.plan import plan_task
 

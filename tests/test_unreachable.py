@@ -4,6 +4,7 @@ the certificate's weak duality, and grids on which every goal called unreachable
 with the verdict switched off, and never reached."""
 import dataclasses
 import math
+import zlib
 from fractions import Fraction
 
 import numpy as np
@@ -86,7 +87,7 @@ def _random_in_box(rng, goal, tol, n):
 def test_the_hold_bound_is_never_below_the_cores_hold_ratio_in_the_box(name):
     """A property over random goals near the task's and random poses in their boxes, every pusher's
     gravity, every corner model: the bound is an upper bound of the core's own hold_ratio."""
-    rng = np.random.default_rng(abs(hash(name)) % 2**32)
+    rng = np.random.default_rng(zlib.crc32(name.encode()))  # hash() differs per process
     task = shipped(name)
     for trial in range(4):
         tol = (float(rng.uniform(0.1, 3.0)), float(rng.uniform(0.1, 5.0)))

@@ -1,6 +1,7 @@
 // The exact re-check of a stable-push decision that the double evaluation could not certify.
 // Every input is the double the fast path used; sums and products are exact in CGAL::Gmpzf, and
-// the sticking case is CGAL's exact LP solver (about 50 us, so it stays off the common path).
+// the sticking case is CGAL's exact LP solver (about 50 us, so it stays off the common path). The
+// pads' hold ratio falls back to the same solver where the fast one stalls.
 #include <CGAL/QP_functions.h>
 #include <CGAL/QP_models.h>
 
@@ -120,6 +121,38 @@ PushResult StablePushModel::exact_sticking(const WrenchCone& cone, const MotionW
     result.witness -= sticking_wrench(load.rotation, loads.groups[g].arm, Vec2(x[2 * g], x[2 * g + 1]));
   }
   return result;
+}
+
+// maximize lambda  s.t.  sum_g f_g + lambda W = 0,  sum_g cross_y(arm_g, f_g) + lambda cross_y(r_cm, W) = 0,
+//                        n_k . f_g <= rho_g cos(pi / sides),  lambda <= cap        (hold_ratio's LP)
+double StablePushModel::exact_hold_ratio(const std::vector<StickingGroup>& groups, const Vec2& weight, const Vec2& r_cm,
+                                         double cap) const {
+  const int count = static_cast<int>(groups.size());
+  const int lambda = 2 * count;
+  using Program = CGAL::Quadratic_program<ExactFT>;
+  Program lp(CGAL::EQUAL, false, 0, false, 0);  // free variables, rows "=" unless set
+  for (int g = 0; g < count; ++g) {
+    lp.set_a(2 * g, 0, exact(1));
+    lp.set_a(2 * g + 1, 1, exact(1));
+    lp.set_a(2 * g, 2, exact(groups[g].arm.y()));  // cross_y(arm, f) = arm_z f_x - arm_x f_z
+    lp.set_a(2 * g + 1, 2, -exact(groups[g].arm.x()));
+  }
+  lp.set_a(lambda, 0, exact(weight.x()));
+  lp.set_a(lambda, 1, exact(weight.y()));
+  lp.set_a(lambda, 2, exact(r_cm.y()) * exact(weight.x()) - exact(r_cm.x()) * exact(weight.y()));
+  int row = 3;
+  for (int g = 0; g < count; ++g)
+    for (int k = 0; k < polygon_sides_; ++k, ++row) {
+      lp.set_a(2 * g, row, exact(polygon_normals_[k].x()));
+      lp.set_a(2 * g + 1, row, exact(polygon_normals_[k].y()));
+      lp.set_r(row, CGAL::SMALLER);
+      lp.set_b(row, exact(groups[g].friction_limit * polygon_inradius_));
+    }
+  lp.set_u(lambda, true, exact(cap));
+  lp.set_c(lambda, exact(-1));
+  const auto solution = CGAL::solve_linear_program(lp, ExactFT());
+  // lambda = 0, every force 0, is feasible and lambda is capped: an optimum always exists.
+  return CGAL::to_double(-solution.objective_value());
 }
 
 }  // namespace stablepush

@@ -160,7 +160,9 @@ double StablePushModel::hold_ratio(const Pose& q, int pusher) const {
   Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
   c[n - 1] = 1.0;
   const SmallLpResult lp = maximize_from_feasible(A * N, b, N.transpose() * c, Eigen::VectorXd::Zero(N.cols()), 1000);
-  if (lp.status != SmallLpResult::Status::Optimal) throw std::runtime_error("hold_ratio: the LP did not converge");
+  // The fast solver can stall at a degenerate vertex (symmetric pads, the centre of mass on a
+  // pad's axis); the exact solver answers every instance.
+  if (lp.status != SmallLpResult::Status::Optimal) return exact_hold_ratio(groups, weight, r_cm, kCap);
   return (N * lp.x)[n - 1];
 }
 

@@ -123,7 +123,8 @@ class StablePushModel {
   /// plan, or between two features): the largest factor lambda such that lambda times the weight
   /// (m g at the centre of mass) is balanced by friction forces of the pad points, all sticking
   /// at rest, each in its friction polygon (grouped by location as in the sticking case). The
-  /// grasp holds the object when lambda >= 1; +infinity without gravity. Double precision: a
+  /// grasp holds the object when lambda >= 1; +infinity without gravity; capped at 1e3. Double
+  /// precision (CGAL's exact LP on the same doubles where the fast solver does not converge): a
   /// report and a goal filter, not a certified decision.
   /// Gravity as during a push by `pusher` (the last one before the object is let go), or with G's
   /// axes the world's for kNoPusher.
@@ -146,6 +147,8 @@ class StablePushModel {
   PushResult exact_all_sliding(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq,
                                PushResult double_answer) const;
   PushResult exact_sticking(const WrenchCone& cone, const MotionWrench& load, const Pose& q, const Motion& dq) const;
+  double exact_hold_ratio(const std::vector<StickingGroup>& groups, const Vec2& weight, const Vec2& r_cm,
+                          double cap) const;
 
   CrossSection section_;
   RigidBody body_;
