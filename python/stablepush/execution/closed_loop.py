@@ -191,9 +191,7 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
             found = list(result.waypoints)
             break
     if not found:
-        blocked = no_way_back(task, end, loop.final_tolerance)  # where the plan, run as it is, ends
-        tried += [f"from the plan's end no stable push moves the object toward the goal along {blocked}"] \
-            if blocked else []
+        tried += _way_back_note(task, end, loop.final_tolerance, "from the plan's end")  # where it ends, run as it is
     record = Replan(after_step=0, measured=tuple(start), planned=tuple(end), solved=bool(found),
                     pushers=result.pusher_sequence if found else [], pushes=max(len(found) - 1, 0),
                     kept_pusher=False, planning_ms=elapsed * 1e3, trigger="plan_short",
@@ -224,6 +222,12 @@ def no_way_back(task: Task, pose: Sequence[float], tolerance: Tuple[float, float
             most = "none" if largest[sense] is None else f"at most {max(largest[sense], 0.0):.2f} of a unit step"
             blocked.append(f"{sense} ({most})")
     return ", ".join(blocked) if blocked else None
+
+
+def _way_back_note(task: Task, pose: Sequence[float], tolerance: Tuple[float, float], where: str) -> List[str]:
+    """A failed search's last line, when `no_way_back` finds senses blocked from `pose`."""
+    blocked = no_way_back(task, pose, tolerance)
+    return [f"{where} no stable push moves the object toward the goal along {blocked}"] if blocked else []
 
 
 @dataclass(frozen=True)
@@ -296,8 +300,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         steps = list(result.waypoints)
         break
     if not steps:
-        blocked = no_way_back(task, measured, loop.final_tolerance)
-        tried += [f"from here no stable push moves the object toward the goal along {blocked}"] if blocked else []
+        tried += _way_back_note(task, measured, loop.final_tolerance, "from here")
     record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=bool(steps),
                     pushers=result.pusher_sequence if steps else [], pushes=max(len(steps) - 1, 0),
                     kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3,
