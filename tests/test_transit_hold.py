@@ -51,3 +51,18 @@ def test_with_start_keeps_the_features_orientation():
     assert [moved.feature_angle(p) for p in moved.pusher_names] == [task.start[2]] * len(task.pushers)
     q = pose_to_si(moved.start)
     assert moved.build_model().hold_ratio(q, 0) == pytest.approx(task.build_model().hold_ratio(q, 0))
+
+
+def test_a_correction_switches_where_the_pads_hold_1_4_times_when_nothing_holding_1_5_is_found():
+    """The large manipulation, 0.61 mm low at its plan's end in a world of pad mu x0.90 (evaluate's
+    trial 32): only another pusher lifts it, and the pads hold 1.47 times the weight there. The
+    correction's last attempt switches there, and says so."""
+    from stablepush.execution.closed_loop import TRANSIT_HOLD_RATIO, TRANSIT_HOLD_RATIO_LEAST, ClosedLoop, replan
+
+    task = shipped("large-manipulation")
+    measured = (15.029502682765594, -13.611996401049778, 45.325170827884875)
+    record, steps = replan(task, measured, "left", ClosedLoop.for_task(task), 57, task.goal, "off_goal")
+    assert record.solved and steps[1].pusher != "left", record.failure
+    assert "hold 1.4 times" in record.attempt
+    hold = task.build_model().hold_ratio(pose_to_si(measured), task.pusher_index("left"))
+    assert TRANSIT_HOLD_RATIO_LEAST <= hold < TRANSIT_HOLD_RATIO

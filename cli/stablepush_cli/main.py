@@ -785,7 +785,8 @@ def _print_report(report) -> None:
         elif r.solved:
             kept = ", starting with the pusher in contact" if r.kept_pusher and len(r.pushers) > 1 else ""
             kept = " (the pusher in contact alone)" if r.kept_pusher and len(r.pushers) == 1 else kept
-            outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{kept}"
+            how = f" (search: {r.attempt})" if r.attempt else ""
+            outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{kept}{how}"
         else:
             outcome = f"no correction taken: {r.failure}; kept the plan"
         when = {"off_goal": f"after step {r.after_step}: off the goal by",
