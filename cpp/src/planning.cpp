@@ -104,6 +104,9 @@ struct Problem {
 template <class PoseValidity, class MotionValidity, class Goal>
 Problem make_problem(const PlannerSettings& settings, double reach, PoseValidity pose_validity,
                      MotionValidity motion_validity, Goal goal) {
+  // OMPL's warnings are of cases the plan's outcome reports itself (a start the pads do not hold:
+  // invalid_start); printed, they cluttered every closed-loop run that lost its grasp.
+  ompl::msg::setLogLevel(ompl::msg::LOG_ERROR);
   Problem problem;
   problem.space = std::make_shared<GraspPoseSpace>(settings.step, sampling_region(settings, reach));
   problem.si = std::make_shared<ob::SpaceInformation>(problem.space);
@@ -173,7 +176,6 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   for (const StablePushModel* m : models)
     if (m == nullptr) throw std::invalid_argument("a model to plan in is None");
   const StablePushModel& model = *models.front();  // the geometry, which every model shares
-  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
 
   std::shared_ptr<StablePushValidator> validator;
   std::shared_ptr<PoseGoal> goal;
@@ -269,7 +271,6 @@ class CheckerMotionValidator : public ob::MotionValidator, public PushChecker {
 CheckedPlan plan_with_checker(std::shared_ptr<PushChecker> checker, const PlannerSettings& settings) {
   check_settings(settings);
   if (!checker) throw std::invalid_argument("no push checker");
-  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   const Problem problem = make_problem(
       settings, std::numeric_limits<double>::infinity(),
       [](const ob::SpaceInformationPtr& si) { return std::make_shared<ob::AllValidStateValidityChecker>(si); },
