@@ -118,6 +118,24 @@ def _outcomes(evaluation):
     return [(t["trial"], t["world"], t["goal_error"], t["success"], t["cause"]) for t in evaluation.trials]
 
 
+def test_a_slow_simulated_arm_is_waited_for_not_called_a_fault(monkeypatch):
+    """Outcomes must not depend on the machine's load: a world that takes 6 s to build (Ray beside
+    other jobs on two cores) is waited for, where the real arm's 5 s reply deadline faulted it."""
+    import time
+
+    from stablepush.sim.server import SimArmServer
+
+    hello = SimArmServer._hello
+
+    def slow_hello(self, message):
+        time.sleep(6.0)
+        return hello(self, message)
+
+    monkeypatch.setattr(SimArmServer, "_hello", slow_hello)
+    record = batch_mod.run_trial(_batch(), 0)
+    assert record["cause"] != "arm_fault" and record["goal_error"] is not None, record["error"]
+
+
 def test_the_same_seed_gives_the_same_trials_serially_on_workers_and_on_ray():
     batch = _batch()
     serial = evaluate(batch, 3, Runner(workers=1))
@@ -125,6 +143,8 @@ def test_the_same_seed_gives_the_same_trials_serially_on_workers_and_on_ray():
     on_ray = evaluate(batch, 3, Runner(ray=True))
     assert _outcomes(serial) == _outcomes(workers) == _outcomes(on_ray)
     assert len({json.dumps(t["world"], sort_keys=True) for t in serial.trials}) == 3  # three different worlds
+    for t in serial.trials:  # the run's verdict sentence, as `execute` prints it
+        assert t["verdict"].startswith("landed" if t["success"] else "missed"), t["verdict"]
     assert on_ray.runner.startswith("Ray")
 
 

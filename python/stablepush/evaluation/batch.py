@@ -35,6 +35,10 @@ from stablepush.task.model import Task
 DEFAULT_TOLERANCE = (0.5, 0.5)  # mm, deg: a trial succeeds within this of the goal, per coordinate
 RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
 PERCENTILES = (50, 90, 95, 99)
+# s a trial waits for each reply of its simulated arm before calling it hung (arm_fault). The real
+# arm's 5 s made outcomes depend on the machine's load: on Ray beside other jobs, a world built
+# slowly faulted trials that ran on workers.
+SIM_ACK_TIMEOUT = 120.0
 
 
 @dataclass(frozen=True)
@@ -83,17 +87,20 @@ def run_trial(batch: Batch, trial: int) -> dict:
         with running_sim_arm(log=lambda text: None, deviation=deviation_of(batch, world),
                              engine=batch.engine) as server:
             report = execute_plan(batch.task, batch.plan, server.host, server.port, rate_hz=RATE_HZ, pace=False,
-                                  closed_loop=loop, success_tolerance=batch.tolerance, record=recording)
+                                  ack_timeout=SIM_ACK_TIMEOUT, closed_loop=loop, success_tolerance=batch.tolerance,
+                                  record=recording)
         record.update(final_error=report.final_error, goal_error=report.goal_error,
                       replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
                       cause=report.verdict.cause if report.verdict else None,
+                      verdict=report.verdict.detail if report.verdict else None,
                       sim_time_s=report.waypoints / RATE_HZ, error=None)
     except ArmFault as fault:  # the simulated arm failed (a simulator blow-up, a protocol error): stopped
-        record.update(final_error=None, goal_error=None, replans=0, success=False, cause="arm_fault",
+        record.update(final_error=None, goal_error=None, replans=0, success=False, cause="arm_fault", verdict=None,
                       sim_time_s=0.0, error=str(fault))
     except Exception as exc:  # noqa: BLE001 - a crashed trial is a result, not the end of the batch
         last = traceback.extract_tb(exc.__traceback__)[-1]
-        record.update(final_error=None, goal_error=None, replans=0, success=False, cause="crash", sim_time_s=0.0,
+        record.update(final_error=None, goal_error=None, replans=0, success=False, cause="crash", verdict=None,
+                      sim_time_s=0.0,
                       error=f"{type(exc).__name__}: {exc} ({os.path.basename(last.filename)}:{last.lineno})")
     record["wall_s"] = time.perf_counter() - started
     if recording is not None:
@@ -119,7 +126,8 @@ def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: 
 
 def _crashed(batch: Batch, trial: int, why: str) -> dict:
     return {"trial": trial, "world": batch.world(trial).as_dict(), "final_error": None, "goal_error": None,
-            "replans": 0, "success": False, "cause": "crash", "sim_time_s": 0.0, "error": why, "wall_s": 0.0}
+            "replans": 0, "success": False, "cause": "crash", "verdict": None, "sim_time_s": 0.0, "error": why,
+            "wall_s": 0.0}
 
 
 def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
@@ -194,14 +202,14 @@ class Evaluation:
         header = (["trial", "success", "cause"] + list(VARY_KEYS)
                   + [f"{name}_{c}" for name in offsets for c in ("dx_mm", "dz_mm", "dtheta_deg")]
                   + ["goal_x_mm", "goal_z_mm", "goal_theta_deg", "goal_distance_mm", "replans", "sim_time_s",
-                     "wall_s", "error"] + (["video"] if self.batch.video_dir else []))
+                     "wall_s", "verdict", "error"] + (["video"] if self.batch.video_dir else []))
         rows = []
         for t in self.trials:
             w, g = t["world"], t["goal_error"] or {}
             rows.append([t["trial"], t["success"], t["cause"] or ""] + [w[k] for k in VARY_KEYS]
                         + [v for name in offsets for v in w["feature_offsets"].get(name, ("", "", ""))]
                         + [g.get("x", ""), g.get("z", ""), g.get("theta", ""), g.get("distance", ""), t["replans"],
-                           t["sim_time_s"], t["wall_s"], t["error"] or ""]
+                           t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or ""]
                         + ([t.get("video") or ""] if self.batch.video_dir else []))
         return header, rows
 
