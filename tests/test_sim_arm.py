@@ -137,6 +137,35 @@ def test_convex_pieces_of_the_t_cover_its_area():
                    - (p[i][1] - p[i - 1][1]) * (p[(i + 1) % n][0] - p[i - 1][0]) > 0 for i in range(n))
 
 
+@pytest.mark.parametrize("offset", [(0.0, 0.0, 0.0), (0.1, -0.4, 0.45), (-0.3, 0.2, -0.5)])
+def test_a_feature_stops_short_of_a_reflex_corner_of_the_object_wherever_it_is_placed(offset):
+    """The T's web feature runs down the web to its corner with the flange: its solid, at home and
+    placed off by up to 0.5 mm / 0.5 deg, ends FEATURE_CORNER_GAP short of that corner and nowhere
+    else, so the flange passes under it on the approach. The other features keep their segments."""
+    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.scene import FEATURE_CORNER_GAP, FEATURE_DEPTH, feature_solid
+
+    task = shipped("t-shaped")
+    scene = scene_description(task, place_features(task, [Waypoint(*task.start)], every_pusher=True), task.start)
+    world = WorldDeviation(feature_offsets=tuple((name, *offset) for name in task.pusher_names)).apply(scene)
+    for feature in world["features"]:
+        solid = feature_solid(feature, world["object"])
+        a, b = np.asarray(feature["from"]), np.asarray(feature["to"])
+        length = np.linalg.norm(b - a)
+        if feature["pusher"] != "web":
+            assert 2 * solid["half_size"][0] == pytest.approx(length, abs=1e-12), feature["pusher"]
+            continue
+        assert 2 * solid["half_size"][0] == pytest.approx(length - FEATURE_CORNER_GAP, abs=1e-12)
+        # The end that stops short is the one at the corner (10, -10) mm in O, the web's foot.
+        T_WO = pose_to_matrix(feature["object_pose"])
+        corner = (T_WO @ np.array([0.010, 0.0, -0.010, 1.0]))[:3]
+        near = a if np.linalg.norm(a - corner) < np.linalg.norm(b - corner) else b
+        u = (b - a) / length
+        centre = np.asarray(solid["center"]) + np.asarray(feature["normal"]) * FEATURE_DEPTH / 2  # on the contact face
+        assert np.linalg.norm(centre + np.sign(u @ (near - centre)) * u * solid["half_size"][0] - near) == \
+            pytest.approx(FEATURE_CORNER_GAP, abs=1e-9)
+
+
 def test_a_deviated_world_scales_every_pad_and_feature_mu():
     from stablepush.sim.arm import WorldDeviation
 

@@ -15,7 +15,7 @@ from typing import Callable, Dict, Optional, Sequence, Tuple
 import mujoco
 import numpy as np
 
-from stablepush.frames import matrix_to_pose, rot_y
+from stablepush.frames import matrix_to_pose, pose_to_matrix, rot_y
 from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.friction import CoulombPadFriction
@@ -70,7 +70,8 @@ class WorldDeviation:
 
 
 def _move_feature(feature: dict, dx_mm: float, dz_mm: float, dtheta_deg: float) -> None:
-    """Turn a feature by dtheta about the world's y through the middle of its segment, then shift it."""
+    """Turn a feature by dtheta about the world's y through the middle of its segment, then shift it,
+    with the object's pose on it (its segment stays where it was on the object)."""
     a, b = np.asarray(feature["from"], float), np.asarray(feature["to"], float)
     middle = (a + b) / 2
     R = rot_y(math.radians(dtheta_deg))
@@ -78,6 +79,10 @@ def _move_feature(feature: dict, dx_mm: float, dz_mm: float, dtheta_deg: float) 
     feature["from"] = (middle + R @ (a - middle) + shift).tolist()
     feature["to"] = (middle + R @ (b - middle) + shift).tolist()
     feature["normal"] = (R @ np.asarray(feature["normal"], float)).tolist()
+    T_WO = pose_to_matrix(feature["object_pose"])
+    T_WO[:3, 3] = middle + R @ (T_WO[:3, 3] - middle) + shift
+    T_WO[:3, :3] = R @ T_WO[:3, :3]
+    feature["object_pose"] = matrix_to_pose(T_WO)
 
 
 class SimulatedGrasp:

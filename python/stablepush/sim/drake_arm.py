@@ -250,7 +250,7 @@ class DrakeGrasp:
         d, plant = self._d, self.plant
         out = {}
         for feature in scene["features"]:
-            solid = scene_mod.feature_solid(feature, scene["object"]["thickness"])
+            solid = scene_mod.feature_solid(feature, scene["object"])
             if solid["kind"] == "box":
                 R = d.RotationMatrix.MakeYRotation(solid["angle"])
                 shape = d.Box(*(2 * np.asarray(solid["half_size"])))

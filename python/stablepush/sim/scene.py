@@ -27,7 +27,7 @@ from typing import List, Sequence, Tuple
 
 import numpy as np
 
-from stablepush.frames import quat_about_y
+from stablepush.frames import pose_to_matrix, quat_about_y
 
 ARM_XML = Path(__file__).with_name("arm.xml")
 ARM_JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6", "j7")
@@ -48,6 +48,12 @@ PAD_POINT_RADIUS = 0.0005  # m, radius of each pad contact sphere
 FEATURE_DEPTH = 0.01  # m, how far a feature extends behind its contact face
 FEATURE_CLEARANCE = 0.002  # m, a feature is this much narrower than the object along y on each side
 FEATURE_ROD_RADIUS = 0.001  # m, the rod of a point pusher's feature
+# m a line feature's solid stops short of an end of its segment that lies in a reflex corner of the
+# object: placed off by any amount toward the adjacent face, a solid reaching the corner meets that
+# face (the T's web feature sits over its flange: with features off by up to 0.5 mm / 0.5 deg, 2 of
+# 40 closed-loop trials were knocked 9 mm on the approach and lost the grasp). A real fixture must
+# stop short too, by more than its placement error.
+FEATURE_CORNER_GAP = 0.001
 
 
 def pad_points(center: Sequence[float], radius: float, rings: int) -> List[Tuple[float, float]]:
@@ -248,21 +254,39 @@ def add_object_geoms(body: ET.Element, assets: ET.Element, obj: dict, half_y: fl
     return names
 
 
-def feature_solid(feature: dict, thickness: float) -> dict:
-    """A feature's fixed solid in W: a box whose contact face is the pusher's segment, extending
-    FEATURE_DEPTH behind it (`center`, `angle` about y, `half_size`), or for a point pusher a rod
-    along y (`center`, `radius`, `half_length`). It is FEATURE_CLEARANCE narrower than the object
-    on each side along y, so that it touches the object's face and never a pad."""
+def feature_solid(feature: dict, obj: dict) -> dict:
+    """A feature's fixed solid in W: a box whose contact face is the pusher's segment (less
+    FEATURE_CORNER_GAP at an end in a reflex corner of the object's polygon), extending FEATURE_DEPTH
+    behind it (`center`, `angle` about y, `half_size`), or for a point pusher a rod along y
+    (`center`, `radius`, `half_length`). It is FEATURE_CLEARANCE narrower than the object `obj` (the
+    scene's, m) on each side along y, so that it touches the object's face and never a pad."""
     a = np.asarray(feature["from"], float)
     b = np.asarray(feature["to"], float)
     n = np.asarray(feature["normal"], float)
-    half_y = max(thickness / 2 - FEATURE_CLEARANCE, 0.001)
+    half_y = max(obj["thickness"] / 2 - FEATURE_CLEARANCE, 0.001)
     length = float(np.linalg.norm(b - a))
     if length > 0:
         t = (b - a) / length
+        corners = _reflex_corners_in_world(obj["polygon"], feature["object_pose"])
+        in_corner = lambda p: any(np.linalg.norm(p - c) < 1e-6 for c in corners)  # noqa: E731
+        a, b = (a + t * FEATURE_CORNER_GAP if in_corner(a) else a), (b - t * FEATURE_CORNER_GAP if in_corner(b) else b)
+        length = max(float(np.linalg.norm(b - a)), 1e-4)
         return {"kind": "box", "center": (a + b) / 2 - n * FEATURE_DEPTH / 2, "angle": math.atan2(-t[2], t[0]),
                 "half_size": (length / 2, half_y, FEATURE_DEPTH / 2)}
     return {"kind": "rod", "center": a - n * FEATURE_ROD_RADIUS, "radius": FEATURE_ROD_RADIUS, "half_length": half_y}
+
+
+def _reflex_corners_in_world(polygon: Sequence[Sequence[float]], object_pose: Sequence[float]) -> List[np.ndarray]:
+    """The vertices of a counterclockwise polygon (O's x, z, m) whose interior angle exceeds 180
+    deg, in W with the object at `object_pose` (x, y, z, qw, qx, qy, qz)."""
+    pts = np.asarray(polygon, float)
+    T_WO = pose_to_matrix(object_pose)
+    corners = []
+    for k, v in enumerate(pts):
+        before, after = v - pts[k - 1], pts[(k + 1) % len(pts)] - v
+        if before[0] * after[1] - before[1] * after[0] < 0:  # a right turn on a counterclockwise walk
+            corners.append((T_WO @ np.array([v[0], 0.0, v[1], 1.0]))[:3])
+    return corners
 
 
 def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
@@ -307,7 +331,7 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
     contact = ET.SubElement(root, "contact")
     for feature in scene["features"]:
         name = feature_geom(feature["pusher"])
-        solid = feature_solid(feature, obj["thickness"])
+        solid = feature_solid(feature, obj)
         if solid["kind"] == "box":
             ET.SubElement(worldbody, "geom", name=name, type="box", pos=mjcf_numbers(solid["center"]),
                           quat=mjcf_numbers(quat_about_y(solid["angle"])), size=mjcf_numbers(solid["half_size"]),

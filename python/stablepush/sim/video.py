@@ -261,7 +261,7 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
     world = ET.SubElement(root, "worldbody")
 
     for feature in scene["features"]:
-        solid = feature_solid(feature, obj["thickness"])
+        solid = feature_solid(feature, obj)
         name = feature_geom(feature["pusher"])
         if solid["kind"] == "box":
             ET.SubElement(world, "geom", name=name, type="box", pos=mjcf_numbers(solid["center"]),
