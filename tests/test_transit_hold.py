@@ -57,12 +57,20 @@ def test_a_correction_switches_where_the_pads_hold_1_4_times_when_nothing_holdin
     """The large manipulation, 0.61 mm low at its plan's end in a world of pad mu x0.90 (evaluate's
     trial 32): only another pusher lifts it, and the pads hold 1.47 times the weight there. The
     correction's last attempt switches there, and says so."""
-    from stablepush.execution.closed_loop import TRANSIT_HOLD_RATIO, TRANSIT_HOLD_RATIO_LEAST, ClosedLoop, replan
+    from stablepush.execution.closed_loop import (
+        TRANSIT_HOLD_RATIO,
+        TRANSIT_HOLD_RATIO_LEAST,
+        ClosedLoop,
+        _transits_held,
+        replan,
+    )
 
     task = shipped("large-manipulation")
     measured = (15.029502682765594, -13.611996401049778, 45.325170827884875)
     record, steps = replan(task, measured, "left", ClosedLoop.for_task(task), 57, task.goal, "off_goal")
     assert record.solved and steps[1].pusher != "left", record.failure
     assert "hold 1.4 times" in record.attempt
+    assert _transits_held(task, steps, "left", TRANSIT_HOLD_RATIO_LEAST)
+    assert not _transits_held(task, steps, "left", TRANSIT_HOLD_RATIO)
     hold = task.build_model().hold_ratio(pose_to_si(measured), task.pusher_index("left"))
     assert TRANSIT_HOLD_RATIO_LEAST <= hold < TRANSIT_HOLD_RATIO

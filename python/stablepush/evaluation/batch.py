@@ -35,9 +35,8 @@ from stablepush.task.model import Task
 DEFAULT_TOLERANCE = (0.5, 0.5)  # mm, deg: a trial succeeds within this of the goal, per coordinate
 RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
 PERCENTILES = (50, 90, 95, 99)
-# s a trial waits for each reply of its simulated arm before calling it hung (arm_fault). The real
-# arm's 5 s made outcomes depend on the machine's load: on Ray beside other jobs, a world built
-# slowly faulted trials that ran on workers.
+# s a trial waits for each reply of its simulated arm before calling it hung (arm_fault): long
+# enough that a loaded machine building a world slowly does not change an outcome.
 SIM_ACK_TIMEOUT = 120.0
 
 
@@ -95,13 +94,11 @@ def run_trial(batch: Batch, trial: int) -> dict:
                       verdict=report.verdict.detail if report.verdict else None,
                       sim_time_s=report.waypoints / RATE_HZ, error=None)
     except ArmFault as fault:  # the simulated arm failed (a simulator blow-up, a protocol error): stopped
-        record.update(final_error=None, goal_error=None, replans=0, success=False, cause="arm_fault", verdict=None,
-                      sim_time_s=0.0, error=str(fault))
+        record.update(_not_run("arm_fault", str(fault)))
     except Exception as exc:  # noqa: BLE001 - a crashed trial is a result, not the end of the batch
         last = traceback.extract_tb(exc.__traceback__)[-1]
-        record.update(final_error=None, goal_error=None, replans=0, success=False, cause="crash", verdict=None,
-                      sim_time_s=0.0,
-                      error=f"{type(exc).__name__}: {exc} ({os.path.basename(last.filename)}:{last.lineno})")
+        where = f"{os.path.basename(last.filename)}:{last.lineno}"
+        record.update(_not_run("crash", f"{type(exc).__name__}: {exc} ({where})"))
     record["wall_s"] = time.perf_counter() - started
     if recording is not None:
         record["video"] = None if record["success"] else _failed_trial_video(batch, trial, world, recording, record)
@@ -124,10 +121,14 @@ def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: 
     return path
 
 
+def _not_run(cause: str, error: str) -> dict:
+    """A trial record's outcome fields when the run did not end: an arm fault or a crash."""
+    return {"final_error": None, "goal_error": None, "replans": 0, "success": False, "cause": cause, "verdict": None,
+            "sim_time_s": 0.0, "error": error}
+
+
 def _crashed(batch: Batch, trial: int, why: str) -> dict:
-    return {"trial": trial, "world": batch.world(trial).as_dict(), "final_error": None, "goal_error": None,
-            "replans": 0, "success": False, "cause": "crash", "verdict": None, "sim_time_s": 0.0, "error": why,
-            "wall_s": 0.0}
+    return {"trial": trial, "world": batch.world(trial).as_dict(), **_not_run("crash", why), "wall_s": 0.0}
 
 
 def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),

@@ -48,11 +48,10 @@ PAD_POINT_RADIUS = 0.0005  # m, radius of each pad contact sphere
 FEATURE_DEPTH = 0.01  # m, how far a feature extends behind its contact face
 FEATURE_CLEARANCE = 0.002  # m, a feature is this much narrower than the object along y on each side
 FEATURE_ROD_RADIUS = 0.001  # m, the rod of a point pusher's feature
-# m a line feature's solid stops short of an end of its segment that lies in a reflex corner of the
-# object: placed off by any amount toward the adjacent face, a solid reaching the corner meets that
-# face (the T's web feature sits over its flange: with features off by up to 0.5 mm / 0.5 deg, 2 of
-# 40 closed-loop trials were knocked 9 mm on the approach and lost the grasp). A real fixture must
-# stop short too, by more than its placement error.
+# m a line feature's solid stops short of an end of its segment in a reflex corner of the object
+# (at most a quarter of the segment): a solid reaching the corner, placed off by any amount toward
+# the adjacent face, lies in that face's path on the approach (the T's web feature over its
+# flange). A real fixture must stop short too, by more than its placement error.
 FEATURE_CORNER_GAP = 0.001
 
 
@@ -256,10 +255,11 @@ def add_object_geoms(body: ET.Element, assets: ET.Element, obj: dict, half_y: fl
 
 def feature_solid(feature: dict, obj: dict) -> dict:
     """A feature's fixed solid in W: a box whose contact face is the pusher's segment (less
-    FEATURE_CORNER_GAP at an end in a reflex corner of the object's polygon), extending FEATURE_DEPTH
-    behind it (`center`, `angle` about y, `half_size`), or for a point pusher a rod along y
-    (`center`, `radius`, `half_length`). It is FEATURE_CLEARANCE narrower than the object `obj` (the
-    scene's, m) on each side along y, so that it touches the object's face and never a pad."""
+    FEATURE_CORNER_GAP, or a quarter of it, at an end in a reflex corner of the object's polygon),
+    extending FEATURE_DEPTH behind it (`center`, `angle` about y, `half_size`), or for a point
+    pusher a rod along y (`center`, `radius`, `half_length`). It is FEATURE_CLEARANCE narrower than
+    the object `obj` (the scene's, m) on each side along y, so that it touches the object's face and
+    never a pad."""
     a = np.asarray(feature["from"], float)
     b = np.asarray(feature["to"], float)
     n = np.asarray(feature["normal"], float)
@@ -269,8 +269,9 @@ def feature_solid(feature: dict, obj: dict) -> dict:
         t = (b - a) / length
         corners = _reflex_corners_in_world(obj["polygon"], feature["object_pose"])
         in_corner = lambda p: any(np.linalg.norm(p - c) < 1e-6 for c in corners)  # noqa: E731
-        a, b = (a + t * FEATURE_CORNER_GAP if in_corner(a) else a), (b - t * FEATURE_CORNER_GAP if in_corner(b) else b)
-        length = max(float(np.linalg.norm(b - a)), 1e-4)
+        gap = min(FEATURE_CORNER_GAP, length / 4)
+        a, b = (a + t * gap if in_corner(a) else a), (b - t * gap if in_corner(b) else b)
+        length = float(np.linalg.norm(b - a))
         return {"kind": "box", "center": (a + b) / 2 - n * FEATURE_DEPTH / 2, "angle": math.atan2(-t[2], t[0]),
                 "half_size": (length / 2, half_y, FEATURE_DEPTH / 2)}
     return {"kind": "rod", "center": a - n * FEATURE_ROD_RADIUS, "radius": FEATURE_ROD_RADIUS, "half_length": half_y}
