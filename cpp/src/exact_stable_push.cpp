@@ -151,7 +151,8 @@ double StablePushModel::exact_hold_ratio(const std::vector<StickingGroup>& group
   lp.set_u(lambda, true, exact(cap));
   lp.set_c(lambda, exact(-1));
   const auto solution = CGAL::solve_linear_program(lp, ExactFT());
-  // lambda = 0, every force 0, is feasible and lambda is capped: an optimum always exists.
+  // lambda = 0, every force 0, is feasible and lambda is capped: an optimum exists.
+  if (!solution.is_optimal()) throw std::logic_error("hold_ratio: the exact LP found no optimum");
   return CGAL::to_double(-solution.objective_value());
 }
 
