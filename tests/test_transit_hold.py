@@ -56,7 +56,8 @@ def test_with_start_keeps_the_features_orientation():
 def test_a_correction_switches_where_the_pads_hold_1_4_times_when_nothing_holding_1_5_is_found():
     """The large manipulation, 0.61 mm low at its plan's end in a world of pad mu x0.90 (evaluate's
     trial 32): only another pusher lifts it, and the pads hold 1.47 times the weight there. The
-    correction's last attempt switches there, and says so."""
+    correction's last attempt switches there, and says so, when the run would miss its verdict
+    otherwise."""
     from stablepush.execution.closed_loop import (
         TRANSIT_HOLD_RATIO,
         TRANSIT_HOLD_RATIO_LEAST,
@@ -67,7 +68,10 @@ def test_a_correction_switches_where_the_pads_hold_1_4_times_when_nothing_holdin
 
     task = shipped("large-manipulation")
     measured = (15.029502682765594, -13.611996401049778, 45.325170827884875)
-    record, steps = replan(task, measured, "left", ClosedLoop.for_task(task), 57, task.goal, "off_goal")
+    loop = ClosedLoop.for_task(task)
+    refused, _ = replan(task, measured, "left", loop, 57, task.goal, "off_goal")  # a landed run risks no such switch
+    assert not refused.solved and "1.4 times" not in refused.failure
+    record, steps = replan(task, measured, "left", loop, 57, task.goal, "off_goal", verdict_at_stake=True)
     assert record.solved and steps[1].pusher != "left", record.failure
     assert "hold 1.4 times" in record.attempt
     assert _transits_held(task, steps, "left", TRANSIT_HOLD_RATIO_LEAST)

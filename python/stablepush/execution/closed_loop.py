@@ -28,9 +28,10 @@ The policy lives here; `executor.py` streams and splices. A re-plan
   and a feature met off its place puts it there (the pivot with features off by up to 0.5 mm /
   0.5 deg landed 3 of 8 trials without them, 8 with). Last, since they change the corrections they
   are not needed for (the low-mu offset's lifted less and ended 0.35 mm low);
-- when none of those is found either, tries every pusher once more, switching where the pads hold
-  TRANSIT_HOLD_RATIO_LEAST times the weight (the weight still held at the worst corner of the
-  worlds `evaluate` rates); the record names the attempt that found the correction taken;
+- when none of those is found either and the run would miss its verdict otherwise, tries every
+  pusher once more, switching where the pads hold TRANSIT_HOLD_RATIO_LEAST times the weight (the
+  weight still held at rest at the worst corner of the worlds `evaluate` rates); the record names
+  the attempt that found the correction taken;
 - plans in the world the run is in: the features keep the object's world orientation they had
   (`Task.with_start`), so gravity in O on each feature is the world's, not the measured pose's;
 - takes milliseconds (the planner's own time; limits below), between two waypoints;
@@ -68,10 +69,12 @@ MAX_FAILED_REPLANS = 3  # per run: past this, a pose the planner cannot leave is
 # for worlds that differ from the model; with 1.0, a world with 15% less mu dropped the low-mu
 # prism in transit, 13.8 mm / 45 deg off).
 TRANSIT_HOLD_RATIO = 1.5
-# Last, when no correction keeps TRANSIT_HOLD_RATIO: a switch-over where the pads hold this multiple,
-# which still holds the weight at the worst corner of the worlds `evaluate` rates (pad mu -15%, grip
-# force -10%, mass +5% scale the ratio by 0.73); where only another pusher can push the error back
-# (the large manipulation's plan ends where the pads hold 1.47).
+# Last, when no correction keeps TRANSIT_HOLD_RATIO and the run would otherwise miss its verdict: a
+# switch-over where the pads hold this multiple, which still holds the weight at rest at the worst
+# corner of the worlds `evaluate` rates (pad mu -15%, grip force -10%, mass +5% scale the ratio by
+# 0.73), for where only another pusher can push the error back (the large manipulation's plan ends
+# where the pads hold 1.47). The arm's moves between features shake the object more than rest
+# does, so it is not risked for a run that has landed.
 TRANSIT_HOLD_RATIO_LEAST = 1.4
 # A sense of x, z or theta in which no stable push moves the object by more than this fraction of a
 # unit step counts as one the pushers cannot push it in (the pegs' -x: 0.05, and only while turning).
@@ -274,11 +277,13 @@ ATTEMPTS = tuple(_Attempt(every, limit, robust, pivot) for pivot in (False, True
     + (_Attempt(True, REPLAN_TIME_LIMIT, robust=False, transit_hold=TRANSIT_HOLD_RATIO_LEAST),)
 
 
-def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
-           after_step: int, planned: Sequence[float], trigger: str = "off_plan") -> Tuple[Replan, List[Waypoint]]:
+def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop, after_step: int,
+           planned: Sequence[float], trigger: str = "off_plan",
+           verdict_at_stake: bool = False) -> Tuple[Replan, List[Waypoint]]:
     """Plan from the measured pose to the task's goal within the loop's final tolerance, trying
     ATTEMPTS in turn (robust first, the pusher pushing now alone first, pivot steps after those,
-    switch-overs where the pads hold TRANSIT_HOLD_RATIO_LEAST last) and taking
+    switch-overs where the pads hold TRANSIT_HOLD_RATIO_LEAST last, only with `verdict_at_stake`:
+    the run, ended here, would miss its success tolerance) and taking
     the first plan whose transits are held. Returns the record and the new plan's steps (empty when
     none was found); the first step is the measured pose."""
     tolerance = list(loop.final_tolerance)
@@ -290,9 +295,11 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
     elapsed, tried, steps, found_by = 0.0, [], [], None
     robust = dataclasses.replace(base, uncertainty={"pusher_mu": CORRECTION_MU_SPREAD, "pad_mu": CORRECTION_MU_SPREAD})
     for attempt in ATTEMPTS:
-        if (attempt.robust or attempt.transit_hold != TRANSIT_HOLD_RATIO) and task.uncertainty \
-                or (attempt.pivot_steps and task.planner.get("pivot_steps")):
+        least = attempt.transit_hold != TRANSIT_HOLD_RATIO
+        if (attempt.robust or least) and task.uncertainty or (attempt.pivot_steps and task.planner.get("pivot_steps")):
             continue  # the task's own box is the model and its rule of every attempt; its pivot steps are in all
+        if least and not verdict_at_stake:
+            continue
         planner = {**base.planner, "time_limit": min(attempt.time_limit, task.planner["time_limit"])}
         if attempt.pivot_steps:
             planner["pivot_steps"] = 1

@@ -256,7 +256,8 @@ def execute_plan(
                 if "object_in_grasp" not in state:
                     loop_status = "no tracker"  # the cell reports no pose in the grasp: open loop
                 elif closed_loop.may_replan(replans):
-                    spliced = _correct(task, steps, features, closed_loop, w, state, rate_hz, replans)
+                    spliced = _correct(task, steps, features, closed_loop, w, state, rate_hz, replans,
+                                       success_tolerance or task.planner["tolerance"])
                     if spliced is not None:
                         steps, new_points = spliced
                         pending = deque(dataclasses.replace(p, seq=w.seq + 1 + p.seq, t=w.t + p.t) for p in new_points)
@@ -297,13 +298,15 @@ def fault_report(task: Task, fault: ArmFault, success_tolerance: Optional[Sequen
 
 
 def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
-             state: dict, rate_hz: float, replans: List[Replan]):
+             state: dict, rate_hz: float, replans: List[Replan], success_tolerance: Sequence[float]):
     """After plan step w.step: when the tracked pose is off the plan (or, at rest after the last
     push, off the goal) by more than the loop allows, re-plan from it and return the spliced steps and the
     waypoints that carry them out from where G is now (seq and t counted from this waypoint);
-    else None. `features` is updated in place: the object's pose on the current feature becomes
-    the measured one (G's pose times the tracked pose in the grasp), so the rest of this contact
-    pushes from where the object really is."""
+    else None. At rest off the goal by more than `success_tolerance` (mm, deg) the verdict is at
+    stake, and the re-plan may take its last, riskier attempt (closed_loop.replan). `features` is
+    updated in place: the object's pose on the current feature becomes the measured one (G's pose
+    times the tracked pose in the grasp), so the rest of this contact pushes from where the object
+    really is."""
     k = w.step
     tracked = state["object_in_grasp"]
     last = k == len(steps) - 1
@@ -313,7 +316,8 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     theta = steps[k].pose[2] + angle_difference_deg(float(tracked["theta"]), steps[k].pose[2])
     measured = (float(tracked["x"]), float(tracked["z"]), theta)
     record, new_steps = replan(task, measured, steps[k].pusher, loop, k, steps[k].pose,
-                               trigger="off_goal" if last else "off_plan")
+                               trigger="off_goal" if last else "off_plan",
+                               verdict_at_stake=last and loop.off_by(tracked, task.goal, tuple(success_tolerance)))
     replans.append(record)
     if not record.solved or record.pushes == 0:
         return None
