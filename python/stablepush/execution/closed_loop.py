@@ -296,7 +296,8 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
     robust = dataclasses.replace(base, uncertainty={"pusher_mu": CORRECTION_MU_SPREAD, "pad_mu": CORRECTION_MU_SPREAD})
     for attempt in ATTEMPTS:
         least = attempt.transit_hold != TRANSIT_HOLD_RATIO
-        if (attempt.robust or least) and task.uncertainty or (attempt.pivot_steps and task.planner.get("pivot_steps")):
+        own_box = (attempt.robust or least) and bool(task.uncertainty)
+        if own_box or (attempt.pivot_steps and task.planner.get("pivot_steps")):
             continue  # the task's own box is the model and its rule of every attempt; its pivot steps are in all
         if least and not verdict_at_stake:
             continue
