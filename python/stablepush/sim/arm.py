@@ -74,15 +74,13 @@ def _move_feature(feature: dict, dx_mm: float, dz_mm: float, dtheta_deg: float) 
     with the object's pose on it (its segment stays where it was on the object)."""
     a, b = np.asarray(feature["from"], float), np.asarray(feature["to"], float)
     middle = (a + b) / 2
-    R = rot_y(math.radians(dtheta_deg))
-    shift = np.array([dx_mm * 1e-3, 0.0, dz_mm * 1e-3])
-    feature["from"] = (middle + R @ (a - middle) + shift).tolist()
-    feature["to"] = (middle + R @ (b - middle) + shift).tolist()
-    feature["normal"] = (R @ np.asarray(feature["normal"], float)).tolist()
-    T_WO = pose_to_matrix(feature["object_pose"])
-    T_WO[:3, 3] = middle + R @ (T_WO[:3, 3] - middle) + shift
-    T_WO[:3, :3] = R @ T_WO[:3, :3]
-    feature["object_pose"] = matrix_to_pose(T_WO)
+    move = np.eye(4)  # the turn about the middle, then the shift, as one rigid motion in W
+    move[:3, :3] = rot_y(math.radians(dtheta_deg))
+    move[:3, 3] = middle + np.array([dx_mm * 1e-3, 0.0, dz_mm * 1e-3]) - move[:3, :3] @ middle
+    feature["from"] = (move @ np.append(a, 1.0))[:3].tolist()
+    feature["to"] = (move @ np.append(b, 1.0))[:3].tolist()
+    feature["normal"] = (move[:3, :3] @ np.asarray(feature["normal"], float)).tolist()
+    feature["object_pose"] = matrix_to_pose(move @ pose_to_matrix(feature["object_pose"]))
 
 
 class SimulatedGrasp:

@@ -280,14 +280,9 @@ def feature_solid(feature: dict, obj: dict) -> dict:
 def _reflex_corners_in_world(polygon: Sequence[Sequence[float]], object_pose: Sequence[float]) -> List[np.ndarray]:
     """The vertices of a counterclockwise polygon (O's x, z, m) whose interior angle exceeds 180
     deg, in W with the object at `object_pose` (x, y, z, qw, qx, qy, qz)."""
-    pts = np.asarray(polygon, float)
-    T_WO = pose_to_matrix(object_pose)
-    corners = []
-    for k, v in enumerate(pts):
-        before, after = v - pts[k - 1], pts[(k + 1) % len(pts)] - v
-        if before[0] * after[1] - before[1] * after[0] < 0:  # a right turn on a counterclockwise walk
-            corners.append((T_WO @ np.array([v[0], 0.0, v[1], 1.0]))[:3])
-    return corners
+    n, T_WO = len(polygon), pose_to_matrix(object_pose)
+    return [(T_WO @ np.array([v[0], 0.0, v[1], 1.0]))[:3] for k, v in enumerate(polygon)
+            if _cross(polygon[k - 1], v, polygon[(k + 1) % n]) < -1e-15]  # a right turn, as _is_convex counts one
 
 
 def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
