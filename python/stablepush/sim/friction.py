@@ -45,6 +45,7 @@ STICK_SPEED = 1e-4  # m/s: a sliding pad point whose slip falls below this stick
 SLIDE_STEPS = 4
 ON_CONE = 0.99  # |friction| / (mu N) in the solver's step from which a contact counts as sliding
 DIRECTION_TOLERANCE_DEG = 0.5  # friction vs the opposite of the slip it produces, at the end of a step
+_DIRECTIONS_AGREE = np.cos(np.radians(DIRECTION_TOLERANCE_DEG))  # the least cosine between them
 MAX_TRIALS = 8  # trial steps per time step; the last trial's direction is taken if none agrees
 FRICTIONLESS_MU = 1e-5  # MuJoCo's least friction coefficient (mjMINMU): the contact of a sliding point
 
@@ -63,9 +64,11 @@ class CoulombPadFriction:
         self.model = model
         n_points = len(pad_geoms)
         slot_of_geom = {int(g): k for k, g in enumerate(pad_geoms)}
-        self._slot_of_geom = np.full(model.ngeom, -1, dtype=int)
-        for geom, slot in slot_of_geom.items():
-            self._slot_of_geom[geom] = slot
+        slot = np.full(model.ngeom, -1, dtype=np.int32)
+        for geom, k in slot_of_geom.items():
+            slot[geom] = k
+        # the pad point of each geom pair (or -1): a contact's slot in one lookup, as it is met every step
+        self._slot_of_pair = np.maximum(slot[:, None], slot[None, :])
         pairs, pair_slots = [], []
         for i in range(model.npair):
             for geom in (model.pair_geom1[i], model.pair_geom2[i]):
@@ -87,7 +90,7 @@ class CoulombPadFriction:
         self._fast_steps = np.zeros(n_points, dtype=int)
         self.solver_steps = 0  # scratch steps with the solver's friction, deciding new sliders
         self.trial_steps = 0  # scratch steps finding the friction's direction
-        self._frictionless = None  # which pad pairs model.pair_friction makes frictionless now
+        self._frictionless = None  # which pad pairs model.pair_friction makes frictionless now, as bytes
         self._set_frictionless(self.sliding)
 
     def update(self, data) -> None:
@@ -133,7 +136,7 @@ class CoulombPadFriction:
         mu = self._point_mu[solver.slots]
         tangential = np.hypot(s.efc_force[solver.rows + 1], s.efc_force[solver.rows + 2])
         on_cone = tangential >= ON_CONE * mu * s.efc_force[solver.rows]
-        slip = np.linalg.norm(solver.tangential(solver.end_velocity()), axis=1)
+        slip = _norm(solver.tangential(solver.end_velocity()))
         slides = on_cone & (slip >= STICK_SPEED)
         sliding = new & (solver.count(~slides) == 0) & solver.touched
         friction = solver.tangential(s.efc_force)
@@ -147,8 +150,7 @@ class CoulombPadFriction:
         m, s = self.model, self._scratch
         history = None  # (directions, residual) of the last trial, for the Anderson step
         for _ in range(MAX_TRIALS):
-            take = sliding[at.slots]
-            qfrc = at.generalized_force(take, self._friction(at, take, normal))
+            qfrc = self._generalized_friction(at, sliding, normal)
             self._set_frictionless(sliding)
             mujoco.mj_setState(m, s, self._state, self._state_kind)
             s.qfrc_applied[:] = qfrc
@@ -158,7 +160,7 @@ class CoulombPadFriction:
             sliding = sliding & trial.touched  # a point that touches nothing has no friction
             v_end = trial.tangential(trial.end_velocity())
             in_trial = sliding[trial.slots]
-            speed = np.linalg.norm(v_end, axis=1)
+            speed = _norm(v_end)
             opposite = -v_end / np.maximum(speed, 1e-12)[:, None]
             agree = (self._direction[trial.slots] * opposite).sum(1)
             # our friction turned the slip back, or stopped it: the point sticks (the solver's friction)
@@ -171,12 +173,11 @@ class CoulombPadFriction:
                 return sliding
             if sticks.any():
                 continue
-            if agree[in_trial].min() >= np.cos(np.radians(DIRECTION_TOLERANCE_DEG)):
+            if agree[in_trial].min() >= _DIRECTIONS_AGREE:
                 break
             points = trial.slots[in_trial]
             history = self._next_directions(points, opposite[in_trial], history)
-        take = sliding[at.slots]
-        data.qfrc_applied[:] = at.generalized_force(take, self._friction(at, take, normal))
+        data.qfrc_applied[:] = self._generalized_friction(at, sliding, normal)
         return sliding
 
     def _next_directions(self, points: np.ndarray, opposite: np.ndarray, history):
@@ -197,23 +198,31 @@ class CoulombPadFriction:
         self._direction[points] = _unit((d + step).reshape(-1, 3))
         return d, residual
 
-    def _friction(self, at: "_PadContacts", take: np.ndarray, normal) -> np.ndarray:
-        """mu N d of `at`'s contacts `take` (world vectors, N), d in each contact's tangent plane."""
+    def _generalized_friction(self, at: "_PadContacts", sliding: np.ndarray, normal) -> np.ndarray:
+        """J^T f of the `sliding` points' contacts in `at`: f = mu N d, d each point's direction in
+        its contact's tangent plane [N -> generalized]."""
+        take = sliding[at.slots]
         points = at.slots[take]
-        return (self._point_mu[points] * normal(at, take))[:, None] * at.in_tangent_plane(take, self._direction[points])
+        return at.generalized_force(take, self._point_mu[points] * normal(at, take), self._direction[points])
 
     def _set_frictionless(self, sliding: np.ndarray) -> None:
         frictionless = sliding[self._pair_slots]
-        if self._frictionless is not None and np.array_equal(frictionless, self._frictionless):
+        key = frictionless.tobytes()
+        if key == self._frictionless:
             return  # the pairs hold these values already (every write comes through here)
         mu = self._mu.copy()
         mu[frictionless] = FRICTIONLESS_MU
         self.model.pair_friction[self._pairs, :2] = mu
-        self._frictionless = frictionless
+        self._frictionless = key
+
+
+def _norm(v: np.ndarray) -> np.ndarray:
+    """Each row's Euclidean norm, as np.linalg.norm(v, axis=1) computes it, without its wrapper."""
+    return np.sqrt((v * v).sum(1))
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.maximum(np.linalg.norm(v, axis=1), 1e-12)[:, None]
+    return v / np.maximum(_norm(v), 1e-12)[:, None]
 
 
 class _PadContacts:
@@ -229,11 +238,12 @@ class _PadContacts:
         n = data.ncon
         contact = data.contact  # MuJoCo builds this view at each access: once per step, not per field
         geoms = contact.geom[:n]
-        slots = np.maximum(friction._slot_of_geom[geoms[:, 0]], friction._slot_of_geom[geoms[:, 1]])
+        slots = friction._slot_of_pair[geoms[:, 0], geoms[:, 1]]
         rows = contact.efc_address[:n]
-        index = np.nonzero((slots >= 0) & (rows >= 0))[0]
+        index = np.flatnonzero((slots >= 0) & (rows >= 0))
         self.slots, self.rows = slots[index], rows[index]
-        self.keys = geoms[index, 0] * self.model.ngeom + geoms[index, 1]
+        pairs = geoms[index]
+        self.keys = pairs[:, 0] * self.model.ngeom + pairs[:, 1]
         frames = contact.frame[index].reshape(-1, 3, 3)
         self._t1, self._t2 = frames[:, 1], frames[:, 2]
         self._n_points = len(friction.slipping)
@@ -246,11 +256,6 @@ class _PadContacts:
     def tangential(self, per_row: np.ndarray) -> np.ndarray:
         """The tangential rows of a constraint-space vector as world vectors, one per contact."""
         return per_row[self.rows + 1][:, None] * self._t1 + per_row[self.rows + 2][:, None] * self._t2
-
-    def in_tangent_plane(self, take: np.ndarray, vectors: np.ndarray) -> np.ndarray:
-        """World unit `vectors` projected on the tangent planes of these contacts `take`, made unit again."""
-        t1, t2 = self._t1[take], self._t2[take]
-        return _unit((vectors * t1).sum(1)[:, None] * t1 + (vectors * t2).sum(1)[:, None] * t2)
 
     def end_velocity(self) -> np.ndarray:
         """J qvel: each constraint row's velocity at the end of the step [m/s]."""
@@ -274,11 +279,16 @@ class _PadContacts:
             return found
         return normal
 
-    def generalized_force(self, take: np.ndarray, force: np.ndarray) -> np.ndarray:
-        """J^T of tangential world vectors `force` on these contacts `take` [N -> generalized]."""
+    def generalized_force(self, take: np.ndarray, magnitude: np.ndarray, directions: np.ndarray) -> np.ndarray:
+        """J^T of forces on these contacts `take` [N -> generalized]: `magnitude` [N] along world unit
+        `directions` projected on each contact's tangent plane and made unit again."""
+        t1, t2 = self._t1[take], self._t2[take]
+        d = _unit((directions * t1).sum(1)[:, None] * t1 + (directions * t2).sum(1)[:, None] * t2)
+        force = magnitude[:, None] * d
+        rows = self.rows[take]
         per_row = np.zeros(self.data.nefc)
-        per_row[self.rows[take] + 1] = (force * self._t1[take]).sum(1)
-        per_row[self.rows[take] + 2] = (force * self._t2[take]).sum(1)
+        per_row[rows + 1] = (force * t1).sum(1)
+        per_row[rows + 2] = (force * t2).sum(1)
         out = np.zeros(self.model.nv)
         mujoco.mj_mulJacTVec(self.model, self.data, out, per_row)
         return out
