@@ -5,6 +5,8 @@ judged within 0.5 mm / 0.5 deg of the goal. One table row per task and loop.
 
     python3 benchmarks/evaluate_tasks.py [TASK.yaml ...] [--trials 100] [--seed 1] [--workers 2 | --ray [ADDRESS]]
                                          [--loop open closed] [--engine mujoco] [--json OUT.json]
+
+`--json` keeps each row's missed trials, to look into why they missed.
 """
 import argparse
 import json
@@ -30,7 +32,9 @@ def main() -> None:
     parser.add_argument("--ray", nargs="?", const="", default=None, metavar="ADDRESS")
     parser.add_argument("--loop", nargs="+", choices=("open", "closed"), default=["open", "closed"])
     parser.add_argument("--engine", choices=ENGINES, default="mujoco")
-    parser.add_argument("--json", type=Path, default=None, help="every summary, as JSON")
+    parser.add_argument("--json", type=Path, default=None,
+                        help="every row's summary, with its missed trials' records under `missed` (trial, world, "
+                             "verdict, replans: enough to run one again), as JSON")
     args = parser.parse_args()
     runner = Runner(workers=args.workers, ray=args.ray is not None, ray_address=args.ray or None)
     print(f"{args.trials} trials per row, seed {args.seed}, {args.engine}, on {runner.describe()}", file=sys.stderr)
@@ -44,8 +48,9 @@ def main() -> None:
         for loop in args.loop:
             batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=args.seed, closed_loop=loop == "closed",
                           engine=args.engine)
-            s = evaluate(batch, args.trials, runner).summary()
-            summaries.append(s)
+            evaluation = evaluate(batch, args.trials, runner)
+            s = evaluation.summary()
+            summaries.append({**s, "missed": [t for t in evaluation.trials if not t["success"]]})
             mm, deg = s["goal_error_mm"] or {}, s["goal_error_deg"] or {}
             misses = ", ".join(f"{k} {v}" for k, v in sorted(s["causes"].items())) or "-"
             print(f"| {task.name} | {loop} | {s['successes']}/{s['trials']} | {s['success_rate']:.1%} "
