@@ -21,7 +21,8 @@ from stablepush.errors import ArmFault
 from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan
 from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from
-from stablepush.execution.verdict import Verdict, judge
+from stablepush.execution.verdict import Verdict, judge, within
+from stablepush.execution.verdict import success_tolerance as judged_with
 from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.plan.plan import Plan, Waypoint
@@ -257,7 +258,7 @@ def execute_plan(
                     loop_status = "no tracker"  # the cell reports no pose in the grasp: open loop
                 elif closed_loop.may_replan(replans):
                     spliced = _correct(task, steps, features, closed_loop, w, state, rate_hz, replans,
-                                       success_tolerance or task.planner["tolerance"])
+                                       judged_with(task, success_tolerance))
                     if spliced is not None:
                         steps, new_points = spliced
                         pending = deque(dataclasses.replace(p, seq=w.seq + 1 + p.seq, t=w.t + p.t) for p in new_points)
@@ -290,8 +291,7 @@ def execute_plan(
 def fault_report(task: Task, fault: ArmFault, success_tolerance: Optional[Sequence[float]] = None) -> dict:
     """The report of a run that ended in an arm fault, in the fields of ExecutionReport.as_dict that
     a script reads first: the verdict (cause "arm_fault"), the reason and where to resume."""
-    verdict = Verdict.for_fault(success_tolerance if success_tolerance is not None else task.planner["tolerance"],
-                                fault.reason)
+    verdict = Verdict.for_fault(judged_with(task, success_tolerance), fault.reason)
     return {"task": task.name, "success": verdict.success, "tolerance": list(verdict.tolerance),
             "cause": verdict.cause, "verdict": verdict.detail, "last_confirmed_step": fault.last_confirmed_step,
             "arm_stopped": fault.arm_stopped, "connected": fault.connected}
@@ -317,7 +317,7 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     measured = (float(tracked["x"]), float(tracked["z"]), theta)
     record, new_steps = replan(task, measured, steps[k].pusher, loop, k, steps[k].pose,
                                trigger="off_goal" if last else "off_plan",
-                               verdict_at_stake=last and loop.off_by(tracked, task.goal, tuple(success_tolerance)))
+                               verdict_at_stake=last and not within(tracked, task.goal, success_tolerance))
     replans.append(record)
     if not record.solved or record.pushes == 0:
         return None
