@@ -16,6 +16,7 @@ from stablepush.execution.protocol import PROTOCOL, ProtocolError, decode, encod
 from stablepush.plan import check_plan, plan_task
 from stablepush.plan.files import write_plan
 from stablepush.sim.server import running_sim_arm
+from stablepush.task import load_task
 from stablepush_cli.main import cli
 
 from conftest import TASKS, shipped
@@ -474,7 +475,8 @@ def test_closed_loop_lands_the_pivot_with_its_feature_off_its_place():
     trial 2 of seed 1 with features off by up to 0.5 mm / 0.5 deg): the first touch pushes the prism
     0.38 mm off the pads' centre, about which the plan turns it. Corrections turn it about that centre
     from where it is (planner.pivot_steps) and it lands within 0.5 mm / 0.5 deg; without them every
-    correction was refused and it ended 0.41 mm / -0.82 deg off."""
+    correction was refused and it ended 0.41 mm / -0.82 deg off. The first correction is made as
+    the prism comes onto the feature, before the first push."""
     from stablepush.execution.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
 
@@ -485,7 +487,31 @@ def test_closed_loop_lands_the_pivot_with_its_feature_off_its_place():
         report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
                               closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.5, 0.5))
     assert report.success is True, (report.goal_error, report.verdict.detail)
-    assert report.replans[0].solved and report.replans[0].after_step == 1
+    first = report.replans[0]
+    assert first.solved and first.trigger == "on_touch" and first.after_step == 0
+
+
+def test_closed_loop_corrects_when_the_last_feature_is_met_early():
+    """The hexagon's one contact (lower-left, 12 pushes to the goal) with its feature 0.49 mm off in
+    x and 0.38 mm in z (evaluate's trial 74 of seed 1, the 1,000-trial table's worlds): the approach
+    pushes the prism about 0.5 mm along the push before the first push, below the re-plan
+    threshold, and the pushes carry it 0.55 mm past the goal, where the lower-left face cannot push
+    it back. Compared when it comes onto the feature, it is re-planned then, with that pusher, and
+    lands within 0.2 mm / 0.2 deg."""
+    from stablepush.execution.closed_loop import ClosedLoop
+    from stablepush.sim.arm import WorldDeviation
+
+    task = load_task(TASKS / "more" / "hexagon-offset.yaml")
+    plan = check_plan(task, plan_task(task, seed=1))
+    world = WorldDeviation(pad_mu_scale=1.0846, pusher_mu_scale=0.9725, grip_scale=1.0518, mass_scale=0.9612,
+                           feature_offsets=(("lower-left", 0.4906, 0.3846, 0.1700),
+                                            ("bottom", 0.2018, 0.3975, -0.1038)))
+    with running_sim_arm(log=lambda text: None, deviation=world) as server:
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
+                              closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.2, 0.2))
+    assert report.success is True, (report.goal_error, report.verdict.detail)
+    touch = report.replans[0]
+    assert touch.trigger == "on_touch" and touch.after_step == 0 and touch.solved and touch.kept_pusher
 
 
 def test_closed_loop_on_drake_lands_the_t_shape_in_a_low_friction_world(tmp_path):

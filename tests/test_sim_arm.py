@@ -3,6 +3,7 @@
 The friction test is what the measured results rest on: a ledge pushing the held object along the
 pads must need 2 mu N + m g (both pads slide; the weight is lifted), Coulomb's law, within 5%.
 """
+import itertools
 import math
 
 import numpy as np
@@ -109,6 +110,28 @@ def test_during_a_push_the_object_stays_on_its_feature():
     assert all(b.t - a.t == pytest.approx(0.01) for a, b in zip(waypoints, waypoints[1:]))
     confirmed = [w.step for w in waypoints if w.completes]
     assert confirmed == sorted(confirmed) == list(range(1, len(steps)))
+
+
+def test_a_stream_resumed_on_a_feature_backs_off_that_feature():
+    """A correction made as the object comes onto the next contact's feature (B), that begins with
+    another pusher, first retracts G along B's inward normal, not along the normal of the feature
+    that pushed the object into that step (A), which it left before the approach."""
+    from stablepush.plan import plan_task
+
+    task = shipped("t-shaped")
+    steps = plan_task(task, seed=2).waypoints
+    k = next(i for i in range(1, len(steps) - 1) if steps[i + 1].pusher != steps[i].pusher)
+    a, b = steps[k].pusher, steps[k + 1].pusher
+    c = next(name for name in task.pusher_names if name not in (a, b))
+    features = place_features(task, steps, every_pusher=True)
+    on_b = features[b].object_pose @ np.linalg.inv(grasp_transform(steps[k].pose))
+    spliced = list(steps[:k + 1]) + [Waypoint(*steps[k + 1].pose, pusher=c)]
+    retract = task.environment["retract"] * 1e-3
+    for resting_on, normal in ((b, features[b].normal), (None, features[a].normal)):
+        points = arm_trajectory(task, spliced, features, 100.0, _pose(on_b), resume_from=k, resting_on=resting_on)
+        backing_off = list(itertools.takewhile(lambda w: w.phase == "retract", points))
+        assert backing_off, [w.phase for w in points[:3]]
+        np.testing.assert_allclose(np.array(backing_off[-1].pose[:3]) - on_b[:3, 3], normal * retract, atol=1e-9)
 
 
 def test_features_from_the_task_environment():

@@ -251,14 +251,16 @@ def execute_plan(
             if w.completes:
                 last_confirmed = w.step
                 _record(contacts, task, steps, features, w.step, touch_state, state)
-            # Compare after each push but the last, and once the object has come to rest after it.
+            # Compare when the object has come onto a feature, after each push but the last, and
+            # once the object has come to rest after it.
             at_rest = w.phase == "settle" and not (pending and pending[0].phase == "settle")
-            if loop_status == "on" and ((w.completes and w.step < len(steps) - 1) or at_rest):
+            touched = w.phase == "approach" and bool(pending) and pending[0].phase == "push"
+            if loop_status == "on" and ((w.completes and w.step < len(steps) - 1) or at_rest or touched):
                 if "object_in_grasp" not in state:
                     loop_status = "no tracker"  # the cell reports no pose in the grasp: open loop
                 elif closed_loop.may_replan(replans):
                     spliced = _correct(task, steps, features, closed_loop, w, state, rate_hz, replans,
-                                       judged_with(task, success_tolerance))
+                                       judged_with(task, success_tolerance), touched)
                     if spliced is not None:
                         steps, new_points = spliced
                         pending = deque(dataclasses.replace(p, seq=w.seq + 1 + p.seq, t=w.t + p.t) for p in new_points)
@@ -298,34 +300,41 @@ def fault_report(task: Task, fault: ArmFault, success_tolerance: Optional[Sequen
 
 
 def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
-             state: dict, rate_hz: float, replans: List[Replan], success_tolerance: Sequence[float]):
+             state: dict, rate_hz: float, replans: List[Replan], success_tolerance: Sequence[float],
+             touched: bool = False):
     """After plan step w.step: when the tracked pose is off the plan (or, at rest after the last
     push, off the goal) by more than the loop allows, re-plan from it and return the spliced steps and the
     waypoints that carry them out from where G is now (seq and t counted from this waypoint);
     else None. At rest off the goal by more than `success_tolerance` (mm, deg) the verdict is at
-    stake, and the re-plan may take its last, riskier attempt (closed_loop.replan). `features` is
-    updated in place: the object's pose on the current feature becomes the measured one (G's pose
-    times the tracked pose in the grasp), so the rest of this contact pushes from where the object
-    really is."""
+    stake, and the re-plan may take its last, riskier attempt (closed_loop.replan). `touched`: the
+    object has just come onto the feature of the next push (w ends an approach); a feature met off
+    its place has pushed it already, and every push of the contact would carry that error on. In
+    the plan's last contact it is corrected past the loop's final tolerance: the contact ends at the
+    goal, where an error along the push is one the pusher cannot push back (the hexagon's closed-loop
+    misses, docs/evaluate.md). `features` is updated in place: the object's pose on the
+    feature in contact becomes the measured one (G's pose times the tracked pose in the grasp), so
+    the rest of this contact pushes from where the object really is."""
     k = w.step
     tracked = state["object_in_grasp"]
-    last = k == len(steps) - 1
-    if not loop.off_by(tracked, task.goal if last else steps[k].pose, loop.final_tolerance if last else loop.threshold):
+    last = k == len(steps) - 1 and not touched
+    pusher = steps[k + 1].pusher if touched else steps[k].pusher  # the one the object rests on
+    final_contact = touched and all(s.pusher == pusher for s in steps[k + 1:])
+    limit = loop.final_tolerance if last or final_contact else loop.threshold
+    if not loop.off_by(tracked, task.goal if last else steps[k].pose, limit):
         return None
     # The tracker's theta on the plan's turn (a plan may run past +-180 deg; a tracker reports one turn).
     theta = steps[k].pose[2] + angle_difference_deg(float(tracked["theta"]), steps[k].pose[2])
     measured = (float(tracked["x"]), float(tracked["z"]), theta)
-    record, new_steps = replan(task, measured, steps[k].pusher, loop, k, steps[k].pose,
-                               trigger="off_goal" if last else "off_plan",
+    record, new_steps = replan(task, measured, pusher, loop, k, steps[k].pose,
+                               trigger="off_goal" if last else "on_touch" if touched else "off_plan",
                                verdict_at_stake=last and not within(tracked, task.goal, success_tolerance))
     replans.append(record)
     if not record.solved or record.pushes == 0:
         return None
-    pusher = steps[k].pusher
     on_feature = pose_to_matrix(state["ee_pose"]) @ grasp_transform(measured)
     features[pusher] = dataclasses.replace(features[pusher], object_pose=on_feature)
-    spliced = steps[:k] + [Waypoint(*measured, pusher=pusher)] + new_steps[1:]
-    points = arm_trajectory(task, spliced, features, rate_hz, state["ee_pose"], resume_from=k)
+    spliced = steps[:k] + [Waypoint(*measured, pusher=steps[k].pusher)] + new_steps[1:]
+    points = arm_trajectory(task, spliced, features, rate_hz, state["ee_pose"], resume_from=k, resting_on=pusher)
     return spliced, points
 
 

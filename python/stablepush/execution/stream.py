@@ -123,9 +123,11 @@ def arm_trajectory(
     rate_hz: float,
     start_pose: Sequence[float],
     resume_from: int = 0,
+    resting_on: Optional[str] = None,
 ) -> List[ArmWaypoint]:
     """The end-effector waypoints that carry out plan steps resume_from+1 .. end, starting with
-    G at `start_pose` holding the object at plan pose `resume_from`."""
+    G at `start_pose` holding the object at plan pose `resume_from`, on the feature of pusher
+    `resting_on` (default: the one that pushed it there; none at step 0)."""
     check_resume_from(steps, resume_from)
     env = task.environment
     retract = env["retract"] * MM
@@ -135,8 +137,10 @@ def arm_trajectory(
     top = max(max(f.start[2], f.end[2]) for f in features.values())
 
     stream = _Stream(rate_hz, pose_to_matrix(start_pose), resume_from, [s.pose for s in steps])
-    # On a resume the object may still rest on the feature of the last confirmed push: back off first.
-    current: Optional[Feature] = features.get(steps[resume_from].pusher) if resume_from > 0 else None
+    # On a resume the object may still rest on a feature: back off it first.
+    if resting_on is None and resume_from > 0:
+        resting_on = steps[resume_from].pusher
+    current: Optional[Feature] = features.get(resting_on) if resting_on is not None else None
     lane = home[1] + env["lane_offset"] * MM
     for contact in contacts_of(steps):
         if contact.last <= resume_from:
