@@ -17,7 +17,7 @@ from stablepush.plan import check_plan, plan_task
 from stablepush.plan.files import write_plan
 from stablepush.sim.server import running_sim_arm
 from stablepush.task import load_task
-from stablepush_cli.main import cli
+from stablepush_cli.main import _print_report, cli
 
 from conftest import TASKS, shipped
 
@@ -491,7 +491,7 @@ def test_closed_loop_lands_the_pivot_with_its_feature_off_its_place():
     assert first.solved and first.trigger == "on_touch" and first.after_step == 0
 
 
-def test_closed_loop_corrects_when_the_last_feature_is_met_early():
+def test_closed_loop_corrects_when_the_last_feature_is_met_early(capsys):
     """The hexagon's one contact (lower-left, 12 pushes to the goal) with its feature 0.49 mm off in
     x and 0.38 mm in z (evaluate's trial 74 of seed 1, the 1,000-trial table's worlds): the approach
     pushes the prism about 0.5 mm along the push before the first push, below the re-plan
@@ -512,6 +512,8 @@ def test_closed_loop_corrects_when_the_last_feature_is_met_early():
     assert report.success is True, (report.goal_error, report.verdict.detail)
     touch = report.replans[0]
     assert touch.trigger == "on_touch" and touch.after_step == 0 and touch.solved and touch.kept_pusher
+    _print_report(report)
+    assert "on the feature of step 1: off the plan by" in capsys.readouterr().out
 
 
 def test_closed_loop_on_drake_lands_the_t_shape_in_a_low_friction_world(tmp_path):

@@ -1,6 +1,9 @@
 """Closed-loop execution: with a sticking pusher the object's pose in the grasp is
-observable, so after each push the executor compares the tracker's pose (`object_in_grasp` in the
-arm protocol) with the plan's and, past a threshold, re-plans from the measured pose.
+observable, so as the object comes onto each feature and after each push the executor compares
+the tracker's pose (`object_in_grasp` in the arm protocol) with the plan's and, past a threshold,
+re-plans from the measured pose. On the feature of the plan's last contact the threshold is the
+final tolerance: the contact ends at the goal, and a feature met early has pushed the object
+along the push already, an error the pusher cannot push back once it is past the goal.
 
 The policy lives here; `executor.py` streams and splices. A re-plan
 - aims at the task's goal within the final tolerance (a run is checked again at rest after its
@@ -119,7 +122,8 @@ class ClosedLoop:
 @dataclass(frozen=True)
 class Replan:
     """One correction: after plan step `after_step` the object was measured at `measured` where
-    the plan had `planned` (`trigger`: "off_plan" after a push, "off_goal" at rest after the last);
+    the plan had `planned` (`trigger`: "off_plan" after a push, "on_touch" as it came onto the
+    feature of step after_step + 1, "off_goal" at rest after the last);
     whether a new plan from there was found and taken (`solved`), its pushers and length, and, when
     none was taken, why (`failure`)."""
 
