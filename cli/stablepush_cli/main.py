@@ -617,15 +617,17 @@ def _host_port(value: str):
               metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise on the "
                                      "object's pose in the grasp (x and z in mm, theta in deg).")
 @click.option("--closed-loop", "closed_loop", is_flag=True,
-              help="After each push compare the arm's tracked pose in the grasp with the plan's; past "
-                   "--replan-threshold re-plan from the measured pose and continue with the new plan. "
+              help="As the object comes onto each feature and after each push compare the arm's tracked "
+                   "pose in the grasp with the plan's; past --replan-threshold (on the last contact's "
+                   "feature, --final-tolerance) re-plan from the measured pose and continue with the new plan. "
                    "An arm that reports no tracked pose runs open loop (and says so).")
 @click.option("--replan-threshold", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a re-plan "
                                      "(default: half the task's goal tolerance).")
 @click.option("--final-tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
-                                     "this close to the goal (default: a fifth of the task's goal tolerance).")
+                                     "this close to the goal, and re-plan on the last contact's feature past it "
+                                     "(default: a fifth of the task's goal tolerance).")
 def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
             ack_timeout: float, json_path, success_tolerance, record_path, video_path, video_fps: float, video_size,
             quiet: bool, mu_scale: float, tracker_noise, closed_loop: bool, replan_threshold, final_tolerance) -> None:

@@ -191,11 +191,12 @@ def execute_plan(
 ) -> ExecutionReport:
     """Stream the plan from step `resume_from` to the arm server at host:port. `pace` holds the
     stream to rate_hz in wall-clock time (a real arm); without it waypoints go as fast as they are
-    acknowledged (a simulator keeps its own clock). With `closed_loop`, the tracker's pose after
-    each push is compared with the plan's and, past its threshold, the rest of the run is re-planned
-    from the measured pose and spliced into the stream (`stablepush.closed_loop`), and a plan that
-    ends outside the loop's final tolerance is planned again to it first (`closed_loop.aim`); the
-    world then holds a feature for every pusher of the task. The report's verdict judges the final pose with
+    acknowledged (a simulator keeps its own clock). With `closed_loop`, the tracker's pose as the
+    object comes onto each feature and after each push is compared with the plan's and, past its
+    threshold, the rest of the run is re-planned from the measured pose and spliced into the stream
+    (`stablepush.closed_loop`), and a plan that ends outside the loop's final tolerance is planned
+    again to it first (`closed_loop.aim`); the world then holds a feature for every pusher of the
+    task. The report's verdict judges the final pose with
     `success_tolerance` (mm, deg; default: the task's goal tolerance). `progress(waypoint,
     confirmed_step, total_steps)` is called per ack, and `record(waypoint, state, pusher)` with the
     arm's state and the pusher in contact (None between contacts; `bags.RunRecording`). `plan`: a
