@@ -1,0 +1,63 @@
+"""The compiled pad friction (cpp/sim/coulomb_pad_friction.cpp) against its numpy reference
+(reference_pad_friction.py): the same algorithm written twice, run on the same arm and plan.
+
+The pivot's pushes make the pad's ring points slide about its sticking centre, so every branch runs:
+new sliders decided by the solver's step, trial steps for the friction's direction, points that
+stick again. The two may differ in a dot product's last bits (numpy's BLAS sums in another order),
+not in the physics: the object's path must agree to a nanometre.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from stablepush.execution.stream import arm_trajectory
+from stablepush.execution.world import place_features, scene_description
+from stablepush.plan import plan_task
+from stablepush.sim import scene as scene_mod
+from stablepush.sim.arm import SimArm
+from stablepush.sim.friction import CoulombPadFriction
+
+from conftest import shipped
+from reference_pad_friction import ReferencePadFriction
+
+WAYPOINTS = 120  # 1.2 s of the pivot's plan: the first pushes, where the ring points slide
+
+
+def _object_path(friction_class):
+    """The object's pose (x, y, z m; quaternion) after each of the pivot plan's first waypoints on the
+    arm, with the given pad friction, and the friction object at the end."""
+    task = shipped("pivoting")
+    steps = list(plan_task(task).waypoints)
+    features = place_features(task, steps)
+    scene = scene_description(task, features, steps[0].pose)
+    arm = SimArm(scene)
+    arm.pad_friction = friction_class(arm.model, scene_mod.pad_geoms(arm.model))
+    q = arm._object_qpos
+    path = []
+    for point in arm_trajectory(task, steps, features, 100.0, scene["gripper_pose"])[:WAYPOINTS]:
+        arm.move_to(point.pose, 0.01)
+        path.append(arm.data.qpos[q:q + 7].copy())
+    return np.array(path), arm.pad_friction
+
+
+@pytest.mark.slow
+def test_the_compiled_pad_friction_moves_the_object_as_the_numpy_reference():
+    compiled, compiled_friction = _object_path(CoulombPadFriction)
+    reference, reference_friction = _object_path(ReferencePadFriction)
+    # the pads slid over the object (the hand turned about it), and the sliding points' directions
+    # took trial steps: the comparison is not of two resting grasps
+    assert reference_friction.trial_steps > 1000
+    assert abs(compiled_friction.trial_steps - reference_friction.trial_steps) <= 0.001 * reference_friction.trial_steps
+    assert compiled_friction.solver_steps == pytest.approx(reference_friction.solver_steps, abs=2)
+    assert np.abs(compiled[:, :3] - reference[:, :3]).max() < 1e-9  # m
+    turn = 2 * np.arccos(np.clip(np.abs((compiled[:, 3:] * reference[:, 3:]).sum(1)), 0, 1))
+    assert math.degrees(turn.max()) < 1e-4
+
+
+def test_a_pad_geom_not_in_the_model_is_refused_by_name():
+    task = shipped("pivoting")
+    steps = list(plan_task(task).waypoints)
+    arm = SimArm(scene_description(task, place_features(task, steps), steps[0].pose))
+    with pytest.raises(ValueError, match=f"pad geom {arm.model.ngeom} is not in the model"):
+        CoulombPadFriction(arm.model, [arm.model.ngeom])
