@@ -1,6 +1,7 @@
 """The pad friction's first implementation, in numpy: the reference the compiled one
 (`stablepush.sim._pad_friction`, cpp/sim/coulomb_pad_friction.cpp) is checked against in
-tests/test_pad_friction.py. The algorithm and its thresholds are stablepush/sim/friction.py's."""
+tests/test_pad_friction.py, bit for bit. The algorithm and its thresholds are
+stablepush/sim/friction.py's."""
 from __future__ import annotations
 
 from typing import Sequence
@@ -161,8 +162,13 @@ class ReferencePadFriction:
         residual = opposite.ravel() - d
         if history is not None and history[0].shape == d.shape:
             dd, dr = d - history[0], residual - history[1]
-            denominator = dr @ dr
-            gamma = (dr @ residual) / denominator if denominator > 0 else 0.0
+            # summed one term after another, as the compiled version does (BLAS's `@` sums in another
+            # order, and a pivot's sliding pads turn that last bit into micrometres)
+            denominator, numerator = 0.0, 0.0
+            for a, b in zip(dr.tolist(), residual.tolist()):
+                denominator += a * a
+                numerator += a * b
+            gamma = numerator / denominator if denominator > 0 else 0.0
             step = residual - gamma * (dd + dr)
         else:
             step = 0.5 * residual

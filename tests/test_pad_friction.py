@@ -3,11 +3,11 @@
 
 The pivot's pushes make the pad's ring points slide about its sticking centre, so every branch runs:
 new sliders decided by the solver's step, trial steps for the friction's direction, points that
-stick again. The two may differ in a dot product's last bits (numpy's BLAS sums in another order),
-not in the physics: the object's path must agree to a nanometre.
+stick again. Both do the same floating-point operations in the same order, so the states must be
+the same to the bit: the pivot turns a last-bit difference into micrometres within seconds (the
+rig's 30 deg pivot ended 0.0025 and 0.0098 mm off while the reference summed its Anderson step
+with BLAS), and a tolerance would hide a real slip.
 """
-import math
-
 import numpy as np
 import pytest
 
@@ -42,17 +42,15 @@ def _object_path(friction_class):
 
 
 @pytest.mark.slow
-def test_the_compiled_pad_friction_moves_the_object_as_the_numpy_reference():
+def test_the_compiled_pad_friction_moves_the_object_as_the_numpy_reference_to_the_bit():
     compiled, compiled_friction = _object_path(CoulombPadFriction)
     reference, reference_friction = _object_path(ReferencePadFriction)
     # the pads slid over the object (the hand turned about it), and the sliding points' directions
     # took trial steps: the comparison is not of two resting grasps
     assert reference_friction.trial_steps > 1000
-    assert abs(compiled_friction.trial_steps - reference_friction.trial_steps) <= 0.001 * reference_friction.trial_steps
-    assert compiled_friction.solver_steps == pytest.approx(reference_friction.solver_steps, abs=2)
-    assert np.abs(compiled[:, :3] - reference[:, :3]).max() < 1e-9  # m
-    turn = 2 * np.arccos(np.clip(np.abs((compiled[:, 3:] * reference[:, 3:]).sum(1)), 0, 1))
-    assert math.degrees(turn.max()) < 1e-4
+    assert compiled_friction.trial_steps == reference_friction.trial_steps
+    assert compiled_friction.solver_steps == reference_friction.solver_steps
+    np.testing.assert_array_equal(compiled, reference)
 
 
 def test_a_pad_geom_not_in_the_model_is_refused_by_name():
