@@ -23,14 +23,7 @@ _DIRECTIONS_AGREE = np.cos(np.radians(DIRECTION_TOLERANCE_DEG))
 
 
 class ReferencePadFriction:
-    """Per pad point, stick by the solver or slide with Coulomb friction we apply (module docstring).
-
-    `pad_geoms` are the ids of the pad point geoms; every explicit contact pair that holds one of
-    them is switched with it. Call `update(data)` before each `mj_step`, after the step's drives
-    are set: it writes `model.pair_friction` of the pad pairs and `data.qfrc_applied` (which it
-    owns: nothing else in the simulated arm applies forces) with the sliding points' friction,
-    sum of J_t^T f_t with f_t = mu N d [N], d the unit friction direction in the contact's tangent plane.
-    """
+    """stablepush.sim.friction.CoulombPadFriction's interface and behaviour, in numpy."""
 
     def __init__(self, model, pad_geoms: Sequence[int]):
         self.model = model
