@@ -48,7 +48,7 @@ def main() -> None:
         for loop in args.loop:
             batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=args.seed, closed_loop=loop == "closed",
                           engine=args.engine)
-            evaluation = evaluate(batch, args.trials, runner)
+            evaluation = evaluate(batch, args.trials, runner, progress=_progress(task.name, loop, args.trials))
             s = evaluation.summary()
             summaries.append({**s, "missed": [t for t in evaluation.trials if not t["success"]]})
             mm, deg = s["goal_error_mm"] or {}, s["goal_error_deg"] or {}
@@ -60,6 +60,16 @@ def main() -> None:
                   flush=True)
     if args.json:
         args.json.write_text(json.dumps(summaries, indent=1) + "\n")
+
+
+def _progress(name: str, loop: str, trials: int):
+    """A line on stderr, rewritten after each trial: trials done and landed so far (the table row
+    comes at the end of the batch, which at 1,000 trials takes the better part of an hour)."""
+    def show(record: dict, done: list) -> None:
+        landed = sum(1 for r in done if r["success"])
+        end = "\n" if len(done) == trials else ""
+        print(f"\r{name} {loop}: {len(done)}/{trials} trials, {landed} landed", end=end, file=sys.stderr, flush=True)
+    return show
 
 
 if __name__ == "__main__":
