@@ -56,9 +56,10 @@ FRICTIONLESS_MU = 1e-5  # MuJoCo's least friction coefficient (mjMINMU): the con
 
 
 if _pad_friction.MUJOCO_VERSION != mujoco.mj_version():
+    _built = ".".join(str(_pad_friction.MUJOCO_VERSION))  # mjVERSION_HEADER: 330 is 3.3.0
     raise ImportError(
-        f"stablepush's pad friction was built against MuJoCo {_pad_friction.MUJOCO_VERSION} but MuJoCo "
-        f"{mujoco.mj_version()} is installed: install the mujoco pyproject.toml pins, then reinstall stablepush")
+        f"stablepush's pad friction was built against MuJoCo {_built} but mujoco {mujoco.__version__} is "
+        f"installed: pip install mujoco=={_built} (the version pyproject.toml pins), or reinstall stablepush")
 
 
 class CoulombPadFriction:
