@@ -828,6 +828,10 @@ def _vary(_ctx, _param, values):
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
 @click.option("--plan", "plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False), default=None,
               help="The plan to evaluate (checked against the task). Default: plan once from the task.")
+@click.option("--robust", is_flag=True,
+              help="Plan robust to the worlds: the task's uncertainty box widened to the --vary spreads, so every "
+                   "push is stable for every multiplier they draw (docs/model.md section 7). Corrections keep "
+                   "the box. Not with --plan.")
 @click.option("--trials", default=100, show_default=True, type=click.IntRange(min=1, max=1_000_000),
               help="Number of trials (worlds).")
 @click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
@@ -861,9 +865,9 @@ def _vary(_ctx, _param, values):
                    "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv).")
 @_video_options("--video-failed")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_error, tracker_noise, closed_loop: bool,
-             engine: str, success_tolerance, workers, ray_address, json_path, csv_path, png_path, video_dir,
-             video_fps: float, video_size, quiet: bool) -> None:
+def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, vary, feature_error, tracker_noise,
+             closed_loop: bool, engine: str, success_tolerance, workers, ray_address, json_path, csv_path, png_path,
+             video_dir, video_fps: float, video_size, quiet: bool) -> None:
     """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
 
     Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
@@ -882,13 +886,14 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
       stablepush evaluate data/tasks/pivoting.yaml --trials 200 --vary pad_mu=0.15 --vary pusher_mu=0.15 \\
           --vary grip_force=0.1 --vary mass=0.05 --feature-error 0.5 0.5 --json piv.eval.json --plot piv.png
       stablepush evaluate data/tasks/t-shaped.yaml --trials 1000 --closed-loop --vary pad_mu=0.15 --ray
+      stablepush evaluate data/tasks/t-shaped.yaml --trials 100 --robust --vary pad_mu=0.15 --vary pusher_mu=0.15
       stablepush evaluate data/tasks/t-shaped.yaml --trials 20 --vary pad_mu=0.3 --video-failed t-failed
     """
     if video_dir:  # before the trials load MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
         _check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video_fps, video_size)
     else:
         _video_settings_need("--video-failed")
-    from stablepush.evaluation import Batch, Spreads, write_evaluation
+    from stablepush.evaluation import Batch, Spreads, robust_task, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
     from stablepush.plan import check_plan, plan_task
     from stablepush.runners import default_workers
@@ -898,13 +903,19 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
         spreads = Spreads(vary=vary, feature_error=tuple(feature_error), tracker_noise=tuple(tracker_noise))
     except ValueError as exc:
         _fail(f"--vary: {exc}")
+    if robust and plan_file:
+        _fail("--robust plans from the task; a plan given with --plan is evaluated as it is")
+    if robust and not spreads.vary:
+        _fail("--robust needs --vary: the box is widened to its spreads")
     if plan_file:
         task, plan = _load_plan_and_task(plan_file, task_file)
     else:
         task = _load(task_file)
+        if robust:
+            task = robust_task(task, spreads)
         plan = plan_task(task)
         if not plan.solved:
-            click.echo(f"{task.name}: {plan.message}", err=True)
+            click.echo(f"{task.name}{' (robust)' if robust else ''}: {plan.message}", err=True)
             sys.exit(EXIT_NOT_SOLVED)
         plan = check_plan(task, plan)
     if video_dir:
@@ -918,8 +929,9 @@ def evaluate(task_file: str, plan_file, trials: int, seed: int, vary, feature_er
                   tolerance=tuple(success_tolerance), video_dir=video_dir, video_fps=video_fps,
                   video_size=tuple(video_size))
     if not quiet:
+        box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
         click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop on {engine}, "
-                   f"on {runner.describe()}", err=True)
+                   f"on {runner.describe()}" + (f"; the plan is robust to {box}" if box else ""), err=True)
     bar = None if quiet else click.progressbar(length=trials, label="trials", file=sys.stderr, show_pos=True)
 
     def progress(record, done) -> None:

@@ -9,7 +9,7 @@ from stablepush.evaluation.batch import (
     wilson_interval,
     write_evaluation,
 )
-from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
+from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world, robust_task
 
 __all__ = ["Batch", "Evaluation", "Spreads", "TrialWorld", "VARY_KEYS", "draw_world",
-           "evaluate", "run_trial", "wilson_interval", "write_evaluation"]
+           "evaluate", "robust_task", "run_trial", "wilson_interval", "write_evaluation"]

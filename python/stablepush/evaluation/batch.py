@@ -186,6 +186,7 @@ class Evaluation:
             "ci95": list(wilson_interval(successes, n)) if n else None,
             "tolerance": list(self.batch.tolerance), "closed_loop": self.batch.closed_loop,
             "engine": self.batch.engine, "seed": self.batch.seed,
+            "plan_uncertainty": dict(self.batch.task.uncertainty),
             "vary": dict(self.batch.spreads.vary), "feature_error": list(self.batch.spreads.feature_error),
             "tracker_noise": list(self.batch.spreads.tracker_noise),
             "goal_error_mm": _percentiles(distance), "goal_error_deg": _percentiles(angle),

@@ -4,17 +4,21 @@ whichever worker runs it, in whatever order.
 
 A world multiplies the task's pad mu, pusher mu, grip force and mass by factors drawn uniformly
 within +-FRACTION (`Spreads.vary`), places each feature off by up to (mm, deg) in x, z and theta
-(uniform), and seeds the tracker's noise.
+(uniform), and seeds the tracker's noise. `robust_task` widens a task's uncertainty box to hold
+those multipliers, for a plan every push of which is stable in every such world.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Dict, Sequence, Tuple
 
 import numpy as np
 
-VARY_KEYS = ("pad_mu", "pusher_mu", "grip_force", "mass")
-MAX_FRACTION = 0.9  # a spread of +-90% at most: every multiplier stays positive
+from stablepush.task.model import UNCERTAIN, Task
+
+VARY_KEYS = tuple(UNCERTAIN)  # pad_mu, pusher_mu, grip_force, mass: the keys of a task's uncertainty box
+MAX_FRACTION = 0.9  # a spread of +-90% at most: every multiplier stays positive (the box's own limit)
 
 
 @dataclass(frozen=True)
@@ -61,3 +65,12 @@ def draw_world(seed: int, trial: int, spreads: Spreads, pushers: Sequence[str]) 
                for name in pushers}
     return TrialWorld(trial=trial, multipliers=multipliers, feature_offsets=offsets,
                       tracker_seed=int(rng.integers(2**31)))
+
+
+def robust_task(task: Task, spreads: Spreads) -> Task:
+    """The task whose `uncertainty` box holds every multiplier the spreads draw: each key the
+    larger of the task's fraction and the spread's. A plan of it has every push stable at the box's
+    corners, and so in every world of the batch up to the features' offsets and the tracker's noise,
+    which the box does not describe (docs/model.md section 7)."""
+    box = {key: max(task.uncertainty.get(key, 0.0), spreads.vary.get(key, 0.0)) for key in VARY_KEYS}
+    return dataclasses.replace(task, uncertainty={key: value for key, value in box.items() if value > 0.0})
