@@ -1,10 +1,13 @@
 """Success rates at scale (docs/evaluate.md): every task (default: the shipped ones and
 data/tasks/more), its seed-1 plan, N trials in worlds with the issue's spreads (pad and pusher mu
 +-15%, grip force +-10%, mass +-5%, features off by up to 0.5 mm / 0.5 deg), open and closed loop,
-judged within 0.5 mm / 0.5 deg of the goal. One table row per task and loop.
+judged within 0.5 mm / 0.5 deg of the goal. One table row per task, plan and loop. The plan is the
+task's own (`nominal`) or robust to those spreads (`robust`: `stablepush evaluate --robust`); a
+task with no robust plan gets a row that says why.
 
     python3 benchmarks/evaluate_tasks.py [TASK.yaml ...] [--trials 100] [--seed 1] [--workers 2 | --ray [ADDRESS]]
-                                         [--loop open closed] [--engine mujoco] [--json OUT.json]
+                                         [--plans nominal robust] [--loop open closed] [--engine mujoco]
+                                         [--json OUT.json]
 
 `--json` keeps each row's missed trials, to look into why they missed.
 """
@@ -13,7 +16,7 @@ import json
 import sys
 from pathlib import Path
 
-from stablepush.evaluation import Batch, Spreads, evaluate
+from stablepush.evaluation import Batch, Spreads, evaluate, robust_task
 from stablepush.plan import check_plan, plan_task
 from stablepush.runners import Runner, default_workers
 from stablepush.sim.engines import ENGINES
@@ -30,6 +33,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--workers", type=int, default=default_workers())
     parser.add_argument("--ray", nargs="?", const="", default=None, metavar="ADDRESS")
+    parser.add_argument("--plans", nargs="+", choices=("nominal", "robust"), default=["nominal"])
     parser.add_argument("--loop", nargs="+", choices=("open", "closed"), default=["open", "closed"])
     parser.add_argument("--engine", choices=ENGINES, default="mujoco")
     parser.add_argument("--json", type=Path, default=None,
@@ -38,26 +42,35 @@ def main() -> None:
     args = parser.parse_args()
     runner = Runner(workers=args.workers, ray=args.ray is not None, ray_address=args.ray or None)
     print(f"{args.trials} trials per row, seed {args.seed}, {args.engine}, on {runner.describe()}", file=sys.stderr)
-    print("| task | loop | landed | success rate (95% CI) | goal error p50 / p95 mm | p50 / p95 deg | misses | wall s "
-          "| x real time |")
-    print("|---|---|---:|---|---|---|---|---:|---:|")
+    print("| task | plan | loop | landed | success rate (95% CI) | goal error p50 / p95 mm | p50 / p95 deg | misses "
+          "| wall s | x real time |")
+    print("|---|---|---|---:|---|---|---|---|---:|---:|")
     summaries = []
     for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
-        task = load_task(path)
-        plan = check_plan(task, plan_task(task, seed=1))
-        for loop in args.loop:
-            batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=args.seed, closed_loop=loop == "closed",
-                          engine=args.engine)
-            evaluation = evaluate(batch, args.trials, runner, progress=_progress(task.name, loop, args.trials))
-            s = evaluation.summary()
-            summaries.append({**s, "missed": [t for t in evaluation.trials if not t["success"]]})
-            mm, deg = s["goal_error_mm"] or {}, s["goal_error_deg"] or {}
-            misses = ", ".join(f"{k} {v}" for k, v in sorted(s["causes"].items())) or "-"
-            print(f"| {task.name} | {loop} | {s['successes']}/{s['trials']} | {s['success_rate']:.1%} "
-                  f"({s['ci95'][0]:.1%}-{s['ci95'][1]:.1%}) | {mm.get('p50', float('nan')):.2f} / "
-                  f"{mm.get('p95', float('nan')):.2f} | {deg.get('p50', float('nan')):.2f} / "
-                  f"{deg.get('p95', float('nan')):.2f} | {misses} | {s['wall_s']:.0f} | {s['real_time_factor']:.2f} |",
-                  flush=True)
+        for kind in args.plans:
+            task = load_task(path)
+            if kind == "robust":
+                task = robust_task(task, SPREADS)
+            plan = plan_task(task, seed=1)
+            if not plan.solved:
+                print(f"| {task.name} | {kind} | - | no plan: {plan.message} |", flush=True)
+                summaries.append({"task": task.name, "plan": kind, "no_plan": plan.message})
+                continue
+            plan = check_plan(task, plan)
+            for loop in args.loop:
+                batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=args.seed, closed_loop=loop == "closed",
+                              engine=args.engine)
+                progress = _progress(f"{task.name} {kind}", loop, args.trials)
+                evaluation = evaluate(batch, args.trials, runner, progress=progress)
+                s = evaluation.summary()
+                summaries.append({**s, "plan": kind, "missed": [t for t in evaluation.trials if not t["success"]]})
+                mm, deg = s["goal_error_mm"] or {}, s["goal_error_deg"] or {}
+                misses = ", ".join(f"{k} {v}" for k, v in sorted(s["causes"].items())) or "-"
+                print(f"| {task.name} | {kind} | {loop} | {s['successes']}/{s['trials']} | {s['success_rate']:.1%} "
+                      f"({s['ci95'][0]:.1%}-{s['ci95'][1]:.1%}) | {mm.get('p50', float('nan')):.2f} / "
+                      f"{mm.get('p95', float('nan')):.2f} | {deg.get('p50', float('nan')):.2f} / "
+                      f"{deg.get('p95', float('nan')):.2f} | {misses} | {s['wall_s']:.0f} | "
+                      f"{s['real_time_factor']:.2f} |", flush=True)
     if args.json:
         args.json.write_text(json.dumps(summaries, indent=1) + "\n")
 
