@@ -10,6 +10,8 @@ namespace stablepush::sim {
 namespace {
 
 constexpr unsigned kState = mjSTATE_INTEGRATION;  // everything a step reads, qfrc_applied included
+// mjModel::pair_friction holds 5 numbers a pair: tangent 1, tangent 2, torsional, rolling 1, rolling 2.
+constexpr int kPairFrictionWidth = 5;
 
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
@@ -20,9 +22,9 @@ Vec3 unit(const Vec3& v) {
   return {v[0] / n, v[1] / n, v[2] / n};
 }
 
-/// Row j's tangential components of a constraint-space vector as a world vector (the contact
+/// Row j's tangential components of a constraint-space vector (nefc values) as a world vector (the contact
 /// frame's tangents, in the sign convention of the rows).
-Vec3 tangential(const PadContacts& at, const std::vector<double>& per_row, std::size_t j) {
+Vec3 tangential(const PadContacts& at, const double* per_row, std::size_t j) {
   const double a = per_row[at.rows[j] + 1], b = per_row[at.rows[j] + 2];
   const Vec3 &t1 = at.t1[j], &t2 = at.t2[j];
   return {a * t1[0] + b * t2[0], a * t1[1] + b * t2[1], a * t1[2] + b * t2[2]};
@@ -76,7 +78,8 @@ CoulombPadFriction::CoulombPadFriction(mjModel* model, const std::vector<int>& p
       if (slot < 0) continue;
       pairs_.push_back(i);
       pair_slots_.push_back(slot);
-      pair_mu_.push_back({model_->pair_friction[5 * i], model_->pair_friction[5 * i + 1]});
+      const mjtNum* mu = model_->pair_friction + kPairFrictionWidth * i;
+      pair_mu_.push_back({mu[0], mu[1]});
       point_mu_[slot] = pair_mu_.back()[0];
     }
   }
@@ -93,7 +96,7 @@ CoulombPadFriction::CoulombPadFriction(mjModel* model, const std::vector<int>& p
 CoulombPadFriction::~CoulombPadFriction() { mj_deleteData(scratch_); }
 
 void CoulombPadFriction::update(mjData* data) {
-  const PadContacts contacts = contacts_of(data);
+  PadContacts contacts = contacts_of(data);
   // Candidates from the previous step's slip (the tangential rows of efc_vel, m/s: the cones are
   // elliptic, so those rows are the contact frame's tangents). A point touching the object through
   // several convex pieces slips if any of them does; a point that touches nothing does not.
@@ -115,7 +118,7 @@ void CoulombPadFriction::update(mjData* data) {
   if (any(slipping_)) {
     mj_getState(model_, data, state_.data(), kState);
     const Normals normal(contacts);
-    PadContacts at = contacts;
+    PadContacts at = std::move(contacts);  // not read after this
     Flags fresh(n_points_);
     for (int k = 0; k < n_points_; ++k) fresh[k] = slipping_[k] && !sliding[k];
     if (any(fresh)) {
@@ -179,14 +182,14 @@ CoulombPadFriction::Flags CoulombPadFriction::new_sliders(const PadContacts& sol
   // slip at its end; its friction direction starts from the solver's.
   const mjData* s = scratch_;
   const std::vector<double> v_end = end_velocity(s);
-  const std::vector<double> force(s->efc_force, s->efc_force + s->nefc);
+  const mjtNum* force = s->efc_force;
   const std::size_t n = solver.rows.size();
   Flags stays(n);
   for (std::size_t j = 0; j < n; ++j) {
     const int row = solver.rows[j];
     const double mu = point_mu_[solver.slots[j]];
     const bool on_cone = std::hypot(force[row + 1], force[row + 2]) >= p_.on_cone * mu * force[row];
-    stays[j] = !(on_cone && norm(tangential(solver, v_end, j)) >= p_.stick_speed);
+    stays[j] = !(on_cone && norm(tangential(solver, v_end.data(), j)) >= p_.stick_speed);
   }
   const std::vector<int> staying = count(solver, stays);
   Flags sliding(n_points_);
@@ -216,7 +219,7 @@ CoulombPadFriction::Flags CoulombPadFriction::coulomb_friction(mjData* data, Fla
     for (std::size_t j = 0; j < n; ++j) {
       const int slot = trial.slots[j];
       if (!sliding[slot]) continue;
-      const Vec3 v = tangential(trial, v_end, j);
+      const Vec3 v = tangential(trial, v_end.data(), j);
       const double speed = norm(v), scale = std::max(speed, 1e-12);
       const Vec3 away{-v[0] / scale, -v[1] / scale, -v[2] / scale};
       const double agree = dot(direction_[slot], away);
@@ -301,7 +304,7 @@ void CoulombPadFriction::set_frictionless(const Flags& sliding) {
   for (std::size_t j = 0; j < pairs_.size(); ++j) frictionless[j] = sliding[pair_slots_[j]];
   if (frictionless_known_ && frictionless == frictionless_) return;  // every write comes through here
   for (std::size_t j = 0; j < pairs_.size(); ++j) {
-    mjtNum* mu = model_->pair_friction + 5 * pairs_[j];
+    mjtNum* mu = model_->pair_friction + kPairFrictionWidth * pairs_[j];
     mu[0] = frictionless[j] ? p_.frictionless_mu : pair_mu_[j][0];
     mu[1] = frictionless[j] ? p_.frictionless_mu : pair_mu_[j][1];
   }
