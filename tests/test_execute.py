@@ -516,6 +516,42 @@ def test_closed_loop_corrects_when_the_last_feature_is_met_early(capsys):
     assert "on the feature of step 1: off the plan by" in capsys.readouterr().out
 
 
+def _open_loop_in(task, world):
+    plan = check_plan(task, plan_task(task, seed=1))
+    with running_sim_arm(log=lambda text: None, deviation=world) as server:
+        return execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
+                            success_tolerance=(0.5, 0.5))
+
+
+def test_a_feature_beyond_its_place_is_blamed_not_the_friction():
+    """The tilted-gravity offset's left feature 0.48 mm beyond its place along the push, open loop:
+    the object rides with the hand 0.47 mm into the first push before the feature stops it, then
+    sticks, and ends that much short of the goal. The verdict blames the feature (`feature_off`),
+    and the slip after the feature met it is nil. 42 of the 50 misses of this plan's 1,000-trial
+    open loop were this (docs/evaluate.md), all called `pusher_slipped` before."""
+    from stablepush.sim.arm import WorldDeviation
+
+    report = _open_loop_in(load_task(TASKS / "more" / "tilted-gravity.yaml"),
+                           WorldDeviation(feature_offsets=(("left", -0.48, 0.0, 0.0),)))
+    assert report.success is False and report.verdict.cause == "feature_off", report.verdict.detail
+    assert "left's feature was met 0.47 mm beyond its place" in report.verdict.detail
+    left = report.contacts[0]
+    assert left.carried_mm == pytest.approx(0.47, abs=0.02) and left.slip_mm < 0.02
+
+
+def test_a_pusher_that_slips_on_a_feature_in_its_place_is_a_slip():
+    """The high-mu offset's pusher slips in a world with 15% less friction (its pushes have 0.1 N
+    of margin): the feature is where the plan says, so nothing is carried, and the verdict is
+    `pusher_slipped`."""
+    from stablepush.sim.arm import WorldDeviation
+
+    report = _open_loop_in(shipped("horizontal-offset-high-mu"),
+                           WorldDeviation(pad_mu_scale=0.85, pusher_mu_scale=0.85))
+    assert report.success is False and report.verdict.cause == "pusher_slipped", report.verdict.detail
+    left = report.contacts[0]  # it slips turning: 0.2 mm and 0.9 deg
+    assert left.slip_deg > 0.5 and left.carried_mm < 0.02
+
+
 def test_closed_loop_on_drake_lands_the_t_shape_in_a_low_friction_world(tmp_path):
     """The second engine end to end: the T through two switch-overs on the Drake arm (whose contact
     solver alone decides stick and slip), mu x0.85, closed loop: it lands within 0.2 mm and

@@ -58,6 +58,15 @@ def test_a_slipping_pusher_is_the_cause_and_named():
     assert judge(TASK, _report((21.6, 0.0, 0.0), contacts=small)).cause == "drift"
 
 
+def test_a_feature_met_beyond_its_place_is_blamed_before_a_slip():
+    late = [ContactRecord("left", 1, 20, slip_mm=0.3, slip_deg=0.0, carried_mm=0.45)]
+    v = judge(TASK, _report((19.4, 0.0, 0.0), contacts=late))
+    assert v.cause == "feature_off" and "left's feature was met 0.45 mm beyond its place" in v.detail
+    # Carried no more than half the tolerance (0.25 mm): the slip is the cause again.
+    v = judge(TASK, _report((19.4, 0.0, 0.0), contacts=[dataclasses.replace(late[0], carried_mm=0.24)]))
+    assert v.cause == "pusher_slipped"
+
+
 def test_a_plan_that_stops_short_is_its_own_cause():
     v = judge(TASK, _report((18.5, 0.0, 0.0), planned=(18.5, 0.0, 0.0)))
     assert v.cause == "plan_short" and "the plan itself ends 1.500 mm" in v.detail

@@ -798,8 +798,8 @@ def _print_report(report) -> None:
         click.echo(f"  {when} {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; {outcome} ({r.planning_ms:.1f} ms)")
     for c in report.contacts:
         if c.slip_mm is not None:
-            click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} slip at the pusher "
-                       f"{c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
+            click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} carried to the feature "
+                       f"{c.carried_mm:.3f} mm, then slip at the pusher {c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
     change = report.release_change
     if report.release_moved:
         click.echo(f"note: when the last feature let go the object moved in the grasp by "

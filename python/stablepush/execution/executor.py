@@ -37,6 +37,10 @@ RELEASE_MOVE = (0.5, 0.5)
 # a row is not following the stream (a real arm lags by a fraction of a mm): the run ends in a fault.
 FOLLOW_LIMIT = (0.01, math.radians(5.0))
 FOLLOW_ACKS = 50
+# The object rides with the hand between two acks when its point at the pusher moved in the world
+# within this fraction of the hand's motion there of where the hand alone would have taken it: the
+# feature has not stopped it yet (measured: 0.1-1% while riding, 33-100% once stopped).
+RIDE_FRACTION = 0.25
 
 
 def execution_warnings(task: Task) -> List[str]:
@@ -50,14 +54,17 @@ def execution_warnings(task: Task) -> List[str]:
 
 @dataclass
 class ContactRecord:
-    """How one stay on a feature went: the object's motion in the world while the pusher pushed
-    (zero when the pusher stuck), measured at the middle of the pusher's segment."""
+    """How one stay on a feature went, measured in the world at the middle of the pusher's segment:
+    `carried_mm`, how far the object rode with the hand into the push before the feature stopped
+    it (a feature that far beyond its place along the push), and `slip_mm` / `slip_deg`, its motion
+    after that, while the pusher pushed (zero when the pusher stuck)."""
 
     pusher: str
     first_step: int
     last_step: int
     slip_mm: Optional[float] = None
     slip_deg: Optional[float] = None
+    carried_mm: Optional[float] = None
 
 
 @dataclass
@@ -222,7 +229,8 @@ def execute_plan(
         ready = _expect(link.receive(), "ready")
         pending = deque(arm_trajectory(task, steps, features, rate_hz, ready["state"]["ee_pose"], resume_from))
         contacts: Dict[int, ContactRecord] = {}
-        touch_state: Optional[dict] = None
+        touch_state: Optional[dict] = None  # as the object came onto the feature, by the plan
+        met_state: Optional[dict] = None  # as the feature stopped it (a feature off its place: later)
         state = ready["state"]
         settled: Optional[dict] = None
         sent = 0
@@ -241,7 +249,10 @@ def execute_plan(
             sent += 1
             if w.phase == "push" and state is not None and touch_state is None:
                 touch_state = state  # the object as it came to rest on the feature
-            state = reply["state"]
+            previous, state = state, reply["state"]
+            if w.phase == "push" and touch_state is not None and met_state is None:
+                if _rode_with_hand(task, steps[w.step].pusher, previous, state) is False:
+                    met_state = state  # met during this waypoint: its motion still counts as carried
             lagging = lagging + 1 if _off_command(state["ee_pose"], w.pose) else 0
             if lagging >= FOLLOW_ACKS:
                 raise ProtocolError(f"the arm is not following: its reported pose stayed over "
@@ -251,7 +262,7 @@ def execute_plan(
                 record(w, state, steps[w.step].pusher if w.phase == "push" else None)
             if w.completes:
                 last_confirmed = w.step
-                _record(contacts, task, steps, features, w.step, touch_state, state)
+                _record(contacts, task, steps, w.step, touch_state, met_state, state)
             # Compare when the object has come onto a feature, after each push but the last, and
             # once the object has come to rest after it.
             at_rest = w.phase == "settle" and not (pending and pending[0].phase == "settle")
@@ -266,7 +277,7 @@ def execute_plan(
                         steps, new_points = spliced
                         pending = deque(dataclasses.replace(p, seq=w.seq + 1 + p.seq, t=w.t + p.t) for p in new_points)
             if w.phase != "push":
-                touch_state = None
+                touch_state = met_state = None
             if w.phase == "settle":
                 settled = state
             if progress is not None:
@@ -361,10 +372,33 @@ def _stop(link: _Link, within: float = 2.0) -> Optional[bool]:
         return None
 
 
-def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Waypoint], features: Dict[str, Feature],
-            step: int, touch_state: Optional[dict], state: dict) -> None:
+def _pusher_point(task: Task, pusher: str) -> np.ndarray:
+    """The middle of the pusher's segment in O, homogeneous [m]."""
+    spec = task.pushers[task.pusher_index(pusher)]
+    return np.array([(spec.a[0] + spec.b[0]) / 2 * MM, 0.0, (spec.a[1] + spec.b[1]) / 2 * MM, 1.0])
+
+
+def _rode_with_hand(task: Task, pusher: str, before: dict, after: dict) -> Optional[bool]:
+    """Whether, between two acks, the object's point at the pusher moved in the world with the hand
+    (RIDE_FRACTION): True while a feature beyond its place has not stopped it yet, False once the
+    feature holds it; None when the hand did not move there or the arm does not report the object."""
+    if "object_pose" not in before or "object_pose" not in after:
+        return None
+    point = _pusher_point(task, pusher)
+    p0, p1 = pose_to_matrix(before["object_pose"]) @ point, pose_to_matrix(after["object_pose"]) @ point
+    rode = pose_to_matrix(after["ee_pose"]) @ np.linalg.inv(pose_to_matrix(before["ee_pose"])) @ p0
+    hand = float(np.linalg.norm((rode - p0)[:3]))
+    if hand < 1e-7:  # m: the hand stood still, which tells nothing
+        return None
+    return float(np.linalg.norm((p1 - rode)[:3])) <= RIDE_FRACTION * hand
+
+
+def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Waypoint], step: int,
+            touch_state: Optional[dict], met_state: Optional[dict], state: dict) -> None:
     """Update the record of the contact that plan step `step` belongs to with the object's motion in
-    the world since it came to rest on the feature (when the arm reports the object)."""
+    the world since it came onto the feature by the plan (`touch_state`): up to where the feature
+    stopped it (`met_state`; None: not yet) it was carried, after that it slipped (when the arm
+    reports the object)."""
     pusher = steps[step].pusher
     first = step
     while first > 1 and steps[first - 1].pusher == pusher:
@@ -373,9 +407,11 @@ def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Wayp
     record.last_step = step
     if touch_state is None or "object_pose" not in state or "object_pose" not in touch_state:
         return
-    spec = task.pushers[task.pusher_index(pusher)]
-    mid = np.array([(spec.a[0] + spec.b[0]) / 2 * MM, 0.0, (spec.a[1] + spec.b[1]) / 2 * MM, 1.0])
-    T0, T1 = pose_to_matrix(touch_state["object_pose"]), pose_to_matrix(state["object_pose"])
-    record.slip_mm = float(np.linalg.norm((T1 @ mid - T0 @ mid)[:3])) / MM
-    R = T0[:3, :3].T @ T1[:3, :3]
+    point = _pusher_point(task, pusher)
+    T0 = pose_to_matrix(touch_state["object_pose"])
+    Tm = pose_to_matrix((met_state or state)["object_pose"])
+    T1 = pose_to_matrix(state["object_pose"])
+    record.carried_mm = float(np.linalg.norm((Tm @ point - T0 @ point)[:3])) / MM
+    record.slip_mm = float(np.linalg.norm((T1 @ point - Tm @ point)[:3])) / MM
+    R = Tm[:3, :3].T @ T1[:3, :3]
     record.slip_deg = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(R) - 1) / 2))))

@@ -13,6 +13,10 @@ A miss is given one cause, the first of CAUSES that applies, so a script can act
 - `correction_not_found`: the closed loop was off the plan and found no correction (each re-plan's
   `failure` says why; the plan's own shortfall, found before the first push, is `plan_short`);
 - `corrections_exhausted`: the closed loop made as many corrections as it may and is still off;
+- `feature_off`: a feature stood beyond its place along the push by more than SLIP_FRACTION of
+  the tolerance: the object rode with the hand that far into the push before the feature stopped
+  it, so it ends that much short (the executor's ContactRecord.carried_mm). The fixture, not the
+  friction, is to blame;
 - `pusher_slipped`: a pusher slipped on its feature by more than SLIP_FRACTION of the tolerance;
 - `plan_short`: the plan itself ends outside the tolerance (the planner's own tolerance is wider);
 - `drift`: none of the above, the error grew without one large slip.
@@ -29,9 +33,9 @@ from typing import Dict, Optional, Sequence, Tuple
 from stablepush.task.model import Task
 from stablepush.units import angle_difference_deg, pose_to_si
 
-CAUSES = ("grasp_lost", "correction_not_found", "corrections_exhausted", "pusher_slipped",
+CAUSES = ("grasp_lost", "correction_not_found", "corrections_exhausted", "feature_off", "pusher_slipped",
           "plan_short", "drift", "arm_fault", "not_measured")
-# A contact counts as slipped past this fraction of the tolerance (mm at the pusher, deg).
+# A contact counts as met late or slipped past this fraction of the tolerance (mm at the pusher, deg).
 SLIP_FRACTION = 0.5
 
 
@@ -90,6 +94,11 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
         return miss("correction_not_found", f"no correction found after step {last.after_step} ({last.failure})")
     if report.closed_loop == "on" and max_replans is not None and len(report.replans) >= max_replans:
         return miss("corrections_exhausted", f"the closed loop made its {max_replans} corrections and is still off")
+    late = [c for c in report.contacts if c.carried_mm is not None and c.carried_mm > SLIP_FRACTION * tol[0]]
+    if late:
+        worst = max(late, key=lambda c: c.carried_mm)
+        return miss("feature_off", f"{worst.pusher}'s feature was met {worst.carried_mm:.2f} mm beyond its place: "
+                                   f"the object rode with the hand that far into step {worst.first_step}")
     slipped = [c for c in report.contacts if c.slip_mm is not None
                and (c.slip_mm > SLIP_FRACTION * tol[0] or c.slip_deg > SLIP_FRACTION * tol[1])]
     if slipped:
