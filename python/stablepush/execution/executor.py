@@ -232,6 +232,7 @@ def execute_plan(
         contacts: Dict[int, ContactRecord] = {}
         touch_state: Optional[dict] = None  # as the object came onto the feature, by the plan
         met_state: Optional[dict] = None  # as the feature stopped it (a feature off its place: later)
+        rode = False  # whether the object has ridden with the hand since touch_state
         state = ready["state"]
         settled: Optional[dict] = None
         sent = 0
@@ -252,8 +253,10 @@ def execute_plan(
                 touch_state = state  # the object as it came to rest on the feature
             previous, state = state, reply["state"]
             if w.phase == "push" and touch_state is not None and met_state is None:
-                if _rode_with_hand(task, steps[w.step].pusher, previous, state) is False:
-                    met_state = state  # met during this waypoint: its motion still counts as carried
+                riding = _rode_with_hand(task, steps[w.step].pusher, previous, state)
+                if riding is False:  # met during this waypoint: after a ride, its motion is still carried
+                    met_state = state if rode else previous
+                rode = rode or bool(riding)
             lagging = lagging + 1 if _off_command(state["ee_pose"], w.pose) else 0
             if lagging >= FOLLOW_ACKS:
                 raise ProtocolError(f"the arm is not following: its reported pose stayed over "
@@ -279,6 +282,7 @@ def execute_plan(
                         pending = deque(dataclasses.replace(p, seq=w.seq + 1 + p.seq, t=w.t + p.t) for p in new_points)
             if w.phase != "push":
                 touch_state = met_state = None
+                rode = False
             if w.phase == "settle":
                 settled = state
             if progress is not None:
