@@ -65,6 +65,10 @@ def test_a_feature_met_beyond_its_place_is_blamed_before_a_slip():
     # Carried no more than half the tolerance (0.25 mm): the slip is the cause again.
     v = judge(TASK, _report((19.4, 0.0, 0.0), contacts=[dataclasses.replace(late[0], carried_mm=0.24)]))
     assert v.cause == "pusher_slipped"
+    # A feature that never stopped the object is not said to have been met.
+    v = judge(TASK, _report((0.0, 0.0, 0.0), contacts=[dataclasses.replace(late[0], carried_mm=20.0,
+                                                                           feature_met=False)]))
+    assert v.cause == "feature_off" and "left's feature was not met" in v.detail and "steps 1-20" in v.detail
 
 
 def test_a_plan_that_stops_short_is_its_own_cause():

@@ -66,6 +66,7 @@ class ContactRecord:
     slip_mm: Optional[float] = None
     slip_deg: Optional[float] = None
     carried_mm: Optional[float] = None
+    feature_met: Optional[bool] = None  # False: the object rode with the hand through the whole contact
 
 
 @dataclass
@@ -416,6 +417,7 @@ def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Wayp
     T0 = pose_to_matrix(touch_state["object_pose"])
     Tm = pose_to_matrix((met_state or state)["object_pose"])
     T1 = pose_to_matrix(state["object_pose"])
+    record.feature_met = met_state is not None
     record.carried_mm = float(np.linalg.norm((Tm @ point - T0 @ point)[:3])) / MM
     record.slip_mm = float(np.linalg.norm((T1 @ point - Tm @ point)[:3])) / MM
     R = Tm[:3, :3].T @ T1[:3, :3]

@@ -97,6 +97,9 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
     late = [c for c in report.contacts if c.carried_mm is not None and c.carried_mm > SLIP_FRACTION * tol[0]]
     if late:
         worst = max(late, key=lambda c: c.carried_mm)
+        if worst.feature_met is False:
+            return miss("feature_off", f"{worst.pusher}'s feature was not met: the object rode with the hand "
+                                       f"{worst.carried_mm:.2f} mm, through steps {worst.first_step}-{worst.last_step}")
         return miss("feature_off", f"{worst.pusher}'s feature was met {worst.carried_mm:.2f} mm beyond its place: "
                                    f"the object rode with the hand that far into step {worst.first_step}")
     slipped = [c for c in report.contacts if c.slip_mm is not None
