@@ -47,10 +47,9 @@ def main() -> None:
     print("|---|---|---|---:|---|---|---|---|---:|---:|")
     summaries = []
     for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
+        nominal = load_task(path)
         for kind in args.plans:
-            task = load_task(path)
-            if kind == "robust":
-                task = robust_task(task, SPREADS)
+            task = robust_task(nominal, SPREADS) if kind == "robust" else nominal
             plan = plan_task(task, seed=1)
             if not plan.solved:
                 print(f"| {task.name} | {kind} | - | no plan: {plan.message} |", flush=True)
