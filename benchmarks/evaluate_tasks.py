@@ -1,12 +1,14 @@
 """Success rates at scale (docs/evaluate.md): every task (default: the shipped ones and
 data/tasks/more), its seed-1 plan, N trials in worlds with the issue's spreads (pad and pusher mu
 +-15%, grip force +-10%, mass +-5%, features off by up to 0.5 mm / 0.5 deg), open and closed loop,
-judged within 0.5 mm / 0.5 deg of the goal. One table row per task, plan and loop. The plan is the
-task's own (`nominal`) or robust to those spreads (`robust`: `stablepush evaluate --robust`); a
-task with no robust plan gets a row that says why.
+judged within 0.5 mm / 0.5 deg of the goal. One table row per task, plan, loop and approach. The
+plan is the task's own (`nominal`) or robust to those spreads (`robust`: `stablepush evaluate
+--robust`); a task with no robust plan gets a row that says why. The approaches find each feature
+by touch (`guarded`, the default) or end where the plan puts it (`plain`: `evaluate --no-guard`).
 
     python3 benchmarks/evaluate_tasks.py [TASK.yaml ...] [--trials 100] [--seed 1] [--workers 2 | --ray [ADDRESS]]
-                                         [--plans nominal robust] [--loop open closed] [--engine mujoco]
+                                         [--plans nominal robust] [--loop open closed]
+                                         [--approach guarded plain] [--engine mujoco]
                                          [--json OUT.json]
 
 `--json` keeps each row's missed trials, to look into why they missed.
@@ -35,6 +37,7 @@ def main() -> None:
     parser.add_argument("--ray", nargs="?", const="", default=None, metavar="ADDRESS")
     parser.add_argument("--plans", nargs="+", choices=("nominal", "robust"), default=["nominal"])
     parser.add_argument("--loop", nargs="+", choices=("open", "closed"), default=["open", "closed"])
+    parser.add_argument("--approach", nargs="+", choices=("guarded", "plain"), default=["guarded"])
     parser.add_argument("--engine", choices=ENGINES, default="mujoco")
     parser.add_argument("--json", type=Path, default=None,
                         help="every row's summary, with its missed trials' records under `missed` (trial, world, "
@@ -42,9 +45,9 @@ def main() -> None:
     args = parser.parse_args()
     runner = Runner(workers=args.workers, ray=args.ray is not None, ray_address=args.ray or None)
     print(f"{args.trials} trials per row, seed {args.seed}, {args.engine}, on {runner.describe()}", file=sys.stderr)
-    print("| task | plan | loop | landed | success rate (95% CI) | goal error p50 / p95 mm | p50 / p95 deg | misses "
-          "| wall s | x real time |")
-    print("|---|---|---|---:|---|---|---|---|---:|---:|")
+    print("| task | plan | loop | approach | landed | success rate (95% CI) | goal error p50 / p95 mm | p50 / p95 deg "
+          "| misses | wall s | x real time |")
+    print("|---|---|---|---|---:|---|---|---|---|---:|---:|")
     summaries = []
     for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
         nominal = load_task(path)
@@ -56,16 +59,16 @@ def main() -> None:
                 summaries.append({"task": task.name, "plan": kind, "no_plan": plan.message})
                 continue
             plan = check_plan(task, plan)
-            for loop in args.loop:
+            for loop, approach in ((loop, approach) for loop in args.loop for approach in args.approach):
                 batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=args.seed, closed_loop=loop == "closed",
-                              engine=args.engine)
-                progress = _progress(f"{task.name} {kind}", loop, args.trials)
+                              guarded=approach == "guarded", engine=args.engine)
+                progress = _progress(f"{task.name} {kind}", f"{loop} {approach}", args.trials)
                 evaluation = evaluate(batch, args.trials, runner, progress=progress)
                 s = evaluation.summary()
-                summaries.append({**s, "plan": kind, "missed": [t for t in evaluation.trials if not t["success"]]})
+                summaries.append({**s, "plan": kind, "approach": approach, "missed": [t for t in evaluation.trials if not t["success"]]})
                 mm, deg = s["goal_error_mm"] or {}, s["goal_error_deg"] or {}
                 misses = ", ".join(f"{k} {v}" for k, v in sorted(s["causes"].items())) or "-"
-                print(f"| {task.name} | {kind} | {loop} | {s['successes']}/{s['trials']} | {s['success_rate']:.1%} "
+                print(f"| {task.name} | {kind} | {loop} | {approach} | {s['successes']}/{s['trials']} | {s['success_rate']:.1%} "
                       f"({s['ci95'][0]:.1%}-{s['ci95'][1]:.1%}) | {mm.get('p50', float('nan')):.2f} / "
                       f"{mm.get('p95', float('nan')):.2f} | {deg.get('p50', float('nan')):.2f} / "
                       f"{deg.get('p95', float('nan')):.2f} | {misses} | {s['wall_s']:.0f} | "

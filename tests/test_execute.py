@@ -330,6 +330,7 @@ def test_closed_loop_on_an_arm_without_a_tracker_runs_open_loop_and_says_so():
     report = execute_plan(task, plan, "127.0.0.1", arm.port, rate_hz=100.0, pace=False,
                           closed_loop=ClosedLoop.for_task(task))
     assert report.closed_loop == "no tracker" and report.replans == []
+    assert report.guard == "no tracker" and all(c.found_mm is None for c in report.contacts)
     assert report.last_confirmed_step == 20 and report.final_error is None
 
 
@@ -516,27 +517,55 @@ def test_closed_loop_corrects_when_the_last_feature_is_met_early(capsys):
     assert "on the feature of step 1: off the plan by" in capsys.readouterr().out
 
 
-def _open_loop_in(task, world):
+def _open_loop_in(task, world, guarded=True):
+    from stablepush.execution.guard import GuardedApproach
+
     plan = check_plan(task, plan_task(task, seed=1))
     with running_sim_arm(log=lambda text: None, deviation=world) as server:
         return execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
-                            success_tolerance=(0.5, 0.5))
+                            guard=GuardedApproach() if guarded else None, success_tolerance=(0.5, 0.5))
 
 
 def test_a_feature_beyond_its_place_is_blamed_not_the_friction():
-    """The tilted-gravity offset's left feature 0.48 mm beyond its place along the push, open loop:
-    the object rides with the hand 0.47 mm into the first push before the feature stops it, then
-    sticks, and ends that much short of the goal. The verdict blames the feature (`feature_off`),
-    and the slip after the feature met it is nil. 42 of the 50 misses of this plan's 1,000-trial
-    open loop were this (docs/evaluate.md), all called `pusher_slipped` before."""
+    """The tilted-gravity offset's left feature 0.48 mm beyond its place along the push, open loop
+    with approaches that end where the plan puts the feature: the object rides with the hand about
+    0.5 mm into the first push before the feature stops it, then sticks, and ends that much short of
+    the goal. The verdict blames the feature (`feature_off`), and the slip after the feature met it
+    is nil. 42 of the 50 misses of this plan's 1,000-trial open loop were this (docs/evaluate.md),
+    all called `pusher_slipped` before."""
     from stablepush.sim.arm import WorldDeviation
 
     report = _open_loop_in(load_task(TASKS / "more" / "tilted-gravity.yaml"),
-                           WorldDeviation(feature_offsets=(("left", -0.48, 0.0, 0.0),)))
+                           WorldDeviation(feature_offsets=(("left", -0.48, 0.0, 0.0),)), guarded=False)
     assert report.success is False and report.verdict.cause == "feature_off", report.verdict.detail
-    assert "left's feature was met 0.47 mm beyond its place" in report.verdict.detail
+    assert re.search(r"left's feature was met 0\.(4[6-9]|5[0-2]) mm beyond its place", report.verdict.detail)
     left = report.contacts[0]
-    assert left.carried_mm == pytest.approx(0.47, abs=0.02) and left.slip_mm < 0.02
+    assert left.carried_mm == pytest.approx(0.49, abs=0.03) and left.slip_mm < 0.02 and left.found_mm is None
+
+
+@pytest.mark.parametrize("task_file, offsets, found_mm, unguarded_mm", [
+    # the tilted-gravity offset's left feature 0.48 mm beyond its place (the test above)
+    ("tilted-gravity.yaml", (("left", -0.48, 0.0, 0.0),), 0.48, 0.52),
+    # the hexagon's lower-left feature met 0.64 mm early along the approach (evaluate's trial 74 of seed 1,
+    # the closed-loop test above), which the approach pushed 0.58 mm off its plan
+    ("hexagon-offset.yaml", (("lower-left", 0.4906, 0.3846, 0.1700), ("bottom", 0.2018, 0.3975, -0.1038)),
+     -0.64, 0.58),
+])
+def test_a_guarded_approach_finds_a_feature_off_its_place_and_the_run_lands(task_file, offsets, found_mm,
+                                                                              unguarded_mm):
+    """Open loop, no correction: the approach's slow end finds the feature by touch, where it is,
+    and the contact's pushes start there; the run ends within 0.2 mm / 0.2 deg of the goal, and the
+    contact's record says how far from its place the feature was found. Without the guard the same
+    world ends more than 0.5 mm off."""
+    from stablepush.sim.arm import WorldDeviation
+
+    task = load_task(TASKS / "more" / task_file)
+    world = WorldDeviation(feature_offsets=offsets)
+    guarded, plain = _open_loop_in(task, world), _open_loop_in(task, world, guarded=False)
+    error = guarded.goal_error
+    assert guarded.success and error["distance"] < 0.2 and abs(error["theta"]) < 0.2, guarded.verdict.detail
+    assert guarded.guard == "on" and guarded.contacts[0].found_mm == pytest.approx(found_mm, abs=0.03)
+    assert plain.guard == "off" and plain.goal_error["distance"] == pytest.approx(unguarded_mm, abs=0.03)
 
 
 def test_a_pusher_that_slips_on_a_feature_in_its_place_is_a_slip():

@@ -112,6 +112,38 @@ def test_during_a_push_the_object_stays_on_its_feature():
     assert confirmed == sorted(confirmed) == list(range(1, len(steps)))
 
 
+def test_every_approach_ends_slowly_toward_where_the_plan_puts_its_feature():
+    """Each contact's approach ends with GUARD_SPAN of guarded waypoints at GUARD_SPEED along the
+    feature's inward normal, up to the plan's touch; the run starts GUARD_SPAN back from the
+    feature it starts on (the world is built with the object clear of it)."""
+    from stablepush.execution.stream import GUARD_SPEED
+    from stablepush.execution.world import GUARD_SPAN
+    from stablepush.plan import plan_task
+
+    task = shipped("t-shaped")
+    steps = plan_task(task, seed=2).waypoints
+    features = place_features(task, steps)
+    scene = scene_description(task, features, task.start)
+    first = features[steps[1].pusher]
+    touching = first.object_pose @ np.linalg.inv(grasp_transform(task.start))
+    np.testing.assert_allclose(np.array(scene["gripper_pose"][:3]) - touching[:3, 3], first.normal * GUARD_SPAN,
+                               atol=1e-12)
+    points = arm_trajectory(task, steps, features, 100.0, scene["gripper_pose"])
+    starts = [i for i, w in enumerate(points) if w.phase == "push" and points[i - 1].phase != "push"]
+    assert len(starts) == sum(1 for a, b in zip(steps[1:], steps[2:]) if a.pusher != b.pusher) + 1
+    for i in starts:
+        n = len(list(itertools.takewhile(lambda w: w.guarded, reversed(points[:i]))))
+        before = points[i - n - 1].pose if i > n else scene["gripper_pose"]  # where the slow end begins
+        path = np.array([before[:3]] + [w.pose[:3] for w in points[i - n:i]])
+        feature = features[steps[points[i].step].pusher]
+        touch = feature.object_pose @ np.linalg.inv(grasp_transform(steps[points[i].step - 1].pose))
+        np.testing.assert_allclose(path[-1], touch[:3, 3], atol=1e-12)
+        np.testing.assert_allclose(path[0] - path[-1], feature.normal * GUARD_SPAN, atol=1e-12)
+        travel = np.linalg.norm(np.diff(path, axis=0), axis=1)
+        assert travel.max() <= GUARD_SPEED * 0.01 * (1 + 1e-9) and travel.min() > 0.9 * GUARD_SPEED * 0.01
+        assert all(w.phase == "approach" for w in points[i - n:i])
+
+
 def test_a_stream_resumed_on_a_feature_backs_off_that_feature():
     """A correction made as the object comes onto the next contact's feature (B), that begins with
     another pusher, first retracts G along B's inward normal, not along the normal of the feature

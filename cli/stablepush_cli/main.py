@@ -621,6 +621,10 @@ def _host_port(value: str):
                    "pose in the grasp with the plan's; past --replan-threshold (on the last contact's "
                    "feature, --final-tolerance) re-plan from the measured pose and continue with the new plan. "
                    "An arm that reports no tracked pose runs open loop (and says so).")
+@click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
+              help="End each approach slowly and find the feature by touch, from the arm's tracked pose in the "
+                   "grasp, then push from where it was found (a feature off its place is found, not pushed into "
+                   "or missed). An arm that reports no tracked pose approaches as planned (and says so).")
 @click.option("--replan-threshold", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a re-plan "
                                      "(default: half the task's goal tolerance).")
@@ -630,13 +634,14 @@ def _host_port(value: str):
                                      "(default: a fifth of the task's goal tolerance).")
 def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
             ack_timeout: float, json_path, success_tolerance, record_path, video_path, video_fps: float, video_size,
-            quiet: bool, mu_scale: float, tracker_noise, closed_loop: bool, replan_threshold, final_tolerance) -> None:
+            quiet: bool, mu_scale: float, tracker_noise, closed_loop: bool, guarded: bool, replan_threshold,
+            final_tolerance) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
     places them, else one station per pusher along y, 150 mm apart and alternating about home).
     During a push the object rests on its feature while the gripper moves; between pushes the
-    gripper retracts, moves and approaches.
+    gripper retracts, moves and approaches, and the approach finds the feature by touch (--guard).
     Waypoints (G's pose in the world, m and a quaternion) go out at --rate as JSON lines over TCP and
     each is acknowledged with the arm's state.
 
@@ -657,6 +662,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
     """
     from stablepush.execution import execute_plan, execution_warnings, fault_report
+    from stablepush.execution.guard import GuardedApproach
     from stablepush.execution.stream import check_resume_from
     from stablepush.outputs import write_atomically
 
@@ -723,8 +729,9 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
                          video_size, quiet)
     try:
         report = execute_plan(task, plan, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
-                              ack_timeout=ack_timeout, closed_loop=loop, success_tolerance=success_tolerance,
-                              progress=progress, record=recording)
+                              ack_timeout=ack_timeout, closed_loop=loop,
+                              guard=GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None,
+                              success_tolerance=success_tolerance, progress=progress, record=recording)
     except ArmFault as fault:
         if bar is not None:
             bar.__exit__(None, None, None)
@@ -776,6 +783,9 @@ def _print_report(report) -> None:
     click.echo(f"final pose in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
                f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg; "
                f"to the task's goal {report.goal_error['distance']:.3f} mm, {report.goal_error['theta']:+.3f} deg")
+    if report.guard == "no tracker":
+        click.echo("guard: the arm reports no object_in_grasp (no tracker), so each approach ended where the plan "
+                   "puts its feature")
     if report.closed_loop == "no tracker":
         click.echo("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
     for r in report.replans:
@@ -798,7 +808,8 @@ def _print_report(report) -> None:
         click.echo(f"  {when} {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; {outcome} ({r.planning_ms:.1f} ms)")
     for c in report.contacts:
         if c.slip_mm is not None:
-            click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} carried to the feature "
+            found = "" if c.found_mm is None else f"feature found {c.found_mm:+.3f} mm from its place; "
+            click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} {found}carried to the feature "
                        f"{c.carried_mm:.3f} mm, then slip at the pusher {c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
     change = report.release_change
     if report.release_moved:
@@ -845,6 +856,8 @@ def _vary(_ctx, _param, values):
 @click.option("--tracker-noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0), metavar="MM DEG",
               help="Standard deviations of the tracker's noise on the pose in the grasp.")
 @click.option("--closed-loop", is_flag=True, help="Run each trial closed loop (re-plan from the tracked pose).")
+@click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
+              help="Find each feature by touch at the end of its approach (as `execute --guard`).")
 @click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
               help="The simulated arm's physics engine.")
 @click.option("--success-tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True), default=(0.5, 0.5),
@@ -866,8 +879,8 @@ def _vary(_ctx, _param, values):
 @_video_options("--video-failed")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, vary, feature_error, tracker_noise,
-             closed_loop: bool, engine: str, success_tolerance, workers, ray_address, json_path, csv_path, png_path,
-             video_dir, video_fps: float, video_size, quiet: bool) -> None:
+             closed_loop: bool, guarded: bool, engine: str, success_tolerance, workers, ray_address, json_path,
+             csv_path, png_path, video_dir, video_fps: float, video_size, quiet: bool) -> None:
     """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
 
     Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
@@ -925,12 +938,14 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
             video_dir = video_directory(video_dir)
         except OutputError as exc:
             _fail(f"--video-failed {exc}")
-    batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, engine=engine,
+    batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
+                  engine=engine,
                   tolerance=tuple(success_tolerance), video_dir=video_dir, video_fps=video_fps,
                   video_size=tuple(video_size))
     if not quiet:
         box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
-        click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop on {engine}, "
+        click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop"
+                   f"{'' if guarded else ', approaches not guarded'} on {engine}, "
                    f"on {runner.describe()}" + (f"; the plan is robust to {box}" if box else ""), err=True)
     bar = None if quiet else click.progressbar(length=trials, label="trials", file=sys.stderr, show_pos=True)
 

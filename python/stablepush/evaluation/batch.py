@@ -26,6 +26,7 @@ from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_wo
 from stablepush.execution.bags import RunRecording
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.executor import execute_plan
+from stablepush.execution.guard import GuardedApproach
 from stablepush.plan.plan import Plan
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.sim.arm import WorldDeviation
@@ -43,13 +44,15 @@ SIM_ACK_TIMEOUT = 120.0
 @dataclass(frozen=True)
 class Batch:
     """What every trial shares: the task, its plan, the spreads of the worlds, open or closed
-    loop, the engine and the success tolerance (mm, deg)."""
+    loop, guarded approaches or not (stablepush.execution.guard), the engine and the success
+    tolerance (mm, deg)."""
 
     task: Task
     plan: Plan
     spreads: Spreads
     seed: int = 1
     closed_loop: bool = False
+    guarded: bool = True
     engine: str = "mujoco"
     tolerance: Tuple[float, float] = DEFAULT_TOLERANCE
     # Where each failed trial's video goes (`trial-<i>.mp4`; None: no videos), and how it is drawn
@@ -71,6 +74,12 @@ def deviation_of(batch: Batch, world: TrialWorld) -> WorldDeviation:
                           feature_offsets=tuple((k, *v) for k, v in world.feature_offsets.items()))
 
 
+def guard_of(batch: Batch) -> Optional[GuardedApproach]:
+    """The guarded approach the trials run with (None: not guarded), its touch clear of the
+    tracker's noise."""
+    return GuardedApproach.for_tracker_noise(*batch.spreads.tracker_noise) if batch.guarded else None
+
+
 def run_trial(batch: Batch, trial: int) -> dict:
     """Run trial `trial` and return its record. A trial whose arm faults is recorded with cause
     `arm_fault`, one that raises anything else as `crash` (`error` says what); neither ends the
@@ -86,8 +95,8 @@ def run_trial(batch: Batch, trial: int) -> dict:
         with running_sim_arm(log=lambda text: None, deviation=deviation_of(batch, world),
                              engine=batch.engine) as server:
             report = execute_plan(batch.task, batch.plan, server.host, server.port, rate_hz=RATE_HZ, pace=False,
-                                  ack_timeout=SIM_ACK_TIMEOUT, closed_loop=loop, success_tolerance=batch.tolerance,
-                                  record=recording)
+                                  ack_timeout=SIM_ACK_TIMEOUT, closed_loop=loop, guard=guard_of(batch),
+                                  success_tolerance=batch.tolerance, record=recording)
         record.update(final_error=report.final_error, goal_error=report.goal_error,
                       replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
                       cause=report.verdict.cause if report.verdict else None,
@@ -185,6 +194,7 @@ class Evaluation:
             "successes": successes, "success_rate": successes / n if n else None,
             "ci95": list(wilson_interval(successes, n)) if n else None,
             "tolerance": list(self.batch.tolerance), "closed_loop": self.batch.closed_loop,
+            "guarded": self.batch.guarded,
             "engine": self.batch.engine, "seed": self.batch.seed,
             "plan_uncertainty": dict(self.batch.task.uncertainty),
             "vary": dict(self.batch.spreads.vary), "feature_error": list(self.batch.spreads.feature_error),

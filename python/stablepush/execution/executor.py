@@ -19,8 +19,9 @@ import numpy as np
 
 from stablepush.errors import ArmFault
 from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan
+from stablepush.execution.guard import GuardedApproach, found_feature, from_touch, offset_along_approach_mm
 from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
-from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from
+from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from, past_touch
 from stablepush.execution.verdict import Verdict, judge, within
 from stablepush.execution.verdict import success_tolerance as judged_with
 from stablepush.execution.world import Feature, place_features, scene_description
@@ -58,7 +59,9 @@ class ContactRecord:
     """How one stay on a feature went, measured in the world at the middle of the pusher's segment:
     `carried_mm`, how far the object rode with the hand into the push before the feature stopped
     it (a feature that far beyond its place along the push), and `slip_mm` / `slip_deg`, its motion
-    after that, while the pusher pushed (zero when the pusher stuck)."""
+    after that, while the pusher pushed (zero when the pusher stuck). `found_mm`: where the guarded
+    approach (guard.py) found the feature, mm beyond its place along the approach (negative: short
+    of it); None when the approach was not guarded or met nothing within its reach."""
 
     pusher: str
     first_step: int
@@ -67,6 +70,7 @@ class ContactRecord:
     slip_deg: Optional[float] = None
     carried_mm: Optional[float] = None
     feature_met: Optional[bool] = None  # False: the object rode with the hand through the whole contact
+    found_mm: Optional[float] = None
 
 
 @dataclass
@@ -88,6 +92,7 @@ class ExecutionReport:
     sim_steps_per_s: Optional[float] = None
     # "off", "on", or "no tracker" (closed loop asked for, but the arm reports no object_in_grasp)
     closed_loop: str = "off"
+    guard: str = "off"  # the guarded approach (guard.py): "off", "on", or "no tracker"
     replans: List[Replan] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)  # execution_warnings(task)
     engine: Optional[str] = None  # the simulator that ran it, as the arm server says ("mujoco"); None for an arm
@@ -146,7 +151,7 @@ class ExecutionReport:
             "release_moved": self.release_moved, "warnings": list(self.warnings),
             "contacts": [c.__dict__ for c in self.contacts], "features": self.features,
             "wall_time_s": self.wall_time_s, "sim_steps_per_s": self.sim_steps_per_s,
-            "closed_loop": self.closed_loop, "replans": [r.as_dict() for r in self.replans],
+            "closed_loop": self.closed_loop, "guard": self.guard, "replans": [r.as_dict() for r in self.replans],
         }
 
 
@@ -194,6 +199,7 @@ def execute_plan(
     pace: bool = True,
     ack_timeout: float = DEFAULT_ACK_TIMEOUT,
     closed_loop: Optional[ClosedLoop] = None,
+    guard: Optional[GuardedApproach] = GuardedApproach(),
     success_tolerance: Optional[Sequence[float]] = None,
     progress: Optional[Callable[[ArmWaypoint, int, int], None]] = None,
     record: Optional[Callable[[ArmWaypoint, dict, Optional[str]], None]] = None,
@@ -205,7 +211,8 @@ def execute_plan(
     threshold, the rest of the run is re-planned from the measured pose and spliced into the stream
     (`stablepush.closed_loop`), and a plan that ends outside the loop's final tolerance is planned
     again to it first (`closed_loop.aim`); the world then holds a feature for every pusher of the
-    task. The report's verdict judges the final pose with
+    task. With `guard`, each approach ends by finding its feature by touch (guard.py; None: the
+    approaches end where the plan puts the features). The report's verdict judges the final pose with
     `success_tolerance` (mm, deg; default: the task's goal tolerance). `progress(waypoint,
     confirmed_step, total_steps)` is called per ack, and `record(waypoint, state, pusher)` with the
     arm's state and the pusher in contact (None between contacts; `bags.RunRecording`). `plan`: a
@@ -223,6 +230,11 @@ def execute_plan(
     scene = scene_description(task, features, steps[resume_from].pose)
     last_confirmed = resume_from
     loop_status = "off" if closed_loop is None else "on"
+    guard_status = "off" if guard is None else "on"
+    guard_from: Optional[dict] = None  # the pose in the grasp as the approach's slow end began
+    sought_past = False  # whether this approach has gone on past the plan's touch
+    holding = False  # the feature has met the object: held still before it is measured
+    found: Dict[int, float] = {}  # contact's first step -> where its feature was found (mm)
     link = None
     try:
         link = _Link(host, port, ack_timeout)
@@ -241,6 +253,11 @@ def execute_plan(
         next_time = time.perf_counter()
         while pending:
             w = pending.popleft()
+            if w.guarded and guard_from is None and guard_status == "on":
+                if "object_in_grasp" in state:
+                    guard_from = state["object_in_grasp"]
+                else:
+                    guard_status = "no tracker"  # the cell reports no pose in the grasp: approach as planned
             if pace:
                 next_time += 1.0 / rate_hz
                 time.sleep(max(0.0, next_time - time.perf_counter()))
@@ -267,7 +284,29 @@ def execute_plan(
                 record(w, state, steps[w.step].pusher if w.phase == "push" else None)
             if w.completes:
                 last_confirmed = w.step
-                _record(contacts, task, steps, w.step, touch_state, met_state, state)
+                _record(contacts, task, steps, w.step, touch_state, met_state, state, found)
+            if w.guarded and guard_from is not None:
+                k, pusher = w.step, steps[w.step + 1].pusher
+                if holding:
+                    if not (pending and pending[0].guarded):  # held still: the object rests on the feature
+                        # The contact's pushes start from where the object is, on the feature where it is.
+                        measured = _measured(steps[k].pose, state["object_in_grasp"])
+                        on_feature = found_feature(features[pusher], state["ee_pose"], measured)
+                        found[k] = offset_along_approach_mm(features[pusher], on_feature)
+                        features[pusher] = on_feature
+                        steps = from_touch(steps, k, measured)
+                        pending = _renumbered(w, rate_hz, arm_trajectory(task, steps, features, rate_hz,
+                                                                         state["ee_pose"], resume_from=k,
+                                                                         resting_on=pusher))
+                        guard_from, holding = None, False
+                elif guard.met(guard_from, state["object_in_grasp"]):  # met: hold still, then measure
+                    holding = True
+                    pending = _renumbered(w, rate_hz, [w] * max(1, round(guard.hold_s * rate_hz)))
+                elif not (pending and pending[0].guarded) and not sought_past:
+                    # The plan's touch reached with nothing met: the feature is beyond its place.
+                    sought_past = True
+                    pending = _renumbered(w, rate_hz, past_touch(features[pusher], w.pose, guard.reach_mm * MM,
+                                                                 rate_hz, k, [s.pose for s in steps]) + list(pending))
             # Compare when the object has come onto a feature, after each push but the last, and
             # once the object has come to rest after it.
             at_rest = w.phase == "settle" and not (pending and pending[0].phase == "settle")
@@ -280,10 +319,12 @@ def execute_plan(
                                        judged_with(task, success_tolerance), touched)
                     if spliced is not None:
                         steps, new_points = spliced
-                        pending = deque(dataclasses.replace(p, seq=w.seq + 1 + p.seq, t=w.t + p.t) for p in new_points)
+                        pending = _renumbered(w, rate_hz, new_points)
             if w.phase != "push":
                 touch_state = met_state = None
                 rode = False
+            if not w.guarded and w.phase != "approach":
+                guard_from, sought_past, holding = None, False, False
             if w.phase == "settle":
                 settled = state
             if progress is not None:
@@ -302,7 +343,8 @@ def execute_plan(
         final_in_grasp=(settled or state).get("object_in_grasp"), released_in_grasp=state.get("object_in_grasp"),
         contacts=list(contacts.values()), features=[f.as_dict() for f in features.values()],
         wall_time_s=time.perf_counter() - started, sim_steps_per_s=state.get("steps_per_s"),
-        closed_loop=loop_status, replans=replans, warnings=execution_warnings(task), engine=ready.get("engine"),
+        closed_loop=loop_status, guard=guard_status, replans=replans, warnings=execution_warnings(task),
+        engine=ready.get("engine"),
     )
     report.verdict = judge(task, report, success_tolerance, closed_loop.max_replans if closed_loop else None)
     return report
@@ -340,9 +382,7 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     limit = loop.final_tolerance if last or final_contact else loop.threshold
     if not loop.off_by(tracked, task.goal if last else steps[k].pose, limit):
         return None
-    # The tracker's theta on the plan's turn (a plan may run past +-180 deg; a tracker reports one turn).
-    theta = steps[k].pose[2] + angle_difference_deg(float(tracked["theta"]), steps[k].pose[2])
-    measured = (float(tracked["x"]), float(tracked["z"]), theta)
+    measured = _measured(steps[k].pose, tracked)
     record, new_steps = replan(task, measured, pusher, loop, k, steps[k].pose,
                                trigger="off_goal" if last else "on_touch" if touched else "off_plan",
                                verdict_at_stake=last and not within(tracked, task.goal, success_tolerance))
@@ -354,6 +394,19 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     spliced = steps[:k] + [Waypoint(*measured, pusher=steps[k].pusher)] + new_steps[1:]
     points = arm_trajectory(task, spliced, features, rate_hz, state["ee_pose"], resume_from=k, resting_on=pusher)
     return spliced, points
+
+
+def _measured(planned: Sequence[float], tracked: dict) -> tuple:
+    """The tracker's pose in the grasp (x mm, z mm, theta deg) with theta on the planned pose's turn (a
+    plan may run past +-180 deg; a tracker reports one turn)."""
+    theta = planned[2] + angle_difference_deg(float(tracked["theta"]), planned[2])
+    return float(tracked["x"]), float(tracked["z"]), theta
+
+
+def _renumbered(w: ArmWaypoint, rate_hz: float, points: Sequence[ArmWaypoint]) -> deque:
+    """`points` streamed next after `w`: seq and t counted on from it."""
+    period = 1.0 / rate_hz
+    return deque(dataclasses.replace(p, seq=w.seq + 1 + i, t=w.t + (i + 1) * period) for i, p in enumerate(points))
 
 
 def _expect(message: dict, kind: str) -> dict:
@@ -400,7 +453,7 @@ def _rode_with_hand(task: Task, pusher: str, before: dict, after: dict) -> Optio
 
 
 def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Waypoint], step: int,
-            touch_state: Optional[dict], met_state: Optional[dict], state: dict) -> None:
+            touch_state: Optional[dict], met_state: Optional[dict], state: dict, found: Dict[int, float]) -> None:
     """Update the record of the contact that plan step `step` belongs to with the object's motion in
     the world since it came onto the feature by the plan (`touch_state`): up to where the feature
     stopped it (`met_state`; None: not yet) it was carried, after that it slipped (when the arm
@@ -411,6 +464,7 @@ def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Wayp
         first -= 1
     record = contacts.setdefault(first, ContactRecord(pusher, first, step))
     record.last_step = step
+    record.found_mm = found.get(first - 1)  # keyed by the pose the contact starts from
     if touch_state is None or "object_pose" not in state or "object_pose" not in touch_state:
         return
     point = _pusher_point(task, pusher)

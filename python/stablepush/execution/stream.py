@@ -9,7 +9,10 @@ grasp (docs/model.md section 1), G's world pose is
 Between two contacts the gripper retracts the object from the feature along the pusher's inward
 normal, moves it along y into a lane between features (lifting it over everything first when the
 lanes differ), brings it opposite the next feature and approaches until the pusher's segment
-touches. Poses are (x, y, z, qw, qx, qy, qz) in W [m].
+touches. The approach's last GUARD_SPAN runs at GUARD_SPEED, slow enough that the executor sees the
+feature meet the object within a few hundredths of a millimetre and starts the contact's pushes
+from there (guard.py): a feature off its place along the approach is found, not pushed.
+Poses are (x, y, z, qw, qx, qy, qz) in W [m].
 """
 from __future__ import annotations
 
@@ -20,7 +23,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from stablepush.errors import PlanError
-from stablepush.execution.world import Feature, contacts_of
+from stablepush.execution.world import GUARD_SPAN, Feature, contacts_of, near_pose
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, slerp, translation
 from stablepush.plan.plan import Waypoint
 from stablepush.task.model import Task
@@ -30,6 +33,9 @@ MOVE_SPEED = 0.1  # m/s of G between contacts
 TURN_SPEED = math.radians(60)  # rad/s of G between contacts
 SETTLE_TIME = 0.2  # s held still at the end of the last push, before the final retract
 LIFT_MARGIN = 0.02  # m above every feature when the object changes lanes
+# The guarded end of each approach (world.GUARD_SPAN, guard.py) runs at this speed: 0.02 mm of G's
+# travel a waypoint at 100 Hz.
+GUARD_SPEED = 2.0e-3  # m/s
 # Samples a trajectory may hold: 50 min of motion at 100 Hz. Each costs tens of microseconds to make
 # and hundreds of bytes to keep, so a longer one is refused before it takes minutes and gigabytes.
 MAX_TRAJECTORY_SAMPLES = 300_000
@@ -50,6 +56,7 @@ class ArmWaypoint:
     phase: str  # push | settle | retract | move | approach
     pose: Tuple[float, ...]
     planned: Optional[Tuple[float, float, float]] = None
+    guarded: bool = False  # part of an approach's slow end, where the executor watches for the touch
 
 
 class _Stream:
@@ -62,7 +69,7 @@ class _Stream:
         self.step = step
         self.planned = [tuple(float(v) for v in pose) for pose in planned]  # each plan step's pose in the grasp
 
-    def _emit(self, T: np.ndarray, phase: str, step: int, completes: bool = False) -> None:
+    def _emit(self, T: np.ndarray, phase: str, step: int, completes: bool = False, guarded: bool = False) -> None:
         if len(self.points) >= MAX_TRAJECTORY_SAMPLES:
             raise PlanError("waypoints", f"the trajectory passes {MAX_TRAJECTORY_SAMPLES} samples "
                                          f"({MAX_TRAJECTORY_SAMPLES * self.period / 60:.0f} min of motion at "
@@ -70,25 +77,27 @@ class _Stream:
                                          f"shorter plan")
         self.points.append(ArmWaypoint(seq=len(self.points), t=(len(self.points) + 1) * self.period, step=step,
                                        completes=completes, phase=phase, pose=tuple(matrix_to_pose(T)),
-                                       planned=self.planned[step]))
+                                       planned=self.planned[step], guarded=guarded))
         self.pose = T
 
-    def move(self, target: np.ndarray, phase: str) -> None:
-        """A straight move of G to `target` with smooth (3s^2 - 2s^3) timing."""
+    def move(self, target: np.ndarray, phase: str, guarded_speed: Optional[float] = None) -> None:
+        """A straight move of G to `target` with smooth (3s^2 - 2s^3) timing, or, with
+        `guarded_speed` [m/s], at that constant speed with its waypoints marked `guarded`."""
         start = self.pose
         distance = float(np.linalg.norm(target[:3, 3] - start[:3, 3]))
         q0 = np.array(matrix_to_pose(start)[3:])
         q1 = np.array(matrix_to_pose(target)[3:])
         angle = 2 * math.acos(min(1.0, abs(float(np.dot(q0, q1)))))
-        duration = max(distance / MOVE_SPEED, angle / TURN_SPEED)
+        duration = max(distance / (guarded_speed or MOVE_SPEED), angle / TURN_SPEED)
         if duration < 1e-9:
             return
         n = max(1, math.ceil(duration / self.period))
         for i in range(1, n + 1):
             s = i / n
-            s = s * s * (3 - 2 * s)
+            if guarded_speed is None:
+                s = s * s * (3 - 2 * s)
             T = pose_to_matrix([*(start[:3, 3] + s * (target[:3, 3] - start[:3, 3])), *slerp(q0, q1, s)])
-            self._emit(T, phase, self.step)
+            self._emit(T, phase, self.step, guarded=guarded_speed is not None)
 
     def push(self, T_WO: np.ndarray, q0, q1, duration: float, step: int, come_to_rest: bool = False) -> None:
         """One unit push: q moves from q0 to q1 over `duration` while the object stays at T_WO, at
@@ -149,8 +158,12 @@ def arm_trajectory(
         feature = features[contact.pusher]
         q_first = steps[first].pose
         touching = feature.object_pose @ np.linalg.inv(grasp_transform(q_first))
-        if _near(stream.pose, touching):
-            stream.move(touching, "approach")  # already there, up to the arm's tracking error
+        guarded_from = translation(feature.normal * min(GUARD_SPAN, retract)) @ touching
+        if near_pose(stream.pose, touching) and current is not None:
+            stream.move(touching, "approach")  # resting on it, up to the arm's tracking error
+        elif current is None and (near_pose(stream.pose, touching) or near_pose(stream.pose, guarded_from)):
+            stream.move(guarded_from, "approach")  # the run starts at this feature (scene_description)
+            stream.move(touching, "approach", guarded_speed=GUARD_SPEED)
         else:
             approach = translation(feature.normal * retract) @ touching
             if current is not None:
@@ -164,7 +177,8 @@ def arm_trajectory(
                 stream.move(_with(stream.pose, y=target_lane), "move")
             stream.move(_with(approach, y=target_lane), "move")
             stream.move(approach, "approach")
-            stream.move(touching, "approach")
+            stream.move(guarded_from, "approach")
+            stream.move(touching, "approach", guarded_speed=GUARD_SPEED)
         for i in range(first + 1, contact.last + 1):
             stream.push(feature.object_pose, steps[i - 1].pose, steps[i].pose, task.step_time, i,
                         come_to_rest=i == contact.last)
@@ -175,9 +189,17 @@ def arm_trajectory(
     return stream.points
 
 
-def _near(a: np.ndarray, b: np.ndarray, distance: float = 1e-3, angle: float = math.radians(0.5)) -> bool:
-    cos = (np.trace(a[:3, :3].T @ b[:3, :3]) - 1) / 2
-    return np.linalg.norm(a[:3, 3] - b[:3, 3]) < distance and cos > math.cos(angle)
+def past_touch(feature: Feature, touching: Sequence[float], reach: float, rate_hz: float, step: int,
+               planned: Sequence[Sequence[float]]) -> List[ArmWaypoint]:
+    """The guarded approach carried on past the plan's touch (`touching`, G's pose there), for a
+    feature beyond its place: up to `reach` [m] further along the approach at GUARD_SPEED, then
+    back to the plan's touch if nothing was met (the contact's pushes, streamed after these, start
+    there). `step`: the plan step the object is at; `planned`: every plan step's pose in the grasp."""
+    start = pose_to_matrix(touching)
+    stream = _Stream(rate_hz, start, step, planned)
+    stream.move(translation(-feature.normal * reach) @ start, "approach", guarded_speed=GUARD_SPEED)
+    stream.move(start, "approach")
+    return stream.points
 
 
 def _with(T: np.ndarray, **coordinate) -> np.ndarray:

@@ -19,6 +19,11 @@ from stablepush.plan.plan import Waypoint
 from stablepush.task.model import Task
 from stablepush.units import MM, mm2_to_si
 
+# The guarded end of every approach to a feature (stream.py, guard.py): it starts this far short of
+# where the plan puts the feature, to find one placed up to half a millimetre and half a degree off
+# before it pushes the object. A run whose object touches a feature at home starts this far back.
+GUARD_SPAN = 1.0e-3  # m
+
 
 @dataclass(frozen=True)
 class Feature:
@@ -112,9 +117,14 @@ def station_offset(k: int) -> int:
 
 def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float]) -> dict:
     """What a simulated arm needs to build the world (SI units): the object, the gripper, gravity,
-    the features, G's home pose and the object's pose when the run starts (`in_grasp`, mm/deg)."""
+    the features, G's pose when the run starts (home, or GUARD_SPAN back from a feature the object
+    would touch there) and the object's pose then (`in_grasp`, mm/deg)."""
     body = task.rigid_body()
     home = translation(np.asarray(task.environment["home"], float) * MM)
+    for feature in features.values():  # start clear of a feature the plan starts on: the run finds it
+        if near_pose(home, feature.object_pose @ np.linalg.inv(grasp_transform(in_grasp))):
+            home = translation(feature.normal * GUARD_SPAN) @ home
+            break
     return {
         "task": task.name,
         "gravity": list(task.gravity),
@@ -129,3 +139,9 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequen
     }
 
 
+
+
+def near_pose(a: np.ndarray, b: np.ndarray, distance: float = 1e-3, angle: float = math.radians(0.5)) -> bool:
+    """Whether two poses of G (4x4, m) lie within `distance` [m] and `angle` [rad] of each other."""
+    cos = (np.trace(a[:3, :3].T @ b[:3, :3]) - 1) / 2
+    return bool(np.linalg.norm(a[:3, 3] - b[:3, 3]) < distance and cos > math.cos(angle))

@@ -1,0 +1,104 @@
+"""The guarded approach: find each feature by touch rather than trust where the plan put it.
+
+A feature off its place along the approach either pushes the object in the grasp before the
+contact's first push (met early) or lets it ride with the hand into it (met late); every push of
+the contact then carries that error to the goal, where the pusher cannot push it back (the
+hexagon's and the tilted-gravity offset's misses, docs/evaluate.md). So the approach ends slowly
+(world.GUARD_SPAN at stream.GUARD_SPEED) and the executor watches the tracker's pose of the object
+in the grasp there: the feature has met the object when that pose has moved past `touch_mm` or
+`touch_deg` since the slow end began. The contact's pushes then start from the measured pose with
+the feature where it was found (G's pose times the measured pose in the grasp), so they move the
+object in the grasp as planned wherever the feature stands. A feature not met by the plan's touch
+is sought up to `reach_mm` beyond it, as slowly; not met there, the contact runs as planned.
+
+The guard reads the same tracker field as the closed loop (`object_in_grasp`, protocol.py) and
+re-plans nothing; a cell without a tracker approaches as planned. Poses in the grasp are
+(x mm, z mm, theta deg).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import List, Mapping, Sequence
+
+import numpy as np
+
+from stablepush.execution.world import Feature
+from stablepush.frames import grasp_transform, pose_to_matrix
+from stablepush.plan.plan import Waypoint
+from stablepush.units import MM, angle_difference_deg
+
+# Valid ranges of the guard's parameters (mm, deg). A touch threshold below the tracker's noise fires
+# on noise; the reach is travel into where the plan says a feature is, so it stays short.
+GUARD_PARAMETER_RANGES = {"touch_mm": (0.001, 0.5), "touch_deg": (0.001, 0.5), "reach_mm": (0.0, 2.0),
+                          "hold_s": (0.0, 1.0)}
+
+
+@dataclass(frozen=True)
+class GuardedApproach:
+    """When the tracker says the feature has met the object (`touch_mm`, `touch_deg`: the pose in
+    the grasp moved past either since the approach's slow end began; 0.02 mm of the pivot's
+    1 mm unit push), and how far past the plan's touch to seek a feature not met by then
+    (`reach_mm`: features placed up to 0.5 mm off, turned up to 0.5 deg over a 30 mm face)."""
+
+    touch_mm: float = 0.01
+    touch_deg: float = 0.02
+    reach_mm: float = 0.8
+    hold_s: float = 0.05
+
+    def __post_init__(self):
+        for name, (low, high) in GUARD_PARAMETER_RANGES.items():
+            value = getattr(self, name)
+            if not low <= value <= high:
+                raise ValueError(f"guard {name} must lie in [{low:g}, {high:g}], got {value!r}")
+
+    @classmethod
+    def for_tracker_noise(cls, noise_mm: float = 0.0, noise_deg: float = 0.0) -> "GuardedApproach":
+        """The default guard with its touch thresholds no lower than four standard deviations of the
+        tracker's noise (mm, deg), so that noise alone does not read as a touch."""
+        default = cls()
+        return cls(touch_mm=max(default.touch_mm, 4 * noise_mm), touch_deg=max(default.touch_deg, 4 * noise_deg))
+
+    def met(self, before: Mapping[str, float], now: Mapping[str, float]) -> bool:
+        """Whether the object has moved in the grasp from `before` to `now` past the touch threshold."""
+        moved = math.hypot(float(now["x"]) - float(before["x"]), float(now["z"]) - float(before["z"]))
+        turned = abs(angle_difference_deg(float(now["theta"]), float(before["theta"])))
+        return moved > self.touch_mm or turned > self.touch_deg
+
+
+def found_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
+    """The feature where it met the object: the object's world position there, G's world pose
+    `ee_pose` times the measured pose in the grasp `in_grasp` (x mm, z mm, theta deg), with the
+    world orientation the plan gives it on the feature. The measured orientation holds the arm's
+    tracking error of the moment (a tenth of a degree), and the pushes would then hold the object
+    that far off flush with the feature: it turns in the grasp by as much as it seats."""
+    T_WO = feature.object_pose.copy()
+    T_WO[:3, 3] = (pose_to_matrix(ee_pose) @ grasp_transform(in_grasp))[:3, 3]
+    return replace(feature, object_pose=T_WO)
+
+
+def from_touch(steps: Sequence[Waypoint], k: int, measured: Sequence[float]) -> List[Waypoint]:
+    """The plan with its contact from step k starting at the pose measured at the touch: the
+    difference from the plan's pose k is taken out in equal parts over the contact's pushes, so that
+    the contact still ends where the plan does. The guard's touch has pushed the object a few
+    hundredths of a millimetre along the approach, and a first push asked to undo all of it at once
+    asks the feature to pull (the pivot's first push, a pure turn, then turned the object with the
+    hand and lost 0.37 deg)."""
+    last = k + 1
+    while last + 1 < len(steps) and steps[last + 1].pusher == steps[k + 1].pusher:
+        last += 1
+    d = [measured[0] - steps[k].pose[0], measured[1] - steps[k].pose[1], measured[2] - steps[k].pose[2]]
+    out = list(steps[:k]) + [Waypoint(*measured, pusher=steps[k].pusher)]
+    for i in range(k + 1, last):
+        share = (last - i) / (last - k)
+        out.append(replace(steps[i], x=steps[i].x + share * d[0], z=steps[i].z + share * d[1],
+                           theta=steps[i].theta + share * d[2]))
+    return out + list(steps[last:])
+
+
+def offset_along_approach_mm(planned: Feature, found: Feature) -> float:
+    """How far beyond its place (positive) or short of it (negative) the feature was found, along
+    the approach (against the pusher's inward normal), at the object's origin [mm]."""
+    shift = found.object_pose[:3, 3] - planned.object_pose[:3, 3]
+    return float(-np.dot(planned.normal, shift)) / MM
+

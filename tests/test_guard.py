@@ -1,0 +1,44 @@
+"""The guarded approach's parts (stablepush.execution.guard): when a touch is read, and how a
+contact's plan starts from the pose measured at the touch. End to end on the simulated arm:
+tests/test_execute.py."""
+import pytest
+
+from stablepush.execution.guard import GuardedApproach, from_touch
+from stablepush.plan import Waypoint
+
+
+def test_a_touch_is_a_move_in_the_grasp_past_either_threshold():
+    guard = GuardedApproach(touch_mm=0.01, touch_deg=0.02)
+    at = {"x": 1.0, "z": 2.0, "theta": 179.995}
+    assert not guard.met(at, {"x": 1.006, "z": 2.006, "theta": 179.995})  # 0.0085 mm
+    assert guard.met(at, {"x": 1.008, "z": 2.008, "theta": 179.995})  # 0.0113 mm
+    assert guard.met(at, {"x": 1.0, "z": 2.0, "theta": -179.98})  # 0.025 deg across +-180
+    assert not guard.met(at, {"x": 1.0, "z": 2.0, "theta": -179.999})
+
+
+@pytest.mark.parametrize("field, value", [("touch_mm", 0.0), ("touch_deg", -1.0), ("reach_mm", 5.0),
+                                          ("hold_s", 2.0)])
+def test_guard_parameters_outside_their_ranges_are_refused_by_name(field, value):
+    with pytest.raises(ValueError, match=field):
+        GuardedApproach(**{field: value})
+
+
+def test_touch_thresholds_stay_clear_of_the_trackers_noise():
+    assert GuardedApproach.for_tracker_noise() == GuardedApproach()
+    guard = GuardedApproach.for_tracker_noise(0.05, 0.001)
+    assert guard.touch_mm == pytest.approx(0.2) and guard.touch_deg == GuardedApproach().touch_deg
+
+
+def test_a_contact_starts_from_the_measured_pose_and_still_ends_where_the_plan_does():
+    """Contact 'a' runs steps 1-4 from step 0; the touch measured (0.04, -0.02, 0.1) off step 0's pose
+    is taken out in equal parts over its four pushes. Contact 'b' is left alone."""
+    steps = [Waypoint(0.0, 0.0, 0.0)] + [Waypoint(float(i), 0.0, 0.0, pusher="a") for i in range(1, 5)] + \
+        [Waypoint(4.0, float(i), 0.0, pusher="b") for i in range(1, 3)]
+    out = from_touch(steps, 0, (0.04, -0.02, 0.1))
+    assert out[0].pose == (0.04, -0.02, 0.1) and out[0].pusher is None
+    for i, share in zip(range(1, 5), (0.75, 0.5, 0.25, 0.0)):
+        assert out[i].pose == pytest.approx((i + 0.04 * share, -0.02 * share, 0.1 * share))
+        assert out[i].pusher == "a"
+    assert out[5:] == steps[5:] and len(out) == len(steps)
+    later = from_touch(steps, 4, (4.0, 0.01, 0.0))  # contact 'b' from step 4
+    assert later[:4] == steps[:4] and later[5].pose == pytest.approx((4.0, 1.005, 0.0)) and later[6] == steps[6]
