@@ -16,8 +16,19 @@ def test_a_touch_is_a_move_in_the_grasp_past_either_threshold():
     assert not guard.met(at, {"x": 1.0, "z": 2.0, "theta": -179.999})
 
 
+def test_a_touch_is_read_from_the_contact_force_when_the_arm_reports_one():
+    """A wrist force-torque reading tells the touch before the object moves in the grasp; the
+    tracker's pose then does not count."""
+    guard = GuardedApproach(touch_n=0.5)
+    at = {"x": 0.0, "z": 0.0, "theta": 0.0}
+    moved = {"x": 0.5, "z": 0.0, "theta": 0.0}
+    assert not guard.met(at, moved, [0.3, 0.0, -0.3])  # 0.42 N
+    assert guard.met(at, at, [0.0, 0.1, 0.6])  # 0.61 N
+    assert guard.met(at, moved, None)
+
+
 @pytest.mark.parametrize("field, value", [("touch_mm", 0.0), ("touch_deg", -1.0), ("reach_mm", 5.0),
-                                          ("hold_s", 2.0)])
+                                          ("hold_s", 2.0), ("touch_n", 0.0)])
 def test_guard_parameters_outside_their_ranges_are_refused_by_name(field, value):
     with pytest.raises(ValueError, match=field):
         GuardedApproach(**{field: value})

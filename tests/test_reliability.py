@@ -377,6 +377,8 @@ def test_the_executor_holds_its_ack_deadline_against_a_trickling_arm(high_mu_run
     ({"ee_pose": [0.4, 0, 0.3, 2, 0, 0, 0]}, "state.ee_pose: the quaternion is not of unit length"),
     ({"ee_pose": [0.4, 0, 0.3, 1, 0, 0, 0], "object_in_grasp": {"x": 0, "z": 0, "theta": 1e17}},
      "object_in_grasp must have"),
+    ({"ee_pose": [0.4, 0, 0.3, 1, 0, 0, 0], "contact_force": [0, 0]}, "state.contact_force must be 3 finite"),
+    ({"ee_pose": [0.4, 0, 0.3, 1, 0, 0, 0], "contact_force": [0, 1e9, 0]}, "state.contact_force must be 3 finite"),
 ])
 def test_bad_arm_states_end_in_an_arm_fault_and_a_stop(high_mu_run, state, says):
     task, plan, _ = high_mu_run

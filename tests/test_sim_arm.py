@@ -28,7 +28,7 @@ def _ledge_force(task, speed=0.01, duration=1.0, engine="mujoco"):
     start = task.start
     steps = [Waypoint(*start), Waypoint(*start, pusher="bottom")]
     features = place_features(task, steps)
-    arm = make_arm(engine, scene_description(task, features, start))
+    arm = make_arm(engine, scene_description(task, features, start, start_clear=False))
     pose = list(arm.state()["ee_pose"])
     z0 = pose[2]
     period = 0.01

@@ -299,7 +299,8 @@ def execute_plan(
                                                                          state["ee_pose"], resume_from=k,
                                                                          resting_on=pusher))
                         guard_from, holding = None, False
-                elif guard.met(guard_from, state["object_in_grasp"]):  # met: hold still, then measure
+                elif guard.met(guard_from, state["object_in_grasp"], state.get("contact_force")):
+                    # met: hold still, then measure
                     holding = True
                     pending = _renumbered(w, rate_hz, [w] * max(1, round(guard.hold_s * rate_hz)))
                 elif not (pending and pending[0].guarded) and not sought_past:

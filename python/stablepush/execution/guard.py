@@ -28,10 +28,10 @@ from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.plan.plan import Waypoint
 from stablepush.units import MM, angle_difference_deg
 
-# Valid ranges of the guard's parameters (mm, deg). A touch threshold below the tracker's noise fires
-# on noise; the reach is travel into where the plan says a feature is, so it stays short.
-GUARD_PARAMETER_RANGES = {"touch_mm": (0.001, 0.5), "touch_deg": (0.001, 0.5), "reach_mm": (0.0, 2.0),
-                          "hold_s": (0.0, 1.0)}
+# Valid ranges of the guard's parameters (mm, deg, N, s). A touch threshold below the sensor's noise
+# fires on noise; the reach is travel into where the plan says a feature is, so it stays short.
+GUARD_PARAMETER_RANGES = {"touch_mm": (0.001, 0.5), "touch_deg": (0.001, 0.5), "touch_n": (0.01, 50.0),
+                          "reach_mm": (0.0, 2.0), "hold_s": (0.0, 1.0)}
 
 
 @dataclass(frozen=True)
@@ -42,6 +42,7 @@ class GuardedApproach:
     (`reach_mm`: features placed up to 0.5 mm off, turned up to 0.5 deg over a 30 mm face)."""
 
     touch_mm: float = 0.01
+    touch_n: float = 0.5
     touch_deg: float = 0.02
     reach_mm: float = 0.8
     hold_s: float = 0.05
@@ -59,8 +60,12 @@ class GuardedApproach:
         default = cls()
         return cls(touch_mm=max(default.touch_mm, 4 * noise_mm), touch_deg=max(default.touch_deg, 4 * noise_deg))
 
-    def met(self, before: Mapping[str, float], now: Mapping[str, float]) -> bool:
-        """Whether the object has moved in the grasp from `before` to `now` past the touch threshold."""
+    def met(self, before: Mapping[str, float], now: Mapping[str, float], force=None) -> bool:
+        """Whether the feature has met the object: the arm's `contact_force` (N) past touch_n when
+        it reports one, else the object moved in the grasp from `before` to `now` past the touch
+        thresholds."""
+        if force is not None:
+            return float(np.linalg.norm(np.asarray(force, float))) > self.touch_n
         moved = math.hypot(float(now["x"]) - float(before["x"]), float(now["z"]) - float(before["z"]))
         turned = abs(angle_difference_deg(float(now["theta"]), float(before["theta"])))
         return moved > self.touch_mm or turned > self.touch_deg

@@ -38,6 +38,10 @@ its deadline for a whole line (a line trickled a byte at a time does not extend 
       object's pose in the grasp as the cell measures it (motion capture, fiducials, tactile
       sensing), in the plan's coordinates. With a sticking pusher this pose is observable, and the
       executor compares it with the plan. A cell without a tracker leaves it out.
+  "contact_force" [fx, fy, fz] N in the world: the force the features exert on the held object, as
+      a wrist force-torque sensor reads it with the held load's weight and inertia compensated. The
+      guarded approach (guard.py) reads a touch from it before the object moves in the grasp; without
+      it, from object_in_grasp. Optional in arm/1 and arm/2 alike.
   "time", "object_pose" (the object's true world pose) and "steps_per_s": from a simulator.
 """
 from __future__ import annotations
@@ -76,6 +80,7 @@ _SERVER_FIELDS = {
 ARM_REACH_M = 10.0
 GRASP_REACH_MM = 10_000.0
 GRASP_TURN_DEG = 3_600.0
+MAX_CONTACT_FORCE_N = 10_000.0
 
 
 class ProtocolError(ValueError):
@@ -125,7 +130,8 @@ def _check_pose(pose: Any, what: str) -> None:
 def _check_state(state: dict, kind: str) -> None:
     """A server's `state`: ee_pose 7 finite numbers within ARM_REACH_M of the base with a unit
     quaternion; object_in_grasp, when given, x, z within GRASP_REACH_MM and theta within
-    GRASP_TURN_DEG. Values past these are a broken arm or tracker, not a pose to plan from."""
+    GRASP_TURN_DEG; contact_force, when given, 3 finite numbers within MAX_CONTACT_FORCE_N. Values
+    past these are a broken arm, tracker or sensor, not a state to act on."""
     _check_pose(state.get("ee_pose"), f"{kind}: state.ee_pose")
     _check_placed(state["ee_pose"], f"{kind}: state.ee_pose")
     tracked = state.get("object_in_grasp")
@@ -136,6 +142,11 @@ def _check_state(state: dict, kind: str) -> None:
                                     and abs(tracked["theta"]) <= GRASP_TURN_DEG):
         raise ProtocolError(f"{kind}: state.object_in_grasp must have |x|, |z| <= {GRASP_REACH_MM:g} mm and "
                             f"|theta| <= {GRASP_TURN_DEG:g} deg")
+    force = state.get("contact_force")
+    if force is not None and not (isinstance(force, list) and len(force) == 3
+                                  and all(is_finite_number(v) and abs(v) <= MAX_CONTACT_FORCE_N for v in force)):
+        raise ProtocolError(f"{kind}: state.contact_force must be 3 finite numbers [fx, fy, fz] within "
+                            f"+-{MAX_CONTACT_FORCE_N:g} N")
     if "object_pose" in state:
         _check_pose(state["object_pose"], f"{kind}: state.object_pose")
         _check_placed(state["object_pose"], f"{kind}: state.object_pose")

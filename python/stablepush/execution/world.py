@@ -115,13 +115,16 @@ def station_offset(k: int) -> int:
     return (k + 1) // 2 if k % 2 else -(k // 2)
 
 
-def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float]) -> dict:
+def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float],
+                      start_clear: bool = True) -> dict:
     """What a simulated arm needs to build the world (SI units): the object, the gripper, gravity,
-    the features, G's pose when the run starts (home, or GUARD_SPAN back from a feature the object
-    would touch there) and the object's pose then (`in_grasp`, mm/deg)."""
+    the features, G's pose when the run starts and the object's pose then (`in_grasp`, mm/deg).
+    G starts at home, or, with `start_clear`, GUARD_SPAN back from a feature the object would touch
+    there, which the run's guarded approach then finds (the executor's world); without it, the
+    object starts on that feature (the friction-fidelity rigs, which load it from the start)."""
     body = task.rigid_body()
     home = translation(np.asarray(task.environment["home"], float) * MM)
-    for feature in features.values():  # start clear of a feature the plan starts on: the run finds it
+    for feature in features.values() if start_clear else ():
         if near_pose(home, feature.object_pose @ np.linalg.inv(grasp_transform(in_grasp))):
             home = translation(feature.normal * GUARD_SPAN) @ home
             break

@@ -235,7 +235,9 @@ class TrackingArm:
 
     def _report(self, time_s: float, joints) -> dict:
         """The arm's state message: G's pose and the joints [rad]; the tracker's `object_in_grasp`,
-        the truth plus the deviation's noise; the object's true world pose."""
+        the truth plus the deviation's noise; `contact_force`, the features' force on the object
+        (N, W), what a wrist force-torque sensor reads with the held load compensated; the
+        object's true world pose."""
         T_g, T_o = self.gripper_matrix(), self.object_matrix()
         tracked = in_grasp(T_g, T_o)
         d = self.deviation
@@ -248,6 +250,8 @@ class TrackingArm:
             "joints": [float(v) for v in joints],
             "object_pose": matrix_to_pose(T_o),
             "object_in_grasp": tracked,
+            "contact_force": [float(v) for v in sum((self.contact_force_on_object(f["pusher"])
+                                                     for f in self.scene["features"]), np.zeros(3))],
             "steps_per_s": round(self.steps_per_second, 1),
         }
 

@@ -90,7 +90,8 @@ class KinematicGrasp:
 
     def __init__(self, task: Task, pushers: Sequence[str] = (), engine: str = DEFAULT_ENGINE):
         steps = [Waypoint(*task.start)] + [Waypoint(*task.start, pusher=name) for name in pushers]
-        self.world = make_grasp(engine, scene_description(task, place_features(task, steps), task.start))
+        self.world = make_grasp(engine, scene_description(task, place_features(task, steps), task.start,
+                                                              start_clear=False))
         self.timestep = self.world.timestep
 
     def step(self, motion: Sequence[float], velocity: Sequence[float]) -> None:
