@@ -105,9 +105,12 @@ def test_trajectory_command_writes_csv_and_json_in_either_quaternion_order(tmp_p
     assert CliRunner().invoke(cli, ["plan", str(task), "-o", str(plan_file), "--quiet"]).exit_code == 0
     out = CliRunner().invoke(cli, ["trajectory", str(plan_file), "--task", str(task), "-o", str(tmp_path / "t.csv")])
     assert out.exit_code == 0, out.output
-    header, first = (tmp_path / "t.csv").read_text().splitlines()[:2]
+    header, *rows = (tmp_path / "t.csv").read_text().splitlines()
     assert header == "t,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz,phase,step"
-    assert first.endswith(",push,1")
+    # The run starts 1 mm back from its first feature and approaches it at 2 mm/s (the guarded approach).
+    approach = [row for row in rows[:60] if row.endswith(",approach,0")]
+    assert rows[0].endswith(",approach,0") and len(approach) == 51 and rows[51].endswith(",push,1")
+    assert float(rows[0].split(",")[8]) == pytest.approx(-0.002, rel=0.05)  # vx, m/s
     out = CliRunner().invoke(cli, ["trajectory", str(plan_file), "--task", str(task), "-o", str(tmp_path / "t.json"),
                                    "--quat", "wxyz", "--rate", "50"])
     assert out.exit_code == 0, out.output
