@@ -538,7 +538,8 @@ def test_a_feature_beyond_its_place_is_blamed_not_the_friction():
     report = _open_loop_in(load_task(TASKS / "more" / "tilted-gravity.yaml"),
                            WorldDeviation(feature_offsets=(("left", -0.48, 0.0, 0.0),)), guarded=False)
     assert report.success is False and report.verdict.cause == "feature_off", report.verdict.detail
-    assert re.search(r"left's feature was met 0\.(4[6-9]|5[0-2]) mm beyond its place", report.verdict.detail)
+    assert re.search(r"left's feature was met late: the object rode with the hand 0\.(4[6-9]|5[0-2]) mm into step 1",
+                     report.verdict.detail)
     left = report.contacts[0]
     assert left.carried_mm == pytest.approx(0.49, abs=0.03) and left.slip_mm < 0.02 and left.found_mm is None
 

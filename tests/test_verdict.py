@@ -61,7 +61,11 @@ def test_a_slipping_pusher_is_the_cause_and_named():
 def test_a_feature_met_beyond_its_place_is_blamed_before_a_slip():
     late = [ContactRecord("left", 1, 20, slip_mm=0.3, slip_deg=0.0, carried_mm=0.45)]
     v = judge(TASK, _report((19.4, 0.0, 0.0), contacts=late))
-    assert v.cause == "feature_off" and "left's feature was met 0.45 mm beyond its place" in v.detail
+    assert v.cause == "feature_off" and "left's feature was met late: the object rode with the hand 0.45 mm into " \
+        "step 1 before it stopped it (its feature beyond its place along the push, or the object moved" in v.detail
+    # Where the guarded approach found that feature, the verdict says so rather than guess.
+    v = judge(TASK, _report((19.4, 0.0, 0.0), contacts=[dataclasses.replace(late[0], found_mm=0.02)]))
+    assert v.cause == "feature_off" and "(the guarded approach found the feature +0.02 mm from its place)" in v.detail
     # Carried no more than half the tolerance (0.25 mm): the slip is the cause again.
     v = judge(TASK, _report((19.4, 0.0, 0.0), contacts=[dataclasses.replace(late[0], carried_mm=0.24)]))
     assert v.cause == "pusher_slipped"

@@ -13,10 +13,11 @@ A miss is given one cause, the first of CAUSES that applies, so a script can act
 - `correction_not_found`: the closed loop was off the plan and found no correction (each re-plan's
   `failure` says why; the plan's own shortfall, found before the first push, is `plan_short`);
 - `corrections_exhausted`: the closed loop made as many corrections as it may and is still off;
-- `feature_off`: a feature stood beyond its place along the push by more than SLIP_FRACTION of
-  the tolerance: the object rode with the hand that far into the push before the feature stopped
-  it, so it ends that much short (the executor's ContactRecord.carried_mm). The fixture, not the
-  friction, is to blame;
+- `feature_off`: the object rode with the hand into a push, before its feature stopped it, by
+  more than SLIP_FRACTION of the tolerance, and ends that much short (the executor's
+  ContactRecord.carried_mm): the feature stood beyond its place along the push (an approach that
+  is not guarded ends where the plan puts it), or the object had moved in the grasp. The fixture,
+  not the pusher's friction, is to blame;
 - `pusher_slipped`: a pusher slipped on its feature by more than SLIP_FRACTION of the tolerance;
 - `plan_short`: the plan itself ends outside the tolerance (the planner's own tolerance is wider);
 - `drift`: none of the above, the error grew without one large slip.
@@ -100,8 +101,12 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
         if worst.feature_met is False:
             return miss("feature_off", f"{worst.pusher}'s feature was not met: the object rode with the hand "
                                        f"{worst.carried_mm:.2f} mm, through steps {worst.first_step}-{worst.last_step}")
-        return miss("feature_off", f"{worst.pusher}'s feature was met {worst.carried_mm:.2f} mm beyond its place: "
-                                   f"the object rode with the hand that far into step {worst.first_step}")
+        where = ("its feature beyond its place along the push, or the object moved in the grasp"
+                 if worst.found_mm is None else
+                 f"the guarded approach found the feature {worst.found_mm:+.2f} mm from its place")
+        return miss("feature_off", f"{worst.pusher}'s feature was met late: the object rode with the hand "
+                                   f"{worst.carried_mm:.2f} mm into step {worst.first_step} before it stopped it "
+                                   f"({where})")
     slipped = [c for c in report.contacts if c.slip_mm is not None
                and (c.slip_mm > SLIP_FRACTION * tol[0] or c.slip_deg > SLIP_FRACTION * tol[1])]
     if slipped:
