@@ -4,10 +4,11 @@ the tasks of data/tasks/more, which nothing was tuned for.
 `--mu-scale` runs each plan again in worlds whose pads' and features' mu differ from the task's.
 
     python3 benchmarks/execute_shipped.py [TASK.yaml ...] [--seed 1] [--mu-scale 1 0.85 1.15] [--closed-loop]
-                                          [--success-tolerance MM DEG] [--engine mujoco drake]
+                                          [--success-tolerance MM DEG] [--engine mujoco drake] [--no-guard]
 
 The verdict column is the run's (stablepush.execution.verdict): landed within the task's goal
-tolerance, or --success-tolerance, or missed and why.
+tolerance, or --success-tolerance, or missed and why. Approaches are guarded (the executor's
+default: each feature found by touch) unless --no-guard.
 """
 import argparse
 import math
@@ -15,6 +16,7 @@ from pathlib import Path
 
 from stablepush.execution import execute_plan
 from stablepush.execution.closed_loop import ClosedLoop
+from stablepush.execution.guard import GuardedApproach
 from stablepush.plan import check_plan, plan_task
 from stablepush.sim.arm import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
@@ -35,7 +37,9 @@ def main() -> None:
                         help="judge each run with this tolerance (default: the task's goal tolerance)")
     parser.add_argument("--engine", nargs="+", choices=ENGINES, default=[DEFAULT_ENGINE],
                         help="the simulated arm's physics engine, one run per engine (default mujoco)")
+    parser.add_argument("--no-guard", action="store_true", help="approaches end where the plan puts each feature")
     args = parser.parse_args()
+    guard = None if args.no_guard else GuardedApproach()
     print("| task | engine | world mu | loop | pushes | contacts | final error mm | final error deg | goal error mm / deg "
           "| re-plans | max slip at pusher mm (deg) | release moves it mm / deg | verdict | sim steps/s | wall s |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -45,13 +49,13 @@ def main() -> None:
         for scale in args.mu_scale:
             for engine in args.engine:
                 _run(task, plan, scale, ClosedLoop.for_task(task) if args.closed_loop else None, args.success_tolerance,
-                     engine)
+                     engine, guard)
 
 
-def _run(task, plan, mu_scale: float, loop, tolerance, engine: str) -> None:
+def _run(task, plan, mu_scale: float, loop, tolerance, engine: str, guard) -> None:
     with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=mu_scale), engine=engine) as server:
         report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop,
-                              success_tolerance=tolerance)
+                              guard=guard, success_tolerance=tolerance)
     err, goal = report.final_error, report.goal_error
     replans = f"{sum(r.solved for r in report.replans)}" + (f" (+{sum(not r.solved for r in report.replans)} failed)"
                                                             if any(not r.solved for r in report.replans) else "")

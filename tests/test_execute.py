@@ -477,7 +477,8 @@ def test_closed_loop_lands_the_pivot_with_its_feature_off_its_place():
     0.38 mm off the pads' centre, about which the plan turns it. Corrections turn it about that centre
     from where it is (planner.pivot_steps) and it lands within 0.5 mm / 0.5 deg; without them every
     correction was refused and it ended 0.41 mm / -0.82 deg off. The first correction is made as
-    the prism comes onto the feature, before the first push."""
+    the prism comes onto the feature, before the first push (with approaches that end where the plan
+    puts the feature: a guarded approach finds it instead)."""
     from stablepush.execution.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
 
@@ -485,7 +486,7 @@ def test_closed_loop_lands_the_pivot_with_its_feature_off_its_place():
     plan = check_plan(task, plan_task(task, seed=1))
     world = WorldDeviation(feature_offsets=(("left", 0.3219, -0.4503, -0.4070),))
     with running_sim_arm(log=lambda text: None, deviation=world) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, guard=None,
                               closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.5, 0.5))
     assert report.success is True, (report.goal_error, report.verdict.detail)
     first = report.replans[0]
@@ -498,7 +499,8 @@ def test_closed_loop_corrects_when_the_last_feature_is_met_early(capsys):
     pushes the prism about 0.5 mm along the push before the first push, below the re-plan
     threshold, and the pushes carry it 0.55 mm past the goal, where the lower-left face cannot push
     it back. Compared when it comes onto the feature, it is re-planned then, with that pusher, and
-    lands within 0.2 mm / 0.2 deg."""
+    lands within 0.2 mm / 0.2 deg. (An approach that is not guarded: a guarded one stops at the
+    feature, test_a_guarded_approach_finds_a_feature_off_its_place_and_the_run_lands.)"""
     from stablepush.execution.closed_loop import ClosedLoop
     from stablepush.sim.arm import WorldDeviation
 
@@ -508,7 +510,7 @@ def test_closed_loop_corrects_when_the_last_feature_is_met_early(capsys):
                            feature_offsets=(("lower-left", 0.4906, 0.3846, 0.1700),
                                             ("bottom", 0.2018, 0.3975, -0.1038)))
     with running_sim_arm(log=lambda text: None, deviation=world) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, guard=None,
                               closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.2, 0.2))
     assert report.success is True, (report.goal_error, report.verdict.detail)
     touch = report.replans[0]

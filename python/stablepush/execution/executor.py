@@ -230,11 +230,7 @@ def execute_plan(
     scene = scene_description(task, features, steps[resume_from].pose)
     last_confirmed = resume_from
     loop_status = "off" if closed_loop is None else "on"
-    guard_status = "off" if guard is None else "on"
-    guard_from: Optional[dict] = None  # the pose in the grasp as the approach's slow end began
-    sought_past = False  # whether this approach has gone on past the plan's touch
-    holding = False  # the feature has met the object: held still before it is measured
-    found: Dict[int, float] = {}  # contact's first step -> where its feature was found (mm)
+    watch = _GuardWatch(guard)
     link = None
     try:
         link = _Link(host, port, ack_timeout)
@@ -253,11 +249,7 @@ def execute_plan(
         next_time = time.perf_counter()
         while pending:
             w = pending.popleft()
-            if w.guarded and guard_from is None and guard_status == "on":
-                if "object_in_grasp" in state:
-                    guard_from = state["object_in_grasp"]
-                else:
-                    guard_status = "no tracker"  # the cell reports no pose in the grasp: approach as planned
+            watch.before(w, state)
             if pace:
                 next_time += 1.0 / rate_hz
                 time.sleep(max(0.0, next_time - time.perf_counter()))
@@ -284,30 +276,10 @@ def execute_plan(
                 record(w, state, steps[w.step].pusher if w.phase == "push" else None)
             if w.completes:
                 last_confirmed = w.step
-                _record(contacts, task, steps, w.step, touch_state, met_state, state, found)
-            if w.guarded and guard_from is not None:
-                k, pusher = w.step, steps[w.step + 1].pusher
-                if holding:
-                    if not (pending and pending[0].guarded):  # held still: the object rests on the feature
-                        # The contact's pushes start from where the object is, on the feature where it is.
-                        measured = _measured(steps[k].pose, state["object_in_grasp"])
-                        on_feature = found_feature(features[pusher], state["ee_pose"], measured)
-                        found[k] = offset_along_approach_mm(features[pusher], on_feature)
-                        features[pusher] = on_feature
-                        steps = from_touch(steps, k, measured)
-                        pending = _renumbered(w, rate_hz, arm_trajectory(task, steps, features, rate_hz,
-                                                                         state["ee_pose"], resume_from=k,
-                                                                         resting_on=pusher))
-                        guard_from, holding = None, False
-                elif guard.met(guard_from, state["object_in_grasp"], state.get("contact_force")):
-                    # met: hold still, then measure
-                    holding = True
-                    pending = _renumbered(w, rate_hz, [w] * max(1, round(guard.hold_s * rate_hz)))
-                elif not (pending and pending[0].guarded) and not sought_past:
-                    # The plan's touch reached with nothing met: the feature is beyond its place.
-                    sought_past = True
-                    pending = _renumbered(w, rate_hz, past_touch(features[pusher], w.pose, guard.reach_mm * MM,
-                                                                 rate_hz, k, [s.pose for s in steps]) + list(pending))
+                _record(contacts, task, steps, w.step, touch_state, met_state, state, watch.found)
+            guarded = watch.after(task, steps, features, w, state, pending, rate_hz)
+            if guarded is not None:
+                steps, pending = guarded
             # Compare when the object has come onto a feature, after each push but the last, and
             # once the object has come to rest after it.
             at_rest = w.phase == "settle" and not (pending and pending[0].phase == "settle")
@@ -324,8 +296,6 @@ def execute_plan(
             if w.phase != "push":
                 touch_state = met_state = None
                 rode = False
-            if not w.guarded and w.phase != "approach":
-                guard_from, sought_past, holding = None, False, False
             if w.phase == "settle":
                 settled = state
             if progress is not None:
@@ -344,7 +314,7 @@ def execute_plan(
         final_in_grasp=(settled or state).get("object_in_grasp"), released_in_grasp=state.get("object_in_grasp"),
         contacts=list(contacts.values()), features=[f.as_dict() for f in features.values()],
         wall_time_s=time.perf_counter() - started, sim_steps_per_s=state.get("steps_per_s"),
-        closed_loop=loop_status, guard=guard_status, replans=replans, warnings=execution_warnings(task),
+        closed_loop=loop_status, guard=watch.status, replans=replans, warnings=execution_warnings(task),
         engine=ready.get("engine"),
     )
     report.verdict = judge(task, report, success_tolerance, closed_loop.max_replans if closed_loop else None)
@@ -358,6 +328,65 @@ def fault_report(task: Task, fault: ArmFault, success_tolerance: Optional[Sequen
     return {"task": task.name, "success": verdict.success, "tolerance": list(verdict.tolerance),
             "cause": verdict.cause, "verdict": verdict.detail, "last_confirmed_step": fault.last_confirmed_step,
             "arm_stopped": fault.arm_stopped, "connected": fault.connected}
+
+
+class _GuardWatch:
+    """The guarded approach through one run (guard.py): from the first waypoint of an approach's
+    slow end, watch for the touch; on it, hold still, then splice in the contact started from the
+    measured pose on the feature where it was found; at the plan's touch with nothing met, seek on
+    past it. `found`: the contact's starting plan step -> where its feature was found (mm)."""
+
+    def __init__(self, guard: Optional[GuardedApproach]):
+        self.guard = guard
+        self.status = "off" if guard is None else "on"  # or "no tracker"
+        self.found: Dict[int, float] = {}
+        self._clear()
+
+    def _clear(self) -> None:
+        self.since: Optional[dict] = None  # the pose in the grasp as the slow end began
+        self.sought_past = False  # this approach has gone on past the plan's touch
+        self.holding = False  # met: held still before the pose is measured
+
+    def before(self, w: ArmWaypoint, state: dict) -> None:
+        """Before waypoint `w` is sent, with the arm's last `state`."""
+        if not w.guarded:
+            if w.phase != "approach":
+                self._clear()
+            return
+        if self.since is None and self.status == "on":
+            if "object_in_grasp" in state:
+                self.since = state["object_in_grasp"]
+            else:
+                self.status = "no tracker"  # no pose in the grasp to start from: approach as planned
+
+    def after(self, task: Task, steps: List[Waypoint], features: Dict[str, Feature], w: ArmWaypoint,
+              state: dict, pending: deque, rate_hz: float):
+        """After the arm acknowledged `w` with `state`: the new (steps, pending waypoints) when the
+        stream changes here, else None. `features` is updated in place with a feature found."""
+        if not w.guarded or self.since is None:
+            return None
+        k, pusher = w.step, steps[w.step + 1].pusher
+        slow_end_left = bool(pending) and pending[0].guarded
+        if self.holding:
+            if slow_end_left:
+                return None
+            # Held still: the contact's pushes start from where the object is, on the feature where it is.
+            measured = _measured(steps[k].pose, state["object_in_grasp"])
+            on_feature = found_feature(features[pusher], state["ee_pose"], measured)
+            self.found[k] = offset_along_approach_mm(features[pusher], on_feature)
+            features[pusher] = on_feature
+            steps = from_touch(steps, k, measured)
+            self.since, self.holding = None, False
+            return steps, _renumbered(w, rate_hz, arm_trajectory(task, steps, features, rate_hz, state["ee_pose"],
+                                                                 resume_from=k, resting_on=pusher))
+        if self.guard.met(self.since, state["object_in_grasp"], state.get("contact_force")):
+            self.holding = True
+            return steps, _renumbered(w, rate_hz, [w] * max(1, round(self.guard.hold_s * rate_hz)))
+        if not slow_end_left and not self.sought_past:  # at the plan's touch, nothing met: seek on past it
+            self.sought_past = True
+            past = past_touch(features[pusher], w.pose, self.guard.reach_mm * MM, rate_hz, k, [s.pose for s in steps])
+            return steps, _renumbered(w, rate_hz, past + list(pending))
+        return None
 
 
 def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
