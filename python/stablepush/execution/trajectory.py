@@ -1,8 +1,10 @@
 """Timed trajectories: the gripper's world poses that carry out a plan, with time, linear and
 angular velocity, phase and plan step (`stablepush trajectory`, `Plan.trajectory`).
 
-They are the executor's stream (stablepush.execution.stream.arm_trajectory) for an arm that starts at the task's
-home pose with every feature placed as the executor places it, sampled at the stream's rate.
+They are the executor's stream (stablepush.execution.stream.arm_trajectory) for an arm that starts where the
+executor's world starts it (the task's home pose, or 1 mm back from a feature the object starts on) with every
+feature placed as the executor places it, sampled at the stream's rate: each approach ends at the
+feature's planned place, as a guarded approach does when the feature stands there.
 World frame W (x forward, y the gripping axis at home, z up), m, s. Velocities are those of G's
 origin and frame over the period that ends at each sample (backward differences), in W:
 v_i = (p_i - p_{i-1}) / dt, omega_i = axis-angle(R_i R_{i-1}^T) / dt.
@@ -81,7 +83,8 @@ class Trajectory:
 
 def timed_trajectory(task: Task, plan: Plan, rate_hz: float = 100.0) -> Trajectory:
     """The executor's stream for a plan checked against the task (stablepush.plan.verify.check_plan),
-    from G at the task's home pose. ValueError unless `rate_hz` lies in the arm protocol's RATE_HZ."""
+    from G where the executor's world starts it (world.scene_description). ValueError unless `rate_hz`
+    lies in the arm protocol's RATE_HZ."""
     if isinstance(rate_hz, bool) or not isinstance(rate_hz, (int, float)) or not RATE_HZ[0] <= rate_hz <= RATE_HZ[1]:
         raise ValueError(f"rate_hz must be a number from {RATE_HZ[0]:g} to {RATE_HZ[1]:g}, got {rate_hz!r:.40}")
     steps = list(plan.waypoints)
