@@ -122,7 +122,7 @@ def _start_sim_arm(*args):
 def test_server_gone_mid_plan_names_the_last_step_and_resume_finishes(high_mu_plan, tmp_path):
     plan, task = high_mu_plan
     runner = CliRunner()
-    process, port = _start_sim_arm("--exit-after", "100")
+    process, port = _start_sim_arm("--exit-after", "150")
     try:
         result = runner.invoke(cli, ["execute", plan, "--task", task, "--arm", f"127.0.0.1:{port}", "--no-pace", "--quiet",
                                      "--json", str(tmp_path / "fault.json")])
@@ -133,7 +133,8 @@ def test_server_gone_mid_plan_names_the_last_step_and_resume_finishes(high_mu_pl
     assert fault["success"] is False and fault["cause"] == "arm_fault" and fault["last_confirmed_step"] == 9
     assert "closed the connection" in result.output
     assert "could not be reached to stop it" in result.output
-    # 99 waypoints were acknowledged: the approach, then 10 per push: 9 pushes confirmed.
+    # 149 waypoints were acknowledged: the guarded approach (51 waypoints, 3 past the plan's touch before
+    # the force reads it, 5 held still: 59), then 10 per push: 9 pushes confirmed.
     step = int(re.search(r"last confirmed step: (\d+) of 20", result.output).group(1))
     assert step == 9
     assert f"--resume-from {step}" in result.output
@@ -213,7 +214,7 @@ class FakeArm:
 def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
     task = shipped("horizontal-offset-high-mu")
     plan = check_plan(task, plan_task(task, seed=1))
-    arm = FakeArm(good=41, bad_reply=bad_reply)  # the approach and 4 pushes
+    arm = FakeArm(good=91, bad_reply=bad_reply)  # the approach's 51 waypoints and 4 pushes of 10
     with pytest.raises(ArmFault) as fault:
         execute_plan(task, plan, "127.0.0.1", arm.port, rate_hz=100.0, pace=False, ack_timeout=5.0)
     assert says in fault.value.reason
