@@ -41,7 +41,8 @@ its deadline for a whole line (a line trickled a byte at a time does not extend 
   "contact_force" [fx, fy, fz] N in the world: the force the features exert on the held object, as
       a wrist force-torque sensor reads it with the held load's weight and inertia compensated. The
       guarded approach (guard.py) reads a touch from it before the object moves in the grasp; without
-      it, from object_in_grasp. Optional in arm/1 and arm/2 alike.
+      it, from object_in_grasp. Optional in arm/1 and arm/2 alike; the simulated arm reports it in
+      the acks of approach waypoints, where the guard reads it.
   "time", "object_pose" (the object's true world pose) and "steps_per_s": from a simulator.
 """
 from __future__ import annotations

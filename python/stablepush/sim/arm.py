@@ -233,9 +233,9 @@ class TrackingArm:
             raise ik.unreachable(pose, self.ik_error)
         self.advance(duration, q)
 
-    def _report(self, time_s: float, joints) -> dict:
+    def _report(self, time_s: float, joints, contact_force: bool) -> dict:
         """The arm's state message: G's pose and the joints [rad]; the tracker's `object_in_grasp`,
-        the truth plus the deviation's noise; `contact_force`, the features' force on the object
+        the truth plus the deviation's noise; with `contact_force`, the features' force on the object
         (N, W), what a wrist force-torque sensor reads with the held load compensated; the
         object's true world pose."""
         T_g, T_o = self.gripper_matrix(), self.object_matrix()
@@ -244,16 +244,18 @@ class TrackingArm:
         if d.tracker_noise_mm > 0 or d.tracker_noise_deg > 0:
             nx, nz, nth = self._tracker_rng.normal(0.0, [d.tracker_noise_mm, d.tracker_noise_mm, d.tracker_noise_deg])
             tracked.update(x=tracked["x"] + nx, z=tracked["z"] + nz, theta=tracked["theta"] + nth)
-        return {
+        report = {
             "time": time_s,
             "ee_pose": matrix_to_pose(T_g),
             "joints": [float(v) for v in joints],
             "object_pose": matrix_to_pose(T_o),
             "object_in_grasp": tracked,
-            "contact_force": [float(v) for v in sum((self.contact_force_on_object(f["pusher"])
-                                                     for f in self.scene["features"]), np.zeros(3))],
             "steps_per_s": round(self.steps_per_second, 1),
         }
+        if contact_force:
+            report["contact_force"] = [float(v) for v in sum((self.contact_force_on_object(f["pusher"])
+                                                              for f in self.scene["features"]), np.zeros(3))]
+        return report
 
 
 class SimArm(TrackingArm, SimulatedGrasp):
@@ -301,7 +303,8 @@ class SimArm(TrackingArm, SimulatedGrasp):
 
     # -- state --------------------------------------------------------------------------------
 
-    def state(self) -> dict:
+    def state(self, contact_force: bool = False) -> dict:
         """What the arm reports: G's pose and the joints; the tracker's `object_in_grasp` (with the
-        deviation's noise); and, as a simulation, the object's true world pose."""
-        return self._report(float(self.data.time), self.data.qpos[self._arm_qpos])
+        deviation's noise); with `contact_force`, the wrist's force reading; and, as a simulation,
+        the object's true world pose."""
+        return self._report(float(self.data.time), self.data.qpos[self._arm_qpos], contact_force)

@@ -411,9 +411,9 @@ class DrakeArm(TrackingArm, DrakeGrasp):
 
     # -- state --------------------------------------------------------------------------------
 
-    def state(self) -> dict:
+    def state(self, contact_force: bool = False) -> dict:
         """What the arm reports, as `arm.SimArm.state` does."""
-        return self._report(float(self.time), self.plant.GetPositions(self.plant_context)[self._arm_q])
+        return self._report(float(self.time), self.plant.GetPositions(self.plant_context)[self._arm_q], contact_force)
 
 
 def _quietly(build):

@@ -153,7 +153,10 @@ class SimArmServer:
                     if self.exit_after is not None and self._waypoints >= self.exit_after:
                         self.log(f"exiting after {self._waypoints} waypoints (--exit-after)")
                         os._exit(3)
-                    reply = {"type": "ack", "seq": message["seq"], "state": self.arm.state()}
+                    # The wrist's force during approaches, where the guarded approach reads it: on Drake
+                    # it costs as much as the step (its contact results), so not on every ack.
+                    reply = {"type": "ack", "seq": message["seq"],
+                             "state": self.arm.state(contact_force=message["phase"] == "approach")}
                 elif kind == "stop":
                     self.arm.stop()
                     reply = {"type": "stopped", "state": self.arm.state()}
