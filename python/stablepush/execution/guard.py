@@ -4,16 +4,17 @@ A feature off its place along the approach either pushes the object in the grasp
 contact's first push (met early) or lets it ride with the hand into it (met late); every push of
 the contact then carries that error to the goal, where the pusher cannot push it back (the
 hexagon's and the tilted-gravity offset's misses, docs/evaluate.md). So the approach ends slowly
-(world.GUARD_SPAN at stream.GUARD_SPEED) and the executor watches the tracker's pose of the object
-in the grasp there: the feature has met the object when that pose has moved past `touch_mm` or
-`touch_deg` since the slow end began. The contact's pushes then start from the measured pose with
-the feature where it was found (G's pose times the measured pose in the grasp), so they move the
-object in the grasp as planned wherever the feature stands. A feature not met by the plan's touch
-is sought up to `reach_mm` beyond it, as slowly; not met there, the contact runs as planned.
+(world.GUARD_SPAN at stream.GUARD_SPEED) and the executor watches for the touch there: the arm's
+`contact_force` past `touch_n` (a wrist force-torque sensor, which tells it before the pads slide),
+or, from an arm that reports no force, the tracker's pose in the grasp moved past `touch_mm` or
+`touch_deg` since the slow end began. The arm holds still `hold_s`, and the contact's pushes then
+start from the measured pose with the feature where it was found (`found_feature`), so they move
+the object in the grasp as planned wherever the feature stands. A feature not met by the plan's
+touch is sought up to `reach_mm` beyond it, as slowly; not met there, the contact runs as planned.
 
-The guard reads the same tracker field as the closed loop (`object_in_grasp`, protocol.py) and
-re-plans nothing; a cell without a tracker approaches as planned. Poses in the grasp are
-(x mm, z mm, theta deg).
+The guard needs the tracker's `object_in_grasp` (protocol.py) to measure where the object is, and
+re-plans nothing; a cell without a tracker approaches as planned. It finds where a feature stands
+along the approach, not how it is turned. Poses in the grasp are (x mm, z mm, theta deg).
 """
 from __future__ import annotations
 
@@ -36,10 +37,12 @@ GUARD_PARAMETER_RANGES = {"touch_mm": (0.001, 0.5), "touch_deg": (0.001, 0.5), "
 
 @dataclass(frozen=True)
 class GuardedApproach:
-    """When the tracker says the feature has met the object (`touch_mm`, `touch_deg`: the pose in
-    the grasp moved past either since the approach's slow end began; 0.02 mm of the pivot's
-    1 mm unit push), and how far past the plan's touch to seek a feature not met by then
-    (`reach_mm`: features placed up to 0.5 mm off, turned up to 0.5 deg over a 30 mm face)."""
+    """When the feature has met the object: `touch_n` [N] of the arm's contact force, or, without
+    one, the pose in the grasp moved `touch_mm` or `touch_deg` since the approach's slow end began
+    (0.01 mm of the pivot's 1 mm unit push); how long to hold still before measuring where the
+    object is (`hold_s` [s]: the arm's lag behind the stream settles); and how far past the plan's
+    touch to seek a feature not met by then (`reach_mm`: features placed up to 0.5 mm off, turned
+    up to 0.5 deg over a 30 mm face)."""
 
     touch_mm: float = 0.01
     touch_n: float = 0.5
@@ -85,10 +88,11 @@ def found_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
 def from_touch(steps: Sequence[Waypoint], k: int, measured: Sequence[float]) -> List[Waypoint]:
     """The plan with its contact from step k starting at the pose measured at the touch: the
     difference from the plan's pose k is taken out in equal parts over the contact's pushes, so that
-    the contact still ends where the plan does. The guard's touch has pushed the object a few
-    hundredths of a millimetre along the approach, and a first push asked to undo all of it at once
-    asks the feature to pull (the pivot's first push, a pure turn, then turned the object with the
-    hand and lost 0.37 deg)."""
+    the contact still ends where the plan does. The object may have moved in the grasp before the
+    touch (a touch read from the tracker pushes it a few hundredths of a millimetre along the
+    approach; the low-mu offset's moved 0.07 mm in a transit between features), and a first push
+    asked to undo all of it at once may ask the feature to pull (the pivot's first push, a pure
+    turn, then turned the object with the hand and lost 0.37 deg)."""
     last = k + 1
     while last + 1 < len(steps) and steps[last + 1].pusher == steps[k + 1].pusher:
         last += 1
