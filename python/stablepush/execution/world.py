@@ -123,10 +123,10 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequen
     there, which the run's guarded approach then finds (the executor's world); without it, the
     object starts on that feature (the friction-fidelity rigs, which load it from the start)."""
     body = task.rigid_body()
-    home = translation(np.asarray(task.environment["home"], float) * MM)
+    start = translation(np.asarray(task.environment["home"], float) * MM)
     for feature in features.values() if start_clear else ():
-        if near_pose(home, feature.object_pose @ np.linalg.inv(grasp_transform(in_grasp))):
-            home = translation(feature.normal * GUARD_SPAN) @ home
+        if near_pose(start, feature.object_pose @ np.linalg.inv(grasp_transform(in_grasp))):
+            start = translation(feature.normal * GUARD_SPAN) @ start
             break
     return {
         "task": task.name,
@@ -136,12 +136,10 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequen
         "gripper": {"grip_force": task.grip_force, "mu": task.mu, "pad_rings": task.pad_rings,
                     "pads": [{"center": [c[0] * MM, c[1] * MM], "radius": r * MM} for c, r in task.pads]},
         "features": [f.as_dict() for f in features.values()],
-        "gripper_pose": matrix_to_pose(home),
-        "object_pose": matrix_to_pose(home @ grasp_transform(in_grasp)),
+        "gripper_pose": matrix_to_pose(start),
+        "object_pose": matrix_to_pose(start @ grasp_transform(in_grasp)),
         "object_in_grasp": list(in_grasp),
     }
-
-
 
 
 def near_pose(a: np.ndarray, b: np.ndarray, distance: float = 1e-3, angle: float = math.radians(0.5)) -> bool:
