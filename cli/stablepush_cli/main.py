@@ -622,9 +622,10 @@ def _host_port(value: str):
                    "feature, --final-tolerance) re-plan from the measured pose and continue with the new plan. "
                    "An arm that reports no tracked pose runs open loop (and says so).")
 @click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
-              help="End each approach slowly and find the feature by touch, from the arm's tracked pose in the "
-                   "grasp, then push from where it was found (a feature off its place is found, not pushed into "
-                   "or missed). An arm that reports no tracked pose approaches as planned (and says so).")
+              help="End each approach slowly and find the feature by touch (the arm's contact force, else its "
+                   "tracked pose in the grasp), then push from where it was found: a feature off its place is "
+                   "found, not pushed into or missed. An arm that reports no tracked pose approaches as planned "
+                   "(and says so).")
 @click.option("--replan-threshold", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a re-plan "
                                      "(default: half the task's goal tolerance).")
@@ -939,8 +940,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         except OutputError as exc:
             _fail(f"--video-failed {exc}")
     batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
-                  engine=engine,
-                  tolerance=tuple(success_tolerance), video_dir=video_dir, video_fps=video_fps,
+                  engine=engine, tolerance=tuple(success_tolerance), video_dir=video_dir, video_fps=video_fps,
                   video_size=tuple(video_size))
     if not quiet:
         box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
