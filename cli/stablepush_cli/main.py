@@ -648,7 +648,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
 
     The run ends with a verdict: it landed when the object's pose in the grasp is within the task's
     goal tolerance (or --success-tolerance), exit 0; a completed run that missed exits 5 and names
-    its cause (grasp_lost, correction_not_found, corrections_exhausted,
+    its cause (grasp_lost, correction_not_found, corrections_exhausted, feature_off,
     pusher_slipped, plan_short, drift). An arm that reports no pose in the grasp gets no verdict (exit 0).
 
     On a fault (the arm server gone, a malformed or out-of-order reply, an error from the arm) the arm
