@@ -65,11 +65,12 @@ def main() -> None:
                 progress = _progress(f"{task.name} {kind}", f"{loop} {approach}", args.trials)
                 evaluation = evaluate(batch, args.trials, runner, progress=progress)
                 s = evaluation.summary()
-                summaries.append({**s, "plan": kind, "approach": approach, "missed": [t for t in evaluation.trials if not t["success"]]})
+                missed = [t for t in evaluation.trials if not t["success"]]
+                summaries.append({**s, "plan": kind, "approach": approach, "missed": missed})
                 mm, deg = s["goal_error_mm"] or {}, s["goal_error_deg"] or {}
                 misses = ", ".join(f"{k} {v}" for k, v in sorted(s["causes"].items())) or "-"
-                print(f"| {task.name} | {kind} | {loop} | {approach} | {s['successes']}/{s['trials']} | {s['success_rate']:.1%} "
-                      f"({s['ci95'][0]:.1%}-{s['ci95'][1]:.1%}) | {mm.get('p50', float('nan')):.2f} / "
+                print(f"| {task.name} | {kind} | {loop} | {approach} | {s['successes']}/{s['trials']} "
+                      f"| {s['success_rate']:.1%} ({s['ci95'][0]:.1%}-{s['ci95'][1]:.1%}) | {mm.get('p50', float('nan')):.2f} / "
                       f"{mm.get('p95', float('nan')):.2f} | {deg.get('p50', float('nan')):.2f} / "
                       f"{deg.get('p95', float('nan')):.2f} | {misses} | {s['wall_s']:.0f} | "
                       f"{s['real_time_factor']:.2f} |", flush=True)
