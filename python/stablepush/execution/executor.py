@@ -334,7 +334,8 @@ class _GuardWatch:
     """The guarded approach through one run (guard.py): from the first waypoint of an approach's
     slow end, watch for the touch; on it, hold still, then splice in the contact started from the
     measured pose on the feature where it was found; at the plan's touch with nothing met, seek on
-    past it. `found`: the contact's starting plan step -> where its feature was found (mm)."""
+    past it. `found`: the contact's first push (plan step) -> where its feature was found (mm), keyed
+    as the run's contact records are."""
 
     def __init__(self, guard: Optional[GuardedApproach]):
         self.guard = guard
@@ -373,7 +374,7 @@ class _GuardWatch:
             # Held still: the contact's pushes start from where the object is, on the feature where it is.
             measured = _measured(steps[k].pose, state["object_in_grasp"])
             on_feature = found_feature(features[pusher], state["ee_pose"], measured)
-            self.found[k] = offset_along_approach_mm(features[pusher], on_feature)
+            self.found[k + 1] = offset_along_approach_mm(features[pusher], on_feature)
             features[pusher] = on_feature
             steps = from_touch(steps, k, measured)
             self.since, self.holding = None, False
@@ -494,7 +495,7 @@ def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Wayp
         first -= 1
     record = contacts.setdefault(first, ContactRecord(pusher, first, step))
     record.last_step = step
-    record.found_mm = found.get(first - 1)  # keyed by the pose the contact starts from
+    record.found_mm = found.get(first)
     if touch_state is None or "object_pose" not in state or "object_pose" not in touch_state:
         return
     point = _pusher_point(task, pusher)
