@@ -572,6 +572,30 @@ def test_a_guarded_approach_finds_a_feature_off_its_place_and_the_run_lands(task
     assert plain.guard == "off" and plain.goal_error["distance"] == pytest.approx(unguarded_mm, abs=0.03)
 
 
+@pytest.mark.parametrize("task_file, turn_deg, seated_deg, error_deg, unseated_deg", [
+    # the tilted-gravity offset: its 1,000-trial open-loop misses had this feature turned +0.49 to +0.50
+    # deg and ended +0.50 to +0.51 deg off (docs/evaluate.md)
+    ("more/tilted-gravity.yaml", 0.5, 0.5, 0.1, 0.51),
+    # the pivot: its prism seats at about twice the turn, and ends about -0.2 deg off on features in place too
+    ("pivoting.yaml", -0.4, -0.82, 0.25, -0.86),
+])
+def test_a_turned_feature_is_found_as_the_object_seats_and_the_run_lands(task_file, turn_deg, seated_deg, error_deg,
+                                                                        unseated_deg):
+    """Open loop, the left feature turned about y: the object rests turned on it after the contact's
+    first push, and the pushes left are re-based there, so the run ends as it does on a feature not
+    turned. The contact's record says how the object seated. Without the re-base (an approach that
+    is not guarded) the turn, or twice it, stays in the final pose."""
+    from stablepush.sim.arm import WorldDeviation
+
+    task = load_task(TASKS / task_file)
+    world = WorldDeviation(feature_offsets=(("left", 0.0, 0.0, turn_deg),))
+    guarded, plain = _open_loop_in(task, world), _open_loop_in(task, world, guarded=False)
+    assert abs(guarded.goal_error["theta"]) < error_deg and guarded.goal_error["distance"] < 0.1, guarded.verdict.detail
+    assert guarded.contacts[0].seated_deg == pytest.approx(seated_deg, abs=0.05)
+    assert plain.contacts[0].seated_deg is None
+    assert plain.goal_error["theta"] == pytest.approx(unseated_deg, abs=0.05)
+
+
 def test_a_pusher_that_slips_on_a_feature_in_its_place_is_a_slip():
     """The high-mu offset's pusher slips in a world with 15% less friction (its pushes have 0.1 N
     of margin): the feature is where the plan says, so nothing is carried, and the verdict is

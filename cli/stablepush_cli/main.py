@@ -624,8 +624,9 @@ def _host_port(value: str):
 @click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
               help="End each approach slowly and find the feature by touch (the arm's contact force, else its "
                    "tracked pose in the grasp), then push from where it was found: a feature off its place is "
-                   "found, not pushed into or missed. An arm that reports no tracked pose approaches as planned "
-                   "(and says so).")
+                   "found, not pushed into or missed. After a contact's first push, a feature the object rests "
+                   "on turned (past 0.15 deg) is taken as turned for the contact's other pushes. An arm that "
+                   "reports no tracked pose approaches as planned (and says so).")
 @click.option("--replan-threshold", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a re-plan "
                                      "(default: half the task's goal tolerance).")
@@ -810,6 +811,7 @@ def _print_report(report) -> None:
     for c in report.contacts:
         if c.slip_mm is not None:
             found = "" if c.found_mm is None else f"feature found {c.found_mm:+.3f} mm from its place; "
+            found += "" if c.seated_deg is None else f"seated turned {c.seated_deg:+.3f} deg; "
             click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} {found}carried to the feature "
                        f"{c.carried_mm:.3f} mm, then slip at the pusher {c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
     change = report.release_change

@@ -19,7 +19,8 @@ import numpy as np
 
 from stablepush.errors import ArmFault
 from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan
-from stablepush.execution.guard import GuardedApproach, found_feature, from_touch, offset_along_approach_mm
+from stablepush.execution.guard import (GuardedApproach, found_feature, from_touch, offset_along_approach_mm,
+                                        SEAT_BAND_DEG, seated_feature, turned_deg)
 from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from, past_touch
 from stablepush.execution.verdict import Verdict, judge, within
@@ -61,7 +62,10 @@ class ContactRecord:
     it (a feature that far beyond its place along the push), and `slip_mm` / `slip_deg`, its motion
     after that, while the pusher pushed (zero when the pusher stuck). `found_mm`: where the guarded
     approach (guard.py) found the feature, mm beyond its place along the approach (negative: short
-    of it); None when the approach was not guarded or met nothing within its reach."""
+    of it); None when the approach was not guarded or met nothing within its reach. `seated_deg`:
+    how far the object, at rest on the feature after the contact's first push, was turned in the
+    world from where the plan holds it (about y, deg); past guard.SEAT_BAND_DEG the contact's
+    other pushes were re-based there. None when not guarded or the contact is one push."""
 
     pusher: str
     first_step: int
@@ -71,6 +75,7 @@ class ContactRecord:
     carried_mm: Optional[float] = None
     feature_met: Optional[bool] = None  # False: the object rode with the hand through the whole contact
     found_mm: Optional[float] = None
+    seated_deg: Optional[float] = None
 
 
 @dataclass
@@ -276,7 +281,7 @@ def execute_plan(
                 record(w, state, steps[w.step].pusher if w.phase == "push" else None)
             if w.completes:
                 last_confirmed = w.step
-                _record(contacts, task, steps, w.step, touch_state, met_state, state, watch.found)
+                _record(contacts, task, steps, w.step, touch_state, met_state, state, watch)
             guarded = watch.after(task, steps, features, w, state, pending, rate_hz)
             if guarded is not None:
                 steps, pending = guarded
@@ -334,13 +339,16 @@ class _GuardWatch:
     """The guarded approach through one run (guard.py): from the first waypoint of an approach's
     slow end, watch for the touch; on it, hold still, then splice in the contact started from the
     measured pose on the feature where it was found; at the plan's touch with nothing met, seek on
-    past it. `found`: the contact's first push (plan step) -> where its feature was found (mm), keyed
-    as the run's contact records are."""
+    past it. After a contact's first push, splice in the pushes left on the feature where the
+    object rests (seated). `found` and `seated`: the contact's first push (plan step) -> where its
+    feature was found (mm) and how the object rested turned on it (deg), keyed as the run's contact
+    records are."""
 
     def __init__(self, guard: Optional[GuardedApproach]):
         self.guard = guard
         self.status = "off" if guard is None else "on"  # or "no tracker"
         self.found: Dict[int, float] = {}
+        self.seated: Dict[int, float] = {}
         self._clear()
 
     def _clear(self) -> None:
@@ -364,6 +372,8 @@ class _GuardWatch:
               state: dict, pending: deque, rate_hz: float):
         """After the arm acknowledged `w` with `state`: the new (steps, pending waypoints) when the
         stream changes here, else None. `features` is updated in place with a feature found."""
+        if w.completes and w.phase == "push" and self.status == "on":
+            return self._seated(task, steps, features, w, state, rate_hz)
         if not w.guarded or self.since is None:
             return None
         k, pusher = w.step, steps[w.step + 1].pusher
@@ -388,6 +398,26 @@ class _GuardWatch:
             past = past_touch(features[pusher], w.pose, self.guard.reach_mm * MM, rate_hz, k, [s.pose for s in steps])
             return steps, _renumbered(w, rate_hz, past + list(pending))
         return None
+
+
+    def _seated(self, task: Task, steps: List[Waypoint], features: Dict[str, Feature], w: ArmWaypoint, state: dict,
+                rate_hz: float):
+        """After push w.step: when it is its contact's first and more follow, the pushes left re-based
+        on the feature where the object rests (guard.seated_feature), else None."""
+        k = w.step
+        pusher = steps[k].pusher
+        first = k == 1 or steps[k - 1].pusher != pusher
+        if not first or k + 1 >= len(steps) or steps[k + 1].pusher != pusher or "object_in_grasp" not in state:
+            return None
+        measured = _measured(steps[k].pose, state["object_in_grasp"])
+        seated = seated_feature(features[pusher], state["ee_pose"], measured)
+        self.seated[k] = turned_deg(features[pusher], seated)
+        if abs(self.seated[k]) <= SEAT_BAND_DEG:
+            return None
+        features[pusher] = seated
+        steps = from_touch(steps, k, measured)
+        return steps, _renumbered(w, rate_hz, arm_trajectory(task, steps, features, rate_hz, state["ee_pose"],
+                                                             resume_from=k, resting_on=pusher))
 
 
 def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
@@ -484,18 +514,19 @@ def _rode_with_hand(task: Task, pusher: str, before: dict, after: dict) -> Optio
 
 
 def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Waypoint], step: int,
-            touch_state: Optional[dict], met_state: Optional[dict], state: dict, found: Dict[int, float]) -> None:
+            touch_state: Optional[dict], met_state: Optional[dict], state: dict, watch: "_GuardWatch") -> None:
     """Update the record of the contact that plan step `step` belongs to with the object's motion in
     the world since it came onto the feature by the plan (`touch_state`): up to where the feature
     stopped it (`met_state`; None: not yet) it was carried, after that it slipped (when the arm
-    reports the object)."""
+    reports the object); with what the guarded approach found of its feature (`watch`)."""
     pusher = steps[step].pusher
     first = step
     while first > 1 and steps[first - 1].pusher == pusher:
         first -= 1
     record = contacts.setdefault(first, ContactRecord(pusher, first, step))
     record.last_step = step
-    record.found_mm = found.get(first)
+    record.found_mm = watch.found.get(first)
+    record.seated_deg = watch.seated.get(first)
     if touch_state is None or "object_pose" not in state or "object_pose" not in touch_state:
         return
     point = _pusher_point(task, pusher)

@@ -12,9 +12,16 @@ start from the measured pose with the feature where it was found (`found_feature
 the object in the grasp as planned wherever the feature stands. A feature not met by the plan's
 touch is sought up to `reach_mm` beyond it, as slowly; not met there, the contact runs as planned.
 
+At the touch the object is not yet seated on the feature: a feature turned about y meets it at a
+corner, and the pads' friction turns it on during the contact's first push (the pivot's prism, on
+a left feature turned -0.4 deg, came to rest at -0.82 deg in the world there, and ended -0.95 deg
+off). After that push, with the pusher sticking, the object holds still in the world, so its
+measured world pose there (`seated_feature`) is the feature's for the rest of the contact, turn
+included, and the pushes left are re-based on it as at the touch (`from_touch`).
+
 The guard needs the tracker's `object_in_grasp` (protocol.py) to measure where the object is, and
-re-plans nothing; a cell without a tracker approaches as planned. It finds where a feature stands
-along the approach, not how it is turned. Poses in the grasp are (x mm, z mm, theta deg).
+re-plans nothing; a cell without a tracker approaches as planned. Poses in the grasp are (x mm,
+z mm, theta deg).
 """
 from __future__ import annotations
 
@@ -25,10 +32,16 @@ from typing import List, Mapping, Sequence
 import numpy as np
 
 from stablepush.execution.world import Feature
-from stablepush.frames import grasp_transform, pose_to_matrix
+from stablepush.frames import grasp_transform, pose_to_matrix, rot_y
 from stablepush.plan.plan import Waypoint
 from stablepush.units import MM, angle_difference_deg
 
+# deg: a contact whose object rests within this of the plan's world orientation after its first push
+# is left as planned. A flush face seats off by its contact's compliance, which changes with the load
+# (the pivot's prism by -0.09 deg at its first push and -0.21 deg by its last, on a feature not
+# turned); re-based on that, the pivot turned by twice as much with the hand and ended 0.09 deg
+# further off.
+SEAT_BAND_DEG = 0.15
 # Valid ranges of the guard's parameters (mm, deg, N, s). A touch threshold below the sensor's noise
 # fires on noise; the reach is travel into where the plan says a feature is, so it stays short.
 GUARD_PARAMETER_RANGES = {"touch_mm": (0.001, 0.5), "touch_deg": (0.001, 0.5), "touch_n": (0.01, 50.0),
@@ -83,6 +96,28 @@ def found_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
     T_WO = feature.object_pose.copy()
     T_WO[:3, 3] = (pose_to_matrix(ee_pose) @ grasp_transform(in_grasp))[:3, 3]
     return replace(feature, object_pose=T_WO)
+
+
+def seated_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
+    """The feature as the object rests on it after the contact's first push: the object's measured
+    world pose, G's world pose `ee_pose` times the measured pose in the grasp `in_grasp` (x mm,
+    z mm, theta deg), kept in the grasp plane (its turn about y and its x, z; the plan's y)."""
+    T_measured = pose_to_matrix(ee_pose) @ grasp_transform(in_grasp)
+    T_WO = feature.object_pose.copy()
+    turn = _turn_about_y(T_measured[:3, :3]) - _turn_about_y(T_WO[:3, :3])
+    T_WO[:3, :3] = rot_y(turn) @ T_WO[:3, :3]
+    T_WO[[0, 2], 3] = T_measured[[0, 2], 3]
+    return replace(feature, object_pose=T_WO)
+
+
+def turned_deg(planned: Feature, seated: Feature) -> float:
+    """How far the object on `seated` is turned about y from where `planned` holds it [deg]."""
+    return math.degrees(_turn_about_y(seated.object_pose[:3, :3]) - _turn_about_y(planned.object_pose[:3, :3]))
+
+
+def _turn_about_y(R: np.ndarray) -> float:
+    """The angle [rad] of a rotation about y (rot_y's), from its matrix."""
+    return math.atan2(R[0, 2], R[0, 0])
 
 
 def from_touch(steps: Sequence[Waypoint], k: int, measured: Sequence[float]) -> List[Waypoint]:
