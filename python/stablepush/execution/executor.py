@@ -19,8 +19,15 @@ import numpy as np
 
 from stablepush.errors import ArmFault
 from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan
-from stablepush.execution.guard import (GuardedApproach, found_feature, from_touch, offset_along_approach_mm,
-                                        SEAT_BAND_DEG, seated_feature, turned_deg)
+from stablepush.execution.guard import (
+    SEAT_BAND_DEG,
+    GuardedApproach,
+    found_feature,
+    from_touch,
+    offset_along_approach_mm,
+    seated_feature,
+    turned_deg,
+)
 from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from, past_touch
 from stablepush.execution.verdict import Verdict, judge, within
