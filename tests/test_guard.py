@@ -1,9 +1,15 @@
-"""The guarded approach's parts (stablepush.execution.guard): when a touch is read, and how a
-contact's plan starts from the pose measured at the touch. End to end on the simulated arm:
+"""The guarded approach's parts (stablepush.execution.guard): when a touch is read, how a
+contact's plan starts from the pose measured at the touch, and where a seated object puts its
+feature. End to end on the simulated arm:
 tests/test_execute.py."""
+import math
+
+import numpy as np
 import pytest
 
-from stablepush.execution.guard import GuardedApproach, from_touch
+from stablepush.execution.guard import GuardedApproach, from_touch, seated_feature, turned_deg
+from stablepush.execution.world import Feature
+from stablepush.frames import quat_about_y, rot_y
 from stablepush.plan import Waypoint
 
 
@@ -28,7 +34,7 @@ def test_a_touch_is_read_from_the_contact_force_when_the_arm_reports_one():
 
 
 @pytest.mark.parametrize("field, value", [("touch_mm", 0.0), ("touch_deg", -1.0), ("reach_mm", 5.0),
-                                          ("hold_s", 2.0), ("touch_n", 0.0)])
+                                          ("hold_s", 2.0), ("touch_n", 0.0), ("seat_deg", 3.0)])
 def test_guard_parameters_outside_their_ranges_are_refused_by_name(field, value):
     with pytest.raises(ValueError, match=field):
         GuardedApproach(**{field: value})
@@ -38,6 +44,25 @@ def test_touch_thresholds_stay_clear_of_the_trackers_noise():
     assert GuardedApproach.for_tracker_noise() == GuardedApproach()
     guard = GuardedApproach.for_tracker_noise(0.05, 0.001)
     assert guard.touch_mm == pytest.approx(0.2) and guard.touch_deg == GuardedApproach().touch_deg
+    assert guard.seat_deg == GuardedApproach().seat_deg
+    assert GuardedApproach.for_tracker_noise(0.0, 0.1).seat_deg == pytest.approx(0.4)
+
+
+def test_the_seated_feature_is_the_objects_measured_world_pose_in_the_grasp_plane():
+    """The plan holds the object at (0.45, 0.1, 0.3) m turned 30 deg about y. G at (0.4, 0.1, 0.3) m turned
+    20 deg; the object measured at (50 mm, -1 mm, 10.3 deg) in the grasp: in the world, G's turn plus
+    10.3 deg (0.3 deg past the plan's 30) and G's origin plus R_y(20 deg)(50, 0, -1) mm. The plan's y and
+    the feature's segment stay."""
+    T_plan = np.eye(4)
+    T_plan[:3, :3], T_plan[:3, 3] = rot_y(math.radians(30)), (0.45, 0.1, 0.3)
+    feature = Feature("left", T_plan, np.zeros(3), np.ones(3), np.array([1.0, 0.0, 0.0]), 0.6)
+    ee_pose = (0.4, 0.1, 0.3, *quat_about_y(math.radians(20)))
+    seated = seated_feature(feature, ee_pose, (50.0, -1.0, 10.3))
+    assert turned_deg(feature, seated) == pytest.approx(0.3)
+    assert seated.object_pose[:3, :3] == pytest.approx(rot_y(math.radians(30.3)))
+    expected = np.array([0.4, 0.1, 0.3]) + rot_y(math.radians(20)) @ np.array([0.05, 0.0, -0.001])
+    assert seated.object_pose[:3, 3] == pytest.approx(expected)
+    assert seated.start is feature.start and seated.normal is feature.normal
 
 
 def test_a_contact_starts_from_the_measured_pose_and_still_ends_where_the_plan_does():

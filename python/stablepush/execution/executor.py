@@ -20,7 +20,6 @@ import numpy as np
 from stablepush.errors import ArmFault
 from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan
 from stablepush.execution.guard import (
-    SEAT_BAND_DEG,
     GuardedApproach,
     found_feature,
     from_touch,
@@ -71,7 +70,7 @@ class ContactRecord:
     approach (guard.py) found the feature, mm beyond its place along the approach (negative: short
     of it); None when the approach was not guarded or met nothing within its reach. `seated_deg`:
     how far the object, at rest on the feature after the contact's first push, was turned in the
-    world from where the plan holds it (about y, deg); past guard.SEAT_BAND_DEG the contact's
+    world from where the plan holds it (about y, deg); past the guard's `seat_deg` the contact's
     other pushes were re-based there. None when not guarded or the contact is one push."""
 
     pusher: str
@@ -406,7 +405,6 @@ class _GuardWatch:
             return steps, _renumbered(w, rate_hz, past + list(pending))
         return None
 
-
     def _seated(self, task: Task, steps: List[Waypoint], features: Dict[str, Feature], w: ArmWaypoint, state: dict,
                 rate_hz: float):
         """After push w.step: when it is its contact's first and more follow, the pushes left re-based
@@ -419,7 +417,7 @@ class _GuardWatch:
         measured = _measured(steps[k].pose, state["object_in_grasp"])
         seated = seated_feature(features[pusher], state["ee_pose"], measured)
         self.seated[k] = turned_deg(features[pusher], seated)
-        if abs(self.seated[k]) <= SEAT_BAND_DEG:
+        if abs(self.seated[k]) <= self.guard.seat_deg:
             return None
         features[pusher] = seated
         steps = from_touch(steps, k, measured)

@@ -36,16 +36,10 @@ from stablepush.frames import grasp_transform, pose_to_matrix, rot_y
 from stablepush.plan.plan import Waypoint
 from stablepush.units import MM, angle_difference_deg
 
-# deg: a contact whose object rests within this of the plan's world orientation after its first push
-# is left as planned. A flush face seats off by its contact's compliance, which changes with the load
-# (the pivot's prism by -0.09 deg at its first push and -0.21 deg by its last, on a feature not
-# turned); re-based on that, the pivot turned by twice as much with the hand and ended 0.09 deg
-# further off.
-SEAT_BAND_DEG = 0.15
 # Valid ranges of the guard's parameters (mm, deg, N, s). A touch threshold below the sensor's noise
 # fires on noise; the reach is travel into where the plan says a feature is, so it stays short.
 GUARD_PARAMETER_RANGES = {"touch_mm": (0.001, 0.5), "touch_deg": (0.001, 0.5), "touch_n": (0.01, 50.0),
-                          "reach_mm": (0.0, 2.0), "hold_s": (0.0, 1.0)}
+                          "reach_mm": (0.0, 2.0), "hold_s": (0.0, 1.0), "seat_deg": (0.0, 2.0)}
 
 
 @dataclass(frozen=True)
@@ -55,13 +49,19 @@ class GuardedApproach:
     (0.01 mm of the pivot's 1 mm unit push); how long to hold still before measuring where the
     object is (`hold_s` [s]: the arm's lag behind the stream settles); and how far past the plan's
     touch to seek a feature not met by then (`reach_mm`: features placed up to 0.5 mm off, turned
-    up to 0.5 deg over a 30 mm face)."""
+    up to 0.5 deg over a 30 mm face). After a contact's first push, an object at rest turned more
+    than `seat_deg` [deg] in the world from where the plan holds it has met a turned feature; within
+    it, the contact runs as planned. A flush face seats off by its contact's compliance, which
+    changes with the load (the pivot's prism by -0.09 deg at its first push and -0.21 deg by its
+    last, on a feature not turned); re-based on that, the pivot turned twice as far with the hand
+    and ended 0.09 deg further off."""
 
     touch_mm: float = 0.01
     touch_n: float = 0.5
     touch_deg: float = 0.02
     reach_mm: float = 0.8
     hold_s: float = 0.05
+    seat_deg: float = 0.15
 
     def __post_init__(self):
         for name, (low, high) in GUARD_PARAMETER_RANGES.items():
@@ -71,10 +71,11 @@ class GuardedApproach:
 
     @classmethod
     def for_tracker_noise(cls, noise_mm: float = 0.0, noise_deg: float = 0.0) -> "GuardedApproach":
-        """The default guard with its touch thresholds no lower than four standard deviations of the
-        tracker's noise (mm, deg), so that noise alone does not read as a touch."""
+        """The default guard with its touch and seat thresholds no lower than four standard deviations
+        of the tracker's noise (mm, deg), so that noise alone does not read as a touch or a turn."""
         default = cls()
-        return cls(touch_mm=max(default.touch_mm, 4 * noise_mm), touch_deg=max(default.touch_deg, 4 * noise_deg))
+        return cls(touch_mm=max(default.touch_mm, 4 * noise_mm), touch_deg=max(default.touch_deg, 4 * noise_deg),
+                   seat_deg=max(default.seat_deg, 4 * noise_deg))
 
     def met(self, before: Mapping[str, float], now: Mapping[str, float], force=None) -> bool:
         """Whether the feature has met the object: the arm's `contact_force` (N) past touch_n when
