@@ -30,15 +30,12 @@ from stablepush.execution.guard import GuardedApproach
 from stablepush.plan.plan import Plan
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.sim.arm import WorldDeviation
-from stablepush.sim.server import running_sim_arm
+from stablepush.sim.server import SIM_ACK_TIMEOUT, running_sim_arm
 from stablepush.task.model import Task
 
 DEFAULT_TOLERANCE = (0.5, 0.5)  # mm, deg: a trial succeeds within this of the goal, per coordinate
 RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
 PERCENTILES = (50, 90, 95, 99)
-# s a trial waits for each reply of its simulated arm before calling it hung (arm_fault): long
-# enough that a loaded machine building a world slowly does not change an outcome.
-SIM_ACK_TIMEOUT = 120.0
 
 
 @dataclass(frozen=True)

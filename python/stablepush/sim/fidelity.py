@@ -225,11 +225,12 @@ def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1,
                  engine: str = DEFAULT_ENGINE) -> ArmPivotResult:
     """Run the first `pushes` pushes of `task`'s plan (seed `seed`) on the simulated arm, open loop."""
     from stablepush.execution.executor import execute_plan  # the executor is the arm's client, not the rig's
-    from stablepush.sim.server import running_sim_arm
+    from stablepush.sim.server import SIM_ACK_TIMEOUT, running_sim_arm
 
     plan = check_plan(task, plan_task(task, seed=seed))
     plan = dataclasses.replace(plan, waypoints=plan.waypoints[:pushes + 1])
     with running_sim_arm(log=lambda text: None, engine=engine) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
+                              ack_timeout=SIM_ACK_TIMEOUT)
     return ArmPivotResult(pushes=len(plan.waypoints) - 1, error_mm=report.final_error["distance"],
                           error_deg=report.final_error["theta"], steps_per_s=report.sim_steps_per_s)

@@ -210,6 +210,12 @@ def _send_quietly(connection: socket.socket, message: dict) -> None:
         pass
 
 
+# s a client of an in-process simulated arm waits for each reply before calling it hung: long enough
+# that a loaded machine building a world or stepping Drake slowly does not change an outcome (the
+# arm pivot on Drake waited more than 5 s for a reply beside a 2-worker batch on 2 cores).
+SIM_ACK_TIMEOUT = 120.0
+
+
 @contextmanager
 def running_sim_arm(log: Optional[Callable[[str], None]] = None, deviation: WorldDeviation = WorldDeviation(),
                     engine: str = DEFAULT_ENGINE) -> Iterator[SimArmServer]:
