@@ -16,8 +16,9 @@ At the touch the object is not yet seated on the feature: a feature turned about
 corner, and the pads' friction turns it on during the contact's first push (the pivot's prism, on
 a left feature turned -0.4 deg, came to rest at -0.82 deg in the world there, and ended -0.95 deg
 off). After that push, with the pusher sticking, the object holds still in the world, so its
-measured world pose there (`seated_feature`) is the feature's for the rest of the contact, turn
-included, and the pushes left are re-based on it as at the touch (`from_touch`).
+measured world pose there (`seated_feature`), when it is turned more than `seat_deg` from the plan's,
+is the feature's for the rest of the contact, turn included, and the pushes left are re-based on it
+as at the touch (`from_touch`).
 
 The guard needs the tracker's `object_in_grasp` (protocol.py) to measure where the object is, and
 re-plans nothing; a cell without a tracker approaches as planned. Poses in the grasp are (x mm,
