@@ -39,6 +39,12 @@ def rot_y(angle: float) -> np.ndarray:
     return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
+def angle_about_y(R: np.ndarray) -> float:
+    """The angle [rad] of a rotation about y from its matrix: rot_y's inverse (of a rotation that has
+    others, the turn of its x axis about y)."""
+    return math.atan2(R[0, 2], R[0, 0])
+
+
 def grasp_transform(pose_mm_deg: Sequence[float]) -> np.ndarray:
     """T_GO(q) = Trans(x, 0, z) · Rot_y(theta), for q in mm and degrees."""
     T = np.eye(4)

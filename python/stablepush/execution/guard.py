@@ -33,7 +33,7 @@ from typing import List, Mapping, Sequence
 import numpy as np
 
 from stablepush.execution.world import Feature
-from stablepush.frames import grasp_transform, pose_to_matrix, rot_y
+from stablepush.frames import angle_about_y, grasp_transform, pose_to_matrix, rot_y
 from stablepush.plan.plan import Waypoint
 from stablepush.units import MM, angle_difference_deg
 
@@ -106,7 +106,7 @@ def seated_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
     z mm, theta deg), kept in the grasp plane (its turn about y and its x, z; the plan's y)."""
     T_measured = pose_to_matrix(ee_pose) @ grasp_transform(in_grasp)
     T_WO = feature.object_pose.copy()
-    turn = _turn_about_y(T_measured[:3, :3]) - _turn_about_y(T_WO[:3, :3])
+    turn = angle_about_y(T_measured[:3, :3]) - angle_about_y(T_WO[:3, :3])
     T_WO[:3, :3] = rot_y(turn) @ T_WO[:3, :3]
     T_WO[[0, 2], 3] = T_measured[[0, 2], 3]
     return replace(feature, object_pose=T_WO)
@@ -114,12 +114,7 @@ def seated_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
 
 def turned_deg(planned: Feature, seated: Feature) -> float:
     """How far the object on `seated` is turned about y from where `planned` holds it [deg]."""
-    return math.degrees(_turn_about_y(seated.object_pose[:3, :3]) - _turn_about_y(planned.object_pose[:3, :3]))
-
-
-def _turn_about_y(R: np.ndarray) -> float:
-    """The angle [rad] of a rotation about y (rot_y's), from its matrix."""
-    return math.atan2(R[0, 2], R[0, 0])
+    return math.degrees(angle_about_y(seated.object_pose[:3, :3]) - angle_about_y(planned.object_pose[:3, :3]))
 
 
 def from_touch(steps: Sequence[Waypoint], k: int, measured: Sequence[float]) -> List[Waypoint]:

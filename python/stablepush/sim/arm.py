@@ -15,7 +15,7 @@ from typing import Callable, Dict, Optional, Sequence, Tuple
 import mujoco
 import numpy as np
 
-from stablepush.frames import matrix_to_pose, pose_to_matrix, rot_y
+from stablepush.frames import angle_about_y, matrix_to_pose, pose_to_matrix, rot_y
 from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.friction import CoulombPadFriction
@@ -29,7 +29,7 @@ def in_grasp(T_world_gripper: np.ndarray, T_world_object: np.ndarray) -> Dict[st
     T = np.linalg.inv(T_world_gripper) @ T_world_object
     R = T[:3, :3]
     tilt = math.degrees(math.acos(max(-1.0, min(1.0, R[1, 1]))))
-    return {"x": T[0, 3] * 1e3, "z": T[2, 3] * 1e3, "theta": math.degrees(math.atan2(R[0, 2], R[0, 0])),
+    return {"x": T[0, 3] * 1e3, "z": T[2, 3] * 1e3, "theta": math.degrees(angle_about_y(R)),
             "y": T[1, 3] * 1e3, "tilt": tilt}
 
 

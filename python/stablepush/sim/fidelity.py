@@ -34,6 +34,7 @@ import numpy as np
 import yaml
 
 from stablepush.execution.world import place_features, scene_description
+from stablepush.frames import angle_about_y
 from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
 from stablepush.plan.verify import check_plan
@@ -108,8 +109,7 @@ class KinematicGrasp:
 
     def object_angle(self) -> float:
         """The object's rotation about the world's y axis, rad."""
-        R = self.world.object_matrix()[:3, :3]
-        return math.atan2(R[0, 2], R[0, 0])
+        return angle_about_y(self.world.object_matrix()[:3, :3])
 
 
 def _ramp(t: float, speed: float) -> tuple:
