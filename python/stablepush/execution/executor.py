@@ -411,8 +411,8 @@ class _GuardWatch:
         on the feature where the object rests (guard.seated_feature), else None."""
         k = w.step
         pusher = steps[k].pusher
-        first = k == 1 or steps[k - 1].pusher != pusher
-        if not first or k + 1 >= len(steps) or steps[k + 1].pusher != pusher or "object_in_grasp" not in state:
+        if _contact_first(steps, k) != k or k + 1 >= len(steps) or steps[k + 1].pusher != pusher \
+                or "object_in_grasp" not in state:
             return None
         measured = _measured(steps[k].pose, state["object_in_grasp"])
         seated = seated_feature(features[pusher], state["ee_pose"], measured)
@@ -518,6 +518,15 @@ def _rode_with_hand(task: Task, pusher: str, before: dict, after: dict) -> Optio
     return float(np.linalg.norm((p1 - rode)[:3])) <= RIDE_FRACTION * hand
 
 
+def _contact_first(steps: Sequence[Waypoint], step: int) -> int:
+    """The first push of the contact that plan step `step` (a push) belongs to: the run's contact
+    records and the guard's findings are keyed by it."""
+    first = step
+    while first > 1 and steps[first - 1].pusher == steps[step].pusher:
+        first -= 1
+    return first
+
+
 def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Waypoint], step: int,
             touch_state: Optional[dict], met_state: Optional[dict], state: dict, watch: "_GuardWatch") -> None:
     """Update the record of the contact that plan step `step` belongs to with the object's motion in
@@ -525,9 +534,7 @@ def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Wayp
     stopped it (`met_state`; None: not yet) it was carried, after that it slipped (when the arm
     reports the object); with what the guarded approach found of its feature (`watch`)."""
     pusher = steps[step].pusher
-    first = step
-    while first > 1 and steps[first - 1].pusher == pusher:
-        first -= 1
+    first = _contact_first(steps, step)
     record = contacts.setdefault(first, ContactRecord(pusher, first, step))
     record.last_step = step
     record.found_mm = watch.found.get(first)
