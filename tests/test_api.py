@@ -1,6 +1,7 @@
 """The Python API (`import stablepush as sp`) and timed trajectories."""
 import json
 import math
+from collections import Counter
 
 import numpy as np
 import pytest
@@ -60,6 +61,18 @@ def test_the_package_leaves_the_plotting_backend_alone():
     bare = subprocess.run([sys.executable, "-c", "import sys, stablepush; assert 'matplotlib' not in sys.modules"],
                           capture_output=True, text=True)
     assert bare.returncode == 0, bare.stderr
+
+
+@pytest.mark.parametrize("rate_hz", [100.0, 30.0, 25.0, 15.0, 7.0])
+def test_each_push_lasts_the_models_step_time_or_the_next_whole_period_never_less(rate_hz):
+    """The stability test assumed each push takes dynamics.step_time (0.1 s here); a stream at a
+    rate that does not divide it must not push faster than that (at 25 Hz, 3 samples, not 2)."""
+    task = sp.load_task(TASKS / "horizontal-offset-low-mu.yaml")
+    traj = sp.trajectory(task, sp.plan(task, seed=1), rate_hz=rate_hz)
+    samples = Counter(int(step) for phase, step in zip(traj.phase, traj.step) if phase == "push")
+    expected = math.ceil(task.step_time * rate_hz - 1e-9)
+    assert set(samples.values()) == {expected}
+    assert expected / rate_hz >= task.step_time - 1e-12 and (expected - 1) / rate_hz < task.step_time
 
 
 def test_the_trajectory_puts_the_object_where_the_plan_says_at_every_push():

@@ -104,8 +104,10 @@ class _Stream:
         constant speed, or, with `come_to_rest` (the last push of a contact), along
         s(u) = u + u^2 - u^3: the same speed at the start, none at the end. An arm stopped dead from
         full speed overshoots its lag, and the high-mu offset then sagged 0.2 mm and 0.45 deg in the
-        grasp before the settle hold ended (docs/execution.md, "Measured: plans on the simulated arm")."""
-        n = max(1, round(duration / self.period))
+        grasp before the settle hold ended (docs/execution.md, "Measured: plans on the simulated arm").
+        The push takes the fewest whole periods that last `duration` (the model's step time): a rate
+        that does not divide it pushes slower than the stability test assumed, never faster."""
+        n = max(1, math.ceil(duration / self.period - 1e-9))
         for i in range(1, n + 1):
             u = i / n
             s = u + u * u - u ** 3 if come_to_rest else u
