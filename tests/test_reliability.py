@@ -68,6 +68,9 @@ def _edited(tmp_path, old, new, name="task.yaml"):
     ("name: horizontal-offset-low-mu", "name: \"a\\0b\"", "name: must be at most 100 printable characters"),
     ("name: horizontal-offset-low-mu", "name: " + "[" * 3000 + "]" * 3000, "values nested too deeply"),
     ("name: horizontal-offset-low-mu", "name: x\n? [1, 2]\n: y", "a mapping key must be a name, got a list"),
+    # YAML 1.1 reads no/off/yes/on as booleans: the message said only "got False".
+    ("name: horizontal-offset-low-mu", "name: no",
+     "name: must be a non-empty string, got False: YAML read it as a boolean; put the name in quotes"),
 ])
 def test_hostile_numbers_and_yaml_are_refused_in_one_line_naming_the_field(tmp_path, old, new, says):
     result = CliRunner().invoke(cli, ["plan", str(_edited(tmp_path, old, new)), "-o", str(tmp_path / "p.json")])
@@ -180,6 +183,7 @@ def low_mu_plan():
     (lambda p: p.update(solved="no"), "solved: must be a boolean, got a string"),
     (lambda p: p["waypoints"][2].update(x=p["waypoints"][2]["x"] + 50), "waypoints[2]: a step of 5"),
     (lambda p: p["waypoints"][3].update(x=10 ** 400), "waypoints[3].x: must be a finite number"),
+    (lambda p: p["waypoints"][2].update(x="1"), 'waypoints[2].x: must be a finite number, got "1"'),
     (lambda p: p["waypoints"].extend([p["waypoints"][-1]] * 10_001), "a plan has at most 10000"),
     # "Solved" plans that do not end at this task's goal used to run with exit 0.
     (lambda p: p.update(waypoints=p["waypoints"][:6]), "not within planner.tolerance [0.5, 0.5] of the task's goal"),
@@ -243,6 +247,88 @@ def test_outputs_write_through_symlinks_refuse_directories_and_keep_devices(tmp_
     assert Path(os.devnull).is_char_device()
     with pytest.raises(OutputError, match="does not exist"):
         write_files({tmp_path / "no" / "such.json": "x"})
+
+
+def _plan_and_task(tmp_path):
+    task = tmp_path / "task.yaml"
+    task.write_text(task_text("horizontal-offset-low-mu"))
+    plan = tmp_path / "task.plan.json"
+    assert CliRunner().invoke(cli, ["plan", str(task), "-o", str(plan), "--quiet"]).exit_code == 0
+    return task, plan
+
+
+@pytest.mark.parametrize("args, says", [
+    (["plan", "{task}", "-o", "{task}"], "-o {task}: is the input TASK.yaml; refusing to write over it"),
+    (["plan", "{task}", "-o", "{link}"], "-o {link}: is the input TASK.yaml; refusing to write over it"),
+    (["plan", "{task}", "-o", "{dir}/a.json", "--csv", "{dir}/a.json"], "--csv {dir}/a.json: is also -o's output"),
+    (["show", "{plan}", "--task", "{task}", "-o", "{plan}"], "-o {plan}: the file name must end in .png, .pdf or .svg"),
+    (["show", "{plan}", "--task", "{task}", "-o", "{dir}/p.jpg"], "the file name must end in .png, .pdf or .svg"),
+    (["show", "{plan}", "--task", "{task}", "-o", "{dir}/p.png", "--gif", "{dir}/p.png"],
+     "--gif {dir}/p.png: the file name must end in .gif"),
+    (["show", "{plan}", "--task", "{task}", "-o", "{dir}/plan.png", "--gif", "{dir}/no/p.gif"],
+     "--gif {dir}/no/p.gif: the directory {dir}/no does not exist"),
+    (["trajectory", "{plan}", "--task", "{task}", "-o", "{dir}/task.plan.json"],
+     "-o {dir}/task.plan.json: is the input PLAN.json; refusing to write over it"),
+    (["cone", "{task}", "--pusher", "left", "-o", "{dir}/c.jpg"], "the file name must end in .png, .pdf or .svg"),
+    (["execute", "{plan}", "--task", "{task}", "--arm", "127.0.0.1:9", "--json", "{task}"],
+     "--json {task}: is the input --task; refusing to write over it"),
+    (["reach", "{task}", "--x", "0:1:2", "--workers", "1", "--json", "{dir}/no/r.json"],
+     "--json {dir}/no/r.json: the directory {dir}/no does not exist"),
+    (["reach", "{task}", "--x", "0:1:2", "--workers", "1", "--plot", "{dir}/r.json"],
+     "--plot {dir}/r.json: the file name must end in .png, .pdf or .svg"),
+    (["evaluate", "{task}", "--plan", "{plan}", "--trials", "1", "--workers", "1", "--csv", "{plan}"],
+     "--csv {plan}: is the input --plan; refusing to write over it"),
+])
+def test_an_output_over_an_input_another_output_or_unwritable_is_refused_before_any_work(tmp_path, args, says):
+    """Each used to be written after the work: over the task or plan (lost without a word), over the
+    other output, as PNG bytes under a .pdf name, or after a whole reach map had been planned."""
+    task, plan = _plan_and_task(tmp_path)
+    (tmp_path / "link.yaml").symlink_to(task)
+    names = {"task": task, "plan": plan, "dir": tmp_path, "link": tmp_path / "link.yaml"}
+    before = {p: p.read_bytes() for p in (task, plan)}
+    result = CliRunner().invoke(cli, [a.format(**names) for a in args])
+    assert result.exit_code == 2, result.output
+    assert says.format(**names) in result.stderr
+    assert {p: p.read_bytes() for p in (task, plan)} == before
+    assert not any(tmp_path.glob("*.png")) and not (tmp_path / "a.json").exists()
+
+
+@pytest.mark.parametrize("args, says", [
+    (["reach", str(LOW_MU), "--x", "nan:nan:1"], "expected FROM:TO:COUNT, finite numbers"),
+    (["reach", str(LOW_MU), "--z", "0:inf:2"], "expected FROM:TO:COUNT, finite numbers"),
+    (["check", str(LOW_MU), "--move", "1", "0", "0", "--heading-step", "5"], "--heading-step: only with --directions"),
+])
+def test_options_that_cannot_apply_are_refused_as_usage_errors(args, says):
+    result = CliRunner().invoke(cli, args)
+    assert result.exit_code == 2 and says in result.stderr, result.output
+
+
+def test_an_option_that_needs_another_is_named_alone(tmp_path):
+    """It named --engine and --tracker-noise too, which were not given."""
+    task, plan = _plan_and_task(tmp_path)
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", str(task), "--arm", "127.0.0.1:9",
+                                      "--sim-mu-scale", "2"])
+    assert result.exit_code == 2
+    assert "error: --sim-mu-scale: only with --sim" in result.stderr, result.stderr
+
+
+def test_figures_are_written_in_the_format_their_name_asks(tmp_path):
+    task, plan = _plan_and_task(tmp_path)
+    for suffix, magic in ((".png", b"\x89PNG"), (".pdf", b"%PDF"), (".svg", b"<?xml")):
+        out = tmp_path / f"plan{suffix}"
+        result = CliRunner().invoke(cli, ["show", str(plan), "--task", str(task), "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        assert out.read_bytes().startswith(magic)
+
+
+def test_a_closed_output_pipe_ends_quietly_with_the_sigpipe_status():
+    """`stablepush check ... | head`: the reader is gone before the first line is written."""
+    child = subprocess.Popen([sys.executable, "-m", "stablepush_cli.main", "check", str(LOW_MU), "--move", "1", "0",
+                              "0"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    child.stdout.close()
+    stderr = child.stderr.read().decode()
+    assert child.wait(timeout=60) == 141, stderr
+    assert stderr == ""
 
 
 def test_outputs_respect_the_umask(tmp_path):

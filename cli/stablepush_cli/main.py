@@ -19,6 +19,7 @@ EXIT_BAD_INPUT = 2
 EXIT_ARM_FAULT = 3
 EXIT_INTERNAL = 4
 EXIT_MISSED = 5  # `execute`: the run completed and the object did not land within the tolerance
+EXIT_PIPE_CLOSED = 141  # the output's reader went away (128 + SIGPIPE, as a shell reports such a process)
 # Every error stablepush raises on purpose, and its exit status (the first class that matches).
 EXIT_STATUS = (
     (TaskError, EXIT_BAD_INPUT),
@@ -55,6 +56,9 @@ class _Commands(click.Group):
         except StablepushError as error:
             click.echo(f"error: {error}", err=True)
             ctx.exit(_exit_status(error))
+        except BrokenPipeError:  # the reader went away (`| head`): stop quietly, as a process ended by SIGPIPE
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error as Python exits
+            ctx.exit(EXIT_PIPE_CLOSED)
         except (click.exceptions.Exit, click.ClickException, click.Abort, KeyboardInterrupt, SystemExit):
             raise
         except Exception as error:  # noqa: BLE001 - the last line of defence, reported as a bug
@@ -89,7 +93,9 @@ def cli() -> None:
               show_default=True, help="With --directions: degrees between the headings tried in the (x, z) plane.")
 @click.option("--pusher", default=None, metavar="NAME", help="Test only this pusher (default: every pusher).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object keyed by pusher name.")
-def check(task_file: str, at, move, directions: bool, heading_step: float, pusher, as_json: bool) -> None:
+@click.pass_context
+def check(ctx: click.Context, task_file: str, at, move, directions: bool, heading_step: float, pusher,
+          as_json: bool) -> None:
     """Is moving the object by --move from --at a stable push, pusher by pusher?
 
     For each pusher: feasible or not, the contact case at the pads (all_sliding, or sticking when
@@ -98,7 +104,8 @@ def check(task_file: str, at, move, directions: bool, heading_step: float, pushe
     boundary are re-made in exact arithmetic ("exact" in --json).
 
     With --directions instead: each pusher's stable unit pushes from --at, by heading h in the (x, z)
-    plane and elevation toward +theta (a point pusher's lie on a surface: one elevation a heading),
+    plane and elevation toward +theta (a point pusher's lie on a surface: at each heading, the
+    elevations where it meets that surface),
     then the largest component any of them has along each of +-x, +-z, +-theta in unit steps. A
     sense no push moves the object in (0 or less) cannot be corrected from there: an overshoot that
     way stays.
@@ -110,6 +117,8 @@ def check(task_file: str, at, move, directions: bool, heading_step: float, pushe
     """
     if (move is None) == (not directions):
         raise click.UsageError("give --move DX DZ DTH, or --directions (one of the two)")
+    if not directions and ctx.get_parameter_source("heading_step") is click.core.ParameterSource.COMMANDLINE:
+        raise click.UsageError("--heading-step: only with --directions")
     task = _load(task_file)
     at = at if at else task.start
     if directions:
@@ -187,12 +196,13 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     Example:
       stablepush plan data/tasks/horizontal-offset-low-mu.yaml -o low-mu.plan.json --csv low-mu.csv
     """
-    from stablepush.outputs import default_output
+    from stablepush.outputs import check_outputs, default_output
     from stablepush.plan import plan_task, write_plan
 
+    json_path = json_path or default_output(task_file, ".plan.json")
+    check_outputs({"-o": json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
     task = _load(task_file)
     result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
-    json_path = json_path or default_output(task_file, ".plan.json")
     write_plan(result, json_path, csv_path)
     s = result.stats
     if not result.solved:
@@ -269,8 +279,10 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     if checks_only:
         _bench_checks(tasks, count, seed)
         return
-    if out_path and not out_path.endswith((".csv", ".json")):
-        _fail(f"--out {out_path}: the file name must end in .csv or .json")
+    from stablepush.outputs import check_outputs, require_suffix
+
+    require_suffix("--out", out_path, (".csv", ".json"))
+    check_outputs({"--out": out_path}, {f"TASK.yaml {path}": path for path in task_files})
 
     runner = _runner(workers, ray_address, default=1)
     every, rows = [], []
@@ -392,7 +404,7 @@ def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = T
 @click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
               help="The task the plan was made for (checked against the plan).")
 @click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,
-              help="PNG to write. Default: PLAN.png beside the plan file.")
+              help="Figure to write: PNG, PDF or SVG, as the name ends. Default: PLAN.png beside the plan file.")
 @click.option("--gif", "gif_path", type=click.Path(dir_okay=False), default=None, help="Also write an animated GIF.")
 def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     """Draw a plan: snapshots of the object in the grasp and x, z, theta against step.
@@ -410,10 +422,14 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     """
     from pathlib import Path
 
+    from stablepush.outputs import check_outputs, require_suffix
     from stablepush.viz import figures
 
-    task, plan = _load_plan_and_task(plan_file, task_file, require_solved=False)
     png_path = png_path or str(Path(plan_file).with_suffix("").with_suffix(".png"))
+    require_suffix("-o", png_path, figures.FIGURE_SUFFIXES)
+    require_suffix("--gif", gif_path, (".gif",))
+    check_outputs({"-o": png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})
+    task, plan = _load_plan_and_task(plan_file, task_file, require_solved=False)
     figures.save_figure(figures.plan_figure(task, plan), png_path)
     click.echo(f"figure written to {png_path}")
     if gif_path:
@@ -431,7 +447,9 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
                    "ROS 2 bag in one MCAP file (/tf, the gripper's pose and twist, phase, step and the scene as "
                    "markers; docs/execution.md, 'ROS 2 bags').")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
-              metavar="HZ", help="Samples per second (the executor streams at this rate).")
+              metavar="HZ", help="Samples per second (the executor streams at this rate). Each push takes the "
+                                 "fewest whole samples that last the task's dynamics.step_time: a rate that does not "
+                                 "divide it pushes slower than the stability test assumed, never faster.")
 @click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default="xyzw", show_default=True,
               help="Quaternion order: xyzw as ROS writes it, wxyz as the arm protocol and MuJoCo do.")
 def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str) -> None:
@@ -450,10 +468,10 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
       stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.mcap   # ros2 bag play, Foxglove
     """
     from stablepush.execution import timed_trajectory
-    from stablepush.outputs import write_atomically
+    from stablepush.outputs import check_outputs, require_suffix, write_atomically
 
-    if not out_path.endswith((".csv", ".json", ".mcap")):
-        _fail(f"-o {out_path}: the file name must end in .csv, .json or .mcap")
+    require_suffix("-o", out_path, (".csv", ".json", ".mcap"))
+    check_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file)
     traj = timed_trajectory(task, plan, rate_hz)
     if out_path.endswith(".mcap"):
@@ -470,7 +488,8 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
 @click.option("--pusher", required=True, metavar="NAME", help="The pusher whose cone to draw.")
 @click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,
-              help="PNG to write. Default: <TASK file name>.<pusher>.cone.png in the current directory.")
+              help="Figure to write: PNG, PDF or SVG, as the name ends. Default: <TASK file name>.<pusher>.cone.png "
+                   "in the current directory.")
 def cone(task_file: str, pusher: str, png_path) -> None:
     """Draw a pusher's generalized friction cone in wrench space (paper figs. 4-5).
 
@@ -482,12 +501,14 @@ def cone(task_file: str, pusher: str, png_path) -> None:
     Example:
       stablepush cone data/tasks/pivoting.yaml --pusher left -o left-cone.png
     """
-    from stablepush.outputs import default_output
+    from stablepush.outputs import check_outputs, default_output, require_suffix
     from stablepush.viz import figures
 
     task = _load(task_file)
     task.pusher_index(pusher)
     png_path = png_path or default_output(task_file, f".{pusher}.cone.png")
+    require_suffix("-o", png_path, figures.FIGURE_SUFFIXES)
+    check_outputs({"-o": png_path}, {"TASK.yaml": task_file})
     figures.save_figure(figures.cone_figure(task, pusher), png_path)
     click.echo(f"figure written to {png_path}")
 
@@ -584,7 +605,9 @@ def _host_port(value: str):
               help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with stablepush's own "
                    "Coulomb friction; drake: Drake's contact solver alone decides stick and slip.")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
-              metavar="HZ", help="Waypoints per second of motion.")
+              metavar="HZ", help="Waypoints per second of motion. Each push takes the fewest whole periods that "
+                                 "last the task's dynamics.step_time (slower than the model when HZ does not divide "
+                                 "it, never faster).")
 @click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
               help="Continue after plan step STEP (the last confirmed step a fault reported); a simulated arm then "
                    "keeps the world it has, where every other run starts from a fresh one.")
@@ -666,24 +689,28 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     from stablepush.execution import execute_plan, execution_warnings, fault_report
     from stablepush.execution.guard import GuardedApproach
     from stablepush.execution.stream import check_resume_from
-    from stablepush.outputs import write_atomically
+    from stablepush.outputs import check_outputs, require_suffix, write_atomically
 
+    require_suffix("--record", record_path, (".mcap",))
+    check_outputs({"--json": json_path, "--record": record_path, "--video": video_path},
+                  {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file, changed="refuse")
     for warning in execution_warnings(task):
         click.echo(f"warning: {warning}", err=True)
     check_resume_from(plan.waypoints, resume_from)
-    if (replan_threshold or final_tolerance) and not closed_loop:
-        _fail("--replan-threshold and --final-tolerance: only with --closed-loop")
+    loop_options = [name for name, value in (("--replan-threshold", replan_threshold),
+                                             ("--final-tolerance", final_tolerance)) if value]
+    if loop_options and not closed_loop:
+        _fail(f"{' and '.join(loop_options)}: only with --closed-loop")
     loop = None
     if closed_loop:
         from stablepush.execution import ClosedLoop
 
         loop = ClosedLoop.for_task(task, replan_threshold, final_tolerance)
-    deviated = mu_scale != 1.0 or any(tracker_noise) or engine != DEFAULT_ENGINE
+    deviated = [name for name, given in (("--engine", engine != DEFAULT_ENGINE), ("--sim-mu-scale", mu_scale != 1.0),
+                                         ("--tracker-noise", any(tracker_noise))) if given]
     if deviated and not (sim and arm is None):
-        _fail("--engine, --sim-mu-scale and --tracker-noise: only with --sim (a simulated arm started here)")
-    if record_path and not record_path.endswith(".mcap"):
-        _fail(f"--record {record_path}: the file name must end in .mcap")
+        _fail(f"{' and '.join(deviated)}: only with --sim (a simulated arm started here)")
     if video_path:  # before the simulated arm loads MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
         _check_video("--video", video_path, video_fps, video_size)
     else:
@@ -875,7 +902,8 @@ def _vary(_ctx, _param, values):
               help="Write the summary and every trial as JSON.")
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row.")
 @click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
-              help="Draw the goal error's CDF against the tolerance, and success over the varied parameters (PNG).")
+              help="Draw the goal error's CDF against the tolerance, and success over the varied parameters (PNG, "
+                   "PDF or SVG, as the name ends).")
 @click.option("--video-failed", "video_dir", type=click.Path(file_okay=False), default=None, metavar="DIR",
               help="Draw each failed trial's run as a video, DIR/trial-<i>.mp4 (made if missing; as `execute "
                    "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv).")
@@ -911,8 +939,14 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         _video_settings_need("--video-failed")
     from stablepush.evaluation import Batch, Spreads, robust_task, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
+    from stablepush.outputs import check_outputs, require_suffix
     from stablepush.plan import check_plan, plan_task
     from stablepush.runners import default_workers
+    from stablepush.viz.figures import FIGURE_SUFFIXES
+
+    require_suffix("--plot", png_path, FIGURE_SUFFIXES)
+    check_outputs({"--json": json_path, "--csv": csv_path, "--plot": png_path},
+                  {"TASK.yaml": task_file, "--plan": plan_file})
 
     runner = _runner(workers, ray_address, default=default_workers())
     try:
@@ -998,10 +1032,11 @@ def _axis(_ctx, param, value):
     parts = value.split(":")
     try:
         start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
-        if len(parts) != 3 or not 1 <= count <= 1000:
+        if len(parts) != 3 or not 1 <= count <= 1000 or not (math.isfinite(start) and math.isfinite(stop)):
             raise ValueError
     except (ValueError, IndexError):
-        raise click.BadParameter(f"expected FROM:TO:COUNT with COUNT from 1 to 1000 (e.g. -10:10:11), got {value!r}")
+        raise click.BadParameter(f"expected FROM:TO:COUNT, finite numbers and COUNT from 1 to 1000 (e.g. -10:10:11), "
+                                 f"got {value!r}")
     return start, stop, count
 
 
@@ -1022,26 +1057,31 @@ def _axis(_ctx, param, value):
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the map: its cells (goal, verdict, reason, solved, seed, planning time, switch-overs).")
 @click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
-              help="Draw the map in slices of theta, beside the grasp at the start (PNG).")
+              help="Draw the map in slices of theta, beside the grasp at the start (PNG, PDF or SVG, as the name "
+                   "ends).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, workers, ray_address, json_path,
           png_path, quiet: bool) -> None:
     """Map where the pushers can take the object: plan from the task's start to every goal of a grid.
 
     Each cell is the task with its goal replaced, planned on its own. Its verdict: `reached`,
-    `unreachable` with the reason (decided exactly before any search: no grasp at the goal, or
-    none at the start), or `not found` within --time-limit. The same seed gives the same map,
-    whichever runner plans it.
+    `unreachable` with the reason (decided exactly before any search: no grasp at the goal or at
+    the start, every pusher excluded by the uncertainty box, no stable push out of the start, or a
+    min_hold_ratio the goal cannot meet), or `not found` within --time-limit. The same seed gives
+    the same map, whichever runner plans it.
 
     \b
     Example:
       stablepush reach data/tasks/t-shaped.yaml --x -20:20:9 --z -10:10:5 --theta 0:0:1 \\
           --json t.reach.json --plot t.reach.png
     """
-    from stablepush.outputs import write_atomically
+    from stablepush.outputs import check_outputs, require_suffix, write_atomically
     from stablepush.plan.reach import reach_map
     from stablepush.runners import default_workers
+    from stablepush.viz.figures import FIGURE_SUFFIXES
 
+    require_suffix("--plot", png_path, FIGURE_SUFFIXES)
+    check_outputs({"--json": json_path, "--plot": png_path}, {"TASK.yaml": task_file})
     runner = _runner(workers, ray_address, default=default_workers())
     task = _load(task_file)
     gx, gz, gth = task.goal

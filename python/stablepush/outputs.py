@@ -9,7 +9,7 @@ import signal
 import stat
 import threading
 from pathlib import Path
-from typing import Mapping, Union
+from typing import Mapping, Optional, Union
 
 from stablepush.errors import OutputError
 
@@ -34,23 +34,73 @@ def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
     umask's permissions; a replaced file keeps its own."""
     plan = []
     for path, content in files.items():
-        target = Path(os.path.realpath(path))
-        try:
-            mode = os.stat(target).st_mode
-        except FileNotFoundError:
-            mode = None
-        except OSError as exc:
-            raise OutputError(f"{path}: cannot write ({exc.strerror})") from None
-        if mode is not None and (stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)):
-            plan.append((path, target, content, "stream", None))
-        elif mode is not None and not stat.S_ISREG(mode):
-            raise OutputError(f"{path}: not a regular file; refusing to replace it")
-        elif not target.parent.is_dir():
-            raise OutputError(f"{path}: the directory {target.parent} does not exist")
-        else:
-            plan.append((path, target, content, "replace", stat.S_IMODE(mode) if mode is not None else None))
+        target, how, mode = _writable(path)
+        plan.append((path, target, content, how, mode))
     with _signals_deferred():
         _write_and_rename(plan)
+
+
+def _writable(path: Union[str, Path]):
+    """(target, "stream" or "replace", the replaced file's permissions or None) for an output path,
+    by write_files' rules; OutputError naming the path where it would refuse."""
+    target = Path(os.path.realpath(path))
+    try:
+        mode = os.stat(target).st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write ({exc.strerror})") from None
+    if mode is not None and (stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)):
+        return target, "stream", None
+    if mode is not None and not stat.S_ISREG(mode):
+        raise OutputError(f"{path}: not a regular file; refusing to replace it")
+    if not target.parent.is_dir():
+        raise OutputError(f"{path}: the directory {target.parent} does not exist")
+    return target, "replace", stat.S_IMODE(mode) if mode is not None else None
+
+
+def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
+                  inputs: Mapping[str, Optional[Union[str, Path]]] = None) -> None:
+    """Before any work is done: each output (option name -> path; None: not asked for) can be
+    written by write_files' rules, and none is one of the inputs (name -> path) or another output.
+    A plan written over its task file, or a CSV over its JSON, would lose a file without a word.
+    Streams (/dev/null, a FIFO) may be named more than once. OutputError names the option."""
+    seen = {}  # file identity -> what it already is
+    for name, path in (inputs or {}).items():
+        if path is not None and os.path.exists(path):
+            seen[_identity(path)] = f"the input {name}; refusing to write over it"
+    for name, path in outputs.items():
+        if path is None:
+            continue
+        try:
+            _, how, _ = _writable(path)
+        except OutputError as exc:
+            raise OutputError(f"{name} {exc}") from None
+        if how == "stream":
+            continue
+        key = _identity(path)
+        if key in seen:
+            raise OutputError(f"{name} {path}: is {seen[key]}")
+        seen[key] = f"also {name}'s output; give each output a file of its own"
+
+
+def require_suffix(name: str, path: Optional[Union[str, Path]], suffixes) -> None:
+    """Refuse an output whose file name does not end in one of `suffixes` (OutputError naming the
+    option): the file's kind is taken from it."""
+    suffixes = tuple(suffixes)
+    if path is not None and not str(path).lower().endswith(suffixes):
+        listed = suffixes[0] if len(suffixes) == 1 else f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
+        raise OutputError(f"{name} {path}: the file name must end in {listed}")
+
+
+def _identity(path: Union[str, Path]):
+    """What makes two paths one file: device and inode when it exists (hard links too), else the
+    resolved path."""
+    try:
+        info = os.stat(path)
+        return (info.st_dev, info.st_ino)
+    except OSError:
+        return os.path.realpath(path)
 
 
 def _write_and_rename(plan) -> None:

@@ -165,12 +165,12 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
             fail(field, f"must be a mapping, got {_json_kind(w)}")
         for key in ("x", "z", "theta"):
             if not is_finite_number(w.get(key)):
-                fail(f"{field}.{key}", f"must be a finite number, got {str(w.get(key))[:40]}")
+                fail(f"{field}.{key}", f"must be a finite number, got {_json_shown(w.get(key))}")
         if not (w.get("pusher") is None or isinstance(w.get("pusher"), str)):
             fail(f"{field}.pusher", f"must be a pusher name or null, got {_json_kind(w.get('pusher'))}")
         for key in ("margin", "margin_per_normal"):
             if w.get(key) is not None and not is_finite_number(w[key]):
-                fail(f"{field}.{key}", f"must be a finite number or null, got {str(w[key])[:40]}")
+                fail(f"{field}.{key}", f"must be a finite number or null, got {_json_shown(w[key])}")
         if not (w.get("case") is None or isinstance(w["case"], str)):
             fail(f"{field}.case", f"must be a string or null, got {_json_kind(w['case'])}")
         contact = w.get("pusher_in_gripper")
@@ -198,6 +198,12 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
 
 
 _KIND_NAMES = {str: "string", dict: "mapping", list: "list"}
+
+
+def _json_shown(v, limit: int = 40) -> str:
+    """A JSON value for a message, as JSON writes it (a string in quotes), cut to `limit` characters."""
+    text = json.dumps(v, allow_nan=True, default=str)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _json_kind(v) -> str:

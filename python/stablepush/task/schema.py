@@ -245,6 +245,9 @@ def pose_field(path: str, value: Any) -> Tuple[float, float, float]:
 
 
 def _name(path: str, value: Any) -> str:
+    if isinstance(value, (bool, int, float)):  # YAML 1.1 reads no, off, yes, on as booleans, 007 as 7
+        raise TaskError(path, f"must be a non-empty string, got {_shown(value)}: YAML read it as a "
+                              f"{'boolean' if isinstance(value, bool) else 'number'}; put the name in quotes")
     if not isinstance(value, str) or not value.strip():
         raise TaskError(path, f"must be a non-empty string, got {_shown(value)}")
     if len(value) > 100 or any(not ch.isprintable() for ch in value):

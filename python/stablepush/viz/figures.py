@@ -26,7 +26,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from stablepush.execution.world import contacts_of
 from stablepush.frames import in_gripper
-from stablepush.outputs import write_atomically
+from stablepush.outputs import require_suffix, write_atomically
 from stablepush.plan.plan import Plan, Waypoint
 from stablepush.task.model import Task
 
@@ -156,7 +156,8 @@ def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
 
 def save_plan_gif(task: Task, plan: Plan, path: str, max_frames: int = 80) -> None:
     """The plan animated, one frame per step (thinned to at most `max_frames`); `plan` as for
-    plan_figure."""
+    plan_figure. OutputError unless `path` ends in .gif."""
+    require_suffix("gif", path, (".gif",))
     steps = plan.waypoints
     fig = Figure(figsize=(4, 4))
     ax = fig.subplots()
@@ -174,10 +175,15 @@ def save_plan_gif(task: Task, plan: Plan, path: str, max_frames: int = 80) -> No
         write_atomically(path, Path(scratch, "plan.gif").read_bytes())
 
 
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg")  # what save_figure writes, by the file name's ending
+
+
 def save_figure(fig, path: str, dpi: int = 110) -> None:
-    """Write a figure as PNG the way every output is written (stablepush.outputs.write_files)."""
+    """Write a figure as PNG, PDF or SVG, as the file name ends (FIGURE_SUFFIXES; OutputError for any
+    other), the way every output is written (stablepush.outputs.write_files)."""
+    require_suffix("figure", path, FIGURE_SUFFIXES)
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
+    fig.savefig(buffer, format=Path(path).suffix.lower()[1:], dpi=dpi, bbox_inches="tight")
     write_atomically(path, buffer.getvalue())
 
 
