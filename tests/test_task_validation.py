@@ -192,3 +192,35 @@ def test_too_many_pushers_is_refused():
     with pytest.raises(TaskError) as err:
         task_with("horizontal-offset-low-mu", many)
     assert err.value.field == "pushers" and "at most 32" in err.value.reason
+
+
+STRAIGHT_VERTICES = """
+name: straight
+object:
+  shape: polygon
+  polygon: [[-30, -10], [0, -10], [30, -10], [30, 10], [0, 25], [-30, 10], [-30, 0]]
+  mass: 50
+gripper: {grip_force: 10, mu: 0.5}
+gravity: [0, -9.81]
+pushers:
+  - {name: bottom, from: [-20, -10], to: [20, -10], mu: 0.5}
+  - {name: pin, at: [0, -10], mu: 0.5}
+  - {name: side, at: [-30, 0], mu: 0.5}
+start: [0, 0, 0]
+goal: [0, 3, 0]
+"""
+
+
+def test_a_polygons_straight_vertices_are_no_corners():
+    """(0, -10) and (-30, 0) lie on straight edges of the outline, as CAD outlines have them: a
+    segment pusher across one and point pushers at them were refused as off the boundary or 'on a
+    vertex, where its normal is ambiguous'."""
+    from stablepush.task import parse_task
+
+    task = parse_task(STRAIGHT_VERTICES)
+    assert task.vertices == ((-30, -10), (30, -10), (30, 10), (0, 25), (-30, 10))
+    normals = [tuple(round(c, 12) for c in p.inward_normal) for p in task.build_model().pushers]
+    assert normals == [(0.0, 1.0), (0.0, 1.0), (1.0, 0.0)]
+    corner = STRAIGHT_VERTICES.replace("{name: side, at: [-30, 0], mu: 0.5}", "{name: side, at: [30, 10], mu: 0.5}")
+    with pytest.raises(TaskError, match="sits on a vertex of the object"):
+        parse_task(corner)

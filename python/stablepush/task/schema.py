@@ -457,7 +457,8 @@ def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
         if not isinstance(poly, list) or not 3 <= len(poly) <= MAX_VERTICES:
             raise TaskError("object.polygon", f"must be a list of 3 to {MAX_VERTICES} [x, z] vertices"
                                               + (f", got {len(poly)}" if isinstance(poly, list) else ""))
-        vertices = tuple(_vector(f"object.polygon[{i}]", v, 2, COORDINATE) for i, v in enumerate(poly))
+        vertices = _without_straight_vertices(
+            tuple(_vector(f"object.polygon[{i}]", v, 2, COORDINATE) for i, v in enumerate(poly)))
         thickness = _number("object.thickness", obj.get("thickness", 25.0), LIMITS["length"])
     else:
         raise TaskError("object.shape", f"must be box, polygon or mesh, got {_shown(shape)}")
@@ -465,6 +466,30 @@ def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
     com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else None
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else None
     return vertices, thickness, mass, com, inertia
+
+
+def _without_straight_vertices(vertices: Tuple[Tuple[float, float], ...]) -> Tuple[Tuple[float, float], ...]:
+    """The outline without its straight vertices: those within ON_BOUNDARY of the segment between
+    their neighbours, and between them. They are no corners (CAD outlines have them), and the core
+    takes each edge as one face, so a pusher across one, or at one, would be refused as off the
+    boundary or on a corner. The shape is the same to within ON_BOUNDARY."""
+    kept = list(vertices)
+    dropped = True
+    while dropped and len(kept) > 3:
+        dropped = False
+        for i in range(len(kept)):
+            prev, v, after = np.array(kept[i - 1]), np.array(kept[i]), np.array(kept[(i + 1) % len(kept)])
+            chord = after - prev
+            length = float(np.hypot(*chord))
+            if length == 0.0:
+                continue  # a repeated vertex: CrossSection.defect names it
+            along = float(np.dot(v - prev, chord)) / length
+            off = abs(float(chord[0] * (v - prev)[1] - chord[1] * (v - prev)[0])) / length
+            if off <= ON_BOUNDARY and 0.0 < along < length:
+                del kept[i]
+                dropped = True
+                break
+    return tuple(kept)
 
 
 def _onto_edge(section: "_core.CrossSection", edge: int, p: Tuple[float, float]) -> Tuple[float, float]:
