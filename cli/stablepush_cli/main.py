@@ -422,11 +422,11 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     """
     from pathlib import Path
 
-    from stablepush.outputs import check_outputs, require_suffix
+    from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, require_suffix
     from stablepush.viz import figures
 
     png_path = png_path or str(Path(plan_file).with_suffix("").with_suffix(".png"))
-    require_suffix("-o", png_path, figures.FIGURE_SUFFIXES)
+    require_suffix("-o", png_path, FIGURE_SUFFIXES)
     require_suffix("--gif", gif_path, (".gif",))
     check_outputs({"-o": png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file, require_solved=False)
@@ -501,13 +501,13 @@ def cone(task_file: str, pusher: str, png_path) -> None:
     Example:
       stablepush cone data/tasks/pivoting.yaml --pusher left -o left-cone.png
     """
-    from stablepush.outputs import check_outputs, default_output, require_suffix
+    from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, default_output, require_suffix
     from stablepush.viz import figures
 
     task = _load(task_file)
     task.pusher_index(pusher)
     png_path = png_path or default_output(task_file, f".{pusher}.cone.png")
-    require_suffix("-o", png_path, figures.FIGURE_SUFFIXES)
+    require_suffix("-o", png_path, FIGURE_SUFFIXES)
     check_outputs({"-o": png_path}, {"TASK.yaml": task_file})
     figures.save_figure(figures.cone_figure(task, pusher), png_path)
     click.echo(f"figure written to {png_path}")
@@ -939,10 +939,9 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         _video_settings_need("--video-failed")
     from stablepush.evaluation import Batch, Spreads, robust_task, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
-    from stablepush.outputs import check_outputs, require_suffix
+    from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, require_suffix
     from stablepush.plan import check_plan, plan_task
     from stablepush.runners import default_workers
-    from stablepush.viz.figures import FIGURE_SUFFIXES
 
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_outputs({"--json": json_path, "--csv": csv_path, "--plot": png_path},
@@ -1075,10 +1074,9 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
       stablepush reach data/tasks/t-shaped.yaml --x -20:20:9 --z -10:10:5 --theta 0:0:1 \\
           --json t.reach.json --plot t.reach.png
     """
-    from stablepush.outputs import check_outputs, require_suffix, write_atomically
+    from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, require_suffix, write_atomically
     from stablepush.plan.reach import reach_map
     from stablepush.runners import default_workers
-    from stablepush.viz.figures import FIGURE_SUFFIXES
 
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_outputs({"--json": json_path, "--plot": png_path}, {"TASK.yaml": task_file})

@@ -13,6 +13,8 @@ from typing import Mapping, Optional, Union
 
 from stablepush.errors import OutputError
 
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg")  # what a figure is written as, by the file name's ending
+
 
 def default_output(input_file: Union[str, Path], suffix: str) -> str:
     """The default output for an input file: its stem plus `suffix`, in the current directory.

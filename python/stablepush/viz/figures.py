@@ -26,7 +26,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from stablepush.execution.world import contacts_of
 from stablepush.frames import in_gripper
-from stablepush.outputs import require_suffix, write_atomically
+from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_atomically
 from stablepush.plan.plan import Plan, Waypoint
 from stablepush.task.model import Task
 
@@ -173,9 +173,6 @@ def save_plan_gif(task: Task, plan: Plan, path: str, max_frames: int = 80) -> No
     with tempfile.TemporaryDirectory() as scratch:  # Pillow writes a path; the output is then written safely
         anim.save(os.path.join(scratch, "plan.gif"), writer=animation.PillowWriter(fps=10))
         write_atomically(path, Path(scratch, "plan.gif").read_bytes())
-
-
-FIGURE_SUFFIXES = (".png", ".pdf", ".svg")  # what save_figure writes, by the file name's ending
 
 
 def save_figure(fig, path: str, dpi: int = 110) -> None:
