@@ -68,6 +68,9 @@ def _edited(tmp_path, old, new, name="task.yaml"):
     ("name: horizontal-offset-low-mu", "name: \"a\\0b\"", "name: must be at most 100 printable characters"),
     ("name: horizontal-offset-low-mu", "name: " + "[" * 3000 + "]" * 3000, "values nested too deeply"),
     ("name: horizontal-offset-low-mu", "name: x\n? [1, 2]\n: y", "a mapping key must be a name, got a list"),
+    # A duplicate key was named without its mapping ("mass: duplicate key").
+    ("  mass: 202                    # g", "  mass: 202\n  mass: 203", "object.mass: duplicate key (line 21)"),
+    ("name: right", "name: right, name: again", "pushers[1].name: duplicate key"),
     # YAML 1.1 reads no/off/yes/on as booleans: the message said only "got False".
     ("name: horizontal-offset-low-mu", "name: no",
      "name: must be a non-empty string, got False: YAML read it as a boolean; put the name in quotes"),

@@ -151,6 +151,22 @@ def _expanded_size(node: yaml.Node) -> int:
     return size(node)
 
 
+def _refuse_duplicate_keys(node: yaml.Node, path: str) -> None:
+    """TaskError naming the dotted path of a key written twice in one mapping (`object.mass`), before
+    anything is constructed; _construct_mapping still refuses keys equal only once read (1 and 1.0)."""
+    if isinstance(node, yaml.MappingNode):
+        seen = set()
+        for key_node, value_node in node.value:
+            key = key_node.value if isinstance(key_node, yaml.ScalarNode) else None
+            if key is not None and (key_node.tag, key) in seen:
+                raise TaskError(_join(path, key), f"duplicate key (line {key_node.start_mark.line + 1})")
+            seen.add((key_node.tag, key))
+            _refuse_duplicate_keys(value_node, _join(path, key) if key is not None else path)
+    elif isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            _refuse_duplicate_keys(item, f"{path}[{i}]")
+
+
 def _load_yaml(text: str) -> Any:
     if len(text) > MAX_TASK_BYTES:
         raise TaskError("", f"the file has {len(text)} characters; a task file has at most {MAX_TASK_BYTES}")
@@ -160,6 +176,7 @@ def _load_yaml(text: str) -> Any:
         if node is None:
             return None
         _expanded_size(node)
+        _refuse_duplicate_keys(node, "")
         return loader.construct_document(node)
     except RecursionError:
         raise TaskError("", "values nested too deeply") from None
