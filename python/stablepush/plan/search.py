@@ -16,7 +16,7 @@ from stablepush.errors import TaskError
 from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.plan.unreachable import why_unreachable
-from stablepush.task.model import Task
+from stablepush.task.model import Task, outline_corners
 from stablepush.task.schema import PLANNER_TUNING, planner_limit, planner_parameter
 from stablepush.units import MM, pose_from_si, pose_to_si
 
@@ -187,8 +187,8 @@ def _check_models(task: Task, models) -> None:
     for k, m in enumerate(models):
         if not isinstance(m, _core.StablePushModel):
             raise TypeError(f"models[{k}]: expected a StablePushModel (task.corner_models()), got {type(m).__name__}")
-        vertices = m.section.vertices
-        same = len(m.pushers) == len(task.pushers) and len(vertices) == len(task.vertices) and all(
-            abs(a[0] - b[0] * MM) <= 1e-9 and abs(a[1] - b[1] * MM) <= 1e-9 for a, b in zip(vertices, task.vertices))
+        vertices, corners = m.section.vertices, outline_corners(task.vertices)
+        same = len(m.pushers) == len(task.pushers) and len(vertices) == len(corners) and all(
+            abs(a[0] - b[0] * MM) <= 1e-9 and abs(a[1] - b[1] * MM) <= 1e-9 for a, b in zip(vertices, corners))
         if not same:
             raise ValueError(f"models[{k}]: not a model of task {task.name!r} (another object, or other pushers)")

@@ -24,6 +24,45 @@ UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers[].mu", "grip_force": 
              "mass": "object.mass"}
 
 
+ON_BOUNDARY = 1e-6  # mm: closer than this, a point is on an edge (the core's tolerance, 1e-9 m)
+
+
+def outline_corners(vertices: Sequence[Tuple[float, float]]) -> Tuple[Tuple[float, float], ...]:
+    """The outline's vertices less its straight ones, as the core takes them (mm, in order).
+
+    A vertex is straight when it lies within ON_BOUNDARY of the segment between its neighbours and
+    between them; CAD outlines have them. The core takes each edge as one face, so a pusher across
+    a straight vertex would be off every edge and one at it on a corner. A run of straight vertices
+    between two corners is dropped only when every one of them lies within ON_BOUNDARY of the
+    segment joining those corners, in order along it, so the shape stays the same to ON_BOUNDARY.
+    An outline with fewer than three corners is returned as it is (CrossSection.defect names it)."""
+    n = len(vertices)
+
+    def straight(a, v, b) -> bool:
+        chord = (b[0] - a[0], b[1] - a[1])
+        length = math.hypot(*chord)
+        if length == 0.0:
+            return False
+        along = ((v[0] - a[0]) * chord[0] + (v[1] - a[1]) * chord[1]) / length
+        off = abs(chord[0] * (v[1] - a[1]) - chord[1] * (v[0] - a[0])) / length
+        return off <= ON_BOUNDARY and 0.0 < along < length
+
+    corners = [i for i in range(n) if not straight(vertices[i - 1], vertices[i], vertices[(i + 1) % n])]
+    if len(corners) < 3:
+        return tuple(vertices)
+    kept = []
+    for k, a in enumerate(corners):
+        b = corners[(k + 1) % len(corners)]
+        run = [(a + j) % n for j in range(1, (b - a) % n)]
+        kept.append(a)
+        line = [vertices[a]] + [vertices[i] for i in run] + [vertices[b]]
+        on_one_edge = all(straight(vertices[a], vertices[i], vertices[b]) for i in run) and all(
+            straight(p, q, vertices[b]) for p, q in zip(line, line[1:-1]))  # in order along the edge
+        if not on_one_edge:
+            kept.extend(run)
+    return tuple(vertices[i] for i in kept)
+
+
 @dataclass(frozen=True)
 class PusherSpec:
     """A pusher as the task gives it, in O [mm]; `a == b` for a point pusher."""
@@ -148,7 +187,8 @@ class Task:
             raise TaskError("pusher", f"no pusher named {name!r} (the task has {', '.join(self.pusher_names)})")
 
     def section(self) -> "_core.CrossSection":
-        return _core.CrossSection([mm2_to_si(v) for v in self.vertices])
+        """The core's cross-section: the outline's corners (outline_corners), in m."""
+        return _core.CrossSection([mm2_to_si(v) for v in outline_corners(self.vertices)])
 
     def rigid_body(self, section: "Optional[_core.CrossSection]" = None) -> "_core.RigidBody":
         """The object's mass [kg], com [m, in O] and moment of inertia about y at the com [kg m^2]."""

@@ -5,6 +5,7 @@ names the field and the reason, before anything reaches the C++ core.
 """
 from __future__ import annotations
 
+import datetime
 import math
 import re
 import reprlib
@@ -17,7 +18,7 @@ import yaml
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.inputs import read_capped
-from stablepush.task.model import PUSHES, UNCERTAIN, PusherSpec, Task, make_gripper
+from stablepush.task.model import ON_BOUNDARY, PUSHES, UNCERTAIN, PusherSpec, Task, make_gripper, outline_corners
 from stablepush.units import MM, mm2_to_si, pose_to_si
 
 DEFAULT_PAD_RADIUS_MM = 5.0
@@ -27,7 +28,6 @@ DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
 SNAP_TO_EDGE = 0.05  # mm: a pusher this close to an edge is put on it (a warning says so)
-ON_BOUNDARY = 1e-6  # mm: closer than this, a pusher is on its edge (the core's tolerance)
 # Resource caps: each bounds the model's size (and so the time and memory to build it and to
 # test a push) before anything reaches the core. docs/limits.md, "Limits".
 MAX_TASK_BYTES = 1_000_000
@@ -262,9 +262,10 @@ def pose_field(path: str, value: Any) -> Tuple[float, float, float]:
 
 
 def _name(path: str, value: Any) -> str:
-    if isinstance(value, (bool, int, float)):  # YAML 1.1 reads no, off, yes, on as booleans, 007 as 7
-        raise TaskError(path, f"must be a non-empty string, got {_shown(value)}: YAML read it as a "
-                              f"{'boolean' if isinstance(value, bool) else 'number'}; put the name in quotes")
+    if isinstance(value, (bool, int, float, datetime.date)):  # YAML 1.1: no/off/yes/on, 007, 2024-01-01
+        kind = "boolean" if isinstance(value, bool) else "date" if isinstance(value, datetime.date) else "number"
+        raise TaskError(path, f"must be a non-empty string, got {_shown(value)}: YAML read it as a {kind}; put "
+                              f"the name in quotes")
     if not isinstance(value, str) or not value.strip():
         raise TaskError(path, f"must be a non-empty string, got {_shown(value)}")
     if len(value) > 100 or any(not ch.isprintable() for ch in value):
@@ -323,11 +324,10 @@ def _validate(data: Any, source: Optional[str]) -> Task:
     notes: List[str] = []
     vertices, thickness, mass, com, inertia = _validate_object(top["object"], source, notes)
 
-    vertices_m = [mm2_to_si(v) for v in vertices]
-    section_defect = _core.CrossSection.defect(vertices_m)
+    section_defect = _core.CrossSection.defect([mm2_to_si(v) for v in vertices])  # numbered as written
     if section_defect:
         raise TaskError("object.polygon", section_defect)
-    section = _core.CrossSection(vertices_m)
+    section = _core.CrossSection([mm2_to_si(v) for v in outline_corners(vertices)])
 
     grip = _mapping("gripper", top["gripper"], ["grip_force", "mu"], ["pad_rings", "pads"])
     grip_force = _number("gripper.grip_force", grip["grip_force"], LIMITS["force"])
@@ -474,8 +474,7 @@ def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
         if not isinstance(poly, list) or not 3 <= len(poly) <= MAX_VERTICES:
             raise TaskError("object.polygon", f"must be a list of 3 to {MAX_VERTICES} [x, z] vertices"
                                               + (f", got {len(poly)}" if isinstance(poly, list) else ""))
-        vertices = _without_straight_vertices(
-            tuple(_vector(f"object.polygon[{i}]", v, 2, COORDINATE) for i, v in enumerate(poly)))
+        vertices = tuple(_vector(f"object.polygon[{i}]", v, 2, COORDINATE) for i, v in enumerate(poly))
         thickness = _number("object.thickness", obj.get("thickness", 25.0), LIMITS["length"])
     else:
         raise TaskError("object.shape", f"must be box, polygon or mesh, got {_shown(shape)}")
@@ -483,30 +482,6 @@ def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
     com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else None
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else None
     return vertices, thickness, mass, com, inertia
-
-
-def _without_straight_vertices(vertices: Tuple[Tuple[float, float], ...]) -> Tuple[Tuple[float, float], ...]:
-    """The outline without its straight vertices: those within ON_BOUNDARY of the segment between
-    their neighbours, and between them. They are no corners (CAD outlines have them), and the core
-    takes each edge as one face, so a pusher across one, or at one, would be refused as off the
-    boundary or on a corner. The shape is the same to within ON_BOUNDARY."""
-    kept = list(vertices)
-    dropped = True
-    while dropped and len(kept) > 3:
-        dropped = False
-        for i in range(len(kept)):
-            prev, v, after = np.array(kept[i - 1]), np.array(kept[i]), np.array(kept[(i + 1) % len(kept)])
-            chord = after - prev
-            length = float(np.hypot(*chord))
-            if length == 0.0:
-                continue  # a repeated vertex: CrossSection.defect names it
-            along = float(np.dot(v - prev, chord)) / length
-            off = abs(float(chord[0] * (v - prev)[1] - chord[1] * (v - prev)[0])) / length
-            if off <= ON_BOUNDARY and 0.0 < along < length:
-                del kept[i]
-                dropped = True
-                break
-    return tuple(kept)
 
 
 def _onto_edge(section: "_core.CrossSection", edge: int, p: Tuple[float, float]) -> Tuple[float, float]:
@@ -584,7 +559,10 @@ def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str
             a, b = (_onto_edge(section, edge, a), _onto_edge(section, edge, b))
             if a == b and points > 1:
                 raise TaskError(path, "lies across a vertex; it must lie along one edge")
-            notes.append(f"{path}: {distance / MM:.3g} mm off the object's edge {edge}; moved onto it")
+            corners = section.vertices
+            ends = [tuple(round(c / MM, 6) for c in corners[i % len(corners)]) for i in (edge, edge + 1)]
+            notes.append(f"{path}: {distance / MM:.3g} mm off the object's edge from {ends[0]} to {ends[1]} mm; "
+                         f"moved onto it")
         try:
             _core.Pusher.on_boundary(section, name, mm2_to_si(a), mm2_to_si(b), mu, points)
         except ValueError as exc:
