@@ -263,7 +263,8 @@ def _plan_and_task(tmp_path):
 @pytest.mark.parametrize("args, says", [
     (["plan", "{task}", "-o", "{task}"], "-o {task}: is the input TASK.yaml; refusing to write over it"),
     (["plan", "{task}", "-o", "{link}"], "-o {link}: is the input TASK.yaml; refusing to write over it"),
-    (["plan", "{task}", "-o", "{dir}/a.json", "--csv", "{dir}/a.json"], "--csv {dir}/a.json: is also -o's output"),
+    (["plan", "{task}", "-o", "{dir}/a.json", "--csv", "{dir}/a.json"], "--csv {dir}/a.json: is also the output of -o"),
+    (["plan", "{task}", "--csv", "{dir}/task.plan.json"], "--csv {dir}/task.plan.json: is also the output of the default -o"),
     (["show", "{plan}", "--task", "{task}", "-o", "{plan}"], "-o {plan}: the file name must end in .png, .pdf or .svg"),
     (["show", "{plan}", "--task", "{task}", "-o", "{dir}/p.jpg"], "the file name must end in .png, .pdf or .svg"),
     (["show", "{plan}", "--task", "{task}", "-o", "{dir}/p.png", "--gif", "{dir}/p.png"],
@@ -282,9 +283,11 @@ def _plan_and_task(tmp_path):
     (["evaluate", "{task}", "--plan", "{plan}", "--trials", "1", "--workers", "1", "--csv", "{plan}"],
      "--csv {plan}: is the input --plan; refusing to write over it"),
 ])
-def test_an_output_over_an_input_another_output_or_unwritable_is_refused_before_any_work(tmp_path, args, says):
-    """Each used to be written after the work: over the task or plan (lost without a word), over the
-    other output, as PNG bytes under a .pdf name, or after a whole reach map had been planned."""
+def test_an_output_over_an_input_another_output_or_unwritable_is_refused_before_any_work(tmp_path, monkeypatch, args,
+                                                                                         says):
+    """Each was written after the work: over the task or plan (lost without a word), over the other
+    output, as PNG bytes under a .pdf name, or after a whole reach map had been planned."""
+    monkeypatch.chdir(tmp_path)  # where default outputs go
     task, plan = _plan_and_task(tmp_path)
     (tmp_path / "link.yaml").symlink_to(task)
     names = {"task": task, "plan": plan, "dir": tmp_path, "link": tmp_path / "link.yaml"}
@@ -322,6 +325,22 @@ def test_figures_are_written_in_the_format_their_name_asks(tmp_path):
         result = CliRunner().invoke(cli, ["show", str(plan), "--task", str(task), "-o", str(out)])
         assert result.exit_code == 0, result.output
         assert out.read_bytes().startswith(magic)
+
+
+def test_an_upper_case_suffix_picks_the_format_as_a_lower_case_one(tmp_path):
+    task, plan = _plan_and_task(tmp_path)
+    out = tmp_path / "T.JSON"
+    result = CliRunner().invoke(cli, ["trajectory", str(plan), "--task", str(task), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert json.loads(out.read_text())["columns"][0] == "t"
+
+
+def test_a_plan_written_to_dev_stdout_into_a_pipe_reaches_the_pipe():
+    """/dev/stdout into a pipe resolves to no file name; it was taken for a new file and refused."""
+    run = subprocess.run([sys.executable, "-m", "stablepush_cli.main", "plan", str(LOW_MU), "-o", "/dev/stdout",
+                          "--quiet"], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert json.loads(run.stdout)["format"] == "stablepush.plan/1"
 
 
 def test_a_closed_output_pipe_ends_quietly_with_the_sigpipe_status():

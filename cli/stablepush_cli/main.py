@@ -199,8 +199,9 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     from stablepush.outputs import check_outputs, default_output
     from stablepush.plan import plan_task, write_plan
 
+    json_label = "-o" if json_path else "the default -o"
     json_path = json_path or default_output(task_file, ".plan.json")
-    check_outputs({"-o": json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
+    check_outputs({json_label: json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
     task = _load(task_file)
     result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
     write_plan(result, json_path, csv_path)
@@ -369,7 +370,7 @@ def _write_bench(path: str, trials, rows) -> None:
     from stablepush.outputs import write_atomically
 
     records = [dataclasses.asdict(t) for t in trials]
-    if path.endswith(".json"):
+    if path.lower().endswith(".json"):
         write_atomically(path, json.dumps({"trials": records, "summary": rows}, indent=1) + "\n")
         return
     buffer = io.StringIO()
@@ -425,10 +426,11 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, require_suffix
     from stablepush.viz import figures
 
+    png_label = "-o" if png_path else "the default -o"
     png_path = png_path or str(Path(plan_file).with_suffix("").with_suffix(".png"))
-    require_suffix("-o", png_path, FIGURE_SUFFIXES)
+    require_suffix(png_label, png_path, FIGURE_SUFFIXES)
     require_suffix("--gif", gif_path, (".gif",))
-    check_outputs({"-o": png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})
+    check_outputs({png_label: png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file, require_solved=False)
     figures.save_figure(figures.plan_figure(task, plan), png_path)
     click.echo(f"figure written to {png_path}")
@@ -474,12 +476,12 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
     check_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file)
     traj = timed_trajectory(task, plan, rate_hz)
-    if out_path.endswith(".mcap"):
+    if out_path.lower().endswith(".mcap"):
         from stablepush.execution.bags import write_bag
 
         write_bag(out_path, task, plan, traj)
     else:
-        write_atomically(out_path, traj.to_json(quat) if out_path.endswith(".json") else traj.to_csv(quat))
+        write_atomically(out_path, traj.to_json(quat) if out_path.lower().endswith(".json") else traj.to_csv(quat))
     click.echo(f"{task.name}: {len(traj)} samples at {rate_hz:g} Hz, {traj.t[-1]:.2f} s, "
                f"{len(plan.waypoints) - 1} pushes; written to {out_path}")
 
@@ -506,9 +508,10 @@ def cone(task_file: str, pusher: str, png_path) -> None:
 
     task = _load(task_file)
     task.pusher_index(pusher)
+    png_label = "-o" if png_path else "the default -o"
     png_path = png_path or default_output(task_file, f".{pusher}.cone.png")
-    require_suffix("-o", png_path, FIGURE_SUFFIXES)
-    check_outputs({"-o": png_path}, {"TASK.yaml": task_file})
+    require_suffix(png_label, png_path, FIGURE_SUFFIXES)
+    check_outputs({png_label: png_path}, {"TASK.yaml": task_file})
     figures.save_figure(figures.cone_figure(task, pusher), png_path)
     click.echo(f"figure written to {png_path}")
 

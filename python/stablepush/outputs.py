@@ -45,15 +45,15 @@ def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
 def _writable(path: Union[str, Path]):
     """(target, "stream" or "replace", the replaced file's permissions or None) for an output path,
     by write_files' rules; OutputError naming the path where it would refuse."""
-    target = Path(os.path.realpath(path))
-    try:
-        mode = os.stat(target).st_mode
+    try:  # the path as given: /dev/stdout into a pipe resolves to no file name, but stats as the pipe
+        mode = os.stat(path).st_mode
     except FileNotFoundError:
         mode = None
     except OSError as exc:
         raise OutputError(f"{path}: cannot write ({exc.strerror})") from None
     if mode is not None and (stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)):
-        return target, "stream", None
+        return Path(path), "stream", None
+    target = Path(os.path.realpath(path))
     if mode is not None and not stat.S_ISREG(mode):
         raise OutputError(f"{path}: not a regular file; refusing to replace it")
     if not target.parent.is_dir():
@@ -83,7 +83,7 @@ def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
         key = _identity(path)
         if key in seen:
             raise OutputError(f"{name} {path}: is {seen[key]}")
-        seen[key] = f"also {name}'s output; give each output a file of its own"
+        seen[key] = f"also the output of {name}; give each output a file of its own"
 
 
 def require_suffix(name: str, path: Optional[Union[str, Path]], suffixes) -> None:

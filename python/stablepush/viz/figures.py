@@ -1,7 +1,8 @@
 """Figures of plans and pusher cones: `stablepush show` and `stablepush cone`.
 
 Figures are `matplotlib.figure.Figure` objects made without pyplot, so drawing one neither needs
-nor changes the caller's plotting backend; `save_figure` renders PNG with Agg.
+nor changes the caller's plotting backend; `save_figure` renders PNG, PDF or SVG, as the file
+name ends.
 
 `plan_figure` draws, as the paper's fig. 1 does, snapshots of the object in the grasp along the
 plan (outline, pads, the active pusher thick and coloured, switch-overs marked) above x, z and
@@ -157,7 +158,7 @@ def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
 def save_plan_gif(task: Task, plan: Plan, path: str, max_frames: int = 80) -> None:
     """The plan animated, one frame per step (thinned to at most `max_frames`); `plan` as for
     plan_figure. OutputError unless `path` ends in .gif."""
-    require_suffix("gif", path, (".gif",))
+    require_suffix("the animation", path, (".gif",))
     steps = plan.waypoints
     fig = Figure(figsize=(4, 4))
     ax = fig.subplots()
@@ -176,11 +177,13 @@ def save_plan_gif(task: Task, plan: Plan, path: str, max_frames: int = 80) -> No
 
 
 def save_figure(fig, path: str, dpi: int = 110) -> None:
-    """Write a figure as PNG, PDF or SVG, as the file name ends (FIGURE_SUFFIXES; OutputError for any
-    other), the way every output is written (stablepush.outputs.write_files)."""
-    require_suffix("figure", path, FIGURE_SUFFIXES)
+    """Write a figure as PNG, PDF or SVG, as the file name ends (PNG when it has no suffix; OutputError
+    for any other), the way every output is written (stablepush.outputs.write_files)."""
+    suffix = Path(path).suffix.lower()
+    if suffix:
+        require_suffix("the figure", path, FIGURE_SUFFIXES)
     buffer = io.BytesIO()
-    fig.savefig(buffer, format=Path(path).suffix.lower()[1:], dpi=dpi, bbox_inches="tight")
+    fig.savefig(buffer, format=suffix[1:] or "png", dpi=dpi, bbox_inches="tight")
     write_atomically(path, buffer.getvalue())
 
 
