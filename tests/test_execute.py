@@ -633,3 +633,33 @@ def test_an_arm_that_never_moves_ends_the_run_in_a_fault_and_is_stopped():
         execute_plan(task, check_plan(task, plan_task(task, seed=1)), "127.0.0.1", arm.port, rate_hz=100.0,
                      pace=False)
     assert arm.stopped and fault.value.last_confirmed_step < 20
+
+
+def test_closed_loop_corrects_before_the_last_pose_a_switch_over_is_held_from(capsys):
+    """The high-mu offset in a world of 5% less pad mu and 3% less grip (trial 62 of its 1,000-trial
+    row): the left pusher sags the prism in the grasp, past the re-plan threshold only at step 12,
+    where the pads hold 1.45 times its weight and no correction may switch to the bottom pusher to
+    lift it; it ended 0.54 mm / +0.59 deg off. Compared with the final tolerance after the last push
+    from which a switch-over is held (step 9), it is corrected there, with the bottom pusher, and
+    lands."""
+    from stablepush.execution.closed_loop import ClosedLoop, switch_held
+    from stablepush.execution.guard import GuardedApproach
+    from stablepush.sim.arm import WorldDeviation
+
+    task = shipped("horizontal-offset-high-mu")
+    plan = check_plan(task, plan_task(task, seed=1))
+    held = [switch_held(task, w.pose, "left") for w in plan.waypoints]
+    assert held[:10] == [True] * 10 and not any(held[10:])
+    world = WorldDeviation(pad_mu_scale=0.9523, pusher_mu_scale=1.0546, grip_scale=0.9652, mass_scale=1.0496,
+                           feature_offsets=(("left", -0.1479, -0.3143, -0.4517), ("right", -0.3103, 0.4178, -0.1418),
+                                            ("bottom", 0.2014, -0.2901, 0.0598)))
+    with running_sim_arm(log=lambda text: None, deviation=world) as server:
+        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
+                              guard=GuardedApproach(), closed_loop=ClosedLoop.for_task(task),
+                              success_tolerance=(0.5, 0.5))
+    assert report.success is True, (report.goal_error, report.verdict.detail)
+    first = report.replans[0]
+    assert first.trigger == "last_switch" and first.after_step == 9 and first.solved
+    assert first.pushers[0] == "bottom"
+    _print_report(report)
+    assert "after step 9, the last a switch-over is held from: off the plan by" in capsys.readouterr().out

@@ -835,6 +835,7 @@ def _print_report(report) -> None:
             outcome = f"no correction taken: {r.failure}; kept the plan"
         when = {"off_goal": f"after step {r.after_step}: off the goal by",
                 "on_touch": f"on the feature of step {r.after_step + 1}: off the plan by",
+                "last_switch": f"after step {r.after_step}, the last a switch-over is held from: off the plan by",
                 "plan_short": "before the first push: the plan ends off the goal by"}.get(
             r.trigger, f"after step {r.after_step}: off the plan by")
         click.echo(f"  {when} {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; {outcome} ({r.planning_ms:.1f} ms)")

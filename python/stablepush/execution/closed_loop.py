@@ -3,7 +3,11 @@ observable, so as the object comes onto each feature and after each push the exe
 the tracker's pose (`object_in_grasp` in the arm protocol) with the plan's and, past a threshold,
 re-plans from the measured pose. On the feature of the plan's last contact the threshold is the
 final tolerance: the contact ends at the goal, and a feature met early has pushed the object
-along the push already, an error the pusher cannot push back once it is past the goal.
+along the push already, an error the pusher cannot push back once it is past the goal. So it is
+after the last push from which a correction could still carry the object to another feature
+(`switch_held`): past it, only the pusher in contact is left to push an error back, and one that
+drags the object away from its plan (the high-mu offset's left pusher in a world of less pad
+friction sags it 0.5 mm) cannot lift it.
 
 The policy lives here; `executor.py` streams and splices. A re-plan
 - aims at the task's goal within the final tolerance (a run is checked again at rest after its
@@ -122,8 +126,9 @@ class ClosedLoop:
 @dataclass(frozen=True)
 class Replan:
     """One correction: after plan step `after_step` the object was measured at `measured` where
-    the plan had `planned` (`trigger`: "off_plan" after a push, "on_touch" as it came onto the
-    feature of step after_step + 1, "off_goal" at rest after the last);
+    the plan had `planned` (`trigger`: "off_plan" after a push, "last_switch" after the last push
+    from which a switch-over is held, "on_touch" as it came onto the feature of step after_step + 1,
+    "off_goal" at rest after the last);
     whether a new plan from there was found and taken (`solved`), its pushers and length, and, when
     none was taken, why (`failure`)."""
 
@@ -157,6 +162,29 @@ def _transits_held(task: Task, steps: Sequence[Waypoint], pusher: str, ratio: fl
                 return False
         previous = step.pusher
     return True
+
+
+def switch_held(task: Task, pose: Sequence[float], pusher: str) -> bool:
+    """Whether a correction from `pose` (x mm, z mm, theta deg, resting on `pusher`'s feature) may still
+    switch to another feature: the pads hold TRANSIT_HOLD_RATIO times the object's weight there in
+    the task's model and at every corner of the box the first corrections are planned robust to
+    (CORRECTION_MU_SPREAD, or the task's own uncertainty box), as those corrections ask."""
+    q, index = pose_to_si(pose), task.pusher_index(pusher)
+    return all(m.hold_ratio(q, index) >= TRANSIT_HOLD_RATIO for m in _correction_models(task))
+
+
+_CORRECTION_MODELS: "OrderedDict[str, list]" = OrderedDict()  # by task: the models switch_held asks
+
+
+def _correction_models(task: Task) -> list:
+    key = repr((task.identity(), sorted(task.feature_orientations.items())))
+    if key not in _CORRECTION_MODELS:
+        box = task if task.uncertainty else dataclasses.replace(
+            task, uncertainty={"pusher_mu": CORRECTION_MU_SPREAD, "pad_mu": CORRECTION_MU_SPREAD})
+        _CORRECTION_MODELS[key] = [task.build_model(), *box.corner_models()]
+        while len(_CORRECTION_MODELS) > _AIMED_KEPT:
+            _CORRECTION_MODELS.popitem(last=False)
+    return _CORRECTION_MODELS[key]
 
 
 # The aims made in this process, by task, plan and tolerance: `evaluate` runs one plan in many worlds,

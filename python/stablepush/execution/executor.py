@@ -18,7 +18,7 @@ from typing import Callable, Dict, List, Optional, Sequence
 import numpy as np
 
 from stablepush.errors import ArmFault
-from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan
+from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan, switch_held
 from stablepush.execution.guard import (
     GuardedApproach,
     found_feature,
@@ -437,7 +437,9 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     its place has pushed it already, and every push of the contact would carry that error on. In
     the plan's last contact it is corrected past the loop's final tolerance: the contact ends at the
     goal, where an error along the push is one the pusher cannot push back (the hexagon's closed-loop
-    misses, docs/evaluate.md). `features` is updated in place: the object's pose on the
+    misses, docs/evaluate.md). So it is after the last push of a contact from whose end a correction
+    may still switch to another feature (closed_loop.switch_held): past it, the pusher in contact is
+    the only one left. `features` is updated in place: the object's pose on the
     feature in contact becomes the measured one (G's pose times the tracked pose in the grasp), so
     the rest of this contact pushes from where the object really is."""
     k = w.step
@@ -445,12 +447,14 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     last = k == len(steps) - 1 and not touched
     pusher = steps[k + 1].pusher if touched else steps[k].pusher  # the one the object rests on
     final_contact = touched and all(s.pusher == pusher for s in steps[k + 1:])
-    limit = loop.final_tolerance if last or final_contact else loop.threshold
+    last_switch = not (last or touched) and steps[k + 1].pusher == pusher and switch_held(
+        task, steps[k].pose, pusher) and not switch_held(task, steps[k + 1].pose, pusher)
+    limit = loop.final_tolerance if last or final_contact or last_switch else loop.threshold
     if not loop.off_by(tracked, task.goal if last else steps[k].pose, limit):
         return None
     measured = _measured(steps[k].pose, tracked)
-    record, new_steps = replan(task, measured, pusher, loop, k, steps[k].pose,
-                               trigger="off_goal" if last else "on_touch" if touched else "off_plan",
+    trigger = "off_goal" if last else "on_touch" if touched else "last_switch" if last_switch else "off_plan"
+    record, new_steps = replan(task, measured, pusher, loop, k, steps[k].pose, trigger=trigger,
                                verdict_at_stake=last and not within(tracked, task.goal, success_tolerance))
     replans.append(record)
     if not record.solved or record.pushes == 0:
