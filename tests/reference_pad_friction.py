@@ -58,7 +58,14 @@ class ReferencePadFriction:
         self._frictionless = None  # which pad pairs model.pair_friction makes frictionless now, as bytes
         self._set_frictionless(self.sliding)
 
+    def step(self, data) -> None:
+        """update, then mj_step: where the compiled one copies an accepted trial, this steps again
+        with that trial's force, which repeats it to the bit."""
+        self.update(data)
+        mujoco.mj_step(self.model, data)
+
     def update(self, data) -> None:
+        self.scratch_is_step = False
         contacts = _PadContacts(self, data)
         # Candidates from the previous step's slip (the tangential rows of efc_vel, m/s: the cones are
         # elliptic, so those rows are the contact frame's tangents). A point touching the object through
@@ -78,6 +85,7 @@ class ReferencePadFriction:
             if (self.slipping & ~sliding).any():
                 solver = self._solver_step()
                 sliding |= self._new_sliders(solver, self.slipping & ~sliding)
+                self.scratch_is_step = not sliding.any()
             if sliding.any():
                 sliding = self._coulomb_friction(data, sliding, normal, solver if solver is not None else contacts)
         if (sliding != self.sliding).any() or self.slipping.any():
@@ -122,6 +130,7 @@ class ReferencePadFriction:
             mujoco.mj_step(m, s)
             self.trial_steps += 1
             trial = _PadContacts(self, s)
+            touch_lost = (sliding & ~trial.touched).any()
             sliding = sliding & trial.touched  # a point that touches nothing has no friction
             v_end = trial.tangential(trial.end_velocity())
             in_trial = sliding[trial.slots]
@@ -139,6 +148,10 @@ class ReferencePadFriction:
             if sticks.any():
                 continue
             if agree[in_trial].min() >= _DIRECTIONS_AGREE:
+                if not touch_lost:  # the trial is the step
+                    data.qfrc_applied[:] = qfrc
+                    self.scratch_is_step = True
+                    return sliding
                 break
             points = trial.slots[in_trial]
             history = self._next_directions(points, opposite[in_trial], history)

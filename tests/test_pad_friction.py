@@ -8,6 +8,7 @@ the same to the bit: the pivot turns a last-bit difference into micrometres with
 rig's 30 deg pivot ended 0.0025 and 0.0098 mm off while the reference summed its Anderson step
 with BLAS), and a tolerance would hide a real slip.
 """
+import mujoco
 import numpy as np
 import pytest
 
@@ -59,3 +60,24 @@ def test_a_pad_geom_not_in_the_model_is_refused_by_name():
     arm = SimArm(scene_description(task, place_features(task, steps), steps[0].pose))
     with pytest.raises(ValueError, match=f"pad geom {arm.model.ngeom} is not in the model"):
         CoulombPadFriction(arm.model, [arm.model.ngeom])
+
+
+class _SteppedAgain(CoulombPadFriction):
+    """The compiled friction, with every time step taken by mj_step after `update` (never a copy of
+    the scratch step)."""
+
+    def step(self, data) -> None:
+        self.update(data)
+        mujoco.mj_step(self.model, data)
+
+
+@pytest.mark.slow
+def test_a_time_step_taken_from_the_scratch_is_the_step_mj_step_takes():
+    # An accepted trial (or the solver's step, where no point slides) is copied into the arm's data
+    # instead of stepped again. update leaves the trial's force in qfrc_applied, so mj_step after it
+    # must land on the same state to the bit: the copy saves a step and changes nothing.
+    copied, copied_friction = _object_path(CoulombPadFriction)
+    stepped, _ = _object_path(_SteppedAgain)
+    # the pivot's ring points slide: most of these steps came from the scratch
+    assert copied_friction.scratch_steps_taken > 0.5 * copied_friction.trial_steps
+    np.testing.assert_array_equal(copied, stepped)

@@ -95,7 +95,17 @@ CoulombPadFriction::CoulombPadFriction(mjModel* model, const std::vector<int>& p
 
 CoulombPadFriction::~CoulombPadFriction() { mj_deleteData(scratch_); }
 
+void CoulombPadFriction::step(mjData* data) {
+  update(data);
+  if (scratch_is_step_) {
+    mj_copyData(data, model_, scratch_);
+    ++scratch_steps_taken_;
+  } else
+    mj_step(model_, data);
+}
+
 void CoulombPadFriction::update(mjData* data) {
+  scratch_is_step_ = false;
   PadContacts contacts = contacts_of(data);
   // Candidates from the previous step's slip (the tangential rows of efc_vel, m/s: the cones are
   // elliptic, so those rows are the contact frame's tangents). A point touching the object through
@@ -125,6 +135,8 @@ void CoulombPadFriction::update(mjData* data) {
       at = solver_step();
       const Flags slides = new_sliders(at, fresh);
       for (int k = 0; k < n_points_; ++k) sliding[k] = sliding[k] || slides[k];
+      // no point slides: the step is the solver's, with every friction its own and no force of ours
+      scratch_is_step_ = !any(sliding);
     }
     if (any(sliding)) sliding = coulomb_friction(data, sliding, normal, std::move(at));
   }
@@ -208,7 +220,11 @@ CoulombPadFriction::Flags CoulombPadFriction::coulomb_friction(mjData* data, Fla
     step_scratch(qfrc);
     ++trial_steps_;
     PadContacts trial = contacts_of(scratch_);
-    for (int k = 0; k < n_points_; ++k) sliding[k] = sliding[k] && trial.touched[k];  // no touch, no friction
+    bool touch_lost = false;
+    for (int k = 0; k < n_points_; ++k) {
+      touch_lost = touch_lost || (sliding[k] && !trial.touched[k]);
+      sliding[k] = sliding[k] && trial.touched[k];  // no touch, no friction
+    }
     const std::vector<double> v_end = end_velocity(scratch_);
     const std::size_t n = trial.rows.size();
     Flags sticks(n);
@@ -238,7 +254,16 @@ CoulombPadFriction::Flags CoulombPadFriction::coulomb_friction(mjData* data, Fla
     }
     if (!any(sliding)) return sliding;
     if (any_sticks) continue;
-    if (least_agreement >= p_.directions_agree) break;
+    if (least_agreement >= p_.directions_agree) {
+      if (!touch_lost) {
+        // The trial is the step: each sliding point's friction opposes the slip it produced, and the
+        // same points slid in it. Taking it is the verified step, and saves stepping again.
+        mju_copy(data->qfrc_applied, qfrc.data(), model_->nv);
+        scratch_is_step_ = true;
+        return sliding;
+      }
+      break;
+    }
     next_directions(points, opposite, history);
   }
   const std::vector<double> qfrc = generalized_friction(at, sliding, normal);

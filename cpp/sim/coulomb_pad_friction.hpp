@@ -56,14 +56,23 @@ class CoulombPadFriction {
   CoulombPadFriction(const CoulombPadFriction&) = delete;
   CoulombPadFriction& operator=(const CoulombPadFriction&) = delete;
 
-  /// Before each mj_step of `data`, after the step's drives are set: writes model->pair_friction of the
-  /// pad pairs and data->qfrc_applied (all of it) with the sliding points' friction.
+  /// One time step of `data`, after the step's drives are set: `update`, then mj_step, or a copy of the
+  /// scratch step when `update` left the step itself there (an accepted trial, or the solver's step).
+  void step(mjData* data);
+
+  /// Before an mj_step of `data`, after the step's drives are set: writes model->pair_friction of the
+  /// pad pairs and data->qfrc_applied (all of it) with the sliding points' friction. When a trial step
+  /// is accepted, qfrc_applied is that trial's force, so mj_step then repeats the trial to the bit.
   void update(mjData* data);
 
-  const std::vector<char>& slipping() const { return slipping_; }  ///< candidates, by their own slip
-  const std::vector<char>& sliding() const { return sliding_; }    ///< sliding with our friction
-  long solver_steps() const { return solver_steps_; }              ///< scratch steps deciding new sliders
-  long trial_steps() const { return trial_steps_; }                ///< scratch steps finding friction directions
+  /// Whether the scratch data holds the step `update` prepared (`step` copies it instead of stepping).
+  bool scratch_is_step() const { return scratch_is_step_; }
+
+  const std::vector<char>& slipping() const { return slipping_; }    ///< candidates, by their own slip
+  const std::vector<char>& sliding() const { return sliding_; }      ///< sliding with our friction
+  long solver_steps() const { return solver_steps_; }                ///< scratch steps deciding new sliders
+  long trial_steps() const { return trial_steps_; }                  ///< scratch steps finding friction directions
+  long scratch_steps_taken() const { return scratch_steps_taken_; }  ///< time steps `step` copied from scratch
 
  private:
   using Flags = std::vector<char>;
@@ -93,7 +102,8 @@ class CoulombPadFriction {
   Flags slipping_, sliding_;
   std::vector<Vec3> direction_;  // per sliding point, its unit friction (world, contact rows' convention)
   std::vector<int> fast_steps_;
-  long solver_steps_ = 0, trial_steps_ = 0;
+  long solver_steps_ = 0, trial_steps_ = 0, scratch_steps_taken_ = 0;
+  bool scratch_is_step_ = false;
   Flags frictionless_;  // which pad pairs model->pair_friction makes frictionless now
   bool frictionless_known_ = false;
 };

@@ -47,6 +47,13 @@ PYBIND11_MODULE(_pad_friction, m) {
            py::arg("model_address"), py::arg("pad_geoms"), py::arg("parameters"),
            "model_address: MjModel._address; the model must outlive this object.")
       .def(
+          "step",
+          [](CoulombPadFriction& self, std::uintptr_t data_address) {
+            self.step(reinterpret_cast<mjData*>(data_address));
+          },
+          py::arg("data_address"),
+          "One time step (update, then mj_step or the scratch's copy): data_address is MjData._address.")
+      .def(
           "update",
           [](CoulombPadFriction& self, std::uintptr_t data_address) {
             self.update(reinterpret_cast<mjData*>(data_address));
@@ -54,6 +61,8 @@ PYBIND11_MODULE(_pad_friction, m) {
           py::arg("data_address"), "Before each mj_step: data_address is MjData._address of the model's data.")
       .def_property_readonly("slipping", [](const CoulombPadFriction& f) { return as_array(f.slipping()); })
       .def_property_readonly("sliding", [](const CoulombPadFriction& f) { return as_array(f.sliding()); })
+      .def_property_readonly("scratch_is_step", &CoulombPadFriction::scratch_is_step)
       .def_property_readonly("solver_steps", &CoulombPadFriction::solver_steps)
-      .def_property_readonly("trial_steps", &CoulombPadFriction::trial_steps);
+      .def_property_readonly("trial_steps", &CoulombPadFriction::trial_steps)
+      .def_property_readonly("scratch_steps_taken", &CoulombPadFriction::scratch_steps_taken);
 }

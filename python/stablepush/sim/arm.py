@@ -140,8 +140,7 @@ class SimulatedGrasp:
         t0 = time.perf_counter()
         for i in range(1, n + 1):
             before_step(i)
-            self.pad_friction.update(self.data)
-            mujoco.mj_step(self.model, self.data)
+            self.pad_friction.step(self.data)
         self.step_wall_time += time.perf_counter() - t0
         self.steps += n
 

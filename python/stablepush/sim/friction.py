@@ -21,8 +21,9 @@ once, `_next_directions`), since all points ride one object and one hand and a p
 overshoots. A damped step matters: explicit friction on a slow slip (one 0.25 ms step of 15 N
 changes a hand's speed by mm/s) would otherwise flip its direction every step and chatter. A
 sliding point whose trial slip turns against its friction or falls under STICK_SPEED sticks
-instead. In a steady slide the last step's direction passes at once, so sliding costs one trial
-step per step.
+instead. The trial whose directions agree is the time step itself: the friction in it opposes the
+slip it produced, so the arm takes that state rather than stepping again. In a steady slide the last
+step's direction passes at once, so sliding costs one scratch step per time step and no second one.
 
 Which points may slide is decided from their own slip, measured by the simulator from its own
 state (never told by the plan): a point that has slipped faster than SLIDE_SPEED for SLIDE_STEPS
@@ -66,11 +67,12 @@ class CoulombPadFriction:
     """Per pad point, stick by the solver or slide with Coulomb friction we apply (module docstring).
 
     `pad_geoms` are the ids of the pad point geoms; every explicit contact pair that holds one of
-    them is switched with it. Call `update(data)` before each `mj_step`, after the step's drives
-    are set: it writes `model.pair_friction` of the pad pairs and `data.qfrc_applied` (which it
-    owns: nothing else in the simulated arm applies forces) with the sliding points' friction,
-    sum of J_t^T f_t with f_t = mu N d [N], d the unit friction direction in the contact's tangent plane.
-    The thresholds are read when it is made.
+    them is switched with it. `step(data)` takes one time step in place of `mj_step`, after the
+    step's drives are set: it writes `model.pair_friction` of the pad pairs and `data.qfrc_applied`
+    (which it owns: nothing else in the simulated arm applies forces) with the sliding points'
+    friction, sum of J_t^T f_t with f_t = mu N d [N], d the unit friction direction in the contact's
+    tangent plane, then steps, or takes the scratch step that already is this step. The thresholds
+    are read when it is made.
     """
 
     def __init__(self, model: mujoco.MjModel, pad_geoms: Sequence[int]):
@@ -81,8 +83,18 @@ class CoulombPadFriction:
             frictionless_mu=FRICTIONLESS_MU)
         self._compiled = _pad_friction.CoulombPadFriction(model._address, [int(g) for g in pad_geoms], parameters)
 
+    def step(self, data: mujoco.MjData) -> None:
+        self._compiled.step(data._address)
+
     def update(self, data: mujoco.MjData) -> None:
+        """The friction of the next step only (`step` without its step): `mujoco.mj_step` after it
+        takes the same step as `step`."""
         self._compiled.update(data._address)
+
+    @property
+    def scratch_is_step(self) -> bool:
+        """Whether the last `update`'s scratch step is the time step itself (then `step` copies it)."""
+        return self._compiled.scratch_is_step
 
     @property
     def slipping(self) -> np.ndarray:
@@ -103,3 +115,9 @@ class CoulombPadFriction:
     def trial_steps(self) -> int:
         """Scratch steps finding the friction's direction."""
         return self._compiled.trial_steps
+
+    @property
+    def scratch_steps_taken(self) -> int:
+        """Time steps `step` took from the scratch (an accepted trial, or the solver's step) rather
+        than stepping again."""
+        return self._compiled.scratch_steps_taken
