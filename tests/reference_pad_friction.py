@@ -124,13 +124,15 @@ class ReferencePadFriction:
         history = None  # (directions, residual) of the last trial, for the Anderson step
         for _ in range(MAX_TRIALS):
             qfrc = self._generalized_friction(at, sliding, normal)
+            pushed_through = np.sort(at.keys[sliding[at.slots]])
             self._set_frictionless(sliding)
             mujoco.mj_setState(m, s, self._state, self._state_kind)
             s.qfrc_applied[:] = qfrc
             mujoco.mj_step(m, s)
             self.trial_steps += 1
             trial = _PadContacts(self, s)
-            touch_lost = (sliding & ~trial.touched).any()
+            # the trial stands as the step only if our force went through the contacts the step has
+            same_contacts = np.array_equal(np.sort(trial.keys[sliding[trial.slots]]), pushed_through)
             sliding = sliding & trial.touched  # a point that touches nothing has no friction
             v_end = trial.tangential(trial.end_velocity())
             in_trial = sliding[trial.slots]
@@ -148,7 +150,7 @@ class ReferencePadFriction:
             if sticks.any():
                 continue
             if agree[in_trial].min() >= _DIRECTIONS_AGREE:
-                if not touch_lost:  # the trial is the step
+                if same_contacts:  # the trial is the step
                     data.qfrc_applied[:] = qfrc
                     self.scratch_is_step = True
                     return sliding

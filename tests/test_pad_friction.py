@@ -71,13 +71,36 @@ class _SteppedAgain(CoulombPadFriction):
         mujoco.mj_step(self.model, data)
 
 
+def _end_state(friction_class):
+    """The arm's whole state after the pivot's first waypoints, what the next step reads of its
+    last one (contacts, constraint forces and velocities), and the friction object."""
+    _, friction = _object_path(friction_class)
+    data = friction.stepped_data
+    state = np.zeros(mujoco.mj_stateSize(friction.model, mujoco.mjtState.mjSTATE_INTEGRATION))
+    mujoco.mj_getState(friction.model, data, state, mujoco.mjtState.mjSTATE_INTEGRATION)
+    return (state, data.efc_force[:data.nefc].copy(), data.efc_vel[:data.nefc].copy(), data.contact.geom.copy(),
+            friction.model.pair_friction.copy()), friction
+
+
 @pytest.mark.slow
-def test_a_time_step_taken_from_the_scratch_is_the_step_mj_step_takes():
+def test_a_time_step_copied_from_the_scratch_is_the_step_mj_step_takes(monkeypatch):
     # An accepted trial (or the solver's step, where no point slides) is copied into the arm's data
     # instead of stepped again. update leaves the trial's force in qfrc_applied, so mj_step after it
     # must land on the same state to the bit: the copy saves a step and changes nothing.
-    copied, copied_friction = _object_path(CoulombPadFriction)
-    stepped, _ = _object_path(_SteppedAgain)
-    # the pivot's ring points slide: most of these steps came from the scratch
-    assert copied_friction.scratch_steps_taken > 0.5 * copied_friction.trial_steps
-    np.testing.assert_array_equal(copied, stepped)
+    def keep_data(step):
+        def stepped(self, data):
+            self.stepped_data = data
+            step(self, data)
+        return stepped
+    monkeypatch.setattr(CoulombPadFriction, "step", keep_data(CoulombPadFriction.step))
+    monkeypatch.setattr(_SteppedAgain, "step", keep_data(_SteppedAgain.step))
+    copied, copied_friction = _end_state(CoulombPadFriction)
+    stepped, stepped_friction = _end_state(_SteppedAgain)
+    # the pivot's ring points slide: most of the time steps came from the scratch
+    time_steps = round(WAYPOINTS * 0.01 / scene_mod.TIMESTEP)
+    assert copied_friction.copied_steps > 0.5 * time_steps
+    assert stepped_friction.copied_steps == 0
+    assert copied_friction.trial_steps == stepped_friction.trial_steps
+    assert copied_friction.solver_steps == stepped_friction.solver_steps
+    for a, b in zip(copied, stepped):
+        np.testing.assert_array_equal(a, b)

@@ -99,7 +99,7 @@ void CoulombPadFriction::step(mjData* data) {
   update(data);
   if (scratch_is_step_) {
     mj_copyData(data, model_, scratch_);
-    ++scratch_steps_taken_;
+    ++copied_steps_;
   } else
     mj_step(model_, data);
 }
@@ -170,6 +170,14 @@ std::vector<int> CoulombPadFriction::count(const PadContacts& at, const Flags& p
   return out;
 }
 
+std::vector<std::int64_t> CoulombPadFriction::keys_of(const PadContacts& at, const Flags& points) const {
+  std::vector<std::int64_t> keys;
+  for (std::size_t j = 0; j < at.slots.size(); ++j)
+    if (points[at.slots[j]]) keys.push_back(at.keys[j]);
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
 std::vector<double> CoulombPadFriction::end_velocity(const mjData* data) const {
   std::vector<double> velocity(data->nefc, 0.0);
   mj_mulJacVec(model_, data, velocity.data(), data->qvel);
@@ -216,15 +224,16 @@ CoulombPadFriction::Flags CoulombPadFriction::coulomb_friction(mjData* data, Fla
   History history;
   for (int trial_number = 0; trial_number < p_.max_trials; ++trial_number) {
     const std::vector<double> qfrc = generalized_friction(at, sliding, normal);
+    const std::vector<std::int64_t> pushed_through = keys_of(at, sliding);
     set_frictionless(sliding);
     step_scratch(qfrc);
     ++trial_steps_;
     PadContacts trial = contacts_of(scratch_);
-    bool touch_lost = false;
-    for (int k = 0; k < n_points_; ++k) {
-      touch_lost = touch_lost || (sliding[k] && !trial.touched[k]);
-      sliding[k] = sliding[k] && trial.touched[k];  // no touch, no friction
-    }
+    // The trial can stand as the step only if our force went through the contacts the step has:
+    // a sliding point that gained or lost a contact (a convex piece, a multiccd point) would get
+    // friction through one that is gone, and none through the new one (its pair is frictionless).
+    const bool same_contacts = keys_of(trial, sliding) == pushed_through;
+    for (int k = 0; k < n_points_; ++k) sliding[k] = sliding[k] && trial.touched[k];  // no touch, no friction
     const std::vector<double> v_end = end_velocity(scratch_);
     const std::size_t n = trial.rows.size();
     Flags sticks(n);
@@ -255,9 +264,9 @@ CoulombPadFriction::Flags CoulombPadFriction::coulomb_friction(mjData* data, Fla
     if (!any(sliding)) return sliding;
     if (any_sticks) continue;
     if (least_agreement >= p_.directions_agree) {
-      if (!touch_lost) {
-        // The trial is the step: each sliding point's friction opposes the slip it produced, and the
-        // same points slid in it. Taking it is the verified step, and saves stepping again.
+      if (same_contacts) {
+        // The trial is the step: each sliding point's friction opposes the slip it produced at the
+        // step's end, through the contacts the step has.
         mju_copy(data->qfrc_applied, qfrc.data(), model_->nv);
         scratch_is_step_ = true;
         return sliding;

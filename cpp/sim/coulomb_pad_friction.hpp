@@ -68,11 +68,11 @@ class CoulombPadFriction {
   /// Whether the scratch data holds the step `update` prepared (`step` copies it instead of stepping).
   bool scratch_is_step() const { return scratch_is_step_; }
 
-  const std::vector<char>& slipping() const { return slipping_; }    ///< candidates, by their own slip
-  const std::vector<char>& sliding() const { return sliding_; }      ///< sliding with our friction
-  long solver_steps() const { return solver_steps_; }                ///< scratch steps deciding new sliders
-  long trial_steps() const { return trial_steps_; }                  ///< scratch steps finding friction directions
-  long scratch_steps_taken() const { return scratch_steps_taken_; }  ///< time steps `step` copied from scratch
+  const std::vector<char>& slipping() const { return slipping_; }  ///< candidates, by their own slip
+  const std::vector<char>& sliding() const { return sliding_; }    ///< sliding with our friction
+  long solver_steps() const { return solver_steps_; }              ///< scratch steps deciding new sliders
+  long trial_steps() const { return trial_steps_; }                ///< scratch steps finding friction directions
+  long copied_steps() const { return copied_steps_; }              ///< time steps `step` copied from scratch
 
  private:
   using Flags = std::vector<char>;
@@ -81,6 +81,8 @@ class CoulombPadFriction {
 
   PadContacts contacts_of(const mjData* data) const;
   std::vector<int> count(const PadContacts& at, const Flags& per_contact) const;
+  /// The geom-pair keys of the contacts of `points` in `at`, sorted (a pair touching twice is there twice).
+  std::vector<std::int64_t> keys_of(const PadContacts& at, const Flags& points) const;
   std::vector<double> end_velocity(const mjData* data) const;
   PadContacts solver_step();
   Flags new_sliders(const PadContacts& solver, const Flags& fresh);
@@ -102,7 +104,7 @@ class CoulombPadFriction {
   Flags slipping_, sliding_;
   std::vector<Vec3> direction_;  // per sliding point, its unit friction (world, contact rows' convention)
   std::vector<int> fast_steps_;
-  long solver_steps_ = 0, trial_steps_ = 0, scratch_steps_taken_ = 0;
+  long solver_steps_ = 0, trial_steps_ = 0, copied_steps_ = 0;
   bool scratch_is_step_ = false;
   Flags frictionless_;  // which pad pairs model->pair_friction makes frictionless now
   bool frictionless_known_ = false;

@@ -58,11 +58,13 @@ PYBIND11_MODULE(_pad_friction, m) {
           [](CoulombPadFriction& self, std::uintptr_t data_address) {
             self.update(reinterpret_cast<mjData*>(data_address));
           },
-          py::arg("data_address"), "Before each mj_step: data_address is MjData._address of the model's data.")
+          py::arg("data_address"),
+          "The next step's friction only: mj_step after it takes the step `step` takes. data_address is "
+          "MjData._address of the model's data.")
       .def_property_readonly("slipping", [](const CoulombPadFriction& f) { return as_array(f.slipping()); })
       .def_property_readonly("sliding", [](const CoulombPadFriction& f) { return as_array(f.sliding()); })
       .def_property_readonly("scratch_is_step", &CoulombPadFriction::scratch_is_step)
       .def_property_readonly("solver_steps", &CoulombPadFriction::solver_steps)
       .def_property_readonly("trial_steps", &CoulombPadFriction::trial_steps)
-      .def_property_readonly("scratch_steps_taken", &CoulombPadFriction::scratch_steps_taken);
+      .def_property_readonly("copied_steps", &CoulombPadFriction::copied_steps);
 }

@@ -21,9 +21,10 @@ once, `_next_directions`), since all points ride one object and one hand and a p
 overshoots. A damped step matters: explicit friction on a slow slip (one 0.25 ms step of 15 N
 changes a hand's speed by mm/s) would otherwise flip its direction every step and chatter. A
 sliding point whose trial slip turns against its friction or falls under STICK_SPEED sticks
-instead. The trial whose directions agree is the time step itself: the friction in it opposes the
-slip it produced, so the arm takes that state rather than stepping again. In a steady slide the last
-step's direction passes at once, so sliding costs one scratch step per time step and no second one.
+instead. The trial whose directions agree is the time step itself, when its sliding points touched
+through the contacts the force was built on: the friction in it opposes the slip it produced, so
+the arm takes that state (a copy). In a steady slide the last step's direction passes at once, so
+a sliding step costs one `mj_step`, the trial's.
 
 Which points may slide is decided from their own slip, measured by the simulator from its own
 state (never told by the plan): a point that has slipped faster than SLIDE_SPEED for SLIDE_STEPS
@@ -117,7 +118,6 @@ class CoulombPadFriction:
         return self._compiled.trial_steps
 
     @property
-    def scratch_steps_taken(self) -> int:
-        """Time steps `step` took from the scratch (an accepted trial, or the solver's step) rather
-        than stepping again."""
-        return self._compiled.scratch_steps_taken
+    def copied_steps(self) -> int:
+        """Time steps `step` copied from the scratch data (an accepted trial, or the solver's step)."""
+        return self._compiled.copied_steps
