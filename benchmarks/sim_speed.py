@@ -47,7 +47,7 @@ def main() -> None:
         friction = arm.pad_friction
         steps_before = round(float(arm.data.time) / arm.timestep)
         scratch_before = friction.trial_steps + friction.solver_steps
-        taken_before = friction.copied_steps
+        copied_before = friction.copied_steps
         wall, cpu = time.perf_counter(), time.process_time()
         for point in points:
             arm.move_to(point.pose, period)
@@ -55,7 +55,7 @@ def main() -> None:
         robot = len(points) * period
         real_steps = round(float(arm.data.time) / arm.timestep) - steps_before
         scratch_steps = friction.trial_steps + friction.solver_steps - scratch_before
-        calls = real_steps - (friction.copied_steps - taken_before) + scratch_steps
+        calls = real_steps - (friction.copied_steps - copied_before) + scratch_steps
         state = hashlib.sha1(np.concatenate([arm.data.qpos, arm.data.qvel]).tobytes()).hexdigest()[:12]
         print(f"| {task.name} | {len(points)} | {robot:.2f} | {wall:.2f} | {cpu:.2f} | {robot / wall:.2f} "
               f"| {scratch_steps / max(real_steps, 1):.2f} | {calls / max(real_steps, 1):.2f} | {state} |", flush=True)

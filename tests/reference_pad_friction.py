@@ -65,7 +65,6 @@ class ReferencePadFriction:
         mujoco.mj_step(self.model, data)
 
     def update(self, data) -> None:
-        self.scratch_is_step = False
         contacts = _PadContacts(self, data)
         # Candidates from the previous step's slip (the tangential rows of efc_vel, m/s: the cones are
         # elliptic, so those rows are the contact frame's tangents). A point touching the object through
@@ -85,7 +84,6 @@ class ReferencePadFriction:
             if (self.slipping & ~sliding).any():
                 solver = self._solver_step()
                 sliding |= self._new_sliders(solver, self.slipping & ~sliding)
-                self.scratch_is_step = not sliding.any()
             if sliding.any():
                 sliding = self._coulomb_friction(data, sliding, normal, solver if solver is not None else contacts)
         if (sliding != self.sliding).any() or self.slipping.any():
@@ -152,7 +150,6 @@ class ReferencePadFriction:
             if agree[in_trial].min() >= _DIRECTIONS_AGREE:
                 if same_contacts:  # the trial is the step
                     data.qfrc_applied[:] = qfrc
-                    self.scratch_is_step = True
                     return sliding
                 break
             points = trial.slots[in_trial]

@@ -27,7 +27,7 @@ WAYPOINTS = 120  # 1.2 s of the pivot's plan: the first pushes, where the ring p
 
 def _object_path(friction_class):
     """The object's pose (x, y, z m; quaternion) after each of the pivot plan's first waypoints on the
-    arm, with the given pad friction, and the friction object at the end."""
+    arm, with the given pad friction, and the arm at the end."""
     task = shipped("pivoting")
     steps = list(plan_task(task).waypoints)
     features = place_features(task, steps)
@@ -39,13 +39,14 @@ def _object_path(friction_class):
     for point in arm_trajectory(task, steps, features, 100.0, scene["gripper_pose"])[:WAYPOINTS]:
         arm.move_to(point.pose, 0.01)
         path.append(arm.data.qpos[q:q + 7].copy())
-    return np.array(path), arm.pad_friction
+    return np.array(path), arm
 
 
 @pytest.mark.slow
 def test_the_compiled_pad_friction_moves_the_object_as_the_numpy_reference_to_the_bit():
-    compiled, compiled_friction = _object_path(CoulombPadFriction)
-    reference, reference_friction = _object_path(ReferencePadFriction)
+    compiled, compiled_arm = _object_path(CoulombPadFriction)
+    reference, reference_arm = _object_path(ReferencePadFriction)
+    compiled_friction, reference_friction = compiled_arm.pad_friction, reference_arm.pad_friction
     # the pads slid over the object (the hand turned about it), and the sliding points' directions
     # took trial steps: the comparison is not of two resting grasps
     assert reference_friction.trial_steps > 1000
@@ -71,36 +72,28 @@ class _SteppedAgain(CoulombPadFriction):
         mujoco.mj_step(self.model, data)
 
 
-def _end_state(friction_class):
-    """The arm's whole state after the pivot's first waypoints, what the next step reads of its
-    last one (contacts, constraint forces and velocities), and the friction object."""
-    _, friction = _object_path(friction_class)
-    data = friction.stepped_data
-    state = np.zeros(mujoco.mj_stateSize(friction.model, mujoco.mjtState.mjSTATE_INTEGRATION))
-    mujoco.mj_getState(friction.model, data, state, mujoco.mjtState.mjSTATE_INTEGRATION)
-    return (state, data.efc_force[:data.nefc].copy(), data.efc_vel[:data.nefc].copy(), data.contact.geom.copy(),
-            friction.model.pair_friction.copy()), friction
+def _end_state(arm) -> list:
+    """The arm's whole state after its last step, and what the next step reads of that step
+    (contacts, constraint forces and velocities, the pad pairs' friction)."""
+    m, d = arm.model, arm.data
+    state = np.zeros(mujoco.mj_stateSize(m, mujoco.mjtState.mjSTATE_INTEGRATION))
+    mujoco.mj_getState(m, d, state, mujoco.mjtState.mjSTATE_INTEGRATION)
+    return [state, d.efc_force[:d.nefc].copy(), d.efc_vel[:d.nefc].copy(), d.contact.geom.copy(),
+            m.pair_friction.copy()]
 
 
 @pytest.mark.slow
-def test_a_time_step_copied_from_the_scratch_is_the_step_mj_step_takes(monkeypatch):
+def test_a_time_step_copied_from_the_scratch_is_the_step_mj_step_takes():
     # An accepted trial (or the solver's step, where no point slides) is copied into the arm's data
     # instead of stepped again. update leaves the trial's force in qfrc_applied, so mj_step after it
     # must land on the same state to the bit: the copy saves a step and changes nothing.
-    def keep_data(step):
-        def stepped(self, data):
-            self.stepped_data = data
-            step(self, data)
-        return stepped
-    monkeypatch.setattr(CoulombPadFriction, "step", keep_data(CoulombPadFriction.step))
-    monkeypatch.setattr(_SteppedAgain, "step", keep_data(_SteppedAgain.step))
-    copied, copied_friction = _end_state(CoulombPadFriction)
-    stepped, stepped_friction = _end_state(_SteppedAgain)
+    _, copied = _object_path(CoulombPadFriction)
+    _, stepped = _object_path(_SteppedAgain)
     # the pivot's ring points slide: most of the time steps came from the scratch
     time_steps = round(WAYPOINTS * 0.01 / scene_mod.TIMESTEP)
-    assert copied_friction.copied_steps > 0.5 * time_steps
-    assert stepped_friction.copied_steps == 0
-    assert copied_friction.trial_steps == stepped_friction.trial_steps
-    assert copied_friction.solver_steps == stepped_friction.solver_steps
-    for a, b in zip(copied, stepped):
+    assert copied.pad_friction.copied_steps > 0.5 * time_steps
+    assert stepped.pad_friction.copied_steps == 0
+    assert copied.pad_friction.trial_steps == stepped.pad_friction.trial_steps
+    assert copied.pad_friction.solver_steps == stepped.pad_friction.solver_steps
+    for a, b in zip(_end_state(copied), _end_state(stepped)):
         np.testing.assert_array_equal(a, b)

@@ -65,9 +65,6 @@ class CoulombPadFriction {
   /// is accepted, qfrc_applied is that trial's force, so mj_step then repeats the trial to the bit.
   void update(mjData* data);
 
-  /// Whether the scratch data holds the step `update` prepared (`step` copies it instead of stepping).
-  bool scratch_is_step() const { return scratch_is_step_; }
-
   const std::vector<char>& slipping() const { return slipping_; }  ///< candidates, by their own slip
   const std::vector<char>& sliding() const { return sliding_; }    ///< sliding with our friction
   long solver_steps() const { return solver_steps_; }              ///< scratch steps deciding new sliders
@@ -105,8 +102,8 @@ class CoulombPadFriction {
   std::vector<Vec3> direction_;  // per sliding point, its unit friction (world, contact rows' convention)
   std::vector<int> fast_steps_;
   long solver_steps_ = 0, trial_steps_ = 0, copied_steps_ = 0;
-  bool scratch_is_step_ = false;
-  Flags frictionless_;  // which pad pairs model->pair_friction makes frictionless now
+  bool scratch_is_step_ = false;  // the scratch data holds the step `update` prepared: `step` copies it
+  Flags frictionless_;            // which pad pairs model->pair_friction makes frictionless now
   bool frictionless_known_ = false;
 };
 

@@ -63,7 +63,6 @@ PYBIND11_MODULE(_pad_friction, m) {
           "MjData._address of the model's data.")
       .def_property_readonly("slipping", [](const CoulombPadFriction& f) { return as_array(f.slipping()); })
       .def_property_readonly("sliding", [](const CoulombPadFriction& f) { return as_array(f.sliding()); })
-      .def_property_readonly("scratch_is_step", &CoulombPadFriction::scratch_is_step)
       .def_property_readonly("solver_steps", &CoulombPadFriction::solver_steps)
       .def_property_readonly("trial_steps", &CoulombPadFriction::trial_steps)
       .def_property_readonly("copied_steps", &CoulombPadFriction::copied_steps);

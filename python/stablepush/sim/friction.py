@@ -93,11 +93,6 @@ class CoulombPadFriction:
         self._compiled.update(data._address)
 
     @property
-    def scratch_is_step(self) -> bool:
-        """Whether the last `update`'s scratch step is the time step itself (then `step` copies it)."""
-        return self._compiled.scratch_is_step
-
-    @property
     def slipping(self) -> np.ndarray:
         """Per pad point: a candidate to slide, by its own slip speed."""
         return self._compiled.slipping
