@@ -7,7 +7,7 @@ Each task's seed-1 plan runs N trials in the worlds of docs/evaluate.md's tables
 +-15%, grip force +-10%, mass +-5%, features off by up to 0.5 mm / 0.5 deg; evaluate_tasks.SPREADS),
 open loop unless `--loop closed`, on MuJoCo. One table row per task, then a line a script can read:
 
-    speed target (20x real time, 2 workers): not met: pivoting 2.76x, t-shaped 4.30x
+    speed target (20x real time, 2 local processes): not met: pivoting <x>x, t-shaped <x>x
 
     python3 benchmarks/evaluate_speed.py [TASK.yaml ...] [--trials 20] [--workers 2 | --ray [ADDRESS]]
                                          [--loop open|closed] [--target 20] [--json OUT.json]

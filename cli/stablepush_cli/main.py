@@ -901,7 +901,7 @@ def _vary(_ctx, _param, values):
               help="Run the trials on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
               help="Run the trials on Ray: a local instance, or the cluster at ADDRESS (e.g. 10.0.0.5:6379; see "
-                   "docs/evaluate.md, 'Evaluating a plan').")
+                   "docs/evaluate.md, 'Where the trials run').")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the summary and every trial as JSON.")
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row.")
