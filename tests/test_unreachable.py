@@ -3,6 +3,7 @@ are, the bounds' soundness as properties over random poses (never below what the
 the certificate's weak duality, and grids on which every goal called unreachable is also planned,
 with the verdict switched off, and never reached."""
 import dataclasses
+import itertools
 import math
 import zlib
 from fractions import Fraction
@@ -38,6 +39,34 @@ start: [0, 0, 0]
 goal: [0, -5, 0]
 planner: {time_limit: 5}
 """
+
+# A 1 kg bar held by pads that carry about half its weight (mu 0.5 at 5 N), over a ledge under its
+# right end (x 20 to 45 mm in O). Only pads left of the centre of mass by at least the ledge's
+# nearest reach can balance the weight's moment: from the pads at -x in O, the ledge carries the
+# bar where x >= about 20 mm, and no push of it ends near x = 0.
+LEDGE = """
+name: bar-on-a-ledge
+object: {shape: box, size: [100, 20, 20], mass: 1000}
+gripper: {grip_force: 5, mu: 0.5, pad_rings: 1}
+gravity: [0, -9.81]
+pushers:
+  - {name: ledge, from: [20, -10], to: [45, -10], mu: 0.5}
+start: [30, 0, 0]
+goal: [0, -4, 0]
+planner: {time_limit: 5}
+"""
+
+
+def test_a_goal_no_push_can_end_at_is_unreachable_and_one_beside_the_ledge_is_planned():
+    task = parse_task(LEDGE)
+    assert task.build_model().hold_ratio(pose_to_si(task.goal), 0) < 1.0  # the pads alone do not hold it there
+    plan = plan_task(task)
+    assert plan.outcome == "unreachable" and len(plan.waypoints) == 1, plan.message
+    assert "no pusher has a stable push that ends within planner.tolerance of the goal (ledge)" in plan.message
+    assert plan.stats["planning_time_s"] < 2.0
+    # The start is no dead end: with the ledge under the pads' side of the bar it pushes, and a
+    # goal there is reached.
+    assert plan_task(dataclasses.replace(task, goal=(30.0, -4.0, 0.0))).solved
 
 
 def test_a_goal_the_pads_cannot_hold_within_its_tolerance_is_unreachable_at_once():
@@ -137,6 +166,56 @@ def test_a_start_with_a_stable_push_is_never_called_stuck(name):
     assert found > len(plan.waypoints) - 1 or any(p.is_point for p in task.pushers)
 
 
+@pytest.mark.parametrize("name", SHIPPED + ["ledge"])
+def test_a_box_with_a_stable_push_anywhere_in_it_is_never_called_stuck(name):
+    """A property (verdict 4's LP): boxes of random half-widths (up to 10 mm and 20 deg, so that
+    some reach across the ledge's edge of support, where the slack decides) about random poses,
+    most of them not held by the pads alone; wherever the core or the independent LP (tests/independent_lp.py) finds
+    a stable push of a pusher in a random direction from a pose in the box (its corners included),
+    the LP over the box says the pusher may push."""
+    rng = np.random.default_rng(11 + len(name))
+    task = parse_task(LEDGE) if name == "ledge" else shipped(name)
+    model, independent = task.build_model(), IndependentModel(task)
+    step = task.planner["step"]
+    found = 0
+    for _ in range(12):
+        centre = np.array(task.start) + rng.normal(0.0, [12.0, 3.0, 15.0])
+        if name == "ledge":  # about the edge of the ledge's support (x about 17 mm)
+            centre = np.array([rng.uniform(5.0, 25.0), rng.normal(0.0, 2.0), rng.normal(0.0, 5.0)])
+        half = np.array([rng.uniform(0.2, 10.0), 0.0, rng.uniform(0.2, 20.0)])
+        half[1] = half[0]  # the LP's box: the same half-width in x and z
+        box = (half[0] * 1e-3, math.radians(half[2]))
+        corners = [centre + half * np.array(signs) for signs in itertools.product((-1, 1), repeat=3)]
+        poses = [pose_to_si(tuple(q)) for q in [centre, *(centre + rng.uniform(-1, 1, (6, 3)) * half), *corners]]
+        for pusher in range(len(task.pushers)):
+            stable_somewhere = False
+            for q in poses:
+                if not model.grasp_maintained(q):
+                    continue
+                for _ in range(16):
+                    d = rng.normal(size=3)
+                    d /= np.linalg.norm(d)
+                    dq = (d[0] * step[0] * 1e-3, d[1] * step[0] * 1e-3, math.radians(d[2] * step[1]))
+                    if model.check(q, _core.Motion(*dq), pusher).feasible or independent.stable(q, dq, pusher)[0]:
+                        stable_somewhere = True
+                        break
+                if stable_somewhere:
+                    break
+            if stable_somewhere:
+                found += 1
+                assert U._may_push(task, model, pose_to_si(tuple(centre)), pusher, box), (name, centre, half, pusher)
+    # A point pusher's stable pushes are a surface random directions miss: the plan's pushes, each
+    # at a random place in a box about its start.
+    plan = plan_task(task, seed=1)
+    for before, push in zip(plan.waypoints[::4], plan.waypoints[1::4]):
+        half = rng.uniform(0.2, 2.0, size=2)
+        centre = np.array(before.pose) + rng.uniform(-1, 1, 3) * np.array([half[0], half[0], half[1]])
+        box = (half[0] * 1e-3, math.radians(half[1]))
+        found += 1
+        assert U._may_push(task, model, pose_to_si(tuple(centre)), task.pusher_index(push.pusher), box), (name, before)
+    assert found > 0
+
+
 def test_the_certificate_is_an_upper_bound_for_any_dual_and_tight_for_highs_own():
     rng = np.random.default_rng(3)
     for _ in range(20):
@@ -157,6 +236,26 @@ def test_the_certificate_is_an_upper_bound_for_any_dual_and_tight_for_highs_own(
 
 GRID_TASKS = [("horizontal-offset-high-mu", 1.0), ("horizontal-offset-low-mu", 1.0), ("more/hexagon-offset", 4.0),
               ("more/tilted-gravity", 1.5), ("t-shaped", 2.2)]
+
+
+def test_no_goal_the_ledge_cannot_end_at_is_reached_by_a_long_search(monkeypatch):
+    """Verdict 4 on a grid of goals along the bar: every goal it calls unreachable is planned again
+    with the verdict switched off, 2 seeds x 1.5 s, and none is reached; some goals are called
+    unreachable and some are reached."""
+    task = parse_task(LEDGE)
+    verdicts = {}
+    for x in (0.0, 10.0, 20.0, 30.0, 40.0):
+        for theta in (-10.0, 0.0, 10.0):
+            goal = (x, -4.0, theta)
+            verdicts[goal] = U.why_unreachable(dataclasses.replace(task, goal=goal))
+    unreachable = [goal for goal, why in verdicts.items() if why is not None]
+    assert unreachable and len(unreachable) < len(verdicts), verdicts
+    assert plan_task(dataclasses.replace(task, goal=(30.0, -4.0, 0.0))).solved
+    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None: None)
+    for goal in unreachable:
+        for seed in (1, 2):
+            plan = plan_task(dataclasses.replace(task, goal=goal), seed=seed, time_limit=1.5)
+            assert not plan.solved, (goal, verdicts[goal], plan.message)
 
 
 @pytest.mark.slow

@@ -9,7 +9,8 @@ Each cell ends with a verdict:
   are not all on the object at the goal (no grasp there, so no push can end there), the pads are
   not on the object at the start (the planner's `invalid_start`), or the planner's own verdict
   before its search (`stablepush.plan.unreachable`: every pusher excluded by the uncertainty box,
-  no stable push out of the start, the goal not held well enough anywhere in its tolerance);
+  no stable push out of the start, none that ends within the goal's tolerance, the goal not held
+  well enough anywhere in its tolerance);
 - `not found`: the search ran out of time (`outcome` says how: `time_limit`, or
   `goal_over_switch_limit` when the goal was reached with more switch-overs than allowed).
 

@@ -7,20 +7,26 @@
 2. no pusher that may push has a stable push out of the start, in any direction, in every model
    the plan must hold in (the corners of an uncertainty box);
 3. with `planner.min_hold_ratio` > 0, the pads cannot hold the object with that factor of its
-   weight anywhere in the goal's tolerance box, whichever pusher pushes last.
+   weight anywhere in the goal's tolerance box, whichever pusher pushes last;
+4. no pusher has a stable push that ends within the goal's tolerance: wherever such a last push
+   would start (the tolerance box grown by one unit step, since a push is checked at its start
+   pose), the pads do not hold the object and no pusher's cone can carry what they leave.
 
-Each is a linear program over an outer approximation of the model, so that its infeasibility (2)
-or an upper bound under the requirement (3) holds for the model itself:
+Each is a linear program over an outer approximation of the model, so that its infeasibility (2,
+4) or an upper bound under the requirement (3) holds for the model itself:
 - every pad point's force lies in its friction disc (a sliding point's on its rim, a sticking
   point's in the polygon inscribed in it), so in the polygon circumscribed about it;
 - the momentum term M xi / dt of a push of at most one unit step lies in a box;
 - over the tolerance box, the weight in G moves by at most m |g| |dtheta| (gravity fixed in O)
   and its moment about G's origin, cross_y(o + R(theta) r_cm, W), within an interval bounded on
   a grid in theta with the derivative's bound for the gaps;
-- a pusher's wrench lies in its closed cone (the model asks for the relative interior).
+- a pusher's wrench lies in its closed cone (the model asks for the relative interior);
+- over a box of poses (4), the pads' wrench and the weight's move by at most their sizes times
+  the box's half-widths (|R(dtheta) - I| <= |dtheta|, a moment arm moves by at most |do|).
 For a held start, 2 never fires: the ray from the gravity wrench into a pusher's cone leaves the
 pads' limit surface somewhere, and there a motion is a stable push; it decides the starts the
-pads alone do not hold.
+pads alone do not hold. The same holds for 4 at the goal: only goals the pads do not hold are
+tested.
 
 HiGHS (scipy) solves each LP in doubles; the verdict rests on a bound computed from its dual
 solution in exact rational arithmetic (weak duality with the variables' bounds, Neumaier and
@@ -29,6 +35,7 @@ Wrenches are (f_x, f_z [N], torque [N m]); forces in G unless said; poses in SI 
 """
 from __future__ import annotations
 
+import itertools
 import math
 from fractions import Fraction
 from typing import List, Optional, Sequence
@@ -61,8 +68,22 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
         return ("no pusher has a stable push out of the start in any direction (" + ", ".join(
             task.pushers[i].name for i in stuck) + "): the pads do not hold the object there, and no pusher's "
             "friction cone can carry what they leave")
-    need = float(task.planner.get("min_hold_ratio", 0.0))
     goal = pose_to_si(task.goal)
+    # A last push ends within the tolerance, so it starts within it grown by a unit step (a push is
+    # checked at its start). Where the pads hold at the goal, or the core finds a push from it,
+    # some pusher may finish there and no LP is needed.
+    tol, step = task.planner["tolerance"], task.planner["step"]
+    box = ((tol[0] + step[0]) * MM, math.radians(tol[1] + step[1]))
+
+    def may_finish(i: int, exact: bool) -> bool:  # exact: with the LP when no witness is at hand
+        return all(m.hold_ratio(goal, i) >= 1.0 or _pushes_from(task, m, goal, i)
+                   or (exact and _may_push(task, m, goal, i, box)) for m in models)
+
+    if not any(may_finish(i, False) for i in usable) and not any(may_finish(i, True) for i in usable):
+        return ("no pusher has a stable push that ends within planner.tolerance of the goal (" + ", ".join(
+            task.pushers[i].name for i in usable) + "): wherever such a last push would start, the pads do "
+            "not hold the object, and no pusher's friction cone can carry what they leave")
+    need = float(task.planner.get("min_hold_ratio", 0.0))
     # The bound is at least the hold at the goal itself: only goals held too little by every pusher need it.
     if need > 0.0 and all(min(m.hold_ratio(goal, i) for m in models) < need for i in usable):
         bounds = {i: min(_hold_bound(task, m, i) for m in models) for i in usable}
@@ -101,11 +122,13 @@ def _cross_y(a, f) -> float:
     return float(a[1] * f[0] - a[0] * f[1])
 
 
-def _may_push(task: Task, model, q: Sequence[float], pusher: int) -> bool:
+def _may_push(task: Task, model, q: Sequence[float], pusher: int, box=(0.0, 0.0)) -> bool:
     """False only when no motion from q is a stable push of `pusher` in `model` (module docstring, 2):
     the LP  sum_j l_j g_j - sum_i W(f_i) - e = w_g,  l >= 0, f_i in the circumscribed polygons,
     e in the momentum box, is infeasible (in O about O's origin; w_g the weight's wrench that
-    the pusher and pads must carry). Decided as: the least t with |residual| <= t is positive."""
+    the pusher and pads must carry). Decided as: the least t with |residual| <= t + s is positive.
+    With `box` = (a [m], b [rad]), for every pose within a in x and z and b in theta of q (4):
+    s bounds how far W(f_i) and w_g move over the box; s = 0 at q alone."""
     gens = [np.asarray(g, float) for g in model.pusher_cones[pusher].generators]
     positions = [np.asarray(p, float) for p in model.gripper.point_positions]
     limits = list(model.gripper.point_friction_limits)
@@ -121,6 +144,7 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int) -> bool:
     arm = float(np.linalg.norm(r_cm))
     force = body.mass * (math.sqrt(2.0) * L + A * arm) / dt2
     momentum = np.array([force, force, arm * force + body.inertia * A / dt2])
+    slack = _box_slack(model, limits, np.linalg.norm(weight), arm, *box)
     n_g, n_p = len(gens), len(positions)
     # Columns: l (n_g), f (2 n_p), e (3), t.
     n = n_g + 2 * n_p + 3 + 1
@@ -139,7 +163,7 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int) -> bool:
             row = sign * eq[r].copy()
             row[-1] = -1.0
             ub_rows.append(row)
-            ub_rhs.append(sign * w_g[r])
+            ub_rhs.append(sign * w_g[r] + slack[r])
     scale = float(np.abs(w_g).sum() + sum(limits) + momentum.sum())
     lam_cap = 1e3 * scale
     bounds = ([(0.0, lam_cap)] * n_g + [(-2.0 * lim, 2.0 * lim) for lim in limits for _ in range(2)]
@@ -148,6 +172,33 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int) -> bool:
     c[-1] = -1.0  # maximize -t
     bound = _certified_max(c, np.array(ub_rows), np.array(ub_rhs), None, None, bounds)
     return not (bound < 0)
+
+
+def _pushes_from(task: Task, model, q: Sequence[float], pusher: int) -> bool:
+    """Whether the core finds a stable push of `pusher` from q toward one of the 26 neighbours of a
+    unit-step grid: a witness that spares the LP (milliseconds) wherever one is that cheap (microseconds)."""
+    L, A = task.planner["step"][0] * MM, math.radians(task.planner["step"][1])
+    for d in itertools.product((-1.0, 0.0, 1.0), repeat=3):
+        norm = math.sqrt(sum(v * v for v in d))
+        if norm and model.check(q, (d[0] * L / norm, d[1] * L / norm, d[2] * A / norm), pusher).feasible:
+            return True
+    return False
+
+
+def _box_slack(model, limits: Sequence[float], weight: float, com_arm: float, a: float, b: float) -> np.ndarray:
+    """How far each row of _may_push's wrench balance (f_x, f_z [N], torque [N m], in O) can move
+    between q and any pose within a [m] in x and z and b [rad] in theta of it. A pad force, at most
+    F_i = limit_i / cos(pi / POLYGON_SIDES) in its polygon, turns into O by at most b F_i; its
+    moment about O's origin, cross_y(p_i - o, f_i), moves by at most sqrt(2) a F_i. With gravity
+    fixed in G, the weight turns in O by b |W| and its moment by b |r_cm| |W|; fixed in O, neither
+    moves."""
+    if a == 0.0 and b == 0.0:
+        return np.zeros(3)
+    pads = sum(limits) / math.cos(math.pi / POLYGON_SIDES)
+    turns = str(model.gravity_frame).endswith("object")
+    force = b * pads + (0.0 if turns else b * weight)
+    torque = math.sqrt(2.0) * a * pads + (0.0 if turns else b * com_arm * weight)
+    return np.array([force, force, torque]) * (1.0 + 1e-9)  # and the rounding of these sums
 
 
 def _hold_bound(task: Task, model, pusher: int):
