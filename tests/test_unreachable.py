@@ -69,6 +69,77 @@ def test_a_goal_no_push_can_end_at_is_unreachable_and_one_beside_the_ledge_is_pl
     assert plan_task(dataclasses.replace(task, goal=(30.0, -4.0, 0.0))).solved
 
 
+def dumbbell(neck_mm: float) -> str:
+    """Two 30 mm squares joined by a bar `neck_mm` tall, held by 5 mm pads (10 mm wide) in the
+    right square, with a goal that puts them in the left one."""
+    h = neck_mm / 2
+    outline = [[-45, -15], [-15, -15], [-15, -h], [15, -h], [15, -15], [45, -15], [45, 15], [15, 15], [15, h],
+               [-15, h], [-15, 15], [-45, 15]]
+    return yaml.safe_dump({
+        "name": "dumbbell", "object": {"shape": "polygon", "polygon": outline, "thickness": 20, "mass": 100},
+        "gripper": {"grip_force": 10, "mu": 0.5, "pad_rings": 1}, "gravity": [0, -9.81],
+        "pushers": [{"name": "left", "from": [-45, -15], "to": [-45, 15], "mu": 0.6},
+                    {"name": "right", "from": [45, -15], "to": [45, 15], "mu": 0.6}],
+        "start": [30, 0, 0], "goal": [-30, 0, 0], "planner": {"time_limit": 5}})
+
+
+def test_a_goal_the_pads_cannot_slide_to_without_leaving_the_object_is_unreachable(monkeypatch):
+    # A 9.9 mm neck: the 10 mm pads cannot pass it. A goal in the same square is planned.
+    task = parse_task(dumbbell(9.9))
+    plan = plan_task(task)
+    assert plan.outcome == "unreachable" and len(plan.waypoints) == 1, plan.message
+    assert "gripper.pads[0] (radius 5 mm) would have to leave the object" in plan.message
+    assert plan_task(dataclasses.replace(task, goal=(20.0, 0.0, 0.0))).solved
+    # A 10.1 mm neck lets them through: no verdict, and the plan crosses.
+    assert plan_task(parse_task(dumbbell(10.1))).solved
+    # With the verdict off, the search does not cross the 9.9 mm neck either.
+    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None: None)
+    for seed in (1, 2):
+        assert not plan_task(task, seed=seed, time_limit=1.5).solved
+
+
+@pytest.mark.parametrize("name", ["t-shaped", "more/l-bracket-mesh", "more/wedge-heel", "dumbbell"])
+def test_pads_a_chain_of_grasps_joins_are_never_called_cut_off(name):
+    """A property against the core's own grasp test: start and goal at random grasps; wherever a
+    chain of grasps 0.25 mm apart (pad centres in O on a grid, the core's grasp_maintained at each)
+    joins them, verdict 5 says nothing; on the dumbbell's 9.9 mm neck some pairs are cut off."""
+    task = parse_task(dumbbell(9.9)) if name == "dumbbell" else shipped(name)
+    model = task.build_model()
+    xs = np.array([v[0] for v in task.vertices])
+    zs = np.array([v[1] for v in task.vertices])
+    step = 0.25
+    gx = np.arange(xs.min(), xs.max() + step, step)
+    gz = np.arange(zs.min(), zs.max() + step, step)
+    # A pad centre c in O at theta 0 is the pose (-c) for a pad at G's origin (the default pads).
+    assert all(tuple(p[0]) == (0.0, 0.0) for p in task.pads)
+    ok = np.array([[model.grasp_maintained(pose_to_si((-x, -z, 0.0))) for z in gz] for x in gx])
+    label = np.zeros(ok.shape, int)
+    n = 0
+    for i, j in zip(*np.nonzero(ok)):  # flood fill, 4-neighbours
+        if label[i, j]:
+            continue
+        n += 1
+        stack = [(i, j)]
+        label[i, j] = n
+        while stack:
+            a, b = stack.pop()
+            for c, d in ((a + 1, b), (a - 1, b), (a, b + 1), (a, b - 1)):
+                if 0 <= c < ok.shape[0] and 0 <= d < ok.shape[1] and ok[c, d] and not label[c, d]:
+                    label[c, d] = n
+                    stack.append((c, d))
+    rng = np.random.default_rng(len(name))
+    cells = list(zip(*np.nonzero(ok)))
+    cut = 0
+    for _ in range(40):
+        (i, j), (k, m) = (cells[r] for r in rng.choice(len(cells), 2))
+        t = dataclasses.replace(task, start=(-gx[i], -gz[j], 0.0), goal=(-gx[k], -gz[m], 0.0))
+        why = U._pad_cut_off(t)
+        if label[i, j] == label[k, m]:
+            assert why is None, (name, t.start, t.goal, why)
+        cut += why is not None
+    assert (cut > 0) == (name == "dumbbell")
+
+
 def test_a_goal_the_pads_cannot_hold_within_its_tolerance_is_unreachable_at_once():
     # The high-mu offset's goal: the pads hold 0.908 of the prism's weight there; in the whole
     # 0.5 mm / 0.5 deg box around it, at most 0.942 (the bound). It searched its full time limit.

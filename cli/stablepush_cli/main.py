@@ -187,8 +187,8 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     \b
     A goal that no plan can reach for a reason decided before the search (every pusher excluded by
     the uncertainty box, no stable push out of the start, none that ends within the goal's
-    tolerance, a hold requirement the goal cannot meet within its tolerance) returns at once,
-    "unreachable: " and the reason.
+    tolerance, a hold requirement the goal cannot meet within its tolerance, a pad that would have
+    to leave the object on the way) returns at once, "unreachable: " and the reason.
 
     \b
     Exit status: 0 solved, 1 not solved (time limit, or unreachable), 2 bad input.
@@ -1071,8 +1071,8 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
     Each cell is the task with its goal replaced, planned on its own. Its verdict: `reached`,
     `unreachable` with the reason (decided exactly before any search: no grasp at the goal or at
     the start, every pusher excluded by the uncertainty box, no stable push out of the start or
-    none into the goal's tolerance, or a min_hold_ratio the goal cannot meet), or `not found`
-    within --time-limit. The same seed gives
+    none into the goal's tolerance, a min_hold_ratio the goal cannot meet, or a pad that would
+    have to leave the object on the way), or `not found` within --time-limit. The same seed gives
     the same map, whichever runner plans it.
 
     \b

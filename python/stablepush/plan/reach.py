@@ -10,7 +10,7 @@ Each cell ends with a verdict:
   not on the object at the start (the planner's `invalid_start`), or the planner's own verdict
   before its search (`stablepush.plan.unreachable`: every pusher excluded by the uncertainty box,
   no stable push out of the start, none that ends within the goal's tolerance, the goal not held
-  well enough anywhere in its tolerance);
+  well enough anywhere in its tolerance, a pad that would have to leave the object);
 - `not found`: the search ran out of time (`outcome` says how: `time_limit`, or
   `goal_over_switch_limit` when the goal was reached with more switch-overs than allowed).
 

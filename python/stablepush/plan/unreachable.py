@@ -10,7 +10,11 @@
    weight anywhere in the goal's tolerance box, whichever pusher pushes last;
 4. no pusher has a stable push that ends within the goal's tolerance: wherever such a last push
    would start (the tolerance box grown by one unit step, since a push is checked at its start
-   pose), the pads do not hold the object and no pusher's cone can carry what they leave.
+   pose), the pads do not hold the object and no pusher's cone can carry what they leave;
+5. a pad would have to leave the object between the start and the goal: its centre must stay
+   where the pad's disc lies inside the outline (the outline eroded by the disc), and at the start
+   and at the goal it lies in two parts of that set, joined only through a neck narrower than the
+   pad (decided geometrically, without an LP; below).
 
 Each is a linear program over an outer approximation of the model, so that its infeasibility (2,
 4) or an upper bound under the requirement (3) holds for the model itself:
@@ -28,6 +32,11 @@ pads' limit surface somewhere, and there a motion is a stable push; it decides t
 pads alone do not hold. The same holds for 4 at the goal: only goals the pads do not hold are
 tested.
 
+For 5, shapely (GEOS) erodes the outline by a slightly smaller disc, r cos(pi / (4 QUAD_SEGS))
+less ERODE_MARGIN: whatever polygon GEOS draws for the arcs about reflex corners then lies within
+the true disc, so its eroded set contains the true one, and two of its parts can only be joined
+through one of them.
+
 HiGHS (scipy) solves each LP in doubles; the verdict rests on a bound computed from its dual
 solution in exact rational arithmetic (weak duality with the variables' bounds, Neumaier and
 Shcherbina 2004), so a rounding in the solver cannot call a reachable goal unreachable.
@@ -43,12 +52,14 @@ from typing import List, Optional, Sequence
 import numpy as np
 
 from stablepush.frames import direction_in_gripper
-from stablepush.task.model import Task
+from stablepush.task.model import Task, outline_corners
 from stablepush.units import MM, pose_to_si
 
 POLYGON_SIDES = 16  # of the polygon circumscribed about each pad point's friction disc
 THETA_GRID = 65  # poses in theta at which the moment of the weight is bounded over the tolerance box
 HOLD_CAP = 1e3  # hold factors are bounded by this in the LP (as in StablePushModel::hold_ratio)
+QUAD_SEGS = 64  # segments per quarter circle of the eroding disc (verdict 5)
+ERODE_MARGIN = 1e-6  # mm the eroding disc is made smaller by, over GEOS's rounding (verdict 5)
 
 
 def why_unreachable(task: Task, models=None) -> Optional[str]:
@@ -68,6 +79,9 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
         return ("no pusher has a stable push out of the start in any direction (" + ", ".join(
             task.pushers[i].name for i in stuck) + "): the pads do not hold the object there, and no pusher's "
             "friction cone can carry what they leave")
+    apart = _pad_cut_off(task)
+    if apart is not None:
+        return apart
     goal = pose_to_si(task.goal)
     # A last push ends within the tolerance, so it starts within it grown by a unit step (a push is
     # checked at its start). Where the pads hold at the goal, or the core finds a push from it,
@@ -93,6 +107,36 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
                     f"tolerance of the goal, whichever pusher pushes last, and planner.min_hold_ratio asks for "
                     f"{need:g}")
     return None
+
+
+def _pad_cut_off(task: Task) -> Optional[str]:
+    """Verdict 5 (module docstring): the reason, when a pad's centre lies at the start and at the goal
+    in two parts of the outline eroded by the pad's disc; else None. A convex outline erodes to one
+    convex part, so only outlines with reflex corners are eroded (and shapely imported)."""
+    corners = outline_corners(task.vertices)
+    turns = [_cross_z(corners[i - 2], corners[i - 1], corners[i]) for i in range(len(corners))]
+    if all(t >= 0 for t in turns) or all(t <= 0 for t in turns):
+        return None
+    from shapely.geometry import Point, Polygon  # here: only outlines with reflex corners need it
+
+    outline = Polygon(corners)
+    for k, (centre, radius) in enumerate(task.pads):
+        eroded = outline.buffer(-(radius * math.cos(math.pi / (4 * QUAD_SEGS)) - ERODE_MARGIN), quad_segs=QUAD_SEGS)
+        parts = list(getattr(eroded, "geoms", [eroded]))
+        if len(parts) < 2:
+            continue
+        where = []
+        for pose in (task.start, task.goal):
+            c = Point(direction_in_gripper(-pose[2], (centre[0] - pose[0], centre[1] - pose[1])))  # the centre in O
+            where.append({i for i, part in enumerate(parts) if part.covers(c)})
+        if where[0] and where[1] and not where[0] & where[1]:
+            return (f"gripper.pads[{k}] (radius {radius:g} mm) would have to leave the object between the start and "
+                    f"the goal: the outline narrows to less than the pad's width between where it sits at each")
+    return None
+
+
+def _cross_z(a, b, c) -> float:
+    return (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])
 
 
 def _excluded_by_box(task: Task, pusher) -> bool:
