@@ -16,8 +16,8 @@
    and at the goal it lies in two parts of that set, joined only through a neck narrower than the
    pad (decided geometrically, without an LP; below).
 
-Each is a linear program over an outer approximation of the model, so that its infeasibility (2,
-4) or an upper bound under the requirement (3) holds for the model itself:
+Each of 2-4 is a linear program over an outer approximation of the model, so that its
+infeasibility (2, 4) or an upper bound under the requirement (3) holds for the model itself:
 - every pad point's force lies in its friction disc (a sliding point's on its rim, a sticking
   point's in the polygon inscribed in it), so in the polygon circumscribed about it;
 - the momentum term M xi / dt of a push of at most one unit step lies in a box;
@@ -114,8 +114,8 @@ def _pad_cut_off(task: Task) -> Optional[str]:
     in two parts of the outline eroded by the pad's disc; else None. A convex outline erodes to one
     convex part, so only outlines with reflex corners are eroded (and shapely imported)."""
     corners = outline_corners(task.vertices)
-    turns = [_cross_z(corners[i - 2], corners[i - 1], corners[i]) for i in range(len(corners))]
-    if all(t >= 0 for t in turns) or all(t <= 0 for t in turns):
+    bends = [_cross_z(corners[i - 2], corners[i - 1], corners[i]) for i in range(len(corners))]
+    if all(b >= 0 for b in bends) or all(b <= 0 for b in bends):
         return None
     from shapely.geometry import Point, Polygon  # here: only outlines with reflex corners need it
 
