@@ -14,6 +14,7 @@ import yaml
 from scipy.optimize import linprog
 
 from stablepush import _core
+from stablepush.frames import direction_in_gripper
 from stablepush.plan import search
 from stablepush.plan import unreachable as U
 from stablepush.plan.search import plan_task
@@ -69,18 +70,20 @@ def test_a_goal_no_push_can_end_at_is_unreachable_and_one_beside_the_ledge_is_pl
     assert plan_task(dataclasses.replace(task, goal=(30.0, -4.0, 0.0))).solved
 
 
-def dumbbell(neck_mm: float) -> str:
-    """Two 30 mm squares joined by a bar `neck_mm` tall, held by 5 mm pads (10 mm wide) in the
-    right square, with a goal that puts them in the left one."""
-    h = neck_mm / 2
-    outline = [[-45, -15], [-15, -15], [-15, -h], [15, -h], [15, -15], [45, -15], [45, 15], [15, 15], [15, h],
-               [-15, h], [-15, 15], [-45, 15]]
+def dumbbell(neck_mm: float, neck_half_length: float = 15.0, start=(30, 0, 0), goal=(-30, 0, 0), pads=None) -> str:
+    """Two squares (30 mm for the default neck) joined by a bar `neck_mm` tall and 2
+    `neck_half_length` long, held by 5 mm pads (10 mm wide; `pads` as in a task file) in the right
+    square, with a goal that puts them in the left one."""
+    h, a, e = neck_mm / 2, neck_half_length, neck_half_length + 30
+    outline = [[-e, -15], [-a, -15], [-a, -h], [a, -h], [a, -15], [e, -15], [e, 15], [a, 15], [a, h],
+               [-a, h], [-a, 15], [-e, 15]]
+    gripper = {"grip_force": 10, "mu": 0.5, "pad_rings": 1, **({"pads": pads} if pads else {})}
     return yaml.safe_dump({
         "name": "dumbbell", "object": {"shape": "polygon", "polygon": outline, "thickness": 20, "mass": 100},
-        "gripper": {"grip_force": 10, "mu": 0.5, "pad_rings": 1}, "gravity": [0, -9.81],
-        "pushers": [{"name": "left", "from": [-45, -15], "to": [-45, 15], "mu": 0.6},
-                    {"name": "right", "from": [45, -15], "to": [45, 15], "mu": 0.6}],
-        "start": [30, 0, 0], "goal": [-30, 0, 0], "planner": {"time_limit": 5}})
+        "gripper": gripper, "gravity": [0, -9.81],
+        "pushers": [{"name": "left", "from": [-e, -15], "to": [-e, 15], "mu": 0.6},
+                    {"name": "right", "from": [e, -15], "to": [e, 15], "mu": 0.6}],
+        "start": list(start), "goal": list(goal), "planner": {"time_limit": 5}})
 
 
 def test_a_goal_the_pads_cannot_slide_to_without_leaving_the_object_is_unreachable(monkeypatch):
@@ -92,10 +95,31 @@ def test_a_goal_the_pads_cannot_slide_to_without_leaving_the_object_is_unreachab
     assert plan_task(dataclasses.replace(task, goal=(20.0, 0.0, 0.0))).solved
     # A 10.1 mm neck lets them through: no verdict, and the plan crosses.
     assert plan_task(parse_task(dumbbell(10.1))).solved
+    # Pads away from G's origin, the part turned at the start and at the goal: the same verdict.
+    # A pad centre c in O sits, at theta, where o = p - R(theta) c.
+    p, c_start, c_goal = np.array([4.0, 3.0]), (-30.0, 2.0), (30.0, -2.0)
+    start = (*(p - direction_in_gripper(25.0, c_start)).tolist(), 25.0)
+    goal = (*(p - direction_in_gripper(-20.0, c_goal)).tolist(), -20.0)
+    pads = [{"center": p.tolist(), "radius": 5}, {"center": p.tolist(), "radius": 5}]
+    turned = parse_task(dumbbell(9.9, start=start, goal=goal, pads=pads))
+    assert "would have to leave the object" in U.why_unreachable(turned)
+    same_square = (*(p - direction_in_gripper(-20.0, (-25.0, 0.0))).tolist(), -20.0)
+    assert U.why_unreachable(dataclasses.replace(turned, goal=same_square)) is None
     # With the verdict off, the search does not cross the 9.9 mm neck either.
     monkeypatch.setattr(search, "why_unreachable", lambda task, models=None: None)
-    for seed in (1, 2):
-        assert not plan_task(task, seed=seed, time_limit=1.5).solved
+    for t in (task, turned):
+        for seed in (1, 2):
+            assert not plan_task(t, seed=seed, time_limit=1.5).solved
+
+
+def test_a_goal_whose_tolerance_reaches_back_across_a_short_neck_is_not_called_cut_off():
+    # A 9.99 mm neck 0.2 mm long: the goal's own pose puts the pads' centre across it, but a pose
+    # within the 1 mm tolerance keeps it in the start's square, and the planner ends there.
+    task = parse_task(dumbbell(9.99, neck_half_length=0.1, start=(20, 0, 0), goal=(-0.4, 0, 0)))
+    assert U.why_unreachable(task) is None
+    assert plan_task(task).solved
+    # 5 mm farther, no pose within the tolerance is in the start's square.
+    assert "would have to leave" in U.why_unreachable(dataclasses.replace(task, goal=(-5.4, 0.0, 0.0)))
 
 
 @pytest.mark.parametrize("name", ["t-shaped", "more/l-bracket-mesh", "more/wedge-heel", "dumbbell"])
@@ -237,7 +261,15 @@ def test_a_start_with_a_stable_push_is_never_called_stuck(name):
     assert found > len(plan.waypoints) - 1 or any(p.is_point for p in task.pushers)
 
 
-@pytest.mark.parametrize("name", SHIPPED + ["ledge"])
+# The bar over a ledge under its middle, pads that carry a tenth of its weight, pushed by a moving
+# pusher: gravity is fixed in G and turns in O with theta, and past about 30 deg of turn the
+# ledge's cone no longer carries it.
+CENTRED_LEDGE = (LEDGE.replace("from: [20, -10], to: [45, -10]", "from: [-10, -10], to: [10, -10]")
+                 .replace("start: [30, 0, 0]", "start: [0, 0, 0]").replace("grip_force: 5", "grip_force: 1")
+                 + "dynamics: {pushes: by_moving_pusher}\n")
+
+
+@pytest.mark.parametrize("name", SHIPPED + ["ledge", "centred ledge"])
 def test_a_box_with_a_stable_push_anywhere_in_it_is_never_called_stuck(name):
     """A property (verdict 4's LP): boxes of random half-widths (up to 10 mm and 20 deg, so that
     some reach across the ledge's edge of support, where the slack decides) about random poses,
@@ -245,7 +277,7 @@ def test_a_box_with_a_stable_push_anywhere_in_it_is_never_called_stuck(name):
     a stable push of a pusher in a random direction from a pose in the box (its corners included),
     the LP over the box says the pusher may push."""
     rng = np.random.default_rng(11 + len(name))
-    task = parse_task(LEDGE) if name == "ledge" else shipped(name)
+    task = parse_task({"ledge": LEDGE, "centred ledge": CENTRED_LEDGE}[name]) if "ledge" in name else shipped(name)
     model, independent = task.build_model(), IndependentModel(task)
     step = task.planner["step"]
     found = 0
@@ -253,6 +285,8 @@ def test_a_box_with_a_stable_push_anywhere_in_it_is_never_called_stuck(name):
         centre = np.array(task.start) + rng.normal(0.0, [12.0, 3.0, 15.0])
         if name == "ledge":  # about the edge of the ledge's support (x about 17 mm)
             centre = np.array([rng.uniform(5.0, 25.0), rng.normal(0.0, 2.0), rng.normal(0.0, 5.0)])
+        if name == "centred ledge":  # about the turns past which its cone no longer carries the bar
+            centre = np.array([rng.normal(0.0, 3.0), rng.normal(0.0, 2.0), rng.uniform(-60.0, 60.0)])
         half = np.array([rng.uniform(0.2, 10.0), 0.0, rng.uniform(0.2, 20.0)])
         half[1] = half[0]  # the LP's box: the same half-width in x and z
         box = (half[0] * 1e-3, math.radians(half[2]))

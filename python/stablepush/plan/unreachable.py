@@ -12,9 +12,10 @@
    would start (the tolerance box grown by one unit step, since a push is checked at its start
    pose), the pads do not hold the object and no pusher's cone can carry what they leave;
 5. a pad would have to leave the object between the start and the goal: its centre must stay
-   where the pad's disc lies inside the outline (the outline eroded by the disc), and at the start
-   and at the goal it lies in two parts of that set, joined only through a neck narrower than the
-   pad (decided geometrically, without an LP; below).
+   where the pad's disc lies inside the outline (the outline eroded by the disc), and the part of
+   that set it lies in at the start keeps clear of every place the goal's tolerance lets it end,
+   the other parts joined to it only through necks narrower than the pad (decided geometrically,
+   without an LP; below).
 
 Each of 2-4 is a linear program over an outer approximation of the model, so that its
 infeasibility (2, 4) or an upper bound under the requirement (3) holds for the model itself:
@@ -89,11 +90,10 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
     tol, step = task.planner["tolerance"], task.planner["step"]
     box = ((tol[0] + step[0]) * MM, math.radians(tol[1] + step[1]))
 
-    def may_finish(i: int, exact: bool) -> bool:  # exact: with the LP when no witness is at hand
-        return all(m.hold_ratio(goal, i) >= 1.0 or _pushes_from(task, m, goal, i)
-                   or (exact and _may_push(task, m, goal, i, box)) for m in models)
-
-    if not any(may_finish(i, False) for i in usable) and not any(may_finish(i, True) for i in usable):
+    witnessed = {(i, k): m.hold_ratio(goal, i) >= 1.0 or _pushes_from(task, m, goal, i)
+                 for i in usable for k, m in enumerate(models)}
+    if not any(all(witnessed[i, k] for k in range(len(models))) for i in usable) and not any(
+            all(witnessed[i, k] or _may_push(task, m, goal, i, box) for k, m in enumerate(models)) for i in usable):
         return ("no pusher has a stable push that ends within planner.tolerance of the goal (" + ", ".join(
             task.pushers[i].name for i in usable) + "): wherever such a last push would start, the pads do "
             "not hold the object, and no pusher's friction cone can carry what they leave")
@@ -110,9 +110,12 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
 
 
 def _pad_cut_off(task: Task) -> Optional[str]:
-    """Verdict 5 (module docstring): the reason, when a pad's centre lies at the start and at the goal
-    in two parts of the outline eroded by the pad's disc; else None. A convex outline erodes to one
-    convex part, so only outlines with reflex corners are eroded (and shapely imported)."""
+    """Verdict 5 (module docstring): the reason, when the part of the outline eroded by a pad's disc
+    that holds the pad's centre at the start is farther than the goal's tolerance lets the centre
+    end from where it is at the goal; else None. Over the tolerance box (|do| <= sqrt(2) a,
+    |dtheta| <= b) the centre in O, R(-theta) (p - o), moves by at most sqrt(2) a + 2 sin(b / 2)
+    |p - o|. A convex outline erodes to one convex part, so only outlines with reflex corners are
+    eroded (and shapely imported)."""
     corners = outline_corners(task.vertices)
     bends = [_cross_z(corners[i - 2], corners[i - 1], corners[i]) for i in range(len(corners))]
     if all(b >= 0 for b in bends) or all(b <= 0 for b in bends):
@@ -125,11 +128,13 @@ def _pad_cut_off(task: Task) -> Optional[str]:
         parts = list(getattr(eroded, "geoms", [eroded]))
         if len(parts) < 2:
             continue
-        where = []
-        for pose in (task.start, task.goal):
-            c = Point(direction_in_gripper(-pose[2], (centre[0] - pose[0], centre[1] - pose[1])))  # the centre in O
-            where.append({i for i, part in enumerate(parts) if part.covers(c)})
-        if where[0] and where[1] and not where[0] & where[1]:
+        start, goal = (Point(direction_in_gripper(-pose[2], (centre[0] - pose[0], centre[1] - pose[1])))
+                       for pose in (task.start, task.goal))  # the pad's centre in O
+        tol = task.planner["tolerance"]
+        reach = math.sqrt(2.0) * tol[0] + 2.0 * math.sin(math.radians(tol[1]) / 2.0) * math.hypot(
+            centre[0] - task.goal[0], centre[1] - task.goal[1])
+        held = [part for part in parts if part.covers(start)]
+        if held and all(part.distance(goal) > reach * (1.0 + 1e-9) + ERODE_MARGIN for part in held):
             return (f"gripper.pads[{k}] (radius {radius:g} mm) would have to leave the object between the start and "
                     f"the goal: the outline narrows to less than the pad's width between where it sits at each")
     return None
