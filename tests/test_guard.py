@@ -7,9 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from stablepush.execution.guard import GuardedApproach, from_touch, seated_feature, turned_deg
-from stablepush.execution.world import Feature
-from stablepush.frames import quat_about_y, rot_y
+from stablepush.execution.guard import (GuardedApproach, found_feature, from_touch, seated_feature, touched_feature,
+                                        turned_deg)
+from stablepush.execution.world import Feature, near_pose
+from stablepush.frames import grasp_transform, pose_to_matrix, quat_about_y, rot_y
 from stablepush.plan import Waypoint
 
 
@@ -63,6 +64,29 @@ def test_the_seated_feature_is_the_objects_measured_world_pose_in_the_grasp_plan
     expected = np.array([0.4, 0.1, 0.3]) + rot_y(math.radians(20)) @ np.array([0.05, 0.0, -0.001])
     assert seated.object_pose[:3, 3] == pytest.approx(expected)
     assert seated.start is feature.start and seated.normal is feature.normal
+
+
+def test_a_touch_that_turned_the_object_rests_it_on_the_feature_turned():
+    """The plan and G of the test above. A touch that left the object 0.3 deg past the plan's turn
+    finds the feature in the plan's orientation; one that left it 1 deg past finds it turned, and G
+    then rests the object on it where G is (the stream's near_pose: no backing off and approaching
+    again), where the plan's orientation would put G 1 deg off and the stream would approach again."""
+    T_plan = np.eye(4)
+    T_plan[:3, :3], T_plan[:3, 3] = rot_y(math.radians(30)), (0.45, 0.1, 0.3)
+    feature = Feature("left", T_plan, np.zeros(3), np.ones(3), np.array([1.0, 0.0, 0.0]), 0.6)
+    ee_pose = (0.4, 0.1, 0.3, *quat_about_y(math.radians(20)))
+
+    def g_on(found, measured):  # G's pose that holds the object at `measured` on `found`
+        return found.object_pose @ np.linalg.inv(grasp_transform(measured))
+
+    slight = (50.0, -1.0, 10.3)
+    assert touched_feature(feature, ee_pose, slight).object_pose == pytest.approx(
+        found_feature(feature, ee_pose, slight).object_pose)
+    turned = (50.0, -1.0, 11.0)
+    found, touched = found_feature(feature, ee_pose, turned), touched_feature(feature, ee_pose, turned)
+    assert turned_deg(feature, touched) == pytest.approx(1.0)
+    assert not near_pose(pose_to_matrix(ee_pose), g_on(found, turned))
+    assert near_pose(pose_to_matrix(ee_pose), g_on(touched, turned), distance=1e-9, angle=1e-6)
 
 
 def test_a_contact_starts_from_the_measured_pose_and_still_ends_where_the_plan_does():

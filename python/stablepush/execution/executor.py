@@ -21,10 +21,10 @@ from stablepush.errors import ArmFault
 from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan, switch_held
 from stablepush.execution.guard import (
     GuardedApproach,
-    found_feature,
     from_touch,
     offset_along_approach_mm,
     seated_feature,
+    touched_feature,
     turned_deg,
 )
 from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
@@ -389,7 +389,7 @@ class _GuardWatch:
                 return None
             # Held still: the contact's pushes start from where the object is, on the feature where it is.
             measured = _measured(steps[k].pose, state["object_in_grasp"])
-            on_feature = found_feature(features[pusher], state["ee_pose"], measured)
+            on_feature = touched_feature(features[pusher], state["ee_pose"], measured)
             self.found[k + 1] = offset_along_approach_mm(features[pusher], on_feature)
             features[pusher] = on_feature
             steps = from_touch(steps, k, measured)

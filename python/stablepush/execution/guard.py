@@ -8,8 +8,9 @@ hexagon's and the tilted-gravity offset's misses, docs/evaluate.md). So the appr
 `contact_force` past `touch_n` (a wrist force-torque sensor, which tells it before the pads slide),
 or, from an arm that reports no force, the tracker's pose in the grasp moved past `touch_mm` or
 `touch_deg` since the slow end began. The arm holds still `hold_s`, and the contact's pushes then
-start from the measured pose with the feature where it was found (`found_feature`), so they move
-the object in the grasp as planned wherever the feature stands. A feature not met by the plan's
+start from the measured pose with the feature where it was found (`found_feature`, or turned as
+the object rests on it when the touch turned it: `touched_feature`), so they move the object in
+the grasp as planned wherever the feature stands. A feature not met by the plan's
 touch is sought up to `reach_mm` beyond it, as slowly; not met there, the contact runs as planned.
 
 At the touch the object is not yet seated on the feature: a feature turned about y meets it at a
@@ -32,7 +33,7 @@ from typing import List, Mapping, Sequence
 
 import numpy as np
 
-from stablepush.execution.world import Feature
+from stablepush.execution.world import RESTING_ANGLE, Feature
 from stablepush.frames import angle_about_y, grasp_transform, pose_to_matrix, rot_y
 from stablepush.plan.plan import Waypoint
 from stablepush.units import MM, angle_difference_deg
@@ -98,6 +99,19 @@ def found_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
     T_WO = feature.object_pose.copy()
     T_WO[:3, 3] = (pose_to_matrix(ee_pose) @ grasp_transform(in_grasp))[:3, 3]
     return replace(feature, object_pose=T_WO)
+
+
+def touched_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
+    """The feature as the touch found it: `found_feature`, unless the touch turned the object past
+    what the stream takes for resting on the feature (world.RESTING_ANGLE), in the grasp or in
+    the world. Then the feature is taken turned, as the object rests on it (`seated_feature`):
+    held to the plan's orientation, G's pose on it would differ from where G is by that turn, the
+    stream would back off the feature and approach it again, and each touch would turn the object
+    further."""
+    seated = seated_feature(feature, ee_pose, in_grasp)
+    if abs(math.radians(turned_deg(feature, seated))) > RESTING_ANGLE:
+        return seated
+    return found_feature(feature, ee_pose, in_grasp)
 
 
 def seated_feature(feature: Feature, ee_pose, in_grasp) -> Feature:

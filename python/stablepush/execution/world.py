@@ -142,7 +142,11 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequen
     }
 
 
-def near_pose(a: np.ndarray, b: np.ndarray, distance: float = 1e-3, angle: float = math.radians(0.5)) -> bool:
+RESTING_DISTANCE = 1e-3  # m: G this near the pose that holds the object on a feature rests it there (near_pose)
+RESTING_ANGLE = math.radians(0.5)  # rad: and this near in orientation
+
+
+def near_pose(a: np.ndarray, b: np.ndarray, distance: float = RESTING_DISTANCE, angle: float = RESTING_ANGLE) -> bool:
     """Whether two poses of G (4x4, m) lie within `distance` [m] and `angle` [rad] of each other."""
     cos = (np.trace(a[:3, :3].T @ b[:3, :3]) - 1) / 2
     return bool(np.linalg.norm(a[:3, 3] - b[:3, 3]) < distance and cos > math.cos(angle))
