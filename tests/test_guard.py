@@ -7,8 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from stablepush.execution.guard import (GuardedApproach, found_feature, from_touch, seated_feature, touched_feature,
-                                        turned_deg)
+from stablepush.execution.guard import (
+    GuardedApproach,
+    found_feature,
+    from_touch,
+    seated_feature,
+    touched_feature,
+    turned_deg,
+)
 from stablepush.execution.world import Feature, near_pose
 from stablepush.frames import grasp_transform, pose_to_matrix, quat_about_y, rot_y
 from stablepush.plan import Waypoint
