@@ -102,12 +102,12 @@ def found_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
 
 
 def touched_feature(feature: Feature, ee_pose, in_grasp) -> Feature:
-    """The feature as the touch found it: `found_feature`, unless the touch turned the object past
-    what the stream takes for resting on the feature (world.RESTING_ANGLE), in the grasp or in
-    the world. Then the feature is taken turned, as the object rests on it (`seated_feature`):
-    held to the plan's orientation, G's pose on it would differ from where G is by that turn, the
-    stream would back off the feature and approach it again, and each touch would turn the object
-    further."""
+    """The feature as the touch found it: `found_feature`, unless the touch left the object turned
+    in the world, from where the plan holds it on the feature, past what the stream takes for
+    resting on it (world.RESTING_ANGLE). Then the feature is taken turned, as the object rests on
+    it (`seated_feature`): held to the plan's orientation, G's pose on it would differ from where
+    G is by that turn, the stream would back off the feature and approach it again, and each
+    touch would turn the object further."""
     seated = seated_feature(feature, ee_pose, in_grasp)
     if abs(math.radians(turned_deg(feature, seated))) > RESTING_ANGLE:
         return seated
