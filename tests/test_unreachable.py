@@ -123,7 +123,7 @@ def test_a_goal_whose_tolerance_reaches_back_across_a_short_neck_is_not_called_c
 
 
 @pytest.mark.parametrize("name", ["t-shaped", "more/l-bracket-mesh", "more/wedge-heel", "dumbbell"])
-def test_pads_a_chain_of_grasps_joins_are_never_called_cut_off(name):
+def test_a_start_and_goal_a_chain_of_grasps_joins_are_never_called_cut_off(name):
     """A property against the core's own grasp test: start and goal at random grasps; wherever a
     chain of grasps 0.25 mm apart (pad centres in O on a grid, the core's grasp_maintained at each)
     joins them, verdict 5 says nothing; on the dumbbell's 9.9 mm neck some pairs are cut off."""
