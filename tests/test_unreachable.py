@@ -157,7 +157,7 @@ def test_a_start_and_goal_a_chain_of_grasps_joins_are_never_called_cut_off(name)
     for _ in range(40):
         (i, j), (k, m) = (cells[r] for r in rng.choice(len(cells), 2))
         t = dataclasses.replace(task, start=(-gx[i], -gz[j], 0.0), goal=(-gx[k], -gz[m], 0.0))
-        why = U._pad_cut_off(t)
+        why = U._pad_cut_off(t, model)
         if label[i, j] == label[k, m]:
             assert why is None, (name, t.start, t.goal, why)
         cut += why is not None

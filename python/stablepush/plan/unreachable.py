@@ -80,7 +80,7 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
         return ("no pusher has a stable push out of the start in any direction (" + ", ".join(
             task.pushers[i].name for i in stuck) + "): the pads do not hold the object there, and no pusher's "
             "friction cone can carry what they leave")
-    apart = _pad_cut_off(task)
+    apart = _pad_cut_off(task, models[0])
     if apart is not None:
         return apart
     goal = pose_to_si(task.goal)
@@ -109,20 +109,19 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
     return None
 
 
-def _pad_cut_off(task: Task) -> Optional[str]:
+def _pad_cut_off(task: Task, model) -> Optional[str]:
     """Verdict 5 (module docstring): the reason, when the part of the outline eroded by a pad's disc
     that holds the pad's centre at the start is farther than the goal's tolerance lets the centre
     end from where it is at the goal; else None. Over the tolerance box (|do| <= sqrt(2) a,
     |dtheta| <= b) the centre in O, R(-theta) (p - o), moves by at most sqrt(2) a + 2 sin(b / 2)
     |p - o|. A convex outline erodes to one convex part, so only outlines with reflex corners are
-    eroded (and shapely imported)."""
-    corners = outline_corners(task.vertices)
-    bends = [_cross_z(corners[i - 2], corners[i - 1], corners[i]) for i in range(len(corners))]
-    if all(b >= 0 for b in bends) or all(b <= 0 for b in bends):
+    eroded (and shapely imported); `model` is one of the task's, for its cross-section."""
+    if model.section.convex:
         return None
     from shapely.geometry import Point, Polygon  # here: only outlines with reflex corners need it
 
-    outline = Polygon(corners)
+    outline = Polygon(outline_corners(task.vertices))
+    tol = task.planner["tolerance"]
     for k, (centre, radius) in enumerate(task.pads):
         eroded = outline.buffer(-(radius * math.cos(math.pi / (4 * QUAD_SEGS)) - ERODE_MARGIN), quad_segs=QUAD_SEGS)
         parts = list(getattr(eroded, "geoms", [eroded]))
@@ -130,7 +129,6 @@ def _pad_cut_off(task: Task) -> Optional[str]:
             continue
         start, goal = (Point(direction_in_gripper(-pose[2], (centre[0] - pose[0], centre[1] - pose[1])))
                        for pose in (task.start, task.goal))  # the pad's centre in O
-        tol = task.planner["tolerance"]
         reach = math.sqrt(2.0) * tol[0] + 2.0 * math.sin(math.radians(tol[1]) / 2.0) * math.hypot(
             centre[0] - task.goal[0], centre[1] - task.goal[1])
         held = [part for part in parts if part.covers(start)]
@@ -138,10 +136,6 @@ def _pad_cut_off(task: Task) -> Optional[str]:
             return (f"gripper.pads[{k}] (radius {radius:g} mm) would have to leave the object between the start and "
                     f"the goal: the outline narrows to less than the pad's width between where it sits at each")
     return None
-
-
-def _cross_z(a, b, c) -> float:
-    return (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])
 
 
 def _excluded_by_box(task: Task, pusher) -> bool:
