@@ -62,7 +62,7 @@ def main() -> None:
             for loop, approach in ((loop, approach) for loop in args.loop for approach in args.approach):
                 batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=args.seed, closed_loop=loop == "closed",
                               guarded=approach == "guarded", engine=args.engine)
-                progress = _progress(f"{task.name} {kind}", f"{loop} {approach}", args.trials)
+                progress = progress_line(f"{task.name} {kind}", f"{loop} {approach}", args.trials)
                 evaluation = evaluate(batch, args.trials, runner, progress=progress)
                 s = evaluation.summary()
                 missed = [t for t in evaluation.trials if not t["success"]]
@@ -78,7 +78,7 @@ def main() -> None:
         args.json.write_text(json.dumps(summaries, indent=1) + "\n")
 
 
-def _progress(name: str, loop: str, trials: int):
+def progress_line(name: str, loop: str, trials: int):
     """A line on stderr, rewritten after each trial: trials done and landed so far (the table row
     comes at the end of the batch, which at 1,000 trials takes the better part of an hour)."""
     def show(record: dict, done: list) -> None:

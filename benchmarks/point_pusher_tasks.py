@@ -47,6 +47,15 @@ def _convex_polygon(rng: np.random.Generator) -> list:
     return [[round(float(a * math.cos(t)), 2), round(float(b * math.sin(t)), 2)] for t in angles]
 
 
+def outline(rng: np.random.Generator) -> list:
+    """A box of 25-80 x 20-60 mm or, as often, a convex polygon (`_convex_polygon`), in mm."""
+    if rng.uniform() < 0.5:
+        w, h = rng.uniform(25.0, 80.0), rng.uniform(20.0, 60.0)
+        polygon = [[-w / 2, -h / 2], [w / 2, -h / 2], [w / 2, h / 2], [-w / 2, h / 2]]
+        return [[round(float(x), 2), round(float(z), 2)] for x, z in polygon]
+    return _convex_polygon(rng)
+
+
 def _pins(rng: np.random.Generator, polygon: list, count: int) -> list:
     """`count` pins on distinct edges, each between 20% and 80% along its edge."""
     edges = rng.choice(len(polygon), size=count, replace=False)
@@ -62,12 +71,7 @@ def _pins(rng: np.random.Generator, polygon: list, count: int) -> list:
 def generate_task(seed: int, index: int) -> dict:
     """Task `index` of the set `seed`, as a task file's mapping (no goal yet: `goal_for`)."""
     rng = np.random.default_rng([seed, index])
-    if rng.uniform() < 0.5:
-        w, h = rng.uniform(25.0, 80.0), rng.uniform(20.0, 60.0)
-        polygon = [[-w / 2, -h / 2], [w / 2, -h / 2], [w / 2, h / 2], [-w / 2, h / 2]]
-        polygon = [[round(float(x), 2), round(float(z), 2)] for x, z in polygon]
-    else:
-        polygon = _convex_polygon(rng)
+    polygon = outline(rng)
     gravity = [0.0, -9.81] if rng.uniform() < 0.7 else [0.0, 0.0]
     return {
         "name": f"pins-{seed}-{index}",
