@@ -181,6 +181,25 @@ def test_a_robust_plan_is_stable_in_every_world_its_spreads_draw():
     assert nominal_slips > 0
 
 
+def test_robust_plans_of_generated_tasks_are_stable_in_every_world_their_spreads_draw(monkeypatch):
+    """The same on tasks nothing was tuned for: benchmarks/generated_task_odds.py's line-pusher
+    tasks (boxes and polygons, 2-3 features on their edges, with and without gravity), each planned
+    robustly to its goal; every push stays stable in each of 25 drawn worlds' own models."""
+    import importlib
+
+    monkeypatch.syspath_prepend(str(TASKS.parent.parent / "benchmarks"))
+    generator = importlib.import_module("generated_task_odds")
+    kinds = set()
+    for index in (3, 5, 6, 8):  # tasks of set 1 whose first goals are planned at once
+        data = generator.generate_task(1, index)
+        goal, task, plan = generator.goal_for(data, 1, index)
+        kinds.add((len(data["object"]["polygon"]) == 4, any(task.gravity)))
+        assert task.uncertainty == SPREADS.vary and len(plan.waypoints) > 5, (task.name, goal)
+        for trial in range(25):
+            check_plan(_in_world(task, draw_world(1, trial, SPREADS, task.pusher_names)), plan)
+    assert len(kinds) >= 3, kinds  # boxes and polygons, with gravity and without
+
+
 def test_evaluate_cli_plans_robust_to_its_spreads_or_says_why_not(tmp_path):
     task = str(TASKS / "more" / "tilted-gravity.yaml")
     out = tmp_path / "e.json"
