@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 from evaluate_tasks import SPREADS, progress_line
-from point_pusher_tasks import outline
+from point_pusher_tasks import random_task
 
 from stablepush.errors import TaskError
 from stablepush.evaluation import Batch, evaluate, robust_task, wilson_interval
@@ -57,21 +57,9 @@ def _features(rng: np.random.Generator, polygon: list, count: int) -> list:
 
 def generate_task(seed: int, index: int) -> dict:
     """Task `index` of the set `seed`, as a task file's mapping (its goal: `goal_for`)."""
-    rng = np.random.default_rng([seed, index])
-    polygon = outline(rng)
-    gravity = [0.0, -9.81] if rng.uniform() < 0.7 else [0.0, 0.0]
-    return {
-        "name": f"edges-{seed}-{index}",
-        "object": {"shape": "polygon", "polygon": polygon, "thickness": round(float(rng.uniform(10.0, 40.0)), 1),
-                   "mass": round(float(rng.uniform(30.0, 300.0)), 1)},
-        "gripper": {"grip_force": round(float(rng.uniform(5.0, 20.0)), 1),
-                    "mu": round(float(rng.uniform(0.3, 0.7)), 2), "pad_rings": 1},
-        "gravity": gravity,
-        "pushers": _features(rng, polygon, int(rng.integers(2, 4))),
-        "start": [0.0, 0.0, 0.0],
-        "goal": [0.0, 0.0, 0.0],
-        "planner": {"time_limit": PLAN_LIMIT, "seed": 1, "max_switches": 2, "tolerance": list(TOLERANCE)},
-    }
+    return random_task(np.random.default_rng([seed, index]), f"edges-{seed}-{index}",
+                       lambda rng, polygon: _features(rng, polygon, int(rng.integers(2, 4))),
+                       {"time_limit": PLAN_LIMIT, "seed": 1, "max_switches": 2, "tolerance": list(TOLERANCE)})
 
 
 def goal_for(data: dict, seed: int, index: int, tries: int = 8):

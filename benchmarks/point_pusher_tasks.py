@@ -68,23 +68,31 @@ def _pins(rng: np.random.Generator, polygon: list, count: int) -> list:
     return pins
 
 
-def generate_task(seed: int, index: int) -> dict:
-    """Task `index` of the set `seed`, as a task file's mapping (no goal yet: `goal_for`)."""
-    rng = np.random.default_rng([seed, index])
+def random_task(rng: np.random.Generator, name: str, place_pushers, planner: dict) -> dict:
+    """A task file's mapping with a random outline (`outline`), mass, thickness, grip, pad mu and
+    gravity (in the grasp plane for 70% of the tasks), its pushers from `place_pushers(rng,
+    polygon)`, start and goal at the origin (the goal: `goal_for`)."""
     polygon = outline(rng)
     gravity = [0.0, -9.81] if rng.uniform() < 0.7 else [0.0, 0.0]
     return {
-        "name": f"pins-{seed}-{index}",
+        "name": name,
         "object": {"shape": "polygon", "polygon": polygon, "thickness": round(float(rng.uniform(10.0, 40.0)), 1),
                    "mass": round(float(rng.uniform(30.0, 300.0)), 1)},
         "gripper": {"grip_force": round(float(rng.uniform(5.0, 20.0)), 1),
                     "mu": round(float(rng.uniform(0.3, 0.7)), 2), "pad_rings": 1},
         "gravity": gravity,
-        "pushers": _pins(rng, polygon, int(rng.integers(2, 4))),
+        "pushers": place_pushers(rng, polygon),
         "start": [0.0, 0.0, 0.0],
         "goal": [0.0, 0.0, 0.0],
-        "planner": {"time_limit": 5.0, "seed": 1, "max_switches": 2},
+        "planner": planner,
     }
+
+
+def generate_task(seed: int, index: int) -> dict:
+    """Task `index` of the set `seed`, as a task file's mapping (no goal yet: `goal_for`)."""
+    return random_task(np.random.default_rng([seed, index]), f"pins-{seed}-{index}",
+                       lambda rng, polygon: _pins(rng, polygon, int(rng.integers(2, 4))),
+                       {"time_limit": 5.0, "seed": 1, "max_switches": 2})
 
 
 def goal_for(data: dict, seed: int, index: int, kind: str = "random", tries: int = 8) -> Optional[list]:
