@@ -10,9 +10,8 @@ grip +-10%, mass +-5%, features off by up to 0.5 mm / 0.5 deg), judged within 0.
 Task i depends only on (--seed, i). Its goal is a random pose within GOAL_SPAN of the start that
 the task's robust plan (seed 1, `uncertainty:` the spreads' box, as `evaluate --robust`) reaches in
 PLAN_LIMIT s, planned to the tolerance the trials are judged by; a task none of whose tries gives
-one is left out and listed. One row per task and
-loop; the line under the table sums the trials over all tasks (issue 20's target, closed loop:
->= 99%).
+one is left out and listed. One row per task and loop; the line under the table sums the trials
+over all tasks (the closed-loop target: >= 99%).
 """
 from __future__ import annotations
 
