@@ -19,11 +19,10 @@ import json
 import sys
 from pathlib import Path
 
-from evaluate_tasks import SPREADS
+from evaluate_tasks import SPREADS, add_runner_options, runner_of
 
 from stablepush.evaluation import Batch, evaluate
 from stablepush.plan import plan_task
-from stablepush.runners import Runner
 from stablepush.task import load_task
 
 TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
@@ -34,13 +33,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("tasks", nargs="*", type=Path, help="task files (default: the pivot and the T)")
     parser.add_argument("--trials", type=int, default=20)
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--ray", nargs="?", const="", default=None, metavar="ADDRESS")
+    add_runner_options(parser, workers=2)
     parser.add_argument("--loop", choices=("open", "closed"), default="open")
     parser.add_argument("--target", type=float, default=TARGET, help="x real time asked for (default 20)")
     parser.add_argument("--json", type=Path, default=None, help="each task's speed figures, as JSON")
     args = parser.parse_args()
-    runner = Runner(workers=args.workers, ray=args.ray is not None, ray_address=args.ray or None)
+    runner = runner_of(args)
     tasks = args.tasks or [TASKS / "pivoting.yaml", TASKS / "t-shaped.yaml"]
     print(f"{args.trials} trials per task, {args.loop} loop, on {runner.describe()}", file=sys.stderr)
     print("| task | trials | landed | robot s | wall s | x real time |")

@@ -17,6 +17,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
+from typing import Optional
 
 from stablepush.evaluation import Batch, Spreads, evaluate, robust_task
 from stablepush.plan import check_plan, plan_task
@@ -33,8 +34,7 @@ def main() -> None:
     parser.add_argument("tasks", nargs="*", type=Path)
     parser.add_argument("--trials", type=int, default=100)
     parser.add_argument("--seed", type=int, default=1)
-    parser.add_argument("--workers", type=int, default=default_workers())
-    parser.add_argument("--ray", nargs="?", const="", default=None, metavar="ADDRESS")
+    add_runner_options(parser)
     parser.add_argument("--plans", nargs="+", choices=("nominal", "robust"), default=["nominal"])
     parser.add_argument("--loop", nargs="+", choices=("open", "closed"), default=["open", "closed"])
     parser.add_argument("--approach", nargs="+", choices=("guarded", "plain"), default=["guarded"])
@@ -43,7 +43,7 @@ def main() -> None:
                         help="every row's summary, with its missed trials' records under `missed` (trial, world, "
                              "verdict, replans: enough to run one again), as JSON")
     args = parser.parse_args()
-    runner = Runner(workers=args.workers, ray=args.ray is not None, ray_address=args.ray or None)
+    runner = runner_of(args)
     print(f"{args.trials} trials per row, seed {args.seed}, {args.engine}, on {runner.describe()}", file=sys.stderr)
     print("| task | plan | loop | approach | landed | success rate (95% CI) | goal error p50 / p95 mm | p50 / p95 deg "
           "| misses | wall s | x real time |")
@@ -76,6 +76,17 @@ def main() -> None:
                       f"{s['real_time_factor']:.2f} |", flush=True)
     if args.json:
         args.json.write_text(json.dumps(summaries, indent=1) + "\n")
+
+
+def add_runner_options(parser: argparse.ArgumentParser, workers: Optional[int] = None) -> None:
+    """`--workers K` (default `workers`, else the CPU count) and `--ray [ADDRESS]`, as `stablepush
+    evaluate` takes them; `runner_of` reads them."""
+    parser.add_argument("--workers", type=int, default=workers or default_workers())
+    parser.add_argument("--ray", nargs="?", const="", default=None, metavar="ADDRESS")
+
+
+def runner_of(args: argparse.Namespace) -> Runner:
+    return Runner(workers=args.workers, ray=args.ray is not None, ray_address=args.ray or None)
 
 
 def progress_line(name: str, loop: str, trials: int):

@@ -23,13 +23,12 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-from evaluate_tasks import SPREADS, progress_line
+from evaluate_tasks import SPREADS, add_runner_options, progress_line, runner_of
 from point_pusher_tasks import random_task
 
 from stablepush.errors import TaskError
 from stablepush.evaluation import Batch, evaluate, robust_task, wilson_interval
 from stablepush.plan import check_plan, plan_task
-from stablepush.runners import Runner, default_workers
 from stablepush.task import parse_task
 
 GOAL_SPAN = (20.0, 15.0, 20.0)  # mm, mm, deg either side of the start
@@ -94,11 +93,10 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=50, help="per task and loop")
     parser.add_argument("--seed", type=int, default=1, help="the task set's seed (the worlds use seed 1)")
     parser.add_argument("--loop", nargs="+", choices=("open", "closed"), default=["closed"])
-    parser.add_argument("--workers", type=int, default=default_workers())
-    parser.add_argument("--ray", nargs="?", const="", default=None, metavar="ADDRESS")
+    add_runner_options(parser)
     parser.add_argument("--json", type=Path, default=None, help="every row's summary and task, with its missed trials")
     args = parser.parse_args()
-    runner = Runner(workers=args.workers, ray=args.ray is not None, ray_address=args.ray or None)
+    runner = runner_of(args)
     print(f"{args.trials} trials per task and loop, task set {args.seed}, on {runner.describe()}", file=sys.stderr)
     print("| task | shape | features | gravity | goal | pushes | loop | landed | success rate (95% CI) "
           "| goal error p95 mm | misses |")
