@@ -20,12 +20,12 @@ import sys
 from pathlib import Path
 
 from evaluate_tasks import SPREADS, add_runner_options, runner_of
+from shipped import TASKS
 
 from stablepush.evaluation import Batch, evaluate
 from stablepush.plan import plan_task
 from stablepush.task import load_task
 
-TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 TARGET = 20.0  # x real time with 2 workers (issue 20)
 
 

@@ -19,13 +19,14 @@ import sys
 from pathlib import Path
 from typing import Optional
 
+from shipped import shipped_tasks
+
 from stablepush.evaluation import Batch, Spreads, evaluate, robust_task
 from stablepush.plan import check_plan, plan_task
 from stablepush.runners import Runner, default_workers
 from stablepush.sim.engines import ENGINES
 from stablepush.task import load_task
 
-TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 SPREADS = Spreads(vary={"pad_mu": 0.15, "pusher_mu": 0.15, "grip_force": 0.1, "mass": 0.05}, feature_error=(0.5, 0.5))
 
 
@@ -45,11 +46,12 @@ def main() -> None:
     args = parser.parse_args()
     runner = runner_of(args)
     print(f"{args.trials} trials per row, seed {args.seed}, {args.engine}, on {runner.describe()}", file=sys.stderr)
+    paths = args.tasks or shipped_tasks()
     print("| task | plan | loop | approach | landed | success rate (95% CI) | goal error p50 / p95 mm | p50 / p95 deg "
           "| misses | wall s | x real time |")
     print("|---|---|---|---|---:|---|---|---|---|---:|---:|")
     summaries = []
-    for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
+    for path in paths:
         nominal = load_task(path)
         for kind in args.plans:
             task = robust_task(nominal, SPREADS) if kind == "robust" else nominal

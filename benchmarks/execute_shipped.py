@@ -14,6 +14,8 @@ import argparse
 import math
 from pathlib import Path
 
+from shipped import shipped_tasks
+
 from stablepush.execution import execute_plan
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.guard import GuardedApproach
@@ -22,8 +24,6 @@ from stablepush.sim.arm import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.sim.server import running_sim_arm
 from stablepush.task import load_task
-
-TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 
 
 def main() -> None:
@@ -40,10 +40,11 @@ def main() -> None:
     parser.add_argument("--no-guard", action="store_true", help="approaches end where the plan puts each feature")
     args = parser.parse_args()
     guard = None if args.no_guard else GuardedApproach()
+    paths = args.tasks or shipped_tasks()
     print("| task | engine | world mu | loop | pushes | contacts | final error mm | final error deg | goal error mm / deg "
           "| re-plans | max slip at pusher mm (deg) | release moves it mm / deg | verdict | sim steps/s | wall s |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for path in args.tasks or sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
+    for path in paths:
         task = load_task(path)
         plan = check_plan(task, plan_task(task, seed=args.seed))
         for scale in args.mu_scale:

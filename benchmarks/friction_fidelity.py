@@ -6,13 +6,12 @@ replaced (the solver's stiff friction on every pad point, sliding or not).
 """
 import argparse
 import time
-from pathlib import Path
+
+from shipped import TASKS
 
 from stablepush.sim import fidelity, friction
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import check_push, load_task
-
-TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 
 
 def main() -> None:

@@ -12,10 +12,10 @@ import argparse
 import json
 from pathlib import Path
 
+from shipped import shipped_tasks
+
 from stablepush.plan import plan_task
 from stablepush.task import load_task
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def main() -> None:
@@ -23,7 +23,7 @@ def main() -> None:
     parser.add_argument("out", type=Path, help="JSON file to write")
     parser.add_argument("--seeds", type=int, default=30, help="seeds 1..N (default 30)")
     args = parser.parse_args()
-    tasks = sorted((ROOT / "data" / "tasks").glob("*.yaml")) + sorted((ROOT / "data" / "tasks" / "more").glob("*.yaml"))
+    tasks = shipped_tasks()
     out = {}
     for path in tasks:
         task = load_task(path)

@@ -10,11 +10,10 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+from shipped import shipped_tasks
 
 from stablepush.plan import plan_task
 from stablepush.task import load_task
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def main() -> None:
@@ -22,9 +21,10 @@ def main() -> None:
     parser.add_argument("tasks", nargs="*", type=Path, help="task files (default: data/tasks/*.yaml)")
     parser.add_argument("--seeds", type=int, default=100, help="seeds 1..N (default 100)")
     args = parser.parse_args()
+    paths = args.tasks or shipped_tasks(more=False)
     print("| task | solved | median ms | p95 ms | max ms | tests median | tests p95 | switch-overs (mean) |")
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
-    for path in args.tasks or sorted((ROOT / "data" / "tasks").glob("*.yaml")):
+    for path in paths:
         task = load_task(path)
         models = task.corner_models()
         times = np.full((2, args.seeds), np.inf)

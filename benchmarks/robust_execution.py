@@ -6,9 +6,9 @@ pad and feature mu are 0.85, 1 and 1.15 times the task's. Prints the "Robust pus
     python3 benchmarks/robust_execution.py      # about 4 minutes
 """
 import time
-from pathlib import Path
 
 import yaml
+from shipped import shipped_tasks
 
 from stablepush.execution import execute_plan
 from stablepush.plan import check_plan, plan_task
@@ -16,16 +16,16 @@ from stablepush.sim.arm import WorldDeviation
 from stablepush.sim.server import running_sim_arm
 from stablepush.task import parse_task
 
-TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 UNCERTAINTY = {"pad_mu": 0.15, "pusher_mu": 0.15}
 WORLDS = (0.85, 1.0, 1.15)
 
 
 def main() -> None:
+    paths = shipped_tasks()
     print("| task | plan | pushes | contacts | planning | least margin N | " +
           " | ".join(f"world μ x{s:g}: error mm / deg" for s in WORLDS) + " |")
     print("|---|---|---|---|---|---|" + "---|" * len(WORLDS))
-    for path in sorted(TASKS.glob("*.yaml")) + sorted((TASKS / "more").glob("*.yaml")):
+    for path in paths:
         data = yaml.safe_load(path.read_text())
         if data.get("uncertainty"):
             continue  # already a robust variant of another task

@@ -15,14 +15,12 @@ from __future__ import annotations
 import argparse
 import copy
 import statistics
-from pathlib import Path
 
 import yaml
+from shipped import TASKS
 
 from stablepush.plan.benchmark import bench_planning
 from stablepush.task import parse_task
-
-TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 
 EXTRA_PUSHERS = [  # on the large manipulation's 80 x 38 mm section, after its left pusher
     {"name": "right", "from": [40, -19], "to": [40, 19], "mu": 0.6},

@@ -15,14 +15,13 @@ import time
 from pathlib import Path
 
 import numpy as np
+from shipped import TASKS
 
 from stablepush.execution.stream import arm_trajectory
 from stablepush.execution.world import place_features, scene_description
 from stablepush.plan import plan_task
 from stablepush.sim.arm import SimArm
 from stablepush.task import load_task
-
-TASKS = Path(__file__).resolve().parent.parent / "data" / "tasks"
 
 
 def main() -> None:
