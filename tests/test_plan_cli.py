@@ -106,3 +106,26 @@ def test_check_directions_lists_stable_pushes_and_their_reach(tmp_path):
         assert result.returncode == 2 and "--move DX DZ DTH, or --directions" in result.stderr
     result = run("check", LOW_MU, "--directions", "--heading-step", "0")
     assert result.returncode == 2 and "--heading-step" in result.stderr
+
+
+def test_every_number_option_refuses_nan_and_infinity():
+    """Every float option of every command names itself and refuses nan, inf and -inf before a
+    command runs (click's own FloatRange lets nan through its bounds: `evaluate
+    --success-tolerance nan nan` ran trials and called every one a miss)."""
+    import click
+
+    from stablepush_cli.main import cli
+
+    options = [(name, param) for name, command in cli.commands.items() for param in command.params
+               if isinstance(param.type, click.types.FloatParamType)]
+    assert len(options) >= 20
+    for name, param in options:
+        ctx = click.Context(cli.commands[name])
+        for text in ("nan", "inf", "-inf"):
+            try:
+                param.type.convert(text, param, ctx)
+            except click.BadParameter:
+                continue
+            raise AssertionError(f"{name} {param.opts[0]} took {text}")
+    result = run("evaluate", LOW_MU, "--success-tolerance", "nan", "0.5")
+    assert result.returncode == 2 and "--success-tolerance" in result.stderr and "finite" in result.stderr

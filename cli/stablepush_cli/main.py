@@ -46,6 +46,19 @@ def _load(task_file: str):
     return task
 
 
+class Finite(click.FloatRange):
+    """A number in a range that is also finite: click's FloatRange compares with < and >, which
+    nan passes, and an unbounded side lets inf through."""
+
+    name = "finite float range"
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number.", param, ctx)
+        return number
+
+
 class _Commands(click.Group):
     """The command group: each StablepushError becomes one line on stderr and its exit status;
     anything else is a bug, reported in one line (STABLEPUSH_DEBUG=1 shows the traceback)."""
@@ -82,14 +95,14 @@ def cli() -> None:
 
 @cli.command()
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
-@click.option("--at", "at", nargs=3, type=float, default=None, metavar="X Z TH",
+@click.option("--at", "at", nargs=3, type=Finite(), default=None, metavar="X Z TH",
               help="Object pose in the grasp: x mm, z mm, theta deg. Default: the task's start.")
-@click.option("--move", nargs=3, type=float, default=None, metavar="DX DZ DTH",
+@click.option("--move", nargs=3, type=Finite(), default=None, metavar="DX DZ DTH",
               help="Unit motion of the object over one step: dx mm, dz mm, dtheta deg.")
 @click.option("--directions", is_flag=True,
               help="Instead of --move: every direction in which a pusher can push the object one unit step "
                    "(planner.step) from --at, and how far any of them moves it along +-x, +-z and +-theta.")
-@click.option("--heading-step", type=click.FloatRange(min=0, max=90, min_open=True), default=10.0, metavar="DEG",
+@click.option("--heading-step", type=Finite(min=0, max=90, min_open=True), default=10.0, metavar="DEG",
               show_default=True, help="With --directions: degrees between the headings tried in the (x, z) plane.")
 @click.option("--pusher", default=None, metavar="NAME", help="Test only this pusher (default: every pusher).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object keyed by pusher name.")
@@ -165,7 +178,7 @@ def _print_directions(found: dict, as_json: bool) -> None:
 @click.option(
     "--seed", type=click.IntRange(min=0), default=None, help="Random seed (default: the task's planner.seed)."
 )
-@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
+@click.option("--time-limit", type=Finite(min=0, min_open=True), default=None, metavar="S",
               help="Give up after S seconds (default: the task's planner.time_limit).")
 @click.option("--max-switches", type=click.IntRange(min=0), default=None, metavar="K",
               help="Stop at the first plan reaching the goal with at most K pusher switch-overs "
@@ -238,14 +251,14 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     help="Planning runs per task (seeds seed, seed+1, ...).",
 )
 @click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0), help="First seed.")
-@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None, metavar="S",
+@click.option("--time-limit", type=Finite(min=0, min_open=True), default=None, metavar="S",
               help="Per-trial time limit (default: each task's planner.time_limit).")
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), default=None,
               help="Also write every trial to this file: .csv (one row per trial) or .json (trials and summary).")
 @click.option(
     "-n", "--count", default=200_000, show_default=True, help="With --checks: checks per contact case and task."
 )
-@click.option("--improve-for", type=float, default=None, metavar="S",
+@click.option("--improve-for", type=Finite(min=0), default=None, metavar="S",
               help="Anytime planning: keep improving S seconds after the first plan (planner.improve_for), "
                    "and report the first and the improved plans.")
 @click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
@@ -449,7 +462,7 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
               help="Where to write the trajectory: CSV (a header, one row per sample), JSON (columns and rows), or a "
                    "ROS 2 bag in one MCAP file (/tf, the gripper's pose and twist, phase, step and the scene as "
                    "markers; docs/execution.md, 'ROS 2 bags').")
-@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
+@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
               metavar="HZ", help="Samples per second (the executor streams at this rate). Each push takes the "
                                  "fewest whole samples that last the task's dynamics.step_time: a rate that does not "
                                  "divide it pushes slower than the stability test assumed, never faster.")
@@ -532,7 +545,7 @@ def _video_options(which: str):
             "--video-size", "video_size", default="640x480", show_default=True, callback=_video_size,
             metavar="WxH", help=f"With {which}: the video's width and height in pixels (even).")(command)
         return click.option(
-            "--video-fps", "video_fps", default=25.0, show_default=True, type=click.FloatRange(min=0, min_open=True),
+            "--video-fps", "video_fps", default=25.0, show_default=True, type=Finite(min=0, min_open=True),
             metavar="FPS", help=f"With {which}: frames per second of the run's time, played at that rate (real "
                                 f"time); at most 100, a frame per waypoint at 100 Hz.")(command)
     return decorate
@@ -608,7 +621,7 @@ def _host_port(value: str):
 @click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
               help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with stablepush's own "
                    "Coulomb friction; drake: Drake's contact solver alone decides stick and slip.")
-@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=click.FloatRange(min=1, max=1000),
+@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
               metavar="HZ", help="Waypoints per second of motion. Each push takes the fewest whole periods that "
                                  "last the task's dynamics.step_time (slower than the model when HZ does not divide "
                                  "it, never faster).")
@@ -617,12 +630,12 @@ def _host_port(value: str):
                    "keeps the world it has, where every other run starts from a fresh one.")
 @click.option("--pace/--no-pace", default=None,
               help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
-@click.option("--ack-timeout", default=5.0, show_default=True, type=click.FloatRange(min=0.01), metavar="S",
+@click.option("--ack-timeout", default=5.0, show_default=True, type=Finite(min=0.01), metavar="S",
               help="Give up when the arm does not reply within S seconds.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the run's report as JSON: success, tolerance, cause of a miss, engine, final pose in the "
                    "grasp, slip per contact, corrections, features (on an arm fault: the verdict and where to resume).")
-@click.option("--success-tolerance", "success_tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True),
+@click.option("--success-tolerance", "success_tolerance", nargs=2, type=Finite(min=0, min_open=True),
               default=None, metavar="MM DEG",
               help="The run lands when the object ends within MM (x and z) and DEG of the goal in the grasp "
                    "(default: the task's planner.tolerance).")
@@ -637,10 +650,10 @@ def _host_port(value: str):
                    "which a simulated arm reports; drawn on a fault too.")
 @_video_options("--video")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-@click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
+@click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=Finite(min=0.1, max=10),
               metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
                                 "the plan against a world whose friction differs from its model.")
-@click.option("--tracker-noise", "tracker_noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0),
+@click.option("--tracker-noise", "tracker_noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0),
               metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise on the "
                                      "object's pose in the grasp (x and z in mm, theta in deg).")
 @click.option("--closed-loop", "closed_loop", is_flag=True,
@@ -654,10 +667,10 @@ def _host_port(value: str):
                    "found, not pushed into or missed. After a contact's first push, a feature the object rests "
                    "on turned (past 0.15 deg) is taken as turned for the contact's other pushes. An arm that "
                    "reports no tracked pose approaches as planned (and says so).")
-@click.option("--replan-threshold", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
+@click.option("--replan-threshold", nargs=2, type=Finite(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a re-plan "
                                      "(default: half the task's goal tolerance).")
-@click.option("--final-tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True), default=None,
+@click.option("--final-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None,
               metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
                                      "this close to the goal, and re-plan on the last contact's feature past it "
                                      "(default: a fifth of the task's goal tolerance).")
@@ -886,16 +899,16 @@ def _vary(_ctx, _param, values):
 @click.option("--vary", "vary", multiple=True, callback=_vary, metavar="KEY=FRACTION",
               help="Multiply the task's KEY (pad_mu, pusher_mu, grip_force or mass) in each world by a factor drawn "
                    "uniformly within 1 +- FRACTION. Repeatable.")
-@click.option("--feature-error", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0), metavar="MM DEG",
+@click.option("--feature-error", nargs=2, type=Finite(min=0), default=(0.0, 0.0), metavar="MM DEG",
               help="Place each feature off by up to MM in x and z and DEG about y (uniform).")
-@click.option("--tracker-noise", nargs=2, type=click.FloatRange(min=0), default=(0.0, 0.0), metavar="MM DEG",
+@click.option("--tracker-noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0), metavar="MM DEG",
               help="Standard deviations of the tracker's noise on the pose in the grasp.")
 @click.option("--closed-loop", is_flag=True, help="Run each trial closed loop (re-plan from the tracked pose).")
 @click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
               help="Find each feature by touch at the end of its approach (as `execute --guard`).")
 @click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
               help="The simulated arm's physics engine.")
-@click.option("--success-tolerance", nargs=2, type=click.FloatRange(min=0, min_open=True), default=(0.5, 0.5),
+@click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=(0.5, 0.5),
               show_default=True, metavar="MM DEG", help="A trial succeeds when it ends within MM (x and z) and DEG "
                                                         "of the goal in the grasp.")
 @click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
@@ -1051,7 +1064,7 @@ def _axis(_ctx, param, value):
 @click.option("--z", "z_axis", callback=_axis, default=None, metavar="A:B:N", help="Goal z values, mm (likewise).")
 @click.option("--theta", "theta_axis", callback=_axis, default=None, metavar="A:B:N",
               help="Goal theta values, deg (likewise).")
-@click.option("--time-limit", default=1.0, show_default=True, type=click.FloatRange(min=0, min_open=True),
+@click.option("--time-limit", default=1.0, show_default=True, type=Finite(min=0, min_open=True),
               metavar="S", help="Each cell's search time.")
 @click.option("--seed", default=None, type=click.IntRange(min=0), help="Planner seed (default: the task's).")
 @click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
@@ -1121,20 +1134,20 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
               help="Port to listen on (0: any free port, printed).")
 @click.option("--exit-after", type=click.IntRange(min=1), default=None, metavar="N",
               help="Fault injection for testing executors: die abruptly after N waypoints.")
-@click.option("--mu-scale", "mu_scale", default=1.0, show_default=True, type=click.FloatRange(min=0.1, max=10),
+@click.option("--mu-scale", "mu_scale", default=1.0, show_default=True, type=Finite(min=0.1, max=10),
               metavar="S", help="The pads' and features' mu are S times each task's (a world unlike the model).")
 @click.option(
     "--tracker-noise",
     "tracker_noise",
     nargs=2,
-    type=click.FloatRange(min=0),
+    type=Finite(min=0),
     default=(0.0, 0.0),
     metavar="MM DEG",
     help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).",
 )
 @click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
               help="Seed of the tracker's noise.")
-@click.option("--idle-timeout", default=30.0, show_default=True, type=click.FloatRange(min=0.1, max=3600), metavar="S",
+@click.option("--idle-timeout", default=30.0, show_default=True, type=Finite(min=0.1, max=3600), metavar="S",
               help="Drop a client that sends no complete message for S seconds (the arm is stopped).")
 @click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
               help="The physics engine. mujoco: pads slide with stablepush's own Coulomb friction; drake: Drake's "
