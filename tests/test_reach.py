@@ -4,11 +4,12 @@ to a goal that a plan reaches (each one is planned again with a long limit), and
 cell's plan passes the task's own check."""
 import dataclasses
 import json
+import math
 
 from click.testing import CliRunner
 
 from stablepush.plan import check_plan, plan_task
-from stablepush.plan.reach import ReachJob, reach_cell, reach_map
+from stablepush.plan.reach import ReachJob, axis_values, reach_cell, reach_map
 from stablepush.runners import Runner
 from stablepush_cli.main import cli
 
@@ -60,6 +61,21 @@ def test_reach_cli_writes_the_map_and_refuses_a_bad_axis(tmp_path):
     assert png.read_bytes()[:4] == b"\x89PNG"
     bad = CliRunner().invoke(cli, ["reach", task, "--x", "1:2"])
     assert bad.exit_code == 2 and "FROM:TO:COUNT" in bad.output
+
+
+def test_an_axis_of_finite_ends_has_finite_values_and_its_ends_exact():
+    """Evenly spaced from one end to the other, where the span itself overflows too: `reach --x
+    1e308:-1e308:3` was an internal error (a goal of nan)."""
+    assert axis_values((-30.0, 30.0, 7)) == [-30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0]
+    assert axis_values((5.0, 9.0, 1)) == [5.0]
+    for start, stop in ((1.7e308, -1.7e308), (-1.7e308, 1.7e308), (1e308, 1.5e308)):
+        values = axis_values((start, stop, 5))
+        assert values[0] == start and values[-1] == stop and all(map(math.isfinite, values))
+        steps = [b - a for a, b in zip(values, values[1:])]
+        assert all((s > 0) == (stop > start) for s in steps)
+    huge = CliRunner().invoke(cli, ["reach", str(TASKS / "pivoting.yaml"), "--x", "1e308:-1e308:3", "--time-limit",
+                                    "0.05", "--workers", "1", "--quiet"])
+    assert huge.exit_code == 0, huge.output
 
 
 def test_show_draws_a_plan_that_found_no_push_and_marks_the_goal(tmp_path):

@@ -32,8 +32,17 @@ Axis = Tuple[float, float, int]  # from, to, count (count 1: `from` alone)
 
 
 def axis_values(axis: Axis) -> List[float]:
+    """The axis' `count` values from `start` to `stop`, evenly spaced, both ends exact. Where
+    stop - start overflows, each is a convex combination of the ends instead, which stays finite."""
     start, stop, count = axis
-    return [float(v) for v in np.linspace(start, stop, int(count))] if count > 1 else [float(start)]
+    if count <= 1:
+        return [float(start)]
+    if np.isfinite(float(stop) - float(start)):
+        values = np.linspace(start, stop, int(count))
+    else:
+        t = np.arange(int(count)) / (int(count) - 1)
+        values = (1.0 - t) * start + t * stop
+    return [float(v) for v in values]
 
 
 @dataclass(frozen=True)
