@@ -53,6 +53,11 @@ def test_bad_spreads_are_refused_naming_the_key():
         Spreads(vary={"friction": 0.1})
     with pytest.raises(ValueError, match="pad_mu"):
         Spreads(vary={"pad_mu": 1.5})
+    for bad in (-0.1, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="feature_error"):
+            Spreads(feature_error=(bad, 0.5))
+        with pytest.raises(ValueError, match="tracker_noise"):
+            Spreads(tracker_noise=(0.1, bad))
 
 
 def test_a_world_deviation_changes_the_scene_as_asked():

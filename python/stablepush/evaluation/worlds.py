@@ -10,6 +10,7 @@ those multipliers, for a plan every push of which is stable in every such world.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 from typing import Dict, Sequence, Tuple
 
@@ -37,8 +38,9 @@ class Spreads:
                 raise ValueError(f"vary: unknown key {key!r} (one of {', '.join(VARY_KEYS)})")
             if not 0.0 <= fraction <= MAX_FRACTION:
                 raise ValueError(f"vary: {key} must be a fraction from 0 to {MAX_FRACTION:g}, got {fraction:g}")
-        if min(self.feature_error) < 0 or min(self.tracker_noise) < 0:
-            raise ValueError("feature error and tracker noise must not be negative")
+        for name, pair in (("feature_error", self.feature_error), ("tracker_noise", self.tracker_noise)):
+            if not all(0.0 <= v < math.inf for v in pair):  # written so that nan fails it too
+                raise ValueError(f"{name} must be finite and not negative, got {tuple(pair)}")
 
 
 @dataclass(frozen=True)
