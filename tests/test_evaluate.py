@@ -60,6 +60,13 @@ def test_bad_spreads_are_refused_naming_the_key():
             Spreads(tracker_noise=(0.1, bad))
 
 
+def test_a_batch_with_a_bad_success_tolerance_is_refused_before_any_trial():
+    good = _batch()
+    for bad in ((float("nan"), 0.5), (0.5, 0.0)):
+        with pytest.raises(ValueError, match="success tolerance"):
+            dataclasses.replace(good, tolerance=bad)
+
+
 def test_a_world_deviation_changes_the_scene_as_asked():
     """Hand-derived: multipliers on mu, grip and mass (and inertia); a feature turned 90 deg about y
     through its middle and shifted by (1, 2) mm."""

@@ -34,6 +34,14 @@ def test_the_goal_tolerance_is_the_tasks_per_coordinate_unless_given():
     assert not within({"x": 20.0, "z": 0.0, "theta": 0.51}, TASK.goal, (0.5, 0.5))
 
 
+@pytest.mark.parametrize("tolerance", [(float("nan"), 0.5), (0.5, float("inf")), (0.0, 0.5), (0.5, -1.0)])
+def test_a_tolerance_that_is_not_finite_and_positive_is_refused_naming_it(tolerance):
+    with pytest.raises(ValueError, match="success tolerance"):
+        success_tolerance(TASK, tolerance)
+    with pytest.raises(ValueError, match="success tolerance"):
+        Verdict.for_fault(tolerance, "stopped")
+
+
 def test_a_run_within_tolerance_landed():
     v = judge(TASK, _report((20.3, -0.2, 0.4)))
     assert v.success is True and v.cause is None and "landed" in v.detail

@@ -27,6 +27,7 @@ from stablepush.execution.bags import RunRecording
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.executor import execute_plan
 from stablepush.execution.guard import GuardedApproach
+from stablepush.execution.verdict import success_tolerance
 from stablepush.plan.plan import Plan
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.sim.arm import WorldDeviation
@@ -57,6 +58,10 @@ class Batch:
     video_dir: Optional[str] = None
     video_fps: float = 25.0
     video_size: Tuple[int, int] = (640, 480)
+
+    def __post_init__(self):
+        # Refused here, before any trial runs, rather than once per trial as a crash.
+        success_tolerance(self.task, self.tolerance)
 
     def world(self, trial: int) -> TrialWorld:
         return draw_world(self.seed, trial, self.spreads, self.task.pusher_names)

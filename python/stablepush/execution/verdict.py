@@ -127,5 +127,9 @@ def _describe(pose: Dict[str, float], goal: Sequence[float]) -> str:
 
 
 def _pair(values: Sequence[float]) -> Tuple[float, float]:
+    # A nan tolerance would call every run a miss, and a negative one every run too: refuse both here,
+    # where the library takes it, as the CLI's options do.
     mm, deg = (float(v) for v in values)
+    if not (math.isfinite(mm) and math.isfinite(deg) and mm > 0 and deg > 0):
+        raise ValueError(f"success tolerance must be two finite numbers above 0 (mm, deg), got {tuple(values)}")
     return mm, deg
