@@ -124,6 +124,9 @@ def test_bad_task_is_refused_naming_the_field(tmp_path, label, edit, field, reas
     assert message.count("\n") == 0, message
     assert f"{field}:" in message and reason in message, message
     assert "Traceback" not in result.output
+    if reason == "unknown key":
+        allowed = message.split("allowed here: ", 1)[1].rstrip(")").split(", ")
+        assert len(allowed) == len(set(allowed)), message
 
 
 @pytest.mark.parametrize(

@@ -195,7 +195,7 @@ def _mapping(path: str, value: Any, required: Sequence[str], optional: Sequence[
         raise TaskError(path, f"has {len(value)} keys; at most 64")
     for key in value:
         if key not in required and key not in optional:
-            allowed = ", ".join(list(required) + list(optional))
+            allowed = ", ".join(dict.fromkeys([*required, *optional]))
             raise TaskError(_join(path, _shown(key, 40) if not isinstance(key, str) else _shown(key, 40).strip("'")),
                             f"unknown key (allowed here: {allowed})")
     for key in required:
