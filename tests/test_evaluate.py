@@ -249,6 +249,22 @@ def test_evaluate_cli_writes_its_files_and_refuses_bad_options(tmp_path):
     assert bad.exit_code == 2 and "--ray" in bad.output
 
 
+def test_ctrl_c_before_any_trial_finished_exits_130_and_keeps_the_files(monkeypatch, tmp_path):
+    """Ctrl-C exits 130 however many trials were done, none included (README, docs/cli.md)."""
+    def interrupted(*_args):
+        raise KeyboardInterrupt
+        yield  # a generator, as run_all is
+
+    monkeypatch.setattr(batch_mod, "run_all", interrupted)
+    out = tmp_path / "e.json"
+    result = CliRunner().invoke(cli, ["evaluate", str(TASKS / "more" / "tilted-gravity.yaml"), "--trials", "3",
+                                      "--workers", "1", "--json", str(out), "--quiet"])
+    assert result.exit_code == 130, result.output
+    assert "interrupted before any trial finished" in result.stderr
+    summary = json.loads(out.read_text())["summary"]
+    assert summary["trials"] == 0 and summary["interrupted"] is True
+
+
 def test_bench_plans_the_same_on_workers_as_here(tmp_path):
     """`stablepush bench --workers` runs the same seeds to the same plans; only the times differ."""
     task = str(TASKS / "t-shaped.yaml")

@@ -47,10 +47,11 @@ def test_same_seed_same_file(tmp_path):
 
 
 def test_unsolved_plan_exits_1_and_still_writes_the_partial_plan(tmp_path):
-    out = tmp_path / "p.json"
-    r = run("plan", LOW_MU, "-o", str(out), "--max-switches", "0", "--time-limit", "0.2")
+    out, table = tmp_path / "p.json", tmp_path / "p.csv"
+    r = run("plan", LOW_MU, "-o", str(out), "--csv", str(table), "--max-switches", "0", "--time-limit", "0.2")
     assert r.returncode == 1
     assert "not solved" in r.stderr and "time limit" in r.stderr
+    assert f"partial plan written to {out} and {table}" in r.stderr and table.exists()
     plan = json.loads(out.read_text())
     assert plan["solved"] is False and plan["outcome"] in ("time_limit", "goal_over_switch_limit")
     assert len(plan["waypoints"]) >= 1

@@ -183,7 +183,9 @@ def _print_directions(found: dict, as_json: bool) -> None:
 @click.option("--max-switches", type=click.IntRange(min=0), default=None, metavar="K",
               help="Stop at the first plan reaching the goal with at most K pusher switch-overs "
                    "(default: the task's planner.max_switches).")
-@click.option("--quiet", is_flag=True, help="Print nothing on success.")
+@click.option("--quiet", is_flag=True,
+              help="Print nothing on stdout on success. A note that the pads do not hold the last pose "
+                   "still goes to stderr.")
 def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, quiet: bool) -> None:
     """Plan stable pushes from the task's start to its goal.
 
@@ -222,7 +224,7 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     s = result.stats
     if not result.solved:
         click.echo(f"{task.name}: {result.message}", err=True)
-        click.echo(f"partial plan written to {json_path}", err=True)
+        click.echo(f"partial plan written to {json_path}" + (f" and {csv_path}" if csv_path else ""), err=True)
         sys.exit(EXIT_NOT_SOLVED)
     if not quiet:
         click.echo(f"{task.name}: solved in {s['planning_time_s'] * 1e3:.1f} ms (seed {s['seed']}): "
@@ -1016,8 +1018,8 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
     write_evaluation(result, json_path, csv_path, png_path)
     s = result.summary()
     if not s["trials"]:
-        click.echo("no trial finished", err=True)
-        sys.exit(EXIT_NOT_SOLVED)
+        click.echo("interrupted before any trial finished" if s["interrupted"] else "no trial finished", err=True)
+        sys.exit(130 if s["interrupted"] else EXIT_NOT_SOLVED)
     low, high = s["ci95"]
     click.echo(f"{task.name}: landed {s['successes']} of {s['trials']} trials within {success_tolerance[0]:g} mm / "
                f"{success_tolerance[1]:g} deg: {s['success_rate']:.1%} (95% CI {low:.1%}-{high:.1%})"
