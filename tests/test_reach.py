@@ -63,6 +63,24 @@ def test_reach_cli_writes_the_map_and_refuses_a_bad_axis(tmp_path):
     assert bad.exit_code == 2 and "FROM:TO:COUNT" in bad.output
 
 
+def test_reach_maps_a_task_whose_own_goal_has_no_grasp(tmp_path):
+    """The grid replaces the goal, so a task whose goal lies off the grasp is mapped, its cells
+    judged on their own; `plan` still refuses that task, naming the goal."""
+    from conftest import task_text
+
+    task = tmp_path / "far.yaml"
+    task.write_text(task_text("horizontal-offset-low-mu").replace("goal: [20, 0, 0]", "goal: [500, 0, 0]"))
+    assert "goal: [500, 0, 0]" in task.read_text()
+    out = tmp_path / "r.json"
+    result = CliRunner().invoke(cli, ["reach", str(task), "--x", "0:500:2", "--z", "0:0:1", "--theta", "0:0:1",
+                                      "--time-limit", "0.2", "--workers", "1", "--json", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    near, far = json.loads(out.read_text())["cells"]
+    assert near["verdict"] == "reached" and far["verdict"] == "unreachable" and "no grasp" in far["reason"]
+    refused = CliRunner().invoke(cli, ["plan", str(task), "-o", str(tmp_path / "p.json")])
+    assert refused.exit_code == 2 and "goal:" in refused.stderr
+
+
 def test_an_axis_of_finite_ends_has_finite_values_and_its_ends_exact():
     """Evenly spaced from one end to the other, where the span itself overflows too: `reach --x
     1e308:-1e308:3` was an internal error (a goal of nan)."""

@@ -38,9 +38,9 @@ def _fail(message: str) -> None:
     sys.exit(EXIT_BAD_INPUT)
 
 
-def _load(task_file: str):
+def _load(task_file: str, goal_in_grasp: bool = True):
     """The task, its warnings printed to stderr (legal, but probably not what was meant)."""
-    task = load_task(task_file)
+    task = load_task(task_file, goal_in_grasp)
     for warning in task.warnings:
         click.echo(f"warning: {task_file}: {warning}", err=True)
     return task
@@ -1084,11 +1084,12 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
     """Map where the pushers can take the object: plan from the task's start to every goal of a grid.
 
     Each cell is the task with its goal replaced, planned on its own. Its verdict: `reached`,
-    `unreachable` with the reason (decided exactly before any search: no grasp at the goal or at
-    the start, every pusher excluded by the uncertainty box, no stable push out of the start or
+    `unreachable` with the reason (decided exactly before any search: no grasp at the goal,
+    every pusher excluded by the uncertainty box, no stable push out of the start or
     none into the goal's tolerance, a min_hold_ratio the goal cannot meet, or a pad that would
     have to leave the object on the way), or `not found` within --time-limit. The same seed gives
-    the same map, whichever runner plans it.
+    the same map, whichever runner plans it. The task's start must have a grasp; its goal need
+    not, as the grid replaces it.
 
     \b
     Example:
@@ -1102,7 +1103,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_outputs({"--json": json_path, "--plot": png_path}, {"TASK.yaml": task_file})
     runner = _runner(workers, ray_address, default=default_workers())
-    task = _load(task_file)
+    task = _load(task_file, goal_in_grasp=False)  # the grid replaces the goal; its cells say where there is no grasp
     gx, gz, gth = task.goal
     axes = [a if a is not None else (g, g, 1) for a, g in ((x_axis, gx), (z_axis, gz), (theta_axis, gth))]
     count = axes[0][2] * axes[1][2] * axes[2][2]
