@@ -207,6 +207,24 @@ def test_bad_plan_files_are_refused_before_anything_moves(tmp_path, low_mu_plan,
     assert result.exit_code == 2 and says in result.stderr
 
 
+def test_a_partial_plan_one_switch_over_past_its_budget_is_drawn_and_two_are_refused(tmp_path, low_mu_plan):
+    """The search extends only nodes within max_switches, so the node nearest the goal, which an
+    unsolved plan ends at, may be one switch-over past it; `show` draws such a plan."""
+    task = shipped("horizontal-offset-low-mu")
+    plan = json.loads(json.dumps(low_mu_plan))  # bottom -> left: one switch-over
+    plan.update(solved=False, outcome="time_limit", message="not solved: the time limit ran out")
+    plan["stats"]["max_switches"] = 0
+    path = tmp_path / "partial.plan.json"
+    path.write_text(json.dumps(plan))
+    check_plan(task, load_plan(path), require_solved=False)
+    result = CliRunner().invoke(cli, ["show", str(path), "--task", str(LOW_MU), "-o", str(tmp_path / "p.png")])
+    assert result.exit_code == 0, result.output
+    _alternate_pushers(plan["waypoints"][1:4])  # bottom -> left -> bottom -> left: 3
+    path.write_text(json.dumps(plan))
+    with pytest.raises(PlanError, match="switch-overs, more than the plan's max_switches"):
+        check_plan(task, load_plan(path), require_solved=False)
+
+
 def test_a_nominal_plan_is_refused_for_the_same_task_with_an_uncertainty_box():
     """Every push is re-checked at each corner of the box: a plan made without it has pushes that
     are stable for the nominal model only (its margins are 0.1 N)."""
