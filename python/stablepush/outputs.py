@@ -58,6 +58,8 @@ def _writable(path: Union[str, Path]):
         raise OutputError(f"{path}: not a regular file; refusing to replace it")
     if not target.parent.is_dir():
         raise OutputError(f"{path}: the directory {target.parent} does not exist")
+    if not os.access(target.parent, os.W_OK | os.X_OK):  # a new file is made in it, then renamed
+        raise OutputError(f"{path}: the directory {target.parent} is not writable")
     return target, "replace", stat.S_IMODE(mode) if mode is not None else None
 
 
@@ -109,6 +111,7 @@ def _write_and_rename(plan) -> None:
     import tempfile  # here, not at the top: it costs every command's start-up about 20 ms
 
     temporaries = []  # written, not yet renamed: removed on any failure
+    path = None  # the output being written, for the message: not its temporary file's name
     try:
         for path, target, content, how, mode in plan:
             data = content.encode() if isinstance(content, str) else content
@@ -117,19 +120,19 @@ def _write_and_rename(plan) -> None:
                     handle.write(data)
                 continue
             fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-            temporaries.append((tmp, target))
+            temporaries.append((tmp, target, path))
             with os.fdopen(fd, "wb") as handle:
                 handle.write(data)
                 handle.flush()
                 os.fsync(handle.fileno())
             os.chmod(tmp, mode if mode is not None else 0o666 & ~_umask())
-        for tmp, target in temporaries:
+        for tmp, target, path in temporaries:
             os.replace(tmp, target)
         temporaries = []
     except OSError as exc:
-        raise OutputError(f"cannot write {exc.filename or 'the output'}: {exc.strerror or exc}") from None
+        raise OutputError(f"cannot write {path or 'the output'}: {exc.strerror or exc}") from None
     finally:
-        for tmp, _ in temporaries:
+        for tmp, _, _ in temporaries:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
 

@@ -104,7 +104,11 @@ def _mcap(path: Union[str, Path], topics: dict):
 
     store = get_typestore(Stores.ROS2_HUMBLE)
     path = Path(path)
-    with tempfile.TemporaryDirectory(dir=path.parent if path.parent.exists() else None) as scratch:
+    try:  # the bag is written beside its output, so that the last move is a rename
+        scratch_directory = tempfile.TemporaryDirectory(dir=path.parent if path.parent.exists() else None)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write the bag ({exc.strerror or exc})") from None
+    with scratch_directory as scratch:
         bag = Path(scratch) / "bag"
         with Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
             connections = {topic: writer.add_connection(topic, kind, typestore=store) for topic, kind in topics.items()}
@@ -116,7 +120,7 @@ def _mcap(path: Union[str, Path], topics: dict):
         try:
             os.replace(bag / "bag.mcap", path)
         except OSError as exc:
-            raise OutputError(str(path), f"cannot write the bag ({exc.strerror or exc})") from None
+            raise OutputError(f"{path}: cannot write the bag ({exc.strerror or exc})") from None
 
 
 # -- messages ---------------------------------------------------------------------------------
