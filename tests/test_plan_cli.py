@@ -131,3 +131,14 @@ def test_every_number_option_refuses_nan_and_infinity():
             raise AssertionError(f"{name} {param.opts[0]} took {text}")
     result = run("evaluate", LOW_MU, "--success-tolerance", "nan", "0.5")
     assert result.returncode == 2 and "--success-tolerance" in result.stderr and "finite" in result.stderr
+
+
+def test_planner_options_out_of_the_planners_ranges_are_refused_naming_the_option():
+    """The library would refuse them too, but naming the task's field (`max_switches:`), not the
+    option that was typed."""
+    for option, value in (("--max-switches", "101"), ("--seed", str(2**32)), ("--time-limit", "1e9")):
+        for command in ("plan", "reach", "bench"):
+            if option == "--max-switches" and command != "plan":
+                continue
+            r = run(command, LOW_MU, option, value)
+            assert r.returncode == 2 and f"Invalid value for '{option}'" in r.stderr, (command, option, r.stderr)

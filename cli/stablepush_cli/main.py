@@ -13,6 +13,7 @@ from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError,
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import check_push, load_task, stable_directions
+from stablepush.task.schema import LIMITS, PLANNER_PARAMETER_RANGES
 
 EXIT_NOT_SOLVED = 1
 EXIT_BAD_INPUT = 2
@@ -57,6 +58,12 @@ class Finite(click.FloatRange):
         if not math.isfinite(number):
             self.fail(f"{value!r} is not a finite number.", param, ctx)
         return number
+
+
+# The planner's own ranges, so that a value out of them is refused naming the option, before any work.
+SEED = click.IntRange(0, int(PLANNER_PARAMETER_RANGES["seed"][2]))
+MAX_SWITCHES = click.IntRange(0, int(PLANNER_PARAMETER_RANGES["max_switches"][2]))
+TIME_LIMIT = Finite(*LIMITS["time_limit"])
 
 
 class _Commands(click.Group):
@@ -176,11 +183,11 @@ def _print_directions(found: dict, as_json: bool) -> None:
 @click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None,
               help="Also write the waypoints as CSV (step,x,z,theta,pusher,...).")
 @click.option(
-    "--seed", type=click.IntRange(min=0), default=None, help="Random seed (default: the task's planner.seed)."
+    "--seed", type=SEED, default=None, help="Random seed (default: the task's planner.seed)."
 )
-@click.option("--time-limit", type=Finite(min=0, min_open=True), default=None, metavar="S",
+@click.option("--time-limit", type=TIME_LIMIT, default=None, metavar="S",
               help="Give up after S seconds (default: the task's planner.time_limit).")
-@click.option("--max-switches", type=click.IntRange(min=0), default=None, metavar="K",
+@click.option("--max-switches", type=MAX_SWITCHES, default=None, metavar="K",
               help="Stop at the first plan reaching the goal with at most K pusher switch-overs "
                    "(default: the task's planner.max_switches).")
 @click.option("--quiet", is_flag=True,
@@ -252,8 +259,8 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     type=click.IntRange(min=1),
     help="Planning runs per task (seeds seed, seed+1, ...).",
 )
-@click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0), help="First seed.")
-@click.option("--time-limit", type=Finite(min=0, min_open=True), default=None, metavar="S",
+@click.option("--seed", default=1, show_default=True, type=SEED, help="First seed.")
+@click.option("--time-limit", type=TIME_LIMIT, default=None, metavar="S",
               help="Per-trial time limit (default: each task's planner.time_limit).")
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), default=None,
               help="Also write every trial to this file: .csv (one row per trial) or .json (trials and summary).")
@@ -1066,9 +1073,9 @@ def _axis(_ctx, param, value):
 @click.option("--z", "z_axis", callback=_axis, default=None, metavar="A:B:N", help="Goal z values, mm (likewise).")
 @click.option("--theta", "theta_axis", callback=_axis, default=None, metavar="A:B:N",
               help="Goal theta values, deg (likewise).")
-@click.option("--time-limit", default=1.0, show_default=True, type=Finite(min=0, min_open=True),
+@click.option("--time-limit", default=1.0, show_default=True, type=TIME_LIMIT,
               metavar="S", help="Each cell's search time.")
-@click.option("--seed", default=None, type=click.IntRange(min=0), help="Planner seed (default: the task's).")
+@click.option("--seed", default=None, type=SEED, help="Planner seed (default: the task's).")
 @click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
               help="Plan the cells on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
