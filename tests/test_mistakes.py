@@ -63,7 +63,9 @@ def test_a_pusher_a_hair_off_its_edge_is_snapped_and_one_far_off_gets_its_true_d
                                                          "from: [-49.99, -12.5], to: [-49.99, 12.5]")
     task = parse_task(near)
     assert task.pushers[0].a == (-50.0, -12.5) and task.pushers[0].b == (-50.0, 12.5)
-    assert any("pushers[0]: 0.01 mm off the object's edge" in w for w in task.warnings)
+    assert any("pushers[0]: 0.01 mm off the object's edge from [-50.0, -12.5] to [-50.0, 12.5] mm" in w
+               or "pushers[0]: 0.01 mm off the object's edge from [-50.0, 12.5] to [-50.0, -12.5] mm" in w
+               for w in task.warnings), task.warnings
     far = task_text("horizontal-offset-low-mu").replace("from: [-50, -12.5], to: [-50, 12.5]",
                                                         "from: [-40, -12.5], to: [-40, 12.5]")
     with pytest.raises(Exception, match="it is 10 mm from the nearest edge"):

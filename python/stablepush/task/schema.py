@@ -562,7 +562,7 @@ def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str
             if a == b and points > 1:
                 raise TaskError(path, "lies across a vertex; it must lie along one edge")
             corners = section.vertices
-            ends = [tuple(round(c / MM, 6) for c in corners[i % len(corners)]) for i in (edge, edge + 1)]
+            ends = [[round(float(c) / MM, 6) for c in corners[i % len(corners)]] for i in (edge, edge + 1)]
             notes.append(f"{path}: {distance / MM:.3g} mm off the object's edge from {ends[0]} to {ends[1]} mm; "
                          f"moved onto it")
         try:
