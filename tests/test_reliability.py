@@ -183,6 +183,8 @@ def low_mu_plan():
     (lambda p: p["waypoints"][2].update(x=float("nan")), "not valid JSON (NaN is not a number JSON allows here)"),
     (lambda p: p.update(stats=[]), "stats: must be a mapping, got a list"),
     (lambda p: p.update(stats=None), "stats: must be a mapping, got null"),
+    (lambda p: p.pop("solved"), "solved: missing"),
+    (lambda p: p["waypoints"][3].pop("theta"), "waypoints[3].theta: missing"),
     (lambda p: p.update(solved="no"), "solved: must be a boolean, got a string"),
     (lambda p: p["waypoints"][2].update(x=p["waypoints"][2]["x"] + 50), "waypoints[2]: a step of 5"),
     (lambda p: p["waypoints"][3].update(x=10 ** 400), "waypoints[3].x: must be a finite number"),

@@ -150,6 +150,8 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         fail("format", f"not a {FORMAT} file")
     for key, kind in (("task", str), ("solved", bool), ("stats", dict), ("waypoints", list)):
+        if key not in data:
+            fail(key, "missing")
         if not isinstance(data.get(key), kind):
             fail(key, f"must be {'a boolean' if kind is bool else 'a ' + _KIND_NAMES[kind]}, got "
                       f"{_json_kind(data.get(key))}")
@@ -164,6 +166,8 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
         if not isinstance(w, dict):
             fail(field, f"must be a mapping, got {_json_kind(w)}")
         for key in ("x", "z", "theta"):
+            if key not in w:
+                fail(f"{field}.{key}", "missing")
             if not is_finite_number(w.get(key)):
                 fail(f"{field}.{key}", f"must be a finite number, got {_json_shown(w.get(key))}")
         if not (w.get("pusher") is None or isinstance(w.get("pusher"), str)):
