@@ -133,7 +133,7 @@ def test_bad_task_is_refused_naming_the_field(tmp_path, label, edit, field, reas
     "text,reason",
     [
         ("name: x\nname: y\n", "duplicate key"),
-        ("object: [unclosed\n", "not valid YAML"),
+        ("object: [unclosed\n", "not valid YAML (expected ',' or ']', but got '<stream end>' at line 2, column 1)"),
         ("", "empty"),
         ("- just\n- a list\n", "must be a mapping"),
         (task_text("horizontal-offset-low-mu").replace("mass: 202", "mass: .nan"), "finite"),

@@ -313,10 +313,18 @@ def parse_task(text: str, source: Optional[str] = None, goal_in_grasp: bool = Tr
     except TaskError:
         raise
     except yaml.YAMLError as exc:
-        raise TaskError("", f"not valid YAML ({exc})".replace("\n", " "), source) from None
+        raise TaskError("", f"not valid YAML ({_yaml_problem(exc)})", source) from None
     if data is None:
         raise TaskError("", "the task file is empty", source)
     return _validate(data, source, goal_in_grasp)
+
+
+def _yaml_problem(exc: "yaml.YAMLError") -> str:
+    """PyYAML's problem and where, in one line (its own text spans lines, with a caret drawing)."""
+    mark = getattr(exc, "problem_mark", None)
+    problem = getattr(exc, "problem", None) or " ".join(str(exc).split())
+    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+    return f"{problem}{where}"
 
 
 def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> Task:
