@@ -131,6 +131,9 @@ def test_trajectory_command_writes_csv_and_json_in_either_quaternion_order(tmp_p
     assert doc["columns"][4:8] == ["qw", "qx", "qy", "qz"] and doc["rate_hz"] == 50
     bad = CliRunner().invoke(cli, ["trajectory", str(plan_file), "--task", str(task), "-o", str(tmp_path / "t.txt")])
     assert bad.exit_code == 2 and "must end in .csv, .json or .mcap" in bad.stderr
+    bad = CliRunner().invoke(cli, ["trajectory", str(plan_file), "--task", str(task), "-o", str(tmp_path / "t.mcap"),
+                                   "--quat", "wxyz"])
+    assert bad.exit_code == 2 and "--quat wxyz" in bad.stderr and not (tmp_path / "t.mcap").exists()
 
 
 def test_plan_refuses_models_that_are_not_the_tasks():

@@ -475,15 +475,17 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
               metavar="HZ", help="Samples per second (the executor streams at this rate). Each push takes the "
                                  "fewest whole samples that last the task's dynamics.step_time: a rate that does not "
                                  "divide it pushes slower than the stability test assumed, never faster.")
-@click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default="xyzw", show_default=True,
-              help="Quaternion order: xyzw as ROS writes it, wxyz as the arm protocol and MuJoCo do.")
+@click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default=None,
+              help="Quaternion order in a .csv or .json: xyzw as ROS writes it (the default), wxyz as the arm "
+                   "protocol and MuJoCo do. A .mcap's messages are ROS's own, xyzw.")
 def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str) -> None:
     """Write the gripper's timed trajectory for a plan: what the executor streams, for your robot.
 
     One sample per 1/HZ s: time (s), G's position in the world (m) and orientation (a unit
     quaternion), its linear (m/s) and angular (rad/s) velocity in the world over the period that
     ends there, the phase (push, settle, retract, move, approach) and the plan step. The world
-    is the executor's: G starts at the task's environment.home, each pusher a fixed feature
+    is the executor's: G starts at the task's environment.home (1 mm back from the first feature
+    when the object starts on it, as the guarded approach starts), each pusher a fixed feature
     placed as `execute` places it.
 
     \b
@@ -496,6 +498,10 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
     from stablepush.outputs import check_outputs, require_suffix, write_atomically
 
     require_suffix("-o", out_path, (".csv", ".json", ".mcap"))
+    if quat is not None and out_path.lower().endswith(".mcap"):
+        _fail(f"--quat {quat}: a ROS 2 bag's quaternions are its message types' own (x, y, z, w); --quat is for "
+              f".csv and .json")
+    quat = quat or "xyzw"
     check_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file)
     traj = timed_trajectory(task, plan, rate_hz)
