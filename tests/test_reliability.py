@@ -188,6 +188,7 @@ def low_mu_plan():
     (lambda p: p.update(solved="no"), "solved: must be a boolean, got a string"),
     (lambda p: p["waypoints"][2].update(x=p["waypoints"][2]["x"] + 50), "waypoints[2]: a step of 5"),
     (lambda p: p["waypoints"][3].update(x=10 ** 400), "waypoints[3].x: must be a finite number"),
+    (lambda p: p["waypoints"][3].update(x=1e300), "waypoints[3]: a step of more unit steps than a double holds"),
     (lambda p: p["waypoints"][2].update(x="1"), 'waypoints[2].x: must be a finite number, got "1"'),
     (lambda p: p["waypoints"].extend([p["waypoints"][-1]] * 10_001), "a plan has at most 10000"),
     # "Solved" plans that do not end at this task's goal used to run with exit 0.

@@ -76,7 +76,8 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
         q0, q1 = pose_to_si(waypoints[i - 1].pose), pose_to_si(waypoints[i].pose)
         length = _core.steps_between(q0, q1, unit)
         if length > 1.0 + STEP_SLACK:
-            fail(f"waypoints[{i}]", f"a step of {length:.3g} unit steps (planner.step {task.planner['step']}); "
+            size = f"{length:.3g} unit steps" if math.isfinite(length) else "more unit steps than a double holds"
+            fail(f"waypoints[{i}]", f"a step of {size} (planner.step {task.planner['step']}); "
                                     f"a plan's pushes are at most one unit step")
         dq = tuple(b - a for a, b in zip(q0, q1))
         if max(abs(v) for v in dq) < 1e-12:
