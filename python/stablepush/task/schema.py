@@ -372,8 +372,10 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
     pushers = _validate_pushers(top["pushers"], section, notes)
     start = pose_field("start", top["start"])
     goal = pose_field("goal", top["goal"])
-    for label, q in (("start", start), ("goal", goal))[:2 if goal_in_grasp else 1]:
-        inside = make_gripper(pads, grip_force, mu, pad_rings).pads_inside(section, pose_to_si(q))
+    gripper = make_gripper(pads, grip_force, mu, pad_rings)
+    grasped = [("start", start), ("goal", goal)] if goal_in_grasp else [("start", start)]
+    for label, q in grasped:
+        inside = gripper.pads_inside(section, pose_to_si(q))
         for i, ok in enumerate(inside):
             if not ok:
                 where = f"gripper.pads[{i}]" if "pads" in grip else "gripper (default pads)"
