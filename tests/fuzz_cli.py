@@ -253,7 +253,7 @@ API_ERRORS = ("StablepushError", "TypeError", "ValueError", "KeyboardInterrupt")
 
 
 def run_api(count: int, seed: int, scratch: Path) -> None:
-    """The Python API misused: sp.plan, sp.check, sp.check_plan, sp.trajectory and sp.save_plan with
+    """The Python API misused: sp.plan_task, sp.check, sp.check_plan, sp.trajectory and sp.save_plan with
     hostile arguments. Each call returns or raises a StablepushError, TypeError or ValueError;
     anything else (or a crash by signal, which kills this process) is a failure. Prints the summary."""
     import dataclasses
@@ -262,7 +262,7 @@ def run_api(count: int, seed: int, scratch: Path) -> None:
 
     rng = random.Random(seed)
     tasks = [sp.load_task(path) for path in TASKS[:5]]
-    plans = [sp.plan(task, seed=1) for task in tasks]
+    plans = [sp.plan_task(task, seed=1) for task in tasks]
     outcomes, failures, slowest = collections.Counter(), [], (0.0, "")
 
     def hostile():
@@ -274,13 +274,13 @@ def run_api(count: int, seed: int, scratch: Path) -> None:
         what = rng.choice(["plan", "check", "check_plan", "trajectory", "save_plan", "plan-models", "plan-edited"])
         if what == "plan":
             key = rng.choice(["seed", "time_limit", "max_switches", "improve_for", "min_transit_hold", "start_pusher"])
-            call = lambda: sp.plan(task, **{key: hostile()}, **({} if key == "time_limit" else {"time_limit": 0.02}))  # noqa: E731
+            call = lambda: sp.plan_task(task, **{key: hostile()}, **({} if key == "time_limit" else {"time_limit": 0.02}))  # noqa: E731
         elif what == "plan-models":
-            call = lambda: sp.plan(task, models=rng.choice([[None], [], "x", [task], tasks[k - 1].corner_models()]),  # noqa: E731
+            call = lambda: sp.plan_task(task, models=rng.choice([[None], [], "x", [task], tasks[k - 1].corner_models()]),  # noqa: E731
                                    time_limit=0.02)
         elif what == "plan-edited":  # a Task edited past its loader's checks
             field = rng.choice(["mu", "grip_force", "mass", "start", "goal", "pads", "pushers", "gravity"])
-            call = lambda: sp.plan(dataclasses.replace(task, **{field: hostile()}), time_limit=0.02)  # noqa: E731
+            call = lambda: sp.plan_task(dataclasses.replace(task, **{field: hostile()}), time_limit=0.02)  # noqa: E731
         elif what == "check":
             call = lambda: sp.check(task, at=hostile(), move=hostile(), pusher=rng.choice([None, "left", hostile()]))  # noqa: E731
         elif what == "check_plan":

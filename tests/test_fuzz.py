@@ -53,7 +53,7 @@ def test_generated_meshes_and_plans_that_do_not_fit_their_task_get_one_line(tmp_
 
 
 def test_the_python_api_misused_refuses_with_its_own_errors(tmp_path):
-    """The API surface (issue 24): sp.plan, sp.check, sp.check_plan, sp.trajectory and sp.save_plan
+    """The API surface (issue 24): sp.plan_task, sp.check, sp.check_plan, sp.trajectory and sp.save_plan
     with hostile arguments, a Task edited past its loader, another task's models. Each call returns
     or raises a StablepushError, TypeError or ValueError: no AttributeError, ZeroDivisionError or
     OverflowError from inside (the first run found 55 of 300), and no crash by signal."""

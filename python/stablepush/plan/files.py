@@ -6,14 +6,15 @@ import hashlib
 import io
 import json
 import math
+import numbers
 from pathlib import Path
 from typing import Optional, Union
 
 from stablepush import strict_json
-from stablepush.errors import PlanError
+from stablepush.errors import OutputError, PlanError
 from stablepush.inputs import read_capped
 from stablepush.outputs import write_files
-from stablepush.plan.plan import Plan, PusherContact, Waypoint
+from stablepush.plan.plan import Plan, PusherContact, Waypoint, require_plan
 from stablepush.strict_json import is_finite_number
 
 FORMAT = "stablepush.plan/1"
@@ -88,11 +89,27 @@ def plan_to_csv(plan: Plan) -> str:
 
 
 def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union[str, Path]] = None) -> None:
-    """The plan as JSON, and as CSV beside it when `csv_path` is given, replaced together."""
-    files = {json_path: json.dumps(plan_to_dict(plan), indent=1) + "\n"}
+    """The plan as JSON, and as CSV beside it when `csv_path` is given, replaced together. PlanError
+    (naming the field) for a plan load_plan would not read back, a NaN pose say, and OutputError
+    when both paths name one file."""
+    require_plan(plan)
+    text = json.dumps(plan_to_dict(plan), indent=1, default=_json_number) + "\n"
+    check_plan_dict(json.loads(text), f"the plan to write to {json_path}")
+    if csv_path and Path(csv_path).resolve() == Path(json_path).resolve():
+        raise OutputError(f"{csv_path}: the CSV would overwrite the plan file; give it another name")
+    files = {json_path: text}
     if csv_path:
         files[csv_path] = plan_to_csv(plan)
     write_files(files)
+
+
+def _json_number(v):
+    """A number JSON does not know (numpy's scalars), as the Python number it is."""
+    if isinstance(v, numbers.Integral) and not isinstance(v, bool):
+        return int(v)
+    if isinstance(v, numbers.Real):
+        return float(v)
+    raise TypeError(f"a plan holds numbers, strings and lists, not {type(v).__name__}")
 
 
 def plan_from_dict(data: dict) -> Plan:
@@ -159,6 +176,8 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
         if key in data and not isinstance(data[key], str):
             fail(key, f"must be a string, got {_json_kind(data[key])}")
     waypoints = data["waypoints"]
+    if not waypoints:
+        fail("waypoints", "empty; a plan's first waypoint is its start")
     if len(waypoints) > MAX_WAYPOINTS:
         fail("waypoints", f"{len(waypoints)} waypoints; a plan has at most {MAX_WAYPOINTS}")
     for i, w in enumerate(waypoints):

@@ -8,6 +8,7 @@ object). The first waypoint is the start and has no pusher.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
@@ -84,3 +85,12 @@ class Plan:
     def __repr__(self) -> str:
         return (f"Plan({self.task!r}, {'solved' if self.solved else self.outcome}, {len(self.waypoints) - 1} pushes, "
                 f"pushers {' -> '.join(self.pusher_sequence) or '(none)'})")
+
+
+def require_plan(value: Any, field: str = "plan") -> "Plan":
+    """`value` when it is a Plan; TypeError naming `field` otherwise (a path, say, where the API
+    wants the loaded plan)."""
+    if not isinstance(value, Plan):
+        hint = " (load it first: sp.load_plan(path))" if isinstance(value, (str, os.PathLike)) else ""
+        raise TypeError(f"{field}: expected a Plan, got {type(value).__name__}{hint}")
+    return value

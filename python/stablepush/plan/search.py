@@ -16,8 +16,8 @@ from stablepush.errors import TaskError
 from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.plan.unreachable import why_unreachable
-from stablepush.task.model import Task, outline_corners
-from stablepush.task.schema import PLANNER_TUNING, planner_limit, planner_parameter
+from stablepush.task.model import Task, require_task
+from stablepush.task.schema import LIMITS, PLANNER_TUNING, number_field, planner_limit, planner_parameter
 from stablepush.units import MM, pose_from_si, pose_to_si
 
 
@@ -50,6 +50,7 @@ def plan_task(
     A goal that no plan can reach for a reason decided before the search (plan.unreachable) returns
     at once: outcome `unreachable`, the start alone, the reason in the message.
     TaskError (field `goal`) when the start is already within the tolerance of the goal."""
+    require_task(task)
     if task.at_goal(task.start):
         tolerance = task.planner["tolerance"]
         raise TaskError("goal", f"the start {list(task.start)} is already within planner.tolerance {tolerance} of the "
@@ -64,8 +65,10 @@ def plan_task(
         settings["time_limit"] = planner_limit("time_limit", time_limit)
     if improve_for is not None:
         settings["improve_for"] = planner_parameter("improve_for", "improve_for", improve_for)
+    # A hold factor, as planner.min_hold_ratio is (docs/model.md section 3).
+    min_transit_hold = number_field("min_transit_hold", min_transit_hold, LIMITS["min_hold_ratio"])
     if models:  # the caller's: they must be this task's
-        _check_models(task, models)
+        task.check_models(models)
     models = models or task.corner_models()
     model = models[0]
     began = time.perf_counter()
@@ -82,7 +85,7 @@ def plan_task(
         time_limit=float(settings["time_limit"]), min_margin=float(settings["min_margin"]),
         sampling_margin=float(settings["sampling_margin"]), min_hold_ratio=float(settings["min_hold_ratio"]),
         parameters=parameters, min_transit_hold=float(min_transit_hold),
-        start_pusher=-1 if start_pusher is None else task.pusher_index(start_pusher)),
+        start_pusher=-1 if start_pusher is None else task.pusher_index(start_pusher, "start_pusher")),
         interruptible=threading.current_thread() is threading.main_thread())
 
     names = task.pusher_names
@@ -179,16 +182,3 @@ def _message(outcome: str, stats: dict, ends_at_goal: bool) -> str:
             if stats["min_hold_ratio"] > 0 else "")
     return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out before the goal was reached{held}; "
             f"the best partial path ends {stats['goal_distance_steps']:.1f} unit steps from the goal")
-
-
-def _check_models(task: Task, models) -> None:
-    """The models given to plan_task must be this task's (its corner_models() or build_model()): a
-    model of another object would plan pushes this task's object does not make."""
-    for k, m in enumerate(models):
-        if not isinstance(m, _core.StablePushModel):
-            raise TypeError(f"models[{k}]: expected a StablePushModel (task.corner_models()), got {type(m).__name__}")
-        vertices, corners = m.section.vertices, outline_corners(task.vertices)
-        same = len(m.pushers) == len(task.pushers) and len(vertices) == len(corners) and all(
-            abs(a[0] - b[0] * MM) <= 1e-9 and abs(a[1] - b[1] * MM) <= 1e-9 for a, b in zip(vertices, corners))
-        if not same:
-            raise ValueError(f"models[{k}]: not a model of task {task.name!r} (another object, or other pushers)")

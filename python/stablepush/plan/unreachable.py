@@ -15,7 +15,9 @@
    where the pad's disc lies inside the outline (the outline eroded by the disc), and the part of
    that set it lies in at the start keeps clear of every place the goal's tolerance lets it end,
    the other parts joined to it only through necks narrower than the pad (decided geometrically,
-   without an LP; below).
+   without an LP; below);
+6. the pads are not all on the object at the goal itself (load_task refuses such a task, so only
+   a task edited in code reaches the planner with one).
 
 Each of 2-4 is a linear program over an outer approximation of the model, so that its
 infeasibility (2, 4) or an upper bound under the requirement (3) holds for the model itself:
@@ -80,10 +82,14 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
         return ("no pusher has a stable push out of the start in any direction (" + ", ".join(
             task.pushers[i].name for i in stuck) + "): the pads do not hold the object there, and no pusher's "
             "friction cone can carry what they leave")
+    goal = pose_to_si(task.goal)
+    off = [k for k, inside in enumerate(models[0].gripper.pads_inside(models[0].section, goal)) if not inside]
+    if off:  # load_task refuses such a goal; a task edited in code (dataclasses.replace) may have one
+        return (f"the pads are not all on the object at the goal (gripper.pads[{off[0]}] is off it): "
+                f"there is no grasp there")
     apart = _pad_cut_off(task, models[0])
     if apart is not None:
         return apart
-    goal = pose_to_si(task.goal)
     # A last push ends within the tolerance, so it starts within it grown by a unit step (a push is
     # checked at its start). Where the pads hold at the goal, or the core finds a push from it,
     # some pusher may finish there and no LP is needed.

@@ -4,12 +4,13 @@ file, or edited by hand, is refused (PlanError naming the waypoint)."""
 from __future__ import annotations
 
 import math
+import numbers
 from typing import List, Optional
 
 from stablepush import _core
 from stablepush.errors import PlanError
-from stablepush.plan.plan import Plan, Waypoint
-from stablepush.task.model import Task
+from stablepush.plan.plan import Plan, Waypoint, require_plan
+from stablepush.task.model import Task, require_task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import MM, pose_to_si
 
@@ -32,6 +33,12 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     def fail(field: str, reason: str):
         raise PlanError(field, reason, source)
 
+    require_task(task)
+    require_plan(plan)
+    if not isinstance(plan.task, str):
+        fail("task", f"must be the task's name, got {type(plan.task).__name__}")
+    if not isinstance(plan.stats, dict):
+        fail("stats", f"must be a mapping, got {type(plan.stats).__name__}")
     if plan.task != task.name:
         fail("task", f"the plan is for task {plan.task[:100]!r}, not {task.name!r}")
     if require_solved and not plan.solved:
@@ -40,8 +47,14 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     for i, w in enumerate(waypoints):
         if not isinstance(w, Waypoint):
             fail(f"waypoints[{i}]", f"must be a Waypoint (x, z, theta, pusher, ...), got {type(w).__name__}")
-        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in w.pose):
+        if not all(isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) for v in w.pose):
             fail(f"waypoints[{i}]", f"must be a pose of 3 finite numbers, got {w.pose!r:.80}")
+        if not (w.pusher is None or isinstance(w.pusher, str)):
+            fail(f"waypoints[{i}].pusher", f"must be a pusher name or None, got {type(w.pusher).__name__}")
+        for key in ("margin", "margin_per_normal"):
+            value = getattr(w, key)
+            if value is not None and not (isinstance(value, numbers.Real) and math.isfinite(value)):
+                fail(f"waypoints[{i}].{key}", f"must be a finite number or None, got {value!r:.40}")
     if len(waypoints) < (2 if require_solved else 1):  # a partial plan may have found no push at all
         fail("waypoints", "needs the start and at least one push" if require_solved else "needs the start")
     for i, w in enumerate(waypoints):

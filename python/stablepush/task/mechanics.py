@@ -8,8 +8,8 @@ import numpy as np
 
 from stablepush import _core
 from stablepush.errors import TaskError
-from stablepush.task.model import Task
-from stablepush.task.schema import pose_field
+from stablepush.task.model import Task, require_task
+from stablepush.task.schema import number_field, pose_field
 from stablepush.units import pose_to_si
 
 SMALLEST_MOVE = 1e-6  # mm or deg: below, the motion's velocity terms are rounding noise
@@ -40,11 +40,13 @@ def check_push(
     at: Sequence[float],
     move: Sequence[float],
     pusher: Optional[str] = None,
-    model: "Optional[_core.StablePushModel]" = None,
 ) -> Dict[str, dict]:
     """Is the unit motion `move` (dx mm, dz mm, dtheta deg) from pose `at` (x mm, z mm, theta deg)
     a stable push? One entry per pusher (or only `pusher`), keyed by pusher name. With the task's
-    `uncertainty`, robustly: the verdict of the least stable corner of the box."""
+    `uncertainty`, robustly: the verdict of the least stable corner of the box. Each call builds
+    the task's models (about a millisecond); a loop of many checks may build
+    `task.build_model()` once and call its `check` (SI units: stablepush.units.pose_to_si)."""
+    require_task(task)
     at = pose_field("at", list(at))
     move = pose_field("move", list(move))
     if max(abs(v) for v in move) < SMALLEST_MOVE:
@@ -52,10 +54,9 @@ def check_push(
                                 f"give a unit motion (dx, dz, dtheta)")
     q, dq = pose_to_si(at), pose_to_si(move)
     names = [pusher] if pusher is not None else task.pusher_names
-    robust = task.uncertainty and model is None
-    model = model or task.build_model()
+    model = task.build_model()
     _require_grasp(model, q, at)
-    if robust:  # the least stable corner of the box decides
+    if any(task.uncertainty.values()):  # the least stable corner of the box decides
         corners = task.corner_models()
         return {name: result_to_dict(_core.worst_case(corners, q, dq, task.pusher_index(name))) for name in names}
     if pusher is not None:
@@ -83,9 +84,11 @@ def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = N
     (dx mm, dz mm, dtheta deg), "margin" (N)}, ...]}, "largest": {"+x", "-x", "+z", "-z",
     "+theta", "-theta": the largest component along that sense of any push returned, in unit
     steps (<= 0 or None: no stable push moves the object that way)}}."""
+    require_task(task)
     at = pose_field("at", list(at))
-    if not 0.0 < heading_step <= 90.0:
-        raise TaskError("heading_step", f"must be in (0, 90] degrees, got {heading_step:g}")
+    heading_step = number_field("heading_step", heading_step, (0.0, 90.0))
+    if heading_step == 0.0:
+        raise TaskError("heading_step", "must be in (0, 90] degrees, got 0")
     names = [pusher] if pusher is not None else task.pusher_names
     indices = [task.pusher_index(name) for name in names]
     model = task.build_model()

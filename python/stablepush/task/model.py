@@ -5,8 +5,11 @@ core's stable-push model built from it in SI (docs/model.md sections 1-4 and 7).
 """
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
+import numbers
+import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
@@ -18,6 +21,18 @@ from stablepush.units import MM, G, mm2_to_si
 # (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
 # world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
 PUSHES = ("against_fixed_features", "by_moving_pusher")
+# The planner section's keys every task has; a task file (or a Task made in code) that leaves one
+# out gets these (docs/model.md section 3).
+PLANNER_DEFAULTS: Dict[str, Any] = {
+    "time_limit": 10.0,  # s
+    "seed": 1,
+    "max_switches": 1,
+    "step": [1.0, 1.0],  # mm, deg per unit step
+    "tolerance": [1.0, 1.0],  # mm, deg
+    "min_margin": 1e-3,  # N: least depth inside the pusher's cone for a push to count
+    "sampling_margin": 5.0,  # unit steps around the start-goal box
+    "min_hold_ratio": 0.0,  # the plan must end where the pads alone hold this multiple of the weight (0: off)
+}
 # uncertainty: key -> the task value it widens (+- this fraction of it); a push must be stable for
 # every value in the box (Task.corner_models).
 UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers[].mu", "grip_force": "gripper.grip_force",
@@ -98,7 +113,7 @@ class Task:
     pushers: Tuple[PusherSpec, ...]
     start: Tuple[float, float, float]  # mm, mm, deg
     goal: Tuple[float, float, float]
-    planner: Dict[str, Any] = field(default_factory=dict)
+    planner: Dict[str, Any] = field(default_factory=dict)  # PLANNER_DEFAULTS fills the keys it leaves out
     environment: Dict[str, Any] = field(default_factory=dict)  # the world around the arm, see ENVIRONMENT_DEFAULTS
     source: Optional[str] = None
     pushes: str = PUSHES[0]  # see PUSHES
@@ -116,6 +131,10 @@ class Task:
         before anything reaches the core."""
         if not isinstance(self.name, str):
             raise TypeError(f"Task.name must be a string, got {type(self.name).__name__}")
+        if not isinstance(self.planner, dict):
+            raise TypeError(f"Task.planner must be a mapping, got {type(self.planner).__name__}")
+        if any(key not in self.planner for key in PLANNER_DEFAULTS):
+            object.__setattr__(self, "planner", {**copy.deepcopy(PLANNER_DEFAULTS), **self.planner})
         for name in ("thickness", "mass", "grip_force", "mu", "step_time"):
             _finite(f"Task.{name}", getattr(self, name))
         for name, size in (("gravity", 2), ("start", 3), ("goal", 3)):
@@ -180,11 +199,13 @@ class Task:
     def pusher_names(self) -> List[str]:
         return [p.name for p in self.pushers]
 
-    def pusher_index(self, name: str) -> int:
+    def pusher_index(self, name: str, field: str = "pusher") -> int:
+        """The index of the pusher called `name`; TaskError (naming `field`) when there is none."""
         try:
             return self.pusher_names.index(name)
         except ValueError:
-            raise TaskError("pusher", f"no pusher named {name!r} (the task has {', '.join(self.pusher_names)})")
+            names = ", ".join(self.pusher_names)
+            raise TaskError(field, f"no pusher named {name!r:.60} (the task has {names})") from None
 
     def section(self) -> "_core.CrossSection":
         """The core's cross-section: the outline's corners (outline_corners), in m."""
@@ -220,6 +241,43 @@ class Task:
                                     uncertainty={}).build_model()
                 for f in friction for m in masses]
 
+    def check_models(self, models: Sequence["_core.StablePushModel"], field: str = "models") -> None:
+        """TypeError or ValueError (naming `field[k]`) unless `models` are this task's corner_models():
+        the same outline and pushers, and each model's pusher mu, mass, pad friction (mu N summed
+        over the pads' points, N) and gravity those of one corner, every corner present. Checked on
+        the models' numbers, without building the task's own, so that models built once for many
+        searches stay cheap; a model of another task, or the nominal model of a task with an
+        uncertainty box, would give answers that are not this task's."""
+        u = self.uncertainty if any(self.uncertainty.values()) else {}
+        low = 1.0 - u.get("pusher_mu", 0.0)
+        friction = ([(1.0 - u.get("pad_mu", 0.0)) * (1.0 - u.get("grip_force", 0.0)),
+                     (1.0 + u.get("pad_mu", 0.0)) * (1.0 + u.get("grip_force", 0.0))] if u else [1.0])
+        masses = [1.0 - u.get("mass", 0.0), 1.0 + u.get("mass", 0.0)] if u else [1.0]
+        corners = [(f, m) for f in friction for m in masses]
+        outline = outline_corners(self.vertices)
+        found = set()
+        for k, model in enumerate(models):
+            name = f"{field}[{k}]"
+            if not isinstance(model, _core.StablePushModel):
+                raise TypeError(f"{name}: expected a StablePushModel (task.corner_models()), "
+                                f"got {type(model).__name__}")
+            vertices = model.section.vertices
+            if (len(vertices) != len(outline) or [p.name for p in model.pushers] != self.pusher_names or any(
+                    abs(a[0] - b[0] * MM) > 1e-9 or abs(a[1] - b[1] * MM) > 1e-9 for a, b in zip(vertices, outline))):
+                raise ValueError(f"{name}: not a model of task {self.name!r} (another object, or other pushers)")
+            pads = len(self.pads) * self.mu * self.grip_force
+            f = sum(model.gripper.point_friction_limits) / pads if pads > 0 else 1.0
+            m = model.body.mass / (self.mass * G)
+            match = [c for c in corners if _close(c[0], f) and _close(c[1], m)]
+            same_pushers = all(_close(p.mu, s.mu * low) for p, s in zip(model.pushers, self.pushers))
+            gravity = model.gravity_in_gripper(_core.Pose(0.0, 0.0, 0.0), -1).ravel()
+            if not match or not same_pushers or not all(_close(a, b) for a, b in zip(gravity, self.gravity)):
+                raise ValueError(f"{name}: not one of task {self.name!r}'s corner_models() (its friction, mass or "
+                                 f"gravity differ{', or the task has an uncertainty box' if u else ''})")
+            found.add(match[0])
+        if found != set(corners):
+            raise ValueError(f"{field}: {len(models)} model(s), not the {len(corners)} of task.corner_models()")
+
     def build_model(self) -> "_core.StablePushModel":
         """The core's stable-push model of this task, in SI units."""
         section = self.section()
@@ -237,8 +295,22 @@ class Task:
         )
 
 
+def require_task(value: Any, field: str = "task") -> Task:
+    """`value` when it is a Task; TypeError naming `field` otherwise (a path, say, where the API
+    wants the loaded task)."""
+    if not isinstance(value, Task):
+        hint = " (load it first: sp.load_task(path))" if isinstance(value, (str, os.PathLike)) else ""
+        raise TypeError(f"{field}: expected a Task, got {type(value).__name__}{hint}")
+    return value
+
+
+def _close(a: float, b: float) -> bool:
+    """Equal but for rounding: the same task value through another product of factors."""
+    return abs(a - b) <= 1e-9 * max(abs(a), abs(b), 1.0)
+
+
 def _finite(field: str, value) -> None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{field} must be a number, got {type(value).__name__}")
     try:
         ok = math.isfinite(float(value))

@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import datetime
 import math
+import numbers
 import re
 import reprlib
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 import yaml
@@ -18,7 +19,16 @@ import yaml
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.inputs import read_capped
-from stablepush.task.model import ON_BOUNDARY, PUSHES, UNCERTAIN, PusherSpec, Task, make_gripper, outline_corners
+from stablepush.task.model import (
+    ON_BOUNDARY,
+    PLANNER_DEFAULTS,
+    PUSHES,
+    UNCERTAIN,
+    PusherSpec,
+    Task,
+    make_gripper,
+    outline_corners,
+)
 from stablepush.units import MM, mm2_to_si, pose_to_si
 
 DEFAULT_PAD_RADIUS_MM = 5.0
@@ -68,16 +78,6 @@ ENVIRONMENT_DEFAULTS: Dict[str, Any] = {
     "lane_offset": 75.0,  # moves between features run this far along y from a feature
 }
 
-PLANNER_DEFAULTS: Dict[str, Any] = {
-    "time_limit": 10.0,  # s
-    "seed": 1,
-    "max_switches": 1,
-    "step": [1.0, 1.0],  # mm, deg per unit step
-    "tolerance": [1.0, 1.0],  # mm, deg
-    "min_margin": 1e-3,  # N: least depth inside the pusher's cone for a push to count
-    "sampling_margin": 5.0,  # unit steps around the start-goal box
-    "min_hold_ratio": 0.0,  # the plan must end where the pads alone hold this multiple of the weight (0: off)
-}
 # TRRTstar's declared parameters and their ranges live in the C++ planner (declared once there;
 # its setters refuse values outside them): key -> (kind, lowest, highest). seed and max_switches
 # are among them; the rest are tuning keys, written to the plan only when the task gives them.
@@ -209,8 +209,9 @@ def _join(path: str, key: str) -> str:
 
 
 def _number(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> float:
-    """A finite number, inside `within` (lowest, highest; both inclusive) when given."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    """A finite number (numpy's scalars too, but not a bool), inside `within` (lowest, highest;
+    both inclusive) when given."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TaskError(path, f"must be a number, got {_shown(value)}")
     try:
         x = float(value)
@@ -237,11 +238,12 @@ def _friction(path: str, value: Any) -> float:
 
 
 def _integer(path: str, value: Any, lowest: int, highest: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
+    """An integer (numpy's too, but not a bool) from `lowest` to `highest`, as a Python int."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise TaskError(path, f"must be an integer, got {_shown(value)}")
-    if not lowest <= value <= highest:
+    if not lowest <= int(value) <= highest:
         raise TaskError(path, f"must be an integer from {lowest} to {highest}, got {_shown(value)}")
-    return value
+    return int(value)
 
 
 def _vector(path: str, value: Any, n: int, within: Optional[Tuple[float, float]] = None) -> Tuple[float, ...]:
@@ -252,6 +254,11 @@ def _vector(path: str, value: Any, n: int, within: Optional[Tuple[float, float]]
 
 COORDINATE = (-MAX_COORDINATE, MAX_COORDINATE)
 ANGLE = (-MAX_ANGLE, MAX_ANGLE)
+
+
+def number_field(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> float:
+    """An argument that must be a finite number (within `within`, inclusive): TaskError naming `path`."""
+    return _number(path, value, within)
 
 
 def pose_field(path: str, value: Any) -> Tuple[float, float, float]:
@@ -307,7 +314,15 @@ def load_task(path: "str | Path", goal_in_grasp: bool = True) -> Task:
         raise
 
 
-def parse_task(text: str, source: Optional[str] = None, goal_in_grasp: bool = True) -> Task:
+def parse_task(text: "str | Mapping[str, Any]", source: Optional[str] = None, goal_in_grasp: bool = True) -> Task:
+    """A task from a task file's text (YAML), or from the mapping it holds (a task written in code:
+    the same keys and units, docs/model.md section 4). Validated as load_task validates a file;
+    `source` names it in errors."""
+    if isinstance(text, Mapping):
+        return _validate(dict(text), source, goal_in_grasp)
+    if not isinstance(text, str):
+        raise TypeError(f"parse_task takes a task file's text or its mapping, got {type(text).__name__} "
+                        f"(a path? use load_task)")
     try:
         data = _load_yaml(text)
     except TaskError:
@@ -316,6 +331,9 @@ def parse_task(text: str, source: Optional[str] = None, goal_in_grasp: bool = Tr
         raise TaskError("", f"not valid YAML ({_yaml_problem(exc)})", source) from None
     if data is None:
         raise TaskError("", "the task file is empty", source)
+    if isinstance(data, str) and source is None:  # parse_task("task.yaml"), meaning load_task
+        raise TaskError("", f"the text is one string ({data!r:.60}), not a task; to read a task file, use "
+                            f"load_task(path)", source)
     return _validate(data, source, goal_in_grasp)
 
 
