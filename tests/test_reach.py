@@ -6,8 +6,11 @@ import dataclasses
 import json
 import math
 
+import numpy as np
+import pytest
 from click.testing import CliRunner
 
+from stablepush.errors import TaskError
 from stablepush.plan import check_plan, plan_task
 from stablepush.plan.reach import ReachJob, axis_values, reach_cell, reach_map
 from stablepush.runners import Runner
@@ -82,8 +85,9 @@ def test_reach_maps_a_task_whose_own_goal_has_no_grasp(tmp_path):
 
 
 def test_an_axis_of_finite_ends_has_finite_values_and_its_ends_exact():
-    """Evenly spaced from one end to the other, where the span itself overflows too: `reach --x
-    1e308:-1e308:3` was an internal error (a goal of nan)."""
+    """Evenly spaced from one end to the other, where the span itself overflows too (`reach --x
+    1e308:-1e308:3` was an internal error, a goal of nan); the command now refuses an axis past
+    the task file's pose bounds, naming the option."""
     assert axis_values((-30.0, 30.0, 7)) == [-30.0, -20.0, -10.0, 0.0, 10.0, 20.0, 30.0]
     assert axis_values((5.0, 9.0, 1)) == [5.0]
     for start, stop in ((1.7e308, -1.7e308), (-1.7e308, 1.7e308), (1e308, 1.5e308)):
@@ -93,7 +97,7 @@ def test_an_axis_of_finite_ends_has_finite_values_and_its_ends_exact():
         assert all((s > 0) == (stop > start) for s in steps)
     huge = CliRunner().invoke(cli, ["reach", str(TASKS / "pivoting.yaml"), "--x", "1e308:-1e308:3", "--time-limit",
                                     "0.05", "--workers", "1", "--quiet"])
-    assert huge.exit_code == 0, huge.output
+    assert huge.exit_code == 2 and "--x" in huge.output and "from -10000 to 10000" in huge.output, huge.output
 
 
 def test_show_draws_a_plan_that_found_no_push_and_marks_the_goal(tmp_path):
@@ -112,3 +116,20 @@ def test_show_draws_a_plan_that_found_no_push_and_marks_the_goal(tmp_path):
     with_push = CliRunner().invoke(cli, ["execute", str(path), "--task", str(TASKS / "horizontal-offset-low-mu.yaml"),
                                          "--sim"])
     assert with_push.exit_code == 2 and "solved" in with_push.output  # running it is still refused
+
+
+def test_the_library_refuses_a_bad_grid_naming_the_axis_before_any_cell():
+    """reach_map checks its axes, seed and time limit as the CLI does: a count that is not a whole
+    number, a bound past the task file's pose bounds, a seed or time limit out of the planner's
+    ranges are refused with the argument named, and the map records the axes it planned."""
+    task = shipped("pivoting")
+    x, z = (0.0, 0.0, 1), (0.0, 0.0, 1)
+    bad = {r"x\[1\]": dict(x=(0.0, math.nan, 2)), "x: must be \\(from, to, count\\)": dict(x=(0.0, 10.0)),
+           r"x\[2\]": dict(x=(0.0, 10.0, 2.7)), r"theta\[0\]": dict(theta=(1e5, 1e5, 1)),
+           r"z\[2\]": dict(z=(0.0, 1.0, 0)), "seed": dict(seed=-1), "time_limit": dict(time_limit=0.0)}
+    for field, change in bad.items():
+        arguments = {"x": x, "z": z, "theta": (0.0, 0.0, 1), "seed": 1, "time_limit": 0.1, **change}
+        with pytest.raises(TaskError, match=field):
+            reach_map(task, **arguments)
+    result = reach_map(task, x=(0.0, 0.0, 1), z=z, theta=(0.0, 90.0, np.int64(2)), time_limit=0.1)
+    assert result.axes["theta"] == [0.0, 90.0, 2] and type(result.axes["theta"][2]) is int

@@ -428,7 +428,8 @@ def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = T
 @click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
               help="The task the plan was made for (checked against the plan).")
 @click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,
-              help="Figure to write: PNG, PDF or SVG, as the name ends. Default: PLAN.png beside the plan file.")
+              help="Figure to write: PNG, PDF or SVG, as the name ends. Default: PLAN.png beside the plan file "
+                   "(t.plan.json: t.png; run.2.json: run.2.png).")
 @click.option("--gif", "gif_path", type=click.Path(dir_okay=False), default=None, help="Also write an animated GIF.")
 def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     """Draw a plan: snapshots of the object in the grasp and x, z, theta against step.
@@ -444,13 +445,11 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
       stablepush plan data/tasks/t-shaped.yaml -o t.plan.json
       stablepush show t.plan.json --task data/tasks/t-shaped.yaml -o t.png --gif t.gif
     """
-    from pathlib import Path
-
     from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, require_suffix
     from stablepush.viz import figures
 
     png_label = "-o" if png_path else "the default -o"
-    png_path = png_path or str(Path(plan_file).with_suffix("").with_suffix(".png"))
+    png_path = png_path or _beside(plan_file, (".json", ".plan"), ".png")
     require_suffix(png_label, png_path, FIGURE_SUFFIXES)
     require_suffix("--gif", gif_path, (".gif",))
     check_outputs({png_label: png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})
@@ -474,7 +473,9 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
               metavar="HZ", help="Samples per second (the executor streams at this rate). Each push takes the "
                                  "fewest whole samples that last the task's dynamics.step_time: a rate that does not "
-                                 "divide it pushes slower than the stability test assumed, never faster.")
+                                 "divide it pushes slower than the stability test assumed. The last push of each "
+                                 "contact eases to rest, up to 4/3 of the planned speed on the way "
+                                 "(docs/execution.md).")
 @click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default=None,
               help="Quaternion order in a .csv or .json: xyzw as ROS writes it (the default), wxyz as the arm "
                    "protocol and MuJoCo do. A .mcap's messages are ROS's own, xyzw.")
@@ -494,7 +495,7 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
       stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.traj.csv
       stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.mcap   # ros2 bag play, Foxglove
     """
-    from stablepush.execution import timed_trajectory
+    from stablepush.execution import execution_warnings, timed_trajectory
     from stablepush.outputs import check_outputs, require_suffix, write_atomically
 
     require_suffix("-o", out_path, (".csv", ".json", ".mcap"))
@@ -504,6 +505,8 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
     quat = quat or "xyzw"
     check_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file)
+    for warning in execution_warnings(task):  # the stream is the executor's, so is its cell
+        click.echo(f"warning: {warning}", err=True)
     traj = timed_trajectory(task, plan, rate_hz)
     if out_path.lower().endswith(".mcap"):
         from stablepush.execution.bags import write_bag
@@ -639,7 +642,8 @@ def _host_port(value: str):
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
               metavar="HZ", help="Waypoints per second of motion. Each push takes the fewest whole periods that "
                                  "last the task's dynamics.step_time (slower than the model when HZ does not divide "
-                                 "it, never faster).")
+                                 "it); the last push of each contact eases to rest, up to 4/3 of the planned "
+                                 "speed on the way (docs/execution.md).")
 @click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
               help="Continue after plan step STEP (the last confirmed step a fault reported); a simulated arm then "
                    "keeps the world it has, where every other run starts from a fresh one.")
@@ -1057,18 +1061,33 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         sys.exit(130)
 
 
+def _beside(path: str, endings, suffix: str) -> str:
+    """`path` with each of `endings` it ends in taken off, in turn, and `suffix` put on."""
+    from pathlib import Path
+
+    name = Path(path).name
+    for ending in endings:
+        if name.lower().endswith(ending) and len(name) > len(ending):
+            name = name[: -len(ending)]
+    return str(Path(path).with_name(name + suffix))
+
+
 def _axis(_ctx, param, value):
-    """A grid axis A:B:N (N values from A to B; N = 1: A alone)."""
+    """A grid axis A:B:N (N values from A to B; N = 1: A alone), within the task file's pose bounds."""
+    from stablepush.plan.reach import MAX_AXIS
+    from stablepush.task.schema import ANGLE, COORDINATE
+
     if value is None:
         return None
+    low, high = ANGLE if param.name == "theta_axis" else COORDINATE
     parts = value.split(":")
     try:
         start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
-        if len(parts) != 3 or not 1 <= count <= 1000 or not (math.isfinite(start) and math.isfinite(stop)):
+        if len(parts) != 3 or not 1 <= count <= MAX_AXIS or not (low <= start <= high and low <= stop <= high):
             raise ValueError
     except (ValueError, IndexError):
-        raise click.BadParameter(f"expected FROM:TO:COUNT, finite numbers and COUNT from 1 to 1000 (e.g. -10:10:11), "
-                                 f"got {value!r}")
+        raise click.BadParameter(f"expected FROM:TO:COUNT, FROM and TO from {low:g} to {high:g} and COUNT from 1 to "
+                                 f"{MAX_AXIS} (e.g. -10:10:11), got {value!r}")
     return start, stop, count
 
 

@@ -92,9 +92,16 @@ def require_suffix(name: str, path: Optional[Union[str, Path]], suffixes) -> Non
     """Refuse an output whose file name does not end in one of `suffixes` (OutputError naming the
     option): the file's kind is taken from it."""
     suffixes = tuple(suffixes)
-    if path is not None and not str(path).lower().endswith(suffixes):
+    if path is None:
+        return
+    file_name = Path(path).name
+    match = next((s for s in suffixes if file_name.lower().endswith(s) and len(file_name) > len(s)), None)
+    if match is None:
         listed = suffixes[0] if len(suffixes) == 1 else f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
-        raise OutputError(f"{name} {path}: the file name must end in {listed}")
+        raise OutputError(f"{name} {path}: the file name must end in {listed}, after a name")
+    if match == ".mcap" and not file_name.endswith(match):  # rosbag2's readers take the storage from it
+        raise OutputError(f"{name} {path}: a bag's name must end in .mcap in lower case, which ROS 2's readers "
+                          f"take as its format")
 
 
 def _identity(path: Union[str, Path]):

@@ -16,9 +16,11 @@ sample unless said:
   extruded to its thickness (in object), the pads (in gripper) and each feature's contact segment
   at its world pose (in world);
 - `/stablepush/arm_scene` (std_msgs/msg/String), once at t = 0: the world as the arm protocol's
-  hello describes it (JSON, SI units; `stablepush.execution.world.scene_description`), so that a
-  bridge can replay the bag to an arm server (examples/bag_to_arm.py).
-Units: m, s, rad; quaternions x, y, z, w.
+  hello describes it (JSON in the protocol's conventions, not ROS's: SI but for `object_in_grasp`,
+  the plan's x mm, z mm, theta deg; poses [x, y, z, qw, qx, qy, qz];
+  `stablepush.execution.world.scene_description`), so that a bridge can replay the bag to an arm
+  server (examples/bag_to_arm.py).
+Units in the ROS messages: m, s, rad; quaternions x, y, z, w.
 """
 from __future__ import annotations
 

@@ -105,8 +105,9 @@ class _Stream:
         s(u) = u + u^2 - u^3: the same speed at the start, none at the end. An arm stopped dead from
         full speed overshoots its lag, and the high-mu offset then sagged 0.2 mm and 0.45 deg in the
         grasp before the settle hold ended (docs/execution.md, "Measured: plans on the simulated arm").
-        The push takes the fewest whole periods that last `duration` (the model's step time): a rate
-        that does not divide it pushes slower than the stability test assumed, never faster."""
+        s'(u) = 1 + 2u - 3u^2 peaks at 4/3, at u = 1/3: the eased push is faster than the stability
+        test assumed on its way to rest (docs/execution.md). The push takes the fewest whole periods
+        that last `duration` (the model's step time): a rate that does not divide it pushes slower."""
         n = max(1, math.ceil(duration / self.period - 1e-9))
         for i in range(1, n + 1):
             u = i / n

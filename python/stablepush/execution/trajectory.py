@@ -1,5 +1,5 @@
 """Timed trajectories: the gripper's world poses that carry out a plan, with time, linear and
-angular velocity, phase and plan step (`stablepush trajectory`, `Plan.trajectory`).
+angular velocity, phase and plan step (`stablepush trajectory`, `sp.trajectory`).
 
 They are the executor's stream (stablepush.execution.stream.arm_trajectory) for an arm that starts where the
 executor's world starts it (the task's home pose, or 1 mm back from a feature the object starts on) with every
@@ -15,6 +15,7 @@ import csv
 import io
 import json
 import math
+import numbers
 from dataclasses import dataclass
 from typing import List
 
@@ -85,20 +86,34 @@ def timed_trajectory(task: Task, plan: Plan, rate_hz: float = 100.0) -> Trajecto
     """The executor's stream for a plan checked against the task (stablepush.plan.verify.check_plan),
     from G where the executor's world starts it (world.scene_description). ValueError unless `rate_hz`
     lies in the arm protocol's RATE_HZ."""
-    if isinstance(rate_hz, bool) or not isinstance(rate_hz, (int, float)) or not RATE_HZ[0] <= rate_hz <= RATE_HZ[1]:
+    if isinstance(rate_hz, bool) or not isinstance(rate_hz, numbers.Real) or not RATE_HZ[0] <= rate_hz <= RATE_HZ[1]:
         raise ValueError(f"rate_hz must be a number from {RATE_HZ[0]:g} to {RATE_HZ[1]:g}, got {rate_hz!r:.40}")
+    rate_hz = rate_hz if isinstance(rate_hz, (int, float)) else float(rate_hz)  # numpy's, as the arm's JSON takes
     steps = list(plan.waypoints)
     features = place_features(task, steps)
     start = scene_description(task, features, steps[0].pose)["gripper_pose"]
     points = arm_trajectory(task, steps, features, rate_hz, start)
     poses = np.array([start] + [p.pose for p in points], float)  # [x, y, z, qw, qx, qy, qz]
     dt = 1.0 / rate_hz
-    quats = poses[:, 3:] * np.sign(poses[:, 3:4] + (poses[:, 3:4] == 0))  # w >= 0: one of the two signs
+    quats = continuous_quaternions(poses[:, 3:])
     return Trajectory(
         t=np.array([p.t for p in points]), position=poses[1:, :3], quaternion_wxyz=quats[1:],
         linear_velocity=np.diff(poses[:, :3], axis=0) / dt,
         angular_velocity=np.array([_rotation_vector(a, b) / dt for a, b in zip(quats[:-1], quats[1:])]).reshape(-1, 3),
         phase=[p.phase for p in points], step=np.array([p.step for p in points], int), rate_hz=rate_hz)
+
+
+def continuous_quaternions(quats: np.ndarray) -> np.ndarray:
+    """Unit quaternions (n, 4), each of the two signs chosen: w >= 0 for the first, then each in the
+    hemisphere of the one before, so that a stream turning past 180 deg does not jump to the
+    other sign between two samples (what interpolating consumers and plots would see)."""
+    out = np.array(quats, float)
+    if len(out) and out[0, 0] < 0:
+        out[0] = -out[0]
+    for k in range(1, len(out)):
+        if out[k] @ out[k - 1] < 0:
+            out[k] = -out[k]
+    return out
 
 
 def _rotation_vector(q0: np.ndarray, q1: np.ndarray) -> np.ndarray:

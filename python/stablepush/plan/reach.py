@@ -19,13 +19,16 @@ Poses are (x mm, z mm, theta deg), as in task files.
 from __future__ import annotations
 
 import dataclasses
+import numbers
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from stablepush.errors import TaskError
 from stablepush.plan.search import plan_task
-from stablepush.task.model import Task, make_gripper
+from stablepush.task.model import Task, make_gripper, require_task
+from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_limit, planner_parameter
 from stablepush.units import pose_to_si
 
 Axis = Tuple[float, float, int]  # from, to, count (count 1: `from` alone)
@@ -48,17 +51,41 @@ def axis_values(axis: Axis) -> List[float]:
 @dataclass(frozen=True)
 class ReachJob:
     """A reach map's shared part: the task, the goals of the grid (x fastest, then z, then
-    theta), the seed and each cell's time limit [s]."""
+    theta), the seed and each cell's time limit [s]; `grid` makes it from the grid's axes."""
 
     task: Task
     goals: Tuple[Tuple[float, float, float], ...]
     seed: int
     time_limit: float
+    axes: Tuple[Axis, ...] = ()  # the grid's (from, to, count) in x, z, theta, when made by `grid`
 
     @classmethod
     def grid(cls, task: Task, x: Axis, z: Axis, theta: Axis, seed: int, time_limit: float) -> "ReachJob":
+        """The job of the grid x by z by theta; TaskError naming the axis, `seed` or `time_limit` when
+        one is out of its range (the task file's pose bounds; at most MAX_AXIS values an axis and
+        MAX_CELLS cells)."""
+        x, z, theta = (grid_axis(name, axis, bound) for name, axis, bound in
+                       (("x", x, COORDINATE), ("z", z, COORDINATE), ("theta", theta, ANGLE)))
+        if x[2] * z[2] * theta[2] > MAX_CELLS:
+            raise TaskError("x, z, theta", f"{x[2] * z[2] * theta[2]} cells; at most {MAX_CELLS}")
         goals = tuple((gx, gz, gth) for gth in axis_values(theta) for gz in axis_values(z) for gx in axis_values(x))
-        return cls(task=task, goals=goals, seed=seed, time_limit=time_limit)
+        return cls(task=task, goals=goals, seed=planner_parameter("seed", "seed", seed),
+                   time_limit=planner_limit("time_limit", time_limit), axes=(x, z, theta))
+
+
+MAX_AXIS, MAX_CELLS = 1000, 100_000
+
+
+def grid_axis(name: str, axis, bound: Tuple[float, float]) -> Axis:
+    """(from, to, count) checked: two numbers within `bound` and an integer count from 1 to
+    MAX_AXIS; TaskError naming `name` otherwise."""
+    if not isinstance(axis, (tuple, list)) or len(axis) != 3:
+        raise TaskError(name, f"must be (from, to, count), got {axis!r:.60}")
+    start, stop = number_field(f"{name}[0]", axis[0], bound), number_field(f"{name}[1]", axis[1], bound)
+    count = axis[2]
+    if isinstance(count, bool) or not isinstance(count, numbers.Integral) or not 1 <= count <= MAX_AXIS:
+        raise TaskError(f"{name}[2]", f"the count must be an integer from 1 to {MAX_AXIS}, got {count!r:.40}")
+    return start, stop, int(count)
 
 
 def pads_off_object(task: Task, pose: Sequence[float]) -> List[int]:
@@ -95,6 +122,10 @@ def reach_cell(job: ReachJob, i: int) -> dict:
 
 @dataclass(frozen=True)
 class ReachMap:
+    """A reach map: the task's name and start, the grid's axes, the seed and each cell's time limit
+    [s], its cells in the order of ReachJob.goals (each a dict: goal, verdict, reason, solved, seed,
+    planning_time_s, switches, pushes, outcome), the wall time [s] and the runner that planned it."""
+
     task: str
     start: Tuple[float, float, float]
     axes: dict  # "x", "z", "theta" -> [from, to, count]
@@ -105,12 +136,14 @@ class ReachMap:
     runner: str
 
     def counts(self) -> dict:
+        """How many cells have each verdict: reached, unreachable, not found."""
         out = {"reached": 0, "unreachable": 0, "not found": 0}
         for c in self.cells:
             out[c["verdict"]] += 1
         return out
 
     def as_dict(self) -> dict:
+        """The map as `stablepush reach --json` writes it (plain data; the cells under `cells`)."""
         return {"task": self.task, "start": list(self.start), "axes": self.axes, "seed": self.seed,
                 "time_limit_s": self.time_limit, "counts": self.counts(), "wall_s": self.wall_s,
                 "runner": self.runner, "cells": self.cells}
@@ -124,18 +157,19 @@ def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_lim
 
     from stablepush.runners import Runner, WorkerLost, run_all
 
-    runner = runner or Runner()
+    require_task(task)
     job = ReachJob.grid(task, x, z, theta, seed, time_limit)
+    runner = runner or Runner()
     started = time.perf_counter()
     cells: List[Optional[dict]] = [None] * len(job.goals)
     for i, cell in run_all(reach_cell, job, range(len(job.goals)), runner):
         if isinstance(cell, WorkerLost):
-            cell = {"goal": list(job.goals[i]), "seed": seed, "solved": False, "planning_time_s": 0.0,
+            cell = {"goal": list(job.goals[i]), "seed": job.seed, "solved": False, "planning_time_s": 0.0,
                     "switches": None, "pushes": None, "outcome": "worker_lost", "verdict": "not found",
                     "reason": cell.why}
         cells[i] = cell
         if progress is not None:
             progress(cell)
-    return ReachMap(task=task.name, start=tuple(task.start), axes={"x": list(x), "z": list(z), "theta": list(theta)},
-                    seed=seed, time_limit=time_limit, cells=cells, wall_s=time.perf_counter() - started,
+    return ReachMap(task=task.name, start=tuple(task.start), axes=dict(zip(("x", "z", "theta"), map(list, job.axes))),
+                    seed=job.seed, time_limit=job.time_limit, cells=cells, wall_s=time.perf_counter() - started,
                     runner=runner.describe())
