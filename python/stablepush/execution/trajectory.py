@@ -55,12 +55,15 @@ class Trajectory:
                 f"plan steps to {int(self.step.max()) if len(self) else 0})")
 
     def columns(self, quat: str = "xyzw") -> List[str]:
+        """The column names of rows(), the quaternion in `quat` order (xyzw or wxyz)."""
         if quat not in QUATERNION_ORDERS:
             raise ValueError(f"quat must be one of {', '.join(QUATERNION_ORDERS)}, got {quat!r}")
         q = ["qx", "qy", "qz", "qw"] if quat == "xyzw" else ["qw", "qx", "qy", "qz"]
         return ["t", "x", "y", "z", *q, "vx", "vy", "vz", "wx", "wy", "wz", "phase", "step"]
 
     def rows(self, quat: str = "xyzw") -> List[list]:
+        """One list per sample, in columns() order: t s, position m, quaternion, velocity m/s and
+        rad/s (world frame), phase, plan step."""
         self.columns(quat)  # checks the order
         q = self.quaternion_wxyz[:, [1, 2, 3, 0]] if quat == "xyzw" else self.quaternion_wxyz
         return [[float(self.t[i]), *map(float, self.position[i]), *map(float, q[i]),
@@ -68,6 +71,7 @@ class Trajectory:
                  int(self.step[i])] for i in range(len(self))]
 
     def to_csv(self, quat: str = "xyzw") -> str:
+        """The CSV `stablepush trajectory -o X.csv` writes: a header of columns(), then rows()."""
         buffer = io.StringIO()
         writer = csv.writer(buffer, lineterminator="\n")
         writer.writerow(self.columns(quat))
@@ -75,6 +79,7 @@ class Trajectory:
         return buffer.getvalue()
 
     def to_json(self, quat: str = "xyzw") -> str:
+        """The JSON `stablepush trajectory -o X.json` writes: frame, rate, units, columns and rows."""
         return json.dumps({
             "format": "stablepush.trajectory/1", "frame": "world (x forward, y the gripping axis at home, z up)",
             "rate_hz": self.rate_hz, "quaternion_order": quat,

@@ -67,6 +67,7 @@ def task_digest(identity: dict) -> str:
 
 
 def plan_to_csv(plan: Plan) -> str:
+    """The plan's waypoints as CSV (CSV_COLUMNS; mm, deg, N; the start's pusher fields empty)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)

@@ -197,6 +197,7 @@ class Task:
 
     @property
     def pusher_names(self) -> List[str]:
+        """The pushers' names, in the task file's order (a pusher's index in the core's model)."""
         return [p.name for p in self.pushers]
 
     def pusher_index(self, name: str, field: str = "pusher") -> int:
