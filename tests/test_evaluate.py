@@ -67,6 +67,21 @@ def test_a_batch_with_a_bad_success_tolerance_is_refused_before_any_trial():
             dataclasses.replace(good, tolerance=bad)
 
 
+def test_an_open_loop_batch_of_a_plan_that_ends_outside_the_success_tolerance_is_warned_of():
+    """The wedge's plan ends within its task's 1 mm but 0.79 mm from the goal in x or z: judged
+    within 0.5 mm, open loop, the batch says so before any trial; closed loop, or judged within
+    1 mm, it does not. A by_moving_pusher task gets the executor's warning of another cell."""
+    task = shipped("more/wedge-heel")
+    plan = check_plan(task, plan_task(task, seed=1))
+    open_loop = Batch(task=task, plan=plan, spreads=Spreads())
+    (warning,) = open_loop.warnings()
+    assert "ends 0.79 mm / 0.53 deg from the goal" in warning and "planner.tolerance: [0.5, 0.5]" in warning
+    assert dataclasses.replace(open_loop, closed_loop=True).warnings() == []
+    assert dataclasses.replace(open_loop, tolerance=(1.0, 1.0)).warnings() == []
+    moving = dataclasses.replace(task, pushes="by_moving_pusher")
+    assert any("another cell" in w for w in dataclasses.replace(open_loop, task=moving, closed_loop=True).warnings())
+
+
 def test_a_world_deviation_changes_the_scene_as_asked():
     """Hand-derived: multipliers on mu, grip and mass (and inertia); a feature turned 90 deg about y
     through its middle and shifted by (1, 2) mm."""

@@ -1014,6 +1014,8 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
     batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
                   engine=engine, tolerance=tuple(success_tolerance), video_dir=video_dir, video_fps=video_fps,
                   video_size=tuple(video_size))
+    for warning in batch.warnings():
+        click.echo(f"warning: {warning}", err=True)
     if not quiet:
         box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
         click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop"

@@ -25,14 +25,15 @@ from stablepush.errors import ArmFault
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.bags import RunRecording
 from stablepush.execution.closed_loop import ClosedLoop
-from stablepush.execution.executor import execute_plan
+from stablepush.execution.executor import execute_plan, execution_warnings
 from stablepush.execution.guard import GuardedApproach
-from stablepush.execution.verdict import success_tolerance
+from stablepush.execution.verdict import success_tolerance, within
 from stablepush.plan.plan import Plan
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.sim.arm import WorldDeviation
 from stablepush.sim.server import SIM_ACK_TIMEOUT, running_sim_arm
 from stablepush.task.model import Task
+from stablepush.units import angle_difference_deg
 
 DEFAULT_TOLERANCE = (0.5, 0.5)  # mm, deg: a trial succeeds within this of the goal, per coordinate
 RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
@@ -62,6 +63,22 @@ class Batch:
     def __post_init__(self):
         # Refused here, before any trial runs, rather than once per trial as a crash.
         success_tolerance(self.task, self.tolerance)
+
+    def warnings(self) -> List[str]:
+        """What makes the trials miss whatever their worlds (legal, but probably not meant), one
+        line each: the executor's cell differing from the task's model (execution_warnings), and,
+        open loop, a plan that ends outside the success tolerance of the goal, which a trial then
+        lands only where the world's own error happens to make up the difference."""
+        out = execution_warnings(self.task)
+        end, goal = self.plan.waypoints[-1].pose, self.task.goal
+        mm, deg = max(abs(end[0] - goal[0]), abs(end[1] - goal[1])), abs(angle_difference_deg(end[2], goal[2]))
+        if not self.closed_loop and not within({"x": end[0], "z": end[1], "theta": end[2]}, goal, self.tolerance):
+            out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), "
+                       f"outside the success tolerance {self.tolerance[0]:g} mm / {self.tolerance[1]:g} deg: an "
+                       f"open-loop trial lands only where its world's error happens to make up the difference. "
+                       f"Plan to the tolerance (planner.tolerance: [{self.tolerance[0]:g}, "
+                       f"{self.tolerance[1]:g}]) or run the closed loop")
+        return out
 
     def world(self, trial: int) -> TrialWorld:
         return draw_world(self.seed, trial, self.spreads, self.task.pusher_names)
