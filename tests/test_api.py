@@ -145,7 +145,7 @@ def test_plan_refuses_models_that_are_not_the_tasks():
     task, other = sp.load_task(TASKS / "t-shaped.yaml"), sp.load_task(TASKS / "pivoting.yaml")
     with pytest.raises(TypeError, match=r"models\[0\]: expected a StablePushModel"):
         sp.plan_task(task, models=[None])  # was a segmentation fault
-    with pytest.raises(ValueError, match="not a model of task 't-shaped'"):
+    with pytest.raises(ValueError, match="not one of task 't-shaped''s corner_models"):
         sp.plan_task(task, models=other.corner_models())
     assert sp.plan_task(task, models=task.corner_models()).solved
 
@@ -175,6 +175,16 @@ def test_check_answers_for_the_task_given_and_plan_takes_only_its_own_corner_mod
     with pytest.raises(ValueError, match="1 model"):
         sp.plan_task(robust, models=robust.corner_models()[:1], time_limit=0.3)
     assert sp.plan_task(robust, models=robust.corner_models()[::-1]).solved  # any order
+    base = sp.load_task(TASKS / "large-manipulation.yaml")
+    edits = {"com": dict(com=(30.0, -5.0)), "step_time": dict(step_time=0.5), "pushes": dict(pushes="by_moving_pusher"),
+             "pad_rings": dict(pad_rings=3), "pads": dict(pads=(((5.0, 0.0), 5.0), ((5.0, 0.0), 5.0)))}
+    for name, edit in edits.items():
+        with pytest.raises(ValueError, match="not one of task"):
+            sp.plan_task(base, models=dataclasses.replace(base, **edit).corner_models(), time_limit=0.3)
+    frictionless = dataclasses.replace(base, mu=0.0, uncertainty={"pad_mu": 0.2})
+    frictionless.check_models(frictionless.corner_models())
+    elsewhere = dataclasses.replace(base, goal=(5.0, 0.0, 0.0))  # a model does not depend on the goal
+    elsewhere.check_models(base.corner_models())
 
 
 def test_a_task_written_in_code_plans_like_the_file():
@@ -191,6 +201,11 @@ def test_a_task_written_in_code_plans_like_the_file():
     assert sp.plan_task(bare, seed=1).waypoints == sp.plan_task(from_file, seed=1).waypoints
     with pytest.raises(sp.TaskError, match="load_task"):
         sp.parse_task(str(path))
+    assert sp.parse_task(path.read_bytes(), str(path)) == from_file
+    defaults = sp.load_task(TASKS / "more" / "wedge-heel.yaml")  # its file leaves tolerance to the default
+    defaults.planner["tolerance"][0] = 5.0  # a task's lists are its own, not the defaults'
+    assert PLANNER_DEFAULTS["tolerance"] == [1.0, 1.0]
+    assert sp.load_task(TASKS / "more" / "hexagon-offset.yaml").planner["tolerance"] == [1.0, 1.0]
 
 
 def test_a_goal_with_no_grasp_is_unreachable_at_once():
@@ -213,6 +228,10 @@ def test_numpy_numbers_are_numbers(tmp_path):
     assert sp.load_plan(tmp_path / "p.plan.json").waypoints == plan.waypoints
     with pytest.raises(sp.TaskError, match="seed"):
         sp.plan_task(task, seed=np.bool_(True))
+    with pytest.raises(sp.TaskError, match="seed: must be an integer"):
+        sp.plan_task(task, seed=np.timedelta64(1, "s"))  # numpy registers it as an integer
+    with pytest.raises(sp.TaskError, match=r"at\[0\]: must be a number"):
+        sp.check(task, at=(np.timedelta64(1, "s"), 0, 0), move=(1, 0, 0))
 
 
 def test_what_save_plan_writes_load_plan_reads(tmp_path):
@@ -226,8 +245,13 @@ def test_what_save_plan_writes_load_plan_reads(tmp_path):
     with pytest.raises(sp.PlanError, match="final_hold"):
         sp.save_plan(dataclasses.replace(plan, final_hold_ratio=math.nan), tmp_path / "a.json")
     assert not (tmp_path / "a.json").exists()
+    with pytest.raises(sp.PlanError, match="stats: holds a number that is not finite"):
+        sp.save_plan(dataclasses.replace(plan, stats={**plan.stats, "goal_distance_steps": math.nan}), tmp_path / "a.json")
     with pytest.raises(sp.OutputError, match="overwrite the plan file"):
         sp.save_plan(plan, tmp_path / "same.json", tmp_path / "same.json")
+    sp.save_plan(plan, "/dev/null", "/dev/null")  # a stream may be named twice
+    with pytest.raises(sp.PlanError, match=r"waypoints\[1\]\.margin"):
+        sp.check_plan(task, dataclasses.replace(plan, waypoints=[w[0], dataclasses.replace(w[1], margin=10**400)] + w[2:]))
     bad = {"margin": dataclasses.replace(w[1], margin=math.nan), "pusher": dataclasses.replace(w[1], pusher=5)}
     for field, waypoint in bad.items():
         with pytest.raises(sp.PlanError, match=rf"waypoints\[1\]\.{field}"):

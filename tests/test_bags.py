@@ -156,3 +156,26 @@ def test_a_recorded_run_reads_back_with_its_corrections_and_verdict(tmp_path):
     assert last.x * 1e3 == pytest.approx(run["released_in_grasp"]["x"], abs=1e-6)
     bad = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--record", str(tmp_path / "x.bag")])
     assert bad.exit_code == 2 and "--record" in bad.output
+
+
+def test_every_quaternion_topic_is_continuous_past_half_a_turn(tmp_path):
+    """A plan that turns the object 200 deg in the grasp: on /tf (world -> gripper and gripper ->
+    object) each quaternion lies in the hemisphere of the one before."""
+    import dataclasses
+
+    from stablepush.execution.bags import write_bag
+
+    task = shipped("pivoting")
+    turned = dataclasses.replace(task, goal=(0.0, 0.0, 200.0), planner={**task.planner, "step": [1.0, 5.0]})
+    plan = check_plan(turned, plan_task(turned, seed=1))
+    write_bag(tmp_path / "turn.mcap", turned, plan, timed_trajectory(turned, plan))
+    quats = {"gripper": [], "object": []}
+    with Reader(tmp_path / "turn.mcap") as reader:
+        for connection, _, raw in reader.messages():
+            if connection.topic == "/tf":
+                for transform in STORE.deserialize_cdr(raw, connection.msgtype).transforms:
+                    q = transform.transform.rotation
+                    quats[transform.child_frame_id].append([q.w, q.x, q.y, q.z])
+    for frame, q in quats.items():
+        q = np.array(q)
+        assert (np.sum(q[1:] * q[:-1], axis=1) > 0.99).all(), frame

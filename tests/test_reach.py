@@ -131,5 +131,6 @@ def test_the_library_refuses_a_bad_grid_naming_the_axis_before_any_cell():
         arguments = {"x": x, "z": z, "theta": (0.0, 0.0, 1), "seed": 1, "time_limit": 0.1, **change}
         with pytest.raises(TaskError, match=field):
             reach_map(task, **arguments)
-    result = reach_map(task, x=(0.0, 0.0, 1), z=z, theta=(0.0, 90.0, np.int64(2)), time_limit=0.1)
+    result = reach_map(task, x=np.array([0.0, 0.0, 1.0]), z=z, theta=(0.0, 90.0, np.int64(2)), time_limit=0.1)
     assert result.axes["theta"] == [0.0, 90.0, 2] and type(result.axes["theta"][2]) is int
+    assert result.axes["x"] == [0.0, 0.0, 1] and len(result.cells) == 2

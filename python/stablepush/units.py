@@ -5,7 +5,8 @@ A pose in the grasp plane is q = (x, z, theta): mm, mm, deg in files, m, m, rad 
 from __future__ import annotations
 
 import math
-from typing import Sequence, Tuple
+import numbers
+from typing import Any, Sequence, Tuple
 
 MM = 1e-3  # m per mm
 G = 1e-3  # kg per g
@@ -24,6 +25,28 @@ def pose_from_si(q: Sequence[float]) -> Tuple[float, float, float]:
 def mm2_to_si(p: Sequence[float]) -> Tuple[float, float]:
     """A point (mm, mm) -> (m, m)."""
     return (p[0] * MM, p[1] * MM)
+
+
+def is_real(value: Any) -> bool:
+    """A real number as the API takes one: Python's and numpy's ints and floats, a Fraction; not a
+    bool, and not numpy's timedelta64 (which calls itself an integer but is a duration)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return False
+    try:
+        float(value)
+    except OverflowError:  # an int past the double range: a number, if not a finite double
+        return True
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def is_finite_real(value: Any) -> bool:
+    """is_real, and finite as a double."""
+    try:
+        return is_real(value) and math.isfinite(float(value))
+    except OverflowError:
+        return False
 
 
 def angle_difference_deg(a: float, b: float) -> float:

@@ -34,7 +34,7 @@ from typing import Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from stablepush.errors import OutputError
-from stablepush.execution.trajectory import Trajectory
+from stablepush.execution.trajectory import Trajectory, continuous_quaternions
 from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix
 from stablepush.plan.plan import Plan
@@ -78,11 +78,12 @@ def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajec
         steps = list(plan.waypoints)
         scene = scene_description(task, place_features(task, steps), steps[0].pose)
         write("/stablepush/arm_scene", 0, T["std_msgs/msg/String"](data=json.dumps(scene)))
+        held_poses = _continuous([matrix_to_pose(m) for m in T_GO])
         for i in range(len(trajectory)):
             ns = int(round(float(trajectory.t[i]) * 1e9))
             stamp = _time(T, ns)
             pose = _pose(T, trajectory.position[i], trajectory.quaternion_wxyz[i])
-            held = matrix_to_pose(T_GO[i])
+            held = held_poses[i]
             write("/tf", ns, T["tf2_msgs/msg/TFMessage"](transforms=[
                 _transform(T, stamp, WORLD, GRIPPER, trajectory.position[i], trajectory.quaternion_wxyz[i]),
                 _transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:])]))
@@ -94,6 +95,19 @@ def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajec
                     angular=_vector3(T, trajectory.angular_velocity[i]))))
             write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=trajectory.phase[i]))
             write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(trajectory.step[i])))
+
+
+def _continuous(poses: Sequence[Optional[Sequence[float]]]) -> List[Optional[List[float]]]:
+    """Poses [x, y, z, qw, qx, qy, qz] (None where a sample has none) with their quaternions made
+    continuous over the ones present (trajectory.continuous_quaternions): a topic's quaternion
+    does not jump to the other sign between two samples."""
+    present = [i for i, p in enumerate(poses) if p is not None]
+    out: List[Optional[List[float]]] = [None] * len(poses)
+    if present:
+        quats = continuous_quaternions(np.array([poses[i][3:] for i in present], float))
+        for i, q in zip(present, quats):
+            out[i] = [*map(float, poses[i][:3]), *map(float, q)]
+    return out
 
 
 @contextmanager
@@ -253,9 +267,17 @@ class RunRecording:
     def write(self, path: Union[str, Path], report: dict) -> None:
         """Write the recording and `report` (ExecutionReport.as_dict, or a fault's report) as one
         MCAP file at `path`."""
+        samples = self.samples
+        commanded_poses = _continuous([s.commanded for s in samples])
+        reported_poses = _continuous([s.reported for s in samples])
+        world_poses = _continuous([s.object_pose for s in samples])
+        grasp_poses = _continuous([None if s.object_in_grasp is None else matrix_to_pose(grasp_transform(
+            (s.object_in_grasp["x"], s.object_in_grasp["z"], s.object_in_grasp["theta"]))) for s in samples])
         with _mcap(path, RUN_TOPICS) as (T, write):
             last_ns, end_of_step = 0, {}
-            for t, commanded, reported, in_world, in_grasp, pusher, phase, step, _ in self.samples:
+            for k, (t, _, _, _, _, pusher, phase, step, _) in enumerate(samples):
+                commanded, reported, in_world, held = (commanded_poses[k], reported_poses[k], world_poses[k],
+                                                       grasp_poses[k])
                 ns = last_ns = int(round(t * 1e9))
                 end_of_step[step] = ns
                 stamp = _time(T, ns)
@@ -267,8 +289,7 @@ class RunRecording:
                 if in_world is not None:
                     write("/stablepush/object_pose", ns, T["geometry_msgs/msg/PoseStamped"](
                         header=_header(T, stamp, WORLD), pose=_pose(T, in_world[:3], in_world[3:])))
-                if in_grasp is not None:
-                    held = matrix_to_pose(grasp_transform((in_grasp["x"], in_grasp["z"], in_grasp["theta"])))
+                if held is not None:
                     write("/stablepush/object_in_grasp", ns, T["geometry_msgs/msg/PoseStamped"](
                         header=_header(T, stamp, GRIPPER), pose=_pose(T, held[:3], held[3:])))
                     transforms.append(_transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:]))

@@ -15,7 +15,6 @@ import csv
 import io
 import json
 import math
-import numbers
 from dataclasses import dataclass
 from typing import List
 
@@ -27,6 +26,7 @@ from stablepush.execution.world import place_features, scene_description
 from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
 from stablepush.task.model import Task
+from stablepush.units import is_real
 
 QUATERNION_ORDERS = ("xyzw", "wxyz")  # xyzw: ROS (geometry_msgs/Quaternion); wxyz: the arm protocol, MuJoCo
 
@@ -91,7 +91,7 @@ def timed_trajectory(task: Task, plan: Plan, rate_hz: float = 100.0) -> Trajecto
     """The executor's stream for a plan checked against the task (stablepush.plan.verify.check_plan),
     from G where the executor's world starts it (world.scene_description). ValueError unless `rate_hz`
     lies in the arm protocol's RATE_HZ."""
-    if isinstance(rate_hz, bool) or not isinstance(rate_hz, numbers.Real) or not RATE_HZ[0] <= rate_hz <= RATE_HZ[1]:
+    if not is_real(rate_hz) or not RATE_HZ[0] <= rate_hz <= RATE_HZ[1]:
         raise ValueError(f"rate_hz must be a number from {RATE_HZ[0]:g} to {RATE_HZ[1]:g}, got {rate_hz!r:.40}")
     rate_hz = rate_hz if isinstance(rate_hz, (int, float)) else float(rate_hz)  # numpy's, as the arm's JSON takes
     steps = list(plan.waypoints)

@@ -94,14 +94,29 @@ def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union
     (naming the field) for a plan load_plan would not read back, a NaN pose say, and OutputError
     when both paths name one file."""
     require_plan(plan)
-    text = json.dumps(plan_to_dict(plan), indent=1, default=_json_number) + "\n"
-    check_plan_dict(json.loads(text), f"the plan to write to {json_path}")
-    if csv_path and Path(csv_path).resolve() == Path(json_path).resolve():
+    source = f"the plan to write to {json_path}"
+    data = plan_to_dict(plan)
+    text = json.dumps(data, indent=1, default=_json_number) + "\n"
+    check_plan_dict(json.loads(text), source)  # names a waypoint's field
+    for key in ("stats", "uncertainty"):  # what else a plan file holds that must be finite
+        try:
+            json.dumps(data[key], default=_json_number, allow_nan=False)
+        except ValueError:
+            raise PlanError(key, "holds a number that is not finite (NaN or infinity), which JSON has not", source)
+    if csv_path and _same_regular_file(csv_path, json_path):
         raise OutputError(f"{csv_path}: the CSV would overwrite the plan file; give it another name")
     files = {json_path: text}
     if csv_path:
         files[csv_path] = plan_to_csv(plan)
     write_files(files)
+
+
+def _same_regular_file(a: Union[str, Path], b: Union[str, Path]) -> bool:
+    """Whether two paths name one file that is, or will be, a regular file (a stream such as
+    /dev/null may be named twice)."""
+    if Path(a).resolve() != Path(b).resolve():
+        return False
+    return not Path(a).exists() or Path(a).is_file()
 
 
 def _json_number(v):

@@ -19,7 +19,6 @@ Poses are (x mm, z mm, theta deg), as in task files.
 from __future__ import annotations
 
 import dataclasses
-import numbers
 from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
@@ -29,7 +28,7 @@ from stablepush.errors import TaskError
 from stablepush.plan.search import plan_task
 from stablepush.task.model import Task, make_gripper, require_task
 from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_limit, planner_parameter
-from stablepush.units import pose_to_si
+from stablepush.units import is_finite_real, pose_to_si
 
 Axis = Tuple[float, float, int]  # from, to, count (count 1: `from` alone)
 
@@ -79,12 +78,12 @@ MAX_AXIS, MAX_CELLS = 1000, 100_000
 def grid_axis(name: str, axis, bound: Tuple[float, float]) -> Axis:
     """(from, to, count) checked: two numbers within `bound` and an integer count from 1 to
     MAX_AXIS; TaskError naming `name` otherwise."""
-    if not isinstance(axis, (tuple, list)) or len(axis) != 3:
+    if not isinstance(axis, (tuple, list, np.ndarray)) or len(axis) != 3:
         raise TaskError(name, f"must be (from, to, count), got {axis!r:.60}")
     start, stop = number_field(f"{name}[0]", axis[0], bound), number_field(f"{name}[1]", axis[1], bound)
     count = axis[2]
-    if isinstance(count, bool) or not isinstance(count, numbers.Integral) or not 1 <= count <= MAX_AXIS:
-        raise TaskError(f"{name}[2]", f"the count must be an integer from 1 to {MAX_AXIS}, got {count!r:.40}")
+    if not (is_finite_real(count) and float(count).is_integer() and 1 <= count <= MAX_AXIS):
+        raise TaskError(f"{name}[2]", f"the count must be a whole number from 1 to {MAX_AXIS}, got {count!r:.40}")
     return start, stop, int(count)
 
 

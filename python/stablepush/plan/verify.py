@@ -4,7 +4,6 @@ file, or edited by hand, is refused (PlanError naming the waypoint)."""
 from __future__ import annotations
 
 import math
-import numbers
 from typing import List, Optional
 
 from stablepush import _core
@@ -12,7 +11,7 @@ from stablepush.errors import PlanError
 from stablepush.plan.plan import Plan, Waypoint, require_plan
 from stablepush.task.model import Task, require_task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
-from stablepush.units import MM, pose_to_si
+from stablepush.units import MM, is_finite_real, pose_to_si
 
 STEP_SLACK = 1e-6  # unit steps: rounding in a plan file's decimal poses
 START_SLACK = 1e-6  # mm or deg: the plan's start against the task's
@@ -47,13 +46,13 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     for i, w in enumerate(waypoints):
         if not isinstance(w, Waypoint):
             fail(f"waypoints[{i}]", f"must be a Waypoint (x, z, theta, pusher, ...), got {type(w).__name__}")
-        if not all(isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) for v in w.pose):
+        if not all(is_finite_real(v) for v in w.pose):
             fail(f"waypoints[{i}]", f"must be a pose of 3 finite numbers, got {w.pose!r:.80}")
         if not (w.pusher is None or isinstance(w.pusher, str)):
             fail(f"waypoints[{i}].pusher", f"must be a pusher name or None, got {type(w.pusher).__name__}")
         for key in ("margin", "margin_per_normal"):
             value = getattr(w, key)
-            if value is not None and not (isinstance(value, numbers.Real) and math.isfinite(value)):
+            if value is not None and not is_finite_real(value):
                 fail(f"waypoints[{i}].{key}", f"must be a finite number or None, got {value!r:.40}")
     if len(waypoints) < (2 if require_solved else 1):  # a partial plan may have found no push at all
         fail("waypoints", "needs the start and at least one push" if require_solved else "needs the start")

@@ -7,15 +7,16 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import json
 import math
-import numbers
 import os
+import weakref
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from stablepush import _core
 from stablepush.errors import TaskError
-from stablepush.units import MM, G, mm2_to_si
+from stablepush.units import MM, G, is_real, mm2_to_si
 
 # How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
 # (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
@@ -230,54 +231,53 @@ class Task:
         scale with mu N and a pusher's cone shrinks with its mu, so a push stable at these corners
         is stable for every value in the box (a convex combination of the corners' witnesses is a
         witness). mu and N enter only as their product, so the corners scale mu alone."""
+        return [corner.build_model() for corner in self._corner_tasks()]
+
+    def _corner_tasks(self) -> List["Task"]:
+        """This task at each corner of its uncertainty box (corner_models), or itself alone."""
         u = self.uncertainty
         if not any(u.values()):
-            return [self.build_model()]
+            return [self]
         low_pushers = tuple(dataclasses.replace(p, mu=p.mu * (1.0 - u.get("pusher_mu", 0.0))) for p in self.pushers)
         friction = [(1.0 - u.get("pad_mu", 0.0)) * (1.0 - u.get("grip_force", 0.0)),
                     (1.0 + u.get("pad_mu", 0.0)) * (1.0 + u.get("grip_force", 0.0))]
         masses = [1.0 - u.get("mass", 0.0), 1.0 + u.get("mass", 0.0)]
         return [dataclasses.replace(self, mu=self.mu * f, mass=self.mass * m, pushers=low_pushers,
-                                    inertia=None if self.inertia is None else self.inertia * m,
-                                    uncertainty={}).build_model()
+                                    inertia=None if self.inertia is None else self.inertia * m, uncertainty={})
                 for f in friction for m in masses]
 
     def check_models(self, models: Sequence["_core.StablePushModel"], field: str = "models") -> None:
-        """TypeError or ValueError (naming `field[k]`) unless `models` are this task's corner_models():
-        the same outline and pushers, and each model's pusher mu, mass, pad friction (mu N summed
-        over the pads' points, N) and gravity those of one corner, every corner present. Checked on
-        the models' numbers, without building the task's own, so that models built once for many
-        searches stay cheap; a model of another task, or the nominal model of a task with an
-        uncertainty box, would give answers that are not this task's."""
-        u = self.uncertainty if any(self.uncertainty.values()) else {}
-        low = 1.0 - u.get("pusher_mu", 0.0)
-        friction = ([(1.0 - u.get("pad_mu", 0.0)) * (1.0 - u.get("grip_force", 0.0)),
-                     (1.0 + u.get("pad_mu", 0.0)) * (1.0 + u.get("grip_force", 0.0))] if u else [1.0])
-        masses = [1.0 - u.get("mass", 0.0), 1.0 + u.get("mass", 0.0)] if u else [1.0]
-        corners = [(f, m) for f in friction for m in masses]
-        outline = outline_corners(self.vertices)
+        """TypeError or ValueError (naming `field[k]`) unless `models` are this task's corner_models(),
+        every corner present, in any order: each model must have been built by build_model from what
+        one corner's model is built from (model_inputs), which is recorded beside each model built.
+        A model of another task, or the nominal model of a task with an uncertainty box, would give
+        answers that are not this task's."""
+        expected = {corner.model_inputs() for corner in self._corner_tasks()}
         found = set()
         for k, model in enumerate(models):
             name = f"{field}[{k}]"
             if not isinstance(model, _core.StablePushModel):
                 raise TypeError(f"{name}: expected a StablePushModel (task.corner_models()), "
                                 f"got {type(model).__name__}")
-            vertices = model.section.vertices
-            if (len(vertices) != len(outline) or [p.name for p in model.pushers] != self.pusher_names or any(
-                    abs(a[0] - b[0] * MM) > 1e-9 or abs(a[1] - b[1] * MM) > 1e-9 for a, b in zip(vertices, outline))):
-                raise ValueError(f"{name}: not a model of task {self.name!r} (another object, or other pushers)")
-            pads = len(self.pads) * self.mu * self.grip_force
-            f = sum(model.gripper.point_friction_limits) / pads if pads > 0 else 1.0
-            m = model.body.mass / (self.mass * G)
-            match = [c for c in corners if _close(c[0], f) and _close(c[1], m)]
-            same_pushers = all(_close(p.mu, s.mu * low) for p, s in zip(model.pushers, self.pushers))
-            gravity = model.gravity_in_gripper(_core.Pose(0.0, 0.0, 0.0), -1).ravel()
-            if not match or not same_pushers or not all(_close(a, b) for a, b in zip(gravity, self.gravity)):
-                raise ValueError(f"{name}: not one of task {self.name!r}'s corner_models() (its friction, mass or "
-                                 f"gravity differ{', or the task has an uncertainty box' if u else ''})")
-            found.add(match[0])
-        if found != set(corners):
-            raise ValueError(f"{field}: {len(models)} model(s), not the {len(corners)} of task.corner_models()")
+            made_from = _MODEL_INPUTS.get(model)
+            if made_from not in expected:
+                box = " (the task has an uncertainty box: its corner models)" if any(self.uncertainty.values()) else ""
+                raise ValueError(f"{name}: not one of task {self.name!r}'s corner_models(){box}: a model of another "
+                                 f"task, or not made by Task.build_model")
+            found.add(made_from)
+        if found != expected:
+            raise ValueError(f"{field}: {len(models)} model(s), not the {len(expected)} of task.corner_models()")
+
+    def model_inputs(self) -> str:
+        """What build_model builds from, as canonical JSON: the object, the pads, gravity and how
+        pushes are made, the pushers and their features' orientation; not the start, goal or
+        planner, which a model does not depend on."""
+        return json.dumps(json_values({
+            "object": [self.vertices, self.thickness, self.mass, self.com, self.inertia],
+            "gripper": [self.grip_force, self.mu, self.pad_rings, self.pads],
+            "dynamics": [self.gravity, self.step_time, self.friction_polygon_sides, self.pushes],
+            "pushers": [[p.name, p.a, p.b, p.mu, p.points, self.feature_angle(p.name)] for p in self.pushers],
+        }), sort_keys=True)
 
     def build_model(self) -> "_core.StablePushModel":
         """The core's stable-push model of this task, in SI units."""
@@ -289,11 +289,18 @@ class Task:
             for p in self.pushers
         ]
         fixed = self.pushes == "against_fixed_features"
-        return _core.StablePushModel(
+        model = _core.StablePushModel(
             section, body, gripper, pushers, self.gravity, self.step_time, self.friction_polygon_sides,
             _core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
             [math.radians(self.feature_angle(p.name)) for p in self.pushers],
         )
+        _MODEL_INPUTS[model] = self.model_inputs()
+        return model
+
+
+# Each model build_model made -> its task's model_inputs(), for check_models; weak, so a model
+# outlives no reference of its own.
+_MODEL_INPUTS: "weakref.WeakKeyDictionary[_core.StablePushModel, str]" = weakref.WeakKeyDictionary()
 
 
 def require_task(value: Any, field: str = "task") -> Task:
@@ -305,13 +312,8 @@ def require_task(value: Any, field: str = "task") -> Task:
     return value
 
 
-def _close(a: float, b: float) -> bool:
-    """Equal but for rounding: the same task value through another product of factors."""
-    return abs(a - b) <= 1e-9 * max(abs(a), abs(b), 1.0)
-
-
 def _finite(field: str, value) -> None:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if not is_real(value):
         raise TypeError(f"{field} must be a number, got {type(value).__name__}")
     try:
         ok = math.isfinite(float(value))

@@ -5,6 +5,7 @@ names the field and the reason, before anything reaches the C++ core.
 """
 from __future__ import annotations
 
+import copy
 import datetime
 import math
 import numbers
@@ -29,7 +30,7 @@ from stablepush.task.model import (
     make_gripper,
     outline_corners,
 )
-from stablepush.units import MM, mm2_to_si, pose_to_si
+from stablepush.units import MM, is_real, mm2_to_si, pose_to_si
 
 DEFAULT_PAD_RADIUS_MM = 5.0
 DEFAULT_GRAVITY = (0.0, -9.81)
@@ -211,7 +212,7 @@ def _join(path: str, key: str) -> str:
 def _number(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> float:
     """A finite number (numpy's scalars too, but not a bool), inside `within` (lowest, highest;
     both inclusive) when given."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if not is_real(value):
         raise TaskError(path, f"must be a number, got {_shown(value)}")
     try:
         x = float(value)
@@ -239,7 +240,7 @@ def _friction(path: str, value: Any) -> float:
 
 def _integer(path: str, value: Any, lowest: int, highest: int) -> int:
     """An integer (numpy's too, but not a bool) from `lowest` to `highest`, as a Python int."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+    if not (is_real(value) and isinstance(value, numbers.Integral)):
         raise TaskError(path, f"must be an integer, got {_shown(value)}")
     if not lowest <= int(value) <= highest:
         raise TaskError(path, f"must be an integer from {lowest} to {highest}, got {_shown(value)}")
@@ -315,11 +316,16 @@ def load_task(path: "str | Path", goal_in_grasp: bool = True) -> Task:
 
 
 def parse_task(text: "str | Mapping[str, Any]", source: Optional[str] = None, goal_in_grasp: bool = True) -> Task:
-    """A task from a task file's text (YAML), or from the mapping it holds (a task written in code:
-    the same keys and units, docs/model.md section 4). Validated as load_task validates a file;
-    `source` names it in errors."""
+    """A task from a task file's text (YAML; str, or bytes in UTF-8), or from the mapping it holds
+    (a task written in code: the same keys and units, docs/model.md section 4). Validated as
+    load_task validates a file; `source` names it in errors."""
     if isinstance(text, Mapping):
         return _validate(dict(text), source, goal_in_grasp)
+    if isinstance(text, bytes):
+        try:
+            text = text.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise TaskError("", f"not UTF-8 text ({exc.reason} at byte {exc.start})", source) from None
     if not isinstance(text, str):
         raise TypeError(f"parse_task takes a task file's text or its mapping, got {type(text).__name__} "
                         f"(a path? use load_task)")
@@ -641,7 +647,7 @@ def planner_limit(path: str, value: Any) -> float:
 def _validate_planner(value: Any) -> Dict[str, Any]:
     """The planner section with defaults filled in; tuning keys appear only when given."""
     planner = _mapping("planner", value, [], list(PLANNER_DEFAULTS) + list(PLANNER_PARAMETER_RANGES))
-    out = dict(PLANNER_DEFAULTS)
+    out = copy.deepcopy(PLANNER_DEFAULTS)  # its lists are the task's own, not the defaults'
     if "time_limit" in planner:
         out["time_limit"] = planner_limit("planner.time_limit", planner["time_limit"])
     for key in ("step", "tolerance"):
