@@ -214,6 +214,7 @@ def test_a_goal_with_no_grasp_is_unreachable_at_once():
     task = dataclasses.replace(sp.load_task(TASKS / "horizontal-offset-high-mu.yaml"), goal=(200.0, 0.0, 0.0))
     plan = sp.plan_task(task, time_limit=5.0)
     assert plan.outcome == "unreachable" and "no grasp there" in plan.message
+    assert sp.PlanOutcome(plan.outcome) is sp.PlanOutcome.unreachable
     assert plan.stats["planning_time_s"] < 1.0
 
 

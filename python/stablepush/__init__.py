@@ -17,9 +17,9 @@ OutputError, ArmFault).
 The package's layers, each importing only those below it (docs/architecture.md):
 `sim`, `viz` > `execution` > `plan` > `task` > `units`, `frames`, `errors`, `outputs`, `_core`.
 """
-from stablepush._core import ContactCase, PlanOutcome, PushResult
+from stablepush._core import ContactCase, PushResult
 from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError
-from stablepush.plan import Plan, PusherContact, Waypoint, check_plan, load_plan, plan_task
+from stablepush.plan import Plan, PlanOutcome, PusherContact, Waypoint, check_plan, load_plan, plan_task
 from stablepush.plan import write_plan as save_plan
 from stablepush.task import PusherSpec, Task, load_task, parse_task
 from stablepush.task import check_push as check

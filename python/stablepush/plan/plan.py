@@ -7,6 +7,7 @@ object). The first waypoint is the start and has no pusher.
 """
 from __future__ import annotations
 
+import enum
 import math
 import os
 from dataclasses import dataclass, field
@@ -43,6 +44,18 @@ class Waypoint:
     def pose(self) -> Tuple[float, float, float]:
         """(x mm, z mm, theta deg)."""
         return (self.x, self.z, self.theta)
+
+
+class PlanOutcome(str, enum.Enum):
+    """How a plan's search ended: `Plan.outcome` is one of these names (a plain string, as the plan
+    file holds it; `PlanOutcome(plan.outcome)` gives the member). The core's search ends in the
+    first four; `unreachable` is decided before it (stablepush.plan.unreachable)."""
+
+    goal_reached = "goal_reached"  # solved
+    goal_over_switch_limit = "goal_over_switch_limit"  # reached only with more switch-overs than allowed
+    time_limit = "time_limit"  # the path to the node nearest the goal
+    invalid_start = "invalid_start"  # the pads are not on the object at the start
+    unreachable = "unreachable"  # no plan can reach the goal; the reason is in the message
 
 
 @dataclass(frozen=True)
