@@ -2,7 +2,9 @@
 import dataclasses
 import json
 import math
+import os
 import re
+import subprocess
 from collections import Counter
 
 import numpy as np
@@ -145,7 +147,7 @@ def test_plan_refuses_models_that_are_not_the_tasks():
     task, other = sp.load_task(TASKS / "t-shaped.yaml"), sp.load_task(TASKS / "pivoting.yaml")
     with pytest.raises(TypeError, match=r"models\[0\]: expected a StablePushModel"):
         sp.plan_task(task, models=[None])  # was a segmentation fault
-    with pytest.raises(ValueError, match="not one of task 't-shaped''s corner_models"):
+    with pytest.raises(ValueError, match="not one of the corner_models.. of task 't-shaped'"):
         sp.plan_task(task, models=other.corner_models())
     assert sp.plan_task(task, models=task.corner_models()).solved
 
@@ -167,7 +169,7 @@ def test_check_answers_for_the_task_given_and_plan_takes_only_its_own_corner_mod
     high, low = sp.load_task(TASKS / "horizontal-offset-high-mu.yaml"), sp.load_task(TASKS / "horizontal-offset-low-mu.yaml")
     with pytest.raises(TypeError):
         sp.check(high, at=(0, 0, 0), move=(1, 0, 0), model=low.build_model())
-    with pytest.raises(ValueError, match=r"models\[0\]: not one of task 'horizontal-offset-high-mu'"):
+    with pytest.raises(ValueError, match=r"models\[0\]: not one of the corner_models.. of task 'horizontal-offset-high"):
         sp.plan_task(high, models=low.corner_models(), time_limit=0.3)
     robust = sp.load_task(TASKS / "more" / "large-manipulation-robust.yaml")
     with pytest.raises(ValueError, match="uncertainty box"):
@@ -179,12 +181,17 @@ def test_check_answers_for_the_task_given_and_plan_takes_only_its_own_corner_mod
     edits = {"com": dict(com=(30.0, -5.0)), "step_time": dict(step_time=0.5), "pushes": dict(pushes="by_moving_pusher"),
              "pad_rings": dict(pad_rings=3), "pads": dict(pads=(((5.0, 0.0), 5.0), ((5.0, 0.0), 5.0)))}
     for name, edit in edits.items():
-        with pytest.raises(ValueError, match="not one of task"):
+        with pytest.raises(ValueError, match="not one of the corner_models"):
             sp.plan_task(base, models=dataclasses.replace(base, **edit).corner_models(), time_limit=0.3)
     frictionless = dataclasses.replace(base, mu=0.0, uncertainty={"pad_mu": 0.2})
     frictionless.check_models(frictionless.corner_models())
     elsewhere = dataclasses.replace(base, goal=(5.0, 0.0, 0.0))  # a model does not depend on the goal
     elsewhere.check_models(base.corner_models())
+    dataclasses.replace(base, mass=round(base.mass)).check_models(base.corner_models())  # 130 is 130.0
+    moving = dataclasses.replace(base, pushes="by_moving_pusher")  # no feature, so no start's turn in it
+    dataclasses.replace(moving, start=(0.0, 0.0, 10.0)).check_models(moving.corner_models())
+    arrays = dataclasses.replace(base, com=np.array([0.0, -5.0]))
+    arrays.check_models(arrays.corner_models())
 
 
 def test_a_task_written_in_code_plans_like_the_file():
@@ -251,6 +258,12 @@ def test_what_save_plan_writes_load_plan_reads(tmp_path):
     with pytest.raises(sp.OutputError, match="overwrite the plan file"):
         sp.save_plan(plan, tmp_path / "same.json", tmp_path / "same.json")
     sp.save_plan(plan, "/dev/null", "/dev/null")  # a stream may be named twice
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    reader = subprocess.Popen(["cat", str(fifo)], stdout=subprocess.PIPE, text=True)
+    sp.save_plan(plan, fifo, fifo)
+    both = reader.communicate(timeout=30)[0]
+    assert '"format": "stablepush.plan/1"' in both and "step,x,z,theta" in both  # the JSON, then the CSV
     with pytest.raises(sp.PlanError, match=r"waypoints\[1\]\.margin"):
         sp.check_plan(task, dataclasses.replace(plan, waypoints=[w[0], dataclasses.replace(w[1], margin=10**400)] + w[2:]))
     bad = {"margin": dataclasses.replace(w[1], margin=math.nan), "pusher": dataclasses.replace(w[1], pusher=5)}

@@ -125,6 +125,7 @@ def test_the_library_refuses_a_bad_grid_naming_the_axis_before_any_cell():
     task = shipped("pivoting")
     x, z = (0.0, 0.0, 1), (0.0, 0.0, 1)
     bad = {r"x\[1\]": dict(x=(0.0, math.nan, 2)), "x: must be \\(from, to, count\\)": dict(x=(0.0, 10.0)),
+           "x: must be": dict(x=np.array(5.0)),
            r"x\[2\]": dict(x=(0.0, 10.0, 2.7)), r"theta\[0\]": dict(theta=(1e5, 1e5, 1)),
            r"z\[2\]": dict(z=(0.0, 1.0, 0)), "seed": dict(seed=-1), "time_limit": dict(time_limit=0.0)}
     for field, change in bad.items():

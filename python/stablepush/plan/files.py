@@ -106,7 +106,9 @@ def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union
     if csv_path and _same_regular_file(csv_path, json_path):
         raise OutputError(f"{csv_path}: the CSV would overwrite the plan file; give it another name")
     files = {json_path: text}
-    if csv_path:
+    if csv_path and Path(csv_path).resolve() == Path(json_path).resolve():  # one stream: the JSON, then the CSV
+        files = {json_path: text + plan_to_csv(plan)}
+    elif csv_path:
         files[csv_path] = plan_to_csv(plan)
     write_files(files)
 

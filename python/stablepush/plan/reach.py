@@ -78,7 +78,7 @@ MAX_AXIS, MAX_CELLS = 1000, 100_000
 def grid_axis(name: str, axis, bound: Tuple[float, float]) -> Axis:
     """(from, to, count) checked: two numbers within `bound` and an integer count from 1 to
     MAX_AXIS; TaskError naming `name` otherwise."""
-    if not isinstance(axis, (tuple, list, np.ndarray)) or len(axis) != 3:
+    if not isinstance(axis, (tuple, list, np.ndarray)) or np.ndim(axis) != 1 or len(axis) != 3:
         raise TaskError(name, f"must be (from, to, count), got {axis!r:.60}")
     start, stop = number_field(f"{name}[0]", axis[0], bound), number_field(f"{name}[1]", axis[1], bound)
     count = axis[2]

@@ -262,22 +262,25 @@ class Task:
             made_from = _MODEL_INPUTS.get(model)
             if made_from not in expected:
                 box = " (the task has an uncertainty box: its corner models)" if any(self.uncertainty.values()) else ""
-                raise ValueError(f"{name}: not one of task {self.name!r}'s corner_models(){box}: a model of another "
-                                 f"task, or not made by Task.build_model")
+                raise ValueError(f"{name}: not one of the corner_models() of task {self.name!r}{box}: a model of "
+                                 f"another task, or not made by Task.build_model")
             found.add(made_from)
         if found != expected:
             raise ValueError(f"{field}: {len(models)} model(s), not the {len(expected)} of task.corner_models()")
 
     def model_inputs(self) -> str:
-        """What build_model builds from, as canonical JSON: the object, the pads, gravity and how
-        pushes are made, the pushers and their features' orientation; not the start, goal or
-        planner, which a model does not depend on."""
-        return json.dumps(json_values({
+        """What build_model builds from, as canonical JSON (numbers as floats, so 62 and 62.0 are
+        one mass): the object, the pads, gravity and how pushes are made, the pushers and, against
+        fixed features, the object's orientation on each (the start's where environment.features
+        does not give it); not the goal or planner, which a model does not depend on."""
+        fixed = self.pushes == "against_fixed_features"
+        return json.dumps(_floats(json_values({
             "object": [self.vertices, self.thickness, self.mass, self.com, self.inertia],
             "gripper": [self.grip_force, self.mu, self.pad_rings, self.pads],
             "dynamics": [self.gravity, self.step_time, self.friction_polygon_sides, self.pushes],
-            "pushers": [[p.name, p.a, p.b, p.mu, p.points, self.feature_angle(p.name)] for p in self.pushers],
-        }), sort_keys=True)
+            "pushers": [[p.name, p.a, p.b, p.mu, p.points, self.feature_angle(p.name) if fixed else None]
+                        for p in self.pushers],
+        })), sort_keys=True)
 
     def build_model(self) -> "_core.StablePushModel":
         """The core's stable-push model of this task, in SI units."""
@@ -331,9 +334,12 @@ def _finite_vector(field: str, value, size: int) -> None:
 
 
 def json_values(value):
-    """`value` with tuples as lists and numbers as floats or ints, as JSON reads it back."""
+    """`value` with tuples (and numpy arrays) as lists and numbers as floats or ints, as JSON reads
+    it back."""
     if isinstance(value, dict):
         return {str(k): json_values(v) for k, v in value.items()}
+    if hasattr(value, "tolist") and getattr(value, "ndim", 0) > 0:  # a numpy array
+        value = value.tolist()
     if isinstance(value, (list, tuple)):
         return [json_values(v) for v in value]
     if isinstance(value, bool) or value is None or isinstance(value, str):
@@ -341,6 +347,15 @@ def json_values(value):
     if isinstance(value, int):
         return int(value)
     return float(value)
+
+
+def _floats(value):
+    """json_values' output with every int a float."""
+    if isinstance(value, list):
+        return [_floats(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _floats(v) for k, v in value.items()}
+    return float(value) if isinstance(value, int) and not isinstance(value, bool) else value
 
 
 def make_gripper(pads, grip_force: float, mu: float, pad_rings: int) -> "_core.Gripper":
