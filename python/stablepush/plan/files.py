@@ -16,6 +16,7 @@ from stablepush.inputs import read_capped
 from stablepush.outputs import write_files
 from stablepush.plan.plan import Plan, PusherContact, Waypoint, require_plan
 from stablepush.strict_json import is_finite_number
+from stablepush.units import is_real
 
 FORMAT = "stablepush.plan/1"
 CSV_COLUMNS = ["step", "x", "z", "theta", "pusher", "margin", "margin_per_normal", "case",
@@ -106,10 +107,11 @@ def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union
     if csv_path and _same_regular_file(csv_path, json_path):
         raise OutputError(f"{csv_path}: the CSV would overwrite the plan file; give it another name")
     files = {json_path: text}
-    if csv_path and Path(csv_path).resolve() == Path(json_path).resolve():  # one stream: the JSON, then the CSV
-        files = {json_path: text + plan_to_csv(plan)}
-    elif csv_path:
-        files[csv_path] = plan_to_csv(plan)
+    if csv_path:
+        if Path(csv_path).resolve() == Path(json_path).resolve():  # one stream: the JSON, then the CSV
+            files[json_path] += plan_to_csv(plan)
+        else:
+            files[csv_path] = plan_to_csv(plan)
     write_files(files)
 
 
@@ -123,10 +125,8 @@ def _same_regular_file(a: Union[str, Path], b: Union[str, Path]) -> bool:
 
 def _json_number(v):
     """A number JSON does not know (numpy's scalars), as the Python number it is."""
-    if isinstance(v, numbers.Integral) and not isinstance(v, bool):
-        return int(v)
-    if isinstance(v, numbers.Real):
-        return float(v)
+    if is_real(v):
+        return int(v) if isinstance(v, numbers.Integral) else float(v)
     raise TypeError(f"a plan holds numbers, strings and lists, not {type(v).__name__}")
 
 

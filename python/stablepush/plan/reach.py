@@ -31,6 +31,7 @@ from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_limi
 from stablepush.units import is_finite_real, pose_to_si
 
 Axis = Tuple[float, float, int]  # from, to, count (count 1: `from` alone)
+MAX_AXIS, MAX_CELLS = 1000, 100_000  # values an axis, cells a map
 
 
 def axis_values(axis: Axis) -> List[float]:
@@ -70,9 +71,6 @@ class ReachJob:
         goals = tuple((gx, gz, gth) for gth in axis_values(theta) for gz in axis_values(z) for gx in axis_values(x))
         return cls(task=task, goals=goals, seed=planner_parameter("seed", "seed", seed),
                    time_limit=planner_limit("time_limit", time_limit), axes=(x, z, theta))
-
-
-MAX_AXIS, MAX_CELLS = 1000, 100_000
 
 
 def grid_axis(name: str, axis, bound: Tuple[float, float]) -> Axis:
