@@ -342,8 +342,8 @@ def test_an_output_over_an_input_another_output_or_unwritable_is_refused_before_
 
 
 @pytest.mark.parametrize("args, says", [
-    (["reach", str(LOW_MU), "--x", "nan:nan:1"], "expected FROM:TO:COUNT, finite numbers"),
-    (["reach", str(LOW_MU), "--z", "0:inf:2"], "expected FROM:TO:COUNT, finite numbers"),
+    (["reach", str(LOW_MU), "--x", "nan:nan:1"], "expected FROM:TO:COUNT, FROM and TO from -10000 to 10000"),
+    (["reach", str(LOW_MU), "--z", "0:inf:2"], "expected FROM:TO:COUNT, FROM and TO from -10000 to 10000"),
     (["check", str(LOW_MU), "--move", "1", "0", "0", "--heading-step", "5"], "--heading-step: only with --directions"),
 ])
 def test_options_that_cannot_apply_are_refused_as_usage_errors(args, says):
