@@ -104,6 +104,16 @@ def require_suffix(name: str, path: Optional[Union[str, Path]], suffixes) -> Non
                           f"take as its format")
 
 
+def same_file(a: Union[str, Path], b: Union[str, Path]) -> bool:
+    """Whether two paths name one file (as check_outputs tells them: hard links and symlinks too)."""
+    return _identity(a) == _identity(b)
+
+
+def is_stream(path: Union[str, Path]) -> bool:
+    """Whether write_files writes `path` as a stream (/dev/null, a FIFO), not by replacing a file."""
+    return _writable(path)[1] == "stream"
+
+
 def _identity(path: Union[str, Path]):
     """What makes two paths one file: device and inode when it exists (hard links too), else the
     resolved path."""

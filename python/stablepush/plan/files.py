@@ -13,7 +13,7 @@ from typing import Optional, Union
 from stablepush import strict_json
 from stablepush.errors import OutputError, PlanError
 from stablepush.inputs import read_capped
-from stablepush.outputs import write_files
+from stablepush.outputs import is_stream, same_file, write_files
 from stablepush.plan.plan import Plan, PusherContact, Waypoint, require_plan
 from stablepush.strict_json import is_finite_number
 from stablepush.units import is_real
@@ -104,23 +104,14 @@ def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union
             json.dumps(data[key], default=_json_number, allow_nan=False)
         except ValueError:
             raise PlanError(key, "holds a number that is not finite (NaN or infinity), which JSON has not", source)
-    if csv_path and _same_regular_file(csv_path, json_path):
-        raise OutputError(f"{csv_path}: the CSV would overwrite the plan file; give it another name")
     files = {json_path: text}
-    if csv_path:
-        if Path(csv_path).resolve() == Path(json_path).resolve():  # one stream: the JSON, then the CSV
-            files[json_path] += plan_to_csv(plan)
-        else:
-            files[csv_path] = plan_to_csv(plan)
+    if csv_path and same_file(csv_path, json_path):
+        if not is_stream(json_path):
+            raise OutputError(f"{csv_path}: the CSV would overwrite the plan file; give it another name")
+        files[json_path] += plan_to_csv(plan)  # one stream: the JSON, then the CSV
+    elif csv_path:
+        files[csv_path] = plan_to_csv(plan)
     write_files(files)
-
-
-def _same_regular_file(a: Union[str, Path], b: Union[str, Path]) -> bool:
-    """Whether two paths name one file that is, or will be, a regular file (a stream such as
-    /dev/null may be named twice)."""
-    if Path(a).resolve() != Path(b).resolve():
-        return False
-    return not Path(a).exists() or Path(a).is_file()
 
 
 def _json_number(v):
