@@ -11,12 +11,13 @@ from click.testing import CliRunner
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from stablepush.errors import PlanError
+from stablepush.errors import PlanError, RunnerError
 from stablepush.evaluation import Batch, Evaluation, Spreads, draw_world, evaluate, robust_task, wilson_interval
 from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.world import place_features, scene_description
 from stablepush.plan import check_plan, plan_task
-from stablepush.runners import Runner
+from stablepush.plan.benchmark import bench_checks
+from stablepush.runners import Runner, run_all
 from stablepush.sim.arm import WorldDeviation
 from stablepush_cli.main import cli
 
@@ -257,7 +258,7 @@ def test_evaluate_cli_writes_its_files_and_refuses_bad_options(tmp_path):
     assert (tmp_path / "e.png").read_bytes()[:4] == b"\x89PNG"
     assert len((tmp_path / "e.csv").read_text().splitlines()) == 3
     bad = CliRunner().invoke(cli, ["evaluate", task, "--vary", "friction=0.1"])
-    assert bad.exit_code == 2 and "friction" in bad.output
+    assert bad.exit_code == 2 and "error: --vary: unknown key 'friction'" in bad.output
     bad = CliRunner().invoke(cli, ["evaluate", task, "--vary", "pad_mu"])
     assert bad.exit_code == 2 and "KEY=FRACTION" in bad.output
     bad = CliRunner().invoke(cli, ["evaluate", task, "--workers", "2", "--ray"])
@@ -293,3 +294,27 @@ def test_bench_plans_the_same_on_workers_as_here(tmp_path):
     assert outs[0] == outs[1] and [t["seed"] for t in outs[0]] == [1, 2, 3, 4]
     bad = CliRunner().invoke(cli, ["bench", task, "--workers", "2", "--ray"])
     assert bad.exit_code == 2 and "--ray" in bad.output
+
+
+def test_a_ray_address_is_checked_where_the_runner_is_made_and_a_silent_head_refused_at_once():
+    """A malformed address was an internal error (exit 4), and one where no head answers waited on
+    Ray's own retries for minutes."""
+    for address in ("notanaddress", ":::", "host:0", "host:65536", "ray://"):
+        with pytest.raises(ValueError, match="expected HOST:PORT"):
+            Runner(ray=True, ray_address=address)
+    for address in ("auto", "local", "10.0.0.5:6379", "ray://10.0.0.5:10001", "[::1]:6379"):
+        assert Runner(ray=True, ray_address=address).ray_address == address
+    with pytest.raises(RunnerError, match="no Ray head answers at 127.0.0.1:1"):
+        list(run_all(_square, None, [1, 2], Runner(ray=True, ray_address="127.0.0.1:1")))
+
+
+def _square(_shared, i):
+    return i * i
+
+
+def test_bench_checks_runs_the_count_asked():
+    """It ran whole batches of 2,000: -n 1 ran 2,000 checks and -n 0 crashed."""
+    timings = bench_checks(shipped("t-shaped"), checks=3)
+    assert [t.checks for t in timings.values()] == [3, 3]
+    with pytest.raises(ValueError, match="checks: must be a whole number of at least 1, got 0"):
+        bench_checks(shipped("t-shaped"), checks=0)

@@ -95,6 +95,18 @@ def test_a_mesh_in_metres_is_named_as_such(tmp_path):
         parse_task(text, source=str(tmp_path / "task.yaml"))
 
 
+def test_a_density_that_gives_a_mass_out_of_range_names_density_and_the_scale(tmp_path):
+    """A mesh in mm read with scale: 0.001 came out 0.04 mm across, and the error blamed object.mass,
+    which the file does not have."""
+    _cylinder(tmp_path)
+    text = ("object: {shape: mesh, file: disc.stl, density: 1.4, scale: 0.001}\ngripper: {grip_force: 10, mu: 0.5}\n"
+            "pushers: [{name: left, at: [-0.0199, 0.0005], mu: 0.5}]\nstart: [0, 0, 0]\ngoal: [0.001, 0, 0]\n")
+    with pytest.raises(TaskError) as error:
+        parse_task(text, source=str(tmp_path / "task.yaml"))
+    assert error.value.field == "object.density"
+    assert "outside 0.001 to 1e+07 g; the object is only 0.04 mm across: written in metres?" in error.value.reason
+
+
 def _washer(tmp_path):
     ring = trimesh.creation.annulus(r_min=8.0, r_max=20.0, height=10.0, sections=64)  # axis z
     ring.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0]))  # axis y

@@ -103,3 +103,16 @@ def test_show_draws_an_unsolved_plan_marked_as_such_and_point_pushers(tmp_path):
         c, s = np.cos(np.radians(theta)), np.sin(np.radians(theta))
         assert np.allclose(arrows[0].xyann, (x, z)) and np.allclose(arrows[0].xy, (x + c * size, z - s * size))
     assert fig.axes[1].get_title().startswith("end")
+
+
+def test_a_centre_of_mass_outside_the_outlines_hull_is_warned_about_naming_it():
+    text = task_text("horizontal-offset-low-mu")
+    outside = parse_task(text.replace("mass: 202 ", "com: [0, 100]\n  mass: 202 ", 1))
+    assert [w for w in outside.warnings if w.startswith("object.com: [0.0, 100.0] mm lies 87.5 mm outside")]
+    assert parse_task(text.replace("mass: 202 ", "com: [50, -12.5]\n  mass: 202 ", 1)).warnings == ()  # a corner
+    # An L's centre of mass may lie off its outline, in the notch: inside the hull, no warning.
+    ell = parse_task("object: {shape: polygon, mass: 50, com: [20, 20], polygon: [[0, 0], [40, 0], [40, 15], "
+                     "[15, 15], [15, 40], [0, 40]]}\ngripper: {grip_force: 10, mu: 0.5}\n"
+                     "pushers: [{name: left, from: [0, 30], to: [0, 40], mu: 0.5}]\nstart: [-7.5, -30, 0]\n"
+                     "goal: [-7.5, -25, 0]\n")
+    assert not [w for w in ell.warnings if "object.com" in w], ell.warnings

@@ -345,9 +345,24 @@ def test_an_output_over_an_input_another_output_or_unwritable_is_refused_before_
     (["reach", str(LOW_MU), "--x", "nan:nan:1"], "expected FROM:TO:COUNT, FROM and TO from -10000 to 10000"),
     (["reach", str(LOW_MU), "--z", "0:inf:2"], "expected FROM:TO:COUNT, FROM and TO from -10000 to 10000"),
     (["check", str(LOW_MU), "--move", "1", "0", "0", "--heading-step", "5"], "--heading-step: only with --directions"),
+    (["evaluate", str(LOW_MU), "--trials", "1", "--ray", "notanaddress"], "Invalid value for '--ray': expected HOST:PORT"),
+    (["reach", str(LOW_MU), "--ray", ":::"], "Invalid value for '--ray': expected HOST:PORT"),
+    (["bench", str(LOW_MU), "--ray", "ray://host:port"], "Invalid value for '--ray': expected HOST:PORT"),
+    (["bench", "--checks", str(LOW_MU), "-n", "0"], "Invalid value for '-n' / '--count'"),
 ])
 def test_options_that_cannot_apply_are_refused_as_usage_errors(args, says):
     result = CliRunner().invoke(cli, args)
+    assert result.exit_code == 2 and says in result.stderr, result.output
+
+
+@pytest.mark.parametrize("extra, says", [
+    (["--arm", "nohostport"], "Invalid value for '--arm': expected HOST:PORT"),
+    (["--arm", "127.0.0.1:99999"], "Invalid value for '--arm': expected HOST:PORT with a port from 1 to 65535"),
+    (["--arm", "127.0.0.1:9", "--resume-from", "99"], "error: --resume-from: must be a step from 0 to"),
+])
+def test_execute_names_the_option_it_refuses(tmp_path, extra, says):
+    task, plan = _plan_and_task(tmp_path)
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", str(task)] + extra)
     assert result.exit_code == 2 and says in result.stderr, result.output
 
 

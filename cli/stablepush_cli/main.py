@@ -9,7 +9,7 @@ import sys
 
 import click
 
-from stablepush.errors import ArmFault, OutputError, PlanError, StablepushError, TaskError
+from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, StablepushError, TaskError
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import check_push, load_task, stable_directions
@@ -26,6 +26,7 @@ EXIT_STATUS = (
     (TaskError, EXIT_BAD_INPUT),
     (PlanError, EXIT_BAD_INPUT),
     (OutputError, EXIT_BAD_INPUT),
+    (RunnerError, EXIT_BAD_INPUT),
     (ArmFault, EXIT_ARM_FAULT),
 )
 
@@ -64,6 +65,16 @@ class Finite(click.FloatRange):
 SEED = click.IntRange(0, int(PLANNER_PARAMETER_RANGES["seed"][2]))
 MAX_SWITCHES = click.IntRange(0, int(PLANNER_PARAMETER_RANGES["max_switches"][2]))
 TIME_LIMIT = Finite(*LIMITS["time_limit"])
+
+
+def _ray_address(_ctx, _param, value):
+    """--ray [ADDRESS] checked before any work (stablepush.runners.check_ray_address)."""
+    from stablepush.runners import check_ray_address
+
+    try:
+        return check_ray_address(value) if value else value
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from None
 
 
 class _Commands(click.Group):
@@ -265,7 +276,8 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), default=None,
               help="Also write every trial to this file: .csv (one row per trial) or .json (trials and summary).")
 @click.option(
-    "-n", "--count", default=200_000, show_default=True, help="With --checks: checks per contact case and task."
+    "-n", "--count", default=200_000, show_default=True, type=click.IntRange(min=1, max=10**9),
+    help="With --checks: checks per contact case and task (timed in batches of up to 2,000).",
 )
 @click.option("--improve-for", type=Finite(min=0), default=None, metavar="S",
               help="Anytime planning: keep improving S seconds after the first plan (planner.improve_for), "
@@ -274,6 +286,7 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
               help="Run the planning trials on K local processes (default: one after the other, here). "
                    "Times are each search's own, so they compare across runners; parallel runs share the CPUs.")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              callback=_ray_address,
               help="Run the planning trials on Ray: a local instance, or the cluster at ADDRESS.")
 def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out_path, count: int,
           improve_for, workers, ray_address) -> None:
@@ -621,10 +634,13 @@ def _write_video(path: str, task, scene: dict, recording, fps: float, size, quie
                f"drawn in {info.render_s:.1f} s ({info.ms_per_frame:.0f} ms a frame)")
 
 
-def _host_port(value: str):
+def _host_port(_ctx, _param, value):
+    """--arm HOST:PORT as (host, port); a HOST left out is this machine."""
+    if value is None:
+        return None
     host, sep, port = value.rpartition(":")
-    if not sep or not port.isdigit():
-        raise click.BadParameter(f"expected HOST:PORT, got {value!r}")
+    if not sep or not port.isdigit() or not 0 < int(port) < 65536:
+        raise click.BadParameter(f"expected HOST:PORT with a port from 1 to 65535, got {value!r}")
     return host or "127.0.0.1", int(port)
 
 
@@ -632,7 +648,7 @@ def _host_port(value: str):
 @click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
 @click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
               help="The task the plan was made for (checked against the plan before anything moves).")
-@click.option("--arm", "arm", default=None, metavar="HOST:PORT",
+@click.option("--arm", "arm", default=None, metavar="HOST:PORT", callback=_host_port,
               help=f"The arm server (stablepush.arm/2 protocol, see docs/execution.md). Default: with --sim a "
                    f"simulated arm started in this process, else 127.0.0.1:{DEFAULT_PORT}.")
 @click.option("--sim", is_flag=True, help="Start a simulated arm here and run the plan on it (see --engine).")
@@ -733,7 +749,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     task, plan = _load_plan_and_task(plan_file, task_file, changed="refuse")
     for warning in execution_warnings(task):
         click.echo(f"warning: {warning}", err=True)
-    check_resume_from(plan.waypoints, resume_from)
+    check_resume_from(plan.waypoints, resume_from, field="--resume-from")
     loop_options = [name for name, value in (("--replan-threshold", replan_threshold),
                                              ("--final-tolerance", final_tolerance)) if value]
     if loop_options and not closed_loop:
@@ -762,7 +778,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
                                                        engine=engine))
         host, port = server.host, server.port
     else:
-        host, port = _host_port(arm) if arm else ("127.0.0.1", DEFAULT_PORT)
+        host, port = arm or ("127.0.0.1", DEFAULT_PORT)
     pace = (not sim) if pace is None else pace
 
     bar = None
@@ -815,7 +831,8 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
                    f"{len(plan.waypoints) - 1}", err=True)
         click.echo(
             f"continue with: stablepush execute {plan_file} --task {task_file} "
-            f"{'--arm ' + arm + ' ' if arm else ''}{'--sim ' if sim else ''}--resume-from {fault.last_confirmed_step}",
+            f"{f'--arm {host}:{port} ' if arm else ''}{'--sim ' if sim else ''}"
+            f"--resume-from {fault.last_confirmed_step}",
             err=True,
         )
         sys.exit(EXIT_ARM_FAULT)
@@ -933,6 +950,7 @@ def _vary(_ctx, _param, values):
 @click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
               help="Run the trials on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              callback=_ray_address,
               help="Run the trials on Ray: a local instance, or the cluster at ADDRESS (e.g. 10.0.0.5:6379; see "
                    "docs/evaluate.md, 'Where the trials run').")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
@@ -987,8 +1005,8 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
     runner = _runner(workers, ray_address, default=default_workers())
     try:
         spreads = Spreads(vary=vary, feature_error=tuple(feature_error), tracker_noise=tuple(tracker_noise))
-    except ValueError as exc:
-        _fail(f"--vary: {exc}")
+    except ValueError as exc:  # only --vary can be refused here, and Spreads names it `vary`
+        _fail(f"--{exc}")
     if robust and plan_file:
         _fail("--robust plans from the task; a plan given with --plan is evaluated as it is")
     if robust and not spreads.vary:
@@ -1106,6 +1124,7 @@ def _axis(_ctx, param, value):
 @click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
               help="Plan the cells on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              callback=_ray_address,
               help="Plan the cells on Ray: a local instance, or the cluster at ADDRESS.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the map: its cells (goal, verdict, reason, solved, seed, planning time, switch-overs).")

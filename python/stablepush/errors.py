@@ -37,6 +37,10 @@ class OutputError(StablepushError, OSError):
     """An output file that cannot, or must not, be written (the path is in the message)."""
 
 
+class RunnerError(StablepushError, RuntimeError):
+    """A batch's runner that cannot start: no Ray cluster where its address says."""
+
+
 class ArmFault(StablepushError, RuntimeError):
     """Execution stopped on the arm's side or on its link: the arm was told to stop when it could
     be (`arm_stopped`: True, or None when the arm could not be reached), and

@@ -14,7 +14,30 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from typing import Any, Callable, Iterable, Iterator, Optional, Tuple
 
+from stablepush.errors import RunnerError
+
 Job = Callable[[Any, int], Any]
+# How long joining a Ray cluster may wait for its head to answer: Ray itself retries for minutes.
+RAY_CONNECT_TIMEOUT_S = 5.0
+
+
+def check_ray_address(address: Optional[str]) -> Optional[str]:
+    """`address` if Ray can take it as where a cluster is: None (a local instance), "auto" or "local"
+    (as `ray.init` reads them), or HOST:PORT of a running head, optionally as ray://HOST:PORT (Ray
+    Client); a ValueError that says which otherwise."""
+    if address is None or address in ("auto", "local"):
+        return address
+    host, port = _host_port(address)
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ValueError(f"expected HOST:PORT of a running Ray head (e.g. 10.0.0.5:6379, or ray://HOST:10001), "
+                         f"'auto' or 'local'; got {address!r}")
+    return address
+
+
+def _host_port(address: str) -> Tuple[str, str]:
+    bare = address[len("ray://"):] if address.startswith("ray://") else address
+    host, _, port = bare.rpartition(":")
+    return host.strip("[]"), port
 
 
 @dataclass(frozen=True)
@@ -25,6 +48,9 @@ class Runner:
     workers: int = 1
     ray: bool = False
     ray_address: Optional[str] = None
+
+    def __post_init__(self):
+        check_ray_address(self.ray_address)
 
     def describe(self) -> str:
         if self.ray:
@@ -88,7 +114,7 @@ def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterat
 
     started_here = not ray.is_initialized()
     if started_here:
-        ray.init(address=address, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
+        _join_ray(ray, address)
     try:
         remote = ray.remote(max_retries=0)(job)
         shared_ref = ray.put(shared)
@@ -110,3 +136,20 @@ def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterat
     finally:
         if started_here:
             ray.shutdown()
+
+
+def _join_ray(ray, address: Optional[str]) -> None:
+    """ray.init, with a head that does not answer (or an address Ray refuses) a RunnerError at once."""
+    if address not in (None, "auto", "local"):
+        import socket
+
+        host, port = _host_port(address)
+        try:
+            socket.create_connection((host, int(port)), timeout=RAY_CONNECT_TIMEOUT_S).close()
+        except OSError as exc:
+            raise RunnerError(f"no Ray head answers at {address} ({exc.strerror or type(exc).__name__}): start one "
+                              f"there (`ray start --head`), or run on a local instance") from None
+    try:
+        ray.init(address=address, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
+    except (ConnectionError, ValueError) as exc:
+        raise RunnerError(f"cannot join Ray at {address or 'a local instance'}: {exc}") from None

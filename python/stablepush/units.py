@@ -41,6 +41,11 @@ def is_real(value: Any) -> bool:
     return True
 
 
+def is_integer(value: Any) -> bool:
+    """is_real, and an integer (Python's or numpy's)."""
+    return is_real(value) and isinstance(value, numbers.Integral)
+
+
 def is_finite_real(value: Any) -> bool:
     """is_real, and finite as a double."""
     try:

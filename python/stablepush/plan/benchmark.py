@@ -15,7 +15,7 @@ import numpy as np
 
 from stablepush.plan.search import plan_task
 from stablepush.task.model import Task
-from stablepush.units import MM
+from stablepush.units import MM, is_integer
 
 # Paper Table II (median planning time over 10 trials, s): this paper's planner in MATLAB on an
 # i7 2.8 GHz, and the earlier complementarity-based planner (Chavan-Dafle and Rodriguez 2017).
@@ -59,23 +59,27 @@ def bench_checks(
     progress: Optional[Callable[[int], None]] = None,
 ) -> Dict[str, CheckTiming]:
     """Median time per stable-push test for the all-sliding and the sticking case, cycling
-    through the task's pushers."""
+    through the task's pushers: `checks` tests of each, timed in batches of up to `batch`."""
+    for name, value in (("checks", checks), ("batch", batch)):
+        if not is_integer(value) or value < 1:
+            raise ValueError(f"{name}: must be a whole number of at least 1, got {value!r}")
     model = task.build_model()
     rng = np.random.default_rng(seed)
     out = {}
     for case, sticking in (("all_sliding", False), ("sticking", True)):
         per_check, feasible, exact, done = [], 0, 0, 0
         while done < checks:
-            q, dq = _queries(task, rng, batch, sticking)
-            pusher = (done // batch) % len(task.pushers)
+            size = min(batch, checks - done)
+            q, dq = _queries(task, rng, size, sticking)
+            pusher = len(per_check) % len(task.pushers)
             start = time.perf_counter()
             f, _, e = model.check_batch(q, dq, pusher)
-            per_check.append((time.perf_counter() - start) / batch)
+            per_check.append((time.perf_counter() - start) / size)
             feasible += int(f.sum())
             exact += int(e.sum())
-            done += batch
+            done += size
             if progress:
-                progress(batch)
+                progress(size)
         out[case] = CheckTiming(
             case=case,
             median_us=float(np.median(per_check)) * 1e6,

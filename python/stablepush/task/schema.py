@@ -8,7 +8,6 @@ from __future__ import annotations
 import copy
 import datetime
 import math
-import numbers
 import re
 import reprlib
 from pathlib import Path
@@ -30,7 +29,7 @@ from stablepush.task.model import (
     make_gripper,
     outline_corners,
 )
-from stablepush.units import MM, is_real, mm2_to_si, pose_to_si
+from stablepush.units import MM, is_integer, is_real, mm2_to_si, pose_to_si
 
 DEFAULT_PAD_RADIUS_MM = 5.0
 DEFAULT_GRAVITY = (0.0, -9.81)
@@ -240,7 +239,7 @@ def _friction(path: str, value: Any) -> float:
 
 def _integer(path: str, value: Any, lowest: int, highest: int) -> int:
     """An integer (numpy's too, but not a bool) from `lowest` to `highest`, as a Python int."""
-    if not (is_real(value) and isinstance(value, numbers.Integral)):
+    if not is_integer(value):
         raise TaskError(path, f"must be an integer, got {_shown(value)}")
     if not lowest <= int(value) <= highest:
         raise TaskError(path, f"must be an integer from {lowest} to {highest}, got {_shown(value)}")
@@ -362,6 +361,8 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
     if section_defect:
         raise TaskError("object.polygon", section_defect)
     section = _core.CrossSection([mm2_to_si(v) for v in outline_corners(vertices)])
+    if "com" in top["object"] and not section.contains_disc(mm2_to_si(com), 0.0):
+        notes.extend(_com_outside(vertices, com))
 
     grip = _mapping("gripper", top["gripper"], ["grip_force", "mu"], ["pad_rings", "pads"])
     grip_force = _number("gripper.grip_force", grip["grip_force"], LIMITS["force"])
@@ -477,6 +478,19 @@ def _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity) ->
     return out
 
 
+def _com_outside(vertices, com) -> List[str]:
+    """A centre of mass given outside the outline's convex hull, where no prism of this section has
+    one: right only for a part that reaches beyond the section along y."""
+    from shapely.geometry import Point, Polygon  # here: only a com off the outline needs it
+
+    off = Polygon(vertices).convex_hull.distance(Point(com))
+    if off <= ON_BOUNDARY:
+        return []
+    return [f"object.com: {list(com)} mm lies {off:.3g} mm outside the object's outline (its convex hull), where "
+            f"no solid of this section has its centre of mass; right only for a part that reaches beyond the "
+            f"section along y (com is in mm, in O)"]
+
+
 MESH_KEYS = ["file", "scale", "plane_y", "tolerance", "density"]
 
 
@@ -560,7 +574,11 @@ def _mesh_object(obj: dict, source: Optional[str], notes: List[str]):
         max_vertices=MAX_VERTICES, thickness_range=LIMITS["length"])
     com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else mesh.com
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else mesh.inertia
-    _number("object.mass", mesh.mass, LIMITS["mass"])
+    lowest, highest = LIMITS["mass"]
+    if not lowest <= mesh.mass <= highest:  # only a density can give it: a mass given was checked above
+        hint = _units_hint(mesh.vertices, mesh.thickness, obj) or "; are object.scale and object.density right?"
+        raise TaskError("object.density", f"gives the solid {mesh.mass:.4g} g, outside {lowest:g} to {highest:g} g"
+                                          + hint)
     notes.extend(mesh.notes)
     return mesh.vertices, mesh.thickness, mesh.mass, com, inertia
 
