@@ -27,9 +27,8 @@ from stablepush.task import check_push as check
 __version__ = "0.1.0"
 __all__ = ["load_task", "parse_task", "plan_task", "check", "check_plan", "save_plan", "load_plan", "trajectory",
            "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PusherSpec", "Trajectory",
-           "StablepushError", "TaskError", "PlanError", "OutputError", "ArmFault", "RunnerError",
-           "ContactCase", "PlanOutcome",
-           "PushResult"]
+           "StablepushError", "TaskError", "PlanError", "OutputError", "ArmFault", "RunnerError", "ContactCase",
+           "PlanOutcome", "PushResult"]
 
 
 # Loaded when first used, so that `import stablepush` (and the CLI's start-up) does not pay for

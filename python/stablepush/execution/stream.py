@@ -124,8 +124,7 @@ class _Stream:
 def check_resume_from(steps: Sequence[Waypoint], resume_from: int, field: str = "resume_from") -> None:
     """PlanError (naming `field`) unless the plan has a push after step `resume_from`."""
     if not 0 <= resume_from < len(steps) - 1:
-        raise PlanError(field, f"must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} "
-                                       f"pushes)")
+        raise PlanError(field, f"must be a step from 0 to {len(steps) - 2} (the plan has {len(steps) - 1} pushes)")
 
 
 def arm_trajectory(
