@@ -2,6 +2,7 @@
 Each trial's world depends on (seed, i) alone, so the same batch gives the same trials serially,
 on local processes and on Ray; the worlds stay inside the spreads asked for; the summary's rate
 and Wilson interval follow from the trials; a crashing trial is a result, not the end."""
+import csv
 import dataclasses
 import json
 import math
@@ -256,7 +257,12 @@ def test_evaluate_cli_writes_its_files_and_refuses_bad_options(tmp_path):
     data = json.loads(out.read_text())
     assert data["summary"]["trials"] == 2 and len(data["trials"]) == 2
     assert (tmp_path / "e.png").read_bytes()[:4] == b"\x89PNG"
-    assert len((tmp_path / "e.csv").read_text().splitlines()) == 3
+    rows = list(csv.DictReader((tmp_path / "e.csv").open()))
+    assert len(rows) == 2
+    for row, trial in zip(rows, data["trials"]):  # the CSV is the record flattened, final_error too
+        for which, short in (("goal_error", "goal"), ("final_error", "final")):
+            for key, unit in (("x", "mm"), ("z", "mm"), ("theta", "deg"), ("distance", "mm")):
+                assert float(row[f"{short}_{key}_{unit}"]) == trial[which][key]
     bad = CliRunner().invoke(cli, ["evaluate", task, "--vary", "friction=0.1"])
     assert bad.exit_code == 2 and "error: --vary: unknown key 'friction'" in bad.output
     bad = CliRunner().invoke(cli, ["evaluate", task, "--vary", "pad_mu"])
@@ -274,9 +280,11 @@ def test_ctrl_c_before_any_trial_finished_exits_130_and_keeps_the_files(monkeypa
     monkeypatch.setattr(batch_mod, "run_all", interrupted)
     out = tmp_path / "e.json"
     result = CliRunner().invoke(cli, ["evaluate", str(TASKS / "more" / "tilted-gravity.yaml"), "--trials", "3",
-                                      "--workers", "1", "--json", str(out), "--quiet"])
+                                      "--workers", "1", "--json", str(out), "--plot", str(tmp_path / "e.png"),
+                                      "--quiet"])
     assert result.exit_code == 130, result.output
     assert "interrupted before any trial finished" in result.stderr
+    assert (tmp_path / "e.png").read_bytes()[:4] == b"\x89PNG"  # the figure's rate had no interval to draw
     summary = json.loads(out.read_text())["summary"]
     assert summary["trials"] == 0 and summary["interrupted"] is True
 

@@ -230,18 +230,20 @@ class Evaluation:
     def rows(self) -> Tuple[List[str], List[list]]:
         """The trials as CSV columns and rows (one trial a row)."""
         offsets = sorted({k for t in self.trials for k in t["world"]["feature_offsets"]})
+        errors = [(which, which.split("_")[0]) for which in ("goal_error", "final_error")]
         header = (["trial", "success", "cause"] + list(VARY_KEYS)
                   + [f"{name}_{c}" for name in offsets for c in ("dx_mm", "dz_mm", "dtheta_deg")]
-                  + ["goal_x_mm", "goal_z_mm", "goal_theta_deg", "goal_distance_mm", "replans", "sim_time_s",
-                     "wall_s", "verdict", "error"] + (["video"] if self.batch.video_dir else []))
+                  + [f"{short}_{c}" for _, short in errors for c in ("x_mm", "z_mm", "theta_deg", "distance_mm")]
+                  + ["replans", "sim_time_s", "wall_s", "verdict", "error"]
+                  + (["video", "video_error"] if self.batch.video_dir else []))
         rows = []
         for t in self.trials:
-            w, g = t["world"], t["goal_error"] or {}
+            w = t["world"]
             rows.append([t["trial"], t["success"], t["cause"] or ""] + [w[k] for k in VARY_KEYS]
                         + [v for name in offsets for v in w["feature_offsets"].get(name, ("", "", ""))]
-                        + [g.get("x", ""), g.get("z", ""), g.get("theta", ""), g.get("distance", ""), t["replans"],
-                           t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or ""]
-                        + ([t.get("video") or ""] if self.batch.video_dir else []))
+                        + [(t[which] or {}).get(c, "") for which, _ in errors for c in ("x", "z", "theta", "distance")]
+                        + [t["replans"], t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or ""]
+                        + ([t.get("video") or "", t.get("video_error") or ""] if self.batch.video_dir else []))
         return header, rows
 
 

@@ -263,10 +263,14 @@ def evaluation_figure(summary: dict, trials: Sequence[dict]) -> Figure:
     cdf.set_xlabel("goal error / tolerance")
     cdf.set_ylabel("fraction of trials")
     cdf.set_ylim(0, 1.02)
-    rate, (low, high) = summary["success_rate"], summary["ci95"]
-    cdf.set_title(f"{summary['task']}: {summary['successes']}/{summary['trials']} landed "
-                  f"({rate:.1%}, 95% CI {low:.1%}-{high:.1%})", fontsize=10)
-    cdf.legend(fontsize=8, loc="lower right")
+    if summary["trials"]:
+        rate, (low, high) = summary["success_rate"], summary["ci95"]
+        cdf.set_title(f"{summary['task']}: {summary['successes']}/{summary['trials']} landed "
+                      f"({rate:.1%}, 95% CI {low:.1%}-{high:.1%})", fontsize=10)
+    else:  # stopped before any trial finished: the axes, and no rate
+        cdf.set_title(f"{summary['task']}: no trial finished", fontsize=10)
+    if ran:
+        cdf.legend(fontsize=8, loc="lower right")
     spreads = sorted(summary["vary"], key=lambda k: -summary["vary"][k])[:2]
     if spreads:
         xs = [t["world"][spreads[0]] for t in trials]
