@@ -300,6 +300,11 @@ def test_bench_plans_the_same_on_workers_as_here(tmp_path):
         keep = ("seed", "solved", "switches", "pushes", "path_length_steps", "nodes", "pusher_sequence", "min_margin")
         outs.append([{k: t[k] for k in keep} for t in json.loads(out.read_text())["trials"]])
     assert outs[0] == outs[1] and [t["seed"] for t in outs[0]] == [1, 2, 3, 4]
+    # The pushers as a list: joined with "-", "left-under-web-left" could not be split back.
+    assert outs[0][0]["pusher_sequence"] == ["left", "under-web", "left"]
+    out = tmp_path / "b.csv"
+    assert CliRunner().invoke(cli, ["bench", task, "--trials", "1", "--out", str(out)]).exit_code == 0
+    assert json.loads(next(csv.DictReader(out.open()))["pusher_sequence"]) == ["left", "under-web", "left"]
     bad = CliRunner().invoke(cli, ["bench", task, "--workers", "2", "--ray"])
     assert bad.exit_code == 2 and "--ray" in bad.output
 

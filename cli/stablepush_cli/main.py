@@ -359,7 +359,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
                        f"{r['first_median_min_margin']:>7.3f} -> {r['improved_median_min_margin']:<7.3f}")
     if out_path:
         _write_bench(out_path, every, rows)
-        click.echo(f"trials written to {out_path}")
+        click.echo(f"written: {out_path}")
 
 
 def _runner(workers, ray_address, default: int):
@@ -412,7 +412,8 @@ def _write_bench(path: str, trials, rows) -> None:
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=list(records[0]), lineterminator="\n")
     writer.writeheader()
-    writer.writerows(records)
+    # A list (pusher_sequence) as JSON in its cell: pusher names may hold any printable character.
+    writer.writerows({k: json.dumps(v) if isinstance(v, list) else v for k, v in r.items()} for r in records)
     write_atomically(path, buffer.getvalue())
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Callable, Dict, Optional
+from typing import Callable, Dict, List, Optional
 
 import numpy as np
 
@@ -103,7 +103,7 @@ class PlanningTrial:
     path_length_steps: float
     feasibility_checks: int
     nodes: int
-    pusher_sequence: str
+    pusher_sequence: List[str]  # the pushers in the plan's order, one entry per contact
     min_margin: Optional[float]  # N: the least margin over the plan's pushes (None: no push)
     # The first plan of an anytime search (improve_for > 0), before the improvement; None otherwise.
     first_time_s: Optional[float] = None
@@ -123,7 +123,7 @@ def planning_trial(task: Task, seed: int, time_limit: Optional[float] = None, im
         task=task.name, seed=seed, solved=plan.solved, outcome=plan.outcome,
         planning_time_s=s["planning_time_s"], switches=s["switches"], pushes=s["pushes"],
         path_length_steps=s["path_length_steps"], feasibility_checks=s["feasibility_checks"], nodes=s["nodes"],
-        pusher_sequence="-".join(plan.pusher_sequence),
+        pusher_sequence=list(plan.pusher_sequence),
         min_margin=min((w.margin for w in plan.waypoints[1:]), default=None),
         first_time_s=first.get("planning_time_s"), first_switches=first.get("switches"),
         first_path_length_steps=first.get("path_length_steps"), first_min_margin=first.get("min_margin"),
