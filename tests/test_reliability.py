@@ -392,6 +392,19 @@ def test_an_upper_case_suffix_picks_the_format_as_a_lower_case_one(tmp_path):
     assert json.loads(out.read_text())["columns"][0] == "t"
 
 
+@pytest.mark.parametrize("args, says", [
+    (["plan", str(LOW_MU), "-o", "/dev/stdout"], "solved in"),
+    (["reach", str(LOW_MU), "--x", "0:1:2", "--z", "0:0:1", "--theta", "0:0:1", "--workers", "1", "--quiet",
+      "--json", "/dev/stdout"], "goals reached"),
+])
+def test_a_file_written_to_stdout_has_the_stream_alone_and_the_summary_goes_to_stderr(args, says):
+    """`reach --json /dev/stdout | jq .` failed: the summary followed the JSON on stdout."""
+    run = subprocess.run([sys.executable, "-m", "stablepush_cli.main"] + args, capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert json.loads(run.stdout) and says in run.stderr
+
+
 def test_a_plan_written_to_dev_stdout_into_a_pipe_reaches_the_pipe():
     """/dev/stdout into a pipe resolves to no file name; it was taken for a new file and refused."""
     run = subprocess.run([sys.executable, "-m", "stablepush_cli.main", "plan", str(LOW_MU), "-o", "/dev/stdout",

@@ -77,6 +77,15 @@ def _ray_address(_ctx, _param, value):
         raise click.BadParameter(str(exc)) from None
 
 
+def _say_beside(*outputs):
+    """click.echo for a command's own lines, on stderr when one of its outputs is standard output
+    itself (`--json /dev/stdout | jq .`), so that the stream holds that file alone."""
+    from stablepush.outputs import same_file
+
+    to_stderr = any(path and same_file(path, "/dev/stdout") for path in outputs)
+    return lambda text="": click.echo(text, err=to_stderr)
+
+
 class _Commands(click.Group):
     """The command group: each StablepushError becomes one line on stderr and its exit status;
     anything else is a bug, reported in one line (STABLEPUSH_DEBUG=1 shows the traceback)."""
@@ -236,6 +245,7 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     json_label = "-o" if json_path else "the default -o"
     json_path = json_path or default_output(task_file, ".plan.json")
     check_outputs({json_label: json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
+    say = _say_beside(json_path, csv_path)
     task = _load(task_file)
     result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
     write_plan(result, json_path, csv_path)
@@ -245,14 +255,14 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
         click.echo(f"partial plan written to {json_path}" + (f" and {csv_path}" if csv_path else ""), err=True)
         sys.exit(EXIT_NOT_SOLVED)
     if not quiet:
-        click.echo(f"{task.name}: solved in {s['planning_time_s'] * 1e3:.1f} ms (seed {s['seed']}): "
+        say(f"{task.name}: solved in {s['planning_time_s'] * 1e3:.1f} ms (seed {s['seed']}): "
                    f"{s['pushes']} pushes, "
                    f"{s['switches']} switch-over(s), pushers {' -> '.join(result.pusher_sequence) or '(none)'}; "
                    f"{s['iterations']} iterations, {s['nodes']} nodes, {s['feasibility_checks']} checks")
-        click.echo("ends at the goal pose" if result.ends_at_goal else
+        say("ends at the goal pose" if result.ends_at_goal else
                    f"ends within tolerance, {s['goal_distance_steps']:.2f} unit steps from the goal (a last push to "
                    f"the goal itself is not a stable push)")
-        click.echo(f"plan written to {json_path}" + (f" and {csv_path}" if csv_path else ""))
+        say(f"plan written to {json_path}" + (f" and {csv_path}" if csv_path else ""))
     hold = result.final_hold_ratio
     if hold < 1.0:
         click.echo(f"note: at the plan's last pose the pads alone hold only {hold:.2f} times the object's weight: "
@@ -320,6 +330,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
 
     require_suffix("--out", out_path, (".csv", ".json"))
     check_outputs({"--out": out_path}, {f"TASK.yaml {path}": path for path in task_files})
+    say = _say_beside(out_path)
 
     runner = _runner(workers, ray_address, default=1)
     every, rows = [], []
@@ -337,29 +348,29 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     def num(v, fmt):
         return "-" if v is None else format(v, fmt)
 
-    click.echo(f"{'task':<26} {'success':>7} {'median ms':>10} {'p95 ms':>8} {'min ms':>8} {'max ms':>9} "
+    say(f"{'task':<26} {'success':>7} {'median ms':>10} {'p95 ms':>8} {'min ms':>8} {'max ms':>9} "
                f"{'switches':>8} "
                f"{'length':>7} {'checks/s':>10} {'paper s':>8} {'earlier s':>9}")
     for r in rows:
-        click.echo(f"{r['task']:<26} {r['success_rate']:>7.0%} {r['median_time_s'] * 1e3:>10.2f} "
+        say(f"{r['task']:<26} {r['success_rate']:>7.0%} {r['median_time_s'] * 1e3:>10.2f} "
                    f"{r['p95_time_s'] * 1e3:>8.2f} "
                    f"{r['min_time_s'] * 1e3:>8.2f} {r['max_time_s'] * 1e3:>9.2f} {num(r['median_switches'], '.0f'):>8} "
                    f"{num(r['median_path_length_steps'], '.1f'):>7} {r['checks_per_s']:>10.3g} "
                    f"{num(r['paper_time_s'], 'g'):>8} {num(r['earlier_planner_time_s'], 'g'):>9}")
     if improve_for is not None:
-        click.echo(f"\nfirst plan -> improved after {improve_for:g} s (medians of the solved trials)")
-        click.echo(f"{'task':<26} {'first ms':>9} {'switches':>13} {'length':>15} {'least margin N':>17}")
+        say(f"\nfirst plan -> improved after {improve_for:g} s (medians of the solved trials)")
+        say(f"{'task':<26} {'first ms':>9} {'switches':>13} {'length':>15} {'least margin N':>17}")
         for r in rows:
             if "first_median_time_s" not in r:
-                click.echo(f"{r['task']:<26} {'-':>9}")
+                say(f"{r['task']:<26} {'-':>9}")
                 continue
-            click.echo(f"{r['task']:<26} {r['first_median_time_s'] * 1e3:>9.2f} "
+            say(f"{r['task']:<26} {r['first_median_time_s'] * 1e3:>9.2f} "
                        f"{r['first_median_switches']:>5.0f} -> {r['improved_median_switches']:<5.0f} "
                        f"{r['first_median_path_length_steps']:>6.1f} -> {r['improved_median_path_length_steps']:<6.1f} "
                        f"{r['first_median_min_margin']:>7.3f} -> {r['improved_median_min_margin']:<7.3f}")
     if out_path:
         _write_bench(out_path, every, rows)
-        click.echo(f"written: {out_path}")
+        say(f"written: {out_path}")
 
 
 def _runner(workers, ray_address, default: int):
@@ -1002,6 +1013,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_outputs({"--json": json_path, "--csv": csv_path, "--plot": png_path},
                   {"TASK.yaml": task_file, "--plan": plan_file})
+    say = _say_beside(json_path, csv_path, png_path)
 
     runner = _runner(workers, ray_address, default=default_workers())
     try:
@@ -1059,23 +1071,23 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         click.echo("interrupted before any trial finished" if s["interrupted"] else "no trial finished", err=True)
         sys.exit(130 if s["interrupted"] else EXIT_NOT_SOLVED)
     low, high = s["ci95"]
-    click.echo(f"{task.name}: landed {s['successes']} of {s['trials']} trials within {success_tolerance[0]:g} mm / "
+    say(f"{task.name}: landed {s['successes']} of {s['trials']} trials within {success_tolerance[0]:g} mm / "
                f"{success_tolerance[1]:g} deg: {s['success_rate']:.1%} (95% CI {low:.1%}-{high:.1%})"
                + (f"; interrupted after {s['trials']} of {trials}" if s["interrupted"] else ""))
     if s["goal_error_mm"]:
-        click.echo(f"goal error: median {s['goal_error_mm']['p50']:.3f} mm / {s['goal_error_deg']['p50']:.3f} deg, "
+        say(f"goal error: median {s['goal_error_mm']['p50']:.3f} mm / {s['goal_error_deg']['p50']:.3f} deg, "
                    f"p95 {s['goal_error_mm']['p95']:.3f} mm / {s['goal_error_deg']['p95']:.3f} deg")
     if s["causes"]:
-        click.echo("misses: " + ", ".join(f"{cause} {count}" for cause, count in sorted(s["causes"].items())))
-    click.echo(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
+        say("misses: " + ", ".join(f"{cause} {count}" for cause, count in sorted(s["causes"].items())))
+    say(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
                f"{s['real_time_factor']:.2f}x real time")
     written = [p for p in (json_path, csv_path, png_path) if p]
     if written:
-        click.echo(f"written: {', '.join(written)}")
+        say(f"written: {', '.join(written)}")
     if video_dir:
         videos = sum(1 for t in result.trials if t.get("video"))
         failed = sum(1 for t in result.trials if not t["success"])
-        click.echo(f"videos of {videos} of the {failed} failed trial(s) written to {video_dir}"
+        say(f"videos of {videos} of the {failed} failed trial(s) written to {video_dir}"
                    + "".join(f"\n  trial {t['trial']}: no video ({t['video_error']})"
                              for t in result.trials if t.get("video_error")))
     if s["interrupted"]:
@@ -1156,6 +1168,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
 
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_outputs({"--json": json_path, "--plot": png_path}, {"TASK.yaml": task_file})
+    say = _say_beside(json_path, png_path)
     runner = _runner(workers, ray_address, default=default_workers())
     task = _load(task_file, goal_in_grasp=False)  # the grid replaces the goal; its cells say where there is no grasp
     gx, gz, gth = task.goal
@@ -1178,11 +1191,11 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
 
         save_figure(reach_figure(task, data), png_path)
     c = data["counts"]
-    click.echo(f"{task.name}: {c['reached']} of {count} goals reached, {c['not found']} not found in {time_limit:g} s, "
+    say(f"{task.name}: {c['reached']} of {count} goals reached, {c['not found']} not found in {time_limit:g} s, "
                f"{c['unreachable']} unreachable ({result.wall_s:.1f} s on {result.runner})")
     written = [p for p in (json_path, png_path) if p]
     if written:
-        click.echo(f"written: {', '.join(written)}")
+        say(f"written: {', '.join(written)}")
 
 
 @cli.command("sim-arm")

@@ -1,7 +1,8 @@
 """Where the pushers can take the object (`stablepush reach`): the task's start planned to every
 goal of a grid of poses in the grasp, the task otherwise unchanged, each cell on its own, where
 `stablepush.runners` says (here, local processes or Ray). A cell's plan depends on the task, the
-goal and the seed alone, so the same seed gives the same map on every runner.
+goal and the seed alone, so the same seed gives the same map on every runner, but for what the
+time limit decides (a `not found` cell's partial path, a goal found only near the limit).
 
 Each cell ends with a verdict:
 - `reached`: a plan reaches the goal within the task's tolerance and switch-over budget;
