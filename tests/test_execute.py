@@ -222,6 +222,27 @@ def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
     assert fault.value.arm_stopped is True and arm.stopped
 
 
+def test_a_fault_after_the_closed_loop_replanned_offers_no_resume_of_the_plan_file(tmp_path):
+    """After a re-plan the confirmed step counts the closed loop's steps: the suggested
+    `--resume-from` named a step of the plan file that was another pose, or none (41 of 40)."""
+    task_file = TASKS / "large-manipulation.yaml"  # its plan ends short: the loop re-plans before the first push
+    task = load_task(task_file)
+    plan_file = tmp_path / "lm.plan.json"
+    write_plan(check_plan(task, plan_task(task, seed=1)), str(plan_file))
+    e_stop = lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "e-stop"})  # noqa: E731
+    arm = FakeArm(good=5, bad_reply=e_stop)
+    result = CliRunner().invoke(cli, ["execute", str(plan_file), "--task", str(task_file), "--arm",
+                                      f"127.0.0.1:{arm.port}", "--closed-loop", "--no-pace", "--quiet",
+                                      "--json", str(tmp_path / "fault.json")])
+    assert result.exit_code == 3, result.output
+    assert "the closed loop had re-planned the run" in result.stderr and "--resume-from" not in result.stderr
+    assert json.loads((tmp_path / "fault.json").read_text())["replanned"] is True and arm.stopped
+    arm = FakeArm(good=5, bad_reply=e_stop)  # open loop: the plan file's own steps, and the way to go on
+    result = CliRunner().invoke(cli, ["execute", str(plan_file), "--task", str(task_file), "--arm",
+                                      f"127.0.0.1:{arm.port}", "--no-pace", "--quiet"])
+    assert result.exit_code == 3 and "--resume-from 0" in result.stderr, result.output
+
+
 def test_the_sim_arm_refuses_malformed_and_out_of_order_waypoints_and_stops():
     task = shipped("horizontal-offset-high-mu")
     plan = check_plan(task, plan_task(task, seed=1))

@@ -839,12 +839,17 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
                        f"(`stablepush sim-arm` serves a simulated arm, or run with --sim)", err=True)
             sys.exit(EXIT_ARM_FAULT)
         stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
+        if fault.replanned:  # its steps are the closed loop's, numbered otherwise than the plan file's
+            click.echo(f"error: {fault.reason}; {stopped}; the closed loop had re-planned the run, so no step of "
+                       f"{plan_file} continues it: plan again from where the object is in the grasp (a task whose "
+                       f"start: is the tracked pose)", err=True)
+            sys.exit(EXIT_ARM_FAULT)
         click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
                    f"{len(plan.waypoints) - 1}", err=True)
         click.echo(
             f"continue with: stablepush execute {plan_file} --task {task_file} "
             f"{f'--arm {host}:{port} ' if arm else ''}{'--sim ' if sim else ''}"
-            f"--resume-from {fault.last_confirmed_step}",
+            f"{'--closed-loop ' if closed_loop else ''}--resume-from {fault.last_confirmed_step}",
             err=True,
         )
         sys.exit(EXIT_ARM_FAULT)

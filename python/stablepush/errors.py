@@ -45,11 +45,15 @@ class ArmFault(StablepushError, RuntimeError):
     """Execution stopped on the arm's side or on its link: the arm was told to stop when it could
     be (`arm_stopped`: True, or None when the arm could not be reached), and
     `last_confirmed_step` is the last plan step the arm confirmed (resume after it). `connected`:
-    False when the arm server was never reached, so nothing was sent."""
+    False when the arm server was never reached, so nothing was sent. `replanned`: the closed loop
+    had changed the run's steps, so `last_confirmed_step` counts the re-planned steps, not the plan
+    file's, and no resume of that file continues the run."""
 
-    def __init__(self, reason: str, last_confirmed_step: int, arm_stopped: Optional[bool], connected: bool = True):
+    def __init__(self, reason: str, last_confirmed_step: int, arm_stopped: Optional[bool], connected: bool = True,
+                 replanned: bool = False):
         super().__init__(reason)
         self.reason = reason
         self.last_confirmed_step = last_confirmed_step
         self.arm_stopped = arm_stopped
         self.connected = connected
+        self.replanned = replanned

@@ -237,6 +237,7 @@ def execute_plan(
     if aimed is not None:
         replans.append(aimed[0])
         steps = aimed[1] or steps
+    replanned = aimed is not None and aimed[1] is not None  # the run's steps are no longer the plan file's
     features = place_features(task, steps, every_pusher=closed_loop is not None)
     scene = scene_description(task, features, steps[resume_from].pose)
     last_confirmed = resume_from
@@ -304,6 +305,7 @@ def execute_plan(
                     if spliced is not None:
                         steps, new_points = spliced
                         pending = _renumbered(w, rate_hz, new_points)
+                        replanned = True
             if w.phase != "push":
                 touch_state = met_state = None
                 rode = False
@@ -315,7 +317,7 @@ def execute_plan(
     except (ConnectionError, TimeoutError, ProtocolError, OSError, KeyError) as exc:
         stopped = _stop(link) if link is not None else None
         reason = str(exc) if not isinstance(exc, KeyError) else f"a reply lacks {exc}"
-        raise ArmFault(reason, last_confirmed, stopped, connected=link is not None) from None
+        raise ArmFault(reason, last_confirmed, stopped, connected=link is not None, replanned=replanned) from None
     finally:
         if link is not None:
             link.close()
@@ -338,7 +340,7 @@ def fault_report(task: Task, fault: ArmFault, success_tolerance: Optional[Sequen
     verdict = Verdict.for_fault(judged_with(task, success_tolerance), fault.reason)
     return {"task": task.name, "success": verdict.success, "tolerance": list(verdict.tolerance),
             "cause": verdict.cause, "verdict": verdict.detail, "last_confirmed_step": fault.last_confirmed_step,
-            "arm_stopped": fault.arm_stopped, "connected": fault.connected}
+            "arm_stopped": fault.arm_stopped, "connected": fault.connected, "replanned": fault.replanned}
 
 
 class _GuardWatch:
