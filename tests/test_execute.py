@@ -6,6 +6,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 
 import pytest
 from click.testing import CliRunner
@@ -167,8 +168,10 @@ class FakeArm:
     """An arm server that misbehaves after `good` acknowledgements, and records whether it was
     told to stop."""
 
-    def __init__(self, good: int, bad_reply, frozen: bool = False):
+    def __init__(self, good: int, bad_reply, frozen: bool = False, stall=None):
         self.good, self.bad_reply, self.frozen = good, bad_reply, frozen  # frozen: always reports the home pose
+        self.stall = stall  # (seq, s): acknowledge waypoint seq that late
+        self.received = []  # when each waypoint arrived (time.perf_counter)
         self.stopped = False
         self.sock = socket.create_server(("127.0.0.1", 0))
         self.port = self.sock.getsockname()[1]
@@ -185,6 +188,9 @@ class FakeArm:
                     state = {"ee_pose": msg["scene"]["gripper_pose"], "joints": [0.0] * 7}
                     conn.sendall(encode({"type": "ready", "protocol": PROTOCOL, "arm": "fake", "state": state}))
                 elif msg["type"] == "waypoint":
+                    self.received.append(time.perf_counter())
+                    if self.stall and msg["seq"] == self.stall[0]:
+                        time.sleep(self.stall[1])
                     state = state if self.frozen else {"ee_pose": msg["pose"], "joints": [0.0] * 7}
                     if msg["seq"] < self.good:
                         conn.sendall(encode({"type": "ack", "seq": msg["seq"], "state": state}))
@@ -220,6 +226,19 @@ def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
     assert says in fault.value.reason
     assert fault.value.last_confirmed_step == 4
     assert fault.value.arm_stopped is True and arm.stopped
+
+
+def test_a_paced_stream_goes_on_at_its_rate_after_the_arm_stalled():
+    """After a stalled acknowledgement the executor sent the waypoints it was behind by at once
+    (316 waypoints, 3.16 s of motion, in 0.17 s after a 3 s stall): a burst of motion into a real arm."""
+    task = shipped("horizontal-offset-high-mu")
+    plan = check_plan(task, plan_task(task, seed=1))
+    arm = FakeArm(good=80, bad_reply=lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "done"}),
+                  stall=(20, 0.5))
+    with pytest.raises(ArmFault):
+        execute_plan(task, plan, "127.0.0.1", arm.port, rate_hz=100.0, pace=True, ack_timeout=5.0)
+    after = arm.received[21:71]  # 50 waypoints after the stall: 0.49 s apart at 100 Hz, however late the stall
+    assert after[-1] - after[0] >= 0.45
 
 
 def test_a_fault_after_the_closed_loop_replanned_offers_no_resume_of_the_plan_file(tmp_path):

@@ -262,8 +262,8 @@ def execute_plan(
         while pending:
             w = pending.popleft()
             watch.before(w, state)
-            if pace:
-                next_time += 1.0 / rate_hz
+            if pace:  # one period after the last send, never sooner: an arm that stalled is not caught up in a burst
+                next_time = max(next_time + 1.0 / rate_hz, time.perf_counter())
                 time.sleep(max(0.0, next_time - time.perf_counter()))
             link.send({"type": "waypoint", "seq": w.seq, "t": w.t, "step": w.step, "phase": w.phase,
                        "pose": list(w.pose)})
