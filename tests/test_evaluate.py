@@ -16,6 +16,7 @@ from stablepush.errors import PlanError, RunnerError
 from stablepush.evaluation import Batch, Evaluation, Spreads, draw_world, evaluate, robust_task, wilson_interval
 from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.world import place_features, scene_description
+from stablepush.plan import benchmark as benchmark_mod
 from stablepush.plan import check_plan, plan_task
 from stablepush.plan.benchmark import bench_checks
 from stablepush.runners import Runner, run_all
@@ -325,9 +326,16 @@ def _square(_shared, i):
     return i * i
 
 
-def test_bench_checks_runs_the_count_asked():
-    """It ran whole batches of 2,000: -n 1 ran 2,000 checks and -n 0 crashed."""
+def test_bench_checks_runs_the_count_asked_in_batches_as_equal_as_they_divide(monkeypatch):
+    """It ran whole batches of 2,000: -n 1 ran 2,000 checks and -n 0 crashed; and a remainder of one
+    check, timed alone, weighed as much in the median as a batch of 2,000."""
     timings = bench_checks(shipped("t-shaped"), checks=3)
     assert [t.checks for t in timings.values()] == [3, 3]
+    sizes = []
+    queries = benchmark_mod._queries
+    monkeypatch.setattr(benchmark_mod, "_queries", lambda task, rng, n, sticking: sizes.append(n) or queries(
+        task, rng, n, sticking))
+    bench_checks(shipped("t-shaped"), checks=4001, batch=2000)
+    assert sizes == [1334, 1334, 1333] * 2
     with pytest.raises(ValueError, match="checks: must be a whole number of at least 1, got 0"):
         bench_checks(shipped("t-shaped"), checks=0)

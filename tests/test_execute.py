@@ -242,24 +242,43 @@ def test_a_paced_stream_goes_on_at_its_rate_after_the_arm_stalled():
 
 
 def test_a_fault_after_the_closed_loop_replanned_offers_no_resume_of_the_plan_file(tmp_path):
-    """After a re-plan the confirmed step counts the closed loop's steps: the suggested
+    """Past a re-plan the confirmed step counts the closed loop's steps: the suggested
     `--resume-from` named a step of the plan file that was another pose, or none (41 of 40)."""
     task_file = TASKS / "large-manipulation.yaml"  # its plan ends short: the loop re-plans before the first push
     task = load_task(task_file)
     plan_file = tmp_path / "lm.plan.json"
     write_plan(check_plan(task, plan_task(task, seed=1)), str(plan_file))
     e_stop = lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "e-stop"})  # noqa: E731
-    arm = FakeArm(good=5, bad_reply=e_stop)
-    result = CliRunner().invoke(cli, ["execute", str(plan_file), "--task", str(task_file), "--arm",
-                                      f"127.0.0.1:{arm.port}", "--closed-loop", "--no-pace", "--quiet",
-                                      "--json", str(tmp_path / "fault.json")])
-    assert result.exit_code == 3, result.output
-    assert "the closed loop had re-planned the run" in result.stderr and "--resume-from" not in result.stderr
-    assert json.loads((tmp_path / "fault.json").read_text())["replanned"] is True and arm.stopped
-    arm = FakeArm(good=5, bad_reply=e_stop)  # open loop: the plan file's own steps, and the way to go on
-    result = CliRunner().invoke(cli, ["execute", str(plan_file), "--task", str(task_file), "--arm",
-                                      f"127.0.0.1:{arm.port}", "--no-pace", "--quiet"])
-    assert result.exit_code == 3 and "--resume-from 0" in result.stderr, result.output
+
+    def fault_after(good, *options):
+        arm = FakeArm(good=good, bad_reply=e_stop)
+        out = tmp_path / f"fault{good}.json"
+        result = CliRunner().invoke(cli, ["execute", str(plan_file), "--task", str(task_file), "--arm",
+                                          f"127.0.0.1:{arm.port}", "--no-pace", "--quiet", "--json", str(out),
+                                          *options])
+        assert result.exit_code == 3 and arm.stopped, result.output
+        return result.stderr, json.loads(out.read_text())
+
+    said, fault = fault_after(150, "--closed-loop")  # pushes of the re-planned steps confirmed
+    assert fault["last_confirmed_step"] > 0 and fault["replanned"] is True
+    assert "the closed loop had re-planned the run" in said and "--resume-from" not in said
+    said, fault = fault_after(5, "--closed-loop")  # stopped before the first push: the plan file's step 0
+    assert fault["last_confirmed_step"] == 0 and fault["replanned"] is False
+    assert "--closed-loop --resume-from 0" in said
+    said, fault = fault_after(150, "--rate", "50", "--no-guard")  # open loop: the plan file's steps, and the way on
+    assert fault["replanned"] is False
+    assert f"--rate 50 --no-pace --no-guard --resume-from {fault['last_confirmed_step']}\n" in said  # as it ran
+
+
+def test_a_report_written_to_stdout_has_the_stream_alone(tmp_path):
+    """`execute --json /dev/stdout` put the run's summary on stdout before the report."""
+    task = TASKS / "horizontal-offset-high-mu.yaml"
+    plan = tmp_path / "p.json"
+    write_plan(check_plan(load_task(task), plan_task(load_task(task), seed=1)), str(plan))
+    run = subprocess.run([sys.executable, "-m", "stablepush_cli.main", "execute", str(plan), "--task", str(task),
+                          "--sim", "--quiet", "--json", "/dev/stdout"], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert json.loads(run.stdout)["success"] is True and "verdict: landed" in run.stderr
 
 
 def test_the_sim_arm_refuses_malformed_and_out_of_order_waypoints_and_stops():

@@ -104,7 +104,8 @@ def test_a_density_that_gives_a_mass_out_of_range_names_density_and_the_scale(tm
     with pytest.raises(TaskError) as error:
         parse_task(text, source=str(tmp_path / "task.yaml"))
     assert error.value.field == "object.density"
-    assert "outside 0.001 to 1e+07 g; the object is only 0.04 mm across: written in metres?" in error.value.reason
+    assert error.value.reason.endswith("outside 0.001 to 1e+07 g; the object is only 0.04 mm across with "
+                                       "object.scale: 0.001: a mesh in mm takes none, one in metres scale: 1000")
 
 
 def _washer(tmp_path):

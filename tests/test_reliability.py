@@ -348,6 +348,7 @@ def test_an_output_over_an_input_another_output_or_unwritable_is_refused_before_
     (["evaluate", str(LOW_MU), "--trials", "1", "--ray", "notanaddress"], "Invalid value for '--ray': expected HOST:PORT"),
     (["reach", str(LOW_MU), "--ray", ":::"], "Invalid value for '--ray': expected HOST:PORT"),
     (["bench", str(LOW_MU), "--ray", "ray://host:port"], "Invalid value for '--ray': expected HOST:PORT"),
+    (["evaluate", str(LOW_MU), "--ray", "127.0.0.1:1"], "error: no Ray head answers at 127.0.0.1:1"),
     (["bench", "--checks", str(LOW_MU), "-n", "0"], "Invalid value for '-n' / '--count'"),
 ])
 def test_options_that_cannot_apply_are_refused_as_usage_errors(args, says):

@@ -380,7 +380,12 @@ def _runner(workers, ray_address, default: int):
 
     if ray_address is not None and workers is not None:
         _fail("--workers and --ray: choose one")
-    return Runner(workers=workers or default, ray=ray_address is not None, ray_address=ray_address or None)
+    runner = Runner(workers=workers or default, ray=ray_address is not None, ray_address=ray_address or None)
+    if runner.ray:
+        from stablepush.runners import probe_ray_head
+
+        probe_ray_head(runner.ray_address)  # before any work: a batch is planned and started only then
+    return runner
 
 
 def _bench_on_runner(job, trials: int, runner, progress) -> list:
@@ -846,47 +851,73 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
             sys.exit(EXIT_ARM_FAULT)
         click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
                    f"{len(plan.waypoints) - 1}", err=True)
-        click.echo(
-            f"continue with: stablepush execute {plan_file} --task {task_file} "
-            f"{f'--arm {host}:{port} ' if arm else ''}{'--sim ' if sim else ''}"
-            f"{'--closed-loop ' if closed_loop else ''}--resume-from {fault.last_confirmed_step}",
-            err=True,
-        )
+        ctx = click.get_current_context()
+        click.echo(f"continue with: {_resume_command(ctx, fault.last_confirmed_step)}", err=True)
         sys.exit(EXIT_ARM_FAULT)
     finally:
         sim_arm.close()
     if bar is not None:
         bar.__exit__(None, None, None)
-    _print_report(report)
+    say = _say_beside(json_path, record_path, video_path)
+    _print_report(report, say)
     if json_path:
         write_atomically(json_path, json.dumps(report.as_dict(), indent=1) + "\n")
-        click.echo(f"report written to {json_path}")
+        say(f"report written to {json_path}")
     if record_path:
         recording.write(record_path, report.as_dict())
-        click.echo(f"run recorded to {record_path}")
+        say(f"run recorded to {record_path}")
     video()
     if report.success is False:
         sys.exit(EXIT_MISSED)
 
 
-def _print_report(report) -> None:
-    click.echo(f"{report.task}: steps {report.resumed_from + 1}-{report.last_confirmed_step} of {report.total_steps} "
-               f"confirmed, {report.waypoints} waypoints in {report.wall_time_s:.1f} s"
-               + (f" ({report.sim_steps_per_s:.0f} simulation steps/s)" if report.sim_steps_per_s else ""))
+# The options of `execute` that say how a run runs, so a resume keeps them (outputs are left out:
+# a resumed run writes its own).
+RUN_OPTIONS = ("arm", "sim", "engine", "rate_hz", "pace", "ack_timeout", "success_tolerance", "mu_scale",
+               "tracker_noise", "closed_loop", "replan_threshold", "final_tolerance", "guarded")
+
+
+def _resume_command(ctx: click.Context, step: int) -> str:
+    """The command that continues this `execute` from plan step `step`: its arguments and every
+    option of RUN_OPTIONS given other than its default, as typed."""
+    import shlex
+
+    words = ["stablepush", "execute", ctx.params["plan_file"], "--task", ctx.params["task_file"]]
+    for param in ctx.command.params:
+        value = ctx.params.get(param.name)
+        if param.name not in RUN_OPTIONS or value is None or value == param.get_default(ctx):
+            continue
+        if param.name == "arm":
+            words += ["--arm", f"{value[0]}:{value[1]}"]
+        elif param.is_flag and param.secondary_opts:  # --x/--no-x
+            words.append(param.opts[0] if value else param.secondary_opts[0])
+        elif param.is_flag:
+            words.append(param.opts[0])
+        else:
+            words += [param.opts[0], *(f"{v:g}" if isinstance(v, float) else str(v)
+                                       for v in (value if isinstance(value, tuple) else (value,)))]
+    return shlex.join(words + ["--resume-from", str(step)])
+
+
+def _print_report(report, say=click.echo) -> None:
+    """The run's report in lines, each through `say`."""
+    say(f"{report.task}: steps {report.resumed_from + 1}-{report.last_confirmed_step} of {report.total_steps} "
+         f"confirmed, {report.waypoints} waypoints in {report.wall_time_s:.1f} s"
+         + (f" ({report.sim_steps_per_s:.0f} simulation steps/s)" if report.sim_steps_per_s else ""))
     err = report.final_error
     if err is None:
-        click.echo("the arm does not report the object, so the final pose in the grasp is not measured")
+        say("the arm does not report the object, so the final pose in the grasp is not measured")
         return
     x, z, th = report.planned_final
     f = report.final_in_grasp
-    click.echo(f"final pose in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
-               f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg; "
-               f"to the task's goal {report.goal_error['distance']:.3f} mm, {report.goal_error['theta']:+.3f} deg")
+    say(f"final pose in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
+         f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg; "
+         f"to the task's goal {report.goal_error['distance']:.3f} mm, {report.goal_error['theta']:+.3f} deg")
     if report.guard == "no tracker":
-        click.echo("guard: the arm reports no object_in_grasp (no tracker), so each approach ended where the plan "
-                   "puts its feature")
+        say("guard: the arm reports no object_in_grasp (no tracker), so each approach ended where the plan "
+             "puts its feature")
     if report.closed_loop == "no tracker":
-        click.echo("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
+        say("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
     for r in report.replans:
         off, ref = {"off_goal": (r.measured, report.goal), "plan_short": (r.planned, report.goal)}.get(
             r.trigger, (r.measured, r.planned))
@@ -905,21 +936,21 @@ def _print_report(report) -> None:
                 "last_switch": f"after step {r.after_step}, the last a switch-over is held from: off the plan by",
                 "plan_short": "before the first push: the plan ends off the goal by"}.get(
             r.trigger, f"after step {r.after_step}: off the plan by")
-        click.echo(f"  {when} {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; {outcome} ({r.planning_ms:.1f} ms)")
+        say(f"  {when} {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; {outcome} ({r.planning_ms:.1f} ms)")
     for c in report.contacts:
         if c.slip_mm is not None:
             found = "" if c.found_mm is None else f"feature found {c.found_mm:+.3f} mm from its place; "
             found += "" if c.seated_deg is None else f"seated turned {c.seated_deg:+.3f} deg; "
-            click.echo(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} {found}carried to the feature "
-                       f"{c.carried_mm:.3f} mm, then slip at the pusher {c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
+            say(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} {found}carried to the feature "
+                 f"{c.carried_mm:.3f} mm, then slip at the pusher {c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
     change = report.release_change
     if report.release_moved:
-        click.echo(f"note: when the last feature let go the object moved in the grasp by "
-                   f"{math.hypot(change['x'], change['z']):.2f} mm, "
-                   f"{change['theta']:+.2f} deg: the grasp alone does not hold the final pose against gravity")
+        say(f"note: when the last feature let go the object moved in the grasp by "
+             f"{math.hypot(change['x'], change['z']):.2f} mm, "
+             f"{change['theta']:+.2f} deg: the grasp alone does not hold the final pose against gravity")
     verdict = report.verdict
     if verdict is not None and verdict.success is not None:
-        click.echo(f"verdict: {verdict.detail}" + (f" [cause: {verdict.cause}]" if verdict.cause else ""))
+        say(f"verdict: {verdict.detail}" + (f" [cause: {verdict.cause}]" if verdict.cause else ""))
 
 
 def _vary(_ctx, _param, values):

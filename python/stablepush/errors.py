@@ -46,8 +46,8 @@ class ArmFault(StablepushError, RuntimeError):
     be (`arm_stopped`: True, or None when the arm could not be reached), and
     `last_confirmed_step` is the last plan step the arm confirmed (resume after it). `connected`:
     False when the arm server was never reached, so nothing was sent. `replanned`: the closed loop
-    had changed the run's steps, so `last_confirmed_step` counts the re-planned steps, not the plan
-    file's, and no resume of that file continues the run."""
+    had changed the run's steps before `last_confirmed_step`, which so counts the re-planned steps,
+    not the plan file's: no resume of that file continues the run."""
 
     def __init__(self, reason: str, last_confirmed_step: int, arm_stopped: Optional[bool], connected: bool = True,
                  replanned: bool = False):

@@ -138,17 +138,24 @@ def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterat
             ray.shutdown()
 
 
+def probe_ray_head(address: Optional[str]) -> None:
+    """RunnerError unless something answers at a HOST:PORT address within RAY_CONNECT_TIMEOUT_S
+    (None, "auto" and "local" are left to ray.init)."""
+    if address in (None, "auto", "local"):
+        return
+    import socket
+
+    host, port = _host_port(check_ray_address(address))
+    try:
+        socket.create_connection((host, int(port)), timeout=RAY_CONNECT_TIMEOUT_S).close()
+    except OSError as exc:
+        raise RunnerError(f"no Ray head answers at {address} ({exc.strerror or type(exc).__name__}): start one "
+                          f"there (`ray start --head`), or run on a local instance") from None
+
+
 def _join_ray(ray, address: Optional[str]) -> None:
     """ray.init, with a head that does not answer (or an address Ray refuses) a RunnerError at once."""
-    if address not in (None, "auto", "local"):
-        import socket
-
-        host, port = _host_port(address)
-        try:
-            socket.create_connection((host, int(port)), timeout=RAY_CONNECT_TIMEOUT_S).close()
-        except OSError as exc:
-            raise RunnerError(f"no Ray head answers at {address} ({exc.strerror or type(exc).__name__}): start one "
-                              f"there (`ray start --head`), or run on a local instance") from None
+    probe_ray_head(address)
     try:
         ray.init(address=address, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
     except (ConnectionError, ValueError) as exc:

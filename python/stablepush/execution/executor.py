@@ -237,7 +237,8 @@ def execute_plan(
     if aimed is not None:
         replans.append(aimed[0])
         steps = aimed[1] or steps
-    replanned = aimed is not None and aimed[1] is not None  # the run's steps are no longer the plan file's
+    # The first step from which the run's steps are no longer the plan file's (None: they all are).
+    replanned_from: Optional[int] = 0 if aimed is not None and aimed[1] else None
     features = place_features(task, steps, every_pusher=closed_loop is not None)
     scene = scene_description(task, features, steps[resume_from].pose)
     last_confirmed = resume_from
@@ -305,7 +306,7 @@ def execute_plan(
                     if spliced is not None:
                         steps, new_points = spliced
                         pending = _renumbered(w, rate_hz, new_points)
-                        replanned = True
+                        replanned_from = w.step if replanned_from is None else min(replanned_from, w.step)
             if w.phase != "push":
                 touch_state = met_state = None
                 rode = False
@@ -317,6 +318,8 @@ def execute_plan(
     except (ConnectionError, TimeoutError, ProtocolError, OSError, KeyError) as exc:
         stopped = _stop(link) if link is not None else None
         reason = str(exc) if not isinstance(exc, KeyError) else f"a reply lacks {exc}"
+        # A step confirmed past where the steps changed is not the plan file's step of that number.
+        replanned = replanned_from is not None and last_confirmed > replanned_from
         raise ArmFault(reason, last_confirmed, stopped, connected=link is not None, replanned=replanned) from None
     finally:
         if link is not None:

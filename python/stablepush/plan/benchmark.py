@@ -59,17 +59,19 @@ def bench_checks(
     progress: Optional[Callable[[int], None]] = None,
 ) -> Dict[str, CheckTiming]:
     """Median time per stable-push test for the all-sliding and the sticking case, cycling
-    through the task's pushers: `checks` tests of each, timed in batches of up to `batch`."""
+    through the task's pushers: `checks` tests of each, timed in batches of up to `batch` (as
+    equal as they divide, so that no short remainder weighs as much as a full batch)."""
     for name, value in (("checks", checks), ("batch", batch)):
         if not is_integer(value) or value < 1:
             raise ValueError(f"{name}: must be a whole number of at least 1, got {value!r}")
     model = task.build_model()
     rng = np.random.default_rng(seed)
     out = {}
+    batches = -(-checks // batch)
+    sizes = [checks // batches + (k < checks % batches) for k in range(batches)]
     for case, sticking in (("all_sliding", False), ("sticking", True)):
         per_check, feasible, exact, done = [], 0, 0, 0
-        while done < checks:
-            size = min(batch, checks - done)
+        for size in sizes:
             q, dq = _queries(task, rng, size, sticking)
             pusher = len(per_check) % len(task.pushers)
             start = time.perf_counter()

@@ -442,8 +442,12 @@ def _units_hint(vertices, thickness, obj: dict) -> str:
                max(z for _, z in vertices) - min(z for _, z in vertices), thickness)
     if size >= 2.0:
         return ""
-    fix = "object.scale: 1000 reads a mesh in metres" if obj.get("shape") == "mesh" else "task files use mm"
-    return f"; the object is only {size:.3g} mm across: written in metres? ({fix})"
+    if obj.get("shape") != "mesh":
+        return f"; the object is only {size:.3g} mm across: written in metres? (task files use mm)"
+    if obj.get("scale", 1.0) != 1.0:  # a scale that shrank a mesh in mm
+        return (f"; the object is only {size:.3g} mm across with object.scale: {obj['scale']:g}: a mesh in mm "
+                f"takes none, one in metres scale: 1000")
+    return f"; the object is only {size:.3g} mm across: written in metres? (object.scale: 1000 reads a mesh in metres)"
 
 
 AIR_DENSITY = 1.2e-3  # g/cm^3: a solid lighter than this is a unit slip
