@@ -192,5 +192,5 @@ def test_evaluate_writes_a_video_of_each_failed_trial(tmp_path):
     keep = ("world", "goal_error", "success", "cause")
     assert [{k: t[k] for k in keep} for t in runs["with"]] == [{k: t[k] for k in keep} for t in runs["without"]]
     header, *rows = (tmp_path / "with.csv").read_text().splitlines()
-    assert header.endswith(",video") and rows[0].endswith("trial-0.mp4")
+    assert header.endswith(",video,video_error") and rows[0].endswith("trial-0.mp4,")  # drawn: no video_error
     assert "video" not in (tmp_path / "without.csv").read_text().splitlines()[0]
