@@ -256,12 +256,12 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
         sys.exit(EXIT_NOT_SOLVED)
     if not quiet:
         say(f"{task.name}: solved in {s['planning_time_s'] * 1e3:.1f} ms (seed {s['seed']}): "
-                   f"{s['pushes']} pushes, "
-                   f"{s['switches']} switch-over(s), pushers {' -> '.join(result.pusher_sequence) or '(none)'}; "
-                   f"{s['iterations']} iterations, {s['nodes']} nodes, {s['feasibility_checks']} checks")
+            f"{s['pushes']} pushes, "
+            f"{s['switches']} switch-over(s), pushers {' -> '.join(result.pusher_sequence) or '(none)'}; "
+            f"{s['iterations']} iterations, {s['nodes']} nodes, {s['feasibility_checks']} checks")
         say("ends at the goal pose" if result.ends_at_goal else
-                   f"ends within tolerance, {s['goal_distance_steps']:.2f} unit steps from the goal (a last push to "
-                   f"the goal itself is not a stable push)")
+            f"ends within tolerance, {s['goal_distance_steps']:.2f} unit steps from the goal (a last push to "
+            f"the goal itself is not a stable push)")
         say(f"plan written to {json_path}" + (f" and {csv_path}" if csv_path else ""))
     hold = result.final_hold_ratio
     if hold < 1.0:
@@ -349,14 +349,14 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
         return "-" if v is None else format(v, fmt)
 
     say(f"{'task':<26} {'success':>7} {'median ms':>10} {'p95 ms':>8} {'min ms':>8} {'max ms':>9} "
-               f"{'switches':>8} "
-               f"{'length':>7} {'checks/s':>10} {'paper s':>8} {'earlier s':>9}")
+        f"{'switches':>8} "
+        f"{'length':>7} {'checks/s':>10} {'paper s':>8} {'earlier s':>9}")
     for r in rows:
         say(f"{r['task']:<26} {r['success_rate']:>7.0%} {r['median_time_s'] * 1e3:>10.2f} "
-                   f"{r['p95_time_s'] * 1e3:>8.2f} "
-                   f"{r['min_time_s'] * 1e3:>8.2f} {r['max_time_s'] * 1e3:>9.2f} {num(r['median_switches'], '.0f'):>8} "
-                   f"{num(r['median_path_length_steps'], '.1f'):>7} {r['checks_per_s']:>10.3g} "
-                   f"{num(r['paper_time_s'], 'g'):>8} {num(r['earlier_planner_time_s'], 'g'):>9}")
+            f"{r['p95_time_s'] * 1e3:>8.2f} "
+            f"{r['min_time_s'] * 1e3:>8.2f} {r['max_time_s'] * 1e3:>9.2f} {num(r['median_switches'], '.0f'):>8} "
+            f"{num(r['median_path_length_steps'], '.1f'):>7} {r['checks_per_s']:>10.3g} "
+            f"{num(r['paper_time_s'], 'g'):>8} {num(r['earlier_planner_time_s'], 'g'):>9}")
     if improve_for is not None:
         say(f"\nfirst plan -> improved after {improve_for:g} s (medians of the solved trials)")
         say(f"{'task':<26} {'first ms':>9} {'switches':>13} {'length':>15} {'least margin N':>17}")
@@ -365,9 +365,9 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
                 say(f"{r['task']:<26} {'-':>9}")
                 continue
             say(f"{r['task']:<26} {r['first_median_time_s'] * 1e3:>9.2f} "
-                       f"{r['first_median_switches']:>5.0f} -> {r['improved_median_switches']:<5.0f} "
-                       f"{r['first_median_path_length_steps']:>6.1f} -> {r['improved_median_path_length_steps']:<6.1f} "
-                       f"{r['first_median_min_margin']:>7.3f} -> {r['improved_median_min_margin']:<7.3f}")
+                f"{r['first_median_switches']:>5.0f} -> {r['improved_median_switches']:<5.0f} "
+                f"{r['first_median_path_length_steps']:>6.1f} -> {r['improved_median_path_length_steps']:<6.1f} "
+                f"{r['first_median_min_margin']:>7.3f} -> {r['improved_median_min_margin']:<7.3f}")
     if out_path:
         _write_bench(out_path, every, rows)
         say(f"written: {out_path}")
@@ -1108,15 +1108,15 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         sys.exit(130 if s["interrupted"] else EXIT_NOT_SOLVED)
     low, high = s["ci95"]
     say(f"{task.name}: landed {s['successes']} of {s['trials']} trials within {success_tolerance[0]:g} mm / "
-               f"{success_tolerance[1]:g} deg: {s['success_rate']:.1%} (95% CI {low:.1%}-{high:.1%})"
-               + (f"; interrupted after {s['trials']} of {trials}" if s["interrupted"] else ""))
+        f"{success_tolerance[1]:g} deg: {s['success_rate']:.1%} (95% CI {low:.1%}-{high:.1%})"
+        + (f"; interrupted after {s['trials']} of {trials}" if s["interrupted"] else ""))
     if s["goal_error_mm"]:
         say(f"goal error: median {s['goal_error_mm']['p50']:.3f} mm / {s['goal_error_deg']['p50']:.3f} deg, "
-                   f"p95 {s['goal_error_mm']['p95']:.3f} mm / {s['goal_error_deg']['p95']:.3f} deg")
+            f"p95 {s['goal_error_mm']['p95']:.3f} mm / {s['goal_error_deg']['p95']:.3f} deg")
     if s["causes"]:
         say("misses: " + ", ".join(f"{cause} {count}" for cause, count in sorted(s["causes"].items())))
     say(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
-               f"{s['real_time_factor']:.2f}x real time")
+        f"{s['real_time_factor']:.2f}x real time")
     written = [p for p in (json_path, csv_path, png_path) if p]
     if written:
         say(f"written: {', '.join(written)}")
@@ -1124,8 +1124,8 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         videos = sum(1 for t in result.trials if t.get("video"))
         failed = sum(1 for t in result.trials if not t["success"])
         say(f"videos of {videos} of the {failed} failed trial(s) written to {video_dir}"
-                   + "".join(f"\n  trial {t['trial']}: no video ({t['video_error']})"
-                             for t in result.trials if t.get("video_error")))
+            + "".join(f"\n  trial {t['trial']}: no video ({t['video_error']})"
+                      for t in result.trials if t.get("video_error")))
     if s["interrupted"]:
         sys.exit(130)
 
@@ -1228,7 +1228,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
         save_figure(reach_figure(task, data), png_path)
     c = data["counts"]
     say(f"{task.name}: {c['reached']} of {count} goals reached, {c['not found']} not found in {time_limit:g} s, "
-               f"{c['unreachable']} unreachable ({result.wall_s:.1f} s on {result.runner})")
+        f"{c['unreachable']} unreachable ({result.wall_s:.1f} s on {result.runner})")
     written = [p for p in (json_path, png_path) if p]
     if written:
         say(f"written: {', '.join(written)}")

@@ -230,7 +230,7 @@ class Evaluation:
     def rows(self) -> Tuple[List[str], List[list]]:
         """The trials as CSV columns and rows (one trial a row)."""
         offsets = sorted({k for t in self.trials for k in t["world"]["feature_offsets"]})
-        errors = [(which, which.split("_")[0]) for which in ("goal_error", "final_error")]
+        errors = (("goal_error", "goal"), ("final_error", "final"))  # record field, column prefix
         header = (["trial", "success", "cause"] + list(VARY_KEYS)
                   + [f"{name}_{c}" for name in offsets for c in ("dx_mm", "dz_mm", "dtheta_deg")]
                   + [f"{short}_{c}" for _, short in errors for c in ("x_mm", "z_mm", "theta_deg", "distance_mm")]
