@@ -276,8 +276,7 @@ PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize
   setThreshold(std::sqrt(2.0 * x * x + t * t));
 }
 
-bool PoseGoal::isSatisfied(const ob::State* s) const {
-  const Pose q = GraspPoseSpace::pose(s);
+bool PoseGoal::contains(const Pose& q) const {
   return std::abs(q.x - goal_.x) <= tolerance_.length && std::abs(q.z - goal_.z) <= tolerance_.length &&
          std::abs(q.theta - goal_.theta) <= tolerance_.angle;
 }

@@ -23,7 +23,7 @@ PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob:
   for (int p = 0; p < kMaxPushers; ++p) {
     if (!contains(wedges, p)) continue;
     const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, step / length, length, p);
-    if (on_surface && wedge_step_valid(from, WedgeStep{0.0, *on_surface, p}, scratch)) {
+    if (on_surface && wedge_step_valid(from, WedgeStep{0.0, *on_surface, p, false}, scratch)) {
       q = *on_surface;
       return PusherSet{1} << p;
     }
@@ -32,8 +32,9 @@ PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob:
   return 0;
 }
 
-std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal, double length,
-                                                       PusherSet wedges) const {
+std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal,
+                                                       const std::vector<double>& lengths, PusherSet wedges) const {
+  const auto* region = pdef_->getGoal()->as<PoseGoal>();
   const Eigen::Vector3d to_goal = space_->in_unit_steps(goal - from);
   const double heading = std::atan2(to_goal[1], to_goal[0]);
   const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
@@ -41,16 +42,21 @@ std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const P
   constexpr int kHeadings = 24;
   for (int p = 0; p < kMaxPushers; ++p) {
     if (!contains(wedges, p)) continue;
-    for (int k = 0; k < kHeadings; ++k) {
-      const double psi = heading + 2.0 * M_PI * k / kHeadings;
-      // The goal's elevation picks the root nearest to it.
-      const Eigen::Vector3d direction(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]);
-      const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, direction.normalized(), length, p);
-      if (on_surface) steps.push_back({space_->distance(*on_surface, goal), *on_surface, p});
+    for (const double length : lengths) {
+      for (int k = 0; k < kHeadings; ++k) {
+        const double psi = heading + 2.0 * M_PI * k / kHeadings;
+        // The goal's elevation picks the root nearest to it.
+        const Eigen::Vector3d direction(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]);
+        const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, direction.normalized(), length, p);
+        if (on_surface)
+          steps.push_back({space_->distance(*on_surface, goal), *on_surface, p,
+                           region->contains(*on_surface) && region->held(*on_surface, p)});
+      }
     }
   }
-  std::sort(steps.begin(), steps.end(),
-            [](const WedgeStep& a, const WedgeStep& b) { return a.goal_distance < b.goal_distance; });
+  std::stable_sort(steps.begin(), steps.end(), [](const WedgeStep& a, const WedgeStep& b) {
+    return a.ends_plan != b.ends_plan ? a.ends_plan : a.goal_distance < b.goal_distance;
+  });
   return steps;
 }
 
@@ -64,7 +70,12 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
   const PusherSet wedges = allowed & validator_->wedge_pushers();
   if (wedges == 0) return 0;
   const double now = space_->distance(from, goal);
-  const std::vector<WedgeStep> steps = wedge_steps(from, goal, length, wedges);
+  // Near the goal, shorter steps too: a surface may cross the tolerance box (a unit step or two
+  // across) only where a full step from here would overshoot it.
+  const bool near = now < 2.0 * pdef_->getGoal()->as<ob::GoalRegion>()->getThreshold();
+  const std::vector<WedgeStep> steps = wedge_steps(
+      from, goal, near ? std::vector<double>{length, 0.5 * length, 0.25 * length} : std::vector<double>{length},
+      wedges);
   const auto take = [&](const WedgeStep& step) {
     q = step.pose;
     GraspPoseSpace::set_pose(scratch, q);
@@ -73,7 +84,7 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
   std::vector<const WedgeStep*> valid;
   for (const WedgeStep& step : steps) {
     if (!wedge_step_valid(from, step, scratch)) continue;
-    if (step.goal_distance < now) return take(step);
+    if (step.ends_plan || step.goal_distance < now) return take(step);
     valid.push_back(&step);
   }
   // A local minimum of one step: one surface alone moves q in two of its three coordinates, so
@@ -81,8 +92,8 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
   constexpr std::size_t kFirstSteps = 8;
   for (std::size_t i = 0; i < std::min(valid.size(), kFirstSteps); ++i) {
     const double next_length = std::min(1.0, valid[i]->goal_distance);
-    for (const WedgeStep& second : wedge_steps(valid[i]->pose, goal, next_length, validator_->wedge_pushers())) {
-      if (second.goal_distance >= now) break;
+    for (const WedgeStep& second : wedge_steps(valid[i]->pose, goal, {next_length}, validator_->wedge_pushers())) {
+      if (!second.ends_plan && second.goal_distance >= now) break;
       if (wedge_step_valid(valid[i]->pose, second, scratch)) return take(*valid[i]);
     }
   }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <utility>
 
 #include "stablepush/internal/grasp_space.hpp"
 #include "stablepush/internal/trrt_star.hpp"
@@ -49,7 +50,9 @@ class ConeChecker : public PushChecker {
 template <class Checker>
 class ToyValidator : public ob::MotionValidator, public Checker {
  public:
-  explicit ToyValidator(const ob::SpaceInformationPtr& si) : ob::MotionValidator(si) {}
+  template <class... Args>
+  explicit ToyValidator(const ob::SpaceInformationPtr& si, Args&&... args)
+      : ob::MotionValidator(si), Checker(std::forward<Args>(args)...) {}
   using Checker::all_pushers;
   using Checker::stable_pushers;
   bool checkMotion(const ob::State* a, const ob::State* b) const override {
@@ -278,4 +281,93 @@ TEST_CASE("pivot_steps: a turn about a pad's centre reaches what straight and st
   CHECK(path.size() >= 31);  // one unit step of turn at most per push
   for (std::size_t i = 1; i < path.size(); ++i) CHECK(path[i].pose.theta > path[i - 1].pose.theta);
   CHECK(solve_pivot(0, &path) == ob::PlannerStatus::APPROXIMATE_SOLUTION);  // the default: none found
+}
+
+namespace {
+/// One point pusher whose stable pushes are the plane n . dq = 0 (dq in unit steps, x z theta):
+/// a point pusher's surface, flat.
+class PlaneChecker : public PushChecker {
+ public:
+  explicit PlaneChecker(const Eigen::Vector3d& normal) : n_(normal.normalized()) {}
+  PusherSet all_pushers() const override { return 0b1; }
+  PusherSet wedge_pushers() const override { return 0b1; }
+  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
+    ++checks_;
+    const Eigen::Vector3d d = in_steps(b - a);
+    return d.norm() > 0.0 && std::abs(n_.dot(d)) <= 1e-9 * d.norm() ? (candidates & 0b1) : 0;
+  }
+  /// The same heading in (x, z), the theta that puts it on the plane, `length` unit steps long.
+  std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
+                                         int) const override {
+    Eigen::Vector3d d(direction.x(), direction.y(), -(n_.x() * direction.x() + n_.y() * direction.y()) / n_.z());
+    d *= length / d.norm();
+    return a + Motion{d.x() * kStep.length, d.y() * kStep.length, d.z() * kStep.angle};
+  }
+  double push_margin(const Pose&, const Pose&, int) const override { return 1.0; }
+  std::uint64_t feasibility_checks() const override { return checks_; }
+  void reset_feasibility_checks() override { checks_ = 0; }
+
+ private:
+  static Eigen::Vector3d in_steps(const Motion& m) {
+    return {m.dx / kStep.length, m.dz / kStep.length, m.dtheta / kStep.angle};
+  }
+  Eigen::Vector3d n_;
+  mutable std::uint64_t checks_ = 0;
+};
+}  // namespace
+
+namespace {
+/// Plans with descents only (goal_bias 1) from the origin to `goal` with PlaneChecker(normal);
+/// returns the iterations the solve took, 0 when it found no plan in 1 s.
+std::uint64_t descents_to(const Eigen::Vector3d& normal, const Pose& goal) {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  ob::RealVectorBounds bounds(3);
+  bounds.setLow(-0.02);
+  bounds.setHigh(0.02);
+  auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  si->setStateValidityChecker([](const ob::State*) { return true; });
+  si->setMotionValidator(std::make_shared<ToyValidator<PlaneChecker>>(si, normal));
+  si->setup();
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  ob::ScopedState<GraspPoseSpace> start(space);
+  GraspPoseSpace::set_pose(start.get(), Pose{});
+  pdef->addStartState(start);
+  pdef->setGoal(std::make_shared<PoseGoal>(si, goal, StepSize{0.5e-3, 0.5 * M_PI / 180.0}));
+  TRRTstar planner(si);
+  planner.params().setParam("seed", "1");
+  planner.params().setParam("goal_bias", "1");  // descents, while a node is left to descend from
+  planner.setProblemDefinition(pdef);
+  planner.setup();
+  const bool solved = planner.solve(ob::timedPlannerTerminationCondition(1.0)) == ob::PlannerStatus::EXACT_SOLUTION;
+  return solved ? planner.iterations() : 0;
+}
+}  // namespace
+
+TEST_CASE("a descent on a point pusher's surface ends in the goal's box where the surface crosses it", "[trrt_star]") {
+  // Planes through the start that cross the goal's box of +-0.5 unit steps, though their point
+  // nearest the goal pose is outside it: a descent ranked by the distance to the goal pose alone
+  // stops at that point (the start's descent reached the box in 25 of these 81).
+  int first_descent = 0, cases = 0;
+  for (const double nz : {0.96, 0.9, 0.8}) {
+    const Eigen::Vector3d n(std::sqrt(1.0 - nz * nz), 0.0, nz);
+    // The nearest point is off by |n.g| nz in theta, outside when |n.g| > 0.5 / nz; the plane
+    // meets the box while |n.g| <= 0.5 (|n_x| + |n_theta|).
+    const double outside = 0.5 / nz, crosses = 0.5 * (n.x() + n.z());
+    for (const double f : {0.2, 0.5, 0.8}) {
+      const double n_dot_goal = outside + f * (crosses - outside);
+      for (const double gx : {3.0, 5.0, 8.0}) {
+        for (const double gz : {0.0, 2.0, -3.0}) {
+          const double gtheta = (-n_dot_goal - n.x() * gx) / nz;  // [unit steps]
+          const std::uint64_t iterations =
+              descents_to(n, Pose{gx * kStep.length, gz * kStep.length, gtheta * kStep.angle});
+          CHECK(iterations > 0);  // every goal planned
+          first_descent += iterations == 1;
+          ++cases;
+        }
+      }
+    }
+  }
+  CHECK(cases == 81);
+  CHECK(first_descent >= 60);
 }

@@ -149,7 +149,9 @@ class PoseGoal : public ompl::base::GoalSampleableRegion {
            double min_hold_ratio = 0.0);
 
   const Pose& pose() const { return goal_; }
-  bool isSatisfied(const ompl::base::State* s) const override;
+  /// q within the tolerance of the goal pose, in each of x, z and theta.
+  bool contains(const Pose& q) const;
+  bool isSatisfied(const ompl::base::State* s) const override { return contains(GraspPoseSpace::pose(s)); }
   bool isSatisfied(const ompl::base::State* s, double* distance) const override;
   /// Whether a plan may end at q after a push by `last_pusher` (always, without a hold requirement).
   bool held(const Pose& q, int last_pusher) const;

@@ -170,16 +170,23 @@ class TRRTstar : public ompl::base::Planner {
     double goal_distance;  ///< [unit steps]
     Pose pose;
     int pusher;
+    bool ends_plan;  ///< within the goal's tolerance (and held there, PoseGoal::held)
   };
-  /// The steps of `length` from `from` onto the surfaces of the point pushers in `wedges`, over 24
-  /// headings around the goal's, nearest the goal first (not yet checked for the grasp and facets).
-  std::vector<WedgeStep> wedge_steps(const Pose& from, const Pose& goal, double length, PusherSet wedges) const;
+  /// The steps of each of `lengths` [unit steps] from `from` onto the surfaces of the point pushers
+  /// in `wedges`, over 24 headings around the goal's: those that end the plan first, then nearest
+  /// the goal first (not yet checked for the grasp and facets). A surface rarely passes through the
+  /// goal pose itself, and where its point nearest the goal pose is outside the tolerance box, a
+  /// descent ranked by that distance alone stops there though the surface crosses the box.
+  std::vector<WedgeStep> wedge_steps(const Pose& from, const Pose& goal, const std::vector<double>& lengths,
+                                     PusherSet wedges) const;
   /// The grasp survives `step` and its pusher makes it stable.
   bool wedge_step_valid(const Pose& from, const WedgeStep& step, ompl::base::State* scratch) const;
-  /// Toward the goal when no straight or steered step is stable: the valid wedge step (wedge_steps)
-  /// ending nearest the goal, if closer than `from`; else, since one surface moves q in only two of
-  /// three coordinates, the first of the best 8 valid steps from which a second valid wedge step
-  /// ends closer. Sets q (and `scratch`) and returns that pusher; 0, q unchanged, when neither.
+  /// Toward the goal when no straight or steered step is stable: the valid wedge step (wedge_steps;
+  /// within two goal thresholds of the goal, of a half and a quarter of `length` too) that ends the
+  /// plan, or else ends nearest the goal if closer than `from`; else, since one surface moves q in
+  /// only two of three coordinates, the first of the best 8 valid steps from which a second valid
+  /// wedge step ends the plan or ends closer. Sets q (and `scratch`) and returns that pusher; 0, q unchanged, when
+  /// neither.
   PusherSet descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
                               ompl::base::State* scratch, Pose& q) const;
   /// Toward the goal when no straight, steered or wedge step is stable: a turn about a pad's centre
