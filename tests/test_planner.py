@@ -9,9 +9,10 @@ import pytest
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.plan import plan_task
+from stablepush.task import load_task
 from stablepush.units import MM, pose_to_si
 
-from conftest import shipped, task_with
+from conftest import TASKS, shipped, task_with
 from independent_lp import IndependentModel
 
 SEEDS = range(1, 6)
@@ -363,6 +364,39 @@ def test_restarts_are_counted_in_tests_so_a_seed_gives_the_same_plan_and_doublin
     recheck(task, plans[0])
     never = plan_task(task_with("large-manipulation", lambda d: d["planner"].update(restart_checks=0)), seed=6)
     assert never.stats["restarts"] == 0 and never.solved
+
+
+def _offset(task, plan):
+    """The plan's end's largest offset from the goal pose, each coordinate over its tolerance."""
+    end, (tol_mm, tol_deg) = plan.waypoints[-1], task.planner["tolerance"]
+    gx, gz, gt = task.goal
+    return max(abs(end.x - gx) / tol_mm, abs(end.z - gz) / tol_mm, abs(end.theta - gt) / tol_deg)
+
+
+@pytest.mark.parametrize("name", ["more/wedge-heel", "more/cube-pegs", "t-shaped"])
+def test_finish_steps_take_a_plan_that_ends_short_deeper_into_the_tolerance(name):
+    """A plan whose last push to the goal pose is not stable ends where the search first met the
+    tolerance, for the wedge 0.79 of it in x. With planner.finish_steps its last pusher goes on:
+    the same pushes, then more by that pusher alone, each stable by the independent LP, ending
+    deeper (within the 0.5 mm / 0.5 deg trials are judged by). A plan that ends at the goal pose
+    (the T) is unchanged."""
+    import dataclasses
+
+    task = load_task(TASKS / f"{name}.yaml")
+    plain = plan_task(task, seed=1)
+    finishing = dataclasses.replace(task, planner={**task.planner, "finish_steps": 1})
+    plan = plan_task(finishing, seed=1)
+    assert plain.solved and plan.solved
+    head = [(w.x, w.z, w.theta, w.pusher) for w in plain.waypoints]
+    assert [(w.x, w.z, w.theta, w.pusher) for w in plan.waypoints[:len(head)]] == head
+    assert {w.pusher for w in plan.waypoints[len(head):]} <= {plain.waypoints[-1].pusher}
+    assert plan.stats["switches"] == plain.stats["switches"]
+    recheck(finishing, plan)
+    if plain.ends_at_goal:
+        assert len(plan.waypoints) == len(head)
+    else:
+        assert len(plan.waypoints) > len(head)
+        assert _offset(task, plan) < _offset(task, plain) and _offset(task, plan) <= 0.5, _offset(task, plan)
 
 
 def test_pivot_steps_plan_the_pivot_from_off_its_centre_and_are_off_by_default():

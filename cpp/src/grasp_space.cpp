@@ -3,6 +3,7 @@
 #include <ompl/base/SpaceInformation.h>
 #include <ompl/util/Exception.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <iterator>
@@ -279,6 +280,11 @@ PoseGoal::PoseGoal(const ob::SpaceInformationPtr& si, const Pose& goal, StepSize
 bool PoseGoal::contains(const Pose& q) const {
   return std::abs(q.x - goal_.x) <= tolerance_.length && std::abs(q.z - goal_.z) <= tolerance_.length &&
          std::abs(q.theta - goal_.theta) <= tolerance_.angle;
+}
+
+double PoseGoal::offset(const Pose& q) const {
+  return std::max({std::abs(q.x - goal_.x) / tolerance_.length, std::abs(q.z - goal_.z) / tolerance_.length,
+                   std::abs(q.theta - goal_.theta) / tolerance_.angle});
 }
 
 bool PoseGoal::held(const Pose& q, int last_pusher) const {

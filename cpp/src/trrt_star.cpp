@@ -33,6 +33,7 @@ const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges() {
       {"improve_for", {false, 0.0, 1e6}},     // [s] after the first plan
       {"restart_checks", {true, 0.0, 1e12}},  // stable-push tests before a restart (0: never)
       {"pivot_steps", {true, 0.0, 1.0}},      // 1: descents turn about the pads' centres
+      {"finish_steps", {true, 0.0, 1.0}},     // 1: the last pusher goes on toward the goal pose
   };
   return ranges;
 }
@@ -80,6 +81,8 @@ TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTsta
   declareParam<long long>("seed", this, &TRRTstar::setSeed, &TRRTstar::getSeed, range_text("seed"));
   declareParam<long long>("pivot_steps", this, &TRRTstar::setPivotSteps, &TRRTstar::getPivotSteps,
                           range_text("pivot_steps"));
+  declareParam<long long>("finish_steps", this, &TRRTstar::setFinishSteps, &TRRTstar::getFinishSteps,
+                          range_text("finish_steps"));
   declareParam<double>("improve_for", this, &TRRTstar::setImproveFor, &TRRTstar::getImproveFor,
                        range_text("improve_for"));
   declareParam<long long>("restart_checks", this, &TRRTstar::setRestartChecks, &TRRTstar::getRestartChecks,
@@ -419,6 +422,7 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
     outcome_ = best_goal() != nullptr ? PlanOutcome::GoalOverSwitchLimit : PlanOutcome::TimeLimit;
   else if (improve_for_ > 0.0)
     choose_improved_path();
+  if (outcome_ == PlanOutcome::GoalReached && finish_steps_) finish_toward_goal(ptc);
   auto path = std::make_shared<ompl::geometric::PathGeometric>(si_);
   for (const PathNode& n : solution()) {
     ob::State* s = si_->allocState();

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "stablepush/internal/trrt_star.hpp"
@@ -243,6 +244,50 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
         previous_end = descent_ends_.back();
       }
     }
+  }
+  si_->freeState(scratch);
+}
+
+void TRRTstar::finish_toward_goal(const ob::PlannerTerminationCondition& ptc) {
+  if (!improved_) improved_ = goal_path(best_goal());
+  GoalPath& path = *improved_;
+  const int pusher = path.nodes.back().pusher;
+  if (pusher == kNoPusher) return;  // the start is within the tolerance: no push to go on with
+  const auto* goal = pdef_->getGoal()->as<PoseGoal>();
+  ob::State* scratch = si_->allocState();
+  // Nearer is deeper into the tolerance box (PoseGoal::offset), not nearer the goal pose in unit
+  // steps: an open-loop run misses by its worst coordinate.
+  constexpr double kDeeper = 1e-3;  // of the tolerance a step must gain
+  while (!ptc) {
+    const Pose from = path.nodes.back().pose;
+    const Steering steering(*space_, steer_angle_, from, goal->pose());
+    if (steering.distance < kMinEdge) break;
+    std::vector<std::pair<double, Pose>> candidates;  // (offset, end), deepest first
+    const auto consider = [&](const Pose& q) {
+      if (goal->offset(q) < goal->offset(from) - kDeeper) candidates.emplace_back(goal->offset(q), q);
+    };
+    const double l = steering.length;
+    if (contains(validator_->wedge_pushers(), pusher)) {
+      for (const WedgeStep& step : wedge_steps(from, goal->pose(), {l, 0.5 * l, 0.25 * l}, single(pusher)))
+        consider(step.pose);
+    } else {  // every ring out to 90 deg, full and shorter steps
+      for (int turn = 0; turn < 8 * (2 * Steering::kRings + 1); turn = turn == 0 ? 8 : turn + 1)
+        for (const double fraction : {1.0, 0.5, 0.25}) consider(from + fraction * (steering.step(turn) - from));
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    const auto taken = std::find_if(candidates.begin(), candidates.end(), [&](const auto& c) {
+      GraspPoseSpace::set_pose(scratch, c.second);
+      return goal->held(c.second, pusher) && si_->isValid(scratch) &&
+             validator_->stable_pushers(from, c.second, single(pusher)) != 0;
+    });
+    if (taken == candidates.end()) break;
+    const Pose next = taken->second;
+    path.nodes.push_back({next, pusher});
+    path.cost.length += space_->distance(from, next);
+    const std::vector<Pose> poses = space_->unit_pushes(from, next);
+    for (std::size_t i = 0; i + 1 < poses.size(); ++i)
+      path.margin = std::min(path.margin, validator_->push_margin(poses[i], poses[i + 1], pusher));
   }
   si_->freeState(scratch);
 }

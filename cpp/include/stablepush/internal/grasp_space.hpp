@@ -151,6 +151,9 @@ class PoseGoal : public ompl::base::GoalSampleableRegion {
   const Pose& pose() const { return goal_; }
   /// q within the tolerance of the goal pose, in each of x, z and theta.
   bool contains(const Pose& q) const;
+  /// The largest of q's offsets from the goal pose in x, z and theta, each over its tolerance
+  /// (at most 1 within the tolerance; 0 at the goal pose).
+  double offset(const Pose& q) const;
   bool isSatisfied(const ompl::base::State* s) const override { return contains(GraspPoseSpace::pose(s)); }
   bool isSatisfied(const ompl::base::State* s, double* distance) const override;
   /// Whether a plan may end at q after a push by `last_pusher` (always, without a hold requirement).

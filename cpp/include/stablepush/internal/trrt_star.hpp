@@ -93,6 +93,11 @@ class TRRTstar : public ompl::base::Planner {
   /// steered steps (pivot_toward_goal); 0 (the default): never.
   void setPivotSteps(long long on) { pivot_steps_ = checked("pivot_steps", static_cast<double>(on)) > 0.0; }
   long long getPivotSteps() const { return pivot_steps_ ? 1 : 0; }
+  /// 1: once the goal is reached, the plan's last pusher goes on toward the goal pose itself
+  /// (finish_toward_goal); 0 (the default): the plan ends at the first pose within the tolerance
+  /// unless one straight push from there to the goal pose is stable.
+  void setFinishSteps(long long on) { finish_steps_ = checked("finish_steps", static_cast<double>(on)) > 0.0; }
+  long long getFinishSteps() const { return finish_steps_ ? 1 : 0; }
   /// How long to keep improving after the first plan [s] (0: stop at the first).
   void setImproveFor(double seconds) { improve_for_ = checked("improve_for", seconds); }
   double getImproveFor() const { return improve_for_; }
@@ -232,6 +237,13 @@ class TRRTstar : public ompl::base::Planner {
   /// goal nodes now, within the budget, the one with the fewest switch-overs, then the largest
   /// least margin, then the shortest.
   void choose_improved_path();
+  /// With finish_steps, after the goal is reached: from the plan's end its last pusher takes, while
+  /// one is found, the straight or a steered step toward the goal pose (Steering; for a point
+  /// pusher, its wedge steps) that ends nearer the goal pose, within the tolerance (held there),
+  /// keeps the grasp and is a stable push. No switch-over, so the plan's cost in switch-overs is
+  /// unchanged. A plan that ends at the edge of the tolerance leaves an open-loop run no room for
+  /// the drift of a real push (docs/evaluate.md).
+  void finish_toward_goal(const ompl::base::PlannerTerminationCondition& ptc);
   /// The anytime phase's end: true once a plan exists and improve_for [s] has passed since the first
   /// (at once when improve_for is 0). solve() ORs it with the caller's condition; the helpers that
   /// grow the tree take that combined condition as their `ptc`.
@@ -269,6 +281,7 @@ class TRRTstar : public ompl::base::Planner {
   std::uint32_t seed_ = 1;
   double improve_for_ = 0.0;
   bool pivot_steps_ = false;
+  bool finish_steps_ = false;
   std::uint64_t restart_checks_ = 5000;
   unsigned restarts_ = 0;
 
@@ -283,7 +296,7 @@ class TRRTstar : public ompl::base::Planner {
   PathCost first_cost_;
   double first_margin_ = std::numeric_limits<double>::quiet_NaN();
   std::vector<GoalPath> kept_paths_;  ///< goal paths seen while improving
-  std::optional<GoalPath> improved_;
+  std::optional<GoalPath> improved_;  ///< the path returned when not the best goal node's own
 };
 
 }  // namespace stablepush
