@@ -72,13 +72,17 @@ def test_a_batch_with_a_bad_success_tolerance_is_refused_before_any_trial():
 
 def test_an_open_loop_batch_of_a_plan_that_ends_outside_the_success_tolerance_is_warned_of():
     """The wedge's plan ends within its task's 1 mm but 0.79 mm from the goal in x or z: judged
-    within 0.5 mm, open loop, the batch says so before any trial; closed loop, or judged within
-    1 mm, it does not. A by_moving_pusher task gets the executor's warning of another cell."""
+    within 0.5 mm, open loop, the batch says so before any trial, and names the cures; judged
+    within 0.85 mm, it warns that the plan ends at the edge (0.93 of it); closed loop, or judged
+    within 1 mm, it does not. A by_moving_pusher task gets the executor's warning of another cell."""
     task = shipped("more/wedge-heel")
     plan = check_plan(task, plan_task(task, seed=1))
     open_loop = Batch(task=task, plan=plan, spreads=Spreads())
     (warning,) = open_loop.warnings()
     assert "ends 0.79 mm / 0.53 deg from the goal" in warning and "planner.tolerance: [0.5, 0.5]" in warning
+    assert "planner.finish_steps: 1" in warning
+    (edge,) = dataclasses.replace(open_loop, tolerance=(0.85, 0.85)).warnings()
+    assert "at the edge of the success tolerance 0.85 mm / 0.85 deg" in edge
     assert dataclasses.replace(open_loop, closed_loop=True).warnings() == []
     assert dataclasses.replace(open_loop, tolerance=(1.0, 1.0)).warnings() == []
     moving = dataclasses.replace(task, pushes="by_moving_pusher")
