@@ -5,17 +5,22 @@ features reach, and run N times in the worlds of docs/evaluate.md's tables (pad 
 grip +-10%, mass +-5%, features off by up to 0.5 mm / 0.5 deg), judged within 0.5 mm / 0.5 deg.
 
     python3 benchmarks/generated_task_odds.py [--tasks 10] [--trials 50] [--seed 1] [--loop closed]
-                                              [--workers 2 | --ray [ADDRESS]] [--json OUT.json]
+                                              [--finish-steps] [--workers 2 | --ray [ADDRESS]]
+                                              [--json OUT.json]
 
 Task i depends only on (--seed, i). Its goal is a random pose within GOAL_SPAN of the start that
 the task's robust plan (seed 1, `uncertainty:` the spreads' box, as `evaluate --robust`) reaches in
 PLAN_LIMIT s, planned to the tolerance the trials are judged by; a task none of whose tries gives
 one is left out and listed. One row per task and loop; the line under the table sums the trials
-over all tasks (the closed-loop target: >= 99%).
+over all tasks (the closed-loop target: >= 99%). The column "ends at" is the plan's end's largest
+offset from the goal, each coordinate over the tolerance (1: at its edge). With --finish-steps the
+plans are made with `planner.finish_steps: 1` (the same goals and pushes, then the last pusher's
+steps deeper into the tolerance).
 """
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
@@ -78,13 +83,20 @@ def goal_for(data: dict, seed: int, index: int, tries: int = 8):
     return None
 
 
+def ends_at(task, plan) -> float:
+    """The plan's end's largest offset from the goal, each coordinate over TOLERANCE (1: its edge)."""
+    end = plan.waypoints[-1]
+    gx, gz, gt = task.goal
+    return max(abs(end.x - gx) / TOLERANCE[0], abs(end.z - gz) / TOLERANCE[0], abs(end.theta - gt) / TOLERANCE[1])
+
+
 def _row(task, data: dict, loop: str, plan, s: dict) -> str:
     shape = "box" if len(data["object"]["polygon"]) == 4 else f"{len(data['object']['polygon'])}-gon"
     misses = ", ".join(f"{k} {v}" for k, v in sorted(s["causes"].items())) or "-"
     mm = (s["goal_error_mm"] or {}).get("p95", float("nan"))
     return (f"| {task.name} | {shape} | {len(task.pushers)} | {'yes' if any(task.gravity) else 'no'} | {data['goal']} "
-            f"| {len(plan.waypoints) - 1} | {loop} | {s['successes']}/{s['trials']} | {s['success_rate']:.1%} "
-            f"({s['ci95'][0]:.1%}-{s['ci95'][1]:.1%}) | {mm:.2f} | {misses} |")
+            f"| {len(plan.waypoints) - 1} | {ends_at(task, plan):.2f} | {loop} | {s['successes']}/{s['trials']} "
+            f"| {s['success_rate']:.1%} ({s['ci95'][0]:.1%}-{s['ci95'][1]:.1%}) | {mm:.2f} | {misses} |")
 
 
 def main() -> None:
@@ -93,14 +105,16 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=50, help="per task and loop")
     parser.add_argument("--seed", type=int, default=1, help="the task set's seed (the worlds use seed 1)")
     parser.add_argument("--loop", nargs="+", choices=("open", "closed"), default=["closed"])
+    parser.add_argument("--finish-steps", action="store_true",
+                        help="plan with planner.finish_steps: 1 (the last pusher goes on deeper into the tolerance)")
     add_runner_options(parser)
     parser.add_argument("--json", type=Path, default=None, help="every row's summary and task, with its missed trials")
     args = parser.parse_args()
     runner = runner_of(args)
     print(f"{args.trials} trials per task and loop, task set {args.seed}, on {runner.describe()}", file=sys.stderr)
-    print("| task | shape | features | gravity | goal | pushes | loop | landed | success rate (95% CI) "
+    print("| task | shape | features | gravity | goal | pushes | ends at | loop | landed | success rate (95% CI) "
           "| goal error p95 mm | misses |")
-    print("|---|---|---:|---|---|---:|---|---:|---|---:|---|")
+    print("|---|---|---:|---|---|---:|---:|---|---:|---|---:|---|")
     rows, left_out, totals = [], [], {}
     for index in range(args.tasks):
         data = generate_task(args.seed, index)
@@ -109,6 +123,10 @@ def main() -> None:
             left_out.append(data["name"])
             continue
         data["goal"], task, plan = found
+        if args.finish_steps:
+            task = dataclasses.replace(task, planner={**task.planner, "finish_steps": 1})
+            data["planner"] = {**data["planner"], "finish_steps": 1}
+            plan = check_plan(task, plan_task(task, seed=1))
         for loop in args.loop:
             batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=1, closed_loop=loop == "closed")
             evaluation = evaluate(batch, args.trials, runner, progress=progress_line(task.name, loop, args.trials))
