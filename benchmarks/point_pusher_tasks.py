@@ -3,7 +3,8 @@ other sizes and masses, two or three pins at other places and friction, with and
 in the grasp plane), goals the pins can reach, and the planning time over seeds.
 
     python3 benchmarks/point_pusher_tasks.py [--tasks 10] [--seeds 30] [--seed 1] [--time-limit 5]
-                                             [--goals random|paths] [--json OUT.json]
+                                             [--goals random|paths] [--goals-from RUN.json]
+                                             [--json OUT.json]
 
 Task i depends only on (--seed, i). Its goal (`goal_for`) is reachable: a random pose near the
 start that a long search with other seeds reaches (as a user picks a goal), or the end of a
@@ -121,11 +122,12 @@ def goal_for(data: dict, seed: int, index: int, kind: str = "random", tries: int
     return None
 
 
-def generated_tasks(seed: int, count: int, kind: str = "random"):
-    """(task, its mapping) for tasks 0..count-1 of the set `seed` that have a reachable goal."""
+def generated_tasks(seed: int, count: int, kind: str = "random", goals: Optional[dict] = None):
+    """(task, its mapping) for tasks 0..count-1 of the set `seed` that have a reachable goal; with
+    `goals` (task name -> goal), those goals instead of goal_for's."""
     for index in range(count):
         data = generate_task(seed, index)
-        goal = goal_for(data, seed, index, kind)
+        goal = goal_for(data, seed, index, kind) if goals is None else goals.get(data["name"])
         if goal is None:
             continue
         data = {**data, "goal": goal}
@@ -140,19 +142,26 @@ def main() -> None:
     parser.add_argument("--time-limit", type=float, default=5.0, help="s per plan")
     parser.add_argument("--goals", choices=("random", "paths"), default="random",
                         help="random poses a long search reaches, or ends of partial paths (goal_for)")
-    parser.add_argument("--json", default=None, help="write every run here")
+    parser.add_argument("--goals-from", default=None, metavar="JSON",
+                        help="the goals of an earlier run's --json: a random goal is one a time-limited search "
+                             "reached, so it depends on the planner and the machine; two planners compared "
+                             "on the same goals")
+    parser.add_argument("--json", default=None, help="write every run and each task's goal here")
     args = parser.parse_args()
+    given = json.loads(Path(args.goals_from).read_text())["goals"] if args.goals_from else None
     print("| task | shape | pins | gravity | goal | solved | median ms | p95 ms |")
     print("|---|---|---:|---|---|---:|---:|---:|")
-    runs, everything = [], []
-    for task, data in generated_tasks(args.seed, args.tasks, args.goals):
+    runs, everything, goals = [], [], {}
+    for task, data in generated_tasks(args.seed, args.tasks, args.goals, given):
+        goals[task.name] = data["goal"]
         times, solved = [], 0
         for s in range(1, args.seeds + 1):
             plan = plan_task(task, seed=s, time_limit=args.time_limit)
             times.append(plan.stats["planning_time_s"] * 1e3)
             solved += plan.solved
             runs.append({"task": task.name, "seed": s, "solved": plan.solved, "ms": times[-1],
-                         "ends_at_goal": plan.ends_at_goal})
+                         "ends_at_goal": plan.ends_at_goal, "checks": plan.stats["feasibility_checks"],
+                         "restarts": plan.stats["restarts"]})
         everything += times
         shape = "box" if len(data["object"]["polygon"]) == 4 else f"{len(data['object']['polygon'])}-gon"
         print(f"| {task.name} | {shape} | {len(task.pushers)} | {'yes' if any(task.gravity) else 'no'} "
@@ -161,9 +170,10 @@ def main() -> None:
     t = np.array(everything)
     solved = sum(r["solved"] for r in runs)
     print(f"\nall {len(runs)} runs: solved {solved}, median {np.median(t):.1f} ms, p95 {np.percentile(t, 95):.1f} ms, "
-          f"max {t.max():.1f} ms (target: median <= 100 ms, p95 <= 500 ms)")
+          f"max {t.max():.1f} ms (target: median <= 100 ms, p95 <= 500 ms); "
+          f"{sum(r['checks'] for r in runs) / 1e6:.1f} M stable-push tests, {t.sum() / 1e3:.1f} s in all")
     if args.json:
-        Path(args.json).write_text(json.dumps({"runs": runs, "args": vars(args)}, indent=1) + "\n")
+        Path(args.json).write_text(json.dumps({"runs": runs, "goals": goals, "args": vars(args)}, indent=1) + "\n")
     sys.exit(0)
 
 
