@@ -422,7 +422,7 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
     outcome_ = best_goal() != nullptr ? PlanOutcome::GoalOverSwitchLimit : PlanOutcome::TimeLimit;
   else if (improve_for_ > 0.0)
     choose_improved_path();
-  if (outcome_ == PlanOutcome::GoalReached && finish_steps_) finish_toward_goal(ptc);
+  if (outcome_ == PlanOutcome::GoalReached && finish_steps_) finish_toward_goal();
   auto path = std::make_shared<ompl::geometric::PathGeometric>(si_);
   for (const PathNode& n : solution()) {
     ob::State* s = si_->allocState();

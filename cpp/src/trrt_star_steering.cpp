@@ -36,6 +36,7 @@ PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob:
 std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal,
                                                        const std::vector<double>& lengths, PusherSet wedges) const {
   const auto* region = pdef_->getGoal()->as<PoseGoal>();
+  const bool outside = !region->contains(from);  // from within the box, nearer is what counts
   const Eigen::Vector3d to_goal = space_->in_unit_steps(goal - from);
   const double heading = std::atan2(to_goal[1], to_goal[0]);
   const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
@@ -51,7 +52,7 @@ std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const P
         const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, direction.normalized(), length, p);
         if (on_surface)
           steps.push_back({space_->distance(*on_surface, goal), *on_surface, p,
-                           region->contains(*on_surface) && region->held(*on_surface, p)});
+                           outside && region->contains(*on_surface) && region->held(*on_surface, p)});
       }
     }
   }
@@ -71,22 +72,25 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
   const PusherSet wedges = allowed & validator_->wedge_pushers();
   if (wedges == 0) return 0;
   const double now = space_->distance(from, goal);
-  // Near the goal, shorter steps too: a surface may cross the tolerance box (a unit step or two
-  // across) only where a full step from here would overshoot it.
-  const bool near = now < 2.0 * pdef_->getGoal()->as<ob::GoalRegion>()->getThreshold();
-  const std::vector<WedgeStep> steps = wedge_steps(
-      from, goal, near ? std::vector<double>{length, 0.5 * length, 0.25 * length} : std::vector<double>{length},
-      wedges);
   const auto take = [&](const WedgeStep& step) {
     q = step.pose;
     GraspPoseSpace::set_pose(scratch, q);
     return PusherSet{1} << step.pusher;
   };
+  const std::vector<WedgeStep> steps = wedge_steps(from, goal, {length}, wedges);
   std::vector<const WedgeStep*> valid;
   for (const WedgeStep& step : steps) {
     if (!wedge_step_valid(from, step, scratch)) continue;
     if (step.ends_plan || step.goal_distance < now) return take(step);
     valid.push_back(&step);
+  }
+  // Stalled near the goal: shorter steps, since a surface may cross the tolerance box (a unit step
+  // or two across) only where a full step from here overshoots it.
+  if (now < 2.0 * pdef_->getGoal()->as<ob::GoalRegion>()->getThreshold()) {
+    for (const WedgeStep& step : wedge_steps(from, goal, {0.5 * length, 0.25 * length}, wedges)) {
+      if (!step.ends_plan && step.goal_distance >= now) break;
+      if (wedge_step_valid(from, step, scratch)) return take(step);
+    }
   }
   // A local minimum of one step: one surface alone moves q in two of its three coordinates, so
   // look two steps ahead (the second on any point pusher's surface) from the best first steps.
@@ -172,8 +176,11 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
       if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
     if (stable == 0) break;
-    if (!transition_test(from->goal_distance, pdef_->getGoal()->as<ob::GoalRegion>()->distanceGoal(step_state), length))
-      break;
+    // A step into the goal's tolerance may climb (a point pusher's surface may cross the box only
+    // farther from the goal pose than the descent's last node): it ends the plan, so it is taken.
+    const auto* goal_region = pdef_->getGoal()->as<PoseGoal>();
+    const bool enters = !goal_region->isSatisfied(from->state) && goal_region->isSatisfied(step_state);
+    if (!enters && !transition_test(from->goal_distance, goal_region->distanceGoal(step_state), length)) break;
     // Go on with the same pusher where it can (no switch-over); the nodes of the other pushers at
     // q_new stay candidates for descents of their own, which start each pusher's straight way in.
     Node* next = connect(from, q_new, stable, from->pusher);
@@ -248,20 +255,24 @@ void TRRTstar::descend_across(Node* root, const ob::PlannerTerminationCondition&
   si_->freeState(scratch);
 }
 
-void TRRTstar::finish_toward_goal(const ob::PlannerTerminationCondition& ptc) {
+void TRRTstar::finish_toward_goal() {
   if (!improved_) improved_ = goal_path(best_goal());
   GoalPath& path = *improved_;
   const int pusher = path.nodes.back().pusher;
   if (pusher == kNoPusher) return;  // the start is within the tolerance: no push to go on with
   const auto* goal = pdef_->getGoal()->as<PoseGoal>();
   ob::State* scratch = si_->allocState();
-  // Nearer is deeper into the tolerance box (PoseGoal::offset), not nearer the goal pose in unit
-  // steps: an open-loop run misses by its worst coordinate.
-  constexpr double kDeeper = 1e-3;  // of the tolerance a step must gain
-  while (!ptc) {
+  // Deeper into the tolerance box (PoseGoal::offset), not nearer the goal pose in unit steps: an
+  // open-loop run misses by its worst coordinate. Each step gains kDeeper of the tolerance, so at
+  // most 1/kDeeper steps: the loop needs no time limit, and a plan does not depend on the machine.
+  constexpr double kDeeper = 1e-3;
+  for (;;) {
     const Pose from = path.nodes.back().pose;
     const Steering steering(*space_, steer_angle_, from, goal->pose());
     if (steering.distance < kMinEdge) break;
+    // From where the push straight to the goal pose is stable, planning.cpp's finish_at_goal ends
+    // the plan there: a step aside would only lose it.
+    if (validator_->stable_pushers(from, goal->pose(), single(pusher)) != 0 && goal->held(goal->pose(), pusher)) break;
     std::vector<std::pair<double, Pose>> candidates;  // (offset, end), deepest first
     const auto consider = [&](const Pose& q) {
       if (goal->offset(q) < goal->offset(from) - kDeeper) candidates.emplace_back(goal->offset(q), q);
@@ -270,9 +281,10 @@ void TRRTstar::finish_toward_goal(const ob::PlannerTerminationCondition& ptc) {
     if (contains(validator_->wedge_pushers(), pusher)) {
       for (const WedgeStep& step : wedge_steps(from, goal->pose(), {l, 0.5 * l, 0.25 * l}, single(pusher)))
         consider(step.pose);
-    } else {  // every ring out to 90 deg, full and shorter steps
+    } else {  // every ring out to 90 deg (whatever steer_angle), full and shorter steps
+      const Steering wide(*space_, 90.0 * Steering::kRings / (2 * Steering::kRings), from, goal->pose());
       for (int turn = 0; turn < 8 * (2 * Steering::kRings + 1); turn = turn == 0 ? 8 : turn + 1)
-        for (const double fraction : {1.0, 0.5, 0.25}) consider(from + fraction * (steering.step(turn) - from));
+        for (const double fraction : {1.0, 0.5, 0.25}) consider(from + fraction * (wide.step(turn) - from));
     }
     std::stable_sort(candidates.begin(), candidates.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });

@@ -186,12 +186,12 @@ class TRRTstar : public ompl::base::Planner {
                                      PusherSet wedges) const;
   /// The grasp survives `step` and its pusher makes it stable.
   bool wedge_step_valid(const Pose& from, const WedgeStep& step, ompl::base::State* scratch) const;
-  /// Toward the goal when no straight or steered step is stable: the valid wedge step (wedge_steps;
-  /// within two goal thresholds of the goal, of a half and a quarter of `length` too) that ends the
-  /// plan, or else ends nearest the goal if closer than `from`; else, since one surface moves q in
-  /// only two of three coordinates, the first of the best 8 valid steps from which a second valid
-  /// wedge step ends the plan or ends closer. Sets q (and `scratch`) and returns that pusher; 0, q unchanged, when
-  /// neither.
+  /// Toward the goal when no straight or steered step is stable: the valid wedge step (wedge_steps)
+  /// that ends the plan, or else ends nearest the goal if closer than `from`; where none does
+  /// within two goal thresholds of the goal, the same among half and quarter steps; else, since
+  /// one surface moves q in only two of three coordinates, the first of the best 8 valid steps
+  /// from which a second valid wedge step ends the plan or ends closer. Sets q (and `scratch`) and
+  /// returns that pusher; 0, q unchanged, when none.
   PusherSet descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
                               ompl::base::State* scratch, Pose& q) const;
   /// Toward the goal when no straight, steered or wedge step is stable: a turn about a pad's centre
@@ -238,12 +238,13 @@ class TRRTstar : public ompl::base::Planner {
   /// least margin, then the shortest.
   void choose_improved_path();
   /// With finish_steps, after the goal is reached: from the plan's end its last pusher takes, while
-  /// one is found, the straight or a steered step toward the goal pose (Steering; for a point
-  /// pusher, its wedge steps) that ends nearer the goal pose, within the tolerance (held there),
-  /// keeps the grasp and is a stable push. No switch-over, so the plan's cost in switch-overs is
-  /// unchanged. A plan that ends at the edge of the tolerance leaves an open-loop run no room for
-  /// the drift of a real push (docs/evaluate.md).
-  void finish_toward_goal(const ompl::base::PlannerTerminationCondition& ptc);
+  /// one is found and the push from there straight to the goal pose is not stable, the step that
+  /// ends deepest in the tolerance box (PoseGoal::offset, by at least 0.001 of it), held there,
+  /// in the grasp and a stable push, among full, half and quarter steps toward the goal turned up
+  /// to 90 deg (for a point pusher, its wedge steps). No switch-over; the plan's length grows and
+  /// its least margin may drop. A plan that ends at the edge of the tolerance leaves an open-loop
+  /// run no room for the drift of a real push (docs/evaluate.md). Bounded in steps, not time.
+  void finish_toward_goal();
   /// The anytime phase's end: true once a plan exists and improve_for [s] has passed since the first
   /// (at once when improve_for is 0). solve() ORs it with the caller's condition; the helpers that
   /// grow the tree take that combined condition as their `ptc`.
