@@ -5,7 +5,7 @@ features reach, and run N times in the worlds of docs/evaluate.md's tables (pad 
 grip +-10%, mass +-5%, features off by up to 0.5 mm / 0.5 deg), judged within 0.5 mm / 0.5 deg.
 
     python3 benchmarks/generated_task_odds.py [--tasks 10] [--trials 50] [--seed 1] [--loop closed]
-                                              [--finish-steps] [--workers 2 | --ray [ADDRESS]]
+                                              [--only NAME ...] [--finish-steps] [--workers 2 | --ray [ADDRESS]]
                                               [--json OUT.json]
 
 Task i depends only on (--seed, i). Its goal is a random pose within GOAL_SPAN of the start that
@@ -105,11 +105,17 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=50, help="per task and loop")
     parser.add_argument("--seed", type=int, default=1, help="the task set's seed (the worlds use seed 1)")
     parser.add_argument("--loop", nargs="+", choices=("open", "closed"), default=["closed"])
+    parser.add_argument("--only", nargs="+", metavar="NAME", default=None,
+                        help="run only these tasks of the set (e.g. edges-2-4), the others generated and skipped")
     parser.add_argument("--finish-steps", action="store_true",
                         help="plan with planner.finish_steps: 1 (the last pusher goes on deeper into the tolerance)")
     add_runner_options(parser)
     parser.add_argument("--json", type=Path, default=None, help="every row's summary and task, with its missed trials")
     args = parser.parse_args()
+    names = {generate_task(args.seed, i)["name"] for i in range(args.tasks)}
+    if args.only is not None and not set(args.only) <= names:
+        parser.error(f"--only: no task {', '.join(sorted(set(args.only) - names))} in set {args.seed} "
+                     f"(its tasks: {', '.join(sorted(names))})")
     runner = runner_of(args)
     print(f"{args.trials} trials per task and loop, task set {args.seed}, on {runner.describe()}", file=sys.stderr)
     print("| task | shape | features | gravity | goal | pushes | ends at | loop | landed | success rate (95% CI) "
@@ -118,6 +124,8 @@ def main() -> None:
     rows, left_out, totals = [], [], {}
     for index in range(args.tasks):
         data = generate_task(args.seed, index)
+        if args.only is not None and data["name"] not in args.only:
+            continue
         found = goal_for(data, args.seed, index)
         if found is None:
             left_out.append(data["name"])
@@ -127,6 +135,8 @@ def main() -> None:
             task = dataclasses.replace(task, planner={**task.planner, "finish_steps": 1})
             data["planner"] = {**data["planner"], "finish_steps": 1}
             plan = check_plan(task, plan_task(task, seed=1))
+            if not plan.solved:  # the same search as goal_for's, under its time limit on a busy machine
+                raise SystemExit(f"{task.name}: with finish_steps, no plan in {PLAN_LIMIT:g} s: {plan.message}")
         for loop in args.loop:
             batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=1, closed_loop=loop == "closed")
             evaluation = evaluate(batch, args.trials, runner, progress=progress_line(task.name, loop, args.trials))

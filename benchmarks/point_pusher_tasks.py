@@ -148,7 +148,13 @@ def main() -> None:
                              "on the same goals")
     parser.add_argument("--json", default=None, help="write every run and each task's goal here")
     args = parser.parse_args()
-    given = json.loads(Path(args.goals_from).read_text())["goals"] if args.goals_from else None
+    given = None
+    if args.goals_from:
+        given = json.loads(Path(args.goals_from).read_text()).get("goals")
+        names = {generate_task(args.seed, i)["name"] for i in range(args.tasks)}
+        if not given or not names & set(given):
+            parser.error(f"--goals-from {args.goals_from}: no goal of a task of set {args.seed} (its 'goals' "
+                         f"must name some of {', '.join(sorted(names))}); --goals is not used with it")
     print("| task | shape | pins | gravity | goal | solved | median ms | p95 ms |")
     print("|---|---|---:|---|---|---:|---:|---:|")
     runs, everything, goals = [], [], {}

@@ -82,7 +82,7 @@ def test_an_open_loop_batch_of_a_plan_that_ends_outside_the_success_tolerance_is
     assert "ends 0.79 mm / 0.53 deg from the goal" in warning and "planner.tolerance: [0.5, 0.5]" in warning
     assert "planner.finish_steps: 1" in warning
     (edge,) = dataclasses.replace(open_loop, tolerance=(0.85, 0.85)).warnings()
-    assert "at the edge of the success tolerance 0.85 mm / 0.85 deg" in edge
+    assert "at the edge of the success tolerance 0.85 mm / 0.85 deg" in edge and "[0.425, 0.425]" in edge
     assert dataclasses.replace(open_loop, closed_loop=True).warnings() == []
     assert dataclasses.replace(open_loop, tolerance=(1.0, 1.0)).warnings() == []
     moving = dataclasses.replace(task, pushes="by_moving_pusher")

@@ -75,17 +75,18 @@ class Batch:
         end, goal = self.plan.waypoints[-1].pose, self.task.goal
         mm, deg = max(abs(end[0] - goal[0]), abs(end[1] - goal[1])), abs(angle_difference_deg(end[2], goal[2]))
         offset = max(mm / self.tolerance[0], deg / self.tolerance[1])
-        cures = (f"plan to the tolerance (planner.tolerance: [{self.tolerance[0]:g}, {self.tolerance[1]:g}]), let "
-                 f"the last pusher go on toward the goal pose (planner.finish_steps: 1) or run the closed loop")
+        others = "let the last pusher go on toward the goal pose (planner.finish_steps: 1) or run the closed loop"
         if not self.closed_loop and not within({"x": end[0], "z": end[1], "theta": end[2]}, goal, self.tolerance):
             out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), "
                        f"outside the success tolerance {self.tolerance[0]:g} mm / {self.tolerance[1]:g} deg: an "
                        f"open-loop trial lands only where its world's error happens to make up the difference. "
-                       f"To land, {cures}")
+                       f"To land, plan to the tolerance (planner.tolerance: [{self.tolerance[0]:g}, "
+                       f"{self.tolerance[1]:g}]), {others}")
         elif not self.closed_loop and offset >= EDGE:
             out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), at "
                        f"the edge of the success tolerance {self.tolerance[0]:g} mm / {self.tolerance[1]:g} deg: an "
-                       f"open-loop trial that drifts outward at all misses. To leave it room, {cures}")
+                       f"open-loop trial that drifts outward at all misses. To leave it room, plan to less "
+                       f"(planner.tolerance: [{self.tolerance[0] / 2:g}, {self.tolerance[1] / 2:g}]), {others}")
         return out
 
     def world(self, trial: int) -> TrialWorld:
