@@ -472,14 +472,18 @@ ob::PlannerTerminationCondition TRRTstar::anytime_over() const {
   });
 }
 
+double TRRTstar::edge_margin(const Pose& a, const Pose& b, int pusher) const {
+  double margin = std::numeric_limits<double>::infinity();
+  const std::vector<Pose> poses = space_->unit_pushes(a, b);
+  for (std::size_t i = 0; i + 1 < poses.size(); ++i)
+    margin = std::min(margin, validator_->push_margin(poses[i], poses[i + 1], pusher));
+  return margin;
+}
+
 double TRRTstar::path_margin(const Node* node) const {
   double margin = std::numeric_limits<double>::infinity();
-  for (; node != nullptr && node->parent != nullptr; node = node->parent) {
-    const std::vector<Pose> poses = space_->unit_pushes(node->parent->pose, node->pose);
-    for (std::size_t i = 0; i + 1 < poses.size(); ++i) {
-      margin = std::min(margin, validator_->push_margin(poses[i], poses[i + 1], node->pusher));
-    }
-  }
+  for (; node != nullptr && node->parent != nullptr; node = node->parent)
+    margin = std::min(margin, edge_margin(node->parent->pose, node->pose, node->pusher));
   return margin;
 }
 

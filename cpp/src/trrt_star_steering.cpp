@@ -282,7 +282,7 @@ void TRRTstar::finish_toward_goal() {
       for (const WedgeStep& step : wedge_steps(from, goal->pose(), {l, 0.5 * l, 0.25 * l}, single(pusher)))
         consider(step.pose);
     } else {  // every ring out to 90 deg (whatever steer_angle), full and shorter steps
-      const Steering wide(*space_, 90.0 * Steering::kRings / (2 * Steering::kRings), from, goal->pose());
+      const Steering wide(*space_, 45.0, from, goal->pose());  // its rings: 11.25 deg apart out to 90
       for (int turn = 0; turn < 8 * (2 * Steering::kRings + 1); turn = turn == 0 ? 8 : turn + 1)
         for (const double fraction : {1.0, 0.5, 0.25}) consider(from + fraction * (wide.step(turn) - from));
     }
@@ -297,9 +297,7 @@ void TRRTstar::finish_toward_goal() {
     const Pose next = taken->second;
     path.nodes.push_back({next, pusher});
     path.cost.length += space_->distance(from, next);
-    const std::vector<Pose> poses = space_->unit_pushes(from, next);
-    for (std::size_t i = 0; i + 1 < poses.size(); ++i)
-      path.margin = std::min(path.margin, validator_->push_margin(poses[i], poses[i + 1], pusher));
+    path.margin = std::min(path.margin, edge_margin(from, next, pusher));
   }
   si_->freeState(scratch);
 }

@@ -231,6 +231,8 @@ class TRRTstar : public ompl::base::Planner {
     double margin = 0.0;
   };
   GoalPath goal_path(const Node* node) const;
+  /// The least margin over the unit pushes of a -> b by `pusher` [N].
+  double edge_margin(const Pose& a, const Pose& b, int pusher) const;
   /// The least margin over the unit pushes of the path to `node` [N] (+inf at the root).
   double path_margin(const Node* node) const;
   /// After an improvement: improved_ = among the goal paths kept while improving and those of the
