@@ -27,7 +27,7 @@ from stablepush.execution.bags import RunRecording
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.executor import execute_plan, execution_warnings
 from stablepush.execution.guard import GuardedApproach
-from stablepush.execution.verdict import success_tolerance, within
+from stablepush.execution.verdict import success_tolerance, tolerance_used, within
 from stablepush.plan.plan import Plan
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.sim.arm import WorldDeviation
@@ -74,15 +74,15 @@ class Batch:
         out = execution_warnings(self.task)
         end, goal = self.plan.waypoints[-1].pose, self.task.goal
         mm, deg = max(abs(end[0] - goal[0]), abs(end[1] - goal[1])), abs(angle_difference_deg(end[2], goal[2]))
-        offset = max(mm / self.tolerance[0], deg / self.tolerance[1])
+        at = {"x": end[0], "z": end[1], "theta": end[2]}
         others = "let the last pusher go on toward the goal pose (planner.finish_steps: 1) or run the closed loop"
-        if not self.closed_loop and not within({"x": end[0], "z": end[1], "theta": end[2]}, goal, self.tolerance):
+        if not self.closed_loop and not within(at, goal, self.tolerance):
             out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), "
                        f"outside the success tolerance {self.tolerance[0]:g} mm / {self.tolerance[1]:g} deg: an "
                        f"open-loop trial lands only where its world's error happens to make up the difference. "
                        f"To land, plan to the tolerance (planner.tolerance: [{self.tolerance[0]:g}, "
                        f"{self.tolerance[1]:g}]), {others}")
-        elif not self.closed_loop and offset >= EDGE:
+        elif not self.closed_loop and tolerance_used(at, goal, self.tolerance) >= EDGE:
             out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), at "
                        f"the edge of the success tolerance {self.tolerance[0]:g} mm / {self.tolerance[1]:g} deg: an "
                        f"open-loop trial that drifts outward at all misses. To leave it room, plan to less "

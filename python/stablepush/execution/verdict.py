@@ -71,6 +71,13 @@ def within(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[fl
             and abs(angle_difference_deg(pose["theta"], goal[2])) <= tolerance[1])
 
 
+def tolerance_used(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[float]) -> float:
+    """The largest of `pose`'s offsets from `goal` in x, z (mm) and theta (deg), each over its
+    `tolerance`: at most 1 within it (`within`), 0 at the goal."""
+    return max(abs(pose["x"] - goal[0]) / tolerance[0], abs(pose["z"] - goal[1]) / tolerance[0],
+               abs(angle_difference_deg(pose["theta"], goal[2])) / tolerance[1])
+
+
 def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
           max_replans: Optional[int] = None) -> Verdict:
     """The verdict on a completed run (`ExecutionReport`), judged with `tolerance` (mm, deg; default:
