@@ -155,6 +155,11 @@ def test_planner_parameters_are_refused_out_of_their_declared_range():
             _core.plan([model], settings(**{name: value}))
     with pytest.raises(ValueError, match="time_limit must be > 0 and at most 1e6 s"):
         _core.plan([model], settings(time_limit=9.3e9))
+    for tolerance in ((0.0, 0.0175), (1e-3, 0.0), (-1e-3, 0.0175)):
+        zero = _core.PlannerSettings(start=pose_to_si(task.start), goal=pose_to_si(task.goal), step=(1e-3, 0.0175),
+                                     tolerance=tolerance, time_limit=1.0)
+        with pytest.raises(ValueError, match="tolerance must be > 0 in length and angle"):
+            _core.plan([model], zero)
     ranges = _core.TRRT_STAR_PARAMETER_RANGES
     assert ranges["seed"] == ("integer", 0.0, 4294967295.0) and ranges["max_switches"][2] == 100.0
 

@@ -77,6 +77,9 @@ void check_settings(const PlannerSettings& s) {
   for (const StepSize& size : {s.step, s.tolerance})
     if (!(std::isfinite(size.length) && std::isfinite(size.angle)))
       throw std::invalid_argument("step and tolerance must be finite");
+  // PoseGoal's threshold and offset divide by the tolerance; a zero tolerance is a goal no pose meets.
+  if (!(s.tolerance.length > 0.0 && s.tolerance.angle > 0.0))
+    throw std::invalid_argument("tolerance must be > 0 in length and angle");
   // GraspPoseSpace::kShortestPush holds for unit steps of at least 0.001 mm and 0.001 deg.
   if (!(s.step.length >= 1e-6 && s.step.angle >= 1e-3 * M_PI / 180.0))
     throw std::invalid_argument("step must be at least 0.001 mm and 0.001 deg");
