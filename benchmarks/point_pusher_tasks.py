@@ -4,7 +4,7 @@ in the grasp plane), goals the pins can reach, and the planning time over seeds.
 
     python3 benchmarks/point_pusher_tasks.py [--tasks 10] [--seeds 30] [--seed 1] [--time-limit 5]
                                              [--goals random|paths] [--goals-from RUN.json]
-                                             [--json OUT.json]
+                                             [--planner KEY=VALUE ...] [--json OUT.json]
 
 Task i depends only on (--seed, i). Its goal (`goal_for`) is reachable: a random pose near the
 start that a long search with other seeds reaches (as a user picks a goal), or the end of a
@@ -89,11 +89,12 @@ def random_task(rng: np.random.Generator, name: str, place_pushers, planner: dic
     }
 
 
-def generate_task(seed: int, index: int) -> dict:
-    """Task `index` of the set `seed`, as a task file's mapping (no goal yet: `goal_for`)."""
+def generate_task(seed: int, index: int, planner: Optional[dict] = None) -> dict:
+    """Task `index` of the set `seed`, as a task file's mapping (no goal yet: `goal_for`), its
+    planner section updated with `planner`."""
     return random_task(np.random.default_rng([seed, index]), f"pins-{seed}-{index}",
                        lambda rng, polygon: _pins(rng, polygon, int(rng.integers(2, 4))),
-                       {"time_limit": 5.0, "seed": 1, "max_switches": 2})
+                       {"time_limit": 5.0, "seed": 1, "max_switches": 2, **(planner or {})})
 
 
 def goal_for(data: dict, seed: int, index: int, kind: str = "random", tries: int = 8) -> Optional[list]:
@@ -122,11 +123,12 @@ def goal_for(data: dict, seed: int, index: int, kind: str = "random", tries: int
     return None
 
 
-def generated_tasks(seed: int, count: int, kind: str = "random", goals: Optional[dict] = None):
+def generated_tasks(seed: int, count: int, kind: str = "random", goals: Optional[dict] = None,
+                    planner: Optional[dict] = None):
     """(task, its mapping) for tasks 0..count-1 of the set `seed` that have a reachable goal; with
-    `goals` (task name -> goal), those goals instead of goal_for's."""
+    `goals` (task name -> goal), those goals instead of goal_for's; `planner` as generate_task's."""
     for index in range(count):
-        data = generate_task(seed, index)
+        data = generate_task(seed, index, planner)
         goal = goal_for(data, seed, index, kind) if goals is None else goals.get(data["name"])
         if goal is None:
             continue
@@ -146,8 +148,17 @@ def main() -> None:
                         help="the goals of an earlier run's --json: a random goal is one a time-limited search "
                              "reached, so it depends on the planner and the machine; two planners compared "
                              "on the same goals")
+    parser.add_argument("--planner", nargs="+", default=[], metavar="KEY=VALUE",
+                        help="planner settings of every task (YAML values), e.g. restart_checks=2000; the goals "
+                             "are found with them too, so compare planners with --goals-from")
     parser.add_argument("--json", default=None, help="write every run and each task's goal here")
     args = parser.parse_args()
+    planner = {}
+    for item in args.planner:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            parser.error(f"--planner {item}: expected KEY=VALUE")
+        planner[key] = yaml.safe_load(value)
     given = None
     if args.goals_from:
         given = json.loads(Path(args.goals_from).read_text()).get("goals")
@@ -158,7 +169,7 @@ def main() -> None:
     print("| task | shape | pins | gravity | goal | solved | median ms | p95 ms |")
     print("|---|---|---:|---|---|---:|---:|---:|")
     runs, everything, goals = [], [], {}
-    for task, data in generated_tasks(args.seed, args.tasks, args.goals, given):
+    for task, data in generated_tasks(args.seed, args.tasks, args.goals, given, planner):
         goals[task.name] = data["goal"]
         times, solved = [], 0
         for s in range(1, args.seeds + 1):
