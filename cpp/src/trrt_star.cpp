@@ -376,6 +376,7 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
     first_cost_ = PathCost{};
     first_margin_ = std::numeric_limits<double>::quiet_NaN();
     validator_->reset_feasibility_checks();
+    goal_rays_.clear();
     begin_attempt(start_pose);
   }
 

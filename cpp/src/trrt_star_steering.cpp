@@ -106,6 +106,125 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
   return 0;
 }
 
+namespace {
+constexpr int kRayHeadings = 24;
+constexpr int kSplitRefinements = 2;
+// At most this many times the straight way (long ways round leave the first-order model). Where
+// a descent stalls, the way left is square to its surface, and a split is over twice as long.
+constexpr double kLongestSplit = 3.0;
+}  // namespace
+
+std::vector<std::optional<Eigen::Vector3d>> TRRTstar::wedge_rays(const Pose& at, int pusher, ob::State* scratch) const {
+  std::vector<std::optional<Eigen::Vector3d>> rays(kRayHeadings);
+  for (int k = 0; k < kRayHeadings; ++k) {
+    const double psi = 2.0 * M_PI * k / kRayHeadings;
+    const std::optional<Pose> end =
+        validator_->onto_wedge_surface(at, Eigen::Vector3d(std::cos(psi), std::sin(psi), 0.0), 1.0, pusher);
+    if (end && wedge_step_valid(at, WedgeStep{0.0, *end, pusher, false}, scratch))
+      rays[k] = space_->in_unit_steps(*end - at);
+  }
+  return rays;
+}
+
+namespace {
+using Rays = std::vector<std::optional<Eigen::Vector3d>>;
+
+/// The shortest d = a + b with a in the cone of `first` (two adjacent rays) and b in that of
+/// `second` (or the other way round), |a| + |b| at most kLongestSplit |d|: (a, |a| + |b|).
+std::optional<std::pair<Eigen::Vector3d, double>> decompose(const Eigen::Vector3d& d, const Rays& first,
+                                                            const Rays& second) {
+  std::optional<std::pair<Eigen::Vector3d, double>> best;
+  const auto consider = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v, const Eigen::Vector3d& w,
+                            bool two_of_first) {
+    Eigen::Matrix3d m;
+    m << u, v, w;
+    if (!(std::abs(m.determinant()) > 1e-6)) return;
+    const Eigen::Vector3d x = m.partialPivLu().solve(d);
+    if (!(x.minCoeff() >= 0.0)) return;
+    const Eigen::Vector3d leg = two_of_first ? Eigen::Vector3d(x[0] * u + x[1] * v) : Eigen::Vector3d(x[2] * w);
+    const double length = leg.norm() + (d - leg).norm();
+    // A long way round (nearly parallel rays) leaves the first-order model.
+    if (length <= kLongestSplit * d.norm() && (!best || length < best->second)) best = std::make_pair(leg, length);
+  };
+  const int n = static_cast<int>(first.size());
+  for (int i = 0; i < n; ++i) {
+    const int next = (i + 1) % n;
+    for (int j = 0; j < n; ++j) {
+      if (first[i] && first[next] && second[j]) consider(*first[i], *first[next], *second[j], true);
+      if (second[i] && second[next] && first[j]) consider(*second[i], *second[next], *first[j], false);
+    }
+  }
+  return best;
+}
+}  // namespace
+
+std::optional<TRRTstar::Split> TRRTstar::split_point(const Pose& q, PusherSet first, PusherSet second,
+                                                     ob::State* scratch) {
+  const Pose goal = pdef_->getGoal()->as<PoseGoal>()->pose();
+  const Eigen::Vector3d d = space_->in_unit_steps(goal - q);
+  const PusherSet wedges = validator_->wedge_pushers();
+  if (goal_rays_.size() != kMaxPushers) goal_rays_.assign(kMaxPushers, std::nullopt);
+  std::optional<Split> best;
+  for (int a = 0; a < kMaxPushers; ++a) {
+    if (!contains(first & wedges, a)) continue;
+    const Rays rays_a = wedge_rays(q, a, scratch);
+    for (int b = 0; b < kMaxPushers; ++b) {
+      if (b == a || !contains(second & wedges, b)) continue;
+      if (!goal_rays_[b]) goal_rays_[b] = wedge_rays(goal, b, scratch);
+      auto found = decompose(d, rays_a, *goal_rays_[b]);
+      // The second surface turns with the object between the switch-over and the goal: its rays
+      // again where the first leg ends, twice.
+      for (int again = 0; again < kSplitRefinements && found; ++again) {
+        auto refined = decompose(d, rays_a, wedge_rays(q + space_->from_unit_steps(found->first), b, scratch));
+        if (!refined) break;
+        found = refined;
+      }
+      if (found && (!best || found->second < best->length)) best = Split{a, b, found->first, found->second};
+    }
+  }
+  return best;
+}
+
+TRRTstar::Node* TRRTstar::walk_to_split(Node* from, Split split, int descent,
+                                        const ob::PlannerTerminationCondition& ptc) {
+  ob::State* scratch = si_->allocState();
+  // Each step is the first leg's heading on the first pusher's surface; the leg is found again
+  // from where the step ends, since the surface turns with the object.
+  const int most = static_cast<int>(std::ceil(split.length)) + 2;
+  for (int k = 0; k < most && !ptc && split.first_leg.norm() >= 0.5; ++k) {
+    const double length = std::min(1.0, split.first_leg.norm());
+    const std::optional<Pose> q =
+        validator_->onto_wedge_surface(from->pose, split.first_leg.normalized(), length, split.first);
+    if (!q || !wedge_step_valid(from->pose, WedgeStep{0.0, *q, split.first, false}, scratch)) break;
+    Node* next = connect(from, *q, single(split.first), split.first);
+    next->extended_to_goal = true;
+    next->descent = descent;
+    if (next->cost.switches > max_switches_) break;
+    from = next;
+    if (outcome_ == PlanOutcome::GoalReached) break;
+    const std::optional<Split> again = split_point(from->pose, single(split.first), single(split.second), scratch);
+    if (!again) break;
+    split = *again;
+  }
+  si_->freeState(scratch);
+  return from;
+}
+
+TRRTstar::Node* TRRTstar::walk_after_stall(Node* from, bool own_first, int descent,
+                                           const ob::PlannerTerminationCondition& ptc) {
+  if (outcome_ == PlanOutcome::GoalReached || validator_->wedge_pushers() == 0) return from;
+  const int spare = max_switches_ - from->cost.switches;
+  if (spare < 1) return from;  // the second leg is a switch-over
+  // The first leg by the descent's own pusher costs no switch-over, another's one more.
+  const PusherSet first = own_first || (from->pusher != kNoPusher && spare < 2)
+                              ? single(from->pusher)
+                              : transit_allowed(from, validator_->all_pushers());
+  ob::State* scratch = si_->allocState();
+  const std::optional<Split> split = split_point(from->pose, first, validator_->wedge_pushers(), scratch);
+  si_->freeState(scratch);
+  return split && split->first_leg.norm() >= 1.0 ? walk_to_split(from, *split, descent, ptc) : from;
+}
+
 PusherSet TRRTstar::pivot_toward_goal(const Pose& from, const Pose& goal, PusherSet allowed, PusherSet own,
                                       ob::State* scratch, Pose& q) const {
   const double turn = goal.theta - from.theta;
@@ -146,51 +265,73 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     return m != next && m->descent >= 0 && descent_ends_[m->descent] > far && m->pusher == next->pusher &&
            m->cost.switches <= next->cost.switches && space_->distance(m->pose, next->pose) < 0.5;
   };
-  while (!ptc) {
-    const Steering steering(*space_, steer_angle_, from->pose, goal);
-    if (steering.distance < kMinEdge) break;
-    const double length = steering.length;
-    // Pushers this node may use without exceeding the switch-over budget.
-    const PusherSet allowed = transit_allowed(from, from->pusher == kNoPusher || from->cost.switches < max_switches_
-                                                        ? validator_->all_pushers()
-                                                        : single(from->pusher));
-    // The step toward the goal, or a deviation from it within steer_angle (Steering) that an
-    // allowed pusher makes stable, the descent's own pusher tested first (it costs no switch-over,
-    // and when it works the others need no test). After the straight step (and a point pusher's
-    // surface), the last step's deviation comes first, since a steered descent tends to keep its
-    // turn; then the rings, nearest first.
-    const PusherSet own = from->pusher == kNoPusher ? 0 : single(from->pusher);
-    const auto try_direction = [&](int turn, Pose& q) -> PusherSet {
-      q = steering.step(turn);
-      GraspPoseSpace::set_pose(step_state, q);
-      return si_->isValid(step_state) ? validator_->stable_pushers_preferring(from->pose, q, allowed, own) : 0;
-    };
-    Pose q_new;
-    int turn_taken = 0;  // ring * 8 + k of the step taken (0: straight, or onto a surface)
-    PusherSet stable = try_direction(0, q_new);
-    // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
-    if (stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
-    // A turn about a pad's centre before the steered steps: they drift the object across the grasp.
-    if (stable == 0 && pivot_steps_) stable = pivot_toward_goal(from->pose, goal, allowed, own, step_state, q_new);
-    if (stable == 0 && turn > 0 && (stable = try_direction(turn, q_new)) != 0) turn_taken = turn;
-    for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
-      if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
-    if (stable == 0) break;
-    // A step into the goal's tolerance may climb (a point pusher's surface may cross the box only
-    // farther from the goal pose than the descent's last node): it ends the plan, so it is taken.
-    const auto* goal_region = pdef_->getGoal()->as<PoseGoal>();
-    const bool enters = !goal_region->isSatisfied(from->state) && goal_region->isSatisfied(step_state);
-    if (!enters && !transition_test(from->goal_distance, goal_region->distanceGoal(step_state), length)) break;
-    // Go on with the same pusher where it can (no switch-over); the nodes of the other pushers at
-    // q_new stay candidates for descents of their own, which start each pusher's straight way in.
-    Node* next = connect(from, q_new, stable, from->pusher);
-    next->extended_to_goal = true;  // this descent goes on from it
-    next->descent = descent;
-    if (next->cost.switches > max_switches_) break;
-    from = next;
-    // connect left q_new's near nodes in near_.
-    if (std::any_of(near_.begin(), near_.end(), [&](const Node* m) { return retraces(m, next); })) break;
-    turn = turn_taken;
+  int splits_left = max_switches_;
+  for (;;) {
+    while (!ptc) {
+      const Steering steering(*space_, steer_angle_, from->pose, goal);
+      if (steering.distance < kMinEdge) break;
+      const double length = steering.length;
+      // Pushers this node may use without exceeding the switch-over budget.
+      const PusherSet allowed = transit_allowed(from, from->pusher == kNoPusher || from->cost.switches < max_switches_
+                                                          ? validator_->all_pushers()
+                                                          : single(from->pusher));
+      // The step toward the goal, or a deviation from it within steer_angle (Steering) that an
+      // allowed pusher makes stable, the descent's own pusher tested first (it costs no switch-over,
+      // and when it works the others need no test). After the straight step (and a point pusher's
+      // surface), the last step's deviation comes first, since a steered descent tends to keep its
+      // turn; then the rings, nearest first.
+      const PusherSet own = from->pusher == kNoPusher ? 0 : single(from->pusher);
+      const auto try_direction = [&](int turn, Pose& q) -> PusherSet {
+        q = steering.step(turn);
+        GraspPoseSpace::set_pose(step_state, q);
+        return si_->isValid(step_state) ? validator_->stable_pushers_preferring(from->pose, q, allowed, own) : 0;
+      };
+      Pose q_new;
+      int turn_taken = 0;  // ring * 8 + k of the step taken (0: straight, or onto a surface)
+      PusherSet stable = try_direction(0, q_new);
+      // A point pusher's stable pushes are a surface: the step on it that brings q nearest the goal.
+      if (stable == 0) stable = descend_on_wedges(from->pose, goal, length, allowed, step_state, q_new);
+      // A turn about a pad's centre before the steered steps: they drift the object across the grasp.
+      if (stable == 0 && pivot_steps_) stable = pivot_toward_goal(from->pose, goal, allowed, own, step_state, q_new);
+      if (stable == 0 && turn > 0 && (stable = try_direction(turn, q_new)) != 0) turn_taken = turn;
+      for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
+        if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
+      if (stable == 0) break;
+      // The descent's own point pusher goes no nearer, and a greedy switch-over would leave the
+      // goal off the next surface: first walk to where the next surface through the goal meets this one.
+      if (own != 0 && (stable & own) == 0 && (own & validator_->wedge_pushers()) != 0 && splits_left > 0) {
+        --splits_left;
+        Node* end = walk_after_stall(from, true, descent, ptc);
+        if (end != from) {
+          from = end;
+          turn = 0;
+          continue;
+        }
+      }
+      // A step into the goal's tolerance may climb (a point pusher's surface may cross the box only
+      // farther from the goal pose than the descent's last node): it ends the plan, so it is taken.
+      const auto* goal_region = pdef_->getGoal()->as<PoseGoal>();
+      const bool enters = !goal_region->isSatisfied(from->state) && goal_region->isSatisfied(step_state);
+      if (!enters && !transition_test(from->goal_distance, goal_region->distanceGoal(step_state), length)) break;
+      // Go on with the same pusher where it can (no switch-over); the nodes of the other pushers at
+      // q_new stay candidates for descents of their own, which start each pusher's straight way in.
+      Node* next = connect(from, q_new, stable, from->pusher);
+      next->extended_to_goal = true;  // this descent goes on from it
+      next->descent = descent;
+      if (next->cost.switches > max_switches_) break;
+      from = next;
+      // connect left q_new's near nodes in near_.
+      if (std::any_of(near_.begin(), near_.end(), [&](const Node* m) { return retraces(m, next); })) break;
+      turn = turn_taken;
+    }
+    // Stalled on point pushers' surfaces: on from where another pusher's surface through the
+    // goal meets this one's (walk_after_stall), at most once per switch-over.
+    if (ptc || splits_left == 0) break;
+    --splits_left;
+    Node* end = walk_after_stall(from, false, descent, ptc);
+    if (end == from) break;
+    from = end;
+    turn = 0;
   }
   descent_ends_[descent] = from->goal_distance;
   si_->freeState(step_state);

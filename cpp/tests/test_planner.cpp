@@ -9,7 +9,9 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "stablepush/internal/grasp_space.hpp"
 #include "stablepush/internal/trrt_star.hpp"
@@ -284,22 +286,28 @@ TEST_CASE("pivot_steps: a turn about a pad's centre reaches what straight and st
 }
 
 namespace {
-/// One point pusher whose stable pushes are the plane n . dq = 0 (dq in unit steps, x z theta):
-/// a point pusher's surface, flat.
+/// Point pushers whose stable pushes are planes: pusher k's are n_k . dq = 0 (dq in unit steps,
+/// x z theta), a point pusher's surface, flat.
 class PlaneChecker : public PushChecker {
  public:
-  explicit PlaneChecker(const Eigen::Vector3d& normal) : n_(normal.normalized()) {}
-  PusherSet all_pushers() const override { return 0b1; }
-  PusherSet wedge_pushers() const override { return 0b1; }
+  explicit PlaneChecker(std::vector<Eigen::Vector3d> normals) : n_(std::move(normals)) {
+    for (Eigen::Vector3d& n : n_) n.normalize();
+  }
+  PusherSet all_pushers() const override { return (PusherSet{1} << n_.size()) - 1; }
+  PusherSet wedge_pushers() const override { return all_pushers(); }
   PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
     ++checks_;
     const Eigen::Vector3d d = in_steps(b - a);
-    return d.norm() > 0.0 && std::abs(n_.dot(d)) <= 1e-9 * d.norm() ? (candidates & 0b1) : 0;
+    PusherSet stable = 0;
+    for (std::size_t k = 0; k < n_.size(); ++k)
+      if (d.norm() > 0.0 && std::abs(n_[k].dot(d)) <= 1e-9 * d.norm()) stable |= PusherSet{1} << k;
+    return stable & candidates;
   }
   /// The same heading in (x, z), the theta that puts it on the plane, `length` unit steps long.
   std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
-                                         int) const override {
-    Eigen::Vector3d d(direction.x(), direction.y(), -(n_.x() * direction.x() + n_.y() * direction.y()) / n_.z());
+                                         int pusher) const override {
+    const Eigen::Vector3d& n = n_[pusher];
+    Eigen::Vector3d d(direction.x(), direction.y(), -(n.x() * direction.x() + n.y() * direction.y()) / n.z());
     d *= length / d.norm();
     return a + Motion{d.x() * kStep.length, d.y() * kStep.length, d.z() * kStep.angle};
   }
@@ -311,15 +319,15 @@ class PlaneChecker : public PushChecker {
   static Eigen::Vector3d in_steps(const Motion& m) {
     return {m.dx / kStep.length, m.dz / kStep.length, m.dtheta / kStep.angle};
   }
-  Eigen::Vector3d n_;
+  std::vector<Eigen::Vector3d> n_;
   mutable std::uint64_t checks_ = 0;
 };
 }  // namespace
 
 namespace {
-/// Plans with descents only (goal_bias 1) from the origin to `goal` with PlaneChecker(normal);
+/// Plans with descents only (goal_bias 1) from the origin to `goal` with PlaneChecker(normals);
 /// returns the iterations the solve took, 0 when it found no plan in 1 s.
-std::uint64_t descents_to(const Eigen::Vector3d& normal, const Pose& goal) {
+std::uint64_t descents_to(const std::vector<Eigen::Vector3d>& normals, const Pose& goal, int max_switches = 1) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   ob::RealVectorBounds bounds(3);
   bounds.setLow(-0.02);
@@ -327,7 +335,7 @@ std::uint64_t descents_to(const Eigen::Vector3d& normal, const Pose& goal) {
   auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
   auto si = std::make_shared<ob::SpaceInformation>(space);
   si->setStateValidityChecker([](const ob::State*) { return true; });
-  si->setMotionValidator(std::make_shared<ToyValidator<PlaneChecker>>(si, normal));
+  si->setMotionValidator(std::make_shared<ToyValidator<PlaneChecker>>(si, normals));
   si->setup();
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
   ob::ScopedState<GraspPoseSpace> start(space);
@@ -337,6 +345,7 @@ std::uint64_t descents_to(const Eigen::Vector3d& normal, const Pose& goal) {
   TRRTstar planner(si);
   planner.params().setParam("seed", "1");
   planner.params().setParam("goal_bias", "1");  // descents, while a node is left to descend from
+  planner.params().setParam("max_switches", std::to_string(max_switches));
   planner.setProblemDefinition(pdef);
   planner.setup();
   const bool solved = planner.solve(ob::timedPlannerTerminationCondition(1.0)) == ob::PlannerStatus::EXACT_SOLUTION;
@@ -360,7 +369,7 @@ TEST_CASE("a descent on a point pusher's surface ends in the goal's box where th
         for (const double gz : {0.0, 2.0, -3.0}) {
           const double gtheta = (-n_dot_goal - n.x() * gx) / nz;  // [unit steps]
           const std::uint64_t iterations =
-              descents_to(n, Pose{gx * kStep.length, gz * kStep.length, gtheta * kStep.angle});
+              descents_to({n}, Pose{gx * kStep.length, gz * kStep.length, gtheta * kStep.angle});
           CHECK(iterations > 0);  // every goal planned
           first_descent += iterations == 1;
           ++cases;
@@ -369,5 +378,28 @@ TEST_CASE("a descent on a point pusher's surface ends in the goal's box where th
     }
   }
   CHECK(cases == 81);
+  CHECK(first_descent == cases);  // the start's own descent, every time
+}
+
+TEST_CASE("a descent stalled on one point pusher's surface walks to where another's meets it", "[trrt_star]") {
+  // Two planes of stable pushes whose normals meet at cos 0.64. Greedy descents project the way
+  // left onto one plane and then the other, shrinking it by 0.64^2 per pair of switch-overs, so
+  // with two allowed they end 1.2-3.3 unit steps off these goals (|n_a . g| from 3 to 8). The
+  // walk to where the second plane through the goal meets the first (split_point) reaches it.
+  const std::vector<Eigen::Vector3d> normals = {{0.6, 0.0, 0.8}, {0.0, 0.6, 0.8}};
+  int first_descent = 0, cases = 0;
+  for (const double na_g : {3.0, 5.0, 8.0}) {
+    for (const double gx : {-4.0, 0.0, 4.0}) {
+      for (const double gz : {-3.0, 0.0, 3.0}) {
+        const double gtheta = (na_g - 0.6 * gx) / 0.8;  // [unit steps]: n_a . g = na_g
+        const std::uint64_t iterations =
+            descents_to(normals, Pose{gx * kStep.length, gz * kStep.length, gtheta * kStep.angle}, 2);
+        CHECK(iterations > 0);
+        first_descent += iterations == 1;
+        ++cases;
+      }
+    }
+  }
+  CHECK(cases == 27);
   CHECK(first_descent == cases);  // the start's own descent, every time
 }

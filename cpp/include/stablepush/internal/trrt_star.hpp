@@ -194,6 +194,36 @@ class TRRTstar : public ompl::base::Planner {
   /// returns that pusher; 0, q unchanged, when none.
   PusherSet descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
                               ompl::base::State* scratch, Pose& q) const;
+  /// A point pusher's stable pushes from `at` as rays: the unit steps onto its surface
+  /// (onto_wedge_surface) over 24 headings that keep the grasp and are stable, in unit
+  /// steps, indexed by heading (nullopt where there is none).
+  std::vector<std::optional<Eigen::Vector3d>> wedge_rays(const Pose& at, int pusher, ompl::base::State* scratch) const;
+  /// A two-push way to the goal: the first pusher's push by `first_leg` [unit steps], then the
+  /// second's to the goal; `length` is the two legs' [unit steps].
+  struct Split {
+    int first = kNoPusher;
+    int second = kNoPusher;
+    Eigen::Vector3d first_leg = Eigen::Vector3d::Zero();
+    double length = 0.0;
+  };
+  /// Where a descent on point pushers' surfaces switches over. Two pushes reach the
+  /// goal g from q when g - q = a + b, a in the cone of the first pusher's stable pushes at q and
+  /// b in the second's at g (each cone spanned by two adjacent rays, wedge_rays; the surfaces
+  /// taken as planes, which they are to first order). A greedy descent goes to the point of the
+  /// first surface nearest g, which the second surface through g rarely passes through; q + a is
+  /// on both. The shortest such pair (|a| + |b|, at most three times |g - q|) with the first pusher in
+  /// `first` and the second in `second`; nullopt when there is none.
+  std::optional<Split> split_point(const Pose& q, PusherSet first, PusherSet second, ompl::base::State* scratch);
+  /// From `from`, `split`'s first pusher steps along its first leg (found again after each step,
+  /// as the surface turns with the object) until that leg is under half a step or a step is not
+  /// stable; returns the last node (`from` when no step was taken). Steps of descent `descent`;
+  /// no transition test, since the way to the switch-over may climb.
+  Node* walk_to_split(Node* from, Split split, int descent, const ompl::base::PlannerTerminationCondition& ptc);
+  /// Where a descent on point pushers' surfaces stalls, or is about to switch pushers because its
+  /// own goes no nearer (extend_toward_goal), with a switch-over left: the split_point walk from
+  /// `from` (walk_to_split), the first leg by its own pusher when `own_first` or when one
+  /// switch-over is left; `from` when there is none.
+  Node* walk_after_stall(Node* from, bool own_first, int descent, const ompl::base::PlannerTerminationCondition& ptc);
   /// Toward the goal when no straight, steered or wedge step is stable: a turn about a pad's centre
   /// (PushChecker::pivot_points), the sticking case, by the rest of the goal's theta or as much of
   /// it as a unit step holds, its translation dq = -omega_cross(dtheta, P - o) so that the pad point
@@ -265,6 +295,8 @@ class TRRTstar : public ompl::base::Planner {
   std::vector<Eigen::Vector3d> unit_coords_;  ///< nodes_[i]'s pose in unit steps
   std::vector<Node*> goal_nodes_;
   std::vector<Node*> near_;  ///< scratch for near-node queries
+  /// wedge_rays at the goal, per pusher (filled when first asked; cleared by a new solve).
+  std::vector<std::optional<std::vector<std::optional<Eigen::Vector3d>>>> goal_rays_;
   /// Per descent (extend_toward_goal): the goal distance where it ended [unit steps]; -1 while it runs.
   std::vector<double> descent_ends_;
   /// `value` if it lies in `name`'s declared range, else std::invalid_argument.
