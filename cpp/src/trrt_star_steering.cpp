@@ -109,8 +109,9 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
 namespace {
 constexpr int kRayHeadings = 24;
 constexpr int kSplitRefinements = 2;
-// At most this many times the straight way (long ways round leave the first-order model). Where
-// a descent stalls, the way left is square to its surface, and a split is over twice as long.
+// At most this many times the straight way (long ways round leave the first-order model): for a
+// way left square to the first surface a split is cot(phi / 2) times as long, phi the angle
+// between the two surfaces, so this admits surfaces at least 37 deg apart.
 constexpr double kLongestSplit = 3.0;
 }  // namespace
 
@@ -143,7 +144,7 @@ std::optional<std::pair<Eigen::Vector3d, double>> decompose(const Eigen::Vector3
     if (!(x.minCoeff() >= 0.0)) return;
     const Eigen::Vector3d leg = two_of_first ? Eigen::Vector3d(x[0] * u + x[1] * v) : Eigen::Vector3d(x[2] * w);
     const double length = leg.norm() + (d - leg).norm();
-    // A long way round (nearly parallel rays) leaves the first-order model.
+    // A long way round (surfaces at a shallow angle) leaves the first-order model.
     if (length <= kLongestSplit * d.norm() && (!best || length < best->second)) best = std::make_pair(leg, length);
   };
   const int n = static_cast<int>(first.size());
@@ -297,8 +298,9 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
       for (int t = 8; t < 8 * (steering.rings() + 1) && stable == 0; ++t)
         if (t != turn && (stable = try_direction(t, q_new)) != 0) turn_taken = t;
       if (stable == 0) break;
-      // The descent's own point pusher goes no nearer, and a greedy switch-over would leave the
-      // goal off the next surface: first walk to where the next surface through the goal meets this one.
+      // The step found is not by the descent's own point pusher (its own goes no nearer, or another's
+      // step ends nearer), and a greedy switch-over would leave the goal off the next surface: first
+      // walk to where the next surface through the goal meets this one.
       if (own != 0 && (stable & own) == 0 && (own & validator_->wedge_pushers()) != 0 && splits_left > 0) {
         --splits_left;
         Node* end = walk_after_stall(from, true, descent, ptc);

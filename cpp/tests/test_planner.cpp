@@ -381,7 +381,7 @@ TEST_CASE("a descent on a point pusher's surface ends in the goal's box where th
   CHECK(first_descent == cases);  // the start's own descent, every time
 }
 
-TEST_CASE("a descent stalled on one point pusher's surface walks to where another's meets it", "[trrt_star]") {
+TEST_CASE("a descent on one point pusher's surface walks to where another's through the goal meets it", "[trrt_star]") {
   // Two planes of stable pushes whose normals meet at cos 0.64. Greedy descents project the way
   // left onto one plane and then the other, shrinking it by 0.64^2 per pair of switch-overs, so
   // with two allowed they end 1.2-3.3 unit steps off these goals (|n_a . g| from 3 to 8). The

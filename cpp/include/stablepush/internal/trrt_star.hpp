@@ -17,7 +17,9 @@
 //   3. some pusher makes the step a stable push (StablePushValidator), or, for a point pusher,
 //      the step of the same length and heading turned onto its surface of stable pushes;
 // then connect the new pose to the cheapest near node whose push to it is stable, and rewire
-// the near nodes through it when that is cheaper (Karaman and Frazzoli, RRT*, 2011).
+// the near nodes through it when that is cheaper (Karaman and Frazzoli, RRT*, 2011). A descent
+// toward the goal on point pushers' surfaces that stalls, or would switch pushers, first walks to
+// where the next pusher's surface through the goal meets its own (walk_after_stall).
 //
 // The planner stops when a node within the goal tolerance costs at most max_switches
 // switch-overs, or when the termination condition (time) fires; outcome() says which. With
@@ -194,9 +196,9 @@ class TRRTstar : public ompl::base::Planner {
   /// returns that pusher; 0, q unchanged, when none.
   PusherSet descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
                               ompl::base::State* scratch, Pose& q) const;
-  /// A point pusher's stable pushes from `at` as rays: the unit steps onto its surface
-  /// (onto_wedge_surface) over 24 headings that keep the grasp and are stable, in unit
-  /// steps, indexed by heading (nullopt where there is none).
+  /// A point pusher's stable pushes from `at` as rays [unit steps]: the unit steps onto its surface
+  /// (onto_wedge_surface, the root nearest no turn) over 24 headings that keep the grasp and are
+  /// stable, indexed by heading (nullopt where there is none).
   std::vector<std::optional<Eigen::Vector3d>> wedge_rays(const Pose& at, int pusher, ompl::base::State* scratch) const;
   /// A two-push way to the goal: the first pusher's push by `first_leg` [unit steps], then the
   /// second's to the goal; `length` is the two legs' [unit steps].
@@ -208,21 +210,23 @@ class TRRTstar : public ompl::base::Planner {
   };
   /// Where a descent on point pushers' surfaces switches over. Two pushes reach the
   /// goal g from q when g - q = a + b, a in the cone of the first pusher's stable pushes at q and
-  /// b in the second's at g (each cone spanned by two adjacent rays, wedge_rays; the surfaces
-  /// taken as planes, which they are to first order). A greedy descent goes to the point of the
+  /// b in the second's (each cone spanned by two adjacent rays, wedge_rays; the surfaces taken as
+  /// planes, which they are to first order; the second's rays first at g, then twice again where
+  /// a ends). A greedy descent goes to the point of the
   /// first surface nearest g, which the second surface through g rarely passes through; q + a is
   /// on both. The shortest such pair (|a| + |b|, at most three times |g - q|) with the first pusher in
   /// `first` and the second in `second`; nullopt when there is none.
   std::optional<Split> split_point(const Pose& q, PusherSet first, PusherSet second, ompl::base::State* scratch);
   /// From `from`, `split`'s first pusher steps along its first leg (found again after each step,
-  /// as the surface turns with the object) until that leg is under half a step or a step is not
-  /// stable; returns the last node (`from` when no step was taken). Steps of descent `descent`;
-  /// no transition test, since the way to the switch-over may climb.
+  /// as the surface turns with the object) until that leg is under half a step, a step is not
+  /// stable, no split is found again, the budget is exceeded or the goal is reached; returns the
+  /// last node. Steps of descent `descent`; no transition test, since the way to the switch-over
+  /// may climb. Only before the first plan: walk_after_stall is not called once the goal is reached.
   Node* walk_to_split(Node* from, Split split, int descent, const ompl::base::PlannerTerminationCondition& ptc);
   /// Where a descent on point pushers' surfaces stalls, or is about to switch pushers because its
   /// own goes no nearer (extend_toward_goal), with a switch-over left: the split_point walk from
   /// `from` (walk_to_split), the first leg by its own pusher when `own_first` or when one
-  /// switch-over is left; `from` when there is none.
+  /// switch-over is left, and at least one unit step long; `from` when there is none.
   Node* walk_after_stall(Node* from, bool own_first, int descent, const ompl::base::PlannerTerminationCondition& ptc);
   /// Toward the goal when no straight, steered or wedge step is stable: a turn about a pad's centre
   /// (PushChecker::pivot_points), the sticking case, by the rest of the goal's theta or as much of
