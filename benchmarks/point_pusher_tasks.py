@@ -178,7 +178,8 @@ def main() -> None:
             solved += plan.solved
             runs.append({"task": task.name, "seed": s, "solved": plan.solved, "ms": times[-1],
                          "ends_at_goal": plan.ends_at_goal, "checks": plan.stats["feasibility_checks"],
-                         "restarts": plan.stats["restarts"]})
+                         "restarts": plan.stats["restarts"], "pushes": plan.stats["pushes"],
+                         "switches": plan.stats["switches"]})
         everything += times
         shape = "box" if len(data["object"]["polygon"]) == 4 else f"{len(data['object']['polygon'])}-gon"
         print(f"| {task.name} | {shape} | {len(task.pushers)} | {'yes' if any(task.gravity) else 'no'} "
