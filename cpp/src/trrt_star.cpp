@@ -134,6 +134,7 @@ void TRRTstar::clear() {
   first_cost_ = PathCost{};
   first_margin_ = std::numeric_limits<double>::quiet_NaN();
   outcome_ = PlanOutcome::TimeLimit;
+  goal_rays_.clear();
 }
 
 TRRTstar::Node* TRRTstar::add_node(const Pose& q, int pusher, Node* parent, const PathCost& cost) {

@@ -111,8 +111,12 @@ constexpr int kRayHeadings = 24;
 constexpr int kSplitRefinements = 2;
 // At most this many times the straight way (long ways round leave the first-order model): for a
 // way left square to the first surface a split is cot(phi / 2) times as long, phi the angle
-// between the two surfaces, so this admits surfaces at least 37 deg apart.
+// between the two surfaces, so this admits surfaces at least 37 deg apart. Every other attempt
+// (an odd restart) admits twice as long, surfaces at least 19 deg apart: on some parts two pins'
+// surfaces meet only at such angles, on others the long ways round lead descents astray
+// (docs/planner.md), so the attempts take turns.
 constexpr double kLongestSplit = 3.0;
+constexpr double kLongestSplitOddAttempt = 6.0;
 }  // namespace
 
 std::vector<std::optional<Eigen::Vector3d>> TRRTstar::wedge_rays(const Pose& at, int pusher, ob::State* scratch) const {
@@ -131,21 +135,22 @@ namespace {
 using Rays = std::vector<std::optional<Eigen::Vector3d>>;
 
 /// The shortest d = a + b with a in the cone of `first` (two adjacent rays) and b in that of
-/// `second` (or the other way round), |a| + |b| at most kLongestSplit |d|: (a, |a| + |b|).
+/// `second` (or the other way round), |a| + |b| at most `longest` |d|: (a, |a| + |b|).
 std::optional<std::pair<Eigen::Vector3d, double>> decompose(const Eigen::Vector3d& d, const Rays& first,
-                                                            const Rays& second) {
+                                                            const Rays& second, double longest) {
   std::optional<std::pair<Eigen::Vector3d, double>> best;
   const auto consider = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v, const Eigen::Vector3d& w,
                             bool two_of_first) {
     Eigen::Matrix3d m;
     m << u, v, w;
     if (!(std::abs(m.determinant()) > 1e-6)) return;
-    const Eigen::Vector3d x = m.partialPivLu().solve(d);
-    if (!(x.minCoeff() >= 0.0)) return;
+    Eigen::Vector3d x = m.partialPivLu().solve(d);
+    if (!(x.minCoeff() >= -1e-12)) return;  // d on an edge of a cone solves with -0 there
+    x = x.cwiseMax(0.0);
     const Eigen::Vector3d leg = two_of_first ? Eigen::Vector3d(x[0] * u + x[1] * v) : Eigen::Vector3d(x[2] * w);
     const double length = leg.norm() + (d - leg).norm();
     // A long way round (surfaces at a shallow angle) leaves the first-order model.
-    if (length <= kLongestSplit * d.norm() && (!best || length < best->second)) best = std::make_pair(leg, length);
+    if (length <= longest * d.norm() && (!best || length < best->second)) best = std::make_pair(leg, length);
   };
   const int n = static_cast<int>(first.size());
   for (int i = 0; i < n; ++i) {
@@ -165,6 +170,7 @@ std::optional<TRRTstar::Split> TRRTstar::split_point(const Pose& q, PusherSet fi
   const Eigen::Vector3d d = space_->in_unit_steps(goal - q);
   const PusherSet wedges = validator_->wedge_pushers();
   if (goal_rays_.size() != kMaxPushers) goal_rays_.assign(kMaxPushers, std::nullopt);
+  const double longest = restarts_ % 2 == 1 ? kLongestSplitOddAttempt : kLongestSplit;
   std::optional<Split> best;
   for (int a = 0; a < kMaxPushers; ++a) {
     if (!contains(first & wedges, a)) continue;
@@ -172,11 +178,11 @@ std::optional<TRRTstar::Split> TRRTstar::split_point(const Pose& q, PusherSet fi
     for (int b = 0; b < kMaxPushers; ++b) {
       if (b == a || !contains(second & wedges, b)) continue;
       if (!goal_rays_[b]) goal_rays_[b] = wedge_rays(goal, b, scratch);
-      auto found = decompose(d, rays_a, *goal_rays_[b]);
+      auto found = decompose(d, rays_a, *goal_rays_[b], longest);
       // The second surface turns with the object between the switch-over and the goal: its rays
       // again where the first leg ends, twice.
       for (int again = 0; again < kSplitRefinements && found; ++again) {
-        auto refined = decompose(d, rays_a, wedge_rays(q + space_->from_unit_steps(found->first), b, scratch));
+        auto refined = decompose(d, rays_a, wedge_rays(q + space_->from_unit_steps(found->first), b, scratch), longest);
         if (!refined) break;
         found = refined;
       }
@@ -184,6 +190,13 @@ std::optional<TRRTstar::Split> TRRTstar::split_point(const Pose& q, PusherSet fi
     }
   }
   return best;
+}
+
+TRRTstar::Node* TRRTstar::connect_descent(Node* from, const Pose& q_new, PusherSet stable, int prefer, int descent) {
+  Node* next = connect(from, q_new, stable, prefer);
+  next->extended_to_goal = true;
+  next->descent = descent;
+  return next;
 }
 
 TRRTstar::Node* TRRTstar::walk_to_split(Node* from, Split split, int descent,
@@ -197,9 +210,7 @@ TRRTstar::Node* TRRTstar::walk_to_split(Node* from, Split split, int descent,
     const std::optional<Pose> q =
         validator_->onto_wedge_surface(from->pose, split.first_leg.normalized(), length, split.first);
     if (!q || !wedge_step_valid(from->pose, WedgeStep{0.0, *q, split.first, false}, scratch)) break;
-    Node* next = connect(from, *q, single(split.first), split.first);
-    next->extended_to_goal = true;
-    next->descent = descent;
+    Node* next = connect_descent(from, *q, single(split.first), split.first, descent);
     if (next->cost.switches > max_switches_) break;
     from = next;
     if (outcome_ == PlanOutcome::GoalReached) break;
@@ -267,6 +278,7 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
            m->cost.switches <= next->cost.switches && space_->distance(m->pose, next->pose) < 0.5;
   };
   int splits_left = max_switches_;
+  bool walked = false;  // the last node was reached by a walk (walk_after_stall)
   for (;;) {
     while (!ptc) {
       const Steering steering(*space_, steer_angle_, from->pose, goal);
@@ -301,12 +313,14 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
       // The step found is not by the descent's own point pusher (its own goes no nearer, or another's
       // step ends nearer), and a greedy switch-over would leave the goal off the next surface: first
       // walk to where the next surface through the goal meets this one.
-      if (own != 0 && (stable & own) == 0 && (own & validator_->wedge_pushers()) != 0 && splits_left > 0) {
+      // Right after a walk this step is the handover the walk led to.
+      if (own != 0 && (stable & own) == 0 && (own & validator_->wedge_pushers()) != 0 && splits_left > 0 && !walked) {
         --splits_left;
         Node* end = walk_after_stall(from, true, descent, ptc);
         if (end != from) {
           from = end;
           turn = 0;
+          walked = true;
           continue;
         }
       }
@@ -317,11 +331,10 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
       if (!enters && !transition_test(from->goal_distance, goal_region->distanceGoal(step_state), length)) break;
       // Go on with the same pusher where it can (no switch-over); the nodes of the other pushers at
       // q_new stay candidates for descents of their own, which start each pusher's straight way in.
-      Node* next = connect(from, q_new, stable, from->pusher);
-      next->extended_to_goal = true;  // this descent goes on from it
-      next->descent = descent;
+      Node* next = connect_descent(from, q_new, stable, from->pusher, descent);
       if (next->cost.switches > max_switches_) break;
       from = next;
+      walked = false;
       // connect left q_new's near nodes in near_.
       if (std::any_of(near_.begin(), near_.end(), [&](const Node* m) { return retraces(m, next); })) break;
       turn = turn_taken;
@@ -334,6 +347,7 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
     if (end == from) break;
     from = end;
     turn = 0;
+    walked = true;
   }
   descent_ends_[descent] = from->goal_distance;
   si_->freeState(step_state);

@@ -326,8 +326,10 @@ class PlaneChecker : public PushChecker {
 
 namespace {
 /// Plans with descents only (goal_bias 1) from the origin to `goal` with PlaneChecker(normals);
-/// returns the iterations the solve took, 0 when it found no plan in 1 s.
-std::uint64_t descents_to(const std::vector<Eigen::Vector3d>& normals, const Pose& goal, int max_switches = 1) {
+/// returns the iterations the solve took, 0 when it found no plan in 1 s. With `restarts`, an
+/// attempt ends after its first descent, and the attempts made are written there.
+std::uint64_t descents_to(const std::vector<Eigen::Vector3d>& normals, const Pose& goal, int max_switches = 1,
+                          unsigned* restarts = nullptr) {
   ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
   ob::RealVectorBounds bounds(3);
   bounds.setLow(-0.02);
@@ -346,9 +348,11 @@ std::uint64_t descents_to(const std::vector<Eigen::Vector3d>& normals, const Pos
   planner.params().setParam("seed", "1");
   planner.params().setParam("goal_bias", "1");  // descents, while a node is left to descend from
   planner.params().setParam("max_switches", std::to_string(max_switches));
+  if (restarts != nullptr) planner.params().setParam("restart_checks", "1");
   planner.setProblemDefinition(pdef);
   planner.setup();
   const bool solved = planner.solve(ob::timedPlannerTerminationCondition(1.0)) == ob::PlannerStatus::EXACT_SOLUTION;
+  if (restarts != nullptr) *restarts = planner.restarts();
   return solved ? planner.iterations() : 0;
 }
 }  // namespace
@@ -402,4 +406,32 @@ TEST_CASE("a descent on one point pusher's surface walks to where another's thro
   }
   CHECK(cases == 27);
   CHECK(first_descent == cases);  // the start's own descent, every time
+}
+
+TEST_CASE("an odd attempt's walk between point pushers' surfaces at a shallow angle takes the long way round",
+          "[trrt_star]") {
+  // Two planes of stable pushes 24.5 deg apart (normals meeting at cos 0.91): the shortest split
+  // of the way to these goals, a on the first plane and b on the second, is 1.8 to 4.6 times as
+  // long as the way itself (|a| + |b| over |g|), and greedy switch-overs shrink the way left only
+  // by 0.91^2 per pair. Each attempt ends after its first descent: the first attempt's splits are
+  // at most three times the way, the second's six, so the second attempt's first descent reaches
+  // every goal.
+  const double nz = std::sqrt(0.91);
+  const std::vector<Eigen::Vector3d> normals = {{0.3, 0.0, nz}, {0.0, 0.3, nz}};
+  int second_attempt = 0, cases = 0;
+  for (const double na_g : {3.0, 5.0, 8.0}) {
+    for (const double gx : {-4.0, 0.0, 4.0}) {
+      for (const double gz : {-3.0, 0.0, 3.0}) {
+        const double gtheta = (na_g - 0.3 * gx) / nz;  // [unit steps]: n_a . g = na_g
+        unsigned restarts = 0;
+        const std::uint64_t iterations =
+            descents_to(normals, Pose{gx * kStep.length, gz * kStep.length, gtheta * kStep.angle}, 2, &restarts);
+        CHECK(iterations > 0);
+        second_attempt += restarts <= 1 && iterations <= 2;
+        ++cases;
+      }
+    }
+  }
+  CHECK(cases == 27);
+  CHECK(second_attempt == cases);
 }

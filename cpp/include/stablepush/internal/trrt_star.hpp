@@ -153,6 +153,9 @@ class TRRTstar : public ompl::base::Planner {
   /// Connect q_new (stable from `from` by `stable`) through the cheapest near parent, rewire,
   /// and note a goal; returns the node added for pusher `prefer` if there is one, else the first.
   Node* connect(Node* from, const Pose& q_new, PusherSet stable, int prefer = kNoPusher);
+  /// connect, for a step of descent `descent`, which goes on from the node returned (so no other
+  /// descent starts there).
+  Node* connect_descent(Node* from, const Pose& q_new, PusherSet stable, int prefer, int descent);
   /// Unit steps from `from` straight toward `target` while each is accepted (Algorithm 1).
   void extend(Node* from, const ompl::base::State* target, const ompl::base::PlannerTerminationCondition& ptc);
   /// A descent: unit steps from `from` toward the goal, each the straight step, else the last
@@ -214,8 +217,8 @@ class TRRTstar : public ompl::base::Planner {
   /// planes, which they are to first order; the second's rays first at g, then twice again where
   /// a ends). A greedy descent goes to the point of the
   /// first surface nearest g, which the second surface through g rarely passes through; q + a is
-  /// on both. The shortest such pair (|a| + |b|, at most three times |g - q|) with the first pusher in
-  /// `first` and the second in `second`; nullopt when there is none.
+  /// on both. The shortest such pair (|a| + |b|, at most three times |g - q|, six in an odd
+  /// attempt) with the first pusher in `first` and the second in `second`; nullopt when there is none.
   std::optional<Split> split_point(const Pose& q, PusherSet first, PusherSet second, ompl::base::State* scratch);
   /// From `from`, `split`'s first pusher steps along its first leg (found again after each step,
   /// as the surface turns with the object) until that leg is under half a step, a step is not
