@@ -111,8 +111,8 @@ constexpr int kRayHeadings = 24;
 constexpr int kSplitRefinements = 2;
 // At most this many times the straight way (long ways round leave the first-order model): for a
 // way left square to the first surface a split is cot(phi / 2) times as long, phi the angle
-// between the two surfaces, so this admits surfaces at least 37 deg apart. Every other attempt
-// (an odd restart) admits twice as long, surfaces at least 19 deg apart: on some parts two pins'
+// between the two surfaces, so this admits surfaces at least 37 deg apart. After an odd number of
+// restarts an attempt admits twice as long, surfaces at least 19 deg apart: on some parts two pins'
 // surfaces meet only at such angles, on others the long ways round lead descents astray
 // (docs/planner.md), so the attempts take turns.
 constexpr double kLongestSplit = 3.0;
@@ -145,7 +145,7 @@ std::optional<std::pair<Eigen::Vector3d, double>> decompose(const Eigen::Vector3
     m << u, v, w;
     if (!(std::abs(m.determinant()) > 1e-6)) return;
     Eigen::Vector3d x = m.partialPivLu().solve(d);
-    if (!(x.minCoeff() >= -1e-12)) return;  // d on an edge of a cone solves with -0 there
+    if (!(x.minCoeff() >= -1e-12)) return;  // d on a cone's edge may solve a rounding below 0
     x = x.cwiseMax(0.0);
     const Eigen::Vector3d leg = two_of_first ? Eigen::Vector3d(x[0] * u + x[1] * v) : Eigen::Vector3d(x[2] * w);
     const double length = leg.norm() + (d - leg).norm();
@@ -313,7 +313,7 @@ void TRRTstar::extend_toward_goal(Node* from, const ob::PlannerTerminationCondit
       // The step found is not by the descent's own point pusher (its own goes no nearer, or another's
       // step ends nearer), and a greedy switch-over would leave the goal off the next surface: first
       // walk to where the next surface through the goal meets this one.
-      // Right after a walk this step is the handover the walk led to.
+      // Not right after a walk: from where it ended the split is the one just walked, or none.
       if (own != 0 && (stable & own) == 0 && (own & validator_->wedge_pushers()) != 0 && splits_left > 0 && !walked) {
         --splits_left;
         Node* end = walk_after_stall(from, true, descent, ptc);

@@ -217,8 +217,8 @@ class TRRTstar : public ompl::base::Planner {
   /// planes, which they are to first order; the second's rays first at g, then twice again where
   /// a ends). A greedy descent goes to the point of the
   /// first surface nearest g, which the second surface through g rarely passes through; q + a is
-  /// on both. The shortest such pair (|a| + |b|, at most three times |g - q|, six in an odd
-  /// attempt) with the first pusher in `first` and the second in `second`; nullopt when there is none.
+  /// on both. The shortest such pair (|a| + |b|, at most three times |g - q|, six after an odd
+  /// number of restarts) with the first pusher in `first` and the second in `second`; nullopt when there is none.
   std::optional<Split> split_point(const Pose& q, PusherSet first, PusherSet second, ompl::base::State* scratch);
   /// From `from`, `split`'s first pusher steps along its first leg (found again after each step,
   /// as the surface turns with the object) until that leg is under half a step, a step is not
