@@ -109,10 +109,12 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   /// puts the required pusher wrench in the plane of wedge pusher `pusher`'s cone, in the first
   /// model. Writing the motion's elevation above the translation plane as beta, the motion is
   /// length (cos beta h, sin beta) with h the unit heading, and e . w(a, dq(beta)) = 0 for the
-  /// wedge's plane normal e is a root in beta: bracketed on a grid over |beta| < 90 deg (10 deg, finer
-  /// toward pure rotation) and refined to rounding (regula falsi, Illinois), the root nearest the direction's own
-  /// elevation. Empty when `pusher`'s cone is not a wedge, the direction has no translation, or no root exists. The
-  /// motion still has to pass stable_pushers (the wedge's facets, every model, the grasp).
+  /// wedge's plane normal e is a root in beta: bracketed on a grid over |beta| < 90 deg (10 deg,
+  /// finer toward pure rotation) and refined to rounding (regula falsi, Illinois), the root nearest
+  /// the direction's own elevation (brackets nearest it first; none is evaluated once a root is
+  /// nearer than it). Empty when `pusher`'s cone is not a wedge, the direction has no translation,
+  /// or no root exists. The motion still has to pass stable_pushers (the wedge's facets, every
+  /// model, the grasp).
   std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                          int pusher) const override;
   /// The centres of the first model's pads, each once.
