@@ -111,10 +111,10 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   /// length (cos beta h, sin beta) with h the unit heading, and e . w(a, dq(beta)) = 0 for the
   /// wedge's plane normal e is a root in beta: bracketed on a grid over |beta| < 90 deg (10 deg,
   /// finer toward pure rotation) and refined to rounding (regula falsi, Illinois), the root nearest
-  /// the direction's own elevation (brackets nearest it first; none is evaluated once a root is
-  /// nearer than it). Empty when `pusher`'s cone is not a wedge, the direction has no translation,
-  /// or no root exists. The motion still has to pass stable_pushers (the wedge's facets, every
-  /// model, the grasp).
+  /// the direction's own elevation, the lower on a tie (brackets nearest it first; a bracket
+  /// farther from it than the best root so far is not evaluated). Empty when `pusher`'s cone is
+  /// not a wedge, the direction has no translation, or no root exists. The motion still has to
+  /// pass stable_pushers (the wedge's facets, every model, the grasp).
   std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                          int pusher) const override;
   /// The centres of the first model's pads, each once.
