@@ -70,7 +70,9 @@ void expose_stable_push(py::module_& m) {
       .def_property_readonly("pushers", &StablePushModel::pushers)
       .def_property_readonly("pusher_cones", &StablePushModel::pusher_cones)
       .def_property_readonly("torque_length", &StablePushModel::torque_length)
-      .def("motion_wrench", &StablePushModel::motion_wrench, py::arg("q"), py::arg("dq"), py::arg("pusher") = kNoPusher)
+      .def("motion_wrench",
+           py::overload_cast<const Pose&, const Motion&, int>(&StablePushModel::motion_wrench, py::const_),
+           py::arg("q"), py::arg("dq"), py::arg("pusher") = kNoPusher)
       .def(
           "check",
           [](const StablePushModel& m, const Pose& q, const Motion& dq, int pusher) { return m.check(q, dq, pusher); },

@@ -115,23 +115,37 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
   const double hx = direction[0] / heading_norm, hz = direction[1] / heading_norm;
   const StablePushModel& model = *models_.front();
   const Wrench& plane_normal = model.pusher_cones()[pusher].equality_rows().front();
-  const auto motion = [&](double beta) {
-    return space_.from_unit_steps(length * Eigen::Vector3d(std::cos(beta) * hx, std::cos(beta) * hz, std::sin(beta)));
+  // Every evaluation is from a, so its R(theta) is taken once, and the grid's sines and cosines
+  // once per process: sines and cosines were a large part of each evaluation (docs/measured.md).
+  const PoseAndRotation from(a);
+  const auto motion = [&](double cos_beta, double sin_beta) {
+    return space_.from_unit_steps(length * Eigen::Vector3d(cos_beta * hx, cos_beta * hz, sin_beta));
   };
   struct Off {
     double beta;
     double off;    ///< e . w(a, dq(beta)) [N]
     double scale;  ///< the motion wrench's scale there (MotionWrench::scale)
   };
-  const auto off_plane = [&](double beta) {
-    const MotionWrench load = model.motion_wrench(a, motion(beta), pusher);
+  const auto off_plane = [&](double beta, double cos_beta, double sin_beta) {
+    const MotionWrench load = model.motion_wrench(from, motion(cos_beta, sin_beta), pusher);
     return Off{beta, plane_normal.dot(load.required), load.scale};
   };
   // The grid in beta [deg], finer toward pure rotation, where a peg's roots crowd (a motion whose
-  // translation is small against its rotation in unit steps).
+  // translation is small against its rotation in unit steps); in radians with its cosines and sines.
   static constexpr double kGridDeg[] = {-89.95, -89.5, -88, -85, -80, -70, -60, -50, -40, -30, -20,  -10,  0,
                                         10,     20,    30,  40,  50,  60,  70,  80,  85,  88,  89.5, 89.95};
   constexpr std::size_t kGrid = std::size(kGridDeg);
+  struct GridAngle {
+    double beta, cos_beta, sin_beta;
+  };
+  static const std::array<GridAngle, kGrid> kGridAngles = [] {
+    std::array<GridAngle, kGrid> angles;
+    for (std::size_t i = 0; i < kGrid; ++i) {
+      const double beta = kGridDeg[i] * M_PI / 180.0;
+      angles[i] = {beta, std::cos(beta), std::sin(beta)};
+    }
+    return angles;
+  }();
   const double beta0 = std::atan2(direction[2], heading_norm);
   // The brackets between neighbouring grid angles, nearest beta0 first, each evaluated when its
   // turn comes: once one is farther from beta0 than the root found, no root in it or beyond can be
@@ -140,11 +154,11 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
   // the motion wrench on the generated pin tasks (docs/measured.md).
   std::array<std::pair<double, std::size_t>, kGrid - 1> brackets;  // (distance from beta0, upper index)
   for (std::size_t i = 1; i < kGrid; ++i)
-    brackets[i - 1] = {std::max({0.0, kGridDeg[i - 1] * M_PI / 180.0 - beta0, beta0 - kGridDeg[i] * M_PI / 180.0}), i};
+    brackets[i - 1] = {std::max({0.0, kGridAngles[i - 1].beta - beta0, beta0 - kGridAngles[i].beta}), i};
   std::sort(brackets.begin(), brackets.end());
   std::array<std::optional<Off>, kGrid> grid;
   const auto at_grid = [&](std::size_t i) -> const Off& {
-    if (!grid[i]) grid[i] = off_plane(kGridDeg[i] * M_PI / 180.0);
+    if (!grid[i]) grid[i] = off_plane(kGridAngles[i].beta, kGridAngles[i].cos_beta, kGridAngles[i].sin_beta);
     return *grid[i];
   };
   std::optional<double> best;
@@ -160,7 +174,7 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
       double mid = (lo.beta * f_hi - hi.beta * f_lo) / (f_hi - f_lo);
       if (!(mid > lo.beta && mid < hi.beta)) mid = 0.5 * (lo.beta + hi.beta);
       if (!(mid > lo.beta && mid < hi.beta)) break;  // lo and hi are adjacent doubles
-      const Off at_mid = off_plane(mid);
+      const Off at_mid = off_plane(mid, std::cos(mid), std::sin(mid));
       if (at_mid.off == 0.0) {
         lo = hi = at_mid;
         f_lo = f_hi = 0.0;
@@ -187,7 +201,7 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
       best = root.beta;
   }
   if (!best) return std::nullopt;
-  return a + motion(*best);
+  return a + motion(std::cos(*best), std::sin(*best));
 }
 
 PusherSet PushChecker::stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,

@@ -100,6 +100,11 @@ Vec2 StablePushModel::gravity_in_gripper(const Rotation2& R, int pusher) const {
 }
 
 MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq, int pusher) const {
+  return motion_wrench(PoseAndRotation(q), dq, pusher);
+}
+
+MotionWrench StablePushModel::motion_wrench(const PoseAndRotation& at, const Motion& dq, int pusher) const {
+  const Pose& q = at.pose();
   if (!(std::isfinite(q.x) && std::isfinite(q.z) && std::isfinite(q.theta)))
     throw std::invalid_argument("the pose q is not finite");
   if (!(std::isfinite(dq.dx) && std::isfinite(dq.dz) && std::isfinite(dq.dtheta)))
@@ -108,7 +113,7 @@ MotionWrench StablePushModel::motion_wrench(const Pose& q, const Motion& dq, int
   if (std::max({std::abs(dq.dx), std::abs(dq.dz), std::abs(dq.dtheta)}) < kSmallestMotion)
     throw std::invalid_argument("the motion dq is zero (or under 1e-12 m and rad)");
   MotionWrench load;
-  load.rotation = Rotation2(q.theta);
+  load.rotation = at.rotation();
   load.gravity = gravity_in_gripper(load.rotation, pusher);
   DoubleLoads loads{1.0 / torque_length_};
   loads.out = &load;

@@ -111,6 +111,8 @@ class StablePushModel {
   /// when `pusher` pushes (its index selects the gravity, see GravityFrame; kNoPusher: G's axes the
   /// world's).
   MotionWrench motion_wrench(const Pose& q, const Motion& dq, int pusher) const;
+  /// The same, with R(theta) already at hand (bit for bit the same wrench).
+  MotionWrench motion_wrench(const PoseAndRotation& q, const Motion& dq, int pusher) const;
 
   /// The stable-push test of dq from q for pusher `pusher` (an index into pushers()).
   PushResult check(const Pose& q, const Motion& dq, int pusher) const;

@@ -58,6 +58,19 @@ struct Rotation2 {
   Vec2 apply_inverse(const Vec2& v) const { return Vec2(c * v.x() - s * v.y(), s * v.x() + c * v.y()); }
 };
 
+/// A pose q with its R(theta) evaluated once, for the many motions a root search tries from one pose
+/// (StablePushModel::motion_wrench); the rotation is always the pose's own.
+class PoseAndRotation {
+ public:
+  explicit PoseAndRotation(const Pose& q) : pose_(q), rotation_(q.theta) {}
+  const Pose& pose() const { return pose_; }
+  const Rotation2& rotation() const { return rotation_; }
+
+ private:
+  Pose pose_;
+  Rotation2 rotation_;
+};
+
 /// The point at angle 2 pi j / n on the unit circle, with the eight symmetries of the square
 /// holding bit for bit (mirror images are exact negations or swaps). Pad rings and friction
 /// polygons are built from it, so a symmetric task gives sums that cancel exactly, which the
