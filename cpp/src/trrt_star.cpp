@@ -150,9 +150,6 @@ TRRTstar::Node* TRRTstar::add_node(const Pose& q, int pusher, Node* parent, cons
   if (parent != nullptr) parent->children.push_back(node);
   nodes_.push_back(node);
   unit_coords_.push_back(space_->in_unit_steps(q));
-  if (nodes_.size() == 1) min_goal_distance_ = max_goal_distance_ = node->goal_distance;
-  min_goal_distance_ = std::min(min_goal_distance_, node->goal_distance);
-  max_goal_distance_ = std::max(max_goal_distance_, node->goal_distance);
   return node;
 }
 

@@ -329,8 +329,6 @@ class TRRTstar : public ompl::base::Planner {
 
   double temperature_ = 0.0;
   unsigned transition_failures_ = 0;
-  double min_goal_distance_ = 0.0;
-  double max_goal_distance_ = 0.0;
   std::uint64_t iterations_ = 0;
   PlanOutcome outcome_ = PlanOutcome::TimeLimit;
   std::chrono::steady_clock::time_point solve_started_;
