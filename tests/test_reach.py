@@ -16,7 +16,7 @@ from stablepush.plan.reach import ReachJob, axis_values, reach_cell, reach_map
 from stablepush.runners import Runner
 from stablepush_cli.main import cli
 
-from conftest import TASKS, shipped
+from conftest import TASKS, shipped, task_with
 
 GRID = dict(x=(-30.0, 30.0, 5), z=(-15.0, 15.0, 3), theta=(-20.0, 20.0, 2))
 
@@ -51,6 +51,19 @@ def test_a_goal_at_the_start_is_reached_with_no_push():
     job = ReachJob(task=task, goals=(tuple(task.start),), seed=1, time_limit=0.1)
     cell = reach_cell(job, 0)
     assert cell["verdict"] == "reached" and cell["pushes"] == 0 and cell["outcome"] == "at_start"
+
+
+def test_a_goal_at_the_start_the_pads_do_not_hold_as_asked_is_not_reached():
+    # 2 N of grip hold the offset bar 0.86 times its weight at the start.
+    def weak(d, need):
+        d["gripper"]["grip_force"] = 2.0
+        d["planner"]["min_hold_ratio"] = need
+    task = task_with("horizontal-offset-high-mu", lambda d: weak(d, 1.0))
+    job = ReachJob(task=task, goals=(tuple(task.start),), seed=1, time_limit=0.1)
+    cell = reach_cell(job, 0)
+    assert cell["verdict"] == "unreachable" and "min_hold_ratio" in cell["reason"] and not cell["solved"]
+    held = reach_cell(dataclasses.replace(job, task=task_with("horizontal-offset-high-mu", lambda d: weak(d, 0.85))), 0)
+    assert held["verdict"] == "reached" and held["pushes"] == 0
 
 
 def test_reach_cli_writes_the_map_and_refuses_a_bad_axis(tmp_path):
@@ -121,13 +134,16 @@ def test_show_draws_a_plan_that_found_no_push_and_marks_the_goal(tmp_path):
 def test_the_library_refuses_a_bad_grid_naming_the_axis_before_any_cell():
     """reach_map checks its axes, seed and time limit as the CLI does: a count that is not a whole
     number, a bound past the task file's pose bounds, a seed or time limit out of the planner's
-    ranges are refused with the argument named, and the map records the axes it planned."""
+    ranges, a count of 1 with two ends or equal ends with a larger count are refused with the
+    argument named, and the map records the axes it planned."""
     task = shipped("pivoting")
     x, z = (0.0, 0.0, 1), (0.0, 0.0, 1)
     bad = {r"x\[1\]": dict(x=(0.0, math.nan, 2)), "x: must be \\(from, to, count\\)": dict(x=(0.0, 10.0)),
            "x: must be": dict(x=np.array(5.0)),
            r"x\[2\]": dict(x=(0.0, 10.0, 2.7)), r"theta\[0\]": dict(theta=(1e5, 1e5, 1)),
-           r"z\[2\]": dict(z=(0.0, 1.0, 0)), "seed": dict(seed=-1), "time_limit": dict(time_limit=0.0)}
+           r"z\[2\]": dict(z=(0.0, 1.0, 0)), "seed": dict(seed=-1), "time_limit": dict(time_limit=0.0),
+           r"x\[2\]: a count of 1 takes from \(0\) alone": dict(x=(0.0, 10.0, 1)),
+           r"z\[2\]: from and to are both 5": dict(z=(5.0, 5.0, 3))}
     for field, change in bad.items():
         arguments = {"x": x, "z": z, "theta": (0.0, 0.0, 1), "seed": 1, "time_limit": 0.1, **change}
         with pytest.raises(TaskError, match=field):
@@ -135,3 +151,18 @@ def test_the_library_refuses_a_bad_grid_naming_the_axis_before_any_cell():
     result = reach_map(task, x=np.array([0.0, 0.0, 1.0]), z=z, theta=(0.0, 90.0, np.int64(2)), time_limit=0.1)
     assert result.axes["theta"] == [0.0, 90.0, 2] and type(result.axes["theta"][2]) is int
     assert result.axes["x"] == [0.0, 0.0, 1] and len(result.cells) == 2
+
+
+def test_the_figure_draws_the_slice_of_the_start_and_says_how_many_it_leaves_out():
+    from stablepush.viz.figures import reach_figure
+
+    task = shipped("t-shaped")  # start theta 0
+    cells = [{"goal": [0.0, 3.0, float(theta)], "verdict": "reached"} for theta in range(-3, 4)]
+    reach = {"task": task.name, "start": list(task.start), "cells": cells, "seed": 1, "time_limit_s": 0.2,
+             "counts": {"reached": 7, "not found": 0, "unreachable": 0}}
+    fig = reach_figure(task, reach)
+    titles = [ax.get_title() for ax in fig.axes[1:]]
+    assert len(titles) == 6 and "goal theta 0 deg" in titles
+    assert "6 of 7 theta slices drawn" in fig._suptitle.get_text()
+    reach["cells"] = cells[:6]
+    assert "slices drawn" not in reach_figure(task, reach)._suptitle.get_text()

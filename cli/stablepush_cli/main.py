@@ -1142,7 +1142,8 @@ def _beside(path: str, endings, suffix: str) -> str:
 
 
 def _axis(_ctx, param, value):
-    """A grid axis A:B:N (N values from A to B; N = 1: A alone), within the task file's pose bounds."""
+    """A grid axis A:B:N (N values from A to B; A:A:1 for A alone), within the task file's pose bounds;
+    ReachJob.grid refuses a count of 1 with B other than A, and equal ends with a larger count."""
     from stablepush.plan.reach import MAX_AXIS
     from stablepush.task.schema import ANGLE, COORDINATE
 
@@ -1179,7 +1180,8 @@ def _axis(_ctx, param, value):
               help="Write the map: its cells (goal, verdict, reason, solved, seed, planning time, switch-overs).")
 @click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
               help="Draw the map in slices of theta, beside the grasp at the start (PNG, PDF or SVG, as the name "
-                   "ends).")
+                   "ends); at most six slices, evenly chosen, the one nearest the start's theta among them (the "
+                   "title says how many of how many).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, workers, ray_address, json_path,
           png_path, quiet: bool) -> None:

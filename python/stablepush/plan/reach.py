@@ -13,7 +13,9 @@ Each cell ends with a verdict:
   no stable push out of the start, none that ends within the goal's tolerance, the goal not held
   well enough anywhere in its tolerance, a pad that would have to leave the object);
 - `not found`: the search ran out of time (`outcome` says how: `time_limit`, or
-  `goal_over_switch_limit` when the goal was reached with more switch-overs than allowed).
+  `goal_over_switch_limit` when the goal was reached with more switch-overs than allowed), or the
+  goal is within the tolerance of the start where the pads do not hold the object as
+  `planner.min_hold_ratio` asks, and nothing decides it (`outcome` `at_start`; see at_start_verdict).
 
 Poses are (x mm, z mm, theta deg), as in task files.
 """
@@ -27,6 +29,7 @@ import numpy as np
 
 from stablepush.errors import TaskError
 from stablepush.plan.search import plan_task
+from stablepush.plan.unreachable import why_unreachable
 from stablepush.task.model import Task, make_gripper, require_task
 from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_limit, planner_parameter
 from stablepush.units import is_finite_real, pose_to_si
@@ -83,6 +86,13 @@ def grid_axis(name: str, axis, bound: Tuple[float, float]) -> Axis:
     count = axis[2]
     if not (is_finite_real(count) and float(count).is_integer() and 1 <= count <= MAX_AXIS):
         raise TaskError(f"{name}[2]", f"the count must be a whole number from 1 to {MAX_AXIS}, got {count!r:.40}")
+    # Either would plan other goals than written: a count of 1 takes `from` alone, equal ends one goal.
+    if count == 1 and start != stop:
+        raise TaskError(f"{name}[2]", f"a count of 1 takes from ({start:g}) alone, not to ({stop:g}): give "
+                                      f"{start:g}:{start:g}:1, or a count of 2 or more")
+    if count > 1 and start == stop:
+        raise TaskError(f"{name}[2]", f"from and to are both {start:g}, so the {int(count)} values would be one goal "
+                                      f"planned {int(count)} times: give a count of 1")
     return start, stop, int(count)
 
 
@@ -91,6 +101,26 @@ def pads_off_object(task: Task, pose: Sequence[float]) -> List[int]:
     inside = make_gripper(task.pads, task.grip_force, task.mu, task.pad_rings).pads_inside(task.section(),
                                                                                            pose_to_si(pose))
     return [i for i, ok in enumerate(inside) if not ok]
+
+
+def at_start_verdict(task: Task) -> dict:
+    """The verdict of a goal within the tolerance of the start, which the planner does not search
+    (plan_task refuses it): reached with no push where the pads alone hold the object at the start
+    as `planner.min_hold_ratio` asks (no pusher pushed, so gravity as with G's axes the world's);
+    else unreachable where the planner's verdicts find the goal's whole tolerance held too little,
+    and otherwise not found (a plan that pushes away and back is not searched)."""
+    need = float(task.planner.get("min_hold_ratio", 0.0))
+    models = task.corner_models()
+    held = min(m.hold_ratio(pose_to_si(task.start), -1) for m in models) if need > 0.0 else float("inf")
+    if held >= need:
+        return {"solved": True, "switches": 0, "pushes": 0, "outcome": "at_start", "verdict": "reached"}
+    reason = why_unreachable(task, models)
+    if reason is not None:
+        return {"outcome": "unreachable", "verdict": "unreachable", "reason": f"unreachable: {reason}"}
+    return {"outcome": "at_start", "verdict": "not found",
+            "reason": f"the goal is within planner.tolerance of the start, where the pads alone hold {held:.3g} times "
+                      f"the weight and planner.min_hold_ratio asks for {need:g}; a plan that pushes away and back "
+                      f"is not searched"}
 
 
 def reach_cell(job: ReachJob, i: int) -> dict:
@@ -104,7 +134,7 @@ def reach_cell(job: ReachJob, i: int) -> dict:
         return {**cell, "verdict": "unreachable",
                 "reason": f"gripper.pads{off} would not lie on the object at the goal: no grasp there"}
     if task.at_goal(task.start):
-        return {**cell, "solved": True, "switches": 0, "pushes": 0, "outcome": "at_start", "verdict": "reached"}
+        return {**cell, **at_start_verdict(task)}
     plan = plan_task(task, seed=job.seed, time_limit=job.time_limit)
     s = plan.stats
     cell.update(solved=plan.solved, planning_time_s=s["planning_time_s"], switches=s["switches"],

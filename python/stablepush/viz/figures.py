@@ -286,16 +286,24 @@ def evaluation_figure(summary: dict, trials: Sequence[dict]) -> Figure:
     return fig
 
 
+MAX_REACH_SLICES = 6  # theta slices a reach map's figure draws
 REACH_STYLE = {"reached": ("tab:green", "o"), "not found": ("tab:orange", "s"), "unreachable": ("0.55", "x")}
 
 
 def reach_figure(task: Task, reach: dict) -> Figure:
     """A reach map (`stablepush.plan.reach`): first the grasp at the start with its pads and
-    pushers (the fixtures); then one panel per slice of theta (at most six, evenly chosen), each
-    goal (x, z) marked by its verdict, the start's (x, z) a star."""
-    thetas = sorted({c["goal"][2] for c in reach["cells"]})
-    if len(thetas) > 6:
-        thetas = [thetas[int(round(k))] for k in np.linspace(0, len(thetas) - 1, 6)]
+    pushers (the fixtures); then one panel per slice of theta (at most MAX_REACH_SLICES, evenly
+    chosen, the one nearest the start's theta among them; the title says how many of how many),
+    each goal (x, z) marked by its verdict, the start's (x, z) a hollow star over it."""
+    all_thetas = sorted({c["goal"][2] for c in reach["cells"]})
+    thetas = all_thetas
+    if len(all_thetas) > MAX_REACH_SLICES:
+        picked = {int(round(k)) for k in np.linspace(0, len(all_thetas) - 1, MAX_REACH_SLICES)}
+        nearest = int(np.argmin([abs(t - reach["start"][2]) for t in all_thetas]))
+        if nearest not in picked:  # it takes the place of the picked slice nearest to it
+            picked.remove(min(picked, key=lambda k: abs(k - nearest)))
+            picked.add(nearest)
+        thetas = [all_thetas[k] for k in sorted(picked)]
     fig = Figure(figsize=(3.3 * (len(thetas) + 1), 3.6))
     axes = np.atleast_1d(fig.subplots(1, len(thetas) + 1))
     start = list(reach["start"])
@@ -308,7 +316,9 @@ def reach_figure(task: Task, reach: dict) -> Figure:
             cells = [c for c in reach["cells"] if c["goal"][2] == theta and c["verdict"] == verdict]
             ax.scatter([c["goal"][0] for c in cells], [c["goal"][1] for c in cells], c=colour, marker=marker, s=28,
                        label=f"{verdict} ({len(cells)})")
-        ax.plot([start[0]], [start[1]], "*", color="k", ms=12, label=f"start (theta {start[2]:g})")
+        # Hollow, so that the cell at the start's (x, z) shows through it.
+        ax.plot([start[0]], [start[1]], "*", markerfacecolor="none", markeredgecolor="k", ms=14,
+                label=f"start (theta {start[2]:g})")
         ax.set_xlim(min(xs) - margin, max(xs) + margin)
         ax.set_ylim(min(zs) - margin, max(zs) + margin)
         ax.set_aspect("equal")
@@ -318,7 +328,8 @@ def reach_figure(task: Task, reach: dict) -> Figure:
         ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2)
     axes[1].set_ylabel("z mm", fontsize=8)
     counts = reach["counts"]
+    drawn = "" if len(thetas) == len(all_thetas) else f"; {len(thetas)} of {len(all_thetas)} theta slices drawn"
     fig.suptitle(f"{reach['task']}: {counts['reached']} reached, {counts['not found']} not found in "
-                 f"{reach['time_limit_s']:g} s, {counts['unreachable']} unreachable (seed {reach['seed']})",
+                 f"{reach['time_limit_s']:g} s, {counts['unreachable']} unreachable (seed {reach['seed']}){drawn}",
                  fontsize=10)
     return fig
