@@ -62,6 +62,9 @@ def test_a_goal_at_the_start_the_pads_do_not_hold_as_asked_is_not_reached():
     job = ReachJob(task=task, goals=(tuple(task.start),), seed=1, time_limit=0.1)
     cell = reach_cell(job, 0)
     assert cell["verdict"] == "unreachable" and "min_hold_ratio" in cell["reason"] and not cell["solved"]
+    # 0.86 asked: the start falls short, but somewhere within the tolerance the bound (0.865) does not.
+    cell = reach_cell(dataclasses.replace(job, task=task_with("horizontal-offset-high-mu", lambda d: weak(d, 0.86))), 0)
+    assert cell["verdict"] == "not found" and cell["outcome"] == "at_start" and not cell["solved"]
     held = reach_cell(dataclasses.replace(job, task=task_with("horizontal-offset-high-mu", lambda d: weak(d, 0.85))), 0)
     assert held["verdict"] == "reached" and held["pushes"] == 0
 
@@ -163,6 +166,6 @@ def test_the_figure_draws_the_slice_of_the_start_and_says_how_many_it_leaves_out
     fig = reach_figure(task, reach)
     titles = [ax.get_title() for ax in fig.axes[1:]]
     assert len(titles) == 6 and "goal theta 0 deg" in titles
-    assert "6 of 7 theta slices drawn" in fig._suptitle.get_text()
+    assert any("6 of 7 theta slices drawn" in text.get_text() for text in fig.texts)
     reach["cells"] = cells[:6]
-    assert "slices drawn" not in reach_figure(task, reach)._suptitle.get_text()
+    assert not any("slices drawn" in text.get_text() for text in reach_figure(task, reach).texts)

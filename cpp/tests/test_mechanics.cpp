@@ -3,7 +3,6 @@
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 #include <cmath>
-#include <random>
 
 #include "stablepush/cross_section.hpp"
 #include "stablepush/friction_cone.hpp"
@@ -78,46 +77,6 @@ TEST_CASE("a pure translation's motion wrench is the inertia plus all the pads' 
   CHECK(model.check(Pose{0, 0, 0}, Motion{dx, 0, 0}, 0).feasible);
   // It cannot pull the object along -x.
   CHECK_FALSE(model.check(Pose{0, 0, 0}, Motion{-dx, 0, 0}, 0).feasible);
-}
-
-TEST_CASE("the motion wrench from a pose with its rotation at hand is the pose's own, bit for bit", "[motion_wrench]") {
-  // A root search evaluates many motions from one pose and takes R(theta) once (PoseAndRotation);
-  // its answers must not depend on that. Gravity turns with each pusher's feature (GravityFrame::
-  // Object), and some motions leave pad points sticking.
-  const CrossSection box = CrossSection::box(kLength, kHeight);
-  const Gripper gripper({Pad{Vec2(0.01, 0.005), 0.005}, Pad{Vec2(0.01, 0.005), 0.005}}, 10.0, 0.5, 2);
-  const std::vector<Pusher> pushers = {
-      Pusher::on_boundary(box, "left", Vec2(-kLength / 2, -0.01), Vec2(-kLength / 2, 0.01), 0.5, 3),
-      Pusher::on_boundary(box, "pin", Vec2(0.02, -kHeight / 2), Vec2(0.02, -kHeight / 2), 0.4, 1)};
-  const StablePushModel model(box, RigidBody::uniform(box, 0.2), gripper, pushers, Vec2(0, -9.81), 0.1, 16,
-                              GravityFrame::Object, {0.0, 0.7});
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> position(-0.03, 0.03), angle(-7.0, 7.0), step(-1e-3, 1e-3);
-  int sticking = 0;
-  for (int i = 0; i < 2000; ++i) {
-    const Pose q{position(rng), position(rng), angle(rng)};
-    // Every fourth motion turns about the pads' centre (fixed in G), where their points stick.
-    const double dtheta = step(rng);
-    const Vec2 about_pads = -omega_cross(dtheta, Vec2(0.01, 0.005) - Vec2(q.x, q.z));
-    const Motion dq =
-        i % 4 == 0 ? Motion{about_pads.x(), about_pads.y(), dtheta} : Motion{step(rng), step(rng), step(rng)};
-    const PoseAndRotation at(q);
-    for (int pusher = 0; pusher < 2; ++pusher) {
-      const MotionWrench expected = model.motion_wrench(q, dq, pusher);
-      const MotionWrench got = model.motion_wrench(at, dq, pusher);
-      REQUIRE(got.required == expected.required);
-      REQUIRE(got.scale == expected.scale);
-      REQUIRE(got.gravity == expected.gravity);
-      REQUIRE(got.sticking_points == expected.sticking_points);
-      REQUIRE(got.sticking.size() == expected.sticking.size());
-      for (std::size_t g = 0; g < got.sticking.size(); ++g) {
-        REQUIRE(got.sticking[g].arm == expected.sticking[g].arm);
-        REQUIRE(got.sticking[g].friction_limit == expected.sticking[g].friction_limit);
-      }
-      sticking += expected.sticking_points > 0;
-    }
-  }
-  CHECK(sticking > 0);  // the sticking case was met
 }
 
 TEST_CASE("the swept grasp test: a pad disc swept along a motion stays inside the section", "[grasp]") {

@@ -107,8 +107,8 @@ def at_start_verdict(task: Task) -> dict:
     """The verdict of a goal within the tolerance of the start, which the planner does not search
     (plan_task refuses it): reached with no push where the pads alone hold the object at the start
     as `planner.min_hold_ratio` asks (no pusher pushed, so gravity as with G's axes the world's);
-    else unreachable where the planner's verdicts find the goal's whole tolerance held too little,
-    and otherwise not found (a plan that pushes away and back is not searched)."""
+    else unreachable where one of the planner's verdicts before its search decides it
+    (why_unreachable), and otherwise not found (a plan that pushes away and back is not searched)."""
     need = float(task.planner.get("min_hold_ratio", 0.0))
     models = task.corner_models()
     held = min(m.hold_ratio(pose_to_si(task.start), -1) for m in models) if need > 0.0 else float("inf")

@@ -88,7 +88,7 @@ def _snapshots(steps: Sequence[Waypoint]) -> List[int]:
     return keys[:MAX_SNAPSHOTS] if len(keys) <= MAX_SNAPSHOTS else keys[:MAX_SNAPSHOTS - 1] + [keys[-1]]
 
 
-def _short_of_goal(task: Task, pose) -> str:
+def _end_from_goal(task: Task, pose) -> str:
     dx, dz, dth = (a - b for a, b in zip(pose, task.goal))
     return f"the end is {math.hypot(dx, dz):.2f} mm and {dth:+.2f} deg in theta\nfrom the goal (red)"
 
@@ -117,8 +117,8 @@ def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
         last = i == len(steps) - 1
         label = "start" if i == 0 else (("goal" if plan.solved else "end") if last else f"step {i}")
         if last and not plan.solved:
-            label = _short_of_goal(task, steps[i].pose) if i > 0 else "start, no push found\n" + \
-                _short_of_goal(task, steps[i].pose)
+            label = _end_from_goal(task, steps[i].pose) if i > 0 else "start, no push found\n" + \
+                _end_from_goal(task, steps[i].pose)
         elif i in switches:
             label += f"\nswitch to {pusher}"
         elif pusher:
