@@ -116,7 +116,7 @@ def at_start_verdict(task: Task) -> dict:
         return {"solved": True, "switches": 0, "pushes": 0, "outcome": "at_start", "verdict": "reached"}
     reason = why_unreachable(task, models)
     if reason is not None:
-        return {"outcome": "unreachable", "verdict": "unreachable", "reason": f"unreachable: {reason}"}
+        return {"outcome": "unreachable", "verdict": "unreachable", "reason": reason}
     return {"outcome": "at_start", "verdict": "not found",
             "reason": f"the goal is within planner.tolerance of the start, where the pads alone hold {held:.3g} times "
                       f"the weight and planner.min_hold_ratio asks for {need:g}; a plan that pushes away and back "
@@ -141,8 +141,8 @@ def reach_cell(job: ReachJob, i: int) -> dict:
                 pushes=s["pushes"], outcome=plan.outcome)
     if plan.solved:
         cell["verdict"] = "reached"
-    elif plan.outcome in ("invalid_start", "unreachable"):
-        cell.update(verdict="unreachable", reason=plan.message)
+    elif plan.outcome in ("invalid_start", "unreachable"):  # the verdict says it: the reason alone
+        cell.update(verdict="unreachable", reason=plan.message.removeprefix("unreachable: "))
     else:
         cell.update(verdict="not found", reason=plan.message)
     return cell
