@@ -90,7 +90,7 @@ def _snapshots(steps: Sequence[Waypoint]) -> List[int]:
 
 def _end_from_goal(task: Task, pose) -> str:
     dx, dz, dth = (a - b for a, b in zip(pose, task.goal))
-    return f"the end is {math.hypot(dx, dz):.2f} mm and {dth:+.2f} deg in theta\nfrom the goal (red)"
+    return f"end: {math.hypot(dx, dz):.2f} mm and {dth:+.2f} deg in theta\nfrom the goal (red)"
 
 
 def plan_title(task: Task, plan: Plan) -> str:
