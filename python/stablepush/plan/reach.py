@@ -110,8 +110,9 @@ def at_start_verdict(task: Task) -> dict:
     else unreachable where one of the planner's verdicts before its search decides it
     (why_unreachable), and otherwise not found (a plan that pushes away and back is not searched)."""
     need = float(task.planner.get("min_hold_ratio", 0.0))
-    models = task.corner_models()
-    held = min(m.hold_ratio(pose_to_si(task.start), -1) for m in models) if need > 0.0 else float("inf")
+    # The models only where a hold is asked for: without one every such goal is reached.
+    models = task.corner_models() if need > 0.0 else []
+    held = min((m.hold_ratio(pose_to_si(task.start), -1) for m in models), default=float("inf"))
     if held >= need:
         return {"solved": True, "switches": 0, "pushes": 0, "outcome": "at_start", "verdict": "reached"}
     reason = why_unreachable(task, models)
