@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <iterator>
+#include <limits>
 
 namespace stablepush {
 
@@ -165,35 +166,9 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
   for (const auto& [distance, upper] : brackets) {
     if (best && distance > std::abs(*best - beta0)) break;
     if ((at_grid(upper - 1).off < 0.0) == (at_grid(upper).off < 0.0)) continue;
-    // Regula falsi with the Illinois rule, to rounding; lo and hi keep their true values beside
-    // the Illinois-weighted ones.
-    Off lo = *grid[upper - 1], hi = *grid[upper];
-    double f_lo = lo.off, f_hi = hi.off;
-    int kept = 0;  // which end was kept last: -1 lo, +1 hi
-    for (int k = 0; k < 60; ++k) {
-      double mid = (lo.beta * f_hi - hi.beta * f_lo) / (f_hi - f_lo);
-      if (!(mid > lo.beta && mid < hi.beta)) mid = 0.5 * (lo.beta + hi.beta);
-      if (!(mid > lo.beta && mid < hi.beta)) break;  // lo and hi are adjacent doubles
-      const Off at_mid = off_plane(mid, std::cos(mid), std::sin(mid));
-      if (at_mid.off == 0.0) {
-        lo = hi = at_mid;
-        f_lo = f_hi = 0.0;
-        break;
-      }
-      if ((at_mid.off < 0.0) == (f_lo < 0.0)) {
-        lo = at_mid;
-        f_lo = at_mid.off;
-        if (kept == -1) f_hi *= 0.5;
-        kept = -1;
-      } else {
-        hi = at_mid;
-        f_hi = at_mid.off;
-        if (kept == 1) f_lo *= 0.5;
-        kept = 1;
-      }
-      if (hi.beta - lo.beta <= 1e-15) break;
-    }
-    const Off& root = std::abs(lo.off) <= std::abs(hi.off) ? lo : hi;
+    const Off root = refine_sign_change(*grid[upper - 1], *grid[upper], &Off::beta, &Off::off, [&](double beta) {
+      return std::optional<Off>(off_plane(beta, std::cos(beta), std::sin(beta)));
+    });
     // A sign change across a jump (a pad point's slip reversing) is not a root.
     const bool on_plane = std::abs(root.off) <= kCertificationBand * root.scale;
     const double d = std::abs(root.beta - beta0);
@@ -202,6 +177,13 @@ std::optional<Pose> StablePushValidator::onto_wedge_surface(const Pose& a, const
   }
   if (!best) return std::nullopt;
   return a + motion(std::cos(*best), std::sin(*best));
+}
+
+double StablePushValidator::wedge_plane_offset(const Pose& a, const Motion& dq, int pusher) const {
+  if (!contains(wedges_, pusher)) return std::numeric_limits<double>::quiet_NaN();
+  const StablePushModel& model = *models_.front();
+  const MotionWrench load = model.motion_wrench(a, dq, pusher);
+  return model.pusher_cones()[pusher].equality_rows().front().dot(load.required) / load.scale;
 }
 
 PusherSet PushChecker::stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,

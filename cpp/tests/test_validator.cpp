@@ -125,3 +125,58 @@ TEST_CASE("onto a point pusher's surface: the root nearest the direction's eleva
   CHECK(cases == 4000);
   CHECK(found > 2000);  // most headings meet the surface
 }
+
+TEST_CASE("refine_sign_change: a root to rounding where the function is continuous, a large value beside a jump",
+          "[validator]") {
+  struct Point {
+    double x, f;
+  };
+  const auto at = [](const auto& function) {
+    return [&function](double x) { return std::optional<Point>(Point{x, function(x)}); };
+  };
+  const auto smooth = [](double x) { return std::cos(x) - x; };  // one root, 0.739085133215160642 (Dottie)
+  const Point root =
+      refine_sign_change(Point{0.0, smooth(0.0)}, Point{1.0, smooth(1.0)}, &Point::x, &Point::f, at(smooth));
+  CHECK(std::abs(root.x - 0.739085133215160642) <= 2e-16);
+  CHECK(std::abs(root.f) <= 4e-16);
+  const auto jump = [](double x) { return x < 0.3 ? -1.0 : 1.0; };
+  const Point beside = refine_sign_change(Point{0.0, -1.0}, Point{1.0, 1.0}, &Point::x, &Point::f, at(jump));
+  CHECK(std::abs(beside.x - 0.3) <= 1e-15);
+  CHECK(std::abs(beside.f) == 1.0);  // not a root: callers refuse it by its size
+  // `at` may end the search: the bracket's own ends come back, the smaller in magnitude.
+  const Point stopped = refine_sign_change(Point{0.0, -2.0}, Point{1.0, 1.0}, &Point::x, &Point::f,
+                                           [](double) { return std::optional<Point>(); });
+  CHECK(stopped.x == 1.0);
+}
+
+TEST_CASE("wedge_plane_offset: within the certification band on a point pusher's surface, outside off it",
+          "[validator]") {
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  const StablePushModel model = cube_with_pegs();
+  ob::RealVectorBounds bounds(3);
+  bounds.setLow(-0.02);
+  bounds.setHigh(0.02);
+  auto space = std::make_shared<GraspPoseSpace>(StepSize{0.5e-3, 0.5 * M_PI / 180.0}, bounds);
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  const StablePushValidator validator(si, ModelSet{&model}, 0.0);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> offset(-0.004, 0.004), turn(-0.3, 0.3), heading(-M_PI, M_PI);
+  int on = 0;
+  for (int k = 0; k < 500; ++k) {
+    const Pose a{offset(rng), offset(rng), turn(rng)};
+    const double psi = heading(rng);
+    for (int pusher = 0; pusher < 2; ++pusher) {
+      const std::optional<Pose> q =
+          validator.onto_wedge_surface(a, Eigen::Vector3d(std::cos(psi), std::sin(psi), 0.0), 1.0, pusher);
+      if (!q) continue;
+      ++on;
+      const Motion dq = *q - a;
+      CHECK(std::abs(validator.wedge_plane_offset(a, dq, pusher)) <= kCertificationBand);
+      // A turn of 0.001 deg off the surface leaves the band.
+      const Motion off{dq.dx, dq.dz, dq.dtheta + 1e-3 * M_PI / 180.0};
+      CHECK(std::abs(validator.wedge_plane_offset(a, off, pusher)) > kCertificationBand);
+    }
+  }
+  CHECK(on > 500);
+  CHECK(std::isnan(validator.wedge_plane_offset(Pose{0.0, 0.0, 0.0}, Motion{1e-3, 0.0, 0.0}, 2)));  // not a wedge
+}

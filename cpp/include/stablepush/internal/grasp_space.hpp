@@ -13,6 +13,7 @@
 #include <ompl/base/goals/GoalSampleableRegion.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -81,6 +82,39 @@ class GraspValidityChecker : public ompl::base::StateValidityChecker {
   const StablePushModel& model_;
 };
 
+/// A root of a function of one variable between two points where it changes sign, refined to
+/// rounding by regula falsi with the Illinois rule. `lo` and `hi` are points with lo.*x < hi.*x
+/// and values lo.*f, hi.*f of opposite signs; `at(x)` gives the point at x, or nullopt to stop
+/// there. Returns the one of the last two kept whose value is the smaller in magnitude: a root
+/// where the function is continuous; beside a jump, a point whose value is not small, which
+/// callers refuse by its size.
+template <class Point, class At>
+Point refine_sign_change(Point lo, Point hi, double Point::*x, double Point::*f, const At& at) {
+  double f_lo = lo.*f, f_hi = hi.*f;  // the Illinois-weighted values
+  int kept = 0;                       // which end was kept last: -1 lo, +1 hi
+  for (int k = 0; k < 60; ++k) {
+    double mid = (lo.*x * f_hi - hi.*x * f_lo) / (f_hi - f_lo);
+    if (!(mid > lo.*x && mid < hi.*x)) mid = 0.5 * (lo.*x + hi.*x);
+    if (!(mid > lo.*x && mid < hi.*x)) break;  // lo and hi are adjacent doubles
+    const std::optional<Point> point = at(mid);
+    if (!point) break;
+    if ((*point).*f == 0.0) return *point;
+    if (((*point).*f < 0.0) == (f_lo < 0.0)) {
+      lo = *point;
+      f_lo = lo.*f;
+      if (kept == -1) f_hi *= 0.5;
+      kept = -1;
+    } else {
+      hi = *point;
+      f_hi = hi.*f;
+      if (kept == 1) f_lo *= 0.5;
+      kept = 1;
+    }
+    if (hi.*x - lo.*x <= 1e-15) break;
+  }
+  return std::abs(lo.*f) <= std::abs(hi.*f) ? lo : hi;
+}
+
 /// A motion a -> b is valid when, for one same pusher, each of its unit pushes
 /// (GraspPoseSpace::unit_pushes) is a stable push with a margin of at least `min_margin` [N] in
 /// every model of the set, and the grasp is maintained throughout (swept pads,
@@ -117,6 +151,12 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   /// pass stable_pushers (the wedge's facets, every model, the grasp).
   std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                          int pusher) const override;
+  /// How far the motion dq from `a` misses wedge pusher `pusher`'s plane, in the first model:
+  ///     e . w_motion(a, dq) / scale   (signed, dimensionless; e the wedge's plane normal, scale
+  /// the sum of the motion wrench's magnitudes, MotionWrench::scale), so that the span counts as
+  /// met where its magnitude is within kCertificationBand (docs/model.md section 2). NaN when
+  /// `pusher`'s cone is not a wedge.
+  double wedge_plane_offset(const Pose& a, const Motion& dq, int pusher) const;
   /// The centres of the first model's pads, each once.
   std::vector<Vec2> pivot_points() const override;
 
