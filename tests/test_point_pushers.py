@@ -118,6 +118,24 @@ def test_generated_point_pusher_tasks_are_solved_and_every_push_passes_the_indep
             recheck(task, plan)
 
 
+def test_a_pin_plan_ends_at_the_goal_pose_by_two_pushes_on_pin_surfaces():
+    """No straight push by a pin ends a plan at the goal pose (a pin's stable pushes form a surface
+    that rarely passes through it); two pushes on pins' surfaces may (finish_on_wedges in
+    planning.cpp). Generated task pins-1-7, with the goal the random-goal benchmark drew for it:
+    the plan ends at the goal pose itself, within its switch-over budget, and every push, the two
+    last included, passes the independent LP."""
+    from stablepush.plan import check_plan
+
+    generator = _generator()
+    [(task, _)] = generator.generated_tasks(seed=1, count=8, goals={"pins-1-7": [7.943, -5.826, -3.109]})
+    plan = plan_task(task, seed=1)
+    assert plan.solved and plan.ends_at_goal, plan.message
+    assert plan.waypoints[-1].pose == pytest.approx(task.goal, abs=1e-9)  # mm, deg (to m, rad and back)
+    assert plan.stats["switches"] == sum(a.pusher != b.pusher for a, b in zip(plan.waypoints[1:], plan.waypoints[2:]))
+    check_plan(task, plan)  # the switch-over budget, unit steps, each push in the task's own model
+    recheck(task, plan)
+
+
 def test_the_generator_is_deterministic_and_its_tasks_are_valid():
     generator = _generator()
     a = [generator.generate_task(9, i) for i in range(6)]

@@ -88,7 +88,9 @@ struct Plan {
   double goal_distance = 0.0;  ///< from the last waypoint [unit steps]
   /// A solved plan ends exactly at the goal when a last, shorter push by the last pusher from the
   /// node within tolerance to the goal pose is stable (in every model; and held, when a hold
-  /// ratio is required); else it ends where the search reached the tolerance.
+  /// ratio is required), or, for a point pusher, two pushes on point pushers' surfaces are (a
+  /// switch-over among them where the budget and min_transit_hold allow; counted in
+  /// stats.switches); else it ends where the search reached the tolerance.
   bool ends_at_goal = false;
 };
 
