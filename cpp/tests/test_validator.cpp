@@ -31,6 +31,23 @@ StablePushModel cube_with_pegs() {
   return StablePushModel(cube, RigidBody::uniform(cube, 0.1), gripper, std::move(pegs), Vec2(0.0, -9.81), 0.1);
 }
 
+/// The pegs' model, its grasp poses (x, z within 20 mm, theta within 0.02 rad; unit steps of
+/// 0.5 mm and 0.5 deg) and a validator on them.
+struct Pegs {
+  Pegs() { ompl::msg::setLogLevel(ompl::msg::LOG_WARN); }
+  static std::shared_ptr<GraspPoseSpace> make_space() {
+    ob::RealVectorBounds bounds(3);
+    bounds.setLow(-0.02);
+    bounds.setHigh(0.02);
+    return std::make_shared<GraspPoseSpace>(StepSize{0.5e-3, 0.5 * M_PI / 180.0}, bounds);
+  }
+  const StablePushModel model = cube_with_pegs();
+  const std::shared_ptr<GraspPoseSpace> space = make_space();
+  // Kept here: the validator (an OMPL MotionValidator) holds a raw pointer to it.
+  const ob::SpaceInformationPtr si = std::make_shared<ob::SpaceInformation>(space);
+  const StablePushValidator validator{si, ModelSet{&model}, 0.0};
+};
+
 /// The grid bracket [deg] that holds `beta` [rad]: the index of its upper end.
 std::size_t bracket_of(double beta) {
   std::size_t i = 1;
@@ -78,17 +95,9 @@ std::optional<double> nearest_root_by_scan(const OffPlane& off, double beta0) {
 }
 }  // namespace
 
-TEST_CASE("onto a point pusher's surface: the root nearest the direction's elevation, as a full scan finds it",
-          "[validator]") {
-  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  const StablePushModel model = cube_with_pegs();
-  ob::RealVectorBounds bounds(3);
-  bounds.setLow(-0.02);
-  bounds.setHigh(0.02);
-  const StepSize step{0.5e-3, 0.5 * M_PI / 180.0};
-  auto space = std::make_shared<GraspPoseSpace>(step, bounds);
-  auto si = std::make_shared<ob::SpaceInformation>(space);
-  const StablePushValidator validator(si, ModelSet{&model}, 0.0);
+TEST_CASE_METHOD(Pegs,
+                 "onto a point pusher's surface: the root nearest the direction's elevation, as a full scan finds it",
+                 "[validator]") {
   REQUIRE(validator.wedge_pushers() == 0b11);
 
   // Poses about the start, headings all round, elevations from none to near pure rotation:
@@ -149,16 +158,8 @@ TEST_CASE("refine_sign_change: a root to rounding where the function is continuo
   CHECK(stopped.x == 1.0);
 }
 
-TEST_CASE("wedge_plane_offset: within the certification band on a point pusher's surface, outside off it",
-          "[validator]") {
-  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
-  const StablePushModel model = cube_with_pegs();
-  ob::RealVectorBounds bounds(3);
-  bounds.setLow(-0.02);
-  bounds.setHigh(0.02);
-  auto space = std::make_shared<GraspPoseSpace>(StepSize{0.5e-3, 0.5 * M_PI / 180.0}, bounds);
-  auto si = std::make_shared<ob::SpaceInformation>(space);
-  const StablePushValidator validator(si, ModelSet{&model}, 0.0);
+TEST_CASE_METHOD(Pegs, "wedge_plane_offset: within the certification band on a point pusher's surface, outside off it",
+                 "[validator]") {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> offset(-0.004, 0.004), turn(-0.3, 0.3), heading(-M_PI, M_PI);
   int on = 0;
