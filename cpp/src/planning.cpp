@@ -8,7 +8,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -151,74 +150,82 @@ void append_pushes(Plan& plan, const GraspPoseSpace& space, const ModelSet& mode
   }
 }
 
-/// Where a plan may switch pushers at pose q, leaving pusher `leaving`: it has a switch-over left
-/// and the pads hold the object there as PlannerSettings::min_transit_hold asks.
-using SwitchAllowed = std::function<bool(const Pose& q, int leaving)>;
-
 /// Where the straight push from the plan's end q0 to the goal pose g is not stable for its last
 /// pusher, a point pusher (whose stable pushes form a surface, docs/model.md section 2, that
-/// rarely passes through g): two pushes, each on a point pusher's surface, the first by the last
-/// pusher and the second by `second`. The first goes a unit step (the longest one push may be)
-/// from q0 at heading phi onto the surface at q0 (onto_wedge_surface), to q1(phi); the second,
-/// straight from q1 to g, is on `second`'s surface at q1 where
-///     m(phi) = e . w_motion(q1, g - q1) / scale = 0        (wedge_plane_offset).
-/// m's sign changes between 48 headings are refined to rounding in phi; a root counts where |m|
-/// is within the certification band (not across a jump). Of the pairs whose two pushes are
-/// stable in every model and keep the grasp (and, with another `second`, where `may_switch`
-/// allows), the shortest is appended. Returns whether it appended them. On the generated pin
-/// tasks (docs/planner.md) shorter first pushes found fewer finishes, 24 headings half as many,
-/// and most finishes switch pins: one surface moves the object in only two of its three
-/// coordinates, and two pushes by one pin lie on nearly the same surface.
-bool finish_on_wedges(Plan& plan, const GraspPoseSpace& space, const StablePushValidator& validator, const Pose& target,
-                      const ModelSet& models, int second, const SwitchAllowed& may_switch) {
+/// rarely passes through g), or does not end held: two pushes, each on a point pusher's surface,
+/// the first by the last pusher and the second by one of `seconds`, tried in their order. The
+/// first goes a unit step (the longest one push may be) from q0 at heading phi onto the surface at
+/// q0 (onto_wedge_surface), to q1(phi); the second, straight from q1 to g, is on the surface of
+/// pusher s at q1 where
+///     m_s(phi) = e_s . w_motion(q1, g - q1) / scale = 0        (wedge_plane_offset).
+/// q1 is found at 48 headings once; m_s's sign changes between them are refined to rounding in
+/// phi, and a root counts where |m_s| is within the certification band (not across a jump). Of
+/// the pairs whose two pushes are stable in every model and keep the grasp (and, for s other
+/// than the last pusher, where `planner.transit_held` allows the switch-over at q1), the shortest
+/// is appended. Returns s, or kNoPusher when none was appended. On the generated pin tasks (docs/planner.md)
+/// shorter first pushes found fewer finishes, 24 headings half as many, and most finishes switch
+/// pins: one surface moves the object in only two of its three coordinates, and two pushes by one
+/// pin lie on nearly the same surface.
+int finish_on_wedges(Plan& plan, const GraspPoseSpace& space, const StablePushValidator& validator, const Pose& target,
+                     const ModelSet& models, const std::vector<int>& seconds, const TRRTstar& planner) {
   const int pusher = plan.waypoints.back().pusher;
   const Pose end = plan.waypoints.back().pose;
   const Eigen::Vector3d way = space.in_unit_steps(target - end);
-  struct Leg {
-    double phi;   ///< the first push's heading in unit steps' (x, z) [rad]
-    double miss;  ///< m(phi)
-    Pose q1;
-  };
-  const auto first_push = [&](double phi) -> std::optional<Leg> {
+  const auto onto_first = [&](double phi) -> std::optional<Pose> {
     const std::optional<Pose> q1 =
         validator.onto_wedge_surface(end, Eigen::Vector3d(std::cos(phi), std::sin(phi), 0.0), 1.0, pusher);
     if (!q1 || space.distance(*q1, target) < GraspPoseSpace::kShortestPush) return std::nullopt;
-    return Leg{phi, validator.wedge_plane_offset(*q1, target - *q1, second), *q1};
+    return q1;
   };
   constexpr int kHeadings = 48;
   const double heading = std::atan2(way[1], way[0]);
-  std::array<std::optional<Leg>, kHeadings + 1> ring;  // the last is the first again, a turn on
-  for (int k = 0; k < kHeadings; ++k) ring[k] = first_push(heading + 2.0 * M_PI * k / kHeadings);
-  ring[kHeadings] = ring[0];
-  if (ring[kHeadings]) ring[kHeadings]->phi += 2.0 * M_PI;
-  std::vector<std::pair<double, Pose>> found;  // (both pushes' length [unit steps], q1)
-  for (int k = 0; k < kHeadings; ++k) {
-    if (!ring[k] || !ring[k + 1] || (ring[k]->miss < 0.0) == (ring[k + 1]->miss < 0.0)) continue;
-    const Leg root = refine_sign_change(*ring[k], *ring[k + 1], &Leg::phi, &Leg::miss, first_push);
-    if (std::abs(root.miss) <= kCertificationBand)
-      found.emplace_back(space.distance(end, root.q1) + space.distance(root.q1, target), root.q1);
+  std::array<double, kHeadings + 1> phis;  // the last is the first again, a turn on
+  std::array<std::optional<Pose>, kHeadings + 1> firsts;
+  for (int k = 0; k < kHeadings; ++k) firsts[k] = onto_first(phis[k] = heading + 2.0 * M_PI * k / kHeadings);
+  phis[kHeadings] = phis[0] + 2.0 * M_PI;
+  firsts[kHeadings] = firsts[0];
+  struct Leg {
+    double phi;   ///< the first push's heading in unit steps' (x, z) [rad]
+    double miss;  ///< m_s(phi)
+    Pose q1;
+  };
+  for (const int second : seconds) {
+    const auto leg = [&](double phi, const std::optional<Pose>& q1) -> std::optional<Leg> {
+      if (!q1) return std::nullopt;
+      return Leg{phi, validator.wedge_plane_offset(*q1, target - *q1, second), *q1};
+    };
+    std::array<std::optional<Leg>, kHeadings + 1> ring;
+    for (int k = 0; k <= kHeadings; ++k) ring[k] = leg(phis[k], firsts[k]);
+    std::vector<std::pair<double, Pose>> found;  // (both pushes' length [unit steps], q1)
+    for (int k = 0; k < kHeadings; ++k) {
+      if (!ring[k] || !ring[k + 1] || (ring[k]->miss < 0.0) == (ring[k + 1]->miss < 0.0)) continue;
+      const Leg root = refine_sign_change(*ring[k], *ring[k + 1], &Leg::phi, &Leg::miss,
+                                          [&](double phi) { return leg(phi, onto_first(phi)); });
+      if (std::abs(root.miss) <= kCertificationBand)
+        found.emplace_back(space.distance(end, root.q1) + space.distance(root.q1, target), root.q1);
+    }
+    std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [length, q1] : found) {
+      if ((second != pusher && !planner.transit_held(q1, pusher)) ||
+          validator.stable_pushers(end, q1, PusherSet{1} << pusher) == 0 ||
+          validator.stable_pushers(q1, target, PusherSet{1} << second) == 0)
+        continue;
+      append_pushes(plan, space, models, q1, pusher);
+      append_pushes(plan, space, models, target, second);
+      return second;
+    }
   }
-  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (const auto& [length, q1] : found) {
-    if ((second != pusher && !may_switch(q1, pusher)) ||
-        validator.stable_pushers(end, q1, PusherSet{1} << pusher) == 0 ||
-        validator.stable_pushers(q1, target, PusherSet{1} << second) == 0)
-      continue;
-    append_pushes(plan, space, models, q1, pusher);
-    append_pushes(plan, space, models, target, second);
-    return true;
-  }
-  return false;
+  return kNoPusher;
 }
 
 /// Append the last, shorter push from the plan's end (within tolerance) to the goal pose itself,
 /// cut into unit pushes as every motion is, with the last pusher, when each is a stable push in
 /// every model and the goal's hold requirement holds there (Plan::ends_at_goal); for a point
-/// pusher, where that push is not stable, two on point pushers' surfaces (finish_on_wedges), by
-/// the last pusher alone or else, where `may_switch` allows, with a switch-over to another point
-/// pusher. Returns the switch-overs it added (0 or 1).
+/// pusher, where it does not, two pushes on point pushers' surfaces (finish_on_wedges), by the
+/// last pusher alone or else, with `switch_left` and where `planner.transit_held` allows, with a
+/// switch-over to another point pusher. Returns the switch-overs it added (0 or 1).
 int finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushValidator& validator, const PoseGoal& goal,
-                   const Pose& target, const ModelSet& models, const SwitchAllowed& may_switch) {
+                   const Pose& target, const ModelSet& models, bool switch_left, const TRRTstar& planner) {
   const Waypoint last = plan.waypoints.back();
   const Pose& end = last.pose;
   if (space.distance(end, target) < GraspPoseSpace::kShortestPush) {  // there: no push is that short
@@ -235,15 +242,15 @@ int finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushVali
   const PusherSet wedges = validator.wedge_pushers();
   if (!contains(wedges, last.pusher)) return 0;
   // The last pusher first: a switch-over is a transit between features.
-  std::vector<int> seconds{last.pusher};
-  for (int p = 0; p < kMaxPushers; ++p)
-    if (p != last.pusher && contains(wedges, p)) seconds.push_back(p);
-  for (const int second : seconds)
-    if (goal.held(target, second) && finish_on_wedges(plan, space, validator, target, models, second, may_switch)) {
-      plan.ends_at_goal = true;
-      return second == last.pusher ? 0 : 1;
-    }
-  return 0;
+  std::vector<int> seconds;
+  if (goal.held(target, last.pusher)) seconds.push_back(last.pusher);
+  for (int p = 0; switch_left && p < kMaxPushers; ++p)
+    if (p != last.pusher && contains(wedges, p) && goal.held(target, p)) seconds.push_back(p);
+  if (seconds.empty()) return 0;
+  const int second = finish_on_wedges(plan, space, validator, target, models, seconds, planner);
+  if (second == kNoPusher) return 0;
+  plan.ends_at_goal = true;
+  return second == last.pusher ? 0 : 1;
 }
 
 }  // namespace
@@ -295,14 +302,8 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   const PathCost cost = planner.solution_cost();
   int finish_switches = 0;
   if (plan.outcome == PlanOutcome::GoalReached) {
-    const SwitchAllowed may_switch = [&](const Pose& q, int leaving) {
-      if (cost.switches >= planner.getMaxSwitches()) return false;
-      if (settings.min_transit_hold <= 0.0) return true;
-      return std::all_of(models.begin(), models.end(), [&](const StablePushModel* m) {
-        return m->hold_ratio(q, leaving) >= settings.min_transit_hold;
-      });
-    };
-    finish_switches = finish_at_goal(plan, *space, *validator, *goal, settings.goal, models, may_switch);
+    finish_switches = finish_at_goal(plan, *space, *validator, *goal, settings.goal, models,
+                                     cost.switches < planner.getMaxSwitches(), planner);
   }
   plan.stats.iterations = planner.iterations();
   plan.stats.nodes = planner.node_count();

@@ -174,17 +174,18 @@ void TRRTstar::set_transit_hold(ModelSet models, double min_ratio, int start_pus
   start_pusher_ = start_pusher;
 }
 
+bool TRRTstar::transit_held(const Pose& q, int leaving) const {
+  if (min_transit_hold_ <= 0.0) return true;
+  return std::all_of(transit_models_.begin(), transit_models_.end(),
+                     [&](const StablePushModel* model) { return model->hold_ratio(q, leaving) >= min_transit_hold_; });
+}
+
 PusherSet TRRTstar::transit_allowed(const Node* from, PusherSet pushers) const {
   if (min_transit_hold_ <= 0.0) return pushers;
   // The pusher in contact at `from`: the one that pushed into it, or at the root the start's.
   const int leaving = from->parent != nullptr ? from->pusher : start_pusher_;
   if (leaving == kNoPusher || (pushers & ~single(leaving)) == 0) return pushers;
-  if (from->transit_held < 0) {
-    bool held = true;
-    for (const StablePushModel* model : transit_models_)
-      held = held && model->hold_ratio(from->pose, leaving) >= min_transit_hold_;
-    from->transit_held = held ? 1 : 0;
-  }
+  if (from->transit_held < 0) from->transit_held = transit_held(from->pose, leaving) ? 1 : 0;
   return from->transit_held ? pushers : pushers & single(leaving);
 }
 

@@ -65,6 +65,9 @@ class TRRTstar : public ompl::base::Planner {
   /// every one of `models` (0: anywhere; PlannerSettings::min_transit_hold), `start_pusher` being
   /// the pusher in contact at the start (kNoPusher: none). Not a declared parameter: it needs the models.
   void set_transit_hold(ModelSet models, double min_ratio, int start_pusher);
+  /// Whether a switch-over from pusher `leaving` may happen at q: the pads alone hold the object
+  /// there with set_transit_hold's ratio in every one of its models (always, with ratio 0).
+  bool transit_held(const Pose& q, int leaving) const;
   void getPlannerData(ompl::base::PlannerData& data) const override;
 
   // Declared parameters (Planner::params()), settable by name from the task's planner section.
