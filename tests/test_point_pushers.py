@@ -1,6 +1,7 @@
 """Point pushers (docs/model.md sections 2 and 3). A peg's cone is a wedge, so with the
 pads sliding its stable pushes form a surface in motion space: random motions are never stable,
 and the planner finds the surface as a root in the push's rotation."""
+import dataclasses
 import math
 
 import numpy as np
@@ -123,7 +124,8 @@ def test_a_pin_plan_ends_at_the_goal_pose_by_two_pushes_on_pin_surfaces():
     that rarely passes through it); two pushes on pins' surfaces may (finish_on_wedges in
     planning.cpp). Generated task pins-1-7, with the goal the random-goal benchmark drew for it:
     the plan ends at the goal pose itself, within its switch-over budget, and every push, the two
-    last included, passes the independent LP."""
+    last included, passes the independent LP. With planner.finish_steps the plan is the same: its
+    last pin takes no step deeper into the tolerance from where the plan can end at the goal pose."""
     from stablepush.plan import check_plan
 
     generator = _generator()
@@ -134,6 +136,8 @@ def test_a_pin_plan_ends_at_the_goal_pose_by_two_pushes_on_pin_surfaces():
     assert plan.stats["switches"] == sum(a.pusher != b.pusher for a, b in zip(plan.waypoints[1:], plan.waypoints[2:]))
     check_plan(task, plan)  # the switch-over budget, unit steps, each push in the task's own model
     recheck(task, plan)
+    finishing = plan_task(dataclasses.replace(task, planner={**task.planner, "finish_steps": 1}), seed=1)
+    assert [(w.pose, w.pusher) for w in finishing.waypoints] == [(w.pose, w.pusher) for w in plan.waypoints]
 
 
 def test_the_generator_is_deterministic_and_its_tasks_are_valid():

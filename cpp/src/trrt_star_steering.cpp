@@ -417,6 +417,7 @@ void TRRTstar::finish_toward_goal() {
   GoalPath& path = *improved_;
   const int pusher = path.nodes.back().pusher;
   if (pusher == kNoPusher) return;  // the start is within the tolerance: no push to go on with
+  if (end_test_ && end_test_(path.nodes.back().pose, pusher, path.cost.switches)) return;
   const auto* goal = pdef_->getGoal()->as<PoseGoal>();
   ob::State* scratch = si_->allocState();
   // Deeper into the tolerance box (PoseGoal::offset), not nearer the goal pose in unit steps: an

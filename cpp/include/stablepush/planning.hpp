@@ -69,8 +69,9 @@ struct PlanStats {
   int switches = 0;
   double length = 0.0;    ///< [unit steps]
   unsigned restarts = 0;  ///< times the search started again (TRRTstar's restart_checks)
-  /// The first plan the search found (TRRTstar's improve_for; the final plan's own without it):
-  /// when [s into the search, NaN when none], its switch-overs, length [unit steps] and least margin [N].
+  /// The first path the search found (TRRTstar's improve_for; the search's own path without it),
+  /// before the plan's end (Plan::ends_at_goal, finish_steps): when [s into the search, NaN when
+  /// none], its switch-overs, length [unit steps] and least margin [N].
   double first_time_s = 0.0;
   int first_switches = 0;
   double first_length = 0.0;

@@ -37,6 +37,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -68,6 +69,12 @@ class TRRTstar : public ompl::base::Planner {
   /// Whether a switch-over from pusher `leaving` may happen at q: the pads alone hold the object
   /// there with set_transit_hold's ratio in every one of its models (always, with ratio 0).
   bool transit_held(const Pose& q, int leaving) const;
+  /// Whether the plan can end at the goal pose from `end`, pushed into by `pusher`, after
+  /// `switches` switch-overs (planning.cpp's end of a plan: the straight push, a point pusher's two).
+  using EndTest = std::function<bool(const Pose& end, int pusher, int switches)>;
+  /// finish_toward_goal takes no step from a search's end where `can_end` holds: a plan that ends
+  /// at the goal pose without finish_steps is unchanged by them. Unset: every step is tried.
+  void set_end_test(EndTest can_end) { end_test_ = std::move(can_end); }
   void getPlannerData(ompl::base::PlannerData& data) const override;
 
   // Declared parameters (Planner::params()), settable by name from the task's planner section.
@@ -279,7 +286,8 @@ class TRRTstar : public ompl::base::Planner {
   /// goal nodes now, within the budget, the one with the fewest switch-overs, then the largest
   /// least margin, then the shortest.
   void choose_improved_path();
-  /// With finish_steps, after the goal is reached: from the plan's end its last pusher takes, while
+  /// With finish_steps, after the goal is reached, unless set_end_test says the plan can end at the
+  /// goal pose from the search's end: from the plan's end its last pusher takes, while
   /// one is found and the push from there straight to the goal pose is not stable, the step that
   /// ends deepest in the tolerance box (PoseGoal::offset, by at least 0.001 of it), held there,
   /// in the grasp and a stable push, among full, half and quarter steps toward the goal turned up
@@ -300,6 +308,7 @@ class TRRTstar : public ompl::base::Planner {
   ModelSet transit_models_;           ///< set_transit_hold's models
   double min_transit_hold_ = 0.0;
   int start_pusher_ = kNoPusher;
+  EndTest end_test_;  ///< set_end_test's
   const GraspPoseSpace* space_ = nullptr;
   std::vector<Node*> nodes_;
   std::vector<Eigen::Vector3d> unit_coords_;  ///< nodes_[i]'s pose in unit steps
