@@ -254,8 +254,9 @@ def test_deeply_nested_plan_json_is_refused(tmp_path):
 
 def test_an_output_that_cannot_be_made_is_refused_naming_it_not_a_temporary(tmp_path, monkeypatch, low_mu_plan):
     """A directory the command may not write to is refused before any work, naming the option; a
-    place where no file can be made (/proc, whatever the permissions say) after it, naming the
-    output, for plan files and ROS 2 bags alike (the bag's scratch directory was an internal error)."""
+    place where no file can be made (/proc, whatever the permissions say) or a full device after
+    it, naming the option and the output, for plan files and ROS 2 bags alike (the bag's scratch
+    directory was an internal error)."""
     from stablepush import outputs
 
     access = os.access
@@ -266,11 +267,14 @@ def test_an_output_that_cannot_be_made_is_refused_naming_it_not_a_temporary(tmp_
     if not os.path.isdir("/proc/self"):
         pytest.skip("no /proc")
     result = CliRunner().invoke(cli, ["plan", str(LOW_MU), "-o", "/proc/p.json"])
-    assert result.exit_code == 2 and "cannot write /proc/p.json:" in result.stderr, result.stderr
+    assert result.exit_code == 2 and "error: -o /proc/p.json: cannot write (" in result.stderr, result.stderr
+    if os.path.exists("/dev/full"):
+        result = CliRunner().invoke(cli, ["plan", str(LOW_MU), "-o", str(tmp_path / "p.json"), "--csv", "/dev/full"])
+        assert result.exit_code == 2 and "error: --csv /dev/full: cannot write (" in result.stderr, result.stderr
     plan = tmp_path / "p.plan.json"
     plan.write_text(json.dumps(low_mu_plan))
     result = CliRunner().invoke(cli, ["trajectory", str(plan), "--task", str(LOW_MU), "-o", "/proc/p.mcap"])
-    assert result.exit_code == 2 and "/proc/p.mcap: cannot write the bag" in result.stderr, result.output
+    assert result.exit_code == 2 and "error: -o /proc/p.mcap: cannot write the bag" in result.stderr, result.output
 
 
 def test_the_default_output_comes_from_the_task_file_name_never_its_name_field(tmp_path, monkeypatch):

@@ -6,6 +6,7 @@ import json
 import math
 import os
 import sys
+from pathlib import Path
 
 import click
 
@@ -38,6 +39,27 @@ def _exit_status(error: StablepushError) -> int:
 def _fail(message: str) -> None:
     click.echo(f"error: {message}", err=True)
     sys.exit(EXIT_BAD_INPUT)
+
+
+_OUTPUTS = "stablepush.outputs"  # click's shared Context.meta: the command's outputs, option -> path
+
+
+def _check_outputs(outputs: dict, inputs: dict) -> None:
+    """stablepush.outputs.check_outputs, remembering the outputs so that one that fails later, while
+    written (a full disk, /dev/full), is reported naming its option as well (_Commands)."""
+    from stablepush.outputs import check_outputs
+
+    check_outputs(outputs, inputs)
+    click.get_current_context().meta[_OUTPUTS] = {name: path for name, path in outputs.items() if path is not None}
+
+
+def _error_text(ctx: click.Context, error: StablepushError) -> str:
+    """The error's message, an output's prefixed with the option that named it (_check_outputs)."""
+    if isinstance(error, OutputError) and error.output is not None:
+        for name, path in ctx.meta.get(_OUTPUTS, {}).items():
+            if Path(path) == Path(error.output):
+                return f"{name} {error}"
+    return str(error)
 
 
 def _load(task_file: str, goal_in_grasp: bool = True):
@@ -94,7 +116,7 @@ class _Commands(click.Group):
         try:
             return super().invoke(ctx)
         except StablepushError as error:
-            click.echo(f"error: {error}", err=True)
+            click.echo(f"error: {_error_text(ctx, error)}", err=True)
             ctx.exit(_exit_status(error))
         except BrokenPipeError:  # the reader went away (`| head`): stop quietly, as a process ended by SIGPIPE
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error as Python exits
@@ -239,12 +261,12 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     Example:
       stablepush plan data/tasks/horizontal-offset-low-mu.yaml -o low-mu.plan.json --csv low-mu.csv
     """
-    from stablepush.outputs import check_outputs, default_output
+    from stablepush.outputs import default_output
     from stablepush.plan import plan_task, write_plan
 
     json_label = "-o" if json_path else "the default -o"
     json_path = json_path or default_output(task_file, ".plan.json")
-    check_outputs({json_label: json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
+    _check_outputs({json_label: json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
     say = _say_beside(json_path, csv_path)
     task = _load(task_file)
     result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
@@ -326,10 +348,10 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     if checks_only:
         _bench_checks(tasks, count, seed)
         return
-    from stablepush.outputs import check_outputs, require_suffix
+    from stablepush.outputs import require_suffix
 
     require_suffix("--out", out_path, (".csv", ".json"))
-    check_outputs({"--out": out_path}, {f"TASK.yaml {path}": path for path in task_files})
+    _check_outputs({"--out": out_path}, {f"TASK.yaml {path}": path for path in task_files})
     say = _say_beside(out_path)
 
     runner = _runner(workers, ray_address, default=1)
@@ -475,14 +497,14 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
       stablepush plan data/tasks/t-shaped.yaml -o t.plan.json
       stablepush show t.plan.json --task data/tasks/t-shaped.yaml -o t.png --gif t.gif
     """
-    from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, require_suffix
+    from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
     from stablepush.viz import figures
 
     png_label = "-o" if png_path else "the default -o"
     png_path = png_path or _beside(plan_file, (".json", ".plan"), ".png")
     require_suffix(png_label, png_path, FIGURE_SUFFIXES)
     require_suffix("--gif", gif_path, (".gif",))
-    check_outputs({png_label: png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})
+    _check_outputs({png_label: png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file, require_solved=False)
     figures.save_figure(figures.plan_figure(task, plan), png_path)
     click.echo(f"figure written to {png_path}")
@@ -526,14 +548,14 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
       stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.mcap   # ros2 bag play, Foxglove
     """
     from stablepush.execution import execution_warnings, timed_trajectory
-    from stablepush.outputs import check_outputs, require_suffix, write_atomically
+    from stablepush.outputs import require_suffix, write_atomically
 
     require_suffix("-o", out_path, (".csv", ".json", ".mcap"))
     if quat is not None and out_path.lower().endswith(".mcap"):
         _fail(f"--quat {quat}: a ROS 2 bag's quaternions are its message types' own (x, y, z, w); --quat is for "
               f".csv and .json")
     quat = quat or "xyzw"
-    check_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
+    _check_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file)
     for warning in execution_warnings(task):  # the stream is the executor's, so is its cell
         click.echo(f"warning: {warning}", err=True)
@@ -565,7 +587,7 @@ def cone(task_file: str, pusher: str, png_path) -> None:
     Example:
       stablepush cone data/tasks/pivoting.yaml --pusher left -o left-cone.png
     """
-    from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, default_output, require_suffix
+    from stablepush.outputs import FIGURE_SUFFIXES, default_output, require_suffix
     from stablepush.viz import figures
 
     task = _load(task_file)
@@ -573,7 +595,7 @@ def cone(task_file: str, pusher: str, png_path) -> None:
     png_label = "-o" if png_path else "the default -o"
     png_path = png_path or default_output(task_file, f".{pusher}.cone.png")
     require_suffix(png_label, png_path, FIGURE_SUFFIXES)
-    check_outputs({png_label: png_path}, {"TASK.yaml": task_file})
+    _check_outputs({png_label: png_path}, {"TASK.yaml": task_file})
     figures.save_figure(figures.cone_figure(task, pusher), png_path)
     click.echo(f"figure written to {png_path}")
 
@@ -758,10 +780,10 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     from stablepush.execution import execute_plan, execution_warnings, fault_report
     from stablepush.execution.guard import GuardedApproach
     from stablepush.execution.stream import check_resume_from
-    from stablepush.outputs import check_outputs, require_suffix, write_atomically
+    from stablepush.outputs import require_suffix, write_atomically
 
     require_suffix("--record", record_path, (".mcap",))
-    check_outputs({"--json": json_path, "--record": record_path, "--video": video_path},
+    _check_outputs({"--json": json_path, "--record": record_path, "--video": video_path},
                   {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file, changed="refuse")
     for warning in execution_warnings(task):
@@ -1042,12 +1064,12 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         _video_settings_need("--video-failed")
     from stablepush.evaluation import Batch, Spreads, robust_task, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
-    from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, require_suffix
+    from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
     from stablepush.plan import check_plan, plan_task
     from stablepush.runners import default_workers
 
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
-    check_outputs({"--json": json_path, "--csv": csv_path, "--plot": png_path},
+    _check_outputs({"--json": json_path, "--csv": csv_path, "--plot": png_path},
                   {"TASK.yaml": task_file, "--plan": plan_file})
     say = _say_beside(json_path, csv_path, png_path)
 
@@ -1132,8 +1154,6 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
 
 def _beside(path: str, endings, suffix: str) -> str:
     """`path` with each of `endings` it ends in taken off, in turn, and `suffix` put on."""
-    from pathlib import Path
-
     name = Path(path).name
     for ending in endings:
         if name.lower().endswith(ending) and len(name) > len(ending):
@@ -1200,12 +1220,12 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
       stablepush reach data/tasks/t-shaped.yaml --x -20:20:9 --z -10:10:5 --theta 0:0:1 \\
           --json t.reach.json --plot t.reach.png
     """
-    from stablepush.outputs import FIGURE_SUFFIXES, check_outputs, require_suffix, write_atomically
+    from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_atomically
     from stablepush.plan.reach import reach_map
     from stablepush.runners import default_workers
 
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
-    check_outputs({"--json": json_path, "--plot": png_path}, {"TASK.yaml": task_file})
+    _check_outputs({"--json": json_path, "--plot": png_path}, {"TASK.yaml": task_file})
     say = _say_beside(json_path, png_path)
     runner = _runner(workers, ray_address, default=default_workers())
     task = _load(task_file, goal_in_grasp=False)  # the grid replaces the goal; its cells say where there is no grasp

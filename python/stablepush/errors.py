@@ -34,7 +34,13 @@ class PlanError(_FieldError):
 
 
 class OutputError(StablepushError, OSError):
-    """An output file that cannot, or must not, be written (the path is in the message)."""
+    """An output file that cannot, or must not, be written (the path is in the message). `output`:
+    the path as the caller gave it, when writing it failed (a full disk, /dev/full), so that a
+    command can name the option it came from."""
+
+    def __init__(self, message: str, output=None):
+        super().__init__(message)
+        self.output = output
 
 
 class RunnerError(StablepushError, RuntimeError):

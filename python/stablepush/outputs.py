@@ -147,7 +147,7 @@ def _write_and_rename(plan) -> None:
             os.replace(tmp, target)
         temporaries = []
     except OSError as exc:
-        raise OutputError(f"cannot write {path or 'the output'}: {exc.strerror or exc}") from None
+        raise OutputError(f"{path or 'the output'}: cannot write ({exc.strerror or exc})", output=path) from None
     finally:
         for tmp, _, _ in temporaries:
             with contextlib.suppress(OSError):

@@ -123,7 +123,7 @@ def _mcap(path: Union[str, Path], topics: dict):
     try:  # the bag is written beside its output, so that the last move is a rename
         scratch_directory = tempfile.TemporaryDirectory(dir=path.parent if path.parent.exists() else None)
     except OSError as exc:
-        raise OutputError(f"{path}: cannot write the bag ({exc.strerror or exc})") from None
+        raise OutputError(f"{path}: cannot write the bag ({exc.strerror or exc})", output=path) from None
     with scratch_directory as scratch:
         bag = Path(scratch) / "bag"
         with Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
@@ -136,7 +136,7 @@ def _mcap(path: Union[str, Path], topics: dict):
         try:
             os.replace(bag / "bag.mcap", path)
         except OSError as exc:
-            raise OutputError(f"{path}: cannot write the bag ({exc.strerror or exc})") from None
+            raise OutputError(f"{path}: cannot write the bag ({exc.strerror or exc})", output=path) from None
 
 
 # -- messages ---------------------------------------------------------------------------------
