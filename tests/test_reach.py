@@ -129,6 +129,17 @@ def test_show_draws_a_plan_that_found_no_push_and_marks_the_goal(tmp_path):
                                       "-o", str(png)])
     assert result.exit_code == 0, result.output
     assert png.read_bytes()[:4] == b"\x89PNG"
+    # One panel (nothing moves, so no pose against step), the goal's outline on it, and the title
+    # within the figure.
+    from stablepush.viz.figures import plan_figure
+
+    fig = plan_figure(task, start_only)
+    [ax] = fig.axes
+    assert ax.get_title().startswith("start, no push found") and any(
+        line.get_color() == "tab:red" and line.get_linestyle() == "--" for line in ax.get_lines())
+    fig.canvas.draw()
+    box = fig._suptitle.get_window_extent()
+    assert 0 <= box.x0 and box.x1 <= fig.bbox.x1, (box, fig.bbox)
     with_push = CliRunner().invoke(cli, ["execute", str(path), "--task", str(TASKS / "horizontal-offset-low-mu.yaml"),
                                          "--sim"])
     assert with_push.exit_code == 2 and "solved" in with_push.output  # running it is still refused

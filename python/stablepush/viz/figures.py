@@ -15,6 +15,7 @@ import io
 import math
 import os
 import tempfile
+import textwrap
 from pathlib import Path
 from typing import List, Optional, Sequence
 
@@ -103,41 +104,51 @@ def plan_title(task: Task, plan: Plan) -> str:
 def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
     """The plan in the grasp: snapshots above, x, z, theta against step below; `title` defaults to
     plan_title. The last snapshot is labelled "goal", or "end" for a plan that does not reach it.
-    `plan`: checked against the task (stablepush.plan.verify.check_plan)."""
+    `plan`: checked against the task (stablepush.plan.verify.check_plan). A plan of the start
+    alone (no push found, or the start already within the tolerance) is one panel: nothing moves."""
     steps = plan.waypoints
+    title = plan_title(task, plan) if title is None else title
+    # A plan that stops short also shows the goal it did not reach (in red, at its end).
+    limits = _limits(task, list(steps) + ([] if plan.solved else [Waypoint(*task.goal)]))
+    if len(steps) == 1:
+        fig = Figure(figsize=(6.4, 4.6), layout="constrained")
+        ax = fig.add_subplot()
+        label = "start" if plan.solved else "start, no push found\n" + _end_from_goal(task, steps[0].pose)
+        _draw_grasp(ax, task, steps[0].pose, None, label, limits)
+        if not plan.solved:
+            _draw_goal_outline(ax, task)
+        ax.set_xlabel("x in G (mm)", fontsize=8)
+        ax.set_ylabel("z in G (mm)", fontsize=8)
+        fig.suptitle(textwrap.fill(title, 72), fontsize=11)
+        return fig
     keys = _snapshots(steps)
     switches = {c.first for c in contacts_of(steps)[1:]}
     fig = Figure(figsize=(2.3 * len(keys) + 0.5, 6.2))
     grid = fig.add_gridspec(2, len(keys), height_ratios=[1.1, 1.0], hspace=0.35)
-    # A plan that stops short also shows the goal it did not reach (in red, at its end).
-    limits = _limits(task, list(steps) + ([] if plan.solved else [Waypoint(*task.goal)]))
     for k, i in enumerate(keys):
         ax = fig.add_subplot(grid[0, k])
         pusher = steps[i + 1].pusher if i + 1 < len(steps) else steps[i].pusher
         last = i == len(steps) - 1
         label = "start" if i == 0 else (("goal" if plan.solved else "end") if last else f"step {i}")
         if last and not plan.solved:
-            label = _end_from_goal(task, steps[i].pose) if i > 0 else "start, no push found\n" + \
-                _end_from_goal(task, steps[i].pose)
+            label = _end_from_goal(task, steps[i].pose)
         elif i in switches:
             label += f"\nswitch to {pusher}"
         elif pusher:
             label += f"\n{pusher}"
         _draw_grasp(ax, task, steps[i].pose, pusher, label, limits)
         if last and not plan.solved:
-            goal = in_gripper(task.goal, list(task.vertices) + [task.vertices[0]])
-            ax.plot(goal[:, 0], goal[:, 1], color="tab:red", lw=1.2, ls="--", zorder=6)
+            _draw_goal_outline(ax, task)
         if k == 0:
             ax.set_ylabel("z in G (mm)", fontsize=8)
         ax.set_xlabel("x in G (mm)", fontsize=8)
     ax = fig.add_subplot(grid[1, :])
     n = np.arange(len(steps))
     poses = np.array([s.pose for s in steps])
-    marker = "o" if len(steps) == 1 else None  # a plan that found no push: its start alone
-    ax.plot(n, poses[:, 0], label="x (mm)", marker=marker)
-    ax.plot(n, poses[:, 1], label="z (mm)", marker=marker)
+    ax.plot(n, poses[:, 0], label="x (mm)")
+    ax.plot(n, poses[:, 1], label="z (mm)")
     ax2 = ax.twinx()
-    ax2.plot(n, poses[:, 2], color="C3", label="theta (deg)", marker=marker)
+    ax2.plot(n, poses[:, 2], color="C3", label="theta (deg)")
     ax2.set_ylabel("theta (deg)", color="C3")
     for c in contacts_of(steps):
         ax.axvspan(c.first, c.last, color=_colour(task, c.pusher), alpha=0.12, lw=0)
@@ -151,8 +162,14 @@ def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
     lines2 = ax2.get_legend_handles_labels()
     ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="best", fontsize=8)
     ax.grid(alpha=0.3)
-    fig.suptitle(plan_title(task, plan) if title is None else title, fontsize=11)
+    fig.suptitle(title, fontsize=11)
     return fig
+
+
+def _draw_goal_outline(ax, task: Task) -> None:
+    """The object's outline at the goal pose, dashed red: where a plan that stops short should have ended."""
+    goal = in_gripper(task.goal, list(task.vertices) + [task.vertices[0]])
+    ax.plot(goal[:, 0], goal[:, 1], color="tab:red", lw=1.2, ls="--", zorder=6)
 
 
 def save_plan_gif(task: Task, plan: Plan, path: str, max_frames: int = 80) -> None:
