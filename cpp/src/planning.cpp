@@ -284,14 +284,15 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
     throw std::invalid_argument("start_pusher must be a pusher index or -1");
   TRRTstar planner(problem.si);
   planner.set_transit_hold(models, settings.min_transit_hold, settings.start_pusher);
-  const auto ends_at_goal_from = [&](Plan& plan, int switches) {
+  // The plan's end (finish_at_goal) after `switches` switch-overs; finish_steps ask it first.
+  const auto end_at_goal = [&](Plan& plan, int switches) {
     return finish_at_goal(plan, *space, *validator, *goal, settings.goal, models, switches < planner.getMaxSwitches(),
                           planner);
   };
   planner.set_end_test([&](const Pose& end, int pusher, int switches) {
     Plan probe;  // the search's end alone: what finish_at_goal would append to it
     probe.waypoints.push_back({end, pusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding});
-    ends_at_goal_from(probe, switches);
+    end_at_goal(probe, switches);
     return probe.ends_at_goal;
   });
   const ob::PlannerStatus status = solve(planner, problem, settings);
@@ -311,7 +312,7 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   for (std::size_t i = 1; i < nodes.size(); ++i) append_pushes(plan, *space, models, nodes[i].pose, nodes[i].pusher);
   const PathCost cost = planner.solution_cost();
   int finish_switches = 0;
-  if (plan.outcome == PlanOutcome::GoalReached) finish_switches = ends_at_goal_from(plan, cost.switches);
+  if (plan.outcome == PlanOutcome::GoalReached) finish_switches = end_at_goal(plan, cost.switches);
   plan.stats.iterations = planner.iterations();
   plan.stats.nodes = planner.node_count();
   plan.stats.feasibility_checks = validator->feasibility_checks();
