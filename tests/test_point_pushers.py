@@ -124,8 +124,9 @@ def test_a_pin_plan_ends_at_the_goal_pose_by_two_pushes_on_pin_surfaces():
     that rarely passes through it); two pushes on pins' surfaces may (finish_on_wedges in
     planning.cpp). Generated task pins-1-7, with the goal the random-goal benchmark drew for it:
     the plan ends at the goal pose itself, within its switch-over budget, and every push, the two
-    last included, passes the independent LP. With planner.finish_steps the plan is the same: its
-    last pin takes no step deeper into the tolerance from where the plan can end at the goal pose."""
+    last included, passes the independent LP. With planner.finish_steps the plan and its counts are the
+    same: its last pin takes no step deeper into the tolerance from where the plan can end at the
+    goal pose."""
     from stablepush.plan import check_plan
 
     generator = _generator()
@@ -138,6 +139,8 @@ def test_a_pin_plan_ends_at_the_goal_pose_by_two_pushes_on_pin_surfaces():
     recheck(task, plan)
     finishing = plan_task(dataclasses.replace(task, planner={**task.planner, "finish_steps": 1}), seed=1)
     assert [(w.pose, w.pusher) for w in finishing.waypoints] == [(w.pose, w.pusher) for w in plan.waypoints]
+    same = ("switches", "feasibility_checks", "iterations")  # the plan's end is searched once
+    assert {k: finishing.stats[k] for k in same} == {k: plan.stats[k] for k in same}
 
 
 def test_the_generator_is_deterministic_and_its_tasks_are_valid():

@@ -289,13 +289,21 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
     return finish_at_goal(plan, *space, *validator, *goal, settings.goal, models, switches < planner.getMaxSwitches(),
                           planner);
   };
+  // The end the test found, kept so that the plan's end is not searched (nor its tests counted) twice.
+  struct Ended {
+    Plan plan;  ///< finish_at_goal on the search's end alone
+    int switches;
+  };
+  std::optional<Ended> ended;
   planner.set_end_test([&](const Pose& end, int pusher, int switches) {
-    Plan probe;  // the search's end alone: what finish_at_goal would append to it
+    Plan probe;
     probe.waypoints.push_back({end, pusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding});
-    end_at_goal(probe, switches);
-    return probe.ends_at_goal;
+    const int added = end_at_goal(probe, switches);
+    if (probe.ends_at_goal) ended = Ended{std::move(probe), added};
+    return ended.has_value();
   });
   const ob::PlannerStatus status = solve(planner, problem, settings);
+  planner.set_end_test(nullptr);  // it refers to this scope
 
   Plan plan;
   plan.outcome = planner.outcome();
@@ -312,7 +320,17 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   for (std::size_t i = 1; i < nodes.size(); ++i) append_pushes(plan, *space, models, nodes[i].pose, nodes[i].pusher);
   const PathCost cost = planner.solution_cost();
   int finish_switches = 0;
-  if (plan.outcome == PlanOutcome::GoalReached) finish_switches = end_at_goal(plan, cost.switches);
+  if (plan.outcome == PlanOutcome::GoalReached) {
+    if (ended) {  // finish_toward_goal took no step from the end it tested (set_end_test)
+      const std::vector<Waypoint>& tail = ended->plan.waypoints;
+      plan.waypoints.back().pose = tail.front().pose;  // the goal pose, where the end was that near
+      plan.waypoints.insert(plan.waypoints.end(), tail.begin() + 1, tail.end());
+      plan.ends_at_goal = true;
+      finish_switches = ended->switches;
+    } else {
+      finish_switches = end_at_goal(plan, cost.switches);
+    }
+  }
   plan.stats.iterations = planner.iterations();
   plan.stats.nodes = planner.node_count();
   plan.stats.feasibility_checks = validator->feasibility_checks();

@@ -50,16 +50,16 @@ def _writable(path: Union[str, Path]):
     except FileNotFoundError:
         mode = None
     except OSError as exc:
-        raise OutputError(f"{path}: cannot write ({exc.strerror})") from None
+        raise OutputError(f"{path}: cannot write ({exc.strerror})", output=path) from None
     if mode is not None and (stat.S_ISCHR(mode) or stat.S_ISFIFO(mode)):
         return Path(path), "stream", None
     target = Path(os.path.realpath(path))
     if mode is not None and not stat.S_ISREG(mode):
-        raise OutputError(f"{path}: not a regular file; refusing to replace it")
+        raise OutputError(f"{path}: not a regular file; refusing to replace it", output=path)
     if not target.parent.is_dir():
-        raise OutputError(f"{path}: the directory {target.parent} does not exist")
+        raise OutputError(f"{path}: the directory {target.parent} does not exist", output=path)
     if not os.access(target.parent, os.W_OK | os.X_OK):  # a new file is made in it, then renamed
-        raise OutputError(f"{path}: the directory {target.parent} is not writable")
+        raise OutputError(f"{path}: the directory {target.parent} is not writable", output=path)
     return target, "replace", stat.S_IMODE(mode) if mode is not None else None
 
 
