@@ -143,6 +143,26 @@ def test_a_pin_plan_ends_at_the_goal_pose_by_two_pushes_on_pin_surfaces():
     assert {k: finishing.stats[k] for k in same} == {k: plan.stats[k] for k in same}
 
 
+def test_finish_steps_walk_a_pin_plan_to_where_it_can_end_at_the_goal_pose():
+    """A plan whose end admits no finish at the goal pose: with planner.finish_steps its last pin
+    steps deeper into the tolerance and, at each step, the plan's end is tried again, so that it
+    stops where two pushes on pins' surfaces reach the goal pose (generated pins-2-4, seed 3, with
+    its benchmark goal). The search's pushes are kept; every push passes the independent LP."""
+    from stablepush.plan import check_plan
+
+    [(task, _)] = _generator().generated_tasks(seed=2, count=5, goals={"pins-2-4": [-6.167, -1.082, 8.373]})
+    plain = plan_task(task, seed=3)
+    assert plain.solved and not plain.ends_at_goal, plain.message
+    finishing = dataclasses.replace(task, planner={**task.planner, "finish_steps": 1})
+    plan = plan_task(finishing, seed=3)
+    assert plan.solved and plan.ends_at_goal, plan.message
+    assert plan.waypoints[-1].pose == pytest.approx(task.goal, abs=1e-9)
+    head = [(w.pose, w.pusher) for w in plain.waypoints]
+    assert [(w.pose, w.pusher) for w in plan.waypoints[:len(head)]] == head
+    check_plan(finishing, plan)
+    recheck(finishing, plan)
+
+
 def test_the_generator_is_deterministic_and_its_tasks_are_valid():
     generator = _generator()
     a = [generator.generate_task(9, i) for i in range(6)]

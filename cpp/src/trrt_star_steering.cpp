@@ -417,7 +417,6 @@ void TRRTstar::finish_toward_goal() {
   GoalPath& path = *improved_;
   const int pusher = path.nodes.back().pusher;
   if (pusher == kNoPusher) return;  // the start is within the tolerance: no push to go on with
-  if (end_test_ && end_test_(path.nodes.back().pose, pusher, path.cost.switches)) return;
   const auto* goal = pdef_->getGoal()->as<PoseGoal>();
   ob::State* scratch = si_->allocState();
   // Deeper into the tolerance box (PoseGoal::offset), not nearer the goal pose in unit steps: an
@@ -428,9 +427,12 @@ void TRRTstar::finish_toward_goal() {
     const Pose from = path.nodes.back().pose;
     const Steering steering(*space_, steer_angle_, from, goal->pose());
     if (steering.distance < kMinEdge) break;
-    // From where the push straight to the goal pose is stable, planning.cpp's finish_at_goal ends
-    // the plan there: a step aside would only lose it.
-    if (validator_->stable_pushers(from, goal->pose(), single(pusher)) != 0 && goal->held(goal->pose(), pusher)) break;
+    // From where the plan can end at the goal pose (planning.cpp's finish_at_goal), a step aside
+    // would only lose it.
+    if (end_test_
+            ? end_test_(from, pusher, path.cost.switches)
+            : validator_->stable_pushers(from, goal->pose(), single(pusher)) != 0 && goal->held(goal->pose(), pusher))
+      break;
     std::vector<std::pair<double, Pose>> candidates;  // (offset, end), deepest first
     const auto consider = [&](const Pose& q) {
       if (goal->offset(q) < goal->offset(from) - kDeeper) candidates.emplace_back(goal->offset(q), q);

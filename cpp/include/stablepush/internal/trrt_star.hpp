@@ -72,8 +72,8 @@ class TRRTstar : public ompl::base::Planner {
   /// Whether the plan can end at the goal pose from `end`, pushed into by `pusher`, after
   /// `switches` switch-overs (planning.cpp's end of a plan: the straight push, a point pusher's two).
   using EndTest = std::function<bool(const Pose& end, int pusher, int switches)>;
-  /// finish_toward_goal takes no step from a search's end where `can_end` holds: a plan that ends
-  /// at the goal pose without finish_steps is unchanged by them. Unset: every step is tried.
+  /// finish_toward_goal stops where `can_end` holds, the search's end included: a plan that ends at
+  /// the goal pose without finish_steps is unchanged by them. Unset: where the straight push is stable.
   void set_end_test(EndTest can_end) { end_test_ = std::move(can_end); }
   void getPlannerData(ompl::base::PlannerData& data) const override;
 
@@ -286,9 +286,8 @@ class TRRTstar : public ompl::base::Planner {
   /// goal nodes now, within the budget, the one with the fewest switch-overs, then the largest
   /// least margin, then the shortest.
   void choose_improved_path();
-  /// With finish_steps, after the goal is reached, unless set_end_test says the plan can end at the
-  /// goal pose from the search's end: from the plan's end its last pusher takes, while
-  /// one is found and the push from there straight to the goal pose is not stable, the step that
+  /// With finish_steps, after the goal is reached: from the plan's end its last pusher takes, while
+  /// one is found and the plan cannot end at the goal pose from there (set_end_test), the step that
   /// ends deepest in the tolerance box (PoseGoal::offset, by at least 0.001 of it), held there,
   /// in the grasp and a stable push, among full, half and quarter steps toward the goal turned up
   /// to 90 deg (for a point pusher, its wedge steps). No switch-over; the plan's length grows and
