@@ -161,7 +161,7 @@ void append_pushes(Plan& plan, const GraspPoseSpace& space, const ModelSet& mode
 /// q1 is found at 48 headings once; m_s's sign changes between them are refined to rounding in
 /// phi, and a root counts where |m_s| is within the certification band (not across a jump). Of
 /// the pairs whose two pushes are stable in every model and keep the grasp (and, for s other
-/// than the last pusher, where `planner.transit_held` allows the switch-over at q1), the shortest
+/// than the last pusher, where `planner.pads_hold_transit` allows the switch-over at q1), the shortest
 /// is appended. Returns s, or kNoPusher when none was appended. On the generated pin tasks (docs/planner.md)
 /// shorter first pushes found fewer finishes, 24 headings half as many, and most finishes switch
 /// pins: one surface moves the object in only two of its three coordinates, and two pushes by one
@@ -206,7 +206,7 @@ int finish_on_wedges(Plan& plan, const GraspPoseSpace& space, const StablePushVa
     }
     std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     for (const auto& [length, q1] : found) {
-      if ((second != pusher && !planner.transit_held(q1, pusher)) ||
+      if ((second != pusher && !planner.pads_hold_transit(q1, pusher)) ||
           validator.stable_pushers(end, q1, PusherSet{1} << pusher) == 0 ||
           validator.stable_pushers(q1, target, PusherSet{1} << second) == 0)
         continue;
@@ -222,7 +222,7 @@ int finish_on_wedges(Plan& plan, const GraspPoseSpace& space, const StablePushVa
 /// cut into unit pushes as every motion is, with the last pusher, when each is a stable push in
 /// every model and the goal's hold requirement holds there (Plan::ends_at_goal); for a point
 /// pusher, where it does not, two pushes on point pushers' surfaces (finish_on_wedges), by the
-/// last pusher alone or else, with `switch_left` and where `planner.transit_held` allows, with a
+/// last pusher alone or else, with `switch_left` and where `planner.pads_hold_transit` allows, with a
 /// switch-over to another point pusher. Returns the switch-overs it added (0 or 1).
 int finish_at_goal(Plan& plan, const GraspPoseSpace& space, const StablePushValidator& validator, const PoseGoal& goal,
                    const Pose& target, const ModelSet& models, bool switch_left, const TRRTstar& planner) {

@@ -174,7 +174,7 @@ void TRRTstar::set_transit_hold(ModelSet models, double min_ratio, int start_pus
   start_pusher_ = start_pusher;
 }
 
-bool TRRTstar::transit_held(const Pose& q, int leaving) const {
+bool TRRTstar::pads_hold_transit(const Pose& q, int leaving) const {
   if (min_transit_hold_ <= 0.0) return true;
   return std::all_of(transit_models_.begin(), transit_models_.end(),
                      [&](const StablePushModel* model) { return model->hold_ratio(q, leaving) >= min_transit_hold_; });
@@ -185,7 +185,7 @@ PusherSet TRRTstar::transit_allowed(const Node* from, PusherSet pushers) const {
   // The pusher in contact at `from`: the one that pushed into it, or at the root the start's.
   const int leaving = from->parent != nullptr ? from->pusher : start_pusher_;
   if (leaving == kNoPusher || (pushers & ~single(leaving)) == 0) return pushers;
-  if (from->transit_held < 0) from->transit_held = transit_held(from->pose, leaving) ? 1 : 0;
+  if (from->transit_held < 0) from->transit_held = pads_hold_transit(from->pose, leaving) ? 1 : 0;
   return from->transit_held ? pushers : pushers & single(leaving);
 }
 

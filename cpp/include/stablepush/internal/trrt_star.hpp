@@ -68,7 +68,7 @@ class TRRTstar : public ompl::base::Planner {
   void set_transit_hold(ModelSet models, double min_ratio, int start_pusher);
   /// Whether a switch-over from pusher `leaving` may happen at q: the pads alone hold the object
   /// there with set_transit_hold's ratio in every one of its models (always, with ratio 0).
-  bool transit_held(const Pose& q, int leaving) const;
+  bool pads_hold_transit(const Pose& q, int leaving) const;
   /// Whether the plan can end at the goal pose from `end`, pushed into by `pusher`, after
   /// `switches` switch-overs (planning.cpp's end of a plan: the straight push, a point pusher's two).
   using EndTest = std::function<bool(const Pose& end, int pusher, int switches)>;
