@@ -321,7 +321,7 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   const PathCost cost = planner.solution_cost();
   int finish_switches = 0;
   if (plan.outcome == PlanOutcome::GoalReached) {
-    if (ended) {  // finish_toward_goal took no step from the end it tested (set_end_test)
+    if (ended) {  // finish_toward_goal stopped at the end the test found (set_end_test)
       const std::vector<Waypoint>& tail = ended->plan.waypoints;
       plan.waypoints.back().pose = tail.front().pose;  // the goal pose, where the end was that near
       plan.waypoints.insert(plan.waypoints.end(), tail.begin() + 1, tail.end());
