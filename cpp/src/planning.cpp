@@ -289,18 +289,22 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
     return finish_at_goal(plan, *space, *validator, *goal, settings.goal, models, switches < planner.getMaxSwitches(),
                           planner);
   };
-  // The end the test found, kept so that the plan's end is not searched (nor its tests counted) twice.
-  struct Ended {
-    Plan plan;  ///< finish_at_goal on the search's end alone
+  // The last end the test tried, kept so that the plan's end is not searched (nor its tests
+  // counted) twice where finish_toward_goal stops there: at an end that passed, or at the last
+  // one tried when no step is left.
+  struct Probe {
+    Waypoint from;  ///< the end tried (pose, pusher)
+    Plan plan;      ///< finish_at_goal on `from` alone
     int switches;
   };
-  std::optional<Ended> ended;
+  std::optional<Probe> probed;
   planner.set_end_test([&](const Pose& end, int pusher, int switches) {
-    Plan probe;
-    probe.waypoints.push_back({end, pusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding});
-    const int added = end_at_goal(probe, switches);
-    if (probe.ends_at_goal) ended = Ended{std::move(probe), added};
-    return ended.has_value();
+    const Waypoint from{end, pusher, std::numeric_limits<double>::quiet_NaN(), ContactCase::AllSliding};
+    Plan plan;
+    plan.waypoints.push_back(from);
+    const int added = end_at_goal(plan, switches);
+    probed = Probe{from, std::move(plan), added};
+    return probed->plan.ends_at_goal;
   });
   const ob::PlannerStatus status = solve(planner, problem, settings);
   planner.set_end_test(nullptr);  // it refers to this scope
@@ -321,14 +325,16 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   const PathCost cost = planner.solution_cost();
   int finish_switches = 0;
   if (plan.outcome == PlanOutcome::GoalReached) {
-    if (ended) {  // finish_toward_goal stopped at the end the test found (set_end_test)
-      const std::vector<Waypoint>& tail = ended->plan.waypoints;
+    const Waypoint& last = plan.waypoints.back();
+    if (!probed || probed->from.pusher != last.pusher || probed->from.pose.x != last.pose.x ||
+        probed->from.pose.z != last.pose.z || probed->from.pose.theta != last.pose.theta) {
+      finish_switches = end_at_goal(plan, cost.switches);
+    } else if (probed->plan.ends_at_goal) {  // finish_toward_goal stopped where the test passed
+      const std::vector<Waypoint>& tail = probed->plan.waypoints;
       plan.waypoints.back().pose = tail.front().pose;  // the goal pose, where the end was that near
       plan.waypoints.insert(plan.waypoints.end(), tail.begin() + 1, tail.end());
       plan.ends_at_goal = true;
-      finish_switches = ended->switches;
-    } else {
-      finish_switches = end_at_goal(plan, cost.switches);
+      finish_switches = probed->switches;
     }
   }
   plan.stats.iterations = planner.iterations();
