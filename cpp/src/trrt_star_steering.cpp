@@ -33,33 +33,101 @@ PusherSet TRRTstar::onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ob:
   return 0;
 }
 
-std::vector<TRRTstar::WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal,
-                                                       const std::vector<double>& lengths, PusherSet wedges) const {
-  const auto* region = pdef_->getGoal()->as<PoseGoal>();
-  const bool outside = !region->contains(from);  // from within the box, nearer is what counts
-  const Eigen::Vector3d to_goal = space_->in_unit_steps(goal - from);
+namespace {
+/// The least distance [unit steps] from d to the half circle length (cos b h + sin b e_theta),
+/// |b| <= 90 deg, h = (hx, hz, 0) a unit heading; a little less, so that rounding cannot put a
+/// step on that circle nearer than it.
+double half_circle_distance(const Eigen::Vector3d& d, double hx, double hz, double length) {
+  const double along = d[0] * hx + d[1] * hz;   // in the circle's plane, along h
+  const double across = d[1] * hx - d[0] * hz;  // off the circle's plane
+  // Behind the heading (along < 0) the nearest point is an end of the half circle, b = +-90 deg.
+  const double in_plane = along >= 0.0 ? std::hypot(along, d[2]) - length : std::hypot(along, std::abs(d[2]) - length);
+  return std::max(0.0, std::hypot(across, in_plane) * (1.0 - 1e-9) - 1e-9);
+}
+}  // namespace
+
+WedgeStepQueue::WedgeStepQueue(const PushChecker& checker, const GraspPoseSpace& space, const PoseGoal& region,
+                               const Pose& from, const Pose& goal, const std::vector<double>& lengths, PusherSet wedges)
+    : checker_(checker), space_(space), region_(region), from_(from), goal_(goal) {
+  outside_ = !region.contains(from);  // from within the box, nearer is what counts
+  const Eigen::Vector3d to_goal = space.in_unit_steps(goal - from);
+  const Eigen::Vector3d to_region = space.in_unit_steps(region.pose() - from);
+  const StepSize& tolerance = region.tolerance();
+  const double box_radius = space.in_unit_steps(Motion{tolerance.length, tolerance.length, tolerance.angle}).norm();
   const double heading = std::atan2(to_goal[1], to_goal[0]);
   const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
-  std::vector<WedgeStep> steps;
   constexpr int kHeadings = 24;
+  std::size_t index = 0;
   for (int p = 0; p < kMaxPushers; ++p) {
     if (!contains(wedges, p)) continue;
     for (const double length : lengths) {
-      for (int k = 0; k < kHeadings; ++k) {
+      for (int k = 0; k < kHeadings; ++k, ++index) {
         const double psi = heading + 2.0 * M_PI * k / kHeadings;
         // The goal's elevation picks the root nearest to it.
-        const Eigen::Vector3d direction(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]);
-        const std::optional<Pose> on_surface = validator_->onto_wedge_surface(from, direction.normalized(), length, p);
-        if (on_surface)
-          steps.push_back({space_->distance(*on_surface, goal), *on_surface, p,
-                           outside && region->contains(*on_surface) && region->held(*on_surface, p)});
+        const Eigen::Vector3d direction =
+            Eigen::Vector3d(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]).normalized();
+        const double heading_norm = std::hypot(direction[0], direction[1]);
+        const double hx = direction[0] / heading_norm, hz = direction[1] / heading_norm;
+        const Pending pending{half_circle_distance(to_goal, hx, hz, length), index, direction, length, p};
+        // A step that may end in the tolerance box is found now: those that end the plan come first.
+        if (!(outside_ && half_circle_distance(to_region, hx, hz, length) <= box_radius)) {
+          pending_.push_back(pending);
+        } else if (std::optional<WedgeStep> step = find(pending)) {
+          (step->ends_plan ? ending_ : found_).push_back({*step, index});
+        }
       }
     }
   }
-  std::stable_sort(steps.begin(), steps.end(), [](const WedgeStep& a, const WedgeStep& b) {
-    return a.ends_plan != b.ends_plan ? a.ends_plan : a.goal_distance < b.goal_distance;
+  std::sort(pending_.begin(), pending_.end(), [](const Pending& a, const Pending& b) {
+    return a.bound != b.bound ? a.bound < b.bound : a.index < b.index;
   });
+  std::sort(ending_.begin(), ending_.end(), [](const Found& a, const Found& b) { return after(b, a); });
+  std::make_heap(found_.begin(), found_.end(), after);
+}
+
+bool WedgeStepQueue::after(const Found& a, const Found& b) {
+  return a.step.goal_distance != b.step.goal_distance ? a.step.goal_distance > b.step.goal_distance : a.index > b.index;
+}
+
+std::optional<WedgeStep> WedgeStepQueue::find(const Pending& pending) const {
+  const std::optional<Pose> on_surface =
+      checker_.onto_wedge_surface(from_, pending.direction, pending.length, pending.pusher);
+  if (!on_surface) return std::nullopt;
+  return WedgeStep{space_.distance(*on_surface, goal_), *on_surface, pending.pusher,
+                   outside_ && region_.contains(*on_surface) && region_.held(*on_surface, pending.pusher)};
+}
+
+std::optional<WedgeStep> WedgeStepQueue::next() {
+  if (next_ending_ < ending_.size()) return ending_[next_ending_++].step;
+  for (;;) {
+    const bool pending_left = next_pending_ < pending_.size();
+    // A found step goes out once every root not yet found lies farther from the goal than it.
+    if (!found_.empty() && (!pending_left || found_.front().step.goal_distance < pending_[next_pending_].bound)) {
+      std::pop_heap(found_.begin(), found_.end(), after);
+      const WedgeStep step = found_.back().step;
+      found_.pop_back();
+      return step;
+    }
+    if (!pending_left) return std::nullopt;
+    const Pending& pending = pending_[next_pending_++];
+    if (std::optional<WedgeStep> step = find(pending)) {
+      found_.push_back({*step, pending.index});
+      std::push_heap(found_.begin(), found_.end(), after);
+    }
+  }
+}
+
+std::vector<WedgeStep> TRRTstar::wedge_steps(const Pose& from, const Pose& goal, const std::vector<double>& lengths,
+                                             PusherSet wedges) const {
+  WedgeStepQueue queue = wedge_step_queue(from, goal, lengths, wedges);
+  std::vector<WedgeStep> steps;
+  while (std::optional<WedgeStep> step = queue.next()) steps.push_back(*step);
   return steps;
+}
+
+WedgeStepQueue TRRTstar::wedge_step_queue(const Pose& from, const Pose& goal, const std::vector<double>& lengths,
+                                          PusherSet wedges) const {
+  return WedgeStepQueue(*validator_, *space_, *pdef_->getGoal()->as<PoseGoal>(), from, goal, lengths, wedges);
 }
 
 bool TRRTstar::wedge_step_valid(const Pose& from, const WedgeStep& step, ob::State* scratch) const {
@@ -77,29 +145,31 @@ PusherSet TRRTstar::descend_on_wedges(const Pose& from, const Pose& goal, double
     GraspPoseSpace::set_pose(scratch, q);
     return PusherSet{1} << step.pusher;
   };
-  const std::vector<WedgeStep> steps = wedge_steps(from, goal, {length}, wedges);
-  std::vector<const WedgeStep*> valid;
-  for (const WedgeStep& step : steps) {
-    if (!wedge_step_valid(from, step, scratch)) continue;
-    if (step.ends_plan || step.goal_distance < now) return take(step);
-    valid.push_back(&step);
+  WedgeStepQueue steps = wedge_step_queue(from, goal, {length}, wedges);
+  std::vector<WedgeStep> valid;
+  while (const std::optional<WedgeStep> step = steps.next()) {
+    if (!wedge_step_valid(from, *step, scratch)) continue;
+    if (step->ends_plan || step->goal_distance < now) return take(*step);
+    valid.push_back(*step);
   }
   // Stalled near the goal: shorter steps, since a surface may cross the tolerance box (a unit step
   // or two across) only where a full step from here overshoots it.
   if (now < 2.0 * pdef_->getGoal()->as<ob::GoalRegion>()->getThreshold()) {
-    for (const WedgeStep& step : wedge_steps(from, goal, {0.5 * length, 0.25 * length}, wedges)) {
-      if (!step.ends_plan && step.goal_distance >= now) break;
-      if (wedge_step_valid(from, step, scratch)) return take(step);
+    WedgeStepQueue shorter = wedge_step_queue(from, goal, {0.5 * length, 0.25 * length}, wedges);
+    while (const std::optional<WedgeStep> step = shorter.next()) {
+      if (!step->ends_plan && step->goal_distance >= now) break;
+      if (wedge_step_valid(from, *step, scratch)) return take(*step);
     }
   }
   // A local minimum of one step: one surface alone moves q in two of its three coordinates, so
   // look two steps ahead (the second on any point pusher's surface) from the best first steps.
   constexpr std::size_t kFirstSteps = 8;
   for (std::size_t i = 0; i < std::min(valid.size(), kFirstSteps); ++i) {
-    const double next_length = std::min(1.0, valid[i]->goal_distance);
-    for (const WedgeStep& second : wedge_steps(valid[i]->pose, goal, {next_length}, validator_->wedge_pushers())) {
-      if (!second.ends_plan && second.goal_distance >= now) break;
-      if (wedge_step_valid(valid[i]->pose, second, scratch)) return take(*valid[i]);
+    const double next_length = std::min(1.0, valid[i].goal_distance);
+    WedgeStepQueue seconds = wedge_step_queue(valid[i].pose, goal, {next_length}, validator_->wedge_pushers());
+    while (const std::optional<WedgeStep> second = seconds.next()) {
+      if (!second->ends_plan && second->goal_distance >= now) break;
+      if (wedge_step_valid(valid[i].pose, *second, scratch)) return take(valid[i]);
     }
   }
   GraspPoseSpace::set_pose(scratch, q);

@@ -3,6 +3,7 @@
 #include <ompl/base/SpaceInformation.h>
 #include <ompl/util/Console.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <memory>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "stablepush/internal/grasp_space.hpp"
+#include "stablepush/internal/trrt_star.hpp"
 
 using namespace stablepush;
 namespace ob = ompl::base;
@@ -180,4 +182,99 @@ TEST_CASE_METHOD(Pegs, "wedge_plane_offset: within the certification band on a p
   }
   CHECK(on > 500);
   CHECK(std::isnan(validator.wedge_plane_offset(Pose{0.0, 0.0, 0.0}, Motion{1e-3, 0.0, 0.0}, 2)));  // not a wedge
+}
+
+namespace {
+/// The pegs' validator, counting the roots asked of it.
+struct CountingChecker : PushChecker {
+  explicit CountingChecker(const StablePushValidator& v) : validator(v) {}
+  PusherSet all_pushers() const override { return validator.all_pushers(); }
+  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
+    return validator.stable_pushers(a, b, candidates);
+  }
+  double push_margin(const Pose& a, const Pose& b, int pusher) const override {
+    return validator.push_margin(a, b, pusher);
+  }
+  PusherSet wedge_pushers() const override { return validator.wedge_pushers(); }
+  std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
+                                         int pusher) const override {
+    ++roots;
+    return validator.onto_wedge_surface(a, direction, length, pusher);
+  }
+  std::uint64_t feasibility_checks() const override { return validator.feasibility_checks(); }
+  void reset_feasibility_checks() override {}
+  const StablePushValidator& validator;
+  mutable long roots = 0;
+};
+}  // namespace
+
+TEST_CASE_METHOD(Pegs, "WedgeStepQueue: the steps of a full sort, in its order, the first found with fewer roots",
+                 "[trrt_star]") {
+  // From poses about the start toward goals a few unit steps away (some within a step, so that
+  // steps end the plan, some from inside the box, half of them with the pads to hold the goal),
+  // the queue must give every step onto the pegs' surfaces that a full sort of all of them gives,
+  // bit for bit and in the same order: those that end the plan first, then nearest the goal, ties
+  // in the order (pusher, length, heading). A bound that is not below every step's distance (the
+  // half circle taken as a full one, or its ends ignored behind the heading) fails this.
+  const CountingChecker checker(validator);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> offset(-0.004, 0.004), turn(-0.3, 0.3), away(-3.0, 3.0);
+  const StepSize unit{0.5e-3, 0.5 * M_PI / 180.0};
+  const std::vector<std::vector<double>> length_sets = {{1.0}, {0.5, 0.25}, {0.7}};
+  long candidates = 0, first_roots = 0, steps = 0, ending = 0, inside = 0;
+  for (int k = 0; k < 300; ++k) {
+    const Pose from{offset(rng), offset(rng), turn(rng)};
+    const double reach = k % 3 == 0 ? 0.4 : 1.0;  // a third within a step or so of the goal
+    const Pose goal =
+        from + Motion{reach * away(rng) * unit.length, reach * away(rng) * unit.length, reach * away(rng) * unit.angle};
+    const bool hold = k % 2 == 1;
+    const PoseGoal region(si, goal, unit, hold ? ModelSet{&model} : ModelSet{}, hold ? 1.0 : 0.0);
+    const bool outside = !region.contains(from);
+    inside += outside ? 0 : 1;
+    const std::vector<double>& lengths = length_sets[k % length_sets.size()];
+
+    // Every step, as the queue asks for them (its headings copied: a change there must be made here).
+    std::vector<WedgeStep> expected;
+    const Eigen::Vector3d to_goal = space->in_unit_steps(goal - from);
+    const double heading = std::atan2(to_goal[1], to_goal[0]);
+    const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
+    for (int p = 0; p < 2; ++p)
+      for (const double length : lengths)
+        for (int h = 0; h < 24; ++h) {
+          const double psi = heading + 2.0 * M_PI * h / 24;
+          const Eigen::Vector3d direction =
+              Eigen::Vector3d(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]).normalized();
+          ++candidates;
+          if (const std::optional<Pose> q = validator.onto_wedge_surface(from, direction, length, p))
+            expected.push_back(
+                {space->distance(*q, goal), *q, p, outside && region.contains(*q) && region.held(*q, p)});
+        }
+    std::stable_sort(expected.begin(), expected.end(), [](const WedgeStep& a, const WedgeStep& b) {
+      return a.ends_plan != b.ends_plan ? a.ends_plan : a.goal_distance < b.goal_distance;
+    });
+
+    checker.roots = 0;
+    WedgeStepQueue queue(checker, *space, region, from, goal, lengths, 0b11);
+    std::vector<WedgeStep> given;
+    while (const std::optional<WedgeStep> step = queue.next()) {
+      given.push_back(*step);
+      if (given.size() == 1) first_roots += checker.roots;
+    }
+    REQUIRE(given.size() == expected.size());
+    for (std::size_t i = 0; i < given.size(); ++i) {
+      INFO("case " << k << ", step " << i);
+      CHECK(given[i].pusher == expected[i].pusher);
+      CHECK(given[i].pose.x == expected[i].pose.x);
+      CHECK(given[i].pose.z == expected[i].pose.z);
+      CHECK(given[i].pose.theta == expected[i].pose.theta);
+      CHECK(given[i].goal_distance == expected[i].goal_distance);
+      CHECK(given[i].ends_plan == expected[i].ends_plan);
+    }
+    steps += static_cast<long>(given.size());
+    ending += std::count_if(given.begin(), given.end(), [](const WedgeStep& s) { return s.ends_plan; });
+  }
+  CHECK(steps > candidates / 2);        // most headings meet a surface
+  CHECK(ending > 100);                  // the steps that end the plan were among them
+  CHECK(inside > 10);                   // and starts within the tolerance box
+  CHECK(first_roots < candidates / 2);  // the first step needs few of the roots
 }

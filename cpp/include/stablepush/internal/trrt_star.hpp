@@ -50,6 +50,56 @@
 
 namespace stablepush {
 
+/// A step onto a point pusher's surface of stable pushes and where it ends.
+struct WedgeStep {
+  double goal_distance;  ///< [unit steps]
+  Pose pose;
+  int pusher;
+  bool ends_plan;  ///< within the goal's tolerance (and held there, PoseGoal::held)
+};
+
+/// The steps of each of `lengths` [unit steps] from `from` onto the surfaces of the point pushers
+/// in `wedges` (PushChecker::onto_wedge_surface) over 24 headings around the goal's, one at a
+/// time: those that end the plan (in `region`, from outside it) first, then nearest `goal` first,
+/// ties in the order (pusher, length, heading). Each surface's root is found only when no step
+/// whose root is not yet found can come before it: a step of length L at heading h ends on the
+/// half circle from + L (cos b h + sin b e_theta), |b| < 90 deg, in unit steps, so the half
+/// circle's point nearest the goal bounds the step's distance from below. A descent mostly takes
+/// one of the first few steps, and the roots of the rest are never found.
+class WedgeStepQueue {
+ public:
+  WedgeStepQueue(const PushChecker& checker, const GraspPoseSpace& space, const PoseGoal& region, const Pose& from,
+                 const Pose& goal, const std::vector<double>& lengths, PusherSet wedges);
+  /// The next step, or nullopt after the last.
+  std::optional<WedgeStep> next();
+
+ private:
+  struct Pending {
+    double bound;       ///< at most the step's goal distance [unit steps]
+    std::size_t index;  ///< its place in the order (pusher, length, heading)
+    Eigen::Vector3d direction;
+    double length;
+    int pusher;
+  };
+  struct Found {
+    WedgeStep step;
+    std::size_t index;
+  };
+  std::optional<WedgeStep> find(const Pending& pending) const;
+  static bool after(const Found& a, const Found& b);  ///< a comes after b (the heap's order)
+
+  const PushChecker& checker_;
+  const GraspPoseSpace& space_;
+  const PoseGoal& region_;
+  Pose from_, goal_;
+  bool outside_;                  ///< from outside the tolerance box: a step may end the plan
+  std::vector<Pending> pending_;  ///< roots not yet found, the least bound first
+  std::size_t next_pending_ = 0;
+  std::vector<Found> ending_;  ///< the steps that end the plan, in order (all found at once)
+  std::size_t next_ending_ = 0;
+  std::vector<Found> found_;  ///< the other steps found, a heap with the next on top
+};
+
 class TRRTstar : public ompl::base::Planner {
  public:
   explicit TRRTstar(const ompl::base::SpaceInformationPtr& si);
@@ -185,18 +235,13 @@ class TRRTstar : public ompl::base::Planner {
   /// that the grasp survives and that pusher makes stable. Sets q (and `scratch`) to it and returns
   /// that pusher; 0, q unchanged, when there is none.
   PusherSet onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ompl::base::State* scratch) const;
-  /// A step onto a point pusher's surface of stable pushes and where it ends.
-  struct WedgeStep {
-    double goal_distance;  ///< [unit steps]
-    Pose pose;
-    int pusher;
-    bool ends_plan;  ///< within the goal's tolerance (and held there, PoseGoal::held)
-  };
-  /// The steps of each of `lengths` [unit steps] from `from` onto the surfaces of the point pushers
-  /// in `wedges`, over 24 headings around the goal's: those that end the plan first, then nearest
-  /// the goal first (not yet checked for the grasp and facets). A surface rarely passes through the
-  /// goal pose itself, and where its point nearest the goal pose is outside the tolerance box, a
-  /// descent ranked by that distance alone stops there though the surface crosses the box.
+  /// The steps onto the point pushers' surfaces of WedgeStepQueue toward this problem's goal region
+  /// (not yet checked for the grasp and facets). A surface rarely passes through the goal pose
+  /// itself, and where its point nearest the goal pose is outside the tolerance box, a descent
+  /// ranked by that distance alone stops there though the surface crosses the box.
+  WedgeStepQueue wedge_step_queue(const Pose& from, const Pose& goal, const std::vector<double>& lengths,
+                                  PusherSet wedges) const;
+  /// All of wedge_step_queue's steps, in its order.
   std::vector<WedgeStep> wedge_steps(const Pose& from, const Pose& goal, const std::vector<double>& lengths,
                                      PusherSet wedges) const;
   /// The grasp survives `step` and its pusher makes it stable.
