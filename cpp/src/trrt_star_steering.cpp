@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -52,8 +53,7 @@ WedgeStepQueue::WedgeStepQueue(const PushChecker& checker, const GraspPoseSpace&
   outside_ = !region.contains(from);  // from within the box, nearer is what counts
   const Eigen::Vector3d to_goal = space.in_unit_steps(goal - from);
   const Eigen::Vector3d to_region = space.in_unit_steps(region.pose() - from);
-  const StepSize& tolerance = region.tolerance();
-  const double box_radius = space.in_unit_steps(Motion{tolerance.length, tolerance.length, tolerance.angle}).norm();
+  const double box_radius = region.getThreshold();  // no pose farther from the goal pose is in the box
   const double heading = std::atan2(to_goal[1], to_goal[0]);
   const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
   constexpr int kHeadings = 24;
@@ -93,8 +93,10 @@ std::optional<WedgeStep> WedgeStepQueue::find(const Pending& pending) const {
   const std::optional<Pose> on_surface =
       checker_.onto_wedge_surface(from_, pending.direction, pending.length, pending.pusher);
   if (!on_surface) return std::nullopt;
-  return WedgeStep{space_.distance(*on_surface, goal_), *on_surface, pending.pusher,
-                   outside_ && region_.contains(*on_surface) && region_.held(*on_surface, pending.pusher)};
+  const WedgeStep step{space_.distance(*on_surface, goal_), *on_surface, pending.pusher,
+                       outside_ && region_.contains(*on_surface) && region_.held(*on_surface, pending.pusher)};
+  assert(step.goal_distance >= pending.bound);  // a checker's steps as PushChecker::onto_wedge_surface says
+  return step;
 }
 
 std::optional<WedgeStep> WedgeStepQueue::next() {

@@ -211,24 +211,30 @@ struct CountingChecker : PushChecker {
 TEST_CASE_METHOD(Pegs, "WedgeStepQueue: the steps of a full sort, in its order, the first found with fewer roots",
                  "[trrt_star]") {
   // From poses about the start toward goals a few unit steps away (some within a step, so that
-  // steps end the plan, some from inside the box, half of them with the pads to hold the goal),
-  // the queue must give every step onto the pegs' surfaces that a full sort of all of them gives,
-  // bit for bit and in the same order: those that end the plan first, then nearest the goal, ties
-  // in the order (pusher, length, heading). A bound that is not below every step's distance (the
-  // half circle taken as a full one, or its ends ignored behind the heading) fails this.
+  // steps end the plan, some from inside the box, half of them with the pads to hold the goal, some
+  // straight up in theta, some ranked against a pose other than the box's centre), the queue must
+  // give every step onto the pegs' surfaces that a full sort of all of them gives, bit for bit and
+  // in the same order: those that end the plan first, then nearest the goal, ties in the order
+  // (pusher, length, heading). A bound above a step's distance fails this (one with 1e-3 unit
+  // steps of slack added fails some 2,700 of its checks).
   const CountingChecker checker(validator);
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> offset(-0.004, 0.004), turn(-0.3, 0.3), away(-3.0, 3.0);
   const StepSize unit{0.5e-3, 0.5 * M_PI / 180.0};
   const std::vector<std::vector<double>> length_sets = {{1.0}, {0.5, 0.25}, {0.7}};
-  long candidates = 0, first_roots = 0, steps = 0, ending = 0, inside = 0;
+  long candidates = 0, first_roots = 0, steps = 0, ending = 0, inside = 0, not_held = 0;
   for (int k = 0; k < 300; ++k) {
     const Pose from{offset(rng), offset(rng), turn(rng)};
     const double reach = k % 3 == 0 ? 0.4 : 1.0;  // a third within a step or so of the goal
-    const Pose goal =
-        from + Motion{reach * away(rng) * unit.length, reach * away(rng) * unit.length, reach * away(rng) * unit.angle};
+    const double up = k % 10 == 5 ? 0.0 : 1.0;    // a tenth with no translation to the goal
+    const Pose centre = from + Motion{up * reach * away(rng) * unit.length, up * reach * away(rng) * unit.length,
+                                      reach * away(rng) * unit.angle};
     const bool hold = k % 2 == 1;
-    const PoseGoal region(si, goal, unit, hold ? ModelSet{&model} : ModelSet{}, hold ? 1.0 : 0.0);
+    // The pads hold the cube some 8-10 times over about the start: a ratio some steps miss.
+    constexpr double kHoldRatio = 9.0;
+    const PoseGoal region(si, centre, unit, hold ? ModelSet{&model} : ModelSet{}, hold ? kHoldRatio : 0.0);
+    // A seventh ranked against a pose half a step off the box's centre.
+    const Pose goal = k % 7 == 3 ? centre + Motion{0.5 * unit.length, -0.3 * unit.length, 0.2 * unit.angle} : centre;
     const bool outside = !region.contains(from);
     inside += outside ? 0 : 1;
     const std::vector<double>& lengths = length_sets[k % length_sets.size()];
@@ -245,9 +251,11 @@ TEST_CASE_METHOD(Pegs, "WedgeStepQueue: the steps of a full sort, in its order, 
           const Eigen::Vector3d direction =
               Eigen::Vector3d(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]).normalized();
           ++candidates;
-          if (const std::optional<Pose> q = validator.onto_wedge_surface(from, direction, length, p))
-            expected.push_back(
-                {space->distance(*q, goal), *q, p, outside && region.contains(*q) && region.held(*q, p)});
+          if (const std::optional<Pose> q = validator.onto_wedge_surface(from, direction, length, p)) {
+            const bool in_box = outside && region.contains(*q);
+            expected.push_back({space->distance(*q, goal), *q, p, in_box && region.held(*q, p)});
+            if (in_box && !expected.back().ends_plan) ++not_held;
+          }
         }
     std::stable_sort(expected.begin(), expected.end(), [](const WedgeStep& a, const WedgeStep& b) {
       return a.ends_plan != b.ends_plan ? a.ends_plan : a.goal_distance < b.goal_distance;
@@ -276,5 +284,6 @@ TEST_CASE_METHOD(Pegs, "WedgeStepQueue: the steps of a full sort, in its order, 
   CHECK(steps > candidates / 2);        // most headings meet a surface
   CHECK(ending > 100);                  // the steps that end the plan were among them
   CHECK(inside > 10);                   // and starts within the tolerance box
+  CHECK(not_held > 10);                 // and steps into the box where the pads do not hold the object
   CHECK(first_roots < candidates / 2);  // the first step needs few of the roots
 }

@@ -63,6 +63,10 @@ class PushChecker {
   /// Point pushers, whose stable pushes are a surface (StablePushValidator::onto_wedge_surface);
   /// by default there are none.
   virtual PusherSet wedge_pushers() const { return 0; }
+  /// A step onto `pusher`'s surface from `a`, `length` unit steps long with the heading of
+  /// `direction` [unit steps]: a + length (cos b h + sin b e_theta) in unit steps, h the unit
+  /// heading of direction's first two coordinates, |b| <= 90 deg (the search bounds where such a
+  /// step can end by it, WedgeStepQueue); nullopt when there is none. By default none.
   virtual std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                                  int pusher) const;
   /// Points fixed in G [m] about which a turn keeps a pad point sticking (the pads' centres): such a

@@ -191,7 +191,6 @@ class PoseGoal : public ompl::base::GoalSampleableRegion {
            double min_hold_ratio = 0.0);
 
   const Pose& pose() const { return goal_; }
-  const StepSize& tolerance() const { return tolerance_; }
   /// q within the tolerance of the goal pose, in each of x, z and theta.
   bool contains(const Pose& q) const;
   /// The largest of q's offsets from the goal pose in x, z and theta, each over its tolerance

@@ -60,12 +60,13 @@ struct WedgeStep {
 
 /// The steps of each of `lengths` [unit steps] from `from` onto the surfaces of the point pushers
 /// in `wedges` (PushChecker::onto_wedge_surface) over 24 headings around the goal's, one at a
-/// time: those that end the plan (in `region`, from outside it) first, then nearest `goal` first,
-/// ties in the order (pusher, length, heading). Each surface's root is found only when no step
-/// whose root is not yet found can come before it: a step of length L at heading h ends on the
-/// half circle from + L (cos b h + sin b e_theta), |b| < 90 deg, in unit steps, so the half
-/// circle's point nearest the goal bounds the step's distance from below. A descent mostly takes
-/// one of the first few steps, and the roots of the rest are never found.
+/// time: those that end the plan (in `region`, from outside it) first, since from outside the box
+/// entering it is what counts, then nearest `goal` first, ties in the order (pusher, length,
+/// heading). Each surface's root is found only when no step whose root is not yet found can come
+/// before it: a step of length L at heading h ends on the half circle
+/// from + L (cos b h + sin b e_theta), |b| <= 90 deg, in unit steps, so the half circle's point
+/// nearest the goal bounds the step's distance from below. A descent mostly takes one of the first
+/// few steps, and the roots of the rest are never found.
 class WedgeStepQueue {
  public:
   WedgeStepQueue(const PushChecker& checker, const GraspPoseSpace& space, const PoseGoal& region, const Pose& from,
@@ -235,8 +236,8 @@ class TRRTstar : public ompl::base::Planner {
   /// that the grasp survives and that pusher makes stable. Sets q (and `scratch`) to it and returns
   /// that pusher; 0, q unchanged, when there is none.
   PusherSet onto_wedge(const Pose& from, Pose& q, PusherSet allowed, ompl::base::State* scratch) const;
-  /// The steps onto the point pushers' surfaces of WedgeStepQueue toward this problem's goal region
-  /// (not yet checked for the grasp and facets). A surface rarely passes through the goal pose
+  /// WedgeStepQueue's steps toward this problem's goal region (not yet checked for the grasp and
+  /// facets). Those that end the plan come first: a surface rarely passes through the goal pose
   /// itself, and where its point nearest the goal pose is outside the tolerance box, a descent
   /// ranked by that distance alone stops there though the surface crosses the box.
   WedgeStepQueue wedge_step_queue(const Pose& from, const Pose& goal, const std::vector<double>& lengths,
@@ -246,7 +247,7 @@ class TRRTstar : public ompl::base::Planner {
                                      PusherSet wedges) const;
   /// The grasp survives `step` and its pusher makes it stable.
   bool wedge_step_valid(const Pose& from, const WedgeStep& step, ompl::base::State* scratch) const;
-  /// Toward the goal when no straight or steered step is stable: the valid wedge step (wedge_steps)
+  /// Toward the goal when no straight or steered step is stable: the valid wedge step (wedge_step_queue)
   /// that ends the plan, or else ends nearest the goal if closer than `from`; where none does
   /// within two goal thresholds of the goal, the same among half and quarter steps; else, since
   /// one surface moves q in only two of three coordinates, the first of the best 8 valid steps
