@@ -122,6 +122,45 @@ def test_a_goal_whose_tolerance_reaches_back_across_a_short_neck_is_not_called_c
     assert "would have to leave" in U.why_unreachable(dataclasses.replace(task, goal=(-5.4, 0.0, 0.0)))
 
 
+@pytest.mark.parametrize("turn", [200.0, 300.0, 360.0, 720.0])
+def test_a_turn_tolerance_past_half_a_turn_never_cuts_a_pad_off(turn):
+    """Turned half a turn the dumbbell's pads sit in their start square again, so a tolerance in
+    theta past 180 deg lets them end where they start: no turn moves a pad's centre farther than
+    twice its distance from the object's origin."""
+    task = parse_task(dumbbell(9.9))
+    assert U.why_unreachable(task) is not None  # the default tolerance: cut off
+    wide = dataclasses.replace(task, planner={**task.planner, "tolerance": [1.0, turn]})
+    assert U.why_unreachable(wide) is None
+
+
+@pytest.mark.parametrize("name", ["t-shaped", "more/l-bracket-mesh", "dumbbell"])
+def test_a_pad_called_off_near_a_goal_is_off_at_every_pose_within_its_tolerance(name):
+    """Verdict 6 as a property: goals about the outline's edges (where pads are off, on or across
+    it), each with random poses in its tolerance box (its corners among them); a pad the verdict
+    calls off is off the object (the core's own test) at every one of them. Some goals must be
+    called off and some not, so the test decides both."""
+    task = parse_task(dumbbell(9.9)) if name == "dumbbell" else shipped(name)
+    task = dataclasses.replace(task, planner={**task.planner, "tolerance": [2.0, 5.0]})
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    section = task.section()
+    model = task.corner_models()[0]
+    called, spared = 0, 0
+    corners = np.array(list(itertools.product((-1.0, 1.0), repeat=3)))
+    for _ in range(150):
+        goal = tuple(rng.uniform(-40.0, 40.0, 2)) + (float(rng.uniform(-30.0, 30.0)),)
+        off = U.pads_off_near(task, goal, section)
+        called += bool(off)
+        spared += len(off) < len(task.pads)
+        if not off:
+            continue
+        scale = np.array([2.0, 2.0, 5.0])
+        for q in [*(corners * scale), *rng.uniform(-1.0, 1.0, (40, 3)) * scale]:
+            pose = np.array(goal) + q
+            inside = model.gripper.pads_inside(section, pose_to_si(pose))
+            assert not any(inside[k] for k in off), (goal, tuple(pose), off)
+    assert called > 10 and spared > 10, (called, spared)
+
+
 @pytest.mark.parametrize("name", ["t-shaped", "more/l-bracket-mesh", "more/wedge-heel", "dumbbell"])
 def test_a_start_and_goal_a_chain_of_grasps_joins_are_never_called_cut_off(name):
     """A property against the core's own grasp test: start and goal at random grasps; wherever a

@@ -6,8 +6,9 @@ time limit decides (a `not found` cell's partial path, a goal found only near th
 
 Each cell ends with a verdict:
 - `reached`: a plan reaches the goal within the task's tolerance and switch-over budget;
-- `unreachable`: no plan can, for a reason decided exactly before any search (`reason`): the pads
-  are not all on the object at the goal (no grasp there, so no push can end there), the pads are
+- `unreachable`: no plan can, for a reason decided exactly before any search (`reason`): a pad is
+  off the object at every pose within the goal's tolerance (no grasp there, so no push can end
+  there; the goal pose itself may be off while poses within its tolerance are not), the pads are
   not on the object at the start (the planner's `invalid_start`), or the planner's own verdict
   before its search (`stablepush.plan.unreachable`: every pusher excluded by the uncertainty box,
   no stable push out of the start, none that ends within the goal's tolerance, the goal not held
@@ -23,14 +24,14 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import List, Optional, Tuple
 
 import numpy as np
 
 from stablepush.errors import TaskError
 from stablepush.plan.search import plan_task
-from stablepush.plan.unreachable import why_unreachable
-from stablepush.task.model import Task, make_gripper, require_task
+from stablepush.plan.unreachable import pads_off_near, why_unreachable
+from stablepush.task.model import Task, require_task
 from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_limit, planner_parameter
 from stablepush.units import is_finite_real, pose_to_si
 
@@ -96,13 +97,6 @@ def grid_axis(name: str, axis, bound: Tuple[float, float]) -> Axis:
     return start, stop, int(count)
 
 
-def pads_off_object(task: Task, pose: Sequence[float]) -> List[int]:
-    """The indices of the pads that are not all on the object at `pose`."""
-    inside = make_gripper(task.pads, task.grip_force, task.mu, task.pad_rings).pads_inside(task.section(),
-                                                                                           pose_to_si(pose))
-    return [i for i, ok in enumerate(inside) if not ok]
-
-
 def at_start_verdict(task: Task) -> dict:
     """The verdict of a goal within the tolerance of the start, which the planner does not search
     (plan_task refuses it): reached with no push where the pads alone hold the object at the start
@@ -130,10 +124,11 @@ def reach_cell(job: ReachJob, i: int) -> dict:
     cell = {"goal": list(goal), "seed": job.seed, "solved": False, "planning_time_s": 0.0, "switches": None,
             "pushes": None, "outcome": None, "verdict": None, "reason": None}
     task = dataclasses.replace(job.task, goal=tuple(goal))
-    off = pads_off_object(task, goal)
+    off = pads_off_near(task, goal)
     if off:
         return {**cell, "verdict": "unreachable",
-                "reason": f"gripper.pads{off} would not lie on the object at the goal: no grasp there"}
+                "reason": f"gripper.pads{off} would be off the object at every pose within planner.tolerance of the "
+                          f"goal: no grasp there"}
     if task.at_goal(task.start):
         return {**cell, **at_start_verdict(task)}
     plan = plan_task(task, seed=job.seed, time_limit=job.time_limit)

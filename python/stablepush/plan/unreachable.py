@@ -16,8 +16,12 @@
    that set it lies in at the start keeps clear of every place the goal's tolerance lets it end,
    the other parts joined to it only through necks narrower than the pad (decided geometrically,
    without an LP; below);
-6. the pads are not all on the object at the goal itself (load_task refuses such a task, so only
-   a task edited in code reaches the planner with one).
+6. a pad is off the object at every pose within the goal's tolerance (load_task refuses a task
+   whose goal pose itself puts one off, so only a task edited in code, or a `reach` cell, has one):
+   no push can end where there is no grasp. A pad's disc lies inside the outline only where its
+   centre is at least its radius r inside; a centre that is d inside (negative: outside) at the
+   goal, with r - d more than it can move over the tolerance box (verdict 5's bound), is off at
+   every pose of the box. The goal pose itself may be off while poses within its tolerance are not.
 
 Each of 2-4 is a linear program over an outer approximation of the model, so that its
 infeasibility (2, 4) or an upper bound under the requirement (3) holds for the model itself:
@@ -83,9 +87,9 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
             task.pushers[i].name for i in stuck) + "): the pads do not hold the object there, and no pusher's "
             "friction cone can carry what they leave")
     goal = pose_to_si(task.goal)
-    off = [k for k, inside in enumerate(models[0].gripper.pads_inside(models[0].section, goal)) if not inside]
-    if off:  # load_task refuses such a goal; a task edited in code (dataclasses.replace) may have one
-        return (f"the pads are not all on the object at the goal (gripper.pads[{off[0]}] is off it): "
+    off = pads_off_near(task, task.goal, models[0].section)
+    if off:
+        return (f"gripper.pads[{off[0]}] is off the object at every pose within planner.tolerance of the goal: "
                 f"there is no grasp there")
     apart = _pad_cut_off(task, models[0])
     if apart is not None:
@@ -127,7 +131,6 @@ def _pad_cut_off(task: Task, model) -> Optional[str]:
     from shapely.geometry import Point, Polygon  # here: only outlines with reflex corners need it
 
     outline = Polygon(outline_corners(task.vertices))
-    tol = task.planner["tolerance"]
     for k, (centre, radius) in enumerate(task.pads):
         eroded = outline.buffer(-(radius * math.cos(math.pi / (4 * QUAD_SEGS)) - ERODE_MARGIN), quad_segs=QUAD_SEGS)
         parts = list(getattr(eroded, "geoms", [eroded]))
@@ -135,13 +138,38 @@ def _pad_cut_off(task: Task, model) -> Optional[str]:
             continue
         start, goal = (Point(direction_in_gripper(-pose[2], (centre[0] - pose[0], centre[1] - pose[1])))
                        for pose in (task.start, task.goal))  # the pad's centre in O
-        reach = math.sqrt(2.0) * tol[0] + 2.0 * math.sin(math.radians(tol[1]) / 2.0) * math.hypot(
-            centre[0] - task.goal[0], centre[1] - task.goal[1])
+        reach = _centre_travel(task, centre, task.goal)
         held = [part for part in parts if part.covers(start)]
         if held and all(part.distance(goal) > reach * (1.0 + 1e-9) + ERODE_MARGIN for part in held):
             return (f"gripper.pads[{k}] (radius {radius:g} mm) would have to leave the object between the start and "
-                    f"the goal: the outline narrows to less than the pad's width between where it sits at each")
+                    f"the goal: between where the pad sits at the start and every place the goal's tolerance lets it "
+                    f"end, the outline narrows to less than the pad's width")
     return None
+
+
+def _centre_travel(task: Task, centre, pose) -> float:
+    """How far [mm] a pad's centre seen from O, R(-theta) (p - o), can move from where it is at `pose`
+    over the goal's tolerance box (|do| <= sqrt(2) a in x and z, |dtheta| <= b): at most
+    sqrt(2) a + 2 sin(min(b, 180 deg) / 2) |p - o|, the turn's chord, which no turn makes longer
+    than 2 |p - o|."""
+    tol = task.planner["tolerance"]
+    chord = 2.0 * math.sin(math.radians(min(tol[1], 180.0)) / 2.0)
+    return math.sqrt(2.0) * tol[0] + chord * math.hypot(centre[0] - pose[0], centre[1] - pose[1])
+
+
+def pads_off_near(task: Task, pose: Sequence[float], section=None) -> List[int]:
+    """Verdict 6 (module docstring): the indices of the pads that are off the object at every pose
+    within planner.tolerance of `pose` (mm, mm, deg). `section`: the task's cross-section, built
+    here unless given."""
+    section = section if section is not None else task.section()
+    off = []
+    for k, (centre, radius) in enumerate(task.pads):
+        c = direction_in_gripper(-pose[2], (centre[0] - pose[0], centre[1] - pose[1]))  # the centre in O [mm]
+        at = np.array(c) * MM
+        depth = section.distance_to_boundary(at) / MM * (1.0 if section.contains_disc(at, 0.0) else -1.0)
+        if radius - depth > _centre_travel(task, centre, pose) * (1.0 + 1e-9) + ERODE_MARGIN:
+            off.append(k)
+    return off
 
 
 def _excluded_by_box(task: Task, pusher) -> bool:
