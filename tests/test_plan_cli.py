@@ -105,8 +105,9 @@ def test_check_directions_lists_stable_pushes_and_their_reach(tmp_path):
     for args in ((), ("--move", "1", "0", "0", "--directions")):
         result = run("check", LOW_MU, *args)
         assert result.returncode == 2 and "--move DX DZ DTH, or --directions" in result.stderr
-    result = run("check", LOW_MU, "--directions", "--heading-step", "0")
-    assert result.returncode == 2 and "--heading-step" in result.stderr
+    for step in ("0", "0.01"):  # 0.01 deg: 36,000 headings, minutes and gigabytes
+        result = run("check", LOW_MU, "--directions", "--heading-step", step)
+        assert result.returncode == 2 and "--heading-step" in result.stderr and "0.5" in result.stderr
 
 
 def test_every_number_option_refuses_nan_and_infinity():

@@ -70,6 +70,21 @@ def test_a_goal_no_push_can_end_at_is_unreachable_and_one_beside_the_ledge_is_pl
     assert plan_task(dataclasses.replace(task, goal=(30.0, -4.0, 0.0))).solved
 
 
+def test_verdicts_past_their_deadline_stop_undecided_and_the_search_runs(monkeypatch):
+    """The verdicts stop, undecided, once the time they are given (the search's limit) is over: on
+    a task of many pushers each test can take seconds. Here the clock passes the deadline after the
+    first test, so the ledge's goal, unreachable by verdict 4, is left undecided; given the search's
+    0.2 s, the verdicts decide it as before."""
+    task = parse_task(LEDGE)
+    assert U.why_unreachable(task) is not None
+    clock = iter(itertools.count(0.0, 10.0))
+    monkeypatch.setattr(U.time, "perf_counter", lambda: next(clock))
+    assert U.why_unreachable(task, deadline=5.0) is None
+    monkeypatch.undo()
+    plan = plan_task(dataclasses.replace(task, planner={**task.planner, "time_limit": 0.2}))
+    assert plan.outcome == "unreachable"  # within its time the verdict decides as before
+
+
 def dumbbell(neck_mm: float, neck_half_length: float = 15.0, start=(30, 0, 0), goal=(-30, 0, 0), pads=None) -> str:
     """Two squares (30 mm for the default neck) joined by a bar `neck_mm` tall and 2
     `neck_half_length` long, held by 5 mm pads (10 mm wide; `pads` as in a task file) in the right
@@ -106,7 +121,7 @@ def test_a_goal_the_pads_cannot_slide_to_without_leaving_the_object_is_unreachab
     same_square = (*(p - direction_in_gripper(-20.0, (-25.0, 0.0))).tolist(), -20.0)
     assert U.why_unreachable(dataclasses.replace(turned, goal=same_square)) is None
     # With the verdict off, the search does not cross the 9.9 mm neck either.
-    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None: None)
+    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None, deadline=None: None)
     for t in (task, turned):
         for seed in (1, 2):
             assert not plan_task(t, seed=seed, time_limit=1.5).solved
@@ -395,7 +410,7 @@ def test_no_goal_the_ledge_cannot_end_at_is_reached_by_a_long_search(monkeypatch
     unreachable = [goal for goal, why in verdicts.items() if why is not None]
     assert unreachable and len(unreachable) < len(verdicts), verdicts
     assert plan_task(dataclasses.replace(task, goal=(30.0, -4.0, 0.0))).solved
-    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None: None)
+    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None, deadline=None: None)
     for goal in unreachable:
         for seed in (1, 2):
             plan = plan_task(dataclasses.replace(task, goal=goal), seed=seed, time_limit=1.5)
@@ -420,7 +435,7 @@ def test_no_goal_called_unreachable_on_a_grid_is_reached_by_a_long_search(name, 
             verdicts[goal] = U.why_unreachable(t)
     unreachable = [goal for goal, why in verdicts.items() if why is not None]
     assert unreachable and len(unreachable) < len(verdicts), verdicts
-    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None: None)
+    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None, deadline=None: None)
     for goal in unreachable:
         t = dataclasses.replace(task, goal=goal)
         for seed in (1, 2):

@@ -13,7 +13,7 @@ import click
 from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, StablepushError, TaskError
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
-from stablepush.task import check_push, load_task, stable_directions
+from stablepush.task import HEADING_STEP_DEG, check_push, load_task, stable_directions
 from stablepush.task.schema import LIMITS, PLANNER_PARAMETER_RANGES
 
 EXIT_NOT_SOLVED = 1
@@ -151,8 +151,10 @@ def cli() -> None:
 @click.option("--directions", is_flag=True,
               help="Instead of --move: every direction in which a pusher can push the object one unit step "
                    "(planner.step) from --at, and how far any of them moves it along +-x, +-z and +-theta.")
-@click.option("--heading-step", type=Finite(min=0, max=90, min_open=True), default=10.0, metavar="DEG",
-              show_default=True, help="With --directions: degrees between the headings tried in the (x, z) plane.")
+@click.option("--heading-step", type=Finite(min=HEADING_STEP_DEG[0], max=HEADING_STEP_DEG[1]), default=10.0,
+              metavar="DEG", show_default=True,
+              help=f"With --directions: degrees between the headings tried in the (x, z) plane "
+                   f"({HEADING_STEP_DEG[0]:g}-{HEADING_STEP_DEG[1]:g}).")
 @click.option("--pusher", default=None, metavar="NAME", help="Test only this pusher (default: every pusher).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object keyed by pusher name.")
 @click.pass_context

@@ -72,7 +72,8 @@ def plan_task(
     models = models or task.corner_models()
     model = models[0]
     began = time.perf_counter()
-    reason = why_unreachable(task, models)
+    # The verdicts are bounded by the search's own limit: past it they stop, undecided.
+    reason = why_unreachable(task, models, deadline=began + float(settings["time_limit"]))
     if reason is not None:
         return _unreachable(task, models, settings, reason, time.perf_counter() - began)
     parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}

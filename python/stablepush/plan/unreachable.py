@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import time
 from fractions import Fraction
 from typing import List, Optional, Sequence
 
@@ -69,10 +70,28 @@ QUAD_SEGS = 64  # segments per quarter circle of the eroding disc (verdict 5)
 ERODE_MARGIN = 1e-6  # mm the eroding disc is made smaller by, over GEOS's rounding (verdict 5)
 
 
-def why_unreachable(task: Task, models=None) -> Optional[str]:
+class _OutOfTime(Exception):
+    """The verdicts' time ran out before they decided."""
+
+
+def why_unreachable(task: Task, models=None, deadline: Optional[float] = None) -> Optional[str]:
     """The reason no plan of `task` can reach its goal, or None when none is found (module
-    docstring). `models`: task.corner_models(), built here unless given."""
-    models = models or task.corner_models()
+    docstring). `models`: task.corner_models(), built here unless given. `deadline`: a
+    time.perf_counter() value after which the verdicts stop, undecided (None), between one pusher's
+    or pad's test and the next: on a task of many pushers and pad points each costs seconds, and
+    a verdict is never needed for soundness."""
+    def on_time() -> None:
+        if deadline is not None and time.perf_counter() > deadline:
+            raise _OutOfTime
+
+    try:
+        return _decide(task, models or task.corner_models(), on_time)
+    except _OutOfTime:
+        return None
+
+
+def _decide(task: Task, models, on_time) -> Optional[str]:
+    """why_unreachable's verdicts in their order, `on_time()` called before each pusher's or pad's test."""
     usable = [i for i, p in enumerate(task.pushers) if not _excluded_by_box(task, p)]
     if not usable:
         return ("every pusher is a point pusher, and a point pusher makes no push robust to the uncertainty "
@@ -81,7 +100,7 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
     # Where the pads hold the object (in pusher i's gravity) the LP is feasible with no pusher force:
     # only the starts they do not hold need it.
     stuck = [i for i in usable
-             if any(m.hold_ratio(start, i) < 1.0 and not _may_push(task, m, start, i) for m in models)]
+             if on_time() or any(m.hold_ratio(start, i) < 1.0 and not _may_push(task, m, start, i) for m in models)]
     if len(stuck) == len(usable):
         return ("no pusher has a stable push out of the start in any direction (" + ", ".join(
             task.pushers[i].name for i in stuck) + "): the pads do not hold the object there, and no pusher's "
@@ -91,7 +110,7 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
     if off:
         return (f"gripper.pads[{off[0]}] is off the object at every pose within planner.tolerance of the goal: "
                 f"there is no grasp there")
-    apart = _pad_cut_off(task, models[0])
+    apart = _pad_cut_off(task, models[0], on_time)
     if apart is not None:
         return apart
     # A last push ends within the tolerance, so it starts within it grown by a unit step (a push is
@@ -100,17 +119,18 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
     tol, step = task.planner["tolerance"], task.planner["step"]
     box = ((tol[0] + step[0]) * MM, math.radians(tol[1] + step[1]))
 
-    witnessed = {(i, k): m.hold_ratio(goal, i) >= 1.0 or _pushes_from(task, m, goal, i)
+    witnessed = {(i, k): on_time() or m.hold_ratio(goal, i) >= 1.0 or _pushes_from(task, m, goal, i)
                  for i in usable for k, m in enumerate(models)}
     if not any(all(witnessed[i, k] for k in range(len(models))) for i in usable) and not any(
-            all(witnessed[i, k] or _may_push(task, m, goal, i, box) for k, m in enumerate(models)) for i in usable):
+            all(witnessed[i, k] or on_time() or _may_push(task, m, goal, i, box) for k, m in enumerate(models))
+            for i in usable):
         return ("no pusher has a stable push that ends within planner.tolerance of the goal (" + ", ".join(
             task.pushers[i].name for i in usable) + "): wherever such a last push would start, the pads do "
             "not hold the object, and no pusher's friction cone can carry what they leave")
     need = float(task.planner.get("min_hold_ratio", 0.0))
     # The bound is at least the hold at the goal itself: only goals held too little by every pusher need it.
-    if need > 0.0 and all(min(m.hold_ratio(goal, i) for m in models) < need for i in usable):
-        bounds = {i: min(_hold_bound(task, m, i) for m in models) for i in usable}
+    if need > 0.0 and all(on_time() or min(m.hold_ratio(goal, i) for m in models) < need for i in usable):
+        bounds = {i: on_time() or min(_hold_bound(task, m, i) for m in models) for i in usable}
         if all(b < need for b in bounds.values()):
             best = max(bounds.values())
             return (f"the pads hold at most {float(best):.3g} times the object's weight anywhere within planner."
@@ -119,7 +139,7 @@ def why_unreachable(task: Task, models=None) -> Optional[str]:
     return None
 
 
-def _pad_cut_off(task: Task, model) -> Optional[str]:
+def _pad_cut_off(task: Task, model, on_time=lambda: None) -> Optional[str]:
     """Verdict 5 (module docstring): the reason, when the part of the outline eroded by a pad's disc
     that holds the pad's centre at the start is farther than the goal's tolerance lets the centre
     end from where it is at the goal; else None. Over the tolerance box (|do| <= sqrt(2) a,
@@ -132,6 +152,7 @@ def _pad_cut_off(task: Task, model) -> Optional[str]:
 
     outline = Polygon(outline_corners(task.vertices))
     for k, (centre, radius) in enumerate(task.pads):
+        on_time()
         eroded = outline.buffer(-(radius * math.cos(math.pi / (4 * QUAD_SEGS)) - ERODE_MARGIN), quad_segs=QUAD_SEGS)
         parts = list(getattr(eroded, "geoms", [eroded]))
         if len(parts) < 2:

@@ -65,6 +65,7 @@ def check_push(
 
 
 ELEVATION_GRID_DEG = 1.0  # deg between the elevations tested at each heading (stable_directions)
+HEADING_STEP_DEG = (0.5, 90.0)  # stable_directions' heading step: at most 720 headings, each a root search per pusher
 ROOT_BISECTIONS = 50  # a point pusher's surface, to rounding of the elevation
 
 
@@ -86,9 +87,7 @@ def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = N
     steps (<= 0 or None: no stable push moves the object that way)}}."""
     require_task(task)
     at = pose_field("at", list(at))
-    heading_step = number_field("heading_step", heading_step, (0.0, 90.0))
-    if heading_step == 0.0:
-        raise TaskError("heading_step", "must be in (0, 90] degrees, got 0")
+    heading_step = number_field("heading_step", heading_step, HEADING_STEP_DEG)
     names = [pusher] if pusher is not None else task.pusher_names
     indices = [task.pusher_index(name) for name in names]
     model = task.build_model()
