@@ -202,6 +202,12 @@ def low_mu_plan():
     # bottom -> left -> bottom -> left: 3 switch-overs where the plan's budget is 1 (10,000 waypoints
     # alternating pushers took minutes to turn into a trajectory).
     (lambda p: _alternate_pushers(p["waypoints"][1:5]), "switch-overs, more than the plan's max_switches (1)"),
+    # Fields that contradict each other or the waypoints: `show` drew such plans as solved.
+    (lambda p: p.update(outcome="unreachable"), "solved: true with outcome unreachable"),
+    (lambda p: p.update(outcome="sideways"), "outcome: must be one of goal_reached,"),
+    (lambda p: p["stats"].update(switches=-5), "stats.switches: must be a whole number from 0 to 10000, got -5"),
+    (lambda p: p["stats"].update(seed=2 ** 40), "stats.seed: must be a whole number from 0 to 4294967295"),
+    (lambda p: p["waypoints"][0].update(pusher="left"), "waypoints[0].pusher: the start has no pusher, got 'left'"),
 ])
 def test_bad_plan_files_are_refused_before_anything_moves(tmp_path, low_mu_plan, edit, says):
     plan = json.loads(json.dumps(low_mu_plan))
@@ -213,6 +219,17 @@ def test_bad_plan_files_are_refused_before_anything_moves(tmp_path, low_mu_plan,
     assert says in str(error.value)
     result = CliRunner().invoke(cli, ["execute", str(path), "--task", str(LOW_MU), "--arm", "127.0.0.1:9"])
     assert result.exit_code == 2 and says in result.stderr
+
+
+def test_show_refuses_a_plan_called_solved_that_ends_short_of_the_goal(tmp_path, low_mu_plan):
+    """A plan file whose `solved` says more than its waypoints: the start alone, called solved."""
+    plan = json.loads(json.dumps(low_mu_plan))
+    plan["waypoints"] = plan["waypoints"][:1]
+    path = tmp_path / "start.plan.json"
+    path.write_text(json.dumps(plan))
+    result = CliRunner().invoke(cli, ["show", str(path), "--task", str(LOW_MU), "-o", str(tmp_path / "p.png")])
+    assert result.exit_code == 2 and "not within planner.tolerance" in result.stderr, result.output
+    assert not (tmp_path / "p.png").exists()
 
 
 def test_a_partial_plan_one_switch_over_past_its_budget_is_drawn_and_two_are_refused(tmp_path, low_mu_plan):

@@ -14,7 +14,7 @@ from stablepush import strict_json
 from stablepush.errors import OutputError, PlanError
 from stablepush.inputs import read_capped
 from stablepush.outputs import is_stream, same_file, write_files
-from stablepush.plan.plan import Plan, PusherContact, Waypoint, require_plan
+from stablepush.plan.plan import Plan, PlanOutcome, PusherContact, Waypoint, require_plan
 from stablepush.strict_json import is_finite_number
 from stablepush.units import is_real
 
@@ -146,6 +146,10 @@ def load_plan(path: Union[str, Path]) -> Plan:
 
 MAX_PLAN_BYTES = 16_000_000
 MAX_WAYPOINTS = 10_000  # a plan this long streams for about 2 h at 100 waypoints/s with no retracts
+# The counts a plan's stats hold and their largest values: a seed is 32 bits, switch-overs and pushes
+# are fewer than the waypoints, the search's own counts far below 10^15.
+STATS_COUNTS = {"seed": 2**32 - 1, "switches": MAX_WAYPOINTS, "pushes": MAX_WAYPOINTS, "max_switches": MAX_WAYPOINTS,
+                "restarts": 10**15, "iterations": 10**15, "nodes": 10**15, "feasibility_checks": 10**15}
 
 
 def read_plan(path: Union[str, Path]) -> dict:
@@ -184,6 +188,18 @@ def check_plan_dict(data, source: Optional[str] = None) -> None:
     for key in ("outcome", "message"):
         if key in data and not isinstance(data[key], str):
             fail(key, f"must be a string, got {_json_kind(data[key])}")
+    outcome = data.get("outcome")
+    if outcome:
+        names = [o.value for o in PlanOutcome]
+        if outcome not in names:
+            fail("outcome", f"must be one of {', '.join(names)}, got {_json_shown(outcome)}")
+        if (outcome == PlanOutcome.goal_reached.value) != data["solved"]:
+            fail("solved", f"{json.dumps(data['solved'])} with outcome {outcome}: only a plan that reached its goal "
+                           f"is solved")
+    for key, largest in STATS_COUNTS.items():
+        value = data["stats"].get(key)
+        if value is not None and not (isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= largest):
+            fail(f"stats.{key}", f"must be a whole number from 0 to {largest}, got {_json_shown(value)}")
     waypoints = data["waypoints"]
     if not waypoints:
         fail("waypoints", "empty; a plan's first waypoint is its start")

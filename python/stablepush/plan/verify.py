@@ -57,8 +57,10 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     if len(waypoints) < (2 if require_solved else 1):  # a partial plan may have found no push at all
         fail("waypoints", "needs the start and at least one push" if require_solved else "needs the start")
     for i, w in enumerate(waypoints):
-        if (w.pusher is None) != (i == 0):
-            fail(f"waypoints[{i}].pusher", "only the first waypoint (the start) has no pusher")
+        if i == 0 and w.pusher is not None:
+            fail("waypoints[0].pusher", f"the start has no pusher, got {w.pusher[:100]!r}")
+        if i > 0 and w.pusher is None:
+            fail(f"waypoints[{i}].pusher", "missing: every waypoint after the start is a push by a pusher")
         if w.pusher is not None and w.pusher not in task.pusher_names:
             fail(f"waypoints[{i}].pusher", f"the task has no pusher {w.pusher[:100]!r}")
     # Each switch-over is a transit between features (hundreds of trajectory samples): no more than
@@ -75,7 +77,7 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     if max(abs(a - b) for a, b in zip(waypoints[0].pose, task.start)) > START_SLACK:
         fail("waypoints[0]", f"the plan starts at {list(waypoints[0].pose)}, the task at {list(task.start)}")
     end = waypoints[-1].pose
-    if require_solved and not task.at_goal(end):
+    if (require_solved or plan.solved) and not task.at_goal(end):
         fail(f"waypoints[{len(waypoints) - 1}]",
              f"the plan ends at {[round(v, 3) for v in end]}, not within planner.tolerance "
              f"{task.planner['tolerance']} of the task's goal {list(task.goal)}: made for another goal, or cut short?")
