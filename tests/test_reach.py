@@ -99,6 +99,10 @@ def test_reach_cli_writes_the_map_and_refuses_a_bad_axis(tmp_path):
     assert png.read_bytes()[:4] == b"\x89PNG"
     bad = CliRunner().invoke(cli, ["reach", task, "--x", "1:2"])
     assert bad.exit_code == 2 and "FROM:TO:COUNT" in bad.output
+    # The library's own checks of an axis, named as the option and with click's usage line.
+    bad = CliRunner().invoke(cli, ["reach", task, "--x", "5:5:3"])
+    assert bad.exit_code == 2 and "Invalid value for '--x'" in bad.output and "from and to are both 5" in bad.output
+    assert "x_axis[2]" not in bad.output
 
 
 def test_reach_maps_a_task_whose_own_goal_has_no_grasp(tmp_path):

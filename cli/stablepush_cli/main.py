@@ -1165,8 +1165,9 @@ def _beside(path: str, endings, suffix: str) -> str:
 
 def _axis(_ctx, param, value):
     """A grid axis A:B:N (N values from A to B; A:A:1 for A alone), within the task file's pose bounds;
-    ReachJob.grid refuses a count of 1 with B other than A, and equal ends with a larger count."""
-    from stablepush.plan.reach import MAX_AXIS
+    the library's own check (grid_axis) refuses a count of 1 with B other than A, and equal ends
+    with a larger count, named as the option."""
+    from stablepush.plan.reach import MAX_AXIS, grid_axis
     from stablepush.task.schema import ANGLE, COORDINATE
 
     if value is None:
@@ -1180,7 +1181,10 @@ def _axis(_ctx, param, value):
     except (ValueError, IndexError):
         raise click.BadParameter(f"expected FROM:TO:COUNT, FROM and TO from {low:g} to {high:g} and COUNT from 1 to "
                                  f"{MAX_AXIS} (e.g. -10:10:11), got {value!r}")
-    return start, stop, count
+    try:
+        return grid_axis(param.name, (start, stop, count), (low, high))
+    except TaskError as exc:
+        raise click.BadParameter(exc.reason) from None
 
 
 @cli.command()

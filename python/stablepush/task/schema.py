@@ -190,7 +190,7 @@ def _load_yaml(text: str) -> Any:
 
 def _mapping(path: str, value: Any, required: Sequence[str], optional: Sequence[str]) -> dict:
     if not isinstance(value, dict):
-        raise TaskError(path, f"must be a mapping, got {type(value).__name__}")
+        raise TaskError(path, f"must be a mapping, got {_yaml_kind(value)}")
     if len(value) > 64:
         raise TaskError(path, f"has {len(value)} keys; at most 64")
     for key in value:
@@ -280,6 +280,17 @@ def _name(path: str, value: Any) -> str:
     return value
 
 
+def _yaml_kind(value: Any) -> str:
+    """What a YAML value is, in YAML's words (an empty value is null)."""
+    if value is None:
+        return "null (an empty value)"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return "a number"
+    return {str: "a string", list: "a list", dict: "a mapping"}.get(type(value), f"a {type(value).__name__}")
+
+
 def _shown(value: Any, limit: int = 60) -> str:
     """A value for a message: its repr, cut to one short line."""
     text = reprlib.Repr()
@@ -305,7 +316,7 @@ def load_task(path: "str | Path", goal_in_grasp: bool = True) -> Task:
     except ValueError as exc:  # not a regular file, too large, or not UTF-8
         raise TaskError("", f"cannot read the task file: {exc}", source) from None
     except OSError as exc:
-        raise TaskError("", f"cannot read the task file ({exc.__class__.__name__}: {exc})", source) from None
+        raise TaskError("", f"cannot read the task file ({exc.strerror or exc})", source) from None
     try:
         return parse_task(text, source, goal_in_grasp)
     except TaskError as exc:
