@@ -68,7 +68,7 @@ def test_a_pusher_a_hair_off_its_edge_is_snapped_and_one_far_off_gets_its_true_d
                for w in task.warnings), task.warnings
     far = task_text("horizontal-offset-low-mu").replace("from: [-50, -12.5], to: [-50, 12.5]",
                                                         "from: [-40, -12.5], to: [-40, 12.5]")
-    with pytest.raises(Exception, match="it is 10 mm from the nearest edge"):
+    with pytest.raises(Exception, match="its farther end is 10 mm from the nearest edge"):
         parse_task(far)
 
 

@@ -16,8 +16,9 @@ Pusher Pusher::on_boundary(const CrossSection& section, std::string name, const 
   if (edges.empty()) {
     std::ostringstream msg;
     const auto [edge, distance] = section.nearest_edge(a, b);
-    msg << "pusher '" << name << "' is not on the object's boundary: it is " << 1e3 * distance
-        << " mm from the nearest edge (edge " << edge << ", from vertex " << edge << ")";
+    // nearest_edge's distance is the farther end's from the edge that holds the segment best.
+    msg << "pusher '" << name << "' is not on the object's boundary: " << (is_point ? "it is " : "its farther end is ")
+        << 1e3 * distance << " mm from the nearest edge (edge " << edge << ", from vertex " << edge << ")";
     throw std::invalid_argument(msg.str());
   }
   if (is_point && edges.size() > 1)
