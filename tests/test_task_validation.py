@@ -255,12 +255,3 @@ def _distance_to_segment(p, a, b):
     t = max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dz) / (dx * dx + dz * dz)))
     return math.hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dz)
 
-
-def test_check_answers_for_a_task_whose_goal_has_no_grasp(tmp_path):
-    """`check` asks about a push from --at (the start by default), not the goal: a goal off the
-    grasp is `plan`'s to refuse, not its."""
-    text = edited(_set(["goal"], [500, 0, 0]))
-    assert run_check(tmp_path, text).exit_code == 0
-    path = tmp_path / "task.yaml"
-    result = CliRunner().invoke(cli, ["plan", str(path), "-o", str(tmp_path / "p.json")])
-    assert result.exit_code == 2 and "goal" in result.stderr

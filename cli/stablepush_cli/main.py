@@ -183,7 +183,7 @@ def check(ctx: click.Context, task_file: str, at, move, directions: bool, headin
         raise click.UsageError("give --move DX DZ DTH, or --directions (one of the two)")
     if not directions and ctx.get_parameter_source("heading_step") is click.core.ParameterSource.COMMANDLINE:
         raise click.UsageError("--heading-step: only with --directions")
-    task = _load(task_file, goal_in_grasp=False)  # check asks about --at, not the goal
+    task = _load(task_file)
     at = at if at else task.start
     if directions:
         _print_directions(stable_directions(task, at, pusher, heading_step), as_json)
