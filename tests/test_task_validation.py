@@ -254,4 +254,3 @@ def _distance_to_segment(p, a, b):
     dx, dz = b[0] - a[0], b[1] - a[1]
     t = max(0.0, min(1.0, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dz) / (dx * dx + dz * dz)))
     return math.hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dz)
-

@@ -70,7 +70,7 @@ def test_a_goal_no_push_can_end_at_is_unreachable_and_one_beside_the_ledge_is_pl
     assert plan_task(dataclasses.replace(task, goal=(30.0, -4.0, 0.0))).solved
 
 
-def test_verdicts_past_their_deadline_stop_undecided_and_the_search_runs(monkeypatch):
+def test_verdicts_past_their_deadline_stop_undecided(monkeypatch):
     """The verdicts stop, undecided, once the time they are given (the search's limit) is over: on
     a task of many pushers each test can take seconds. Here the clock passes the deadline after the
     first test, so the ledge's goal, unreachable by verdict 4, is left undecided; given the search's
@@ -160,6 +160,7 @@ def test_a_pad_called_off_near_a_goal_is_off_at_every_pose_within_its_tolerance(
     section = task.section()
     model = task.corner_models()[0]
     called, spared = 0, 0
+    scale = np.array([2.0, 2.0, 5.0])  # the tolerance box's half-widths
     corners = np.array(list(itertools.product((-1.0, 1.0), repeat=3)))
     for _ in range(150):
         goal = tuple(rng.uniform(-40.0, 40.0, 2)) + (float(rng.uniform(-30.0, 30.0)),)
@@ -168,7 +169,6 @@ def test_a_pad_called_off_near_a_goal_is_off_at_every_pose_within_its_tolerance(
         spared += len(off) < len(task.pads)
         if not off:
             continue
-        scale = np.array([2.0, 2.0, 5.0])
         for q in [*(corners * scale), *rng.uniform(-1.0, 1.0, (40, 3)) * scale]:
             pose = np.array(goal) + q
             inside = model.gripper.pads_inside(section, pose_to_si(pose))

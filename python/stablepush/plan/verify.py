@@ -67,7 +67,7 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     # the plan's own budget, itself within the planner's range. The search extends only nodes within
     # the budget, so a node it reports unsolved (the partial path's end, or a goal reached over the
     # budget) may be one switch-over past it.
-    switches = sum(1 for a, b in zip(waypoints[1:], waypoints[2:]) if a.pusher != b.pusher)
+    switches = max(len(plan.pusher_sequence) - 1, 0)
     recorded = plan.stats.get("max_switches")
     budget = int(recorded) if isinstance(recorded, int) and 0 <= recorded < MAX_SWITCHES else MAX_SWITCHES
     if switches > budget + (0 if plan.solved else 1):

@@ -96,9 +96,9 @@ def _end_from_goal(task: Task, pose) -> str:
 
 def plan_title(task: Task, plan: Plan) -> str:
     """The task, the pushes, switch-overs and seed; NOT SOLVED first for a partial plan."""
-    pushers = [w.pusher for w in plan.waypoints[1:]]
-    switches = sum(a != b for a, b in zip(pushers, pushers[1:]))
-    title = f"{task.name}: {len(pushers)} pushes, {switches} switch-over(s), seed {plan.stats.get('seed', '?')}"
+    switches = max(len(plan.pusher_sequence) - 1, 0)
+    title = (f"{task.name}: {len(plan.waypoints) - 1} pushes, {switches} switch-over(s), "
+             f"seed {plan.stats.get('seed', '?')}")
     return title if plan.solved else f"NOT SOLVED ({plan.outcome or 'partial plan'}): {title}"
 
 
