@@ -96,6 +96,49 @@ std::optional<Pose> PushChecker::onto_wedge_surface(const Pose&, const Eigen::Ve
   return std::nullopt;
 }
 
+std::vector<double> PushChecker::wedge_translation_headings(const Pose&, int) const { return {}; }
+
+std::vector<double> StablePushValidator::wedge_translation_headings(const Pose& a, int pusher) const {
+  if (!contains(wedges_, pusher)) return {};
+  const StablePushModel& model = *models_.front();
+  const Wrench& plane_normal = model.pusher_cones()[pusher].equality_rows().front();
+  const PoseAndRotation from(a);
+  struct Off {
+    double heading;
+    double off;    ///< e . w(a, dq(heading)) [N]
+    double scale;  ///< MotionWrench::scale
+  };
+  const auto off_plane = [&](double heading) {
+    const MotionWrench load = model.motion_wrench(
+        from, space_.from_unit_steps(Eigen::Vector3d(std::cos(heading), std::sin(heading), 0.0)), pusher);
+    return Off{heading, plane_normal.dot(load.required), load.scale};
+  };
+  // A plane's translations are two opposite headings; 24 samples resolve a few more.
+  constexpr int kTranslationScan = 24;
+  std::array<Off, kTranslationScan + 1> scan;
+  for (int k = 0; k < kTranslationScan; ++k) scan[k] = off_plane(2.0 * M_PI * k / kTranslationScan);
+  scan[kTranslationScan] = scan[0];
+  scan[kTranslationScan].heading += 2.0 * M_PI;
+  std::vector<double> headings;
+  for (int k = 0; k < kTranslationScan; ++k) {
+    if ((scan[k].off < 0.0) == (scan[k + 1].off < 0.0)) continue;
+    const Off root = refine_sign_change(scan[k], scan[k + 1], &Off::heading, &Off::off,
+                                        [&](double heading) { return std::optional<Off>(off_plane(heading)); });
+    if (std::abs(root.off) <= kCertificationBand * root.scale) headings.push_back(root.heading);
+  }
+  return headings;
+}
+
+std::vector<double> wedge_step_headings(const PushChecker& checker, const Pose& at, int pusher, double first,
+                                        int count) {
+  static constexpr double kTranslationOffsetsDeg[] = {0.0, -0.25, 0.25, -0.5, 0.5, -1.0, 1.0, -2.0, 2.0, -4.0, 4.0};
+  std::vector<double> headings;
+  for (int k = 0; k < count; ++k) headings.push_back(first + 2.0 * M_PI * k / count);
+  for (const double translation : checker.wedge_translation_headings(at, pusher))
+    for (const double offset_deg : kTranslationOffsetsDeg) headings.push_back(translation + offset_deg * M_PI / 180.0);
+  return headings;
+}
+
 std::vector<Vec2> StablePushValidator::pivot_points() const {
   std::vector<Vec2> points;
   for (const Pad& pad : models_.front()->gripper().pads())

@@ -158,7 +158,8 @@ void append_pushes(Plan& plan, const GraspPoseSpace& space, const ModelSet& mode
 /// q0 (onto_wedge_surface), to q1(phi); the second, straight from q1 to g, is on the surface of
 /// pusher s at q1 where
 ///     m_s(phi) = e_s . w_motion(q1, g - q1) / scale = 0        (wedge_plane_offset).
-/// q1 is found at 48 headings once; m_s's sign changes between them are refined to rounding in
+/// q1 is found once at the last pusher's wedge_step_headings (48 evenly spaced, and closely about
+/// its translation headings) in order round; m_s's sign changes between them are refined to rounding in
 /// phi, and a root counts where |m_s| is within the certification band (not across a jump). Of
 /// the pairs whose two pushes are stable in every model and keep the grasp (and, for s other
 /// than the last pusher, where `planner.pads_hold_transit` allows the switch-over at q1), the shortest
@@ -179,11 +180,15 @@ int finish_on_wedges(Plan& plan, const GraspPoseSpace& space, const StablePushVa
   };
   constexpr int kHeadings = 48;
   const double heading = std::atan2(way[1], way[0]);
-  std::array<double, kHeadings + 1> phis;  // the last is the first again, a turn on
-  std::array<std::optional<Pose>, kHeadings + 1> firsts;
-  for (int k = 0; k < kHeadings; ++k) firsts[k] = onto_first(phis[k] = heading + 2.0 * M_PI * k / kHeadings);
-  phis[kHeadings] = phis[0] + 2.0 * M_PI;
-  firsts[kHeadings] = firsts[0];
+  // In order round from the way's heading, the last the first again, a turn on.
+  std::vector<double> phis = wedge_step_headings(validator, end, pusher, heading, kHeadings);
+  for (double& phi : phis) phi = heading + std::fmod(std::fmod(phi - heading, 2.0 * M_PI) + 2.0 * M_PI, 2.0 * M_PI);
+  std::sort(phis.begin(), phis.end());
+  const std::size_t n = phis.size();
+  phis.push_back(phis.front() + 2.0 * M_PI);
+  std::vector<std::optional<Pose>> firsts(n + 1);
+  for (std::size_t k = 0; k < n; ++k) firsts[k] = onto_first(phis[k]);
+  firsts[n] = firsts[0];
   struct Leg {
     double phi;   ///< the first push's heading in unit steps' (x, z) [rad]
     double miss;  ///< m_s(phi)
@@ -194,10 +199,10 @@ int finish_on_wedges(Plan& plan, const GraspPoseSpace& space, const StablePushVa
       if (!q1) return std::nullopt;
       return Leg{phi, validator.wedge_plane_offset(*q1, target - *q1, second), *q1};
     };
-    std::array<std::optional<Leg>, kHeadings + 1> ring;
-    for (int k = 0; k <= kHeadings; ++k) ring[k] = leg(phis[k], firsts[k]);
+    std::vector<std::optional<Leg>> ring(n + 1);
+    for (std::size_t k = 0; k <= n; ++k) ring[k] = leg(phis[k], firsts[k]);
     std::vector<std::pair<double, Pose>> found;  // (both pushes' length [unit steps], q1)
-    for (int k = 0; k < kHeadings; ++k) {
+    for (std::size_t k = 0; k < n; ++k) {
       if (!ring[k] || !ring[k + 1] || (ring[k]->miss < 0.0) == (ring[k + 1]->miss < 0.0)) continue;
       const Leg root = refine_sign_change(*ring[k], *ring[k + 1], &Leg::phi, &Leg::miss,
                                           [&](double phi) { return leg(phi, onto_first(phi)); });

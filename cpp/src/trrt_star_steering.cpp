@@ -60,9 +60,10 @@ WedgeStepQueue::WedgeStepQueue(const PushChecker& checker, const GraspPoseSpace&
   std::size_t index = 0;
   for (int p = 0; p < kMaxPushers; ++p) {
     if (!contains(wedges, p)) continue;
+    const std::vector<double> headings = wedge_step_headings(checker, from, p, heading, kHeadings);
     for (const double length : lengths) {
-      for (int k = 0; k < kHeadings; ++k, ++index) {
-        const double psi = heading + 2.0 * M_PI * k / kHeadings;
+      for (std::size_t k = 0; k < headings.size(); ++k, ++index) {
+        const double psi = headings[k];
         // The goal's elevation picks the root nearest to it.
         const Eigen::Vector3d direction =
             Eigen::Vector3d(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]).normalized();
@@ -192,9 +193,13 @@ constexpr double kLongestSplitOddAttempt = 6.0;
 }  // namespace
 
 std::vector<std::optional<Eigen::Vector3d>> TRRTstar::wedge_rays(const Pose& at, int pusher, ob::State* scratch) const {
-  std::vector<std::optional<Eigen::Vector3d>> rays(kRayHeadings);
-  for (int k = 0; k < kRayHeadings; ++k) {
-    const double psi = 2.0 * M_PI * k / kRayHeadings;
+  // In the order of their headings: a cone of the split is spanned by two neighbours.
+  std::vector<double> headings = wedge_step_headings(*validator_, at, pusher, 0.0, kRayHeadings);
+  for (double& psi : headings) psi -= 2.0 * M_PI * std::floor(psi / (2.0 * M_PI));
+  std::sort(headings.begin(), headings.end());
+  std::vector<std::optional<Eigen::Vector3d>> rays(headings.size());
+  for (std::size_t k = 0; k < headings.size(); ++k) {
+    const double psi = headings[k];
     const std::optional<Pose> end =
         validator_->onto_wedge_surface(at, Eigen::Vector3d(std::cos(psi), std::sin(psi), 0.0), 1.0, pusher);
     if (end && wedge_step_valid(at, WedgeStep{0.0, *end, pusher, false}, scratch))
@@ -224,14 +229,18 @@ std::optional<std::pair<Eigen::Vector3d, double>> decompose(const Eigen::Vector3
     // A long way round (surfaces at a shallow angle) leaves the first-order model.
     if (length <= longest * d.norm() && (!best || length < best->second)) best = std::make_pair(leg, length);
   };
-  const int n = static_cast<int>(first.size());
-  for (int i = 0; i < n; ++i) {
-    const int next = (i + 1) % n;
-    for (int j = 0; j < n; ++j) {
-      if (first[i] && first[next] && second[j]) consider(*first[i], *first[next], *second[j], true);
-      if (second[i] && second[next] && first[j]) consider(*second[i], *second[next], *first[j], false);
+  // Each cone of one set's neighbouring rays with each ray of the other set.
+  const auto cones = [&](const Rays& pairs, const Rays& singles, bool two_of_first) {
+    const std::size_t n = pairs.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t next = (i + 1) % n;
+      if (!pairs[i] || !pairs[next]) continue;
+      for (const std::optional<Eigen::Vector3d>& single : singles)
+        if (single) consider(*pairs[i], *pairs[next], *single, two_of_first);
     }
-  }
+  };
+  cones(first, second, true);
+  cones(second, first, false);
   return best;
 }
 }  // namespace

@@ -184,6 +184,55 @@ TEST_CASE_METHOD(Pegs, "wedge_plane_offset: within the certification band on a p
   CHECK(std::isnan(validator.wedge_plane_offset(Pose{0.0, 0.0, 0.0}, Motion{1e-3, 0.0, 0.0}, 2)));  // not a wedge
 }
 
+TEST_CASE_METHOD(
+    Pegs, "wedge_translation_headings: the pure translations on a point pusher's surface, as a fine scan finds them",
+    "[validator]") {
+  // Every sign change of e . w over a fine ring of pure translations that is a root (not a jump,
+  // bisected to adjacent doubles) must be answered within half the ring's spacing, and nothing
+  // else; at each heading answered a translation is on the surface, where onto_wedge_surface finds
+  // its root with no turn.
+  constexpr int kRing = 720;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> offset(-0.004, 0.004), turn(-0.3, 0.3);
+  int answered = 0;
+  for (int k = 0; k < 60; ++k) {
+    const Pose a{offset(rng), offset(rng), turn(rng)};
+    for (int pusher = 0; pusher < 2; ++pusher) {
+      const auto off = [&](double psi) {
+        return validator.wedge_plane_offset(
+            a, space->from_unit_steps(Eigen::Vector3d(std::cos(psi), std::sin(psi), 0.0)), pusher);
+      };
+      std::vector<double> scanned;
+      for (int i = 0; i < kRing; ++i) {
+        double lo = 2.0 * M_PI * i / kRing, hi = 2.0 * M_PI * (i + 1) / kRing;
+        const bool lo_negative = off(lo) < 0.0;
+        if (lo_negative == (off(hi) < 0.0)) continue;
+        for (;;) {
+          const double mid = 0.5 * (lo + hi);
+          if (!(mid > lo && mid < hi)) break;
+          (off(mid) < 0.0) == lo_negative ? lo = mid : hi = mid;
+        }
+        if (std::min(std::abs(off(lo)), std::abs(off(hi))) <= kCertificationBand) scanned.push_back(lo);
+      }
+      const std::vector<double> headings = validator.wedge_translation_headings(a, pusher);
+      INFO("case " << k << ", pusher " << pusher);
+      REQUIRE(headings.size() == scanned.size());
+      for (std::size_t i = 0; i < headings.size(); ++i) {
+        ++answered;
+        const double h = headings[i];
+        CHECK(std::abs(std::remainder(h - scanned[i], 2.0 * M_PI)) < M_PI / kRing);
+        CHECK(std::abs(off(h)) <= kCertificationBand);
+        const std::optional<Pose> q =
+            validator.onto_wedge_surface(a, Eigen::Vector3d(std::cos(h), std::sin(h), 0.0), 1.0, pusher);
+        REQUIRE(q.has_value());
+        CHECK(std::abs((*q - a).dtheta) < 1e-6 * space->step().angle);
+      }
+    }
+  }
+  CHECK(answered >= 200);  // two opposite headings per surface, nearly always
+  CHECK(validator.wedge_translation_headings(Pose{0.0, 0.0, 0.0}, 2).empty());  // not a wedge
+}
+
 namespace {
 /// The pegs' validator, counting the roots asked of it.
 struct CountingChecker : PushChecker {
@@ -200,6 +249,9 @@ struct CountingChecker : PushChecker {
                                          int pusher) const override {
     ++roots;
     return validator.onto_wedge_surface(a, direction, length, pusher);
+  }
+  std::vector<double> wedge_translation_headings(const Pose& a, int pusher) const override {
+    return validator.wedge_translation_headings(a, pusher);
   }
   std::uint64_t feasibility_checks() const override { return validator.feasibility_checks(); }
   void reset_feasibility_checks() override {}
@@ -244,10 +296,14 @@ TEST_CASE_METHOD(Pegs, "WedgeStepQueue: the steps of a full sort, in its order, 
     const Eigen::Vector3d to_goal = space->in_unit_steps(goal - from);
     const double heading = std::atan2(to_goal[1], to_goal[0]);
     const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
-    for (int p = 0; p < 2; ++p)
+    for (int p = 0; p < 2; ++p) {
+      std::vector<double> headings;
+      for (int h = 0; h < 24; ++h) headings.push_back(heading + 2.0 * M_PI * h / 24);
+      for (const double t : validator.wedge_translation_headings(from, p))
+        for (const double offset_deg : {0.0, -0.25, 0.25, -0.5, 0.5, -1.0, 1.0, -2.0, 2.0, -4.0, 4.0})
+          headings.push_back(t + offset_deg * M_PI / 180.0);
       for (const double length : lengths)
-        for (int h = 0; h < 24; ++h) {
-          const double psi = heading + 2.0 * M_PI * h / 24;
+        for (const double psi : headings) {
           const Eigen::Vector3d direction =
               Eigen::Vector3d(std::cos(psi) * translation, std::sin(psi) * translation, to_goal[2]).normalized();
           ++candidates;
@@ -257,6 +313,7 @@ TEST_CASE_METHOD(Pegs, "WedgeStepQueue: the steps of a full sort, in its order, 
             if (in_box && !expected.back().ends_plan) ++not_held;
           }
         }
+    }
     std::stable_sort(expected.begin(), expected.end(), [](const WedgeStep& a, const WedgeStep& b) {
       return a.ends_plan != b.ends_plan ? a.ends_plan : a.goal_distance < b.goal_distance;
     });
@@ -286,4 +343,40 @@ TEST_CASE_METHOD(Pegs, "WedgeStepQueue: the steps of a full sort, in its order, 
   CHECK(inside > 10);                   // and starts within the tolerance box
   CHECK(not_held > 10);                 // and steps into the box where the pads do not hold the object
   CHECK(first_roots < candidates / 2);  // the first step needs few of the roots
+}
+
+TEST_CASE_METHOD(Pegs, "WedgeStepQueue: a peg's translating push comes first where the goal lies off its heading",
+                 "[trrt_star]") {
+  // Toward a goal 3 unit steps away at 37 deg from a peg's translation heading, the unit step of
+  // pure translation ends sqrt(10 - 6 cos 37 deg) = 2.28 steps from it; the steps at the evenly
+  // spaced headings (from the goal's, every 15 deg: the nearest 7 deg off) are near-pure turns,
+  // which end farther than the start. The queue's first step must be at least as near as the
+  // translation.
+  const CountingChecker checker(validator);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> offset(-0.004, 0.004), turn(-0.3, 0.3);
+  int cases = 0;
+  for (int k = 0; k < 40; ++k) {
+    const Pose from{offset(rng), offset(rng), turn(rng)};
+    for (int pusher = 0; pusher < 2; ++pusher) {
+      for (const double t : validator.wedge_translation_headings(from, pusher)) {
+        const double side = k % 2 == 0 ? 1.0 : -1.0;
+        const double psi = t + side * 37.0 * M_PI / 180.0;
+        const Pose goal = from + space->from_unit_steps(Eigen::Vector3d(3.0 * std::cos(psi), 3.0 * std::sin(psi), 0.0));
+        const PoseGoal region(si, goal, StepSize{0.1e-3, 0.1 * M_PI / 180.0});
+        const std::optional<Pose> translated =
+            validator.onto_wedge_surface(from, Eigen::Vector3d(std::cos(t), std::sin(t), 0.0), 1.0, pusher);
+        // Where the surface meets pure translation at a jump the root is not that translation.
+        if (!translated || std::abs((*translated - from).dtheta) > 1e-6 * space->step().angle) continue;
+        const double by_translation = space->distance(*translated, goal);
+        REQUIRE(std::abs(by_translation - std::sqrt(10.0 - 6.0 * std::cos(37.0 * M_PI / 180.0))) < 1e-9);
+        WedgeStepQueue queue(checker, *space, region, from, goal, {1.0}, PusherSet{1} << pusher);
+        const std::optional<WedgeStep> first = queue.next();
+        REQUIRE(first.has_value());
+        CHECK(first->goal_distance <= by_translation + 1e-12);
+        ++cases;
+      }
+    }
+  }
+  CHECK(cases >= 100);
 }

@@ -69,6 +69,11 @@ class PushChecker {
   /// step can end by it, WedgeStepQueue); nullopt when there is none. By default none.
   virtual std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                                  int pusher) const;
+  /// The headings [rad] of the pure translations on `pusher`'s surface from `a` (b = 0 above).
+  /// The surface is nearly a plane through pure rotation, so the roots at evenly spaced headings
+  /// crowd near it and its translating pushes lie within a few degrees of these headings. By
+  /// default none.
+  virtual std::vector<double> wedge_translation_headings(const Pose& a, int pusher) const;
   /// Points fixed in G [m] about which a turn keeps a pad point sticking (the pads' centres): such a
   /// turn is the sticking case, one line of motions the straight and steered steps meet only by
   /// chance once the object is off the point it was planned to turn about. By default none.

@@ -151,6 +151,11 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   /// pass stable_pushers (the wedge's facets, every model, the grasp).
   std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
                                          int pusher) const override;
+  /// The headings h at which a unit step of pure translation, h in unit steps, puts the required
+  /// pusher wrench in the wedge's plane, e . w(a, dq(h)) = 0, in the first model: the sign changes
+  /// over kTranslationScan evenly spaced headings, each refined to rounding (regula falsi); a sign
+  /// change across a jump is not a root. Empty when `pusher`'s cone is not a wedge.
+  std::vector<double> wedge_translation_headings(const Pose& a, int pusher) const override;
   /// How far the motion dq from `a` misses wedge pusher `pusher`'s plane, in the first model:
   ///     e . w_motion(a, dq) / scale   (signed, dimensionless; e the wedge's plane normal, scale
   /// the sum of the motion wrench's magnitudes, MotionWrench::scale), so that the span counts as
@@ -180,6 +185,16 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
   PusherSet wedges_ = 0;
   mutable std::uint64_t checks_ = 0;
 };
+
+/// Headings [rad] of steps onto point pusher `pusher`'s surface from `at`
+/// (PushChecker::onto_wedge_surface): `count` evenly spaced from `first`, then, about each of its
+/// translation headings (PushChecker::wedge_translation_headings), offsets of 0, +-0.25, +-0.5,
+/// +-1, +-2 and +-4 deg. The evenly spaced ones find the roots near pure rotation, where they crowd
+/// (the surface is nearly a plane through it); the pushes that translate the part lie within a few
+/// degrees of a translation heading, where the root's elevation turns through 180 deg, faster on
+/// some parts than others (hence offsets growing twofold).
+std::vector<double> wedge_step_headings(const PushChecker& checker, const Pose& at, int pusher, double first,
+                                        int count);
 
 /// The goal: every coordinate within its tolerance of the goal pose (|dx|, |dz| <= tolerance.length,
 /// |dtheta| <= tolerance.angle). distanceGoal is the distance in unit steps.

@@ -59,7 +59,8 @@ struct WedgeStep {
 };
 
 /// The steps of each of `lengths` [unit steps] from `from` onto the surfaces of the point pushers
-/// in `wedges` (PushChecker::onto_wedge_surface) over 24 headings around the goal's, one at a
+/// in `wedges` (PushChecker::onto_wedge_surface) at each pusher's wedge_step_headings (24 evenly
+/// spaced from the goal's, and closely about its translation headings), one at a
 /// time: those that end the plan (in `region`, from outside it) first, since from outside the box
 /// entering it is what counts, then nearest `goal` first, ties in the order (pusher, length,
 /// heading). Each surface's root is found only when no step whose root is not yet found can come
@@ -256,8 +257,9 @@ class TRRTstar : public ompl::base::Planner {
   PusherSet descend_on_wedges(const Pose& from, const Pose& goal, double length, PusherSet allowed,
                               ompl::base::State* scratch, Pose& q) const;
   /// A point pusher's stable pushes from `at` as rays [unit steps]: the unit steps onto its surface
-  /// (onto_wedge_surface, the root nearest no turn) over 24 headings that keep the grasp and are
-  /// stable, indexed by heading (nullopt where there is none).
+  /// (onto_wedge_surface, the root nearest no turn) at its wedge_step_headings (24 evenly spaced,
+  /// and closely about its translation headings) that keep the grasp and are stable, in the order
+  /// of their headings round the circle (nullopt where there is none).
   std::vector<std::optional<Eigen::Vector3d>> wedge_rays(const Pose& at, int pusher, ompl::base::State* scratch) const;
   /// A two-push way to the goal: the first pusher's push by `first_leg` [unit steps], then the
   /// second's to the goal; `length` is the two legs' [unit steps].
