@@ -635,8 +635,10 @@ def test_a_guarded_approach_finds_a_feature_off_its_place_and_the_run_lands(task
     # the tilted-gravity offset: its 1,000-trial open-loop misses had this feature turned +0.49 to +0.50
     # deg and ended +0.50 to +0.51 deg off (docs/evaluate.md)
     ("more/tilted-gravity.yaml", 0.5, 0.5, 0.1, 0.51),
-    # the pivot: its prism seats at about twice the turn, and ends about -0.2 deg off on features in place too
-    ("pivoting.yaml", -0.4, -0.82, 0.25, -0.86),
+    # the pivot: its prism seats at about twice the turn, and ends about -0.2 deg off on features in place too;
+    # here at -0.21 or -0.27 deg, which one decided by the last bits of the arm's IK (numpy's BLAS picks its
+    # kernel by the CPU: -0.27 with AVX-512's, -0.21 with others'), so the bound lies above both
+    ("pivoting.yaml", -0.4, -0.82, 0.3, -0.86),
 ])
 def test_a_turned_feature_is_found_as_the_object_seats_and_the_run_lands(task_file, turn_deg, seated_deg, error_deg,
                                                                         unseated_deg):
