@@ -153,7 +153,7 @@ class StablePushValidator : public ompl::base::MotionValidator, public PushCheck
                                          int pusher) const override;
   /// The headings h at which a unit step of pure translation, h in unit steps, puts the required
   /// pusher wrench in the wedge's plane, e . w(a, dq(h)) = 0, in the first model: the sign changes
-  /// over kTranslationScan evenly spaced headings, each refined to rounding (regula falsi); a sign
+  /// over 24 evenly spaced headings, each refined to rounding (regula falsi); a sign
   /// change across a jump is not a root. Empty when `pusher`'s cone is not a wedge.
   std::vector<double> wedge_translation_headings(const Pose& a, int pusher) const override;
   /// How far the motion dq from `a` misses wedge pusher `pusher`'s plane, in the first model:
