@@ -79,6 +79,16 @@ def _generator():
     return module
 
 
+def test_the_benchmarks_shifted_goals_move_the_goal_by_the_shift_in_x_and_in_z_alone():
+    """point_pusher_tasks.py --shift: the four goals beside a goal, each moved in one of x and z."""
+    assert _generator().shifted_goals([-4.534, 4.419, 18.024], 0.1) == [
+        ("x+0.1", [-4.434, 4.419, 18.024]),
+        ("x-0.1", [-4.634, 4.419, 18.024]),
+        ("z+0.1", [-4.534, 4.519, 18.024]),
+        ("z-0.1", [-4.534, 4.319, 18.024]),
+    ]
+
+
 def test_at_the_pegs_plan_end_no_stable_push_moves_the_cube_back_along_x(cube_pegs):
     """stable_directions (`stablepush check --directions`): every push it lists is stable by the
     independent LP, and at the end of the pegs' plan (seed 1, 0.245 unit steps past the goal in x)
