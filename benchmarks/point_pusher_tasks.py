@@ -184,7 +184,8 @@ def main() -> None:
     parser.add_argument("--shift", type=float, default=None, metavar="MM",
                         help="also plan each goal moved by +-MM in x and in z: a goal where so small a move "
                              "flips solved and unsolved lies at the edge of what the pins reach")
-    parser.add_argument("--json", default=None, help="write every run (the shifted goals' apart) and each task's goal here")
+    parser.add_argument("--json", default=None,
+                        help="write every run (the shifted goals' apart) and each task's goal here")
     args = parser.parse_args()
     planner = {}
     for item in args.planner:
@@ -217,8 +218,11 @@ def main() -> None:
                          "restarts": plan.stats["restarts"], "pushes": plan.stats["pushes"],
                          "switches": plan.stats["switches"]})
         everything += times
-        shifted = "" if args.shift is None else " " + " · ".join(
-            _shifted_runs(data, label, goal, args, shifted_runs) for label, goal in shifted_goals(data["goal"], args.shift)) + " |"
+        shifted = ""
+        if args.shift is not None:
+            entries = [_shifted_runs(data, label, goal, args, shifted_runs)
+                       for label, goal in shifted_goals(data["goal"], args.shift)]
+            shifted = " " + " · ".join(entries) + " |"
         shape = "box" if len(data["object"]["polygon"]) == 4 else f"{len(data['object']['polygon'])}-gon"
         print(f"| {task.name} | {shape} | {len(task.pushers)} | {'yes' if any(task.gravity) else 'no'} "
               f"| {data['goal']} | {solved}/{args.seeds} | {np.median(times):.1f} | {np.percentile(times, 95):.1f} |"
@@ -229,7 +233,8 @@ def main() -> None:
           f"max {t.max():.1f} ms (target: median <= 100 ms, p95 <= 500 ms); "
           f"{sum(r['checks'] for r in runs) / 1e6:.1f} M stable-push tests, {t.sum() / 1e3:.1f} s in all")
     if args.json:
-        Path(args.json).write_text(json.dumps({"runs": runs, "shifted_runs": shifted_runs, "goals": goals, "args": vars(args)}, indent=1) + "\n")
+        record = {"runs": runs, "shifted_runs": shifted_runs, "goals": goals, "args": vars(args)}
+        Path(args.json).write_text(json.dumps(record, indent=1) + "\n")
     sys.exit(0)
 
 
