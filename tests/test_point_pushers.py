@@ -89,6 +89,18 @@ def test_the_benchmarks_shifted_goals_move_the_goal_by_the_shift_in_x_and_in_z_a
     ]
 
 
+@pytest.mark.parametrize("shift", ["0", "-0.1", "inf", "nan", "1e-6"])
+def test_the_benchmark_refuses_a_shift_it_cannot_plan_and_names_it(shift):
+    """--shift must be finite and at least the goals' rounding (1e-4 mm): below it the shifted goals
+    would be the goal itself under another label."""
+    import subprocess
+    import sys
+
+    script = TASKS.parent.parent / "benchmarks" / "point_pusher_tasks.py"
+    done = subprocess.run([sys.executable, str(script), "--shift", shift], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and "--shift" in done.stderr, done.stderr
+
+
 def test_at_the_pegs_plan_end_no_stable_push_moves_the_cube_back_along_x(cube_pegs):
     """stable_directions (`stablepush check --directions`): every push it lists is stable by the
     independent LP, and at the end of the pegs' plan (seed 1, 0.245 unit steps past the goal in x)
