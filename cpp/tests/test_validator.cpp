@@ -291,17 +291,14 @@ TEST_CASE_METHOD(Pegs, "WedgeStepQueue: the steps of a full sort, in its order, 
     inside += outside ? 0 : 1;
     const std::vector<double>& lengths = length_sets[k % length_sets.size()];
 
-    // Every step, as the queue asks for them (its headings copied: a change there must be made here).
+    // Every step, as the queue asks for them: its headings (wedge_step_headings) and, copied, its
+    // direction at each (a change there must be made here).
     std::vector<WedgeStep> expected;
     const Eigen::Vector3d to_goal = space->in_unit_steps(goal - from);
     const double heading = std::atan2(to_goal[1], to_goal[0]);
     const double translation = std::max(std::hypot(to_goal[0], to_goal[1]), 1e-3);
     for (int p = 0; p < 2; ++p) {
-      std::vector<double> headings;
-      for (int h = 0; h < 24; ++h) headings.push_back(heading + 2.0 * M_PI * h / 24);
-      for (const double t : validator.wedge_translation_headings(from, p))
-        for (const double offset_deg : {0.0, -0.25, 0.25, -0.5, 0.5, -1.0, 1.0, -2.0, 2.0, -4.0, 4.0})
-          headings.push_back(t + offset_deg * M_PI / 180.0);
+      const std::vector<double> headings = wedge_step_headings(validator, from, p, heading, 24);
       for (const double length : lengths)
         for (const double psi : headings) {
           const Eigen::Vector3d direction =
