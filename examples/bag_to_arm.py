@@ -28,20 +28,21 @@ STORE = get_typestore(Stores.ROS2_HUMBLE)
 
 
 def read_bag(path: Path):
-    """The arm's scene, the rate [Hz] and the waypoints (t s, pose [x, y, z, qw, qx, qy, qz] m,
-    step, phase) of a stablepush bag."""
-    poses, steps, phases, scene = [], [], [], None
+    """The arm's scene, the rate [Hz] and the waypoints (t s from the bag's start, pose
+    [x, y, z, qw, qx, qy, qz] m, step, phase) of a stablepush bag."""
+    poses, steps, phases, scene, start = [], [], [], None, None
     try:
         reader = Reader(path)
         reader.open()
     except ReaderError as exc:
         raise ValueError(f"{path}: cannot read it as a ROS 2 bag ({exc})") from None
     try:
-        for connection, stamp, raw in reader.messages():
+        for connection, stamp, raw in reader.messages():  # in time order: the first is at the bag's start
+            start = stamp if start is None else start
             msg = STORE.deserialize_cdr(raw, connection.msgtype)
             if connection.topic == "/stablepush/gripper_pose":
                 p, q = msg.pose.position, msg.pose.orientation
-                poses.append((stamp * 1e-9, [p.x, p.y, p.z, q.w, q.x, q.y, q.z]))
+                poses.append(((stamp - start) * 1e-9, [p.x, p.y, p.z, q.w, q.x, q.y, q.z]))
             elif connection.topic == "/stablepush/step":
                 steps.append(int(msg.data))
             elif connection.topic == "/stablepush/phase":

@@ -2,20 +2,24 @@
 for robot stacks, `ros2 bag play` and Foxglove (`stablepush trajectory PLAN --task TASK -o X.mcap`);
 and a run as the executor saw it, in the same form (`RunRecording`, `execute --record run.mcap`).
 
-Frames: `world` (W: x forward, y the gripping axis at home, z up), `gripper` (G, between the
-pads), `object` (O, the task's object frame). Each message is stamped with its trajectory time t
-(s from the start of the stream), as the executor streams it. Topics, one message per trajectory
-sample unless said:
+Frames: `world` (W: x forward, y the gripping axis at home, z up; the arm's base), `gripper` (G,
+between the pads), `object` (O, the task's object frame) and `feature_<pusher>` for each feature
+(fixed in W, `feature_transform`). Each message is stamped with the bag's start plus its
+trajectory time t (s from the start of the stream, as the executor streams it); the start is a
+Unix time (`parse_stamp`), by default when the bag is written, so that a bag played beside live
+data lies in its time. Topics, one message per trajectory sample unless said:
+- `/tf_static` (tf2_msgs/msg/TFMessage, transient local as tf2's static broadcaster offers it), once
+  at the start: world -> each feature;
 - `/tf` (tf2_msgs/msg/TFMessage): world -> gripper, and gripper -> object: the object's pose in
   the grasp (the plan's pose at the last step reached; during a push, where the feature holds it);
 - `/stablepush/gripper_pose` (geometry_msgs/msg/PoseStamped, in world): the CSV's row;
 - `/stablepush/gripper_twist` (geometry_msgs/msg/TwistStamped, in world): its velocity;
 - `/stablepush/phase` (std_msgs/msg/String): push, settle, retract, move or approach;
 - `/stablepush/step` (std_msgs/msg/Int32): the plan step (the one a push heads for);
-- `/stablepush/scene` (visualization_msgs/msg/MarkerArray), once at t = 0: the object's outline
+- `/stablepush/scene` (visualization_msgs/msg/MarkerArray), once at the start: the object's outline
   extruded to its thickness (in object), the pads (in gripper) and each feature's contact segment
   at its world pose (in world);
-- `/stablepush/arm_scene` (std_msgs/msg/String), once at t = 0: the world as the arm protocol's
+- `/stablepush/arm_scene` (std_msgs/msg/String), once at the start: the world as the arm protocol's
   hello describes it (JSON in the protocol's conventions, not ROS's: SI but for `object_in_grasp`,
   the plan's x mm, z mm, theta deg; poses [x, y, z, qw, qx, qy, qz];
   `stablepush.execution.world.scene_description`), so that a bridge can replay the bag to an arm
@@ -24,25 +28,32 @@ Units in the ROS messages: m, s, rad; quaternions x, y, z, w.
 """
 from __future__ import annotations
 
+import datetime
 import json
 import os
+import re
 import tempfile
+import time
 from contextlib import contextmanager
+from decimal import Decimal
 from pathlib import Path
-from typing import Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from stablepush.errors import OutputError
 from stablepush.execution.trajectory import Trajectory, continuous_quaternions
-from stablepush.execution.world import place_features, scene_description
+from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix
 from stablepush.plan.plan import Plan
+from stablepush.plan.verify import check_plan
 from stablepush.task.model import Task
 from stablepush.units import MM
 
 WORLD, GRIPPER, OBJECT = "world", "gripper", "object"
+TF_STATIC = "/tf_static"
 TOPICS = {
+    TF_STATIC: "tf2_msgs/msg/TFMessage",
     "/tf": "tf2_msgs/msg/TFMessage",
     "/stablepush/gripper_pose": "geometry_msgs/msg/PoseStamped",
     "/stablepush/gripper_twist": "geometry_msgs/msg/TwistStamped",
@@ -51,6 +62,51 @@ TOPICS = {
     "/stablepush/scene": "visualization_msgs/msg/MarkerArray",
     "/stablepush/arm_scene": "std_msgs/msg/String",
 }
+
+
+# ROS 2 stamps hold whole seconds in an int32: a bag starts from 1970 to 2038-01-19, less a day for its length.
+STAMP_MAX_S = 2**31 - 1 - 86_400
+_UNIX_SECONDS = re.compile(r"\d+(\.\d+)?")
+
+
+def parse_stamp(value: str) -> int:
+    """A bag's start time (`--stamp`) as Unix ns, from Unix seconds (`1764600000.5`, rounded to
+    the ns) or an ISO-8601 time with its zone (`2026-12-01T15:00:00Z`, `2026-12-01T16:00:00+01:00`).
+    ValueError saying why not."""
+    text = value.strip()
+    if _UNIX_SECONDS.fullmatch(text):
+        ns = int((Decimal(text) * 1_000_000_000).to_integral_value())
+    else:
+        try:  # Python before 3.11 reads no Z
+            when = datetime.datetime.fromisoformat(text[:-1] + "+00:00" if text.endswith(("Z", "z")) else text)
+        except ValueError:
+            raise ValueError(f"expected Unix seconds (e.g. 1764600000.5) or an ISO-8601 time with its zone "
+                             f"(e.g. 2026-12-01T15:00:00Z), got {value!r}") from None
+        if when.tzinfo is None:
+            raise ValueError(f"{value!r} has no zone: add one (Z for UTC, or an offset such as +01:00)")
+        since = when - datetime.datetime(1970, 1, 1, tzinfo=datetime.timezone.utc)
+        ns = (since.days * 86_400 + since.seconds) * 1_000_000_000 + since.microseconds * 1_000
+    if not 0 <= ns <= STAMP_MAX_S * 1_000_000_000:
+        raise ValueError(f"{value!r} is outside 1970-01-01 to 2038-01-18 (ROS 2 stamps hold int32 seconds)")
+    return ns
+
+
+def feature_frame(pusher: str) -> str:
+    """The tf frame of the feature that acts as `pusher`."""
+    return f"feature_{pusher}"
+
+
+def feature_transform(feature: Feature) -> np.ndarray:
+    """T_WF (4x4, m): a feature's frame, at the middle of its contact segment (a point pusher's
+    point), z along its normal (into the object), y the object's thickness axis resting on it (the
+    gripping axis), x = y cross z (along the segment)."""
+    z = feature.normal / np.linalg.norm(feature.normal)
+    y = feature.object_pose[:3, 1] - z * float(feature.object_pose[:3, 1] @ z)  # exactly normal to z
+    y = y / np.linalg.norm(y)
+    out = np.eye(4)
+    out[:3, :3] = np.column_stack([np.cross(y, z), y, z])
+    out[:3, 3] = (feature.start + feature.end) / 2
+    return out
 
 
 def object_in_gripper(task: Task, plan: Plan, trajectory: Trajectory) -> np.ndarray:
@@ -69,18 +125,26 @@ def object_in_gripper(task: Task, plan: Plan, trajectory: Trajectory) -> np.ndar
     return out
 
 
-def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajectory) -> None:
-    """Write the trajectory of `plan` (checked against `task`) as one MCAP file at `path`."""
+def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajectory,
+              start_ns: Optional[int] = None) -> None:
+    """Write the trajectory of `plan` as one MCAP file at `path`, each sample stamped `start_ns`
+    (Unix ns, `parse_stamp`; default: now) plus its time. PlanError unless the plan is the task's
+    as it is now (stablepush.plan.verify.check_plan)."""
+    check_plan(task, plan)
+    start_ns = time.time_ns() if start_ns is None else start_ns
     T_GO = object_in_gripper(task, plan, trajectory)
+    steps = list(plan.waypoints)
+    features = place_features(task, steps)
     with _mcap(path, TOPICS) as (T, write):
-        write("/stablepush/scene", 0, T["visualization_msgs/msg/MarkerArray"](
-            markers=_scene_markers(T, task, plan)))
-        steps = list(plan.waypoints)
-        scene = scene_description(task, place_features(task, steps), steps[0].pose)
-        write("/stablepush/arm_scene", 0, T["std_msgs/msg/String"](data=json.dumps(scene)))
+        start = _time(T, start_ns)
+        write(TF_STATIC, start_ns, _static_transforms(T, start, features.values()))
+        write("/stablepush/scene", start_ns, T["visualization_msgs/msg/MarkerArray"](
+            markers=_scene_markers(T, start, task, features.values())))
+        scene = scene_description(task, features, steps[0].pose)
+        write("/stablepush/arm_scene", start_ns, T["std_msgs/msg/String"](data=json.dumps(scene)))
         held_poses = _continuous([matrix_to_pose(m) for m in T_GO])
         for i in range(len(trajectory)):
-            ns = int(round(float(trajectory.t[i]) * 1e9))
+            ns = start_ns + int(round(float(trajectory.t[i]) * 1e9))
             stamp = _time(T, ns)
             pose = _pose(T, trajectory.position[i], trajectory.quaternion_wxyz[i])
             held = held_poses[i]
@@ -127,7 +191,10 @@ def _mcap(path: Union[str, Path], topics: dict):
     with scratch_directory as scratch:
         bag = Path(scratch) / "bag"
         with Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
-            connections = {topic: writer.add_connection(topic, kind, typestore=store) for topic, kind in topics.items()}
+            connections = {topic: writer.add_connection(topic, kind, typestore=store,
+                                                        offered_qos_profiles=_static_qos() if topic == TF_STATIC
+                                                        else ())
+                           for topic, kind in topics.items()}
 
             def write(topic: str, stamp_ns: int, message) -> None:
                 writer.write(connections[topic], stamp_ns, store.serialize_cdr(message, topics[topic]))
@@ -137,6 +204,16 @@ def _mcap(path: Union[str, Path], topics: dict):
             os.replace(bag / "bag.mcap", path)
         except OSError as exc:
             raise OutputError(f"{path}: cannot write the bag ({exc.strerror or exc})", output=path) from None
+
+
+def _static_qos() -> list:
+    """The QoS tf2's static broadcaster offers on /tf_static (reliable, transient local, the last
+    message kept), recorded so that `ros2 bag play` offers it too: a late listener gets the frames."""
+    from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
+
+    default = QosTime(0, 0)  # no deadline, lifespan or lease
+    return [Qos(QosHistory.KEEP_LAST, 1, QosReliability.RELIABLE, QosDurability.TRANSIENT_LOCAL, default, default,
+                QosLiveliness.AUTOMATIC, default, False)]
 
 
 # -- messages ---------------------------------------------------------------------------------
@@ -171,22 +248,31 @@ def _transform(T, stamp, parent: str, child: str, p, q_wxyz):
         transform=T["geometry_msgs/msg/Transform"](translation=_vector3(T, p), rotation=_quaternion(T, q_wxyz)))
 
 
-def _marker(T, ident: int, frame: str, kind: int, points, scale, colour, pose=None):
+def _static_transforms(T, stamp, features: Iterable[Feature]):
+    """/tf_static's message: world -> each feature's frame (feature_transform)."""
+    transforms = []
+    for feature in features:
+        pose = matrix_to_pose(feature_transform(feature))
+        transforms.append(_transform(T, stamp, WORLD, feature_frame(feature.pusher), pose[:3], pose[3:]))
+    return T["tf2_msgs/msg/TFMessage"](transforms=transforms)
+
+
+def _marker(T, stamp, ident: int, frame: str, kind: int, points, scale, colour, pose=None):
     Marker = T["visualization_msgs/msg/Marker"]
     return Marker(
-        header=_header(T, _time(T, 0), frame), ns="stablepush", id=ident, type=kind, action=Marker.ADD,
+        header=_header(T, stamp, frame), ns="stablepush", id=ident, type=kind, action=Marker.ADD,
         pose=pose or _pose(T, (0, 0, 0), (1, 0, 0, 0)), scale=_vector3(T, scale),
         color=T["std_msgs/msg/ColorRGBA"](r=colour[0], g=colour[1], b=colour[2], a=1.0),
         lifetime=T["builtin_interfaces/msg/Duration"](sec=0, nanosec=0), frame_locked=True,
         points=[T["geometry_msgs/msg/Point"](x=float(x), y=float(y), z=float(z)) for x, y, z in points],
         colors=[], texture_resource="", texture=T["sensor_msgs/msg/CompressedImage"](
-            header=_header(T, _time(T, 0), ""), format="", data=np.zeros(0, np.uint8)),
+            header=_header(T, stamp, ""), format="", data=np.zeros(0, np.uint8)),
         uv_coordinates=[], text="", mesh_resource="",
         mesh_file=T["visualization_msgs/msg/MeshFile"](filename="", data=np.zeros(0, np.uint8)),
         mesh_use_embedded_materials=False)
 
 
-def _scene_markers(T, task: Task, plan: Plan) -> list:
+def _scene_markers(T, stamp, task: Task, features: Iterable[Feature]) -> list:
     """The object's outline extruded to its thickness (LINE_LIST in object), the pads (CYLINDER
     in gripper, axis along y) and each feature's contact segment (LINE_LIST in world)."""
     Marker = T["visualization_msgs/msg/Marker"]
@@ -197,18 +283,18 @@ def _scene_markers(T, task: Task, plan: Plan) -> list:
         for y in (-half, half):
             edges += [(x0, y, z0), (x1, y, z1)]
         edges += [(x0, -half, z0), (x0, half, z0)]
-    markers = [_marker(T, 0, OBJECT, Marker.LINE_LIST, edges, (0.0005, 0, 0), (0.85, 0.55, 0.25))]
+    markers = [_marker(T, stamp, 0, OBJECT, Marker.LINE_LIST, edges, (0.0005, 0, 0), (0.85, 0.55, 0.25))]
     along_y = (np.sqrt(0.5), np.sqrt(0.5), 0.0, 0.0)  # the cylinder's z axis turned onto y
     for k, ((cx, cz), r) in enumerate(task.pads):  # pad k on the finger at +y when k is even
         y = half if k % 2 == 0 else -half
-        markers.append(_marker(T, 1 + k, GRIPPER, Marker.CYLINDER, [], (2 * r * MM, 2 * r * MM, 0.002),
+        markers.append(_marker(T, stamp, 1 + k, GRIPPER, Marker.CYLINDER, [], (2 * r * MM, 2 * r * MM, 0.002),
                                (0.2, 0.2, 0.2), pose=_pose(T, (cx * MM, y, cz * MM), along_y)))
-    for k, feature in enumerate(place_features(task, list(plan.waypoints)).values()):
+    for k, feature in enumerate(features):
         if np.allclose(feature.start, feature.end):  # a point pusher: a peg
-            markers.append(_marker(T, 100 + k, WORLD, Marker.SPHERE, [], (0.004, 0.004, 0.004), (0.3, 0.5, 0.8),
+            markers.append(_marker(T, stamp, 100 + k, WORLD, Marker.SPHERE, [], (0.004, 0.004, 0.004), (0.3, 0.5, 0.8),
                                    pose=_pose(T, feature.start, (1, 0, 0, 0))))
         else:
-            markers.append(_marker(T, 100 + k, WORLD, Marker.LINE_LIST, [feature.start, feature.end],
+            markers.append(_marker(T, stamp, 100 + k, WORLD, Marker.LINE_LIST, [feature.start, feature.end],
                                    (0.003, 0, 0), (0.3, 0.5, 0.8)))
     return markers
 
@@ -216,6 +302,7 @@ def _scene_markers(T, task: Task, plan: Plan) -> list:
 # -- a run, recorded ----------------------------------------------------------------------------
 
 RUN_TOPICS = {
+    TF_STATIC: "tf2_msgs/msg/TFMessage",
     "/tf": "tf2_msgs/msg/TFMessage",
     "/stablepush/commanded_pose": "geometry_msgs/msg/PoseStamped",
     "/stablepush/gripper_pose": "geometry_msgs/msg/PoseStamped",
@@ -248,25 +335,38 @@ class RunSample(NamedTuple):
 
 class RunRecording:
     """A run as the executor saw it (`execute --record run.mcap`, `--video run.mp4`), one
-    `RunSample` per acknowledged waypoint, stamped with the stream's time. As a bag: the commanded
-    and the reported gripper pose (world), the object's pose in the world
+    `RunSample` per acknowledged waypoint, stamped with the run's start plus the stream's time. As
+    a bag: `/tf_static` world -> each of `features` (the world the run starts in; `for_run`), the
+    commanded and the reported gripper pose (world), the object's pose in the world
     (`/stablepush/object_pose`, a simulator's truth) and in the grasp (`/stablepush/object_in_grasp`,
     the tracker's, in gripper), `/tf` world -> gripper -> object, the pusher in contact ("" between
     contacts), phase and step; each correction of the closed loop (`/stablepush/correction`, JSON,
     at the step after which it was made) and the run's report (`/stablepush/verdict`, JSON, at the
     end). Pass it to `execute_plan(record=...)`."""
 
-    def __init__(self):
+    def __init__(self, features: Iterable[Feature] = ()):
         self.samples: List[RunSample] = []
+        self.features = list(features)
+        self.started_ns = time.time_ns()  # Unix ns; at the first sample, when the stream's time began
+
+    @classmethod
+    def for_run(cls, task: Task, plan: Plan, closed_loop: bool = False) -> "RunRecording":
+        """A recording of a run of `plan` on `task`, with the features where `execute_plan` places
+        them (every pusher's with a closed loop)."""
+        return cls(place_features(task, list(plan.waypoints), every_pusher=closed_loop).values())
 
     def __call__(self, waypoint, state: dict, pusher) -> None:
+        if not self.samples:
+            self.started_ns = time.time_ns() - int(round(waypoint.t * 1e9))
         self.samples.append(RunSample(waypoint.t, list(waypoint.pose), list(state["ee_pose"]), state.get("object_pose"),
                                       state.get("object_in_grasp"), pusher or "", waypoint.phase, waypoint.step,
                                       waypoint.planned))
 
-    def write(self, path: Union[str, Path], report: dict) -> None:
+    def write(self, path: Union[str, Path], report: dict, start_ns: Optional[int] = None) -> None:
         """Write the recording and `report` (ExecutionReport.as_dict, or a fault's report) as one
-        MCAP file at `path`."""
+        MCAP file at `path`, each sample stamped `start_ns` (Unix ns, `parse_stamp`; default: when
+        the run started, as its first acknowledgement less the stream's time then) plus its time."""
+        start_ns = self.started_ns if start_ns is None else start_ns
         samples = self.samples
         commanded_poses = _continuous([s.commanded for s in samples])
         reported_poses = _continuous([s.reported for s in samples])
@@ -274,11 +374,12 @@ class RunRecording:
         grasp_poses = _continuous([None if s.object_in_grasp is None else matrix_to_pose(grasp_transform(
             (s.object_in_grasp["x"], s.object_in_grasp["z"], s.object_in_grasp["theta"]))) for s in samples])
         with _mcap(path, RUN_TOPICS) as (T, write):
-            last_ns, end_of_step = 0, {}
+            write(TF_STATIC, start_ns, _static_transforms(T, _time(T, start_ns), self.features))
+            last_ns, end_of_step = start_ns, {}
             for k, (t, _, _, _, _, pusher, phase, step, _) in enumerate(samples):
                 commanded, reported, in_world, held = (commanded_poses[k], reported_poses[k], world_poses[k],
                                                        grasp_poses[k])
-                ns = last_ns = int(round(t * 1e9))
+                ns = last_ns = start_ns + int(round(t * 1e9))
                 end_of_step[step] = ns
                 stamp = _time(T, ns)
                 write("/stablepush/commanded_pose", ns, T["geometry_msgs/msg/PoseStamped"](
