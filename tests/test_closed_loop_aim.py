@@ -39,9 +39,12 @@ def test_when_no_plan_reaches_the_final_tolerance_the_plan_runs_and_the_record_s
     record, steps = aim(task, plan.waypoints, ClosedLoop.for_task(task))
     assert not record.solved and steps == [] and record.pushes == 0 and record.pushers == []
     # The plan ends 0.245 mm past the goal in x, where neither peg moves the cube back along -x.
-    assert record.failure == "0 switch-over(s) in 2000 ms: time_limit; 1 switch-over(s) in 2000 ms: time_limit; " \
-        "2 switch-over(s) in 2000 ms: time_limit; from the plan's end no stable push moves the object toward the " \
-        "goal along -x (at most 0.05 of a unit step)", record.failure
+    # One line sums the searches up (what `execute` prints); each is in `tried` (what --json keeps).
+    way_back = "from the plan's end no stable push moves the object toward the goal along -x (at most 0.05 of a unit step)"
+    assert record.failure == f"3 search(es) failed (out of time 3); {way_back}", record.failure
+    assert record.tried == ["0 switch-over(s) in 2000 ms: time_limit", "1 switch-over(s) in 2000 ms: time_limit",
+                            "2 switch-over(s) in 2000 ms: time_limit", way_back]
+    assert record.as_dict()["tried"] == record.tried
 
 
 def test_no_way_back_names_the_senses_no_pusher_moves_the_object_in():

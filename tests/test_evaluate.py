@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 from stablepush.errors import PlanError, RunnerError
 from stablepush.evaluation import Batch, Evaluation, Spreads, draw_world, evaluate, robust_task, wilson_interval
 from stablepush.evaluation import batch as batch_mod
+from stablepush.evaluation.worlds import DEFAULT_FEATURE_ERROR, DEFAULT_VARY, VARY_KEYS
 from stablepush.execution.world import place_features, scene_description
 from stablepush.plan import benchmark as benchmark_mod
 from stablepush.plan import check_plan, plan_task
@@ -74,10 +75,12 @@ def test_an_open_loop_batch_of_a_plan_that_ends_outside_the_success_tolerance_is
     """The wedge's plan ends within its task's 1 mm but 0.79 mm from the goal in x or z: judged
     within 0.5 mm, open loop, the batch says so before any trial, and names the cures; judged
     within 0.85 mm, it warns that the plan ends at the edge (0.93 of it); closed loop, or judged
-    within 1 mm, it does not. A by_moving_pusher task gets the executor's warning of another cell."""
+    within 1 mm (the task's own, the default), it does not. A by_moving_pusher task gets the
+    executor's warning of another cell."""
     task = shipped("more/wedge-heel")
     plan = check_plan(task, plan_task(task, seed=1))
-    open_loop = Batch(task=task, plan=plan, spreads=Spreads())
+    assert Batch(task=task, plan=plan, spreads=Spreads()).warnings() == []
+    open_loop = Batch(task=task, plan=plan, spreads=Spreads(), tolerance=(0.5, 0.5))
     (warning,) = open_loop.warnings()
     assert "ends 0.79 mm / 0.53 deg from the goal" in warning and "planner.tolerance: [0.5, 0.5]" in warning
     assert "planner.finish_steps: 1" in warning
@@ -86,7 +89,8 @@ def test_an_open_loop_batch_of_a_plan_that_ends_outside_the_success_tolerance_is
     assert dataclasses.replace(open_loop, closed_loop=True).warnings() == []
     assert dataclasses.replace(open_loop, tolerance=(1.0, 1.0)).warnings() == []
     moving = dataclasses.replace(task, pushes="by_moving_pusher")
-    assert any("another cell" in w for w in dataclasses.replace(open_loop, task=moving, closed_loop=True).warnings())
+    moved = Batch(task=moving, plan=check_plan(moving, plan_task(moving, seed=1)), spreads=Spreads(), closed_loop=True)
+    assert any("another cell" in w for w in moved.warnings())
 
 
 def test_a_world_deviation_changes_the_scene_as_asked():
@@ -111,6 +115,43 @@ def test_a_world_deviation_changes_the_scene_as_asked():
     assert after["from"] == pytest.approx(expected, abs=1e-12)
     assert after["normal"] == pytest.approx([before["normal"][2], before["normal"][1], -before["normal"][0]], abs=1e-12)
     assert scene["features"][0] is before and before["mu"] == task.pushers[0].mu  # the scene itself unchanged
+
+
+def test_a_study_is_judged_by_the_tasks_tolerance_as_a_run_is_unless_told():
+    """One tolerance: `execute` judges a run by the task's planner.tolerance, and so does a study
+    (the user study's screwdriver plan landed by execute and 0 of 10 by evaluate's own 0.5 mm)."""
+    batch = _batch("t-shaped")
+    assert batch.tolerance is None and batch.judged_with == (1.0, 1.0) == tuple(batch.task.planner["tolerance"])
+    assert Evaluation(batch=batch, trials=[], wall_s=1.0, runner="", requested=0).summary()["tolerance"] == [1.0, 1.0]
+    assert dataclasses.replace(batch, tolerance=(0.5, 0.5)).judged_with == (0.5, 0.5)
+
+
+def test_a_study_that_names_no_spread_varies_the_tasks_box_or_a_labs_defaults():
+    plain, robust = shipped("t-shaped"), shipped("more/large-manipulation-robust")
+    assert plain.uncertainty == {} and robust.uncertainty
+    lab = Spreads.for_task(plain)
+    assert lab.vary == DEFAULT_VARY and lab.feature_error == DEFAULT_FEATURE_ERROR and not lab.one_world
+    assert all(value > 0 for value in DEFAULT_VARY.values()) and set(DEFAULT_VARY) == set(VARY_KEYS)
+    boxed = Spreads.for_task(robust)
+    assert boxed.vary == robust.uncertainty and boxed.feature_error == DEFAULT_FEATURE_ERROR
+    # Named spreads are taken as given; the features stay in place unless said too.
+    named = Spreads.for_task(plain, {"pad_mu": 0.1})
+    assert named.vary == {"pad_mu": 0.1} and named.feature_error == (0.0, 0.0)
+    assert Spreads.for_task(plain, {}, (0.0, 0.0)).one_world
+    assert not Spreads.for_task(plain, {}, (0.0, 0.0), tracker_noise=(0.1, 0.0)).one_world  # noise differs per trial
+    assert not Spreads.for_task(plain, {}, (0.1, 0.0)).one_world
+
+
+def test_a_study_of_one_world_runs_one_trial_and_gives_no_interval(tmp_path):
+    task = str(TASKS / "more" / "tilted-gravity.yaml")
+    out = tmp_path / "one.json"
+    result = CliRunner().invoke(cli, ["evaluate", task, "--trials", "5", "--workers", "1", "--vary", "none",
+                                      "--feature-error", "0", "0", "--json", str(out)])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(out.read_text())["summary"]
+    assert summary["one_world"] is True and summary["trials"] == 1 and summary["ci95"] is None
+    assert "one world, the model's own (nothing varies)" in result.output and "no interval" in result.output
+    assert "CI" not in result.output
 
 
 def test_the_summary_follows_from_the_trials():
@@ -184,6 +225,12 @@ def test_the_same_seed_gives_the_same_trials_serially_on_workers_and_on_ray():
     assert on_ray.runner.startswith("Ray")
 
 
+def _pushes_of(plan):
+    """The plan without its record of the task it was made for: check_plan then re-checks each push
+    in another world's model rather than refuse the plan as made for another task."""
+    return dataclasses.replace(plan, task_identity=None)
+
+
 def _in_world(task, world):
     """The task with its friction, grip and mass multiplied as in one trial's world (no box)."""
     m = world.multipliers
@@ -207,9 +254,9 @@ def test_a_robust_plan_is_stable_in_every_world_its_spreads_draw():
     nominal_slips = 0
     for trial in range(25):
         world = _in_world(task, draw_world(3, trial, SPREADS, task.pusher_names))
-        check_plan(world, robust_plan)  # raises PlanError naming the push that is not stable there
+        check_plan(world, _pushes_of(robust_plan))  # raises PlanError naming the push that is not stable there
         try:
-            check_plan(world, nominal_plan)
+            check_plan(world, _pushes_of(nominal_plan))
         except PlanError:
             nominal_slips += 1
     assert nominal_slips > 0
@@ -230,7 +277,7 @@ def test_robust_plans_of_generated_tasks_are_stable_in_every_world_their_spreads
         kinds.add((len(data["object"]["polygon"]) == 4, any(task.gravity)))
         assert task.uncertainty == SPREADS.vary and len(plan.waypoints) > 5, (task.name, goal)
         for trial in range(25):
-            check_plan(_in_world(task, draw_world(1, trial, SPREADS, task.pusher_names)), plan)
+            check_plan(_in_world(task, draw_world(1, trial, SPREADS, task.pusher_names)), _pushes_of(plan))
     assert len(kinds) >= 3, kinds  # boxes and polygons, with gravity and without
 
 
@@ -244,8 +291,8 @@ def test_evaluate_cli_plans_robust_to_its_spreads_or_says_why_not(tmp_path):
     pegs = CliRunner().invoke(cli, ["evaluate", str(TASKS / "more" / "cube-pegs.yaml"), "--robust", "--vary",
                                     "pad_mu=0.1", "--quiet"])
     assert pegs.exit_code == 1 and "(robust): unreachable" in pegs.output and "point pusher" in pegs.output
-    bad = CliRunner().invoke(cli, ["evaluate", task, "--robust"])
-    assert bad.exit_code == 2 and "--robust needs --vary" in bad.output
+    bad = CliRunner().invoke(cli, ["evaluate", task, "--robust", "--vary", "none"])
+    assert bad.exit_code == 2 and "--robust needs spreads" in bad.output
     plan = tmp_path / "p.json"
     assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
     bad = CliRunner().invoke(cli, ["evaluate", task, "--plan", str(plan), "--robust", "--vary", "pad_mu=0.1"])
@@ -343,3 +390,16 @@ def test_bench_checks_runs_the_count_asked_in_batches_as_equal_as_they_divide(mo
     assert sizes == [1334, 1334, 1333] * 2
     with pytest.raises(ValueError, match="checks: must be a whole number of at least 1, got 0"):
         bench_checks(shipped("t-shaped"), checks=0)
+
+
+def test_a_study_in_a_pipe_prints_its_summary_not_a_line_per_trial(tmp_path):
+    """In a pipe, click's progress bar printed each new label ("landed 1/1 (100%)") as a line of
+    its own: a line per trial where a summary belongs."""
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, "-m", "stablepush_cli.main", "evaluate", str(TASKS / "more/tilted-gravity.yaml"),
+                          "--trials", "3", "--workers", "1", "--vary", "pad_mu=0.1"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert "landed 1/" not in run.stderr and "landed 2/" not in run.stderr, run.stderr
+    assert "landed 3 of 3 trials" in run.stdout or "of 3 trials" in run.stdout, run.stdout

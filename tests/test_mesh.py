@@ -95,6 +95,19 @@ def test_a_mesh_in_metres_is_named_as_such(tmp_path):
         parse_task(text, source=str(tmp_path / "task.yaml"))
 
 
+def test_a_mesh_in_metres_with_a_mass_and_pushers_in_mm_is_named_as_such(tmp_path):
+    """A 50 x 20 x 10 mm box written in metres, its mass and pushers in mm: the mass hid the scale
+    (no density to go out of range), and the error blamed a pusher's distance from the edge alone."""
+    trimesh.creation.box(extents=(0.05, 0.02, 0.01)).export(tmp_path / "part.stl")
+    text = ("object: {shape: mesh, file: part.stl, mass: 45}\ngripper: {grip_force: 10, mu: 0.5}\n"
+            "pushers: [{name: left, from: [-25, -5], to: [-25, 5], mu: 0.5}]\nstart: [0, 0, 0]\ngoal: [10, 0, 0]\n")
+    with pytest.raises(TaskError) as error:
+        parse_task(text, source=str(tmp_path / "task.yaml"))
+    assert error.value.field == "pushers[0]" and "not on the object's boundary" in error.value.reason
+    assert error.value.reason.endswith("; the object is only 0.05 mm across: written in metres? (object.scale: 1000 "
+                                       "reads a mesh in metres)"), error.value.reason
+
+
 def test_a_density_that_gives_a_mass_out_of_range_names_density_and_the_scale(tmp_path):
     """A mesh in mm read with scale: 0.001 came out 0.04 mm across, and the error blamed object.mass,
     which the file does not have."""

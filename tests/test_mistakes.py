@@ -3,10 +3,11 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from stablepush.errors import TaskError
 from stablepush.task import parse_task
 from stablepush_cli.main import cli
 
-from conftest import task_text
+from conftest import shipped, task_text
 
 
 def _write(tmp_path, text, name="mine.yaml"):
@@ -73,9 +74,11 @@ def test_a_pusher_a_hair_off_its_edge_is_snapped_and_one_far_off_gets_its_true_d
 
 
 def test_show_draws_an_unsolved_plan_marked_as_such_and_point_pushers(tmp_path):
+    import dataclasses
+
     from matplotlib.text import Annotation
 
-    from stablepush.plan import Plan, Waypoint
+    from stablepush.plan import plan_task
     from stablepush.viz import figures
 
     from conftest import TASKS, task_with
@@ -87,22 +90,55 @@ def test_show_draws_an_unsolved_plan_marked_as_such_and_point_pushers(tmp_path):
     assert CliRunner().invoke(cli, args).exit_code == 1
     result = CliRunner().invoke(cli, ["show", str(plan), "--task", str(task), "-o", str(tmp_path / "p.png")])
     assert result.exit_code == 0 and (tmp_path / "p.png").stat().st_size > 0, result.output
-    # A point pusher is a dot; the object's x axis an arrow (its orientation).
+    # A point pusher is a dot; the object's x axis an arrow (its orientation). The partial plan is
+    # a real plan's first pushes: plan_figure draws only a plan of the task (check_plan).
     pegs = task_with("horizontal-offset-low-mu", lambda d: d.update(
-        gravity=[0, 0], pushers=[{"name": "tip", "at": [-50, 0], "mu": 0.6}]))
-    partial = Plan(task=pegs.name, solved=False, outcome="time_limit", message="", stats={},
-                   waypoints=[Waypoint(0, 0, 0), Waypoint(1, 0, 30, pusher="tip")])
+        gravity=[0, 0], pushers=[{"name": "tip", "at": [-50, 0], "mu": 0.6}], goal=[3, 0, 10]))
+    solved = plan_task(pegs)
+    partial = dataclasses.replace(solved, solved=False, outcome="time_limit", waypoints=solved.waypoints[:8])
+    end = partial.waypoints[-1].pose
+    assert abs(end[2]) > 5  # turned enough for the arrow's direction to tell
     fig = figures.plan_figure(pegs, partial)
-    first, last = fig.axes[0], fig.axes[1]
+    snapshots = [ax for ax in fig.axes if ax.get_title()]
+    first, last = snapshots[0], snapshots[-1]
     assert any(line.get_marker() == "o" for line in first.get_lines())
     # The orientation arrow runs along O's x axis: from the pose's (x, z), turned by its theta.
     size = 0.3 * max(max(abs(v) for v in p) for p in pegs.vertices)
-    for ax, (x, z, theta) in ((first, (0, 0, 0)), (last, (1, 0, 30))):
+    for ax, (x, z, theta) in ((first, (0, 0, 0)), (last, end)):
         arrows = [t for t in ax.texts if isinstance(t, Annotation) and t.arrow_patch is not None]
         assert len(arrows) == 1
         c, s = np.cos(np.radians(theta)), np.sin(np.radians(theta))
         assert np.allclose(arrows[0].xyann, (x, z)) and np.allclose(arrows[0].xy, (x + c * size, z - s * size))
-    assert fig.axes[1].get_title().startswith("end")
+    assert last.get_title().startswith("end")
+
+
+def test_a_goal_the_pads_cannot_hold_is_told_at_load_with_what_to_change():
+    """At the high-mu offset's goal the pads hold 0.91 times the weight whichever pusher pushes
+    last: released there, it moves. Its shipped task ends the run on the feature, so no warning."""
+    assert not any("hold" in w for w in shipped("horizontal-offset-high-mu").warnings)
+    released = parse_task(task_text("horizontal-offset-high-mu").replace("end_on_feature: true", "end_on_feature: false"))
+    (warning,) = [w for w in released.warnings if w.startswith("goal:")]
+    assert "the pads alone hold only 0.91 times the object's weight at the goal" in warning
+    assert "moved_on_release" in warning and "gripper.grip_force 11.1 N or more" in warning
+    assert "environment.end_on_feature: true" in warning
+    # Gripped 11.1 N, they hold it (hold_ratio is linear in the grip force): no warning.
+    firm = parse_task(task_text("horizontal-offset-high-mu").replace("end_on_feature: true", "end_on_feature: false")
+                      .replace("grip_force: 10 ", "grip_force: 11.1 "))
+    assert min(firm.goal_hold_ratios().values()) >= 1.0 and not any(w.startswith("goal:") for w in firm.warnings)
+    # The bottom feature turned 90 deg in the world: with its gravity the pads hold the goal (4.29
+    # times the weight), with the side pushers' not; min_hold_ratio: 1 is the cure, and once given,
+    # nothing is left to say.
+    turned_text = task_text("horizontal-offset-high-mu").replace(
+        "end_on_feature: true", "end_on_feature: false") + "  features:\n    bottom: [400, 150, 300, 90]\n"
+    turned = parse_task(turned_text)
+    assert turned.goal_hold_ratios()["bottom"] > 4.0 and turned.goal_hold_ratios()["left"] < 1.0
+    (warning,) = [w for w in turned.warnings if w.startswith("goal:")]
+    assert warning.startswith("goal: the pads alone hold the object at the goal only when the last push is by bottom")
+    assert "a plan that ends with left, right" in warning and "planner.min_hold_ratio: 1" in warning
+    asked = parse_task(turned_text.replace("tolerance: [0.5, 0.5]", "tolerance: [0.5, 0.5]\n  min_hold_ratio: 1"))
+    assert not any(w.startswith("goal:") for w in asked.warnings)
+    with pytest.raises(TaskError, match="environment.end_on_feature: must be true or false"):
+        parse_task(task_text("horizontal-offset-high-mu").replace("end_on_feature: true", "end_on_feature: 1"))
 
 
 def test_a_centre_of_mass_outside_the_outlines_hull_is_warned_about_naming_it():
@@ -116,3 +152,70 @@ def test_a_centre_of_mass_outside_the_outlines_hull_is_warned_about_naming_it():
                      "pushers: [{name: left, from: [0, 30], to: [0, 40], mu: 0.5}]\nstart: [-7.5, -30, 0]\n"
                      "goal: [-7.5, -25, 0]\n")
     assert not [w for w in ell.warnings if "object.com" in w], ell.warnings
+
+
+@pytest.mark.parametrize("old, new, says", [
+    ("goal: [20, 0, 0]", "goal: [20, 0, 0.26]", "goal[2]: 0.26 deg; written in radians? (0.26 rad is 14.9 deg; task "
+                                                "files use degrees)"),
+    ("start: [0, 0, 0]", "start: [0, 0, 1.5708]", "start[2]: 1.5708 deg; written in radians? (1.5708 rad is 90 deg"),
+    # 0.4 rad is no round angle, but 0.4 deg is within the task's 0.5 deg tolerance of no turn at all
+    ("goal: [20, 0, 0]", "goal: [20, 0, -0.4]", "goal[2]: -0.4 deg; written in radians? (-0.4 rad is -22.9 deg"),
+])
+def test_an_angle_written_in_radians_is_warned_about_naming_the_field(old, new, says):
+    text = task_text("horizontal-offset-low-mu")
+    assert old in text
+    warnings = parse_task(text.replace(old, new, 1)).warnings
+    assert [w for w in warnings if says in w], warnings
+
+
+@pytest.mark.parametrize("theta", [0, 1, 2.5, 0.75, -1.5, 7.5, 15, -20, 360])
+def test_an_angle_meant_in_degrees_is_not_taken_for_radians(theta):
+    """Whole degrees, angles past 2 pi, and fractions that are no round angle in radians and lie beyond
+    the tolerance (0.75 rad is 43 deg; 2.5 rad 143 deg; 1.5 rad 86 deg)."""
+    text = task_text("horizontal-offset-low-mu").replace("goal: [20, 0, 0]", f"goal: [20, 0, {theta}]", 1)
+    assert not [w for w in parse_task(text).warnings if "radians" in w]
+
+
+def test_lengths_in_metres_are_named_where_accepted_and_where_refused():
+    from stablepush.errors import TaskError
+
+    from conftest import task_with
+
+    def in_metres(d):
+        d["gripper"]["pads"][0]["radius"] = 0.05
+        d["environment"] = {**d.get("environment", {}), "retract": 0.02, "home": [0.45, 0, 0.3],
+                            "features": {"left": [0.4, 0, 0.3, 0]}}
+
+    warnings = task_with("horizontal-offset-low-mu", in_metres).warnings
+    text = task_text("horizontal-offset-low-mu")
+    for says in ["gripper.pads[0].radius: 0.05 mm; written in metres? task files use mm (0.05 m is 50 mm)",
+                 "environment.retract: 0.02 mm; written in metres? task files use mm (0.02 m is 20 mm)",
+                 "environment.home: [0.45, 0, 0.3] mm; written in metres? task files use mm ([0.45, 0, 0.3] m is "
+                 "[450, 0, 300] mm)",
+                 "environment.features.left: [0.4, 0, 0.3] mm; written in metres? task files use mm ([0.4, 0, 0.3] m "
+                 "is [400, 0, 300] mm)"]:
+        assert says in warnings, warnings
+    assert not [w for w in parse_task(text).warnings if "metres" in w]
+    with pytest.raises(TaskError) as error:  # a pusher in metres on an object in mm is far off its edge
+        parse_task(text.replace("from: [-50, -12.5], to: [-50, 12.5]", "from: [-0.05, -0.0125], to: [-0.05, 0.0125]"))
+    assert error.value.field == "pushers[0]"
+    assert error.value.reason.endswith("; written in metres? task files use mm ([[-0.05, -0.0125], [-0.05, 0.0125]] "
+                                       "m is [[-50, -12.5], [-50, 12.5]] mm)"), error.value.reason
+
+
+def test_a_goal_no_push_from_the_start_moves_the_object_toward_is_named_when_the_search_fails():
+    """The only pusher presses on the left end (+x); the goal lies 20 mm to -x. The search spends its
+    time and used to blame the time limit alone."""
+    from stablepush.plan import plan_task
+
+    from conftest import task_with
+
+    task = task_with("horizontal-offset-high-mu", lambda d: d.update(
+        pushers=[p for p in d["pushers"] if p["name"] == "left"], goal=[-20, 0, 0]))
+    plan = plan_task(task, time_limit=0.3)
+    assert plan.outcome == "time_limit"
+    assert plan.message.endswith(
+        "; the goal lies at dx -20 mm, dz 0 mm, dtheta 0 deg from the start, and no stable push from there moves "
+        "the object along -x (none): a plan must go around, if any can (each pusher's stable pushes from the "
+        "start: check --directions)"), plan.message
+    assert "the goal lies" not in plan_task(task, time_limit=0.3, explain=False).message

@@ -143,3 +143,42 @@ def test_planner_options_out_of_the_planners_ranges_are_refused_naming_the_optio
                 continue
             r = run(command, LOW_MU, option, value)
             assert r.returncode == 2 and f"Invalid value for '{option}'" in r.stderr, (command, option, r.stderr)
+
+
+def _on_a_terminal(*args, cwd=None) -> str:
+    """What `stablepush ARGS` writes to stderr when stderr is a terminal (a pseudo-terminal)."""
+    import os
+    import pty
+
+    main, other = pty.openpty()
+    process = subprocess.Popen([sys.executable, "-m", "stablepush_cli.main", *args], stdout=subprocess.DEVNULL,
+                               stderr=other, cwd=cwd)
+    os.close(other)
+    seen = b""
+    while True:
+        try:
+            chunk = os.read(main, 4096)
+        except OSError:  # the child closed the terminal's other end
+            break
+        if not chunk:
+            break
+        seen += chunk
+    process.wait(timeout=60)
+    os.close(main)
+    return seen.decode(errors="replace")
+
+
+def test_a_long_search_shows_one_bar_on_a_terminal_and_none_in_a_pipe(tmp_path):
+    """A search that the time limit ends (the only pusher presses on the left end, the goal lies to
+    -x): `plan` showed nothing for the whole time limit; now a bar of the time spent, on a
+    terminal. In a pipe the output is the result alone."""
+    data = yaml.safe_load(task_text("horizontal-offset-high-mu"))
+    data.update(pushers=[p for p in data["pushers"] if p["name"] == "left"], goal=[-20, 0, 0])
+    task = tmp_path / "back.yaml"
+    task.write_text(yaml.safe_dump(data))
+    args = ("plan", str(task), "-o", str(tmp_path / "p.json"), "--time-limit", "2")
+    piped = run(*args)
+    assert piped.returncode == 1 and "searching" not in piped.stderr, piped.stderr
+    shown = _on_a_terminal(*args)
+    assert "horizontal-offset-high-mu: searching (time limit 2 s)" in shown and "not solved" in shown, shown
+    assert "searching" not in _on_a_terminal(*args, "--quiet")

@@ -1,6 +1,7 @@
 """Each hostile input and fault of the reliability issue, one by one: the exact message or the
 safe behaviour, never a crash, a hang or a file written where it should not be."""
 import contextlib
+import dataclasses
 import json
 import os
 import signal
@@ -255,8 +256,10 @@ def test_a_nominal_plan_is_refused_for_the_same_task_with_an_uncertainty_box():
     are stable for the nominal model only (its margins are 0.1 N)."""
     nominal = plan_task(shipped("horizontal-offset-low-mu"), seed=1)
     uncertain = parse_task(task_text("horizontal-offset-low-mu") + "uncertainty: {pusher_mu: 0.15}\n")
-    with pytest.raises(PlanError, match="is not a stable push for this task"):
+    with pytest.raises(PlanError, match=r"changed since the plan was made \(uncertainty.pusher_mu\)"):
         check_plan(uncertain, nominal)
+    with pytest.raises(PlanError, match="is not a stable push for this task"):  # the pushes, re-checked
+        check_plan(uncertain, dataclasses.replace(nominal, task_identity=None))
     check_plan(uncertain, plan_task(uncertain, seed=1))
 
 
@@ -702,14 +705,33 @@ def _plan_then_edit(tmp_path, edit):
     (lambda t: t.replace("goal: [20, 0, 0]", "goal: [19.5, 0, 0]"), "goal"),  # still within tolerance of the end
     (lambda t: t.replace("grip_force: 10 ", "grip_force: 10.5 "), "gripper.grip_force"),
 ])
-def test_execute_refuses_a_plan_whose_task_changed_and_names_what(tmp_path, edit, changed):
-    """Issue 24, item 4: a user edited the goal after planning, and show and trajectory took the old
-    plan without a word. Now execute refuses and names the field; show and trajectory warn."""
+def test_every_command_and_the_api_refuse_a_plan_whose_task_changed_and_name_what(tmp_path, edit, changed):
+    """A user edited the task after planning: the library's check_plan refuses the plan (the rule
+    is not the CLI's), so execute, show, trajectory, evaluate and the API all do, naming the field."""
+    import dataclasses
+
+    import stablepush as sp
+    from stablepush.evaluation import Batch, Spreads
+
     plan, task = _plan_then_edit(tmp_path, edit)
-    result = CliRunner().invoke(cli, ["execute", plan, "--task", task, "--sim", "--quiet"])
-    assert result.exit_code == 2 and "changed since the plan was made" in result.output and changed in result.output
-    shown = CliRunner().invoke(cli, ["show", plan, "--task", task, "-o", str(tmp_path / "p.png")])
-    assert shown.exit_code == 0 and "warning:" in shown.output and changed in shown.output
+    for args in (["execute", plan, "--task", task, "--sim", "--quiet"],
+                 ["show", plan, "--task", task, "-o", str(tmp_path / "p.png")],
+                 ["trajectory", plan, "--task", task, "-o", str(tmp_path / "t.csv")],
+                 ["evaluate", task, "--plan", plan, "--trials", "1", "--quiet"]):
+        result = CliRunner().invoke(cli, args)
+        assert result.exit_code == 2, (args, result.output)
+        assert "changed since the plan was made" in result.output and changed in result.output, result.output
+    assert not (tmp_path / "p.png").exists() and not (tmp_path / "t.csv").exists()
+    edited, made = load_task(task), load_plan(plan)
+    for call in (lambda: sp.check_plan(edited, made), lambda: sp.trajectory(edited, made),
+                 lambda: sp.plan_figure(edited, made),
+                 lambda: Batch(task=edited, plan=made, spreads=Spreads())):
+        with pytest.raises(PlanError, match=f"task_identity: .*changed since the plan was made .*{changed}"):
+            call()
+    # The pad mu edited in code, as the user study did: the same refusal.
+    with pytest.raises(PlanError, match=r"changed since the plan was made \(gripper.mu\)"):
+        sp.check_plan(dataclasses.replace(load_task(str(TASKS / "horizontal-offset-high-mu.yaml")), mu=0.5),
+                      sp.plan_task(load_task(str(TASKS / "horizontal-offset-high-mu.yaml"))))
 
 
 def test_a_pusher_edited_after_planning_is_named(tmp_path):

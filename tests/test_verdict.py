@@ -42,12 +42,36 @@ def test_a_tolerance_that_is_not_finite_and_positive_is_refused_naming_it(tolera
         Verdict.for_fault(tolerance, "stopped")
 
 
-def test_a_run_within_tolerance_landed():
+def test_a_run_within_tolerance_landed_and_the_line_names_each_coordinate_and_its_tolerance():
     v = judge(TASK, _report((20.3, -0.2, 0.4)))
-    assert v.success is True and v.cause is None and "landed" in v.detail
-    # The pose at rest on the last feature decides; what the release does is reported beside it.
+    assert v.success is True and v.cause is None
+    # Per coordinate, as the tolerance is: no distance that could read as outside it.
+    assert v.detail == "landed: x +0.30 mm, z -0.20 mm, theta +0.40 deg (tolerance 0.5 mm, 0.5 mm, 0.5 deg)"
+    v = judge(TASK, _report((20.6, 0.0, 0.0)))
+    assert v.detail.startswith("missed: x +0.60 mm, z +0.00 mm, theta +0.00 deg (tolerance 0.5 mm, 0.5 mm, 0.5 deg): ")
+
+
+def test_a_part_that_moves_out_of_tolerance_on_release_did_not_land():
+    # Within the tolerance on its last feature, 8 mm and 23 deg off once the pads alone hold it.
     report = _report((20.3, -0.2, 0.4), released=(28.0, -0.2, 23.0))
-    assert judge(TASK, report).success is True and report.release_moved
+    v = judge(TASK, report)
+    assert v.success is False and v.cause == "moved_on_release" and report.release_moved
+    assert v.detail.startswith("missed: x +8.00 mm, z -0.20 mm, theta +23.00 deg")
+    assert "on its last feature it was within the tolerance (x +0.30 mm, z -0.20 mm, theta +0.40 deg)" in v.detail
+    # The pose before the release stays in the report; the goal error is where it came to rest.
+    d = report.as_dict()
+    assert d["final_in_grasp"]["x"] == 20.3 and d["landed_in_grasp"]["x"] == 28.0
+    assert report.goal_error["x"] == pytest.approx(8.0)
+    # A release that moves it a little, and it stays within: landed.
+    assert judge(TASK, _report((20.3, -0.2, 0.4), released=(20.4, -0.3, 0.45))).success is True
+    # A run that was off before the release keeps the cause it had there.
+    assert judge(TASK, _report((21.6, 0.0, 0.0), released=(23.0, 0.0, 2.0))).cause == "drift"
+
+
+def test_a_run_that_ends_on_its_feature_is_judged_there():
+    report = dataclasses.replace(_report((20.3, -0.2, 0.4), released=(28.0, -0.2, 23.0)), ends_on_feature=True)
+    assert judge(TASK, report).success is True and report.release_change is None
+    assert report.landed_in_grasp == report.final_in_grasp
 
 
 def test_a_tighter_tolerance_turns_the_same_run_into_a_miss():
@@ -85,7 +109,7 @@ def test_a_feature_met_beyond_its_place_is_blamed_before_a_slip():
 
 def test_a_plan_that_stops_short_is_its_own_cause():
     v = judge(TASK, _report((18.5, 0.0, 0.0), planned=(18.5, 0.0, 0.0)))
-    assert v.cause == "plan_short" and "the plan itself ends 1.500 mm" in v.detail
+    assert v.cause == "plan_short" and "the plan itself ends at x -1.50 mm, z +0.00 mm, theta +0.00 deg" in v.detail
 
 
 def test_a_short_plan_that_the_loop_could_not_aim_again_is_plan_short_and_says_why():
@@ -136,6 +160,6 @@ def test_angles_are_compared_within_one_turn():
     report = _report((20.1, 0.0, -0.2), planned=(20.0, 0.0, 360.0))
     report.goal = turned.goal
     v = judge(turned, report)
-    assert v.success is True and "-0.200 deg" in v.detail
+    assert v.success is True and "theta -0.20 deg" in v.detail
     assert report.final_error["theta"] == pytest.approx(-0.2) and report.goal_error["theta"] == pytest.approx(-0.2)
     assert within({"x": 20.0, "z": 0.0, "theta": 179.9}, (20.0, 0.0, -179.9), (0.5, 0.5))

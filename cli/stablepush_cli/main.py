@@ -6,6 +6,8 @@ import json
 import math
 import os
 import sys
+import threading
+import time
 from pathlib import Path
 
 import click
@@ -106,6 +108,39 @@ def _say_beside(*outputs):
 
     to_stderr = any(path and same_file(path, "/dev/stdout") for path in outputs)
     return lambda text="": click.echo(text, err=to_stderr)
+
+
+def _progressbar(quiet: bool, **options):
+    """A progress bar on stderr when it is a terminal, else None: in a pipe click would print each
+    new label as a line of its own (a line per trial, per step)."""
+    if quiet or not sys.stderr.isatty():
+        return None
+    return click.progressbar(file=sys.stderr, **options)
+
+
+@contextlib.contextmanager
+def _searching(label: str, seconds: float, quiet: bool):
+    """While the block searches (with the GIL released in the core): from its first second on, a
+    bar of the time spent against its limit, on a terminal."""
+    done = threading.Event()
+
+    def show() -> None:
+        started = time.monotonic()
+        if done.wait(1.0):
+            return
+        with click.progressbar(length=max(1, round(seconds * 10)), label=label, file=sys.stderr) as bar:
+            while not done.wait(0.1):
+                bar.update(min(round((time.monotonic() - started) * 10), bar.length) - bar.pos)
+
+    watcher = None if quiet or not sys.stderr.isatty() else threading.Thread(target=show, daemon=True)
+    if watcher is not None:
+        watcher.start()
+    try:
+        yield
+    finally:
+        done.set()
+        if watcher is not None:
+            watcher.join()
 
 
 class _Commands(click.Group):
@@ -265,13 +300,16 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     """
     from stablepush.outputs import default_output
     from stablepush.plan import plan_task, write_plan
+    from stablepush.plan.verify import release_note
 
     json_label = "-o" if json_path else "the default -o"
     json_path = json_path or default_output(task_file, ".plan.json")
     _check_outputs({json_label: json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
     say = _say_beside(json_path, csv_path)
     task = _load(task_file)
-    result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
+    limit = time_limit if time_limit is not None else task.planner["time_limit"]
+    with _searching(f"{task.name}: searching (time limit {limit:g} s)", limit, quiet):
+        result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
     write_plan(result, json_path, csv_path)
     s = result.stats
     if not result.solved:
@@ -287,11 +325,9 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
             f"ends within tolerance, {s['goal_distance_steps']:.2f} unit steps from the goal (a last push to "
             f"the goal itself is not a stable push)")
         say(f"plan written to {json_path}" + (f" and {csv_path}" if csv_path else ""))
-    hold = result.final_hold_ratio
-    if hold < 1.0:
-        click.echo(f"note: at the plan's last pose the pads alone hold only {hold:.2f} times the object's weight: "
-                   f"released there, it moves in the grasp (planner.min_hold_ratio: 1 asks for a pose they hold)",
-                   err=True)
+    note = release_note(task, result)
+    if note:
+        click.echo(f"note: {note}", err=True)
 
 
 @cli.command()
@@ -457,24 +493,13 @@ def _write_bench(path: str, trials, rows) -> None:
     write_atomically(path, buffer.getvalue())
 
 
-def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = True, changed: str = "warn"):
-    """The task and the plan, once the plan is shown to belong to the task (exit 2 if not). A task
-    that changed since the plan was made is warned about (`changed="warn"`) or refused ("refuse")."""
-    from stablepush.errors import PlanError
+def _load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = True):
+    """The task and the plan, once the plan is shown to belong to the task as it is now (check_plan;
+    exit 2 if not)."""
     from stablepush.plan import check_plan, load_plan
-    from stablepush.plan.verify import changes_since_planned
 
     task = _load(task_file)
-    plan = load_plan(plan_file)
-    # A plan for another task (its name) is check_plan's to name; for this one, what changed since.
-    changes = changes_since_planned(task, plan) if plan.task == task.name else []
-    if changes:
-        what = f"{task_file} changed since the plan was made ({', '.join(changes[:6])}" + \
-            (f" and {len(changes) - 6} more" if len(changes) > 6 else "") + ")"
-        if changed == "refuse":
-            raise PlanError("task_identity", what + ": plan it again", plan_file)
-        click.echo(f"warning: {what}", err=True)
-    return task, check_plan(task, plan, source=plan_file, require_solved=require_solved)
+    return task, check_plan(task, load_plan(plan_file), source=plan_file, require_solved=require_solved)
 
 
 @cli.command()
@@ -515,6 +540,27 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
         click.echo(f"animation written to {gif_path}")
 
 
+def _stamp(_ctx, _param, value):
+    """--stamp as Unix ns (None: the bag's default), by the library's rule (bags.parse_stamp)."""
+    if value is None:
+        return None
+    from stablepush.execution.bags import parse_stamp
+
+    try:
+        return parse_stamp(value)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc)) from None
+
+
+def _stamp_option(which: str, default: str):
+    """--stamp: the start time of the ROS 2 bag that `which` writes."""
+    return click.option(
+        "--stamp", "stamp_ns", default=None, callback=_stamp, metavar="TIME",
+        help=f"With {which}: the bag's start time, Unix seconds (1764600000.5) or ISO-8601 with its zone "
+             f"(2026-12-01T15:00:00Z); each message is stamped with it plus its time in the stream, so that the "
+             f"bag plays beside live data (default: {default}).")
+
+
 @cli.command()
 @click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
 @click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
@@ -522,8 +568,8 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
 @click.option("-o", "--output", "out_path", required=True, type=click.Path(dir_okay=False),
               metavar="TRAJ.csv|.json|.mcap",
               help="Where to write the trajectory: CSV (a header, one row per sample), JSON (columns and rows), or a "
-                   "ROS 2 bag in one MCAP file (/tf, the gripper's pose and twist, phase, step and the scene as "
-                   "markers; docs/execution.md, 'ROS 2 bags').")
+                   "ROS 2 bag in one MCAP file (/tf, /tf_static, the gripper's pose and twist, phase, step and the "
+                   "scene as markers; docs/execution.md, 'ROS 2 bags').")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
               metavar="HZ", help="Samples per second (the executor streams at this rate). Each push takes the "
                                  "fewest whole samples that last the task's dynamics.step_time: a rate that does not "
@@ -533,7 +579,8 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
 @click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default=None,
               help="Quaternion order in a .csv or .json: xyzw as ROS writes it (the default), wxyz as the arm "
                    "protocol and MuJoCo do. A .mcap's messages are ROS's own, xyzw.")
-def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str) -> None:
+@_stamp_option("a .mcap", "now")
+def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str, stamp_ns) -> None:
     """Write the gripper's timed trajectory for a plan: what the executor streams, for your robot.
 
     One sample per 1/HZ s: time (s), G's position in the world (m) and orientation (a unit
@@ -556,6 +603,8 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
     if quat is not None and out_path.lower().endswith(".mcap"):
         _fail(f"--quat {quat}: a ROS 2 bag's quaternions are its message types' own (x, y, z, w); --quat is for "
               f".csv and .json")
+    if stamp_ns is not None and not out_path.lower().endswith(".mcap"):
+        _fail("--stamp: only with a .mcap (a ROS 2 bag; a .csv or .json counts t from 0)")
     quat = quat or "xyzw"
     _check_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file)
@@ -565,7 +614,7 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
     if out_path.lower().endswith(".mcap"):
         from stablepush.execution.bags import write_bag
 
-        write_bag(out_path, task, plan, traj)
+        write_bag(out_path, task, plan, traj, start_ns=stamp_ns)
     else:
         write_atomically(out_path, traj.to_json(quat) if out_path.lower().endswith(".json") else traj.to_csv(quat))
     click.echo(f"{task.name}: {len(traj)} samples at {rate_hz:g} Hz, {traj.t[-1]:.2f} s, "
@@ -717,8 +766,9 @@ def _host_port(_ctx, _param, value):
                    "(default: the task's planner.tolerance).")
 @click.option("--record", "record_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mcap",
               help="Record the run as a ROS 2 bag (one MCAP file): the commanded and measured gripper pose, the "
-                   "object in the world and in the grasp, /tf, the pusher in contact, each correction and the "
-                   "verdict (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
+                   "object in the world and in the grasp, /tf and /tf_static, the pusher in contact, each correction "
+                   "and the verdict (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
+@_stamp_option("--record", "when the run starts")
 @click.option("--video", "video_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mp4",
               help="Draw the run as a video (H.264 MP4, headless): seen along the gripping axis as the plan figures "
                    "are, the object, the pads, the features (the pusher in contact highlighted) and the plan's pose "
@@ -726,6 +776,9 @@ def _host_port(_ctx, _param, value):
                    "which a simulated arm reports; drawn on a fault too.")
 @_video_options("--video")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("-v", "--verbose", is_flag=True,
+              help="A line per correction of the closed loop and per contact (slip, carry, where the guard found "
+                   "its feature); without, one line sums each up.")
 @click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=Finite(min=0.1, max=10),
               metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
                                 "the plan against a world whose friction differs from its model.")
@@ -751,9 +804,9 @@ def _host_port(_ctx, _param, value):
                                      "this close to the goal, and re-plan on the last contact's feature past it "
                                      "(default: a fifth of the task's goal tolerance).")
 def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
-            ack_timeout: float, json_path, success_tolerance, record_path, video_path, video_fps: float, video_size,
-            quiet: bool, mu_scale: float, tracker_noise, closed_loop: bool, guarded: bool, replan_threshold,
-            final_tolerance) -> None:
+            ack_timeout: float, json_path, success_tolerance, record_path, stamp_ns, video_path, video_fps: float,
+            video_size, quiet: bool, verbose: bool, mu_scale: float, tracker_noise, closed_loop: bool, guarded: bool,
+            replan_threshold, final_tolerance) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -787,7 +840,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     require_suffix("--record", record_path, (".mcap",))
     _check_outputs({"--json": json_path, "--record": record_path, "--video": video_path},
                   {"PLAN.json": plan_file, "--task": task_file})
-    task, plan = _load_plan_and_task(plan_file, task_file, changed="refuse")
+    task, plan = _load_plan_and_task(plan_file, task_file)
     for warning in execution_warnings(task):
         click.echo(f"warning: {warning}", err=True)
     check_resume_from(plan.waypoints, resume_from, field="--resume-from")
@@ -822,10 +875,9 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
         host, port = arm or ("127.0.0.1", DEFAULT_PORT)
     pace = (not sim) if pace is None else pace
 
-    bar = None
-    if not quiet:
-        bar = click.progressbar(length=len(plan.waypoints) - 1 - resume_from, label=f"{task.name}: step {resume_from}",
-                                file=sys.stderr, show_pos=True)
+    bar = _progressbar(quiet, length=len(plan.waypoints) - 1 - resume_from, label=f"{task.name}: step {resume_from}",
+                       show_pos=True)
+    if bar is not None:
         bar.__enter__()
     seen = [resume_from]
 
@@ -841,7 +893,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     if record_path or video_path:
         from stablepush.execution.bags import RunRecording
 
-        recording = RunRecording()
+        recording = RunRecording.for_run(task, plan, closed_loop)
 
     def video() -> None:
         if video_path:
@@ -860,7 +912,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
         if json_path:
             write_atomically(json_path, json.dumps(fault_report(task, fault, success_tolerance), indent=1) + "\n")
         if record_path:
-            recording.write(record_path, fault_report(task, fault, success_tolerance))
+            recording.write(record_path, fault_report(task, fault, success_tolerance), start_ns=stamp_ns)
         if recording is not None and recording.samples:
             video()
         if not fault.connected:
@@ -883,12 +935,12 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     if bar is not None:
         bar.__exit__(None, None, None)
     say = _say_beside(json_path, record_path, video_path)
-    _print_report(report, say)
+    _print_report(report, say, verbose)
     if json_path:
         write_atomically(json_path, json.dumps(report.as_dict(), indent=1) + "\n")
         say(f"report written to {json_path}")
     if record_path:
-        recording.write(record_path, report.as_dict())
+        recording.write(record_path, report.as_dict(), start_ns=stamp_ns)
         say(f"run recorded to {record_path}")
     video()
     if report.success is False:
@@ -923,8 +975,9 @@ def _resume_command(ctx: click.Context, step: int) -> str:
     return shlex.join(words + ["--resume-from", str(step)])
 
 
-def _print_report(report, say=click.echo) -> None:
-    """The run's report in lines, each through `say`."""
+def _print_report(report, say=click.echo, verbose: bool = False) -> None:
+    """The run's report in lines, each through `say`: a line per correction and per contact with
+    `verbose`, else one line summing each up."""
     say(f"{report.task}: steps {report.resumed_from + 1}-{report.last_confirmed_step} of {report.total_steps} "
          f"confirmed, {report.waypoints} waypoints in {report.wall_time_s:.1f} s"
          + (f" ({report.sim_steps_per_s:.0f} simulation steps/s)" if report.sim_steps_per_s else ""))
@@ -934,15 +987,23 @@ def _print_report(report, say=click.echo) -> None:
         return
     x, z, th = report.planned_final
     f = report.final_in_grasp
-    say(f"final pose in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
-         f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg; "
-         f"to the task's goal {report.goal_error['distance']:.3f} mm, {report.goal_error['theta']:+.3f} deg")
+    say(f"on the last feature, in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
+        f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg")
+    change = report.release_change
+    if report.ends_on_feature:
+        say("the run ends with the object on its last feature (environment.end_on_feature), and is judged there")
+    elif change is not None:
+        r = report.released_in_grasp
+        say(f"at rest after the release: x {r['x']:.3f} z {r['z']:.3f} mm, theta {r['theta']:.3f} deg; it moved "
+            f"{math.hypot(change['x'], change['z']):.3f} mm, {change['theta']:+.3f} deg when the feature let go")
     if report.guard == "no tracker":
         say("guard: the arm reports no object_in_grasp (no tracker), so each approach ended where the plan "
              "puts its feature")
     if report.closed_loop == "no tracker":
         say("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
-    for r in report.replans:
+    if not verbose:
+        _sum_up_run(report, say)
+    for r in report.replans if verbose else ():
         off, ref = {"off_goal": (r.measured, report.goal), "plan_short": (r.planned, report.goal)}.get(
             r.trigger, (r.measured, r.planned))
         dx, dz, dth = (m - p for m, p in zip(off, ref))
@@ -961,24 +1022,41 @@ def _print_report(report, say=click.echo) -> None:
                 "plan_short": "before the first push: the plan ends off the goal by"}.get(
             r.trigger, f"after step {r.after_step}: off the plan by")
         say(f"  {when} {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; {outcome} ({r.planning_ms:.1f} ms)")
-    for c in report.contacts:
+    for c in report.contacts if verbose else ():
         if c.slip_mm is not None:
             found = "" if c.found_mm is None else f"feature found {c.found_mm:+.3f} mm from its place; "
             found += "" if c.seated_deg is None else f"seated turned {c.seated_deg:+.3f} deg; "
             say(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} {found}carried to the feature "
                  f"{c.carried_mm:.3f} mm, then slip at the pusher {c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
-    change = report.release_change
-    if report.release_moved:
-        say(f"note: when the last feature let go the object moved in the grasp by "
-             f"{math.hypot(change['x'], change['z']):.2f} mm, "
-             f"{change['theta']:+.2f} deg: the grasp alone does not hold the final pose against gravity")
     verdict = report.verdict
     if verdict is not None and verdict.success is not None:
         say(f"verdict: {verdict.detail}" + (f" [cause: {verdict.cause}]" if verdict.cause else ""))
 
 
+def _sum_up_run(report, say) -> None:
+    """The corrections and the contacts in a line each (`execute -v` prints each, --json keeps all)."""
+    taken = [r for r in report.replans if r.solved and r.pushes]
+    failed = [r for r in report.replans if not r.solved]
+    if report.replans:
+        last = f"; the last found none: {failed[-1].failure}" if failed else ""
+        say(f"closed loop: {len(report.replans)} comparison(s) off the plan, {len(taken)} correction(s) taken, "
+            f"{len(failed)} with none found{last} (each with -v)")
+    measured = [c for c in report.contacts if c.slip_mm is not None]
+    if measured:
+        worst = max(measured, key=lambda c: c.slip_mm)
+        carried = max(c.carried_mm or 0.0 for c in measured)
+        say(f"{len(measured)} contact(s): the most slip at a pusher {worst.slip_mm:.3f} mm, {worst.slip_deg:.3f} deg "
+            f"({worst.pusher}, steps {worst.first_step}-{worst.last_step}); the most carried to a feature "
+            f"{carried:.3f} mm (each with -v)")
+
+
 def _vary(_ctx, _param, values):
-    """--vary KEY=FRACTION, repeated, as a dict (the keys and ranges are checked by Spreads)."""
+    """--vary KEY=FRACTION, repeated, as a dict (the keys and ranges are checked by Spreads); None
+    when not given, {} for `--vary none`."""
+    if not values:
+        return None
+    if [v.strip().lower() for v in values] == ["none"]:
+        return {}
     out = {}
     for value in values:
         key, sep, fraction = value.partition("=")
@@ -1006,9 +1084,12 @@ def _vary(_ctx, _param, values):
                    "serially, on workers or on Ray.")
 @click.option("--vary", "vary", multiple=True, callback=_vary, metavar="KEY=FRACTION",
               help="Multiply the task's KEY (pad_mu, pusher_mu, grip_force or mass) in each world by a factor drawn "
-                   "uniformly within 1 +- FRACTION. Repeatable.")
-@click.option("--feature-error", nargs=2, type=Finite(min=0), default=(0.0, 0.0), metavar="MM DEG",
-              help="Place each feature off by up to MM in x and z and DEG about y (uniform).")
+                   "uniformly within 1 +- FRACTION. Repeatable; `--vary none` varies nothing. Default: the task's "
+                   "uncertainty box, else pad_mu and pusher_mu 0.1, grip_force 0.05, mass 0.02, with "
+                   "--feature-error 0.2 0.2 (docs/evaluate.md, 'The worlds').")
+@click.option("--feature-error", nargs=2, type=Finite(min=0), default=None, metavar="MM DEG",
+              help="Place each feature off by up to MM in x and z and DEG about y (uniform). Default: 0.2 0.2 "
+                   "without --vary, else 0 0.")
 @click.option("--tracker-noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0), metavar="MM DEG",
               help="Standard deviations of the tracker's noise on the pose in the grasp.")
 @click.option("--closed-loop", is_flag=True, help="Run each trial closed loop (re-plan from the tracked pose).")
@@ -1016,9 +1097,9 @@ def _vary(_ctx, _param, values):
               help="Find each feature by touch at the end of its approach (as `execute --guard`).")
 @click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
               help="The simulated arm's physics engine.")
-@click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=(0.5, 0.5),
-              show_default=True, metavar="MM DEG", help="A trial succeeds when it ends within MM (x and z) and DEG "
-                                                        "of the goal in the grasp.")
+@click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None, metavar="MM DEG",
+              help="A trial lands when the object comes to rest within MM (x and z) and DEG of the goal in the "
+                   "grasp, as `execute` judges a run (default: the task's planner.tolerance).")
 @click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
               help="Run the trials on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
@@ -1042,11 +1123,14 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
     """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
 
     Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
-    given spreads, moves each feature by up to --feature-error and adds --tracker-noise; the plan
-    runs there on the simulated arm (open loop, or --closed-loop) and lands when it ends within
-    --success-tolerance of the goal. The summary gives the success rate with its Wilson 95%
-    interval, the goal error's percentiles and the causes of the misses. A trial that crashes is
-    recorded (cause `crash`) and the batch goes on; Ctrl-C stops it and keeps the trials done.
+    given spreads (default: the task's uncertainty box, else a lab's: see --vary), moves each
+    feature by up to --feature-error and adds --tracker-noise; the plan runs there on the simulated
+    arm (open loop, or --closed-loop) and lands, as `execute` judges a run, when the object comes
+    to rest after the release within the task's tolerance of the goal (or --success-tolerance).
+    The summary gives the success rate with its Wilson 95% interval, the goal error's percentiles
+    and the causes of the misses. Spreads that vary nothing make one world: one trial runs, and no
+    interval is given. A trial that crashes is recorded (cause `crash`) and the batch goes on;
+    Ctrl-C stops it and keeps the trials done.
 
     \b
     Exit status: 0 done (whatever the success rate), 1 no plan found, 2 bad input, 130 stopped by
@@ -1076,18 +1160,19 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
     say = _say_beside(json_path, csv_path, png_path)
 
     runner = _runner(workers, ray_address, default=default_workers())
-    try:
-        spreads = Spreads(vary=vary, feature_error=tuple(feature_error), tracker_noise=tuple(tracker_noise))
-    except ValueError as exc:  # only --vary can be refused here, and Spreads names it `vary`
-        _fail(f"--{exc}")
     if robust and plan_file:
         _fail("--robust plans from the task; a plan given with --plan is evaluated as it is")
-    if robust and not spreads.vary:
-        _fail("--robust needs --vary: the box is widened to its spreads")
     if plan_file:
         task, plan = _load_plan_and_task(plan_file, task_file)
     else:
         task = _load(task_file)
+    try:
+        spreads = Spreads.for_task(task, vary, feature_error, tracker_noise)
+    except ValueError as exc:  # only --vary can be refused here, and Spreads names it `vary`
+        _fail(f"--{exc}")
+    if robust and not any(spreads.vary.values()):
+        _fail("--robust needs spreads to widen the box to (--vary, or the defaults it takes without)")
+    if not plan_file:
         if robust:
             task = robust_task(task, spreads)
         plan = plan_task(task)
@@ -1103,16 +1188,24 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         except OutputError as exc:
             _fail(f"--video-failed {exc}")
     batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
-                  engine=engine, tolerance=tuple(success_tolerance), video_dir=video_dir, video_fps=video_fps,
+                  engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video_fps,
                   video_size=tuple(video_size))
     for warning in batch.warnings():
         click.echo(f"warning: {warning}", err=True)
+    trials = 1 if spreads.one_world else trials  # evaluate() runs one: the bar says so too
     if not quiet:
         box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
+        worlds = ("one world, the model's own (nothing varies)" if spreads.one_world else
+                  ", ".join([f"{key} +-{fraction:.0%}" for key, fraction in spreads.vary.items() if fraction]
+                            + [f"features off by up to {spreads.feature_error[0]:g} mm, "
+                               f"{spreads.feature_error[1]:g} deg"] * any(spreads.feature_error)
+                            + [f"tracker noise {spreads.tracker_noise[0]:g} mm, {spreads.tracker_noise[1]:g} deg"]
+                            * any(spreads.tracker_noise)))
+        click.echo(f"{task.name}: {worlds}", err=True)
         click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop"
                    f"{'' if guarded else ', approaches not guarded'} on {engine}, "
                    f"on {runner.describe()}" + (f"; the plan is robust to {box}" if box else ""), err=True)
-    bar = None if quiet else click.progressbar(length=trials, label="trials", file=sys.stderr, show_pos=True)
+    bar = _progressbar(quiet, length=trials, label="trials", show_pos=True)
 
     def progress(record, done) -> None:
         if bar is not None:
@@ -1130,10 +1223,16 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
     if not s["trials"]:
         click.echo("interrupted before any trial finished" if s["interrupted"] else "no trial finished", err=True)
         sys.exit(130 if s["interrupted"] else EXIT_NOT_SOLVED)
-    low, high = s["ci95"]
-    say(f"{task.name}: landed {s['successes']} of {s['trials']} trials within {success_tolerance[0]:g} mm / "
-        f"{success_tolerance[1]:g} deg: {s['success_rate']:.1%} (95% CI {low:.1%}-{high:.1%})"
-        + (f"; interrupted after {s['trials']} of {trials}" if s["interrupted"] else ""))
+    tol = s["tolerance"]
+    within = f"within {tol[0]:g} mm (x and z) and {tol[1]:g} deg"
+    if s["one_world"]:
+        say(f"{task.name}: one world, the model's own (nothing varies): "
+            f"{'landed' if s['successes'] else 'missed'} {within}; one trial, so no interval")
+    else:
+        low, high = s["ci95"]
+        say(f"{task.name}: landed {s['successes']} of {s['trials']} trials {within}: {s['success_rate']:.1%} "
+            f"(95% CI {low:.1%}-{high:.1%})" + (f"; interrupted after {s['trials']} of {trials}"
+                                                if s["interrupted"] else ""))
     if s["goal_error_mm"]:
         say(f"goal error: median {s['goal_error_mm']['p50']:.3f} mm / {s['goal_error_deg']['p50']:.3f} deg, "
             f"p95 {s['goal_error_mm']['p95']:.3f} mm / {s['goal_error_deg']['p95']:.3f} deg")
@@ -1240,7 +1339,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
     count = axes[0][2] * axes[1][2] * axes[2][2]
     if count > 100_000:
         _fail(f"--x, --z, --theta: {count} cells; at most 100000")
-    bar = None if quiet else click.progressbar(length=count, label=f"{count} cells", file=sys.stderr, show_pos=True)
+    bar = _progressbar(quiet, length=count, label=f"{count} cells", show_pos=True)
     try:
         result = reach_map(task, *axes, seed=task.planner["seed"] if seed is None else seed, time_limit=time_limit,
                            runner=runner, progress=(lambda cell: bar.update(1)) if bar else None)

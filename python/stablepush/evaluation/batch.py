@@ -29,13 +29,13 @@ from stablepush.execution.executor import execute_plan, execution_warnings
 from stablepush.execution.guard import GuardedApproach
 from stablepush.execution.verdict import success_tolerance, tolerance_used, within
 from stablepush.plan.plan import Plan
+from stablepush.plan.verify import check_plan
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.sim.arm import WorldDeviation
 from stablepush.sim.server import SIM_ACK_TIMEOUT, running_sim_arm
 from stablepush.task.model import Task
 from stablepush.units import angle_difference_deg
 
-DEFAULT_TOLERANCE = (0.5, 0.5)  # mm, deg: a trial succeeds within this of the goal, per coordinate
 RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
 PERCENTILES = (50, 90, 95, 99)
 EDGE = 0.9  # of the success tolerance: an open-loop plan ending this far out is warned of
@@ -45,7 +45,7 @@ EDGE = 0.9  # of the success tolerance: an open-loop plan ending this far out is
 class Batch:
     """What every trial shares: the task, its plan, the spreads of the worlds, open or closed
     loop, guarded approaches or not (stablepush.execution.guard), the engine and the success
-    tolerance (mm, deg)."""
+    tolerance (mm, deg; None: the task's planner.tolerance, as `execute` judges a run)."""
 
     task: Task
     plan: Plan
@@ -54,7 +54,7 @@ class Batch:
     closed_loop: bool = False
     guarded: bool = True
     engine: str = "mujoco"
-    tolerance: Tuple[float, float] = DEFAULT_TOLERANCE
+    tolerance: Optional[Tuple[float, float]] = None
     # Where each failed trial's video goes (`trial-<i>.mp4`; None: no videos), and how it is drawn
     # (stablepush.sim.video). Drawn after the trial's verdict, so the outcomes do not depend on them.
     video_dir: Optional[str] = None
@@ -63,7 +63,13 @@ class Batch:
 
     def __post_init__(self):
         # Refused here, before any trial runs, rather than once per trial as a crash.
+        check_plan(self.task, self.plan)
         success_tolerance(self.task, self.tolerance)
+
+    @property
+    def judged_with(self) -> Tuple[float, float]:
+        """The tolerance (mm, deg) a trial is judged with: the batch's, else the task's."""
+        return success_tolerance(self.task, self.tolerance)
 
     def warnings(self) -> List[str]:
         """What makes the trials miss whatever their worlds (legal, but probably not meant), one
@@ -72,21 +78,22 @@ class Batch:
         lands only where the world's own error happens to make up the difference, or within it but
         at its edge (EDGE of it or more in some coordinate), where any drift of a real push misses."""
         out = execution_warnings(self.task)
+        tol = self.judged_with
         end, goal = self.plan.waypoints[-1].pose, self.task.goal
         mm, deg = max(abs(end[0] - goal[0]), abs(end[1] - goal[1])), abs(angle_difference_deg(end[2], goal[2]))
         at = {"x": end[0], "z": end[1], "theta": end[2]}
         others = "let the last pusher go on toward the goal pose (planner.finish_steps: 1) or run the closed loop"
-        if not self.closed_loop and not within(at, goal, self.tolerance):
+        if not self.closed_loop and not within(at, goal, tol):
             out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), "
-                       f"outside the success tolerance {self.tolerance[0]:g} mm / {self.tolerance[1]:g} deg: an "
+                       f"outside the success tolerance {tol[0]:g} mm / {tol[1]:g} deg: an "
                        f"open-loop trial lands only where its world's error happens to make up the difference. "
-                       f"To land, plan to the tolerance (planner.tolerance: [{self.tolerance[0]:g}, "
-                       f"{self.tolerance[1]:g}]), {others}")
-        elif not self.closed_loop and tolerance_used(at, goal, self.tolerance) >= EDGE:
+                       f"To land, plan to the tolerance (planner.tolerance: [{tol[0]:g}, "
+                       f"{tol[1]:g}]), {others}")
+        elif not self.closed_loop and tolerance_used(at, goal, tol) >= EDGE:
             out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), at "
-                       f"the edge of the success tolerance {self.tolerance[0]:g} mm / {self.tolerance[1]:g} deg: an "
+                       f"the edge of the success tolerance {tol[0]:g} mm / {tol[1]:g} deg: an "
                        f"open-loop trial that drifts outward at all misses. To leave it room, plan to less "
-                       f"(planner.tolerance: [{self.tolerance[0] / 2:g}, {self.tolerance[1] / 2:g}]), {others}")
+                       f"(planner.tolerance: [{tol[0] / 2:g}, {tol[1] / 2:g}]), {others}")
         return out
 
     def world(self, trial: int) -> TrialWorld:
@@ -171,7 +178,10 @@ def _crashed(batch: Batch, trial: int, why: str) -> dict:
 def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
              progress: Optional[Callable[[dict, List[dict]], None]] = None) -> "Evaluation":
     """Run trials 0 .. trials-1 of `batch` on `runner`; `progress(record, done)` after each. Ctrl-C
-    (KeyboardInterrupt) stops the batch and keeps the trials done (`interrupted`)."""
+    (KeyboardInterrupt) stops the batch and keeps the trials done (`interrupted`). When every world
+    is the model's own (Spreads.one_world) one trial says all there is: it alone runs, and the
+    summary gives no interval."""
+    trials = 1 if batch.spreads.one_world else trials
     source = run_all(run_trial, batch, range(trials), runner)
     started = time.perf_counter()
     done: List[dict] = []
@@ -220,9 +230,10 @@ class Evaluation:
         return {
             "task": self.batch.task.name, "trials": n, "requested": self.requested, "interrupted": self.interrupted,
             "successes": successes, "success_rate": successes / n if n else None,
-            "ci95": list(wilson_interval(successes, n)) if n else None,
-            "tolerance": list(self.batch.tolerance), "closed_loop": self.batch.closed_loop,
-            "guarded": self.batch.guarded,
+            # one world: every trial would be this one, so a rate over them says nothing more
+            "ci95": None if not n or self.batch.spreads.one_world else list(wilson_interval(successes, n)),
+            "tolerance": list(self.batch.judged_with), "one_world": self.batch.spreads.one_world,
+            "closed_loop": self.batch.closed_loop, "guarded": self.batch.guarded,
             "engine": self.batch.engine, "seed": self.batch.seed,
             "plan_uncertainty": dict(self.batch.task.uncertainty),
             "vary": dict(self.batch.spreads.vary), "feature_error": list(self.batch.spreads.feature_error),

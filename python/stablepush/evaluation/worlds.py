@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Dict, Sequence, Tuple
+from typing import Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -20,6 +20,11 @@ from stablepush.task.model import UNCERTAIN, Task
 
 VARY_KEYS = tuple(UNCERTAIN)  # pad_mu, pusher_mu, grip_force, mass: the keys of a task's uncertainty box
 MAX_FRACTION = 0.9  # a spread of +-90% at most: every multiplier stays positive (the box's own limit)
+# The spreads of a study that names none (Spreads.for_task), for a task without an uncertainty
+# box: friction known to 10%, the grip to 5%, the mass to 2% (a scale), and fixtures placed to
+# 0.2 mm and 0.2 deg (a dial gauge and a square). docs/evaluate.md, "The worlds".
+DEFAULT_VARY = {"pad_mu": 0.1, "pusher_mu": 0.1, "grip_force": 0.05, "mass": 0.02}
+DEFAULT_FEATURE_ERROR = (0.2, 0.2)  # mm, deg
 
 
 @dataclass(frozen=True)
@@ -41,6 +46,26 @@ class Spreads:
         for name, pair in (("feature_error", self.feature_error), ("tracker_noise", self.tracker_noise)):
             if not all(0.0 <= v < math.inf for v in pair):  # written so that nan fails it too
                 raise ValueError(f"{name} must be finite and not negative, got {tuple(pair)}")
+
+    @classmethod
+    def for_task(cls, task: Task, vary: Optional[Dict[str, float]] = None,
+                 feature_error: Optional[Sequence[float]] = None,
+                 tracker_noise: Sequence[float] = (0.0, 0.0)) -> "Spreads":
+        """The spreads of a study of `task`: `vary` when given ({} varies nothing), else the task's
+        uncertainty box when it has one, else DEFAULT_VARY; `feature_error` when given, else
+        DEFAULT_FEATURE_ERROR when `vary` was not given either (a study that names no spread gets
+        a lab's), else none."""
+        if vary is None:
+            vary = {k: v for k, v in task.uncertainty.items() if v > 0.0} or dict(DEFAULT_VARY)
+            feature_error = DEFAULT_FEATURE_ERROR if feature_error is None else feature_error
+        return cls(vary=dict(vary), feature_error=tuple(feature_error or (0.0, 0.0)),
+                   tracker_noise=tuple(tracker_noise))
+
+    @property
+    def one_world(self) -> bool:
+        """Whether every world is the model's own: nothing varies, the features are in place and the
+        tracker is exact, so every trial runs the same world (a study of one)."""
+        return not any(self.vary.values()) and not any(self.feature_error) and not any(self.tracker_noise)
 
 
 @dataclass(frozen=True)

@@ -50,13 +50,12 @@ from __future__ import annotations
 
 import dataclasses
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
-from stablepush.errors import TaskError
 from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
-from stablepush.task.mechanics import stable_directions
+from stablepush.task.mechanics import blocked_senses
 from stablepush.task.model import Task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import angle_difference_deg, pose_to_si
@@ -83,9 +82,6 @@ TRANSIT_HOLD_RATIO = 1.5
 # where the pads hold 1.47). The arm's moves between features shake the object more than rest
 # does, so it is not risked for a run that has landed.
 TRANSIT_HOLD_RATIO_LEAST = 1.4
-# A sense of x, z or theta in which no stable push moves the object by more than this fraction of a
-# unit step counts as one the pushers cannot push it in (the pegs' -x: 0.05, and only while turning).
-NO_WAY_BACK = 0.1
 # Corrections are planned first robust to pushers' mu this fraction below the task's and pads' mu this
 # fraction either side of it: the spread of worlds (x0.85 to x1.15) the loop is rated for.
 CORRECTION_MU_SPREAD = 0.15
@@ -141,8 +137,10 @@ class Replan:
     kept_pusher: bool  # the new plan starts with the pusher that was pushing
     planning_ms: float
     trigger: str = "off_plan"
-    failure: Optional[str] = None
+    failure: Optional[str] = None  # one line: how many searches, how they ended (each in `tried`)
     attempt: Optional[str] = None  # how the correction taken was searched for (_Attempt.describe)
+    tried: List[str] = field(default_factory=list)  # each failed search, and how it ended
+
 
     def as_dict(self) -> dict:
         return dataclasses.asdict(self)
@@ -219,26 +217,27 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
         return None
     switches = sum(1 for a, b in zip(steps[1:], steps[2:]) if a.pusher != b.pusher)
     time_limit = min(AIM_TIME_LIMIT, task.planner["time_limit"])
-    elapsed, tried, found = 0.0, [], []
+    elapsed, tried, ended, found = 0.0, [], [], []
     for budget in range(min(switches, task.planner["max_switches"]), task.planner["max_switches"] + 1):
         planner = {**task.planner, "tolerance": list(loop.final_tolerance), "time_limit": time_limit,
                    "max_switches": budget}
         result = plan_task(dataclasses.replace(task.with_start(start), planner=planner),
-                           min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO)
+                           min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO, explain=False)
         elapsed += result.stats["planning_time_s"]
         if not result.solved:
             tried.append(f"{budget} switch-over(s) in {time_limit * 1e3:g} ms: {result.outcome}")
+            ended.append(result.outcome)
         elif not _transits_held(task, result.waypoints, result.waypoints[1].pusher):
             tried.append(_unheld_note(result.pusher_sequence, TRANSIT_HOLD_RATIO))
+            ended.append("transit")
         else:
             found = list(result.waypoints)
             break
-    if not found:
-        tried += _way_back_note(task, end, loop.final_tolerance, "from the plan's end")  # where it ends, run as it is
+    notes = [] if found else _way_back_note(task, end, loop.final_tolerance, "from the plan's end")  # run as it is
     record = Replan(after_step=0, measured=tuple(start), planned=tuple(end), solved=bool(found),
                     pushers=result.pusher_sequence if found else [], pushes=max(len(found) - 1, 0),
                     kept_pusher=False, planning_ms=elapsed * 1e3, trigger="plan_short",
-                    failure=None if found else "; ".join(tried))
+                    failure=None if found else _summed_up(ended, notes), tried=[] if found else tried + notes)
     return record, found
 
 
@@ -250,21 +249,25 @@ def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float,
 def no_way_back(task: Task, pose: Sequence[float], tolerance: Tuple[float, float]) -> Optional[str]:
     """When the goal lies, from `pose` (x mm, z mm, theta deg, in the task's world), beyond
     `tolerance` (mm, deg) in a sense of x, z or theta in which no stable unit push of the task's
-    pushers moves the object by more than NO_WAY_BACK of a unit step (`stable_directions`, headings
-    every 10 deg): those senses, each with the largest such push ("-x (at most 0.05 of a unit
-    step)"), else None. Why a correction cannot exist from there."""
-    try:
-        largest = stable_directions(task.with_start(pose), pose)["largest"]
-    except TaskError:  # no grasp at the pose: the planner's own refusal says so
-        return None
+    pushers moves the object by more than mechanics.NO_WAY_BACK of a unit step (`blocked_senses`,
+    headings every 10 deg): those senses, each with the largest such push ("-x (at most 0.05 of a
+    unit step)"), else None. Why a correction cannot exist from there."""
     gap = (task.goal[0] - pose[0], task.goal[1] - pose[1], angle_difference_deg(task.goal[2], pose[2]))
-    blocked = []
-    for axis, (name, limit) in enumerate(zip(("x", "z", "theta"), (tolerance[0], tolerance[0], tolerance[1]))):
-        sense = ("+" if gap[axis] > 0 else "-") + name
-        if abs(gap[axis]) > limit and (largest[sense] is None or largest[sense] < NO_WAY_BACK):
-            most = "none" if largest[sense] is None else f"at most {max(largest[sense], 0.0):.2f} of a unit step"
-            blocked.append(f"{sense} ({most})")
-    return ", ".join(blocked) if blocked else None
+    return blocked_senses(task.with_start(pose), pose, gap, tolerance)
+
+
+# How a failed search ended, as its one-line summary counts it (_summed_up): a Plan.outcome, or the
+# transit rule refusing the plan found.
+_ENDED = {"time_limit": "out of time", "unreachable": "unreachable", "goal_over_switch_limit": "over the switch-overs",
+          "invalid_start": "no grasp at the start", "transit": "a transit the pads do not hold"}
+
+
+def _summed_up(ended: Sequence[str], notes: Sequence[str]) -> str:
+    """The failed searches in one line: how many, how each kind ended (`ended`: _ENDED's keys),
+    and what no_way_back found (`notes`)."""
+    counts = {kind: ended.count(kind) for kind in dict.fromkeys(ended)}
+    kinds = ", ".join(f"{_ENDED.get(kind, kind)} {n}" for kind, n in counts.items())
+    return "; ".join([f"{len(ended)} search(es) failed ({kinds})"] + list(notes))
 
 
 def _unheld_note(pushers: Sequence[str], ratio: float) -> str:
@@ -324,7 +327,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
     spec = task.pushers[task.pusher_index(pusher)]
-    elapsed, tried, steps, found_by = 0.0, [], [], None
+    elapsed, tried, ended, steps, found_by = 0.0, [], [], [], None
     robust = dataclasses.replace(base, uncertainty={"pusher_mu": CORRECTION_MU_SPREAD, "pad_mu": CORRECTION_MU_SPREAD})
     for attempt in ATTEMPTS:
         least = attempt.transit_hold != TRANSIT_HOLD_RATIO
@@ -349,21 +352,23 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         # robust attempts' box too (its pads' mu is 15% lower at two of them: the stricter rule, as
         # measured).
         transit_hold = (1.0 if task.uncertainty else attempt.transit_hold) if attempt.every_pusher else 0.0
-        result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher)
+        result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher, explain=False)
         elapsed += result.stats["planning_time_s"]
         if not result.solved:
             why = result.message if result.outcome == "unreachable" else result.outcome  # the reason, decided at once
             tried.append(f"{attempt.describe(pusher)}: {why}")
+            ended.append(result.outcome)
             continue
         if not _transits_held(task, result.waypoints, pusher, attempt.transit_hold):
             tried.append(f"{attempt.describe(pusher)}: {_unheld_note(result.pusher_sequence, attempt.transit_hold)}")
+            ended.append("transit")
             continue
         steps, found_by = list(result.waypoints), attempt.describe(pusher)
         break
-    if not steps:
-        tried += _way_back_note(task, measured, loop.final_tolerance, "from here")
+    notes = [] if steps else _way_back_note(task, measured, loop.final_tolerance, "from here")
     record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=bool(steps),
                     pushers=result.pusher_sequence if steps else [], pushes=max(len(steps) - 1, 0),
                     kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3,
-                    trigger=trigger, failure=None if steps else "; ".join(tried), attempt=found_by)
+                    trigger=trigger, failure=None if steps else _summed_up(ended, notes), attempt=found_by,
+                    tried=[] if steps else tried + notes)
     return record, steps

@@ -34,6 +34,7 @@ from stablepush.execution.verdict import success_tolerance as judged_with
 from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.plan.plan import Plan, Waypoint
+from stablepush.plan.verify import check_plan
 from stablepush.task.model import Task
 from stablepush.units import MM, angle_difference_deg
 
@@ -94,7 +95,8 @@ class ExecutionReport:
     planned_final: Sequence[float]  # x mm, z mm, theta deg
     goal: Sequence[float]  # the task's goal, x mm, z mm, theta deg
     # The object in the grasp as the arm reports it (a simulator does): at the end of the last push,
-    # still resting on the pusher, and after the gripper has backed it off the feature.
+    # still resting on the pusher, and at rest after the gripper has backed it off the feature (the
+    # same pose when the run ends on the feature, environment.end_on_feature).
     final_in_grasp: Optional[Dict[str, float]]
     released_in_grasp: Optional[Dict[str, float]] = None
     contacts: List[ContactRecord] = field(default_factory=list)
@@ -108,6 +110,7 @@ class ExecutionReport:
     warnings: List[str] = field(default_factory=list)  # execution_warnings(task)
     engine: Optional[str] = None  # the simulator that ran it, as the arm server says ("mujoco"); None for an arm
     verdict: Optional[Verdict] = None  # whether it landed, and why not (stablepush.execution.verdict)
+    ends_on_feature: bool = False  # the task's environment.end_on_feature: no release at the end
 
     @property
     def success(self) -> Optional[bool]:
@@ -120,23 +123,28 @@ class ExecutionReport:
         return self._error_to(self.planned_final)
 
     @property
+    def landed_in_grasp(self) -> Optional[Dict[str, float]]:
+        """Where the object came to rest in the grasp, the pose the verdict judges: after the
+        release when the arm reports it, else (and on a run that ends on its feature) at the end of
+        the last push."""
+        if self.ends_on_feature or self.released_in_grasp is None:
+            return self.final_in_grasp
+        return self.released_in_grasp
+
+    @property
     def goal_error(self) -> Optional[Dict[str, float]]:
-        """Final pose in the grasp minus the task's goal (the plan may stop within its tolerance)."""
-        return self._error_to(self.goal)
+        """Where the object came to rest in the grasp minus the task's goal (the plan may stop
+        within its tolerance)."""
+        return _error(self.landed_in_grasp, self.goal)
 
     def _error_to(self, pose: Sequence[float]) -> Optional[Dict[str, float]]:
-        if self.final_in_grasp is None:
-            return None
-        dx = self.final_in_grasp["x"] - pose[0]
-        dz = self.final_in_grasp["z"] - pose[1]
-        dth = angle_difference_deg(self.final_in_grasp["theta"], pose[2])
-        return {"x": dx, "z": dz, "theta": dth, "distance": math.hypot(dx, dz)}
+        return _error(self.final_in_grasp, pose)
 
     @property
     def release_change(self) -> Optional[Dict[str, float]]:
         """How the object moved in the grasp when the last feature let go (x, z mm, theta deg): nonzero
         when the grasp alone cannot hold the final pose against gravity."""
-        if self.final_in_grasp is None or self.released_in_grasp is None:
+        if self.final_in_grasp is None or self.released_in_grasp is None or self.ends_on_feature:
             return None
         change = {k: self.released_in_grasp[k] - self.final_in_grasp[k] for k in ("x", "z")}
         return {**change, "theta": angle_difference_deg(self.released_in_grasp["theta"], self.final_in_grasp["theta"])}
@@ -158,12 +166,22 @@ class ExecutionReport:
             "total_steps": self.total_steps, "waypoints": self.waypoints, "planned_final": list(self.planned_final),
             "goal": list(self.goal), "final_in_grasp": self.final_in_grasp, "final_error": self.final_error,
             "goal_error": self.goal_error,
-            "released_in_grasp": self.released_in_grasp, "release_change": self.release_change,
-            "release_moved": self.release_moved, "warnings": list(self.warnings),
+            "released_in_grasp": self.released_in_grasp, "landed_in_grasp": self.landed_in_grasp,
+            "release_change": self.release_change,
+            "release_moved": self.release_moved, "ends_on_feature": self.ends_on_feature,
+            "warnings": list(self.warnings),
             "contacts": [c.__dict__ for c in self.contacts], "features": self.features,
             "wall_time_s": self.wall_time_s, "sim_steps_per_s": self.sim_steps_per_s,
             "closed_loop": self.closed_loop, "guard": self.guard, "replans": [r.as_dict() for r in self.replans],
         }
+
+
+def _error(actual: Optional[Dict[str, float]], pose: Sequence[float]) -> Optional[Dict[str, float]]:
+    """`actual` minus `pose` (x, z mm, theta deg), and the distance mm; None when not measured."""
+    if actual is None:
+        return None
+    dx, dz = actual["x"] - pose[0], actual["z"] - pose[1]
+    return {"x": dx, "z": dz, "theta": angle_difference_deg(actual["theta"], pose[2]), "distance": math.hypot(dx, dz)}
 
 
 def _off_command(reported: Sequence[float], commanded: Sequence[float]) -> bool:
@@ -226,10 +244,10 @@ def execute_plan(
     approaches end where the plan puts the features). The report's verdict judges the final pose with
     `success_tolerance` (mm, deg; default: the task's goal tolerance). `progress(waypoint,
     confirmed_step, total_steps)` is called per ack, and `record(waypoint, state, pusher)` with the
-    arm's state and the pusher in contact (None between contacts; `bags.RunRecording`). `plan`: a
-    plan checked against the task (stablepush.plan.verify.check_plan).
-    PlanError (field `resume_from`) before anything is sent when the plan has no push after it."""
-    steps: List[Waypoint] = list(plan.waypoints)
+    arm's state and the pusher in contact (None between contacts; `bags.RunRecording`).
+    PlanError before anything is sent when the plan does not belong to the task as it is now
+    (stablepush.plan.verify.check_plan) or has no push after `resume_from`."""
+    steps: List[Waypoint] = list(check_plan(task, plan).waypoints)
     check_resume_from(steps, resume_from)
     started = time.perf_counter()
     replans: List[Replan] = []
@@ -331,7 +349,7 @@ def execute_plan(
         contacts=list(contacts.values()), features=[f.as_dict() for f in features.values()],
         wall_time_s=time.perf_counter() - started, sim_steps_per_s=state.get("steps_per_s"),
         closed_loop=loop_status, guard=watch.status, replans=replans, warnings=execution_warnings(task),
-        engine=ready.get("engine"),
+        engine=ready.get("engine"), ends_on_feature=bool(task.environment.get("end_on_feature", False)),
     )
     report.verdict = judge(task, report, success_tolerance, closed_loop.max_replans if closed_loop else None)
     return report

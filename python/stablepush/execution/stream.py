@@ -32,6 +32,9 @@ from stablepush.units import MM
 MOVE_SPEED = 0.1  # m/s of G between contacts
 TURN_SPEED = math.radians(60)  # rad/s of G between contacts
 SETTLE_TIME = 0.2  # s held still at the end of the last push, before the final retract
+# s held still after the final retract: the pads alone hold the object now, and the verdict judges
+# where it comes to rest (stablepush.execution.verdict), not where it is while still sliding.
+RELEASE_TIME = 0.3
 LIFT_MARGIN = 0.02  # m above every feature when the object changes lanes
 # The guarded end of each approach (world.GUARD_SPAN, guard.py) runs at this speed: 0.02 mm of G's
 # travel a waypoint at 100 Hz.
@@ -186,8 +189,9 @@ def arm_trajectory(
                         come_to_rest=i == contact.last)
         current = feature
     stream.hold(SETTLE_TIME, "settle")
-    if current is not None:
+    if current is not None and not env.get("end_on_feature", False):
         stream.move(translation(current.normal * retract) @ stream.pose, "retract")
+        stream.hold(RELEASE_TIME, "retract")
     return stream.points
 
 

@@ -1,15 +1,18 @@
 """The verdict on a run: did the object land at the task's goal in the grasp, and if not, why.
 
-A run lands when the object's pose in the grasp at rest after the last push (`goal_error`) is
-within the tolerance of the goal in each coordinate: |dx|, |dz| <= mm and |dtheta| <= deg, the
-rule by which the planner itself stops (`Task.at_goal`). The tolerance is the task's
-`planner.tolerance` unless the caller gives one. Whether the grasp alone then holds the object
-there when the last feature lets go is a fact of the task (its hold ratio at the goal), reported
-beside the verdict (`ExecutionReport.release_moved`), not folded into it.
+A run lands when the object stays where it was put: its pose in the grasp at rest, held by the
+pads alone after the last feature has let go (`ExecutionReport.landed_in_grasp`), is within the
+tolerance of the goal in each coordinate: |dx|, |dz| <= mm and |dtheta| <= deg, the rule by
+which the planner itself stops (`Task.at_goal`). A task whose run ends on its last feature
+(`environment.end_on_feature`) is judged there, since nothing lets go. The tolerance is the
+task's `planner.tolerance` unless the caller gives one (`execute`, `evaluate` and the API take
+the same override, `success_tolerance`).
 
 A miss is given one cause, the first of CAUSES that applies, so a script can act on it:
 
-- `grasp_lost`: at the final pose some pad is no longer on the object (`grasp_maintained`);
+- `moved_on_release`: the object was within the tolerance on its last feature and the release
+  moved it out: the pads alone do not hold it there against gravity (the plan's `final_hold`);
+- `grasp_lost`: where the object came to rest some pad is no longer on it (`grasp_maintained`);
 - `correction_not_found`: the closed loop was off the plan and found no correction (each re-plan's
   `failure` says why; the plan's own shortfall, found before the first push, is `plan_short`);
 - `corrections_exhausted`: the closed loop made as many corrections as it may and is still off;
@@ -34,8 +37,8 @@ from typing import Dict, Optional, Sequence, Tuple
 from stablepush.task.model import Task
 from stablepush.units import angle_difference_deg, pose_to_si
 
-CAUSES = ("grasp_lost", "correction_not_found", "corrections_exhausted", "feature_off", "pusher_slipped",
-          "plan_short", "drift", "arm_fault", "not_measured")
+CAUSES = ("moved_on_release", "grasp_lost", "correction_not_found", "corrections_exhausted", "feature_off",
+          "pusher_slipped", "plan_short", "drift", "arm_fault", "not_measured")
 # A contact counts as met late or slipped past this fraction of the tolerance (mm at the pusher, deg).
 SLIP_FRACTION = 0.5
 
@@ -83,19 +86,25 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
     """The verdict on a completed run (`ExecutionReport`), judged with `tolerance` (mm, deg; default:
     the task's). `max_replans`: the closed loop's budget, when it ran."""
     tol = success_tolerance(task, tolerance)
-    final = report.final_in_grasp
-    if final is None:
+    final, landed = report.final_in_grasp, report.landed_in_grasp
+    if final is None or landed is None:
         return Verdict(None, tol, "not_measured", "the arm does not report the object in the grasp, so whether "
                                                   "it landed is not known")
-    off = _describe(final, task.goal)
-    if within(final, task.goal, tol):
-        return Verdict(True, tol, None, f"landed {off} from the goal, within {tol[0]:g} mm and {tol[1]:g} deg")
+    off = f"{_offsets(landed, task.goal)} (tolerance {tol[0]:g} mm, {tol[0]:g} mm, {tol[1]:g} deg)"
+    if within(landed, task.goal, tol):
+        return Verdict(True, tol, None, f"landed: {off}")
 
     def miss(cause: str, why: str) -> Verdict:
-        return Verdict(False, tol, cause, f"missed the goal by {off} (tolerance {tol[0]:g} mm, {tol[1]:g} deg): {why}")
+        return Verdict(False, tol, cause, f"missed: {off}: {why}")
 
-    if not task.build_model().grasp_maintained(pose_to_si((final["x"], final["z"], final["theta"]))):
-        return miss("grasp_lost", "a pad is no longer on the object at the final pose")
+    if within(final, task.goal, tol):  # on the feature it was within: the release moved it out
+        change = report.release_change
+        moved = f"{math.hypot(change['x'], change['z']):.2f} mm, {change['theta']:+.2f} deg"
+        return miss("moved_on_release", f"on its last feature it was within the tolerance "
+                                        f"({_offsets(final, task.goal)}); when the feature let go it moved in the "
+                                        f"grasp by {moved}: the pads alone do not hold it there against gravity")
+    if not task.build_model().grasp_maintained(pose_to_si((landed["x"], landed["z"], landed["theta"]))):
+        return miss("grasp_lost", "a pad is no longer on the object where it came to rest")
     failed = [r for r in report.replans if not r.solved and r.trigger != "plan_short"]
     if failed:
         last = failed[-1]
@@ -124,13 +133,14 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
     if not within(planned, task.goal, tol):
         aimed = [r for r in report.replans if r.trigger == "plan_short"]
         why = f" and no plan to the goal was found before the first push ({aimed[0].failure})" if aimed else ""
-        return miss("plan_short", f"the plan itself ends {_describe(planned, task.goal)} from the goal{why}")
+        return miss("plan_short", f"the plan itself ends at {_offsets(planned, task.goal)} from the goal{why}")
     return miss("drift", "no pusher slipped past half the tolerance; the error built up over the run")
 
 
-def _describe(pose: Dict[str, float], goal: Sequence[float]) -> str:
-    return (f"{math.hypot(pose['x'] - goal[0], pose['z'] - goal[1]):.3f} mm, "
-            f"{angle_difference_deg(pose['theta'], goal[2]):+.3f} deg")
+def _offsets(pose: Dict[str, float], goal: Sequence[float]) -> str:
+    """`pose` minus `goal`, each coordinate named: the tolerance is per coordinate, so is the line."""
+    return (f"x {pose['x'] - goal[0]:+.2f} mm, z {pose['z'] - goal[1]:+.2f} mm, "
+            f"theta {angle_difference_deg(pose['theta'], goal[2]):+.2f} deg")
 
 
 def _pair(values: Sequence[float]) -> Tuple[float, float]:

@@ -16,6 +16,7 @@ from stablepush.errors import TaskError
 from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.plan.unreachable import why_unreachable
+from stablepush.task.mechanics import blocked_senses
 from stablepush.task.model import Task, require_task
 from stablepush.task.schema import LIMITS, PLANNER_TUNING, number_field, planner_limit, planner_parameter
 from stablepush.units import MM, pose_from_si, pose_to_si
@@ -39,6 +40,7 @@ def plan_task(
     models: "Optional[List[_core.StablePushModel]]" = None,
     min_transit_hold: float = 0.0,
     start_pusher: Optional[str] = None,
+    explain: bool = True,
 ) -> Plan:
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
     task's planner section (which has defaults for every key). `models` are the task's
@@ -48,7 +50,10 @@ def plan_task(
     factor of its weight in every model; `start_pusher`, the pusher in contact at the start (a
     re-plan from a feature), makes a plan that begins with another pusher a transit at the start.
     A goal that no plan can reach for a reason decided before the search (plan.unreachable) returns
-    at once: outcome `unreachable`, the start alone, the reason in the message.
+    at once: outcome `unreachable`, the start alone, the reason in the message. After a search that
+    ran out of time, `explain` names in the message the senses toward the goal in which no stable
+    push from the start moves the object (_toward_goal: some 0.05 s; the closed loop's re-plans,
+    which read the outcome alone, leave it out).
     TaskError (field `goal`) when the start is already within the tolerance of the goal."""
     require_task(task)
     if task.at_goal(task.start):
@@ -135,8 +140,11 @@ def plan_task(
         stats["path_min_margin"] = s.path_min_margin if solved_once else None
     last = waypoints[-1]
     last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1
+    message = _message(outcome, stats, bool(raw.ends_at_goal))
+    if outcome == "time_limit" and explain:
+        message += _toward_goal(task)
     return Plan(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
-                message=_message(outcome, stats, bool(raw.ends_at_goal)), waypoints=waypoints, stats=stats,
+                message=message, waypoints=waypoints, stats=stats,
                 final_hold_ratio=min(m.hold_ratio(last_q, last_pusher) for m in models),
                 uncertainty=dict(task.uncertainty), ends_at_goal=bool(raw.ends_at_goal),
                 task_identity=task.identity())
@@ -155,6 +163,21 @@ def _unreachable(task: Task, models, settings: dict, reason: str, seconds: float
                 waypoints=[Waypoint(*task.start)], stats=stats,
                 final_hold_ratio=min(m.hold_ratio(start, -1) for m in models), uncertainty=dict(task.uncertainty),
                 ends_at_goal=False, task_identity=task.identity())
+
+
+def _toward_goal(task: Task) -> str:
+    """For a search that ran out of time: the senses of x, z and theta toward the goal, beyond its
+    tolerance, in which no stable push from the start moves the object (mechanics.blocked_senses),
+    with where the goal lies; "" when there is none. Not a proof that the goal is out of reach (a
+    plan may go around, through poses where other pushes are stable): why the search found little."""
+    tol = task.planner["tolerance"]
+    gap = tuple(g - s for g, s in zip(task.goal, task.start))  # theta unwrapped, as the planner turns
+    blocked = blocked_senses(task, task.start, gap, (tol[0], tol[1]))
+    if blocked is None:
+        return ""
+    return (f"; the goal lies at dx {gap[0]:g} mm, dz {gap[1]:g} mm, dtheta {gap[2]:g} deg from the start, and no "
+            f"stable push from there moves the object along {blocked}: a plan must go around, if any can (each "
+            f"pusher's stable pushes from the start: check --directions)")
 
 
 def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:

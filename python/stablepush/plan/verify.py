@@ -23,12 +23,13 @@ MARGIN_SLACK = 1e-9  # N (and weights): the re-check's rounding against the plan
 
 def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_solved: bool = True) -> Plan:
     """`plan`, once it is shown to belong to `task`: solved and ending within the task's tolerance of
-    its goal, for the same task name and start, with pushers the task has, no step longer than the
-    task's unit step, and every push a stable push of this task (at every corner of its uncertainty
-    box, when it has one) with the pads inside the object, each push's margin at least the task's
-    min_margin and, solved, the pads holding min_hold_ratio times the weight at its end. PlanError
-    names what differs (`source`: the plan file, for the message). `require_solved=False` lets an
-    unsolved (partial) plan through, for drawing it."""
+    its goal, for the same task name and start, made for the task as it is now (the plan's
+    recorded Task.identity, where the file has one: changes_since_planned), with pushers the task
+    has, no step longer than the task's unit step, and every push a stable push of this task (at
+    every corner of its uncertainty box, when it has one) with the pads inside the object, each
+    push's margin at least the task's min_margin and, solved, the pads holding min_hold_ratio
+    times the weight at its end. PlanError names what differs (`source`: the plan file, for the
+    message). `require_solved=False` lets an unsolved (partial) plan through, for drawing it."""
     def fail(field: str, reason: str):
         raise PlanError(field, reason, source)
 
@@ -40,6 +41,11 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
         fail("stats", f"must be a mapping, got {type(plan.stats).__name__}")
     if plan.task != task.name:
         fail("task", f"the plan is for task {plan.task[:100]!r}, not {task.name!r}")
+    changes = changes_since_planned(task, plan)
+    if changes:  # its pushes may still pass the re-check below, but not for the reasons it was made
+        more = f" and {len(changes) - 6} more" if len(changes) > 6 else ""
+        fail("task_identity", f"{task.source or 'the task'} changed since the plan was made "
+                              f"({', '.join(changes[:6])}{more}): plan it again")
     if require_solved and not plan.solved:
         fail("solved", f"the plan does not reach the goal ({(plan.message or 'not solved')[:200]})")
     waypoints = plan.waypoints
@@ -116,6 +122,20 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
                  f"the pads hold {held:.3f} times the object's weight at the plan's end, under the task's "
                  f"planner.min_hold_ratio {min_hold:g}")
     return plan
+
+
+def release_note(task: Task, plan: Plan) -> Optional[str]:
+    """What a run of `plan` meets when its last feature lets go, when the pads alone do not hold
+    the object at the plan's end (its `final_hold_ratio` under 1): it moves in the grasp and the
+    run misses (the verdict's `moved_on_release`); None when they hold it, or when the task's run
+    ends on the feature (environment.end_on_feature)."""
+    hold = plan.final_hold_ratio
+    if hold >= 1.0 or task.environment.get("end_on_feature", False) or len(plan.waypoints) < 2:
+        return None
+    return (f"at the plan's last pose the pads alone hold only {hold:.2f} times the object's weight: when the last "
+            f"feature lets go the object moves in the grasp and the run misses (moved_on_release); "
+            f"planner.min_hold_ratio: 1 asks for a pose they hold, environment.end_on_feature: true ends the run "
+            f"on the feature")
 
 
 def changes_since_planned(task: Task, plan: Plan) -> List[str]:

@@ -227,10 +227,13 @@ def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1,
     from stablepush.execution.executor import execute_plan  # the executor is the arm's client, not the rig's
     from stablepush.sim.server import SIM_ACK_TIMEOUT, running_sim_arm
 
-    plan = check_plan(task, plan_task(task, seed=seed))
-    plan = dataclasses.replace(plan, waypoints=plan.waypoints[:pushes + 1])
+    full = check_plan(task, plan_task(task, seed=seed))
+    # The first pushes are a plan of the task whose goal is where they end: the executor runs only
+    # a plan of the task it is given (check_plan).
+    first = dataclasses.replace(task, goal=tuple(full.waypoints[pushes].pose))
+    plan = dataclasses.replace(full, waypoints=full.waypoints[:pushes + 1], task_identity=first.identity())
     with running_sim_arm(log=lambda text: None, engine=engine) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
+        report = execute_plan(first, plan, server.host, server.port, rate_hz=100.0, pace=False,
                               ack_timeout=SIM_ACK_TIMEOUT)
     return ArmPivotResult(pushes=len(plan.waypoints) - 1, error_mm=report.final_error["distance"],
                           error_deg=report.final_error["theta"], steps_per_s=report.sim_steps_per_s)

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import math
-from typing import Dict, Optional, Sequence
+from typing import Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -146,3 +146,31 @@ def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = N
             best = max((sign * u[axis] for u in units), default=None)
             largest[s + label] = None if best is None else float(best)
     return {"unit_step": [step_mm, step_deg], "pushers": out, "largest": largest}
+
+
+# A sense of x, z or theta in which no stable push moves the object by more than this fraction of a
+# unit step counts as one the pushers cannot push it in (the pegs' -x: 0.05, and only while turning).
+NO_WAY_BACK = 0.1
+
+
+def blocked_senses(task: Task, pose: Sequence[float], gap: Sequence[float],
+                   tolerance: Tuple[float, float]) -> Optional[str]:
+    """The senses of x, z and theta in which `gap` (dx mm, dz mm, dtheta deg: where the goal lies
+    from `pose`) is beyond `tolerance` (mm, deg) and no stable unit push from `pose` (x mm, z mm,
+    theta deg) moves the object by more than NO_WAY_BACK of a unit step (stable_directions,
+    headings every 10 deg), each with the largest such push: "-x (none)" (no push moves the object
+    that way), "-x (at most 0.05 of a unit step)"; else None, and None where the pads do not hold
+    the object at `pose`. Not a proof that the goal is out of reach (a plan may go around, through
+    poses with other pushes), but why a search from `pose` finds little."""
+    try:
+        largest = stable_directions(task, pose)["largest"]
+    except TaskError:  # no grasp at the pose: the planner's own refusal says so
+        return None
+    blocked = []
+    for axis, (name, limit) in enumerate(zip(("x", "z", "theta"), (tolerance[0], tolerance[0], tolerance[1]))):
+        sense = ("+" if gap[axis] > 0 else "-") + name
+        if abs(gap[axis]) > limit and (largest[sense] is None or largest[sense] < NO_WAY_BACK):
+            most = ("none" if largest[sense] is None or largest[sense] <= 1e-9  # 1e-9: cos(90 deg)'s rounding
+                    else f"at most {largest[sense]:.2f} of a unit step")
+            blocked.append(f"{sense} ({most})")
+    return ", ".join(blocked) if blocked else None

@@ -246,6 +246,15 @@ class Task:
                                     inertia=None if self.inertia is None else self.inertia * m, uncertainty={})
                 for f in friction for m in masses]
 
+    def goal_hold_ratios(self) -> Dict[str, float]:
+        """Per pusher, `hold_ratio` at the goal with gravity as while that pusher's feature holds
+        the object (the last push's, when the feature lets go), the least over the uncertainty
+        box's corners: below 1 the pads alone do not hold the object there against gravity
+        (docs/model.md section 2, "Holding without a pusher"); +inf without gravity."""
+        q = (self.goal[0] * MM, self.goal[1] * MM, math.radians(self.goal[2]))
+        models = self.corner_models()
+        return {p.name: min(m.hold_ratio(q, i) for m in models) for i, p in enumerate(self.pushers)}
+
     def check_models(self, models: Sequence["_core.StablePushModel"], field: str = "models") -> None:
         """TypeError or ValueError (naming `field[k]`) unless `models` are this task's corner_models(),
         every corner present, in any order: each model must have been built by build_model from what

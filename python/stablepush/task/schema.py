@@ -6,6 +6,7 @@ names the field and the reason, before anything reaches the C++ core.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import datetime
 import math
 import re
@@ -38,6 +39,9 @@ DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
 SNAP_TO_EDGE = 0.05  # mm: a pusher this close to an edge is put on it (a warning says so)
+# mm: a pad radius, retract or spacing under this, or a pusher or world position this near 0 in
+# every coordinate, reads as a length written in metres (the warnings and refusals say so).
+SUB_MM = 1.0
 # Resource caps: each bounds the model's size (and so the time and memory to build it and to
 # test a push) before anything reaches the core. docs/limits.md, "Limits".
 MAX_TASK_BYTES = 1_000_000
@@ -76,6 +80,9 @@ ENVIRONMENT_DEFAULTS: Dict[str, Any] = {
     "retract": 20.0,  # how far the object backs off a feature before moving to the next
     "station_spacing": 150.0,  # default features sit this far apart along y
     "lane_offset": 75.0,  # moves between features run this far along y from a feature
+    # True: the run ends with the object resting on its last feature (no final retract), and the
+    # verdict judges it there; false: the pads alone must hold it where it was put.
+    "end_on_feature": False,
 }
 
 # TRRTstar's declared parameters and their ranges live in the C++ planner (declared once there;
@@ -220,8 +227,18 @@ def _number(path: str, value: Any, within: Optional[Tuple[float, float]] = None)
     if not math.isfinite(x):
         raise TaskError(path, f"must be finite, got {_shown(value)}")
     if within is not None and not within[0] <= x <= within[1]:
-        raise TaskError(path, f"must be between {within[0]:g} and {within[1]:g}, got {x:g}")
+        # A positive length under the least one is a length in metres (every length field takes LIMITS["length"]).
+        slip = _in_metres(x) if tuple(within) == LIMITS["length"] and 0.0 < x < within[0] else ""
+        raise TaskError(path, f"must be between {within[0]:g} and {within[1]:g}, got {x:g}{slip}")
     return x
+
+
+def _in_metres(value: Any) -> str:
+    """The hint for a length, a point or points in mm that read as metres: "(0.006 m is 6 mm)"."""
+    def shown(v: Any, k: float) -> str:
+        return f"{v * k:g}" if isinstance(v, (int, float)) else "[" + ", ".join(shown(c, k) for c in v) + "]"
+
+    return f"; written in metres? task files use mm ({shown(value, 1.0)} m is {shown(value, 1e3)} mm)"
 
 
 # The least positive friction coefficient: below it the cones' rows underflow (a mu of 1e-170
@@ -405,7 +422,9 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
     sides = _integer("dynamics.friction_polygon_sides", dyn.get("friction_polygon_sides", DEFAULT_POLYGON_SIDES), 3,
                      MAX_POLYGON_SIDES)
 
-    pushers = _validate_pushers(top["pushers"], section, notes)
+    # A unit slip the refusals below explain: the object, or a pusher, in metres.
+    units = _units_hint(vertices, thickness, top["object"])
+    pushers = _validate_pushers(top["pushers"], section, notes, units)
     start = pose_field("start", top["start"])
     goal = pose_field("goal", top["goal"])
     gripper = make_gripper(pads, grip_force, mu, pad_rings)
@@ -416,7 +435,7 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
             if not ok:
                 where = f"gripper.pads[{i}]" if "pads" in grip else "gripper (default pads)"
                 raise TaskError(label, f"{where} does not lie inside the object at the {label} pose {list(q)}"
-                                + _units_hint(vertices, thickness, top["object"]))
+                                + units)
 
     planner = _validate_planner(top.get("planner", {}))
     uncertain = _mapping("uncertainty", top.get("uncertainty", {}), [], list(UNCERTAIN))
@@ -432,13 +451,46 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
                          f"x grip force and with mass; "
                          f"a width in pusher_mu alone is fine): plans will not use it")
     environment = _validate_environment(top.get("environment", {}), [p.name for p in pushers])
-    return Task(
+    # Pads in metres on an object in metres: the object's own warning says so.
+    notes.extend(_sub_millimetre(pads if "pads" in grip and not units else (), environment))
+    notes.extend(_in_radians([("start", start), ("goal", goal)], planner["tolerance"][1]))
+    task = Task(
         name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
         grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
         friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner,
         environment=environment, source=source, pushes=pushes, uncertainty=uncertainty,
         warnings=tuple(notes + _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity)),
     )
+    if goal_in_grasp and not environment["end_on_feature"]:
+        task = dataclasses.replace(task, warnings=task.warnings + tuple(goal_hold_warnings(task)))
+    return task
+
+
+def goal_hold_warnings(task: Task) -> List[str]:
+    """What to change when the pads alone cannot hold the object at the goal (Task.goal_hold_ratios):
+    a run releases it there and it moves (the verdict's `moved_on_release`). Empty when they hold
+    it whichever pusher pushes last, or when planner.min_hold_ratio >= 1 already makes the plan end
+    where they do."""
+    ratios = task.goal_hold_ratios()
+    weak = {name: r for name, r in ratios.items() if r < 1.0}
+    if not weak:
+        return []
+    box = " (at the least favourable corner of the uncertainty box)" if any(task.uncertainty.values()) else ""
+    best = max(ratios.values())
+    if best < 1.0:
+        # hold_ratio is linear in pad mu x grip force (the friction that balances the weight scales
+        # with it): the force that holds, rounded up to 0.1 N so that it does
+        grip = math.ceil(task.grip_force / best * 10.0) / 10.0
+        return [f"goal: the pads alone hold only {best:.2f} times the object's weight at the goal{box}: when the "
+                f"last feature lets go the object moves in the grasp and the run misses (moved_on_release). "
+                f"Grip harder (gripper.grip_force {grip:g} N or more), choose a goal where "
+                f"the pads hold it, or end the run on the feature (environment.end_on_feature: true)"]
+    if float(task.planner["min_hold_ratio"]) >= 1.0:
+        return []
+    return [f"goal: the pads alone hold the object at the goal only when the last push is by "
+            f"{', '.join(n for n in ratios if n not in weak)}{box}; a plan that ends with "
+            f"{', '.join(weak)} leaves it to move on release (moved_on_release): planner.min_hold_ratio: 1 "
+            f"makes the plan end where they hold it"]
 
 
 def _default_name(source: Optional[str]) -> str:
@@ -504,6 +556,46 @@ def _com_outside(vertices, com) -> List[str]:
     return [f"object.com: {list(com)} mm lies {off:.3g} mm outside the object's outline (its convex hull), where "
             f"no solid of this section has its centre of mass; right only for a part that reaches beyond the "
             f"section along y (com is in mm, in O)"]
+
+
+def _sub_millimetre(pads, environment: Dict[str, Any]) -> List[str]:
+    """Warnings for lengths in range but under SUB_MM where a cell's are millimetres to metres (a
+    pad's radius, the retract and spacings, world positions near 0 in every coordinate): each
+    reads as written in metres."""
+    out = [f"gripper.pads[{i}].radius: {radius:g} mm" + _in_metres(radius)
+           for i, (_, radius) in enumerate(pads) if radius < SUB_MM]
+    out += [f"environment.{key}: {environment[key]:g} mm" + _in_metres(environment[key])
+            for key in ("retract", "station_spacing", "lane_offset") if environment[key] < SUB_MM]
+    places = [("environment.home", environment["home"])]
+    places += [(f"environment.features.{name}", pose[:3]) for name, pose in environment["features"].items()]
+    out += [f"{path}: [{', '.join(f'{v:g}' for v in p)}] mm" + _in_metres(p)
+            for path, p in places if any(p) and max(map(abs, p)) < SUB_MM]
+    return out
+
+
+# An angle written in radians (task files use degrees) is warned about only where no one writes the
+# value in degrees, so that a deliberate small turn is not. It is nonzero, at most 2 pi (a radian
+# value) and not a whole number of degrees (a turn written in degrees nearly always is), and either
+# - in radians it is a round angle: within RADIAN_ROUNDING of a multiple of 5 deg (0.26 is 14.9 deg,
+#   0.785 is 45.0, 1.57 is 90.0, 3.14 is 179.9). RADIAN_ROUNDING covers radians rounded to two
+#   decimals (off by at most 0.005 rad, 0.29 deg); of the values of one decimal, written in degrees,
+#   only 0.7, 1.4, 3.4, 4.1, 4.8, 5.5 and 6.2 lie that near one; or
+# - it lies within planner.tolerance's angle of 0: in degrees, a turn the planner cannot tell from
+#   none, a fraction nobody writes on purpose.
+RADIAN_ROUNDING = 0.3  # deg
+
+
+def _in_radians(poses, tolerance: float) -> List[str]:
+    """Warnings for the poses' angles (label, (x, z, theta)) that read as written in radians; `tolerance`
+    is planner.tolerance's angle [deg]."""
+    out = []
+    for label, (_, _, theta) in poses:
+        degrees = math.degrees(theta)
+        round_angle = abs(degrees - 5.0 * round(degrees / 5.0)) <= RADIAN_ROUNDING and abs(degrees) >= 2.5
+        if 0.0 < abs(theta) <= 2.0 * math.pi and theta != round(theta) and (round_angle or abs(theta) <= tolerance):
+            out.append(f"{label}[2]: {theta:g} deg; written in radians? ({theta:g} rad is {degrees:.3g} deg; "
+                       f"task files use degrees)")
+    return out
 
 
 MESH_KEYS = ["file", "scale", "plane_y", "tolerance", "density"]
@@ -598,7 +690,10 @@ def _mesh_object(obj: dict, source: Optional[str], notes: List[str]):
     return mesh.vertices, mesh.thickness, mesh.mass, com, inertia
 
 
-def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str]) -> Tuple[PusherSpec, ...]:
+def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str],
+                      units: str = "") -> Tuple[PusherSpec, ...]:
+    """The pushers, each on the object's boundary. `units`: _units_hint's for the object, added to
+    a pusher's refusal (a mesh in metres puts every pusher in mm far off it)."""
     if not isinstance(value, list) or not value:
         raise TaskError("pushers", "must be a non-empty list")
     if len(value) > MAX_PUSHERS:
@@ -635,7 +730,9 @@ def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str
         try:
             _core.Pusher.on_boundary(section, name, mm2_to_si(a), mm2_to_si(b), mu, points)
         except ValueError as exc:
-            raise TaskError(path, str(exc)) from None
+            # Ends within a millimetre of O's origin, on an object larger than that: a pusher in metres.
+            slip = units or (_in_metres(a if a == b else [a, b]) if max(map(abs, a + b)) <= SUB_MM else "")
+            raise TaskError(path, str(exc) + slip) from None
         specs.append(PusherSpec(name=name, a=a, b=b, mu=mu, points=points))
     return tuple(specs)
 
@@ -649,6 +746,8 @@ def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Dict[str, 
     out["home"] = list(_vector("environment.home", out["home"], 3, COORDINATE))
     for key in ("retract", "lane_offset", "station_spacing"):
         out[key] = _number(f"environment.{key}", out[key], LIMITS["length"])
+    if not isinstance(out["end_on_feature"], bool):
+        raise TaskError("environment.end_on_feature", f"must be true or false, got {out['end_on_feature']!r:.40}")
     features = env.get("features", {})
     if not isinstance(features, dict):
         raise TaskError("environment.features", "must map pusher names to [x, y, z, theta] (mm, deg)")

@@ -30,6 +30,7 @@ from stablepush.execution.world import contacts_of
 from stablepush.frames import in_gripper
 from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_atomically
 from stablepush.plan.plan import Plan, Waypoint
+from stablepush.plan.verify import check_plan
 from stablepush.task.model import Task
 
 MAX_SNAPSHOTS = 6
@@ -105,9 +106,10 @@ def plan_title(task: Task, plan: Plan) -> str:
 def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
     """The plan in the grasp: snapshots above, x, z, theta against step below; `title` defaults to
     plan_title. The last snapshot is labelled "goal", or "end" for a plan that does not reach it.
-    `plan`: checked against the task (stablepush.plan.verify.check_plan). A plan of the start
-    alone (no push found, or the start already within the tolerance) is one panel: nothing moves."""
-    steps = plan.waypoints
+    `plan` is checked against the task first (stablepush.plan.verify.check_plan; unsolved plans
+    too, PlanError if it is not this task's). A plan of the start alone (no push found, or the
+    start already within the tolerance) is one panel: nothing moves."""
+    steps = check_plan(task, plan, require_solved=False).waypoints
     title = plan_title(task, plan) if title is None else title
     # A plan that stops short also shows the goal it did not reach (in red, at its end).
     limits = _limits(task, list(steps) + ([] if plan.solved else [Waypoint(*task.goal)]))
@@ -177,7 +179,7 @@ def save_plan_gif(task: Task, plan: Plan, path: str, max_frames: int = 80) -> No
     """The plan animated, one frame per step (thinned to at most `max_frames`); `plan` as for
     plan_figure. OutputError unless `path` ends in .gif."""
     require_suffix("the animation", path, (".gif",))
-    steps = plan.waypoints
+    steps = check_plan(task, plan, require_solved=False).waypoints
     fig = Figure(figsize=(4, 4))
     ax = fig.subplots()
     limits = _limits(task, steps)
