@@ -137,6 +137,10 @@ def test_a_goal_the_pads_cannot_hold_is_told_at_load_with_what_to_change():
     assert "a plan that ends with left, right" in warning and "planner.min_hold_ratio: 1" in warning
     asked = parse_task(turned_text.replace("tolerance: [0.5, 0.5]", "tolerance: [0.5, 0.5]\n  min_hold_ratio: 1"))
     assert not any(w.startswith("goal:") for w in asked.warnings)
+    # Pads without friction hold nothing, and no grip force helps (the fuzz campaign's mu 0).
+    frictionless = parse_task(task_text("horizontal-offset-high-mu").replace("end_on_feature: true", "end_on_feature: false")
+                              .replace("mu: 0.425", "mu: 0"))
+    assert any("no grip force does: the pads hold nothing with gripper.mu 0" in w for w in frictionless.warnings)
     with pytest.raises(TaskError, match="environment.end_on_feature: must be true or false"):
         parse_task(task_text("horizontal-offset-high-mu").replace("end_on_feature: true", "end_on_feature: 1"))
 

@@ -480,10 +480,11 @@ def goal_hold_warnings(task: Task) -> List[str]:
     if best < 1.0:
         # hold_ratio is linear in pad mu x grip force (the friction that balances the weight scales
         # with it): the force that holds, rounded up to 0.1 N so that it does
-        grip = math.ceil(task.grip_force / best * 10.0) / 10.0
+        grip = (f"gripper.grip_force {math.ceil(task.grip_force / best * 10.0) / 10.0:g} N or more" if best > 0.0
+                else "no grip force does: the pads hold nothing with gripper.mu 0")
         return [f"goal: the pads alone hold only {best:.2f} times the object's weight at the goal{box}: when the "
                 f"last feature lets go the object moves in the grasp and the run misses (moved_on_release). "
-                f"Grip harder (gripper.grip_force {grip:g} N or more), choose a goal where "
+                f"Grip harder ({grip}), choose a goal where "
                 f"the pads hold it, or end the run on the feature (environment.end_on_feature: true)"]
     if float(task.planner["min_hold_ratio"]) >= 1.0:
         return []
