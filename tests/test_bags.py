@@ -166,6 +166,10 @@ def test_a_stamp_is_unix_seconds_or_iso_8601_with_its_zone(tmp_path):
                                           str(tmp_path / out), "--stamp", bad])
         assert result.exit_code == 2 and "--stamp" in result.output and not (tmp_path / out).exists()
         assert ("no zone" if out == "t.mcap" else "only with a .mcap") in result.output
+    # execute's --stamp is its recording's start: without --record it would be dropped silently
+    result = CliRunner().invoke(cli, ["execute", str(tmp_path / "t.plan.json"), "--task", task_file, "--sim",
+                                      "--stamp", START])
+    assert result.exit_code == 2 and "--stamp: only with --record" in result.output
 
 
 def test_tf_static_holds_each_features_frame_once_transient_local(now_bag):

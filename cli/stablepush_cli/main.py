@@ -838,6 +838,8 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     from stablepush.outputs import require_suffix, write_atomically
 
     require_suffix("--record", record_path, (".mcap",))
+    if stamp_ns is not None and not record_path:
+        _fail("--stamp: only with --record (it is the recording's start time)")
     _check_outputs({"--json": json_path, "--record": record_path, "--video": video_path},
                   {"PLAN.json": plan_file, "--task": task_file})
     task, plan = _load_plan_and_task(plan_file, task_file)
