@@ -6,8 +6,9 @@ the tasks of data/tasks/more, which nothing was tuned for.
     python3 benchmarks/execute_shipped.py [TASK.yaml ...] [--seed 1] [--mu-scale 1 0.85 1.15] [--closed-loop]
                                           [--success-tolerance MM DEG] [--engine mujoco drake] [--no-guard]
 
-The verdict column is the run's (stablepush.execution.verdict): landed within the task's goal
-tolerance, or --success-tolerance, or missed and why. Approaches are guarded (the executor's
+The verdict column is the run's (stablepush.execution.verdict): landed where the object came to
+rest after the release (the goal error's pose), within the task's goal tolerance, or
+--success-tolerance, or missed and why. Approaches are guarded (the executor's
 default: each feature found by touch) unless --no-guard.
 """
 import argparse
@@ -61,12 +62,14 @@ def _run(task, plan, mu_scale: float, loop, tolerance, engine: str, guard) -> No
     replans = f"{sum(r.solved for r in report.replans)}" + (f" (+{sum(not r.solved for r in report.replans)} failed)"
                                                             if any(not r.solved for r in report.replans) else "")
     slip = max(report.contacts, key=lambda c: c.slip_mm)
-    release = report.release_change
+    release = report.release_change  # None: the run ends on its feature (environment.end_on_feature)
+    released = "on its feature" if release is None else \
+        f"{math.hypot(release['x'], release['z']):.2f} / {release['theta']:+.2f}"
     print(f"| {task.name} | {engine} | x{mu_scale:g} | {'closed' if loop else 'open'} | {report.total_steps} "
           f"| {' → '.join(c.pusher for c in report.contacts)} "
           f"| {err['distance']:.2f} | {err['theta']:+.2f} | {goal['distance']:.2f} / {goal['theta']:+.2f} | {replans} "
           f"| {slip.slip_mm:.2f} ({slip.slip_deg:.2f}) "
-          f"| {math.hypot(release['x'], release['z']):.2f} / {release['theta']:+.2f} "
+          f"| {released} "
           f"| {'landed' if report.success else 'missed: ' + str(report.verdict.cause)} "
           f"| {report.sim_steps_per_s:.0f} | {report.wall_time_s:.1f} |", flush=True)
 

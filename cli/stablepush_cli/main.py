@@ -1140,6 +1140,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
 
     \b
     Examples:
+      stablepush evaluate data/tasks/t-shaped.yaml --trials 100   # a lab's spreads, judged by the task's tolerance
       stablepush evaluate data/tasks/pivoting.yaml --trials 200 --vary pad_mu=0.15 --vary pusher_mu=0.15 \\
           --vary grip_force=0.1 --vary mass=0.05 --feature-error 0.5 0.5 --json piv.eval.json --plot piv.png
       stablepush evaluate data/tasks/t-shaped.yaml --trials 1000 --closed-loop --vary pad_mu=0.15 --ray
