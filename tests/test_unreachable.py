@@ -294,7 +294,7 @@ def test_a_start_with_a_stable_push_is_never_called_stuck(name):
     task = shipped(name)
     model = task.build_model()
     step = task.planner["step"]
-    found = 0
+    sampled = 0  # random poses and directions where the core found a stable push
     for _ in range(30):
         q = pose_to_si(tuple(np.array(task.start) + rng.normal(0.0, [3.0, 3.0, 15.0])))
         if not model.grasp_maintained(q):
@@ -305,14 +305,16 @@ def test_a_start_with_a_stable_push_is_never_called_stuck(name):
                 d /= np.linalg.norm(d)
                 dq = _core.Motion(d[0] * step[0] * 1e-3, d[1] * step[0] * 1e-3, math.radians(d[2] * step[1]))
                 if model.check(q, dq, pusher).feasible:
-                    found += 1
+                    sampled += 1
                     assert U._may_push(task, model, q, pusher), (name, q, pusher)
                     break
     plan = plan_task(task, seed=1)
+    assert plan.solved and len(plan.waypoints) > 1, name  # every push of a plan is a case of the property
     for before, push in zip(plan.waypoints, plan.waypoints[1:]):
-        found += 1
         assert U._may_push(task, model, pose_to_si(before.pose), task.pusher_index(push.pusher)), (name, before)
-    assert found > len(plan.waypoints) - 1 or any(p.is_point for p in task.pushers)
+    # Random directions miss a point pusher's surface of stable pushes; every line pusher's cone is
+    # met by some of them, so the random cases must have run too.
+    assert (sampled > 0) == any(not p.is_point for p in task.pushers), (name, sampled)
 
 
 # The bar over a ledge under its middle, pads that carry a tenth of its weight, pushed by a moving
