@@ -35,8 +35,10 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check --upgrade pip
 
-extra=""
-$test_extras && extra="[test]"
+# Every optional part (pyproject.toml's extras: the simulators, Ray, ROS bags, video) besides the
+# planner, so that every command and test runs; `pip install .` alone plans, checks, draws and exports.
+extra="[all]"
+$test_extras && extra="[all,test]"
 echo "setup: building and installing stablepush${extra} into $venv (a few minutes the first time)" >&2
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check ".${extra}"
 echo "setup: done; run $venv/bin/stablepush, or activate with: . $venv/bin/activate" >&2

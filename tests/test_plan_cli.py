@@ -182,3 +182,33 @@ def test_a_long_search_shows_one_bar_on_a_terminal_and_none_in_a_pipe(tmp_path):
     shown = _on_a_terminal(*args)
     assert "horizontal-offset-high-mu: searching (time limit 2 s)" in shown and "not solved" in shown, shown
     assert "searching" not in _on_a_terminal(*args, "--quiet")
+
+
+OPTIONAL = ("mujoco", "pydrake", "ray", "rosbags", "imageio_ffmpeg")  # stablepush.extras.EXTRAS' packages
+
+
+def _without(packages, *args, cwd=None):
+    """`stablepush ARGS` in a Python where `packages` cannot be imported, as where the extras that
+    bring them were not installed."""
+    code = (f"import sys\nfor name in {list(packages)!r}: sys.modules[name] = None\n"
+            "from stablepush_cli.main import main\nsys.argv = ['stablepush'] + sys.argv[1:]\nmain()")
+    return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=cwd)
+
+
+def test_planning_needs_no_optional_part_and_a_command_that_needs_one_names_it(tmp_path):
+    """pip install stablepush plans, checks, draws and exports CSV/JSON; the simulators, Ray, ROS
+    bags and video are extras, and a command that needs a missing one says which (exit 2)."""
+    plan, csv_path, png = tmp_path / "p.json", tmp_path / "t.csv", tmp_path / "p.png"
+    for args in (("plan", LOW_MU, "-o", str(plan)), ("check", LOW_MU, "--move", "1", "0", "0"),
+                 ("show", str(plan), "--task", LOW_MU, "-o", str(png)),
+                 ("trajectory", str(plan), "--task", LOW_MU, "-o", str(csv_path))):
+        r = _without(OPTIONAL, *args)
+        assert r.returncode == 0, (args, r.stderr)
+    assert png.stat().st_size > 0 and csv_path.stat().st_size > 0
+    for missing, args, extra in (
+            ("mujoco", ("execute", str(plan), "--task", LOW_MU, "--sim", "--quiet"), "sim"),
+            ("rosbags", ("trajectory", str(plan), "--task", LOW_MU, "-o", str(tmp_path / "t.mcap")), "ros"),
+            ("pydrake", ("execute", str(plan), "--task", LOW_MU, "--sim", "--engine", "drake", "--quiet"), "drake")):
+        r = _without([missing], *args)
+        assert r.returncode == 2, (missing, r.stderr)
+        assert f"pip install 'stablepush[{extra}]'" in r.stderr and "Traceback" not in r.stderr, r.stderr

@@ -14,6 +14,7 @@ import click
 
 from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, StablepushError, TaskError
 from stablepush.execution.protocol import DEFAULT_PORT
+from stablepush.extras import MissingExtra
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import HEADING_STEP_DEG, check_push, load_task, stable_directions
 from stablepush.task.schema import LIMITS, PLANNER_PARAMETER_RANGES
@@ -30,6 +31,7 @@ EXIT_STATUS = (
     (PlanError, EXIT_BAD_INPUT),
     (OutputError, EXIT_BAD_INPUT),
     (RunnerError, EXIT_BAD_INPUT),
+    (MissingExtra, EXIT_BAD_INPUT),  # an optional part of the package that the command needs
     (ArmFault, EXIT_ARM_FAULT),
 )
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Iterable, Iterator, Optional, Tuple
 
 from stablepush.errors import RunnerError
+from stablepush.extras import require
 
 Job = Callable[[Any, int], Any]
 # How long joining a Ray cluster may wait for its head to answer: Ray itself retries for minutes.
@@ -110,7 +111,7 @@ def _processes(job: Job, shared: Any, indices: list, workers: int) -> Iterator[T
 
 
 def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterator[Tuple[int, Any]]:
-    import ray
+    ray = require("ray", "--ray")
 
     started_here = not ray.is_initialized()
     if started_here:

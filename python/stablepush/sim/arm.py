@@ -12,13 +12,12 @@ import time
 from dataclasses import dataclass
 from typing import Callable, Dict, Optional, Sequence, Tuple
 
-import mujoco
 import numpy as np
 
 from stablepush.frames import angle_about_y, matrix_to_pose, pose_to_matrix, rot_y
 from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
-from stablepush.sim.friction import CoulombPadFriction
+from stablepush.sim.friction import CoulombPadFriction, mujoco
 
 SETTLE_TIME = 0.3  # s of simulation after the grasp closes, before the first waypoint
 

@@ -35,6 +35,7 @@ from typing import Callable, Dict, Sequence
 
 import numpy as np
 
+from stablepush.extras import require
 from stablepush.frames import pose_to_matrix
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.arm import SETTLE_TIME, TrackingArm, WorldDeviation, in_grasp
@@ -62,9 +63,7 @@ def partner_mu(mu: float, object_mu: float = OBJECT_MU) -> float:
 
 def _drake():
     """pydrake's names, imported on first use: the MuJoCo engine never loads Drake."""
-    import pydrake.all as drake
-
-    return drake
+    return require("pydrake.all", "--engine drake")
 
 
 def _vector(text: str) -> np.ndarray:

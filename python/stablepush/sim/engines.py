@@ -16,6 +16,17 @@ def check_engine(engine: str) -> str:
     return engine
 
 
+def load_engine(engine: str) -> str:
+    """`engine`, checked and its package imported (stablepush.extras.MissingExtra naming the extra
+    to install when it is not there)."""
+    from stablepush.extras import require
+
+    if check_engine(engine) == "drake":
+        require("pydrake.all", "--engine drake")
+    require("mujoco", "the simulated arm (execute --sim, evaluate, sim-arm)")  # Drake's arm reads MuJoCo's MJCF
+    return engine
+
+
 def make_arm(engine: str, scene: dict, deviation=None):
     """The simulated arm of `scene` on `engine` (SimArm or DrakeArm), in the world `deviation`
     (an `arm.WorldDeviation`; None: the task's own)."""

@@ -41,10 +41,14 @@ from __future__ import annotations
 
 from typing import Sequence
 
-import mujoco
 import numpy as np
 
-from stablepush.sim import _pad_friction
+from stablepush.extras import require
+
+# Before _pad_friction, which links against MuJoCo's library: without the package, the extra to install.
+mujoco = require("mujoco", "the simulated arm (execute --sim, evaluate, sim-arm)")
+
+from stablepush.sim import _pad_friction  # noqa: E402
 
 SLIDE_SPEED = 5e-4  # m/s: a pad point slipping faster than this (SLIDE_STEPS steps running) may slide
 STICK_SPEED = 1e-4  # m/s: a sliding pad point whose slip falls below this sticks again

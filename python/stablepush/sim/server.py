@@ -18,7 +18,7 @@ from typing import Any, Callable, Iterator, Optional
 
 from stablepush.execution.protocol import LineReader, ProtocolError, decode, encode
 from stablepush.sim.arm import WorldDeviation
-from stablepush.sim.engines import DEFAULT_ENGINE, check_engine, make_arm
+from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
 from stablepush.sim.scene import simulated_outline
 from stablepush.task.schema import MAX_PAD_RINGS, MAX_PADS, MAX_PUSHERS, MAX_VERTICES
 
@@ -64,7 +64,9 @@ class SimArmServer:
         self.exit_after = exit_after  # fault injection: die abruptly after this many waypoints
         self.deviation = deviation  # how the simulated world departs from each task's model
         self.idle_timeout = idle_timeout
-        self.engine = check_engine(engine)  # the physics engine every session's world is built on
+        # The physics engine every session's world is built on, loaded here: a missing one is the
+        # caller's to hear of (MissingExtra), not a hello's that fails later in the server's thread.
+        self.engine = load_engine(engine)
         self.arm = None
         self._scene: Optional[dict] = None
         self._waypoints = 0

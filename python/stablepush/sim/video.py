@@ -49,6 +49,7 @@ import numpy as np
 from stablepush.errors import OutputError
 from stablepush.execution.bags import RunSample
 from stablepush.execution.world import place_features, scene_description
+from stablepush.extras import require
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, quat_about_y
 from stablepush.plan.plan import Plan
 from stablepush.sim.scene import add_object_geoms, feature_geom, feature_solid, mjcf_numbers, simulated_outline
@@ -147,6 +148,8 @@ def _mujoco():
     try:
         import mujoco
     except (ImportError, AttributeError, OSError) as exc:  # PyOpenGL cannot load libOSMesa
+        if isinstance(exc, ModuleNotFoundError) and (exc.name or "").split(".")[0] == "mujoco":
+            require("mujoco", "a video")  # not installed at all: the extra to install, not OSMesa
         raise OutputError(f"cannot load MuJoCo's headless renderer with MUJOCO_GL={os.environ.get('MUJOCO_GL')} "
                           f"({type(exc).__name__}: {exc}); videos need the Debian package libosmesa6 "
                           f"(apt-get install libosmesa6, or bash scripts/setup.sh)") from None
@@ -154,12 +157,7 @@ def _mujoco():
 
 
 def _encoder():
-    try:
-        import imageio_ffmpeg
-    except ImportError:
-        raise OutputError("videos need the Python package imageio-ffmpeg (pip install imageio-ffmpeg; "
-                          "a dependency of stablepush)") from None
-    return imageio_ffmpeg
+    return require("imageio_ffmpeg", "a video")
 
 
 def _headless_gl(mujoco) -> None:
