@@ -698,6 +698,8 @@ def _check_video(option: str, path: str, fps: float, size) -> None:
         check_video_path(path)
     except OutputError as exc:
         _fail(f"{option} {exc}")
+    except MissingExtra as exc:
+        _fail(f"{option}: {exc}")
 
 
 def _write_video(path: str, task, scene: dict, recording, fps: float, size, quiet: bool) -> None:
