@@ -1158,7 +1158,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
     from stablepush.evaluation import Batch, Spreads, robust_task, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
-    from stablepush.plan import check_plan, plan_task
+    from stablepush.plan import plan_task
     from stablepush.runners import default_workers
 
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
@@ -1186,7 +1186,6 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
         if not plan.solved:
             click.echo(f"{task.name}{' (robust)' if robust else ''}: {plan.message}", err=True)
             sys.exit(EXIT_NOT_SOLVED)
-        plan = check_plan(task, plan)
     if video_dir:
         from stablepush.sim.video import video_directory
 
@@ -1199,7 +1198,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
                   video_size=tuple(video_size))
     for warning in batch.warnings():
         click.echo(f"warning: {warning}", err=True)
-    trials = 1 if spreads.one_world else trials  # evaluate() runs one: the bar says so too
+    trials = spreads.trials_to_run(trials)  # as evaluate() runs them: the bar and the header say so too
     if not quiet:
         box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
         worlds = ("one world, the model's own (nothing varies)" if spreads.one_world else

@@ -181,7 +181,7 @@ def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
     (KeyboardInterrupt) stops the batch and keeps the trials done (`interrupted`). When every world
     is the model's own (Spreads.one_world) one trial says all there is: it alone runs, and the
     summary gives no interval."""
-    trials = 1 if batch.spreads.one_world else trials
+    trials = batch.spreads.trials_to_run(trials)
     source = run_all(run_trial, batch, range(trials), runner)
     started = time.perf_counter()
     done: List[dict] = []

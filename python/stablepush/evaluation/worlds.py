@@ -67,6 +67,11 @@ class Spreads:
         tracker is exact, so every trial runs the same world (a study of one)."""
         return not any(self.vary.values()) and not any(self.feature_error) and not any(self.tracker_noise)
 
+    def trials_to_run(self, requested: int) -> int:
+        """How many of `requested` trials a study of these spreads runs: one for one world, where
+        every trial would run the same world, else all."""
+        return 1 if self.one_world else requested
+
 
 @dataclass(frozen=True)
 class TrialWorld:

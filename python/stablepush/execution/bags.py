@@ -180,9 +180,9 @@ def _mcap(path: Union[str, Path], topics: dict):
     """A ROS 2 bag of `topics` (name -> message type) being written: yields the message types
     (Humble's) and write(topic, stamp ns, message); on leaving, the bag's MCAP file is moved to
     `path` whole (rosbag2 writes a directory; its metadata lives in the MCAP file too)."""
-    rosbag2, typesys = require("rosbags.rosbag2", "a ROS 2 bag"), require("rosbags.typesys", "a ROS 2 bag")
-    StoragePlugin, Writer, Stores, get_typestore = rosbag2.StoragePlugin, rosbag2.Writer, typesys.Stores, \
-        typesys.get_typestore
+    require("rosbags", "a ROS 2 bag")  # the extra to install, when it is missing
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE)
     path = Path(path)

@@ -120,7 +120,7 @@ class ExecutionReport:
     @property
     def final_error(self) -> Optional[Dict[str, float]]:
         """Final pose in the grasp minus the plan's: x, z mm, theta deg, and the distance mm."""
-        return self._error_to(self.planned_final)
+        return _error(self.final_in_grasp, self.planned_final)
 
     @property
     def landed_in_grasp(self) -> Optional[Dict[str, float]]:
@@ -136,9 +136,6 @@ class ExecutionReport:
         """Where the object came to rest in the grasp minus the task's goal (the plan may stop
         within its tolerance)."""
         return _error(self.landed_in_grasp, self.goal)
-
-    def _error_to(self, pose: Sequence[float]) -> Optional[Dict[str, float]]:
-        return _error(self.final_in_grasp, pose)
 
     @property
     def release_change(self) -> Optional[Dict[str, float]]:

@@ -16,7 +16,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from stablepush import _core
 from stablepush.errors import TaskError
-from stablepush.units import MM, G, is_real, mm2_to_si
+from stablepush.units import MM, G, is_real, mm2_to_si, pose_to_si
 
 # How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
 # (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
@@ -251,7 +251,7 @@ class Task:
         the object (the last push's, when the feature lets go), the least over the uncertainty
         box's corners: below 1 the pads alone do not hold the object there against gravity
         (docs/model.md section 2, "Holding without a pusher"); +inf without gravity."""
-        q = (self.goal[0] * MM, self.goal[1] * MM, math.radians(self.goal[2]))
+        q = pose_to_si(self.goal)
         models = self.corner_models()
         return {p.name: min(m.hold_ratio(q, i) for m in models) for i, p in enumerate(self.pushers)}
 
