@@ -2,7 +2,7 @@
 
     python benchmarks/bench_checks.py [TASK.yaml] [-n CHECKS]
 
-Same measurement as `stablepush bench --checks`; kept here so the figure in docs/measured.md can be
+Same measurement as `stablepush bench --checks`; kept here so the figure in docs/results/planning.md can be
 reproduced without the CLI.
 """
 import argparse

@@ -1,5 +1,5 @@
 """CLI start-up time: `stablepush --help` and a `check` (which loads a task and builds its model),
-each run 10 times in a fresh process; prints the median and the fastest (docs/cli.md, "Commands").
+each run 10 times in a fresh process; prints the median and the fastest (docs/results/cli-startup.md).
 
     python3 benchmarks/cli_startup.py
 """

@@ -2,7 +2,7 @@
 data/tasks/more), its seed-1 plan, N trials in worlds with the issue's spreads (pad and pusher mu
 +-15%, grip force +-10%, mass +-5%, features off by up to 0.5 mm / 0.5 deg), open and closed loop,
 judged as `stablepush evaluate` judges a trial: where the object comes to rest after the release,
-within the task's planner.tolerance of the goal, or `--tolerance MM DEG` (docs/evaluate.md's
+within the task's planner.tolerance of the goal, or `--tolerance MM DEG` (docs/results/evaluate-1000-trials.md's
 tables of 1,000 trials were measured with `--tolerance 0.5 0.5`). One table row per task, plan,
 loop and approach. The
 plan is the task's own (`nominal`) or robust to those spreads (`robust`: `stablepush evaluate

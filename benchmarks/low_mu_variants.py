@@ -1,4 +1,4 @@
-"""The low-μ offset varied in ways nothing was tuned for (docs/measured.md, "Planning"): other goals, other
+"""The low-μ offset varied in ways nothing was tuned for (docs/results/planning.md, "Planning"): other goals, other
 friction and grip, an extra ledge. Seeds 1-N, 3 s limit; median and p95 of time and of stable-push
 tests (the machine-independent count).
 

@@ -1,4 +1,4 @@
-"""Planning time and stable-push tests over many seeds (docs/measured.md, "Planning"): each seed planned
+"""Planning time and stable-push tests over many seeds (docs/results/planning.md, "Planning"): each seed planned
 twice and the faster time kept (this machine's timings are noisy; the tests are not).
 
     python3 benchmarks/planning_seeds.py [TASK.yaml ...] [--seeds 100]

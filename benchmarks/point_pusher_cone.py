@@ -1,4 +1,4 @@
-"""Why a point pusher's plan ends off its goal (docs/engines.md, "The pegs"): where the pushers'
+"""Why a point pusher's plan ends off its goal (docs/results/engines-cross-engine.md, the pegs): where the pushers'
 stable pushes can carry the pads, in the object's frame, against where the goal needs them.
 
 With the pads sliding, a push by a point pusher is stable only on a surface of motions (docs/model.md
