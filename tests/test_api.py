@@ -243,13 +243,14 @@ def test_numpy_numbers_are_numbers(tmp_path):
 
 
 def test_what_save_plan_writes_load_plan_reads(tmp_path):
-    """A plan load_plan would refuse (a NaN pose or margin) is refused when written, naming the
-    field, and check_plan names a malformed plan's field rather than failing inside."""
+    """A plan load_plan would refuse is refused when made (Waypoint: a NaN pose or margin) or when
+    written (the rest), naming the field, and check_plan names a malformed plan's field rather than
+    failing inside."""
     task = sp.load_task(TASKS / "horizontal-offset-high-mu.yaml")
     plan = sp.plan_task(task, seed=1)
     w = plan.waypoints
-    with pytest.raises(sp.PlanError, match=r"waypoints\[0\]\.x: must be a finite number"):
-        sp.save_plan(dataclasses.replace(plan, waypoints=[sp.Waypoint(math.nan, 0, 0)] + w[1:]), tmp_path / "a.json")
+    with pytest.raises(sp.PlanError, match=r"waypoint\.x: must be a finite number, got NaN"):
+        sp.Waypoint(math.nan, 0, 0)
     with pytest.raises(sp.PlanError, match="final_hold"):
         sp.save_plan(dataclasses.replace(plan, final_hold_ratio=math.nan), tmp_path / "a.json")
     assert not (tmp_path / "a.json").exists()
@@ -264,12 +265,11 @@ def test_what_save_plan_writes_load_plan_reads(tmp_path):
     sp.save_plan(plan, fifo, fifo)
     both = reader.communicate(timeout=30)[0]
     assert '"format": "stablepush.plan/1"' in both and "step,x,z,theta" in both  # the JSON, then the CSV
-    with pytest.raises(sp.PlanError, match=r"waypoints\[1\]\.margin"):
-        sp.check_plan(task, dataclasses.replace(plan, waypoints=[w[0], dataclasses.replace(w[1], margin=10**400)] + w[2:]))
-    bad = {"margin": dataclasses.replace(w[1], margin=math.nan), "pusher": dataclasses.replace(w[1], pusher=5)}
-    for field, waypoint in bad.items():
-        with pytest.raises(sp.PlanError, match=rf"waypoints\[1\]\.{field}"):
-            sp.check_plan(task, dataclasses.replace(plan, waypoints=[w[0], waypoint] + w[2:]))
+    for field, value in (("margin", 10**400), ("margin", math.nan), ("pusher", 5)):
+        with pytest.raises(sp.PlanError, match=rf"waypoint\.{field}: must be"):
+            dataclasses.replace(w[1], **{field: value})
+    with pytest.raises(sp.PlanError, match=r"waypoints\[1\]: must be a Waypoint"):
+        sp.check_plan(task, dataclasses.replace(plan, waypoints=[w[0], (1.0, 0.0, 0.0)] + w[2:]))
     with pytest.raises(sp.PlanError, match="stats"):
         sp.check_plan(task, dataclasses.replace(plan, stats=None))
     with pytest.raises(sp.PlanError, match="task"):

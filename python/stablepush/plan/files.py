@@ -14,7 +14,18 @@ from stablepush import strict_json
 from stablepush.errors import OutputError, PlanError
 from stablepush.inputs import read_capped
 from stablepush.outputs import is_stream, same_file, write_files
-from stablepush.plan.plan import Plan, PlanOutcome, PusherContact, Waypoint, require_plan
+from stablepush.plan.plan import (
+    Fault,
+    Plan,
+    PlanOutcome,
+    PusherContact,
+    Waypoint,
+    is_point,
+    require_plan,
+    value_kind,
+    value_shown,
+    waypoint_fault,
+)
 from stablepush.strict_json import is_finite_number
 from stablepush.units import is_real
 
@@ -92,8 +103,8 @@ def plan_to_csv(plan: Plan) -> str:
 
 def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union[str, Path]] = None) -> None:
     """The plan as JSON, and as CSV beside it when `csv_path` is given, replaced together. PlanError
-    (naming the field) for a plan load_plan would not read back, a NaN pose say, and OutputError
-    when both paths name one file."""
+    (naming the field) for a plan load_plan would not read back, a NaN final_hold_ratio say, and
+    OutputError when both paths name one file."""
     require_plan(plan)
     source = f"the plan to write to {json_path}"
     data = plan_to_dict(plan)
@@ -174,91 +185,110 @@ def read_plan(path: Union[str, Path]) -> dict:
 
 def check_plan_dict(data, source: Optional[str] = None) -> None:
     """PlanError unless `data` has the structure of a plan document (see read_plan)."""
-    def fail(field: str, reason: str):
-        raise PlanError(field, reason, source)
+    # Each check may assume the ones before it passed (`or` stops at the first fault).
+    fault = (_fields_fault(data) or _outcome_fault(data) or _stats_fault(data["stats"])
+             or _waypoints_fault(data["waypoints"]) or _extras_fault(data))
+    if fault is not None:
+        raise PlanError(*fault, source)
 
+
+_KIND_NAMES = {str: "a string", bool: "a boolean", dict: "a mapping", list: "a list"}
+_REQUIRED = {"task": str, "solved": bool, "stats": dict, "waypoints": list}
+
+
+def _fields_fault(data) -> Fault:
+    """The format, the fields every plan has and their kinds."""
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        fail("format", f"not a {FORMAT} file")
-    for key, kind in (("task", str), ("solved", bool), ("stats", dict), ("waypoints", list)):
+        return "format", f"not a {FORMAT} file"
+    for key, kind in _REQUIRED.items():
         if key not in data:
-            fail(key, "missing")
-        if not isinstance(data.get(key), kind):
-            fail(key, f"must be {'a boolean' if kind is bool else 'a ' + _KIND_NAMES[kind]}, got "
-                      f"{_json_kind(data.get(key))}")
+            return key, "missing"
+        if not isinstance(data[key], kind):
+            return key, f"must be {_KIND_NAMES[kind]}, got {value_kind(data[key])}"
     for key in ("outcome", "message"):
         if key in data and not isinstance(data[key], str):
-            fail(key, f"must be a string, got {_json_kind(data[key])}")
+            return key, f"must be a string, got {value_kind(data[key])}"
+    return None
+
+
+def _outcome_fault(data: dict) -> Fault:
+    """The outcome, one of PlanOutcome's, and `solved` agreeing with it (absent or empty: not checked)."""
     outcome = data.get("outcome")
-    if outcome:
-        names = [o.value for o in PlanOutcome]
-        if outcome not in names:
-            fail("outcome", f"must be one of {', '.join(names)}, got {_json_shown(outcome)}")
-        if (outcome == PlanOutcome.goal_reached.value) != data["solved"]:
-            fail("solved", f"{json.dumps(data['solved'])} with outcome {outcome}: only a plan that reached its goal "
-                           f"is solved")
+    if not outcome:
+        return None
+    names = [o.value for o in PlanOutcome]
+    if outcome not in names:
+        return "outcome", f"must be one of {', '.join(names)}, got {value_shown(outcome)}"
+    if (outcome == PlanOutcome.goal_reached.value) != data["solved"]:
+        return "solved", (f"{json.dumps(data['solved'])} with outcome {outcome}: only a plan that reached its goal "
+                          f"is solved")
+    return None
+
+
+def _stats_fault(stats: dict) -> Fault:
+    """The counts among the stats, whole numbers within STATS_COUNTS."""
     for key, largest in STATS_COUNTS.items():
-        value = data["stats"].get(key)
+        value = stats.get(key)
         if value is not None and not (isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= largest):
-            fail(f"stats.{key}", f"must be a whole number from 0 to {largest}, got {_json_shown(value)}")
-    waypoints = data["waypoints"]
+            return f"stats.{key}", f"must be a whole number from 0 to {largest}, got {value_shown(value)}"
+    return None
+
+
+def _waypoints_fault(waypoints: list) -> Fault:
+    """The start and at most MAX_WAYPOINTS - 1 pushes, each waypoint as a Waypoint takes it."""
     if not waypoints:
-        fail("waypoints", "empty; a plan's first waypoint is its start")
+        return "waypoints", "empty; a plan's first waypoint is its start"
     if len(waypoints) > MAX_WAYPOINTS:
-        fail("waypoints", f"{len(waypoints)} waypoints; a plan has at most {MAX_WAYPOINTS}")
+        return "waypoints", f"{len(waypoints)} waypoints; a plan has at most {MAX_WAYPOINTS}"
     for i, w in enumerate(waypoints):
-        field = f"waypoints[{i}]"
-        if not isinstance(w, dict):
-            fail(field, f"must be a mapping, got {_json_kind(w)}")
-        for key in ("x", "z", "theta"):
-            if key not in w:
-                fail(f"{field}.{key}", "missing")
-            if not is_finite_number(w.get(key)):
-                fail(f"{field}.{key}", f"must be a finite number, got {_json_shown(w.get(key))}")
-        if not (w.get("pusher") is None or isinstance(w.get("pusher"), str)):
-            fail(f"{field}.pusher", f"must be a pusher name or null, got {_json_kind(w.get('pusher'))}")
-        for key in ("margin", "margin_per_normal"):
-            if w.get(key) is not None and not is_finite_number(w[key]):
-                fail(f"{field}.{key}", f"must be a finite number or null, got {_json_shown(w[key])}")
-        if not (w.get("case") is None or isinstance(w["case"], str)):
-            fail(f"{field}.case", f"must be a string or null, got {_json_kind(w['case'])}")
-        contact = w.get("pusher_in_gripper")
-        if contact is not None:
-            if not isinstance(contact, dict):
-                fail(f"{field}.pusher_in_gripper", f"must be a mapping or null, got {_json_kind(contact)}")
-            for key in ("from", "to", "normal"):
-                v = contact.get(key)
-                if not (isinstance(v, list) and len(v) == 2 and all(is_finite_number(c) for c in v)):
-                    fail(f"{field}.pusher_in_gripper.{key}", "must be a list of 2 finite numbers")
+        fault = _waypoint_fault(w)
+        if fault is not None:
+            field, reason = fault
+            return f"waypoints[{i}]{'.' + field if field else ''}", reason
+    return None
+
+
+def _waypoint_fault(w) -> Fault:
+    """One waypoint: a mapping whose fields Waypoint would take ('' names the waypoint itself)."""
+    if not isinstance(w, dict):
+        return "", f"must be a mapping, got {value_kind(w)}"
+    fault = waypoint_fault(w)
+    if fault is not None:
+        return fault
+    contact = w.get("pusher_in_gripper")
+    if contact is None:
+        return None
+    if not isinstance(contact, dict):
+        return "pusher_in_gripper", f"must be a mapping or null, got {value_kind(contact)}"
+    for key in ("from", "to", "normal"):
+        if not (isinstance(contact.get(key), list) and is_point(contact[key])):
+            return f"pusher_in_gripper.{key}", "must be a list of 2 finite numbers"
+    return None
+
+
+def _extras_fault(data: dict) -> Fault:
+    """The optional fields beside the waypoints: final_hold, uncertainty, task_identity and ends_at."""
     hold = data.get("final_hold")
     if hold is not None and not (isinstance(hold, dict) and (hold.get("ratio") is None
                                                              or is_finite_number(hold["ratio"]))):
-        fail("final_hold", "must be a mapping whose ratio is a finite number or null")
+        return "final_hold", "must be a mapping whose ratio is a finite number or null"
     if data.get("uncertainty") is not None and not isinstance(data["uncertainty"], dict):
-        fail("uncertainty", f"must be a mapping, got {_json_kind(data['uncertainty'])}")
-    identity = data.get("task_identity")
-    if identity is not None:
-        if not isinstance(identity, dict) or not isinstance(identity.get("fields"), dict):
-            fail("task_identity", "must be a mapping with the task's fields (or null)")
-        if identity.get("digest") != task_digest(identity["fields"]):
-            fail("task_identity.digest", "does not match its fields: the file was edited by hand")
+        return "uncertainty", f"must be a mapping, got {value_kind(data['uncertainty'])}"
+    fault = _identity_fault(data.get("task_identity"))
+    if fault is not None:
+        return fault
     if data.get("ends_at") not in (None, "goal", "within_tolerance"):
-        fail("ends_at", "must be goal, within_tolerance or null")
+        return "ends_at", "must be goal, within_tolerance or null"
+    return None
 
 
-_KIND_NAMES = {str: "string", dict: "mapping", list: "list"}
-
-
-def _json_shown(v, limit: int = 40) -> str:
-    """A JSON value for a message, as JSON writes it (a string in quotes), cut to `limit` characters."""
-    text = json.dumps(v, allow_nan=True, default=str)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def _json_kind(v) -> str:
-    """What a JSON value is, in JSON's words."""
-    if v is None:
-        return "null"
-    if isinstance(v, bool):
-        return "a boolean"
-    return {str: "a string", dict: "a mapping", list: "a list"}.get(type(v), "a number")
+def _identity_fault(identity) -> Fault:
+    """The task_identity record: null, or the task's fields with their digest."""
+    if identity is None:
+        return None
+    if not isinstance(identity, dict) or not isinstance(identity.get("fields"), dict):
+        return "task_identity", "must be a mapping with the task's fields (or null)"
+    if identity.get("digest") != task_digest(identity["fields"]):
+        return "task_identity.digest", "does not match its fields: the file was edited by hand"
+    return None
 

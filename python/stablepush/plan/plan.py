@@ -8,28 +8,40 @@ object). The first waypoint is the start and has no pusher.
 from __future__ import annotations
 
 import enum
+import json
 import math
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Mapping, Optional, Tuple
 
 import numpy as np
+
+from stablepush.errors import PlanError
+from stablepush.units import is_finite_real, is_real
+
+Fault = Optional[Tuple[str, str]]  # (field, reason) of the first check that fails; None when all pass
 
 
 @dataclass(frozen=True)
 class PusherContact:
     """A pusher's contact in the gripper frame G: the segment from-to (mm; equal for a point
-    pusher) and the unit normal pointing into the object."""
+    pusher) and the unit normal pointing into the object. PlanError unless each is 2 finite numbers."""
 
     start: Tuple[float, float]
     end: Tuple[float, float]
     normal: Tuple[float, float]
 
+    def __post_init__(self):
+        for key in ("start", "end", "normal"):
+            if not is_point(getattr(self, key)):
+                raise PlanError(f"contact.{key}", "must be 2 finite numbers")
+
 
 @dataclass(frozen=True)
 class Waypoint:
     """The pose after a unit push (x mm, z mm, theta deg), the pusher that made the push and the
-    test's verdict on it; the first waypoint is the start and has no pusher."""
+    test's verdict on it; the first waypoint is the start and has no pusher. PlanError naming the
+    field (`waypoint.x`, say) for one a plan file could not hold (waypoint_fault)."""
 
     x: float
     z: float
@@ -40,10 +52,63 @@ class Waypoint:
     contact: Optional[PusherContact] = None  # the pusher's contact in G at this pose
     margin_per_normal: Optional[float] = None  # margin / the pusher's normal force (least stable corner)
 
+    def __post_init__(self):
+        # A waypoint that exists can be written, read back and checked against a task: no NaN pose
+        # reaches the planner's re-check, a trajectory or a plan file.
+        fault = waypoint_fault(vars(self))
+        if fault is None and not (self.contact is None or isinstance(self.contact, PusherContact)):
+            fault = "contact", f"must be a PusherContact or None, got {type(self.contact).__name__}"
+        if fault is not None:
+            raise PlanError(f"waypoint.{fault[0]}", fault[1])
+
     @property
     def pose(self) -> Tuple[float, float, float]:
         """(x mm, z mm, theta deg)."""
         return (self.x, self.z, self.theta)
+
+
+def waypoint_fault(fields: Mapping[str, Any]) -> Fault:
+    """What is wrong with a waypoint's fields, by Waypoint's names (a Waypoint's own, or a plan
+    file's waypoint, which may lack a pose field), other than its contact: the first fault as
+    (field, reason), None when there is none. Reasons are in JSON's words (null), as a plan file's
+    reader reports them."""
+    for key in ("x", "z", "theta"):
+        if key not in fields:
+            return key, "missing"
+        if not is_finite_real(fields[key]):
+            return key, f"must be a finite number, got {value_shown(fields[key])}"
+    if not (fields.get("pusher") is None or isinstance(fields["pusher"], str)):
+        return "pusher", f"must be a pusher name or null, got {value_kind(fields['pusher'])}"
+    for key in ("margin", "margin_per_normal"):
+        if fields.get(key) is not None and not is_finite_real(fields[key]):
+            return key, f"must be a finite number or null, got {value_shown(fields[key])}"
+    if not (fields.get("case") is None or isinstance(fields["case"], str)):
+        return "case", f"must be a string or null, got {value_kind(fields['case'])}"
+    return None
+
+
+def is_point(value: Any) -> bool:
+    """Two finite numbers: a plan file's list of them, or a tuple or array in the API."""
+    try:
+        return len(value) == 2 and all(is_finite_real(c) for c in value)
+    except TypeError:  # no length, or no iteration
+        return False
+
+
+def value_shown(v: Any, limit: int = 40) -> str:
+    """A value for a message, as JSON writes it (a string in quotes, NaN), cut to `limit` characters."""
+    text = json.dumps(v, allow_nan=True, default=str)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def value_kind(v: Any) -> str:
+    """What a value is, in JSON's words (a Python type's name for what JSON has not)."""
+    if v is None:
+        return "null"
+    if isinstance(v, bool):
+        return "a boolean"
+    kinds = {str: "a string", dict: "a mapping", list: "a list"}
+    return kinds.get(type(v), "a number" if is_real(v) else type(v).__name__)
 
 
 class PlanOutcome(str, enum.Enum):

@@ -8,10 +8,10 @@ from typing import List, Optional
 
 from stablepush import _core
 from stablepush.errors import PlanError
-from stablepush.plan.plan import Plan, Waypoint, require_plan
+from stablepush.plan.plan import Fault, Plan, Waypoint, require_plan
 from stablepush.task.model import Task, require_task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
-from stablepush.units import MM, is_finite_real, pose_to_si
+from stablepush.units import MM, pose_to_si
 
 STEP_SLACK = 1e-6  # unit steps: rounding in a plan file's decimal poses
 START_SLACK = 1e-6  # mm or deg: the plan's start against the task's
@@ -30,98 +30,143 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     push's margin at least the task's min_margin and, solved, the pads holding min_hold_ratio
     times the weight at its end. PlanError names what differs (`source`: the plan file, for the
     message). `require_solved=False` lets an unsolved (partial) plan through, for drawing it."""
-    def fail(field: str, reason: str):
-        raise PlanError(field, reason, source)
-
     require_task(task)
     require_plan(plan)
+    # Each check may assume the ones before it passed (`or` stops at the first fault); the
+    # waypoints' own fields are Waypoint's to keep.
+    fault = (_record_fault(task, plan, require_solved) or _waypoints_fault(task, plan.waypoints, require_solved)
+             or _switches_fault(plan) or _ends_fault(task, plan, require_solved))
+    if fault is None:
+        model = task.build_model()
+        # With an uncertainty box every push must be stable at each corner, as the planner made it.
+        corners = task.corner_models() if task.uncertainty else None
+        fault = (_pushes_fault(task, plan.waypoints, model, corners)
+                 or _hold_fault(task, plan.waypoints, corners or [model], require_solved))
+    if fault is not None:
+        raise PlanError(*fault, source)
+    return plan
+
+
+def _record_fault(task: Task, plan: Plan, require_solved: bool) -> Fault:
+    """The plan's own record: for this task by name, as the task is now, solved when that is required."""
     if not isinstance(plan.task, str):
-        fail("task", f"must be the task's name, got {type(plan.task).__name__}")
+        return "task", f"must be the task's name, got {type(plan.task).__name__}"
     if not isinstance(plan.stats, dict):
-        fail("stats", f"must be a mapping, got {type(plan.stats).__name__}")
+        return "stats", f"must be a mapping, got {type(plan.stats).__name__}"
     if plan.task != task.name:
-        fail("task", f"the plan is for task {plan.task[:100]!r}, not {task.name!r}")
+        return "task", f"the plan is for task {plan.task[:100]!r}, not {task.name!r}"
     changes = changes_since_planned(task, plan)
     if changes:  # its pushes may still pass the re-check below, but not for the reasons it was made
         more = f" and {len(changes) - 6} more" if len(changes) > 6 else ""
-        fail("task_identity", f"{task.source or 'the task'} changed since the plan was made "
-                              f"({', '.join(changes[:6])}{more}): plan it again")
+        return "task_identity", (f"{task.source or 'the task'} changed since the plan was made "
+                                 f"({', '.join(changes[:6])}{more}): plan it again")
     if require_solved and not plan.solved:
-        fail("solved", f"the plan does not reach the goal ({(plan.message or 'not solved')[:200]})")
-    waypoints = plan.waypoints
+        return "solved", f"the plan does not reach the goal ({(plan.message or 'not solved')[:200]})"
+    return None
+
+
+def _waypoints_fault(task: Task, waypoints: List[Waypoint], require_solved: bool) -> Fault:
+    """Waypoints, the start and (solved) at least one push, each push by a pusher of the task."""
     for i, w in enumerate(waypoints):
         if not isinstance(w, Waypoint):
-            fail(f"waypoints[{i}]", f"must be a Waypoint (x, z, theta, pusher, ...), got {type(w).__name__}")
-        if not all(is_finite_real(v) for v in w.pose):
-            fail(f"waypoints[{i}]", f"must be a pose of 3 finite numbers, got {w.pose!r:.80}")
-        if not (w.pusher is None or isinstance(w.pusher, str)):
-            fail(f"waypoints[{i}].pusher", f"must be a pusher name or None, got {type(w.pusher).__name__}")
-        for key in ("margin", "margin_per_normal"):
-            value = getattr(w, key)
-            if value is not None and not is_finite_real(value):
-                fail(f"waypoints[{i}].{key}", f"must be a finite number or None, got {value!r:.40}")
+            return f"waypoints[{i}]", f"must be a Waypoint (x, z, theta, pusher, ...), got {type(w).__name__}"
     if len(waypoints) < (2 if require_solved else 1):  # a partial plan may have found no push at all
-        fail("waypoints", "needs the start and at least one push" if require_solved else "needs the start")
-    for i, w in enumerate(waypoints):
-        if i == 0 and w.pusher is not None:
-            fail("waypoints[0].pusher", f"the start has no pusher, got {w.pusher[:100]!r}")
-        if i > 0 and w.pusher is None:
-            fail(f"waypoints[{i}].pusher", "missing: every waypoint after the start is a push by a pusher")
-        if w.pusher is not None and w.pusher not in task.pusher_names:
-            fail(f"waypoints[{i}].pusher", f"the task has no pusher {w.pusher[:100]!r}")
-    # Each switch-over is a transit between features (hundreds of trajectory samples): no more than
-    # the plan's own budget, itself within the planner's range. The search extends only nodes within
-    # the budget, so a node it reports unsolved (the partial path's end, or a goal reached over the
-    # budget) may be one switch-over past it.
+        return "waypoints", "needs the start and at least one push" if require_solved else "needs the start"
+    if waypoints[0].pusher is not None:
+        return "waypoints[0].pusher", f"the start has no pusher, got {waypoints[0].pusher[:100]!r}"
+    for i, w in enumerate(waypoints[1:], 1):
+        if w.pusher is None:
+            return f"waypoints[{i}].pusher", "missing: every waypoint after the start is a push by a pusher"
+        if w.pusher not in task.pusher_names:
+            return f"waypoints[{i}].pusher", f"the task has no pusher {w.pusher[:100]!r}"
+    return None
+
+
+def _switches_fault(plan: Plan) -> Fault:
+    """Each switch-over is a transit between features (hundreds of trajectory samples): no more than
+    the plan's own budget, itself within the planner's range. The search extends only nodes within
+    the budget, so a node it reports unsolved (the partial path's end, or a goal reached over the
+    budget) may be one switch-over past it."""
     switches = max(len(plan.pusher_sequence) - 1, 0)
     recorded = plan.stats.get("max_switches")
     budget = int(recorded) if isinstance(recorded, int) and 0 <= recorded < MAX_SWITCHES else MAX_SWITCHES
     if switches > budget + (0 if plan.solved else 1):
-        fail("waypoints", f"{switches} switch-overs, more than the plan's max_switches ({budget})"
-                          + ("" if plan.solved else " and the one past it a partial path may end with")
-                          + "; not a plan this tool made")
+        return "waypoints", (f"{switches} switch-overs, more than the plan's max_switches ({budget})"
+                             + ("" if plan.solved else " and the one past it a partial path may end with")
+                             + "; not a plan this tool made")
+    return None
+
+
+def _ends_fault(task: Task, plan: Plan, require_solved: bool) -> Fault:
+    """The plan starts at the task's start and, solved, ends within its tolerance of the goal."""
+    waypoints = plan.waypoints
     if max(abs(a - b) for a, b in zip(waypoints[0].pose, task.start)) > START_SLACK:
-        fail("waypoints[0]", f"the plan starts at {list(waypoints[0].pose)}, the task at {list(task.start)}")
+        return "waypoints[0]", f"the plan starts at {list(waypoints[0].pose)}, the task at {list(task.start)}"
     end = waypoints[-1].pose
     if (require_solved or plan.solved) and not task.at_goal(end):
-        fail(f"waypoints[{len(waypoints) - 1}]",
-             f"the plan ends at {[round(v, 3) for v in end]}, not within planner.tolerance "
-             f"{task.planner['tolerance']} of the task's goal {list(task.goal)}: made for another goal, or cut short?")
+        return (f"waypoints[{len(waypoints) - 1}]",
+                f"the plan ends at {[round(v, 3) for v in end]}, not within planner.tolerance "
+                f"{task.planner['tolerance']} of the task's goal {list(task.goal)}: made for another goal, or cut "
+                f"short?")
+    return None
+
+
+def _pushes_fault(task: Task, waypoints: List[Waypoint], model, corners: Optional[list]) -> Fault:
+    """Every push at most one unit step, moving the object, stable (for `model`, the task's, or at
+    each of the `corners` of its uncertainty box) with at least the task's min_margin, and ending
+    with the pads on the object."""
     unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
     min_margin = float(task.planner.get("min_margin", 0.0))
-    model = task.build_model()
-    # With an uncertainty box every push must be stable at each corner, as the planner made it.
-    corners = task.corner_models() if task.uncertainty else None
     for i in range(1, len(waypoints)):
         q0, q1 = pose_to_si(waypoints[i - 1].pose), pose_to_si(waypoints[i].pose)
-        length = _core.steps_between(q0, q1, unit)
-        if length > 1.0 + STEP_SLACK:
-            size = f"{length:.3g} unit steps" if math.isfinite(length) else "more unit steps than a double holds"
-            fail(f"waypoints[{i}]", f"a step of {size} (planner.step {task.planner['step']}); "
-                                    f"a plan's pushes are at most one unit step")
-        dq = tuple(b - a for a, b in zip(q0, q1))
-        if max(abs(v) for v in dq) < 1e-12:
-            fail(f"waypoints[{i}]", "repeats the pose before it (a push that does not move the object)")
-        pusher = waypoints[i].pusher
-        index = task.pusher_index(pusher)
-        verdict = _core.worst_case(corners, q0, dq, index) if corners else model.check(q0, dq, index)
-        if not verdict.feasible:
-            fail(f"waypoints[{i}]", f"the push by {pusher!r} is not a stable push for this task "
-                                    f"(margin {verdict.margin:+.4f} N); was the plan made for another version of it?")
-        if verdict.margin < min_margin - MARGIN_SLACK:
-            fail(f"waypoints[{i}]", f"the push by {pusher!r} has a margin of {verdict.margin:.4f} N, under the "
-                                    f"task's planner.min_margin {min_margin:g} N")
-        if not model.grasp_maintained(q1):
-            fail(f"waypoints[{i}]", "the pads leave the object at this pose")
+        fault = _step_fault(task, q0, q1, unit)
+        if fault is None:
+            fault = _stability_fault(waypoints[i].pusher, task.pusher_index(waypoints[i].pusher), q0, q1, model,
+                                     corners, min_margin)
+        if fault is None and not model.grasp_maintained(q1):
+            fault = "the pads leave the object at this pose"
+        if fault is not None:
+            return f"waypoints[{i}]", fault
+    return None
+
+
+def _step_fault(task: Task, q0, q1, unit) -> Optional[str]:
+    """Why the step q0 -> q1 (SI) is not a push's: longer than a unit step, or no move at all."""
+    length = _core.steps_between(q0, q1, unit)
+    if length > 1.0 + STEP_SLACK:
+        size = f"{length:.3g} unit steps" if math.isfinite(length) else "more unit steps than a double holds"
+        return f"a step of {size} (planner.step {task.planner['step']}); a plan's pushes are at most one unit step"
+    if max(abs(b - a) for a, b in zip(q0, q1)) < 1e-12:
+        return "repeats the pose before it (a push that does not move the object)"
+    return None
+
+
+def _stability_fault(pusher: str, index: int, q0, q1, model, corners: Optional[list],
+                     min_margin: float) -> Optional[str]:
+    """Why the push q0 -> q1 (SI) by `pusher` is not a stable push with min_margin (N) to spare."""
+    dq = tuple(b - a for a, b in zip(q0, q1))
+    verdict = _core.worst_case(corners, q0, dq, index) if corners else model.check(q0, dq, index)
+    if not verdict.feasible:
+        return (f"the push by {pusher!r} is not a stable push for this task (margin {verdict.margin:+.4f} N); "
+                f"was the plan made for another version of it?")
+    if verdict.margin < min_margin - MARGIN_SLACK:
+        return (f"the push by {pusher!r} has a margin of {verdict.margin:.4f} N, under the task's "
+                f"planner.min_margin {min_margin:g} N")
+    return None
+
+
+def _hold_fault(task: Task, waypoints: List[Waypoint], models: list, require_solved: bool) -> Fault:
+    """A solved plan's end, where the pads alone hold min_hold_ratio times the weight (in each of `models`)."""
     min_hold = float(task.planner.get("min_hold_ratio", 0.0))
-    if require_solved and min_hold > 0 and len(waypoints) > 1:
-        q, last = pose_to_si(waypoints[-1].pose), task.pusher_index(waypoints[-1].pusher)
-        held = min(m.hold_ratio(q, last) for m in (corners or [model]))
-        if held < min_hold - MARGIN_SLACK:
-            fail(f"waypoints[{len(waypoints) - 1}]",
-                 f"the pads hold {held:.3f} times the object's weight at the plan's end, under the task's "
-                 f"planner.min_hold_ratio {min_hold:g}")
-    return plan
+    if not (require_solved and min_hold > 0 and len(waypoints) > 1):
+        return None
+    q, last = pose_to_si(waypoints[-1].pose), task.pusher_index(waypoints[-1].pusher)
+    held = min(m.hold_ratio(q, last) for m in models)
+    if held < min_hold - MARGIN_SLACK:
+        return (f"waypoints[{len(waypoints) - 1}]",
+                f"the pads hold {held:.3f} times the object's weight at the plan's end, under the task's "
+                f"planner.min_hold_ratio {min_hold:g}")
+    return None
 
 
 def release_note(task: Task, plan: Plan) -> Optional[str]:

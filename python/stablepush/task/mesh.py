@@ -52,6 +52,46 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
         from shapely.geometry.polygon import orient
     except ImportError as exc:  # pragma: no cover - both are dependencies
         raise TaskError(field, f"mesh objects need trimesh and shapely ({exc})") from None
+    mesh = _read_solid(trimesh, path, field)
+    mesh.apply_scale(scale)
+    thickness = float(mesh.extents[1])
+    if not thickness_range[0] <= thickness <= thickness_range[1]:
+        raise TaskError(f"{field}.file", f"{path} is {thickness:g} mm thick along y (the gripping axis), outside "
+                                         f"{thickness_range[0]:g} to {thickness_range[1]:g} mm: its units? "
+                                         f"({field}.scale multiplies them into mm)")
+    volume = float(mesh.volume)  # mm^3
+    if not volume > 0:
+        raise TaskError(f"{field}.file", f"{path} encloses no volume (inside out?)")
+    if (mass is None) == (density is None):
+        raise TaskError(field, "give exactly one of mass (g) and density (g/cm^3)")
+    grams = mass if mass is not None else density * G_PER_CM3 * volume
+    com = mesh.center_mass
+    y = float(com[1]) if plane_y is None else plane_y
+    low, high = mesh.bounds[:, 1]
+    if not low < y < high:
+        raise TaskError(f"{field}.plane_y", f"{y:g} mm is outside the mesh, which spans y {low:g} to {high:g} mm")
+    outline = _section_outline(mesh, y, f"{field}.plane_y")
+    raw = len(outline.exterior.coords) - 1
+    simple = orient(Polygon(outline.exterior).simplify(tolerance, preserve_topology=True), 1.0)
+    vertices = tuple((float(x), float(z)) for x, z in list(simple.exterior.coords)[:-1])
+    if len(vertices) > max_vertices:
+        raise TaskError(f"{field}.tolerance", f"the section keeps {len(vertices)} vertices at {tolerance:g} mm; "
+                                              f"at most {max_vertices} (a larger tolerance)")
+    mesh.density = grams / volume  # g/mm^3, so moment_inertia is in g mm^2
+    inertia = float(mesh.moment_inertia[1, 1]) * 1e-9  # g mm^2 -> kg m^2
+    notes = []
+    thinnest = _thinnest_across(mesh, simple, low, high)
+    if thinnest is not None and thinnest[0] < (1 - THICKNESS_VARIATION) * thickness:
+        t, (x, z) = thinnest
+        notes.append(f"{field}.file: the solid is {t:.3g} mm thick across the grasp at (x, z) = ({x:.3g}, {z:.3g}) "
+                     f"mm but {thickness:.3g} mm overall; the model takes a slab of {thickness:.3g} mm (the pads "
+                     f"press on its two faces)")
+    return MeshObject(vertices=vertices, thickness=thickness, mass=float(grams),
+                      com=(float(com[0]), float(com[2])), inertia=inertia, section_vertices=raw, notes=tuple(notes))
+
+
+def _read_solid(trimesh, path: Path, field: str):
+    """The mesh in `path` (its own units) once it is one closed body; TaskError naming `field`.file."""
     file_type = path.suffix.lstrip(".").lower()
     if file_type not in MESH_FORMATS:
         raise TaskError(f"{field}.file", f"{path.name}: a mesh file is one of {', '.join(MESH_FORMATS)} "
@@ -73,58 +113,30 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
     if bodies > 1:
         raise TaskError(f"{field}.file", f"{path} holds {bodies} separate bodies; the grasp holds one "
                                          f"(one body per file)")
-    mesh.apply_scale(scale)
-    thickness = float(mesh.extents[1])
-    if not thickness_range[0] <= thickness <= thickness_range[1]:
-        raise TaskError(f"{field}.file", f"{path} is {thickness:g} mm thick along y (the gripping axis), outside "
-                                         f"{thickness_range[0]:g} to {thickness_range[1]:g} mm: its units? "
-                                         f"({field}.scale multiplies them into mm)")
-    volume = float(mesh.volume)  # mm^3
-    if not volume > 0:
-        raise TaskError(f"{field}.file", f"{path} encloses no volume (inside out?)")
-    if (mass is None) == (density is None):
-        raise TaskError(field, "give exactly one of mass (g) and density (g/cm^3)")
-    grams = mass if mass is not None else density * G_PER_CM3 * volume
-    com = mesh.center_mass
-    y = float(com[1]) if plane_y is None else plane_y
-    low, high = mesh.bounds[:, 1]
-    if not low < y < high:
-        raise TaskError(f"{field}.plane_y", f"{y:g} mm is outside the mesh, which spans y {low:g} to {high:g} mm")
+    return mesh
+
+
+def _section_outline(mesh, y: float, field: str):
+    """The mesh's section at the plane y = `y` (mm) in the grasp plane's x, z, as one shapely outline
+    without holes; TaskError naming `field` (the plane) otherwise."""
     section = mesh.section(plane_origin=[0.0, y, 0.0], plane_normal=[0.0, 1.0, 0.0])
     if section is None:
-        raise TaskError(f"{field}.plane_y", f"the plane y = {y:g} mm does not cut the mesh")
+        raise TaskError(field, f"the plane y = {y:g} mm does not cut the mesh")
     to_xz = np.array([[1.0, 0, 0, 0], [0, 0, 1.0, 0], [0, -1.0, 0, y], [0, 0, 0, 1.0]])  # (x, y, z) -> (x, z, y0 - y)
     planar, _ = section.to_2D(to_2D=to_xz)
     polygons = list(planar.polygons_full)
     if not polygons:
-        raise TaskError(f"{field}.plane_y", f"the section at y = {y:g} mm is not a closed outline")
+        raise TaskError(field, f"the section at y = {y:g} mm is not a closed outline")
     # The model's object is one outline without holes: a pad over a hole, or between two pieces of
     # the section, would press on nothing.
     if len(polygons) > 1:
-        raise TaskError(f"{field}.plane_y", f"the section at y = {y:g} mm falls into {len(polygons)} separate "
-                                            f"pieces; the model takes one outline (another plane_y?)")
+        raise TaskError(field, f"the section at y = {y:g} mm falls into {len(polygons)} separate pieces; the model "
+                               f"takes one outline (another plane_y?)")
     outline = polygons[0]
     if outline.interiors:
-        raise TaskError(f"{field}.plane_y", f"the section at y = {y:g} mm has {len(outline.interiors)} hole(s); "
-                                            f"the model takes an outline without holes, and a pad over a hole would "
-                                            f"hold nothing (another plane_y?)")
-    raw = len(outline.exterior.coords) - 1
-    simple = orient(Polygon(outline.exterior).simplify(tolerance, preserve_topology=True), 1.0)
-    vertices = tuple((float(x), float(z)) for x, z in list(simple.exterior.coords)[:-1])
-    if len(vertices) > max_vertices:
-        raise TaskError(f"{field}.tolerance", f"the section keeps {len(vertices)} vertices at {tolerance:g} mm; "
-                                              f"at most {max_vertices} (a larger tolerance)")
-    mesh.density = grams / volume  # g/mm^3, so moment_inertia is in g mm^2
-    inertia = float(mesh.moment_inertia[1, 1]) * 1e-9  # g mm^2 -> kg m^2
-    notes = []
-    thinnest = _thinnest_across(mesh, simple, low, high)
-    if thinnest is not None and thinnest[0] < (1 - THICKNESS_VARIATION) * thickness:
-        t, (x, z) = thinnest
-        notes.append(f"{field}.file: the solid is {t:.3g} mm thick across the grasp at (x, z) = ({x:.3g}, {z:.3g}) "
-                     f"mm but {thickness:.3g} mm overall; the model takes a slab of {thickness:.3g} mm (the pads "
-                     f"press on its two faces)")
-    return MeshObject(vertices=vertices, thickness=thickness, mass=float(grams),
-                      com=(float(com[0]), float(com[2])), inertia=inertia, section_vertices=raw, notes=tuple(notes))
+        raise TaskError(field, f"the section at y = {y:g} mm has {len(outline.interiors)} hole(s); the model takes "
+                               f"an outline without holes, and a pad over a hole would hold nothing (another plane_y?)")
+    return outline
 
 
 def _thinnest_across(mesh, section, low: float, high: float, grid: int = 9):
