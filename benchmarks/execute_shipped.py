@@ -17,13 +17,13 @@ from pathlib import Path
 
 from shipped import shipped_tasks
 
-from stablepush.execution import execute_plan
 from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.guard import GuardedApproach
+from stablepush.execution.run import RunOptions, run_plan
 from stablepush.plan import check_plan, plan_task
-from stablepush.sim.arm import WorldDeviation
+from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
-from stablepush.sim.server import running_sim_arm
+from stablepush.sim.local_arm import SimulatedArm
 from stablepush.task import load_task
 
 
@@ -55,9 +55,9 @@ def main() -> None:
 
 
 def _run(task, plan, mu_scale: float, loop, tolerance, engine: str, guard) -> None:
-    with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=mu_scale), engine=engine) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop,
-                              guard=guard, success_tolerance=tolerance)
+    arm = SimulatedArm(engine, WorldDeviation(mu_scale=mu_scale))
+    report = run_plan(task, plan, arm, RunOptions(rate_hz=100.0, closed_loop=loop, guard=guard,
+                                               success_tolerance=tolerance)).report_or_fault()
     err, goal = report.final_error, report.goal_error
     replans = f"{sum(r.solved for r in report.replans)}" + (f" (+{sum(not r.solved for r in report.replans)} failed)"
                                                             if any(not r.solved for r in report.replans) else "")

@@ -1,7 +1,7 @@
 """Nominal against robust plans on the simulated arm: every shipped task (and data/tasks/more),
 planned once with the task's nominal friction and once with `uncertainty: {pad_mu: 0.15,
 pusher_mu: 0.15}` (seed 1, the task's own switch budget, 20 s), each run open loop in worlds whose
-pad and feature mu are 0.85, 1 and 1.15 times the task's. Prints the "Robust pushes" table of docs/planner.md.
+pad and feature mu are 0.85, 1 and 1.15 times the task's. Prints the table of docs/results/planner-robust-on-arm.md.
 
     python3 benchmarks/robust_execution.py      # about 4 minutes
 """
@@ -10,10 +10,10 @@ import time
 import yaml
 from shipped import shipped_tasks
 
-from stablepush.execution import execute_plan
+from stablepush.execution.run import RunOptions, run_plan
 from stablepush.plan import check_plan, plan_task
-from stablepush.sim.arm import WorldDeviation
-from stablepush.sim.server import running_sim_arm
+from stablepush.sim.deviation import WorldDeviation
+from stablepush.sim.local_arm import SimulatedArm
 from stablepush.task import parse_task
 
 UNCERTAINTY = {"pad_mu": 0.15, "pusher_mu": 0.15}
@@ -42,8 +42,7 @@ def main() -> None:
             check_plan(task, plan)
             errors = []
             for scale in WORLDS:
-                with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=scale)) as server:
-                    report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
+                report = run_plan(task, plan, SimulatedArm(deviation=WorldDeviation(mu_scale=scale)), RunOptions()).report_or_fault()
                 errors.append(f"{report.final_error['distance']:.2f} / {report.final_error['theta']:+.2f}")
             print(
                 f"| {task.name} | {label} | {plan.stats['pushes']} | {' → '.join(plan.pusher_sequence)} "

@@ -21,7 +21,7 @@ from stablepush.plan import benchmark as benchmark_mod
 from stablepush.plan import check_plan, plan_task
 from stablepush.plan.benchmark import bench_checks
 from stablepush.runners import Runner, run_all
-from stablepush.sim.arm import WorldDeviation
+from stablepush.sim.deviation import WorldDeviation
 from stablepush_cli.main import cli
 
 from conftest import TASKS, shipped
@@ -172,17 +172,17 @@ def test_the_summary_follows_from_the_trials():
 
 
 def test_a_crashing_trial_is_recorded_and_the_batch_goes_on(monkeypatch):
-    real = batch_mod.execute_plan
+    real = batch_mod.run_plan
 
     calls = []
 
-    def crash_on_trial_one(task, plan, host, port, **kw):  # the serial runner runs trials 0, 1, 2 in turn
+    def crash_on_trial_one(*args, **kw):  # the serial runner runs trials 0, 1, 2 in turn
         calls.append(1)
         if len(calls) == 2:
             raise RuntimeError("the simulator blew up")
-        return real(task, plan, host, port, **kw)
+        return real(*args, **kw)
 
-    monkeypatch.setattr(batch_mod, "execute_plan", crash_on_trial_one)
+    monkeypatch.setattr(batch_mod, "run_plan", crash_on_trial_one)
     result = evaluate(_batch(), 3, Runner(workers=1))
     assert [t["trial"] for t in result.trials] == [0, 1, 2]
     crashed = result.trials[1]
@@ -197,18 +197,18 @@ def _outcomes(evaluation):
 
 def test_a_slow_simulated_arm_is_waited_for_not_called_a_fault(monkeypatch):
     """Outcomes must not depend on the machine's load: a world that takes 6 s to build (Ray beside
-    other jobs on two cores) is waited for, where the real arm's 5 s reply deadline faulted it."""
+    other jobs on two cores) is waited for, where a real arm's 5 s reply deadline faults one."""
     import time
 
-    from stablepush.sim.server import SimArmServer
+    from stablepush.sim import local_arm
 
-    hello = SimArmServer._hello
+    make_arm = local_arm.make_arm
 
-    def slow_hello(self, message):
+    def slow_make_arm(*args):
         time.sleep(6.0)
-        return hello(self, message)
+        return make_arm(*args)
 
-    monkeypatch.setattr(SimArmServer, "_hello", slow_hello)
+    monkeypatch.setattr(local_arm, "make_arm", slow_make_arm)
     record = batch_mod.run_trial(_batch(), 0)
     assert record["cause"] != "arm_fault" and record["goal_error"] is not None, record["error"]
 

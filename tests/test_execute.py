@@ -13,13 +13,14 @@ import pytest
 from click.testing import CliRunner
 
 from stablepush.errors import ArmFault, PlanError
-from stablepush.execution import execute_plan
+from stablepush.execution import RunOptions, TcpArm, execute_plan
 from stablepush.execution.protocol import PROTOCOL, ProtocolError, decode, encode
 from stablepush.plan import check_plan, plan_task
 from stablepush.plan.files import write_plan
+from stablepush.sim.local_arm import SimulatedArm
 from stablepush.sim.server import running_sim_arm
 from stablepush.task import load_task
-from stablepush_cli.main import _print_report, cli
+from stablepush_cli.main import cli
 
 from conftest import TASKS, shipped
 
@@ -101,7 +102,7 @@ def test_t_shape_end_to_end_through_two_switch_overs():
     task = shipped("t-shaped")
     plan = check_plan(task, plan_task(task, seed=1))
     with running_sim_arm(log=lambda text: None) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
+        report = execute_plan(task, plan, TcpArm(server.host, server.port), RunOptions(rate_hz=100.0))
     assert [c.pusher for c in report.contacts] == ["left", "under-web", "left"]
     # 0.09 mm measured with Coulomb friction on the sliding pad points (1.0 mm was allowed before they slid right)
     assert report.final_error["distance"] < FINAL_BOUND_MM and abs(report.final_error["theta"]) < FINAL_BOUND_DEG
@@ -253,7 +254,7 @@ def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
     plan = check_plan(task, plan_task(task, seed=1))
     arm = FakeArm(good=91, bad_reply=bad_reply)  # the approach's 51 waypoints and 4 pushes of 10
     with pytest.raises(ArmFault) as fault:
-        execute_plan(task, plan, "127.0.0.1", arm.port, rate_hz=100.0, pace=False, ack_timeout=5.0)
+        execute_plan(task, plan, TcpArm("127.0.0.1", arm.port, 5.0), RunOptions(rate_hz=100.0))
     assert says in fault.value.reason
     assert fault.value.last_confirmed_step == 4
     assert fault.value.arm_stopped is True and arm.stopped
@@ -267,7 +268,7 @@ def test_a_paced_stream_goes_on_at_its_rate_after_the_arm_stalled():
     arm = FakeArm(good=80, bad_reply=lambda msg: encode({"type": "error", "seq": msg["seq"], "message": "done"}),
                   stall=(20, 0.5))
     with pytest.raises(ArmFault):
-        execute_plan(task, plan, "127.0.0.1", arm.port, rate_hz=100.0, pace=True, ack_timeout=5.0)
+        execute_plan(task, plan, TcpArm("127.0.0.1", arm.port, 5.0), RunOptions(rate_hz=100.0, pace=True))
     after = arm.received[21:71]  # 50 waypoints after the stall: 0.49 s apart at 100 Hz, however late the stall
     assert after[-1] - after[0] >= 0.45
 
@@ -332,7 +333,7 @@ def test_the_sim_arm_refuses_malformed_and_out_of_order_waypoints_and_stops():
                 reply = decode(reader.readline(), "server")
                 assert reply["type"] == "error" and says in reply["message"], reply
                 assert reader.readline() == b""  # the server closed the connection
-            arm = server.arm
+            arm = server.arm.sim
             assert list(arm.target) == list(arm.data.qpos[arm._arm_qpos])  # held where it was
 
 
@@ -392,15 +393,14 @@ def test_closed_loop_corrects_a_world_with_less_friction_than_the_model():
     correction with the model's mu slipped as the plan did and ended 0.22 mm low, where no pusher
     can lift it), and lands within the final tolerance, a fifth of the goal tolerance."""
     from stablepush.execution.closed_loop import ClosedLoop
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     task = shipped("horizontal-offset-low-mu")
     plan = check_plan(task, plan_task(task, seed=1))
     loop = ClosedLoop.for_task(task)
-    with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=0.85)) as server:
-        open_loop = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False)
-    with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=0.85)) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, closed_loop=loop)
+    open_loop = execute_plan(task, plan, SimulatedArm(deviation=WorldDeviation(mu_scale=0.85)), RunOptions(rate_hz=100.0))
+    report = execute_plan(task, plan, SimulatedArm(deviation=WorldDeviation(mu_scale=0.85)),
+                          RunOptions(rate_hz=100.0, closed_loop=loop))
     assert open_loop.goal_error["distance"] > 0.5, open_loop.goal_error
     assert report.closed_loop == "on"
     assert any(r.solved and r.pushes > 0 for r in report.replans), report.replans
@@ -418,8 +418,7 @@ def test_closed_loop_on_an_arm_without_a_tracker_runs_open_loop_and_says_so():
     task = shipped("horizontal-offset-high-mu")
     plan = check_plan(task, plan_task(task, seed=1))
     arm = FakeArm(good=10**9, bad_reply=None)  # acknowledges everything, reports no object_in_grasp
-    report = execute_plan(task, plan, "127.0.0.1", arm.port, rate_hz=100.0, pace=False,
-                          closed_loop=ClosedLoop.for_task(task))
+    report = execute_plan(task, plan, TcpArm("127.0.0.1", arm.port), RunOptions(rate_hz=100.0, closed_loop=ClosedLoop.for_task(task)))
     assert report.closed_loop == "no tracker" and report.replans == []
     assert report.guard == "no tracker" and all(c.found_mm is None for c in report.contacts)
     assert report.last_confirmed_step == 20 and report.final_error is None
@@ -573,20 +572,18 @@ def test_closed_loop_lands_the_pivot_with_its_feature_off_its_place():
     the prism comes onto the feature, before the first push (with approaches that end where the plan
     puts the feature: a guarded approach finds it instead)."""
     from stablepush.execution.closed_loop import ClosedLoop
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     task = shipped("pivoting")
     plan = check_plan(task, plan_task(task, seed=1))
     world = WorldDeviation(feature_offsets=(("left", 0.3219, -0.4503, -0.4070),))
-    with running_sim_arm(log=lambda text: None, deviation=world) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, guard=None,
-                              closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.5, 0.5))
+    report = execute_plan(task, plan, SimulatedArm(deviation=world), RunOptions(rate_hz=100.0, guard=None, closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.5, 0.5)))
     assert report.success is True, (report.goal_error, report.verdict.detail)
     first = report.replans[0]
     assert first.solved and first.trigger == "on_touch" and first.after_step == 0
 
 
-def test_closed_loop_corrects_when_the_last_feature_is_met_early(capsys):
+def test_closed_loop_corrects_when_the_last_feature_is_met_early():
     """The hexagon's one contact (lower-left, 12 pushes to the goal) with its feature 0.49 mm off in
     x and 0.38 mm in z (evaluate's trial 74 of seed 1, the 1,000-trial table's worlds): the approach
     pushes the prism about 0.5 mm along the push before the first push, below the re-plan
@@ -595,30 +592,25 @@ def test_closed_loop_corrects_when_the_last_feature_is_met_early(capsys):
     lands within 0.2 mm / 0.2 deg. (An approach that is not guarded: a guarded one stops at the
     feature, test_a_guarded_approach_finds_a_feature_off_its_place_and_the_run_lands.)"""
     from stablepush.execution.closed_loop import ClosedLoop
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     task = load_task(TASKS / "more" / "hexagon-offset.yaml")
     plan = check_plan(task, plan_task(task, seed=1))
     world = WorldDeviation(pad_mu_scale=1.0846, pusher_mu_scale=0.9725, grip_scale=1.0518, mass_scale=0.9612,
                            feature_offsets=(("lower-left", 0.4906, 0.3846, 0.1700),
                                             ("bottom", 0.2018, 0.3975, -0.1038)))
-    with running_sim_arm(log=lambda text: None, deviation=world) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False, guard=None,
-                              closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.2, 0.2))
+    report = execute_plan(task, plan, SimulatedArm(deviation=world), RunOptions(rate_hz=100.0, guard=None, closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.2, 0.2)))
     assert report.success is True, (report.goal_error, report.verdict.detail)
     touch = report.replans[0]
     assert touch.trigger == "on_touch" and touch.after_step == 0 and touch.solved and touch.kept_pusher
-    _print_report(report, verbose=True)
-    assert "on the feature of step 1: off the plan by" in capsys.readouterr().out
+    assert any("on the feature of step 1: off the plan by" in line for line in report.describe(verbose=True))
 
 
 def _open_loop_in(task, world, guarded=True):
     from stablepush.execution.guard import GuardedApproach
 
     plan = check_plan(task, plan_task(task, seed=1))
-    with running_sim_arm(log=lambda text: None, deviation=world) as server:
-        return execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
-                            guard=GuardedApproach() if guarded else None, success_tolerance=(0.5, 0.5))
+    return execute_plan(task, plan, SimulatedArm(deviation=world), RunOptions(rate_hz=100.0, guard=GuardedApproach() if guarded else None, success_tolerance=(0.5, 0.5)))
 
 
 def test_a_feature_beyond_its_place_is_blamed_not_the_friction():
@@ -628,7 +620,7 @@ def test_a_feature_beyond_its_place_is_blamed_not_the_friction():
     the goal. The verdict blames the feature (`feature_off`), and the slip after the feature met it
     is nil. 42 of the 50 misses of this plan's 1,000-trial open loop were this (docs/evaluate.md),
     all called `pusher_slipped` before."""
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     report = _open_loop_in(load_task(TASKS / "more" / "tilted-gravity.yaml"),
                            WorldDeviation(feature_offsets=(("left", -0.48, 0.0, 0.0),)), guarded=False)
@@ -653,7 +645,7 @@ def test_a_guarded_approach_finds_a_feature_off_its_place_and_the_run_lands(task
     and the contact's pushes start there; the run ends within 0.2 mm / 0.2 deg of the goal, and the
     contact's record says how far from its place the feature was found. Without the guard the same
     world ends more than 0.5 mm off."""
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     task = load_task(TASKS / "more" / task_file)
     world = WorldDeviation(feature_offsets=offsets)
@@ -679,7 +671,7 @@ def test_a_turned_feature_is_found_as_the_object_seats_and_the_run_lands(task_fi
     first push, and the pushes left are re-based there, so the run ends as it does on a feature not
     turned. The contact's record says how the object seated. Without the re-base (an approach that
     is not guarded) the turn, or twice it, stays in the final pose."""
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     task = load_task(TASKS / task_file)
     world = WorldDeviation(feature_offsets=(("left", 0.0, 0.0, turn_deg),))
@@ -694,7 +686,7 @@ def test_a_pusher_that_slips_on_a_feature_in_its_place_is_a_slip():
     """The high-mu offset's pusher slips in a world with 15% less friction (its pushes have 0.1 N
     of margin): the feature is where the plan says, so nothing is carried, and the verdict is
     `pusher_slipped`."""
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     report = _open_loop_in(shipped("horizontal-offset-high-mu"),
                            WorldDeviation(pad_mu_scale=0.85, pusher_mu_scale=0.85))
@@ -724,12 +716,11 @@ def test_an_arm_that_never_moves_ends_the_run_in_a_fault_and_is_stopped():
     task = shipped("horizontal-offset-high-mu")
     arm = FakeArm(good=10**9, bad_reply=None, frozen=True)
     with pytest.raises(ArmFault, match="not following") as fault:
-        execute_plan(task, check_plan(task, plan_task(task, seed=1)), "127.0.0.1", arm.port, rate_hz=100.0,
-                     pace=False)
+        execute_plan(task, check_plan(task, plan_task(task, seed=1)), TcpArm("127.0.0.1", arm.port), RunOptions(rate_hz=100.0))
     assert arm.stopped and fault.value.last_confirmed_step < 20
 
 
-def test_closed_loop_corrects_before_the_last_pose_a_switch_over_is_held_from(capsys):
+def test_closed_loop_corrects_before_the_last_pose_a_switch_over_is_held_from():
     """The high-mu offset in a world of 5% less pad mu and 3% less grip (trial 62 of its 1,000-trial
     row): the left pusher sags the prism in the grasp, past the re-plan threshold only at step 12,
     where the pads hold 1.45 times its weight and no correction may switch to the bottom pusher to
@@ -738,7 +729,7 @@ def test_closed_loop_corrects_before_the_last_pose_a_switch_over_is_held_from(ca
     lands."""
     from stablepush.execution.closed_loop import ClosedLoop, switch_held
     from stablepush.execution.guard import GuardedApproach
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     task = shipped("horizontal-offset-high-mu")
     plan = check_plan(task, plan_task(task, seed=1))
@@ -747,13 +738,10 @@ def test_closed_loop_corrects_before_the_last_pose_a_switch_over_is_held_from(ca
     world = WorldDeviation(pad_mu_scale=0.9523, pusher_mu_scale=1.0546, grip_scale=0.9652, mass_scale=1.0496,
                            feature_offsets=(("left", -0.1479, -0.3143, -0.4517), ("right", -0.3103, 0.4178, -0.1418),
                                             ("bottom", 0.2014, -0.2901, 0.0598)))
-    with running_sim_arm(log=lambda text: None, deviation=world) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
-                              guard=GuardedApproach(), closed_loop=ClosedLoop.for_task(task),
-                              success_tolerance=(0.5, 0.5))
+    report = execute_plan(task, plan, SimulatedArm(deviation=world), RunOptions(rate_hz=100.0, guard=GuardedApproach(), closed_loop=ClosedLoop.for_task(task), success_tolerance=(0.5, 0.5)))
     assert report.success is True, (report.goal_error, report.verdict.detail)
     first = report.replans[0]
     assert first.trigger == "last_switch" and first.after_step == 9 and first.solved
     assert first.pushers[0] == "bottom"
-    _print_report(report, verbose=True)
-    assert "after step 9, the last a switch-over is held from: off the plan by" in capsys.readouterr().out
+    assert any("after step 9, the last a switch-over is held from: off the plan by" in line
+               for line in report.describe(verbose=True))

@@ -197,7 +197,7 @@ def test_a_feature_stops_short_of_a_reflex_corner_of_the_object_wherever_it_is_p
     """The T's web feature runs down the web to its corner with the flange: its solid, at home and
     placed off by up to 0.5 mm / 0.5 deg, ends FEATURE_CORNER_GAP short of that corner and nowhere
     else, so the flange passes under it on the approach. The other features keep their segments."""
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
     from stablepush.sim.scene import FEATURE_CORNER_GAP, FEATURE_DEPTH, feature_solid
 
     task = shipped("t-shaped")
@@ -222,7 +222,7 @@ def test_a_feature_stops_short_of_a_reflex_corner_of_the_object_wherever_it_is_p
 
 
 def test_a_deviated_world_scales_every_pad_and_feature_mu():
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     task = shipped("horizontal-offset-low-mu")
     steps = [Waypoint(*task.start), Waypoint(*task.start, pusher="left")]
@@ -234,7 +234,7 @@ def test_a_deviated_world_scales_every_pad_and_feature_mu():
 
 
 def test_the_tracker_reports_the_pose_in_the_grasp_with_the_noise_asked_for():
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
 
     task = shipped("horizontal-offset-low-mu")
     arm = SimArm(scene_description(task, {}, task.start), WorldDeviation(tracker_noise_mm=0.2, tracker_noise_deg=0.1, seed=3))

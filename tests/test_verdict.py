@@ -5,7 +5,7 @@ import dataclasses
 import pytest
 
 from stablepush.execution.closed_loop import Replan
-from stablepush.execution.executor import ContactRecord, ExecutionReport
+from stablepush.execution.report import ContactRecord, ExecutionReport
 from stablepush.execution.verdict import CAUSES, Verdict, judge, success_tolerance, within
 
 from conftest import shipped

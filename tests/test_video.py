@@ -138,17 +138,16 @@ def test_the_ghost_follows_the_re_planned_steps(tmp_path):
     (a new plan that starts with another pusher) shows the measured pose itself, until the guarded
     approach measures it again on the next feature."""
     from stablepush import _core
-    from stablepush.execution import ClosedLoop, execute_plan
-    from stablepush.sim.arm import WorldDeviation
-    from stablepush.sim.server import running_sim_arm
+    from stablepush.execution import ClosedLoop, RunOptions, execute_plan
+    from stablepush.sim.deviation import WorldDeviation
+    from stablepush.sim.local_arm import SimulatedArm
     from stablepush.units import pose_to_si
 
     task = shipped("horizontal-offset-low-mu")
     plan = check_plan(task, plan_task(task, seed=1))
     recording = RunRecording()
-    with running_sim_arm(log=lambda text: None, deviation=WorldDeviation(mu_scale=0.85)) as server:
-        report = execute_plan(task, plan, server.host, server.port, rate_hz=100.0, pace=False,
-                              closed_loop=ClosedLoop.for_task(task), record=recording)
+    report = execute_plan(task, plan, SimulatedArm(deviation=WorldDeviation(mu_scale=0.85)),
+                          RunOptions(rate_hz=100.0, closed_loop=ClosedLoop.for_task(task)), record=recording)
     taken = [r for r in report.replans if r.solved and r.pushes]
     assert taken
     unit = (task.planner["step"][0] * 1e-3, np.radians(task.planner["step"][1]))

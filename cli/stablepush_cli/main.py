@@ -702,30 +702,25 @@ def _check_video(option: str, path: str, fps: float, size) -> None:
         _fail(f"{option}: {exc}")
 
 
-def _write_video(path: str, task, scene: dict, recording, fps: float, size, quiet: bool) -> None:
-    """Draw a recorded run into `path` (stablepush.sim.video), with a progress bar on stderr."""
-    from stablepush.sim.video import render_run
+def _video_output(option: str, path: str, fps: float, size, quiet: bool):
+    """The run's video as an output (stablepush.sim.video.RunVideo), with a progress bar on stderr;
+    exit 2 naming `option` for one that could not be written. Loads MuJoCo for headless rendering
+    (MUJOCO_GL=osmesa), so call it before the simulated arm starts."""
+    _check_video(option, path, fps, size)
+    from stablepush.sim.video import RunVideo
 
     bar = None
 
     def progress(done: int, frames: int) -> None:
         nonlocal bar
-        if quiet:
-            return
         if bar is None:
             bar = click.progressbar(length=frames, label=f"video {path}", file=sys.stderr, show_pos=True)
             bar.__enter__()
         bar.update(1)
-
-    try:
-        info = render_run(path, task, scene, recording.samples, fps=fps, size=size, progress=progress)
-    except OutputError as exc:
-        _fail(f"--video {exc}")
-    finally:
-        if bar is not None:
+        if done == frames:
             bar.__exit__(None, None, None)
-    click.echo(f"video written to {path}: {info.frames} frames, {info.width}x{info.height} at {info.fps:g} fps, "
-               f"drawn in {info.render_s:.1f} s ({info.ms_per_frame:.0f} ms a frame)")
+
+    return RunVideo(path, fps, size, progress=None if quiet else progress)
 
 
 def _host_port(_ctx, _param, value):
@@ -760,7 +755,8 @@ def _host_port(_ctx, _param, value):
 @click.option("--pace/--no-pace", default=None,
               help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
 @click.option("--ack-timeout", default=5.0, show_default=True, type=Finite(min=0.01), metavar="S",
-              help="Give up when the arm does not reply within S seconds.")
+              help="Give up when the arm server does not reply within S seconds (not with --sim: the simulated "
+                   "arm runs in this process, and a waypoint takes as long as it takes).")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the run's report as JSON: success, tolerance, cause of a miss, engine, final pose in the "
                    "grasp, slip per contact, corrections, features (on an arm fault: the verdict and where to resume).")
@@ -836,10 +832,10 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
       stablepush sim-arm --port 47100 &     # or your robot's bridge
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
     """
-    from stablepush.execution import execute_plan, execution_warnings, fault_report
-    from stablepush.execution.guard import GuardedApproach
+    from stablepush.execution import ClosedLoop, GuardedApproach, RunOptions, execution_warnings
+    from stablepush.execution.run import BagRecording, JsonReport, run_plan
     from stablepush.execution.stream import check_resume_from
-    from stablepush.outputs import require_suffix, write_atomically
+    from stablepush.outputs import require_suffix
 
     require_suffix("--record", record_path, (".mcap",))
     if stamp_ns is not None and not record_path:
@@ -850,107 +846,98 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     for warning in execution_warnings(task):
         click.echo(f"warning: {warning}", err=True)
     check_resume_from(plan.waypoints, resume_from, field="--resume-from")
-    loop_options = [name for name, value in (("--replan-threshold", replan_threshold),
-                                             ("--final-tolerance", final_tolerance)) if value]
-    if loop_options and not closed_loop:
-        _fail(f"{' and '.join(loop_options)}: only with --closed-loop")
-    loop = None
-    if closed_loop:
-        from stablepush.execution import ClosedLoop
-
-        loop = ClosedLoop.for_task(task, replan_threshold, final_tolerance)
-    deviated = [name for name, given in (("--engine", engine != DEFAULT_ENGINE), ("--sim-mu-scale", mu_scale != 1.0),
-                                         ("--tracker-noise", any(tracker_noise))) if given]
-    if deviated and not (sim and arm is None):
-        _fail(f"{' and '.join(deviated)}: only with --sim (a simulated arm started here)")
-    if video_path:  # before the simulated arm loads MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
-        _check_video("--video", video_path, video_fps, video_size)
-    else:
+    _only_with("--closed-loop", closed_loop, ("--replan-threshold", replan_threshold),
+               ("--final-tolerance", final_tolerance))
+    _only_with("--sim (a simulated arm started here)", sim and arm is None, ("--engine", engine != DEFAULT_ENGINE),
+               ("--sim-mu-scale", mu_scale != 1.0), ("--tracker-noise", any(tracker_noise)))
+    # The video is made first: the renderer needs MUJOCO_GL=osmesa before the simulated arm loads MuJoCo.
+    video = [_video_output("--video", video_path, video_fps, video_size, quiet)] if video_path else []
+    if not video_path:
         _video_settings_need("--video")
-    sim_arm = contextlib.ExitStack()
+    outputs = ([JsonReport(json_path)] if json_path else []) + (
+        [BagRecording(record_path, stamp_ns)] if record_path else []) + video
+    options = RunOptions(rate_hz=rate_hz, resume_from=resume_from, pace=(not sim) if pace is None else pace,
+                         closed_loop=ClosedLoop.for_task(task, replan_threshold, final_tolerance) if closed_loop
+                         else None,
+                         guard=GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None,
+                         success_tolerance=success_tolerance)
+    target = _arm_for(arm, sim, engine, mu_scale, tracker_noise, ack_timeout, quiet)
+    with _run_progress(task, plan, resume_from, quiet) as progress:
+        run = run_plan(task, plan, target, options, outputs, progress=progress)
+    say = _say_beside(json_path, record_path, video_path)
+    if run.fault is not None:
+        _report_fault(run.fault, plan_file, len(plan.waypoints) - 1, run.written)
+    for line in run.report.describe(verbose) + run.written:
+        say(line)
+    if run.report.success is False:
+        sys.exit(EXIT_MISSED)
+
+
+def _only_with(option: str, given: bool, *others) -> None:
+    """Exit 2 when any of `others` ((name, given) pairs) is given without `option`."""
+    named = [name for name, value in others if value]
+    if named and not given:
+        _fail(f"{' and '.join(named)}: only with {option}")
+
+
+def _arm_for(arm, sim: bool, engine: str, mu_scale: float, tracker_noise, ack_timeout: float, quiet: bool):
+    """The arm a run goes to: a simulated one in this process (--sim), else the arm server at
+    --arm (or the default port here)."""
     if sim and arm is None:
-        from stablepush.sim.arm import WorldDeviation
-        from stablepush.sim.server import running_sim_arm
+        from stablepush.sim.deviation import WorldDeviation
+        from stablepush.sim.local_arm import SimulatedArm
 
         deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0],
                                    tracker_noise_deg=tracker_noise[1])
-        server = sim_arm.enter_context(running_sim_arm(log=(lambda text: None) if quiet else None, deviation=deviation,
-                                                       engine=engine))
-        host, port = server.host, server.port
-    else:
-        host, port = arm or ("127.0.0.1", DEFAULT_PORT)
-    pace = (not sim) if pace is None else pace
+        return SimulatedArm(engine, deviation, log=None if quiet else lambda text: click.echo(f"sim-arm: {text}",
+                                                                                             err=True))
+    from stablepush.execution import TcpArm
 
+    host, port = arm or ("127.0.0.1", DEFAULT_PORT)
+    return TcpArm(host, port, ack_timeout)
+
+
+@contextlib.contextmanager
+def _run_progress(task, plan, resume_from: int, quiet: bool):
+    """A progress bar over the plan's steps (a re-plan may change their number), as the progress
+    callback of a run; None without a terminal."""
     bar = _progressbar(quiet, length=len(plan.waypoints) - 1 - resume_from, label=f"{task.name}: step {resume_from}",
                        show_pos=True)
-    if bar is not None:
-        bar.__enter__()
+    if bar is None:
+        yield None
+        return
     seen = [resume_from]
 
     def progress(waypoint, confirmed, total):
-        if bar is not None and total - resume_from != bar.length:  # a re-plan changed the plan's length
+        if total - resume_from != bar.length:  # a re-plan changed the plan's length
             bar.length = total - resume_from
-        if bar is not None and confirmed > seen[0]:
+        if confirmed > seen[0]:
             bar.label = f"{task.name}: step {confirmed} ({waypoint.phase})"
             bar.update(confirmed - seen[0])
             seen[0] = confirmed
 
-    recording = None
-    if record_path or video_path:
-        from stablepush.execution.bags import RunRecording
+    with bar:
+        yield progress
 
-        recording = RunRecording.for_run(task, plan, closed_loop)
 
-    def video() -> None:
-        if video_path:
-            from stablepush.sim.video import run_scene
-
-            _write_video(video_path, task, run_scene(task, plan, closed_loop, resume_from), recording, video_fps,
-                         video_size, quiet)
-    try:
-        report = execute_plan(task, plan, host, port, rate_hz=rate_hz, resume_from=resume_from, pace=pace,
-                              ack_timeout=ack_timeout, closed_loop=loop,
-                              guard=GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None,
-                              success_tolerance=success_tolerance, progress=progress, record=recording)
-    except ArmFault as fault:
-        if bar is not None:
-            bar.__exit__(None, None, None)
-        if json_path:
-            write_atomically(json_path, json.dumps(fault_report(task, fault, success_tolerance), indent=1) + "\n")
-        if record_path:
-            recording.write(record_path, fault_report(task, fault, success_tolerance), start_ns=stamp_ns)
-        if recording is not None and recording.samples:
-            video()
-        if not fault.connected:
-            click.echo(f"error: {fault.reason}; nothing was sent. Is the arm server running? "
-                       f"(`stablepush sim-arm` serves a simulated arm, or run with --sim)", err=True)
-            sys.exit(EXIT_ARM_FAULT)
-        stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
-        if fault.replanned:  # its steps are the closed loop's, numbered otherwise than the plan file's
-            click.echo(f"error: {fault.reason}; {stopped}; the closed loop had re-planned the run, so no step of "
-                       f"{plan_file} continues it: plan again from where the object is in the grasp (a task whose "
-                       f"start: is the tracked pose)", err=True)
-            sys.exit(EXIT_ARM_FAULT)
-        click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
-                   f"{len(plan.waypoints) - 1}", err=True)
-        ctx = click.get_current_context()
-        click.echo(f"continue with: {_resume_command(ctx, fault.last_confirmed_step)}", err=True)
+def _report_fault(fault, plan_file: str, last_step: int, written) -> None:
+    """Print how a run ended in an arm fault, and where to resume, then exit 3."""
+    for line in written:
+        click.echo(line)
+    if not fault.connected:
+        click.echo(f"error: {fault.reason}; nothing was sent. Is the arm server running? "
+                   f"(`stablepush sim-arm` serves a simulated arm, or run with --sim)", err=True)
         sys.exit(EXIT_ARM_FAULT)
-    finally:
-        sim_arm.close()
-    if bar is not None:
-        bar.__exit__(None, None, None)
-    say = _say_beside(json_path, record_path, video_path)
-    _print_report(report, say, verbose)
-    if json_path:
-        write_atomically(json_path, json.dumps(report.as_dict(), indent=1) + "\n")
-        say(f"report written to {json_path}")
-    if record_path:
-        recording.write(record_path, report.as_dict(), start_ns=stamp_ns)
-        say(f"run recorded to {record_path}")
-    video()
-    if report.success is False:
-        sys.exit(EXIT_MISSED)
+    stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
+    if fault.replanned:  # its steps are the closed loop's, numbered otherwise than the plan file's
+        click.echo(f"error: {fault.reason}; {stopped}; the closed loop had re-planned the run, so no step of "
+                   f"{plan_file} continues it: plan again from where the object is in the grasp (a task whose "
+                   f"start: is the tracked pose)", err=True)
+        sys.exit(EXIT_ARM_FAULT)
+    click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
+               f"{last_step}", err=True)
+    click.echo(f"continue with: {_resume_command(click.get_current_context(), fault.last_confirmed_step)}", err=True)
+    sys.exit(EXIT_ARM_FAULT)
 
 
 # The options of `execute` that say how a run runs, so a resume keeps them (outputs are left out:
@@ -979,81 +966,6 @@ def _resume_command(ctx: click.Context, step: int) -> str:
             words += [param.opts[0], *(f"{v:g}" if isinstance(v, float) else str(v)
                                        for v in (value if isinstance(value, tuple) else (value,)))]
     return shlex.join(words + ["--resume-from", str(step)])
-
-
-def _print_report(report, say=click.echo, verbose: bool = False) -> None:
-    """The run's report in lines, each through `say`: a line per correction and per contact with
-    `verbose`, else one line summing each up."""
-    say(f"{report.task}: steps {report.resumed_from + 1}-{report.last_confirmed_step} of {report.total_steps} "
-         f"confirmed, {report.waypoints} waypoints in {report.wall_time_s:.1f} s"
-         + (f" ({report.sim_steps_per_s:.0f} simulation steps/s)" if report.sim_steps_per_s else ""))
-    err = report.final_error
-    if err is None:
-        say("the arm does not report the object, so the final pose in the grasp is not measured")
-        return
-    x, z, th = report.planned_final
-    f = report.final_in_grasp
-    say(f"on the last feature, in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
-        f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg")
-    change = report.release_change
-    if report.ends_on_feature:
-        say("the run ends with the object on its last feature (environment.end_on_feature), and is judged there")
-    elif change is not None:
-        r = report.released_in_grasp
-        say(f"at rest after the release: x {r['x']:.3f} z {r['z']:.3f} mm, theta {r['theta']:.3f} deg; it moved "
-            f"{math.hypot(change['x'], change['z']):.3f} mm, {change['theta']:+.3f} deg when the feature let go")
-    if report.guard == "no tracker":
-        say("guard: the arm reports no object_in_grasp (no tracker), so each approach ended where the plan "
-             "puts its feature")
-    if report.closed_loop == "no tracker":
-        say("closed loop: the arm reports no object_in_grasp (no tracker), so the plan ran open loop")
-    if not verbose:
-        _sum_up_run(report, say)
-    for r in report.replans if verbose else ():
-        off, ref = {"off_goal": (r.measured, report.goal), "plan_short": (r.planned, report.goal)}.get(
-            r.trigger, (r.measured, r.planned))
-        dx, dz, dth = (m - p for m, p in zip(off, ref))
-        if r.solved and r.pushes == 0:
-            outcome = "within the final tolerance of the goal already; nothing to correct"
-        elif r.solved:
-            kept = ", starting with the pusher in contact" if r.kept_pusher and len(r.pushers) > 1 else ""
-            kept = " (the pusher in contact alone)" if r.kept_pusher and len(r.pushers) == 1 else kept
-            how = f" (search: {r.attempt})" if r.attempt else ""
-            outcome = f"re-planned {r.pushes} push(es), {' -> '.join(r.pushers)}{kept}{how}"
-        else:
-            outcome = f"no correction taken: {r.failure}; kept the plan"
-        when = {"off_goal": f"after step {r.after_step}: off the goal by",
-                "on_touch": f"on the feature of step {r.after_step + 1}: off the plan by",
-                "last_switch": f"after step {r.after_step}, the last a switch-over is held from: off the plan by",
-                "plan_short": "before the first push: the plan ends off the goal by"}.get(
-            r.trigger, f"after step {r.after_step}: off the plan by")
-        say(f"  {when} {math.hypot(dx, dz):.3f} mm, {dth:+.3f} deg; {outcome} ({r.planning_ms:.1f} ms)")
-    for c in report.contacts if verbose else ():
-        if c.slip_mm is not None:
-            found = "" if c.found_mm is None else f"feature found {c.found_mm:+.3f} mm from its place; "
-            found += "" if c.seated_deg is None else f"seated turned {c.seated_deg:+.3f} deg; "
-            say(f"  {c.pusher:<12} steps {c.first_step:>3}-{c.last_step:<3} {found}carried to the feature "
-                 f"{c.carried_mm:.3f} mm, then slip at the pusher {c.slip_mm:.3f} mm, {c.slip_deg:.3f} deg")
-    verdict = report.verdict
-    if verdict is not None and verdict.success is not None:
-        say(f"verdict: {verdict.detail}" + (f" [cause: {verdict.cause}]" if verdict.cause else ""))
-
-
-def _sum_up_run(report, say) -> None:
-    """The corrections and the contacts in a line each (`execute -v` prints each, --json keeps all)."""
-    taken = [r for r in report.replans if r.solved and r.pushes]
-    failed = [r for r in report.replans if not r.solved]
-    if report.replans:
-        last = f"; the last found none: {failed[-1].failure}" if failed else ""
-        say(f"closed loop: {len(report.replans)} comparison(s) off the plan, {len(taken)} correction(s) taken, "
-            f"{len(failed)} with none found{last} (each with -v)")
-    measured = [c for c in report.contacts if c.slip_mm is not None]
-    if measured:
-        worst = max(measured, key=lambda c: c.slip_mm)
-        carried = max(c.carried_mm or 0.0 for c in measured)
-        say(f"{len(measured)} contact(s): the most slip at a pusher {worst.slip_mm:.3f} mm, {worst.slip_deg:.3f} deg "
-            f"({worst.pusher}, steps {worst.first_step}-{worst.last_step}); the most carried to a feature "
-            f"{carried:.3f} mm (each with -v)")
 
 
 def _vary(_ctx, _param, values):
@@ -1404,7 +1316,7 @@ def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, se
     (one waypoint period per waypoint), headless, and reports its steps/s. Each acknowledgement carries
     the object's pose in the grasp as a tracker would (`object_in_grasp`), with --tracker-noise.
     """
-    from stablepush.sim.arm import WorldDeviation
+    from stablepush.sim.deviation import WorldDeviation
     from stablepush.sim.server import SimArmServer
 
     deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1],

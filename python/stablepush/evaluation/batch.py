@@ -21,18 +21,18 @@ from typing import Callable, Dict, List, Optional, Tuple
 
 import numpy as np
 
-from stablepush.errors import ArmFault
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.bags import RunRecording
 from stablepush.execution.closed_loop import ClosedLoop
-from stablepush.execution.executor import execute_plan, execution_warnings
+from stablepush.execution.executor import RunOptions, execution_warnings
 from stablepush.execution.guard import GuardedApproach
+from stablepush.execution.run import run_plan
 from stablepush.execution.verdict import success_tolerance, tolerance_used, within
 from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
 from stablepush.runners import Runner, WorkerLost, run_all
-from stablepush.sim.arm import WorldDeviation
-from stablepush.sim.server import SIM_ACK_TIMEOUT, running_sim_arm
+from stablepush.sim.deviation import WorldDeviation
+from stablepush.sim.local_arm import SimulatedArm
 from stablepush.task.model import Task
 from stablepush.units import angle_difference_deg
 
@@ -124,38 +124,43 @@ def run_trial(batch: Batch, trial: int) -> dict:
     world = batch.world(trial)
     started = time.perf_counter()
     record = {"trial": trial, "world": world.as_dict()}
-    recording = RunRecording() if batch.video_dir else None
+    recording = None
     try:
         loop = ClosedLoop.for_task(batch.task) if batch.closed_loop else None
-        with running_sim_arm(log=lambda text: None, deviation=deviation_of(batch, world),
-                             engine=batch.engine) as server:
-            report = execute_plan(batch.task, batch.plan, server.host, server.port, rate_hz=RATE_HZ, pace=False,
-                                  ack_timeout=SIM_ACK_TIMEOUT, closed_loop=loop, guard=guard_of(batch),
-                                  success_tolerance=batch.tolerance, record=recording)
-        record.update(final_error=report.final_error, goal_error=report.goal_error,
-                      replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
-                      cause=report.verdict.cause if report.verdict else None,
-                      verdict=report.verdict.detail if report.verdict else None,
-                      sim_time_s=report.waypoints / RATE_HZ, error=None)
-    except ArmFault as fault:  # the simulated arm failed (a simulator blow-up, a protocol error): stopped
-        record.update(_not_run("arm_fault", str(fault)))
+        options = RunOptions(rate_hz=RATE_HZ, closed_loop=loop, guard=guard_of(batch),
+                             success_tolerance=batch.tolerance)
+        arm = SimulatedArm(batch.engine, deviation_of(batch, world))
+        run = run_plan(batch.task, batch.plan, arm, options, keep_recording=bool(batch.video_dir))
+        recording = run.recording
+        if run.fault is not None:  # the simulated arm failed (a simulator blow-up, an unreachable pose): stopped
+            record.update(_not_run("arm_fault", str(run.fault)))
+        else:
+            report = run.report
+            record.update(final_error=report.final_error, goal_error=report.goal_error,
+                          replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
+                          cause=report.verdict.cause if report.verdict else None,
+                          verdict=report.verdict.detail if report.verdict else None,
+                          sim_time_s=report.waypoints / RATE_HZ, error=None)
     except Exception as exc:  # noqa: BLE001 - a crashed trial is a result, not the end of the batch
         last = traceback.extract_tb(exc.__traceback__)[-1]
         where = f"{os.path.basename(last.filename)}:{last.lineno}"
         record.update(_not_run("crash", f"{type(exc).__name__}: {exc} ({where})"))
     record["wall_s"] = time.perf_counter() - started
-    if recording is not None:
+    if batch.video_dir:
         record["video"] = None if record["success"] else _failed_trial_video(batch, trial, world, recording, record)
     return record
 
 
-def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: RunRecording, record: dict):
+def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: Optional[RunRecording], record: dict):
     """Draw a failed trial's recorded run in its own world (features where this trial put them)
     into video_dir/trial-<i>.mp4 and return the path; None, with `video_error` in the record, when
     it cannot be drawn (no waypoint was acknowledged, say). Never raises: the trial's record stands."""
     from stablepush.sim.video import render_run, run_scene
 
     path = os.path.join(batch.video_dir, f"trial-{trial}.mp4")
+    if recording is None:
+        record["video_error"] = "the trial crashed before its run was recorded"
+        return None
     try:
         scene = deviation_of(batch, world).apply(run_scene(batch.task, batch.plan, batch.closed_loop))
         render_run(path, batch.task, scene, recording.samples, fps=batch.video_fps, size=batch.video_size)

@@ -1,5 +1,6 @@
 """Execution: a checked plan in the world (features, scene), the waypoints that carry it out, the
-arm protocol, the executor that streams them, and the closed loop that corrects a run. Builds on
+arm port and its protocol, the executor that streams them, the closed loop that corrects a run,
+and the run with its outputs (run.py). Builds on
 `stablepush.plan` and `stablepush.task`; knows nothing of any simulator.
 
 The names below are loaded when first used, so that importing one module of the package (the
@@ -8,11 +9,17 @@ arm protocol, say) does not load the executor.
 import importlib
 
 _EXPORTS = {
+    "Arm": "stablepush.execution.arm",
+    "ArmError": "stablepush.execution.arm",
+    "ArmReady": "stablepush.execution.arm",
+    "TcpArm": "stablepush.execution.tcp_arm",
     "ClosedLoop": "stablepush.execution.closed_loop",
-    "ExecutionReport": "stablepush.execution.executor",
+    "GuardedApproach": "stablepush.execution.guard",
+    "ExecutionReport": "stablepush.execution.report",
+    "fault_report": "stablepush.execution.report",
+    "RunOptions": "stablepush.execution.executor",
     "execute_plan": "stablepush.execution.executor",
     "execution_warnings": "stablepush.execution.executor",
-    "fault_report": "stablepush.execution.executor",
     "Verdict": "stablepush.execution.verdict",
     "Trajectory": "stablepush.execution.trajectory",
     "timed_trajectory": "stablepush.execution.trajectory",

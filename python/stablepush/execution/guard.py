@@ -28,14 +28,17 @@ z mm, theta deg).
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, replace
-from typing import List, Mapping, Sequence
+from typing import Dict, List, Mapping, Optional, Sequence
 
 import numpy as np
 
+from stablepush.execution.stream import ArmWaypoint, arm_trajectory, contact_first, past_touch, renumbered
 from stablepush.execution.world import RESTING_ANGLE, Feature
 from stablepush.frames import angle_about_y, grasp_transform, pose_to_matrix, rot_y
 from stablepush.plan.plan import Waypoint
+from stablepush.task.model import Task
 from stablepush.units import MM, angle_difference_deg
 
 # Valid ranges of the guard's parameters (mm, deg, N, s). A touch threshold below the sensor's noise
@@ -157,3 +160,93 @@ def offset_along_approach_mm(planned: Feature, found: Feature) -> float:
     shift = found.object_pose[:3, 3] - planned.object_pose[:3, 3]
     return float(-np.dot(planned.normal, shift)) / MM
 
+
+def measured_pose(planned: Sequence[float], tracked: dict) -> tuple:
+    """The tracker's pose in the grasp (x mm, z mm, theta deg) with theta on the planned pose's turn (a
+    plan may run past +-180 deg; a tracker reports one turn)."""
+    theta = planned[2] + angle_difference_deg(float(tracked["theta"]), planned[2])
+    return float(tracked["x"]), float(tracked["z"]), theta
+
+
+class GuardWatch:
+    """The guarded approach through one run (guard.py): from the first waypoint of an approach's
+    slow end, watch for the touch; on it, hold still, then splice in the contact started from the
+    measured pose on the feature where it was found; at the plan's touch with nothing met, seek on
+    past it. After a contact's first push, splice in the pushes left on the feature where the
+    object rests (seated). `found` and `seated`: the contact's first push (plan step) -> where its
+    feature was found (mm) and how the object rested turned on it (deg), keyed as the run's contact
+    records are."""
+
+    def __init__(self, guard: Optional[GuardedApproach]):
+        self.guard = guard
+        self.status = "off" if guard is None else "on"  # or "no tracker"
+        self.found: Dict[int, float] = {}
+        self.seated: Dict[int, float] = {}
+        self._clear()
+
+    def _clear(self) -> None:
+        self.since: Optional[dict] = None  # the pose in the grasp as the slow end began
+        self.sought_past = False  # this approach has gone on past the plan's touch
+        self.holding = False  # met: held still before the pose is measured
+
+    def before(self, w: ArmWaypoint, state: dict) -> None:
+        """Before waypoint `w` is sent, with the arm's last `state`."""
+        if not w.guarded:
+            if w.phase != "approach":
+                self._clear()
+            return
+        if self.since is None and self.status == "on":
+            if "object_in_grasp" in state:
+                self.since = state["object_in_grasp"]
+            else:
+                self.status = "no tracker"  # no pose in the grasp to start from: approach as planned
+
+    def after(self, task: Task, steps: List[Waypoint], features: Dict[str, Feature], w: ArmWaypoint,
+              state: dict, pending: deque, rate_hz: float):
+        """After the arm acknowledged `w` with `state`: the new (steps, pending waypoints) when the
+        stream changes here, else None. `features` is updated in place with a feature found."""
+        if w.completes and w.phase == "push" and self.status == "on":
+            return self._seated(task, steps, features, w, state, rate_hz)
+        if not w.guarded or self.since is None:
+            return None
+        k, pusher = w.step, steps[w.step + 1].pusher
+        slow_end_left = bool(pending) and pending[0].guarded
+        if self.holding:
+            if slow_end_left:
+                return None
+            # Held still: the contact's pushes start from where the object is, on the feature where it is.
+            measured = measured_pose(steps[k].pose, state["object_in_grasp"])
+            on_feature = touched_feature(features[pusher], state["ee_pose"], measured)
+            self.found[k + 1] = offset_along_approach_mm(features[pusher], on_feature)
+            features[pusher] = on_feature
+            steps = from_touch(steps, k, measured)
+            self.since, self.holding = None, False
+            return steps, renumbered(w, rate_hz, arm_trajectory(task, steps, features, rate_hz, state["ee_pose"],
+                                                                 resume_from=k, resting_on=pusher))
+        if self.guard.met(self.since, state["object_in_grasp"], state.get("contact_force")):
+            self.holding = True
+            return steps, renumbered(w, rate_hz, [w] * max(1, round(self.guard.hold_s * rate_hz)))
+        if not slow_end_left and not self.sought_past:  # at the plan's touch, nothing met: seek on past it
+            self.sought_past = True
+            past = past_touch(features[pusher], w.pose, self.guard.reach_mm * MM, rate_hz, k, [s.pose for s in steps])
+            return steps, renumbered(w, rate_hz, past + list(pending))
+        return None
+
+    def _seated(self, task: Task, steps: List[Waypoint], features: Dict[str, Feature], w: ArmWaypoint, state: dict,
+                rate_hz: float):
+        """After push w.step: when it is its contact's first and more follow, the pushes left re-based
+        on the feature where the object rests (guard.seated_feature), else None."""
+        k = w.step
+        pusher = steps[k].pusher
+        if contact_first(steps, k) != k or k + 1 >= len(steps) or steps[k + 1].pusher != pusher \
+                or "object_in_grasp" not in state:
+            return None
+        measured = measured_pose(steps[k].pose, state["object_in_grasp"])
+        seated = seated_feature(features[pusher], state["ee_pose"], measured)
+        self.seated[k] = turned_deg(features[pusher], seated)
+        if abs(self.seated[k]) <= self.guard.seat_deg:
+            return None
+        features[pusher] = seated
+        steps = from_touch(steps, k, measured)
+        return steps, renumbered(w, rate_hz, arm_trajectory(task, steps, features, rate_hz, state["ee_pose"],
+                                                             resume_from=k, resting_on=pusher))

@@ -16,7 +16,9 @@ Poses are (x, y, z, qw, qx, qy, qz) in W [m].
 """
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections import deque
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
@@ -213,3 +215,18 @@ def _with(T: np.ndarray, **coordinate) -> np.ndarray:
     for axis, value in coordinate.items():
         out["xyz".index(axis), 3] = value
     return out
+
+
+def renumbered(w: ArmWaypoint, rate_hz: float, points: Sequence[ArmWaypoint]) -> deque:
+    """`points` streamed next after `w`: seq and t counted on from it."""
+    period = 1.0 / rate_hz
+    return deque(dataclasses.replace(p, seq=w.seq + 1 + i, t=w.t + (i + 1) * period) for i, p in enumerate(points))
+
+
+def contact_first(steps: Sequence[Waypoint], step: int) -> int:
+    """The first push of the contact that plan step `step` (a push) belongs to: the run's contact
+    records and the guard's findings are keyed by it."""
+    first = step
+    while first > 1 and steps[first - 1].pusher == steps[step].pusher:
+        first -= 1
+    return first

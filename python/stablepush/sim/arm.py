@@ -6,80 +6,15 @@ midway between the pads.
 """
 from __future__ import annotations
 
-import copy
-import math
 import time
-from dataclasses import dataclass
-from typing import Callable, Dict, Optional, Sequence, Tuple
+from typing import Callable, Dict, Sequence
 
 import numpy as np
 
-from stablepush.frames import angle_about_y, matrix_to_pose, pose_to_matrix, rot_y
-from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
+from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.friction import CoulombPadFriction, mujoco
-
-SETTLE_TIME = 0.3  # s of simulation after the grasp closes, before the first waypoint
-
-
-def in_grasp(T_world_gripper: np.ndarray, T_world_object: np.ndarray) -> Dict[str, float]:
-    """The object's pose in the grasp as docs/model.md section 1 defines it (x, z mm; theta deg), with the
-    out-of-plane parts (y mm, tilt deg) that the planar model assumes to be zero."""
-    T = np.linalg.inv(T_world_gripper) @ T_world_object
-    R = T[:3, :3]
-    tilt = math.degrees(math.acos(max(-1.0, min(1.0, R[1, 1]))))
-    return {"x": T[0, 3] * 1e3, "z": T[2, 3] * 1e3, "theta": math.degrees(angle_about_y(R)),
-            "y": T[1, 3] * 1e3, "tilt": tilt}
-
-
-@dataclass(frozen=True)
-class WorldDeviation:
-    """How the simulated world departs from the task it is given, to test plans against a world that
-    differs from their model: every pad's and feature's mu times `mu_scale`, the pads' mu also times
-    `pad_mu_scale` and the features' times `pusher_mu_scale`, the grip force times `grip_scale`, the
-    object's mass (and inertia) times `mass_scale`, each feature `feature_offsets` off where the
-    plan puts it ((pusher, dx mm, dz mm, dtheta deg) in the world's x, z and about y through the
-    middle of its segment), and a tracker whose `object_in_grasp` carries Gaussian noise (standard
-    deviations in mm and deg, drawn from `seed`)."""
-
-    mu_scale: float = 1.0
-    tracker_noise_mm: float = 0.0
-    tracker_noise_deg: float = 0.0
-    seed: int = 0
-    pad_mu_scale: float = 1.0
-    pusher_mu_scale: float = 1.0
-    grip_scale: float = 1.0
-    mass_scale: float = 1.0
-    feature_offsets: Tuple[Tuple[str, float, float, float], ...] = ()
-
-    def apply(self, scene: dict) -> dict:
-        """`scene` (a scene description, SI units) as this world has it; the scene itself unchanged."""
-        scene = copy.deepcopy(scene)
-        scene["gripper"]["mu"] *= self.mu_scale * self.pad_mu_scale
-        scene["gripper"]["grip_force"] *= self.grip_scale
-        obj = scene["object"]
-        obj["mass"] *= self.mass_scale
-        obj["inertia"] *= self.mass_scale
-        offsets = {name: (dx, dz, dth) for name, dx, dz, dth in self.feature_offsets}
-        for feature in scene["features"]:
-            feature["mu"] *= self.mu_scale * self.pusher_mu_scale
-            if feature["pusher"] in offsets:
-                _move_feature(feature, *offsets[feature["pusher"]])
-        return scene
-
-
-def _move_feature(feature: dict, dx_mm: float, dz_mm: float, dtheta_deg: float) -> None:
-    """Turn a feature by dtheta about the world's y through the middle of its segment, then shift it,
-    with the object's pose on it (its segment stays where it was on the object)."""
-    a, b = np.asarray(feature["from"], float), np.asarray(feature["to"], float)
-    middle = (a + b) / 2
-    move = np.eye(4)  # the turn about the middle, then the shift, as one rigid motion in W
-    move[:3, :3] = rot_y(math.radians(dtheta_deg))
-    move[:3, 3] = middle + np.array([dx_mm * 1e-3, 0.0, dz_mm * 1e-3]) - move[:3, :3] @ middle
-    feature["from"] = (move @ np.append(a, 1.0))[:3].tolist()
-    feature["to"] = (move @ np.append(b, 1.0))[:3].tolist()
-    feature["normal"] = (move[:3, :3] @ np.asarray(feature["normal"], float)).tolist()
-    feature["object_pose"] = matrix_to_pose(move @ pose_to_matrix(feature["object_pose"]))
+from stablepush.sim.tracking import SETTLE_TIME, TrackingArm, in_grasp
 
 
 class SimulatedGrasp:
@@ -178,82 +113,6 @@ class SimulatedGrasp:
     @property
     def steps_per_second(self) -> float:
         return self.steps / self.step_wall_time if self.step_wall_time > 0 else 0.0
-
-
-class TrackingArm:
-    """What the arm does the same on every engine: the world `deviation` makes of the scene, IK on
-    the engine's kinematics (`_kinematics(q)` -> R_WG, p_WG, J; `ik.solve_ik`) from the home
-    posture, servo set-points moved linearly from one streamed waypoint's joint angles to the
-    next's over the waypoint period (`_set_servos`, `_run`), and the report with the tracker's
-    noise. Mixed in before the engine's grasp class, whose constructor takes the altered scene."""
-
-    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(deviation.apply(scene))
-        self.scene = scene
-        self.deviation = deviation
-        self._tracker_rng = np.random.default_rng(deviation.seed)
-
-    def _find_home(self) -> np.ndarray:
-        """The joint angles [rad] that put G at the scene's gripper pose: the posture IK's
-        null space pulls toward, and the servos' first target."""
-        self.home_posture = ik.HOME_GUESS.copy()
-        self.home_posture = self.solve_ik(self.scene["gripper_pose"], ik.HOME_GUESS, strict=True, iterations=1000)
-        self.target = self.home_posture.copy()
-        return self.home_posture
-
-    def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, strict: bool = False,
-                 iterations: int = ik.IK_ITERATIONS) -> np.ndarray:
-        """Joint angles [rad] that put G at `pose`, from `q_start`."""
-        q, error = ik.solve_ik(self._kinematics, pose, q_start, self.home_posture, self._lower, self._upper,
-                               iterations)
-        if strict and error > 1e-6:
-            raise ik.unreachable(pose, error)
-        self.ik_error = error
-        return q
-
-    def advance(self, duration: float, target: Optional[np.ndarray] = None) -> None:
-        """Step the physics for `duration` s while the joint servo set-points move linearly from the
-        current target to `target` (the servos interpolate between streamed waypoints)."""
-        n = max(1, int(round(duration / self.timestep)))
-        start = self.target.copy()
-        end = start if target is None else np.asarray(target, float)
-        self._run(n, lambda i: self._set_servos(start + (end - start) * (i / n)))
-        self.target = end.copy()
-
-    def move_to(self, pose: Sequence[float], duration: float) -> None:
-        """Track G toward `pose` over `duration` s (one streamed waypoint period). ValueError, the
-        arm held where it is, when no joint angles within the limits put G there (IK_REACH):
-        driven there anyway, the servos fight the limits and the arm leaves the stream."""
-        q = self.solve_ik(pose, self.target)
-        if self.ik_error > ik.IK_REACH:  # slow to converge near the edge of reach: look harder first
-            q = self.solve_ik(pose, self.target, iterations=10 * ik.IK_ITERATIONS)
-        if self.ik_error > ik.IK_REACH:
-            raise ik.unreachable(pose, self.ik_error)
-        self.advance(duration, q)
-
-    def _report(self, time_s: float, joints, contact_force: bool) -> dict:
-        """The arm's state message: G's pose and the joints [rad]; the tracker's `object_in_grasp`,
-        the truth plus the deviation's noise; with `contact_force`, the features' force on the object
-        (N, W), what a wrist force-torque sensor reads with the held load compensated; the
-        object's true world pose."""
-        T_g, T_o = self.gripper_matrix(), self.object_matrix()
-        tracked = in_grasp(T_g, T_o)
-        d = self.deviation
-        if d.tracker_noise_mm > 0 or d.tracker_noise_deg > 0:
-            nx, nz, nth = self._tracker_rng.normal(0.0, [d.tracker_noise_mm, d.tracker_noise_mm, d.tracker_noise_deg])
-            tracked.update(x=tracked["x"] + nx, z=tracked["z"] + nz, theta=tracked["theta"] + nth)
-        report = {
-            "time": time_s,
-            "ee_pose": matrix_to_pose(T_g),
-            "joints": [float(v) for v in joints],
-            "object_pose": matrix_to_pose(T_o),
-            "object_in_grasp": tracked,
-            "steps_per_s": round(self.steps_per_second, 1),
-        }
-        if contact_force:
-            report["contact_force"] = [float(v) for v in sum((self.contact_force_on_object(f["pusher"])
-                                                              for f in self.scene["features"]), np.zeros(3))]
-        return report
 
 
 class SimArm(TrackingArm, SimulatedGrasp):

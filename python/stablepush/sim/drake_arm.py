@@ -38,7 +38,8 @@ import numpy as np
 from stablepush.extras import require
 from stablepush.frames import pose_to_matrix
 from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import SETTLE_TIME, TrackingArm, WorldDeviation, in_grasp
+from stablepush.sim.deviation import WorldDeviation
+from stablepush.sim.tracking import SETTLE_TIME, TrackingArm, in_grasp
 
 DRAKE_TIMESTEP = 0.000125  # s (the friction-fidelity contract fails at 0.2 ms: module docstring)
 DRAKE_APPROXIMATION = "lagged"  # DiscreteContactApproximation: sap, similar or lagged
@@ -308,7 +309,7 @@ class DrakeGrasp:
         return self._object_body.EvalPoseInWorld(self.plant_context).GetAsMatrix4()
 
     def in_grasp(self) -> Dict[str, float]:
-        """The object's true pose in the grasp now (see `arm.in_grasp`)."""
+        """The object's true pose in the grasp now (see `tracking.in_grasp`)."""
         return in_grasp(self.gripper_matrix(), self.object_matrix())
 
     def _results(self):

@@ -22,15 +22,17 @@ def load_engine(engine: str) -> str:
     from stablepush.extras import require
 
     if check_engine(engine) == "drake":
-        require("pydrake.all", "--engine drake")
-    require("mujoco", "the simulated arm (execute --sim, evaluate, sim-arm)")  # Drake's arm reads MuJoCo's MJCF
+        require("pydrake.all", "--engine drake")  # the arm's MJCF is read by Drake's parser: no MuJoCo needed
+    else:
+        require("mujoco", "the simulated arm (execute --sim, evaluate, sim-arm)")
     return engine
 
 
 def make_arm(engine: str, scene: dict, deviation=None):
     """The simulated arm of `scene` on `engine` (SimArm or DrakeArm), in the world `deviation`
-    (an `arm.WorldDeviation`; None: the task's own)."""
-    from stablepush.sim.arm import SimArm, WorldDeviation
+    (a `deviation.WorldDeviation`; None: the task's own)."""
+    from stablepush.sim.arm import SimArm
+    from stablepush.sim.deviation import WorldDeviation
 
     deviation = deviation or WorldDeviation()
     if check_engine(engine) == "drake":

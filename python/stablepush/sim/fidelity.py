@@ -224,16 +224,14 @@ class ArmPivotResult:
 def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1,
                  engine: str = DEFAULT_ENGINE) -> ArmPivotResult:
     """Run the first `pushes` pushes of `task`'s plan (seed `seed`) on the simulated arm, open loop."""
-    from stablepush.execution.executor import execute_plan  # the executor is the arm's client, not the rig's
-    from stablepush.sim.server import SIM_ACK_TIMEOUT, running_sim_arm
+    from stablepush.execution.run import RunOptions, run_plan  # a run on the arm, not the rig's
+    from stablepush.sim.local_arm import SimulatedArm
 
     full = check_plan(task, plan_task(task, seed=seed))
     # The first pushes are a plan of the task whose goal is where they end: the executor runs only
     # a plan of the task it is given (check_plan).
     first = dataclasses.replace(task, goal=tuple(full.waypoints[pushes].pose))
     plan = dataclasses.replace(full, waypoints=full.waypoints[:pushes + 1], task_identity=first.identity())
-    with running_sim_arm(log=lambda text: None, engine=engine) as server:
-        report = execute_plan(first, plan, server.host, server.port, rate_hz=100.0, pace=False,
-                              ack_timeout=SIM_ACK_TIMEOUT)
+    report = run_plan(first, plan, SimulatedArm(engine), RunOptions(rate_hz=100.0)).report_or_fault()
     return ArmPivotResult(pushes=len(plan.waypoints) - 1, error_mm=report.final_error["distance"],
                           error_deg=report.final_error["theta"], steps_per_s=report.sim_steps_per_s)

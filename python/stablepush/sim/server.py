@@ -1,4 +1,5 @@
-"""`stablepush sim-arm`: the simulated arm (arm.py) behind the arm protocol (stablepush.execution.protocol).
+"""`stablepush sim-arm`: an in-process simulated arm (local_arm.py) served over the arm protocol
+(stablepush.execution.protocol), for a client in another process or on another machine.
 
 One session at a time: a second client is told the arm is busy and let go. Each session starts
 from a fresh world built from its hello's scene, unless the hello asks to `continue` and the scene
@@ -16,14 +17,14 @@ import threading
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator, Optional
 
+from stablepush.execution.arm import ArmError
 from stablepush.execution.protocol import LineReader, ProtocolError, decode, encode
-from stablepush.sim.arm import WorldDeviation
-from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
-from stablepush.sim.scene import simulated_outline
+from stablepush.execution.stream import ArmWaypoint
+from stablepush.sim.deviation import WorldDeviation
+from stablepush.sim.engines import DEFAULT_ENGINE
+from stablepush.sim.local_arm import SimulatedArm
 from stablepush.task.schema import MAX_PAD_RINGS, MAX_PADS, MAX_PUSHERS, MAX_VERTICES
 
-# The scene keys that describe the world; the object's pose at the start may differ on a resume.
-_START_KEYS = ("object_pose", "object_in_grasp")
 DEFAULT_IDLE_TIMEOUT = 30.0  # s a client may stay silent within a session
 BUSY_WAIT = 2.0  # s a new client waits for a session to end before it is told the arm is busy
 
@@ -50,10 +51,6 @@ def check_scene_size(scene: dict) -> None:
     length("features", scene.get("features"), MAX_PUSHERS)
 
 
-def _world(scene: Optional[dict]) -> Optional[dict]:
-    return None if scene is None else {k: v for k, v in scene.items() if k not in _START_KEYS}
-
-
 class SimArmServer:
     """Serves the simulated arm on host:port (port 0 picks a free one; see `.port`)."""
 
@@ -62,13 +59,11 @@ class SimArmServer:
                  idle_timeout: float = DEFAULT_IDLE_TIMEOUT, engine: str = DEFAULT_ENGINE):
         self.log = log or (lambda text: print(f"sim-arm: {text}", file=sys.stderr, flush=True))
         self.exit_after = exit_after  # fault injection: die abruptly after this many waypoints
-        self.deviation = deviation  # how the simulated world departs from each task's model
         self.idle_timeout = idle_timeout
-        # The physics engine every session's world is built on, loaded here: a missing one is the
-        # caller's to hear of (MissingExtra), not a hello's that fails later in the server's thread.
-        self.engine = load_engine(engine)
-        self.arm = None
-        self._scene: Optional[dict] = None
+        # One arm for every session, so that a session may continue the last one's world; its engine
+        # is loaded here: a missing one is the caller's to hear of (MissingExtra), not a hello's.
+        self.arm = SimulatedArm(engine, deviation, log=self.log)
+        self.engine = self.arm.engine
         self._waypoints = 0
         self._session = threading.Lock()
         self._socket = socket.create_server((host, port))
@@ -123,8 +118,7 @@ class SimArmServer:
         except Exception as exc:  # noqa: BLE001 - a session must never take the server down
             self.log(f"session ended by {type(exc).__name__}: {' '.join(str(exc).split())[:200]}")
         finally:
-            if self.arm is not None:
-                self.arm.stop()
+            self.arm.stop()
             self._session.release()  # before the client sees the connection close, so it may come straight back
             connection.close()
 
@@ -140,25 +134,24 @@ class SimArmServer:
                 if not greeted and kind != "hello":
                     raise ProtocolError(f"expected hello first, got {kind!r}")
                 if kind == "hello":
-                    self._hello(message)
+                    check_scene_size(message["scene"])
+                    ready = self.arm.hello(message["scene"], message["rate_hz"], message.get("continue") is True)
                     greeted = True
                     expected_seq = 0
-                    reply = {"type": "ready", "protocol": message["protocol"],
-                             "arm": f"stablepush sim-arm ({self.engine})", "engine": self.engine,
-                             "state": self.arm.state()}
+                    reply = {"type": "ready", "protocol": message["protocol"], "arm": ready.arm,
+                             "engine": ready.engine, "state": ready.state}
                 elif kind == "waypoint":
                     if message["seq"] != expected_seq:
                         raise ProtocolError(f"out-of-order waypoint: expected seq {expected_seq}, got {message['seq']}")
-                    self.arm.move_to(message["pose"], self._period)
+                    state = self.arm.move(ArmWaypoint(seq=message["seq"], t=message["t"], step=message["step"],
+                                                      completes=False, phase=message["phase"],
+                                                      pose=tuple(message["pose"])))
                     expected_seq += 1
                     self._waypoints += 1
                     if self.exit_after is not None and self._waypoints >= self.exit_after:
                         self.log(f"exiting after {self._waypoints} waypoints (--exit-after)")
                         os._exit(3)
-                    # The wrist's force during approaches, where the guarded approach reads it: on Drake
-                    # it costs as much as the step (its contact results), so not on every ack.
-                    reply = {"type": "ack", "seq": message["seq"],
-                             "state": self.arm.state(contact_force=message["phase"] == "approach")}
+                    reply = {"type": "ack", "seq": message["seq"], "state": state}
                 elif kind == "stop":
                     self.arm.stop()
                     reply = {"type": "stopped", "state": self.arm.state()}
@@ -166,9 +159,8 @@ class SimArmServer:
                     self.log(f"run ended after {expected_seq} waypoints; {self.arm.steps_per_second:.0f} steps/s")
                     return
                 connection.sendall(encode(reply))
-            except (TimeoutError, ConnectionError, ProtocolError, ValueError, KeyError, TypeError) as exc:
-                if self.arm is not None:  # stopped before the client hears of it
-                    self.arm.stop()
+            except (TimeoutError, ConnectionError, ProtocolError, ArmError, ValueError, KeyError, TypeError) as exc:
+                self.arm.stop()  # stopped before the client hears of it
                 self._end(connection, exc, message, expected_seq)
                 return
 
@@ -185,23 +177,6 @@ class SimArmServer:
         _send_quietly(connection, {"type": "error", "seq": seq if isinstance(seq, int) else None,
                                    "message": f"{exc}; the arm is stopped"})
 
-    def _hello(self, message: dict) -> None:
-        scene = message["scene"]
-        self._period = 1.0 / float(message["rate_hz"])
-        if self.arm is not None and message.get("continue") is True and _world(scene) == _world(self._scene):
-            self.log("world kept from the previous session (continue)")
-            return
-        check_scene_size(scene)
-        try:
-            arm = make_arm(self.engine, scene, self.deviation)
-        except Exception as exc:  # noqa: BLE001 - any malformed scene is the client's error
-            raise ProtocolError(f"hello: cannot build a world from this scene ({type(exc).__name__}: "
-                                f"{' '.join(str(exc).split())[:200]})") from None
-        self.arm, self._scene = arm, scene
-        _, tolerance = simulated_outline(scene["object"]["polygon"])
-        simplified = f"; outline simplified within {tolerance * 1e3:g} mm" if tolerance else ""
-        self.log(f"world built for {scene.get('task', 'a task')} ({self.arm.describe()}{simplified})")
-
 
 def _send_quietly(connection: socket.socket, message: dict) -> None:
     """Send a last message to a client that may already be gone."""
@@ -212,17 +187,12 @@ def _send_quietly(connection: socket.socket, message: dict) -> None:
         pass
 
 
-# s a client of an in-process simulated arm waits for each reply before calling it hung: long enough
-# that a loaded machine building a world or stepping Drake slowly does not change an outcome (the
-# arm pivot on Drake waited more than 5 s for a reply beside a 2-worker batch on 2 cores).
-SIM_ACK_TIMEOUT = 120.0
-
-
 @contextmanager
 def running_sim_arm(log: Optional[Callable[[str], None]] = None, deviation: WorldDeviation = WorldDeviation(),
                     engine: str = DEFAULT_ENGINE) -> Iterator[SimArmServer]:
     """A simulated arm on `engine` served from a thread of this process on a free localhost port,
-    for the length of the `with` block (`execute --sim`, the tests, the benchmark)."""
+    for the length of the `with` block: a client of the protocol to test against (a run in this
+    process drives `local_arm.SimulatedArm` without a socket)."""
     server = SimArmServer(log=log, deviation=deviation, engine=engine)
     server.start_in_thread()
     try:

@@ -1,0 +1,111 @@
+"""A run of a plan on an arm, with what it writes: `run_plan` streams the plan (executor.py) to
+any arm behind the port (arm.py), records the run when an output needs it, and writes each output
+(the JSON report, an MCAP bag, a video: `stablepush.sim.video.RunVideo`) whether the run landed,
+missed or ended in a fault. `stablepush execute`, evaluate's trials, the fidelity contract and the
+benchmarks all run plans through it.
+"""
+from __future__ import annotations
+
+import abc
+import json
+from dataclasses import dataclass, field
+from typing import List, Optional, Sequence
+
+from stablepush.errors import ArmFault
+from stablepush.execution.arm import Arm
+from stablepush.execution.bags import RunRecording
+from stablepush.execution.executor import Progress, RunOptions, execute_plan
+from stablepush.execution.report import ExecutionReport, fault_report
+from stablepush.outputs import require_suffix, write_atomically
+from stablepush.plan.plan import Plan
+from stablepush.task.model import Task
+
+
+@dataclass
+class RunResult:
+    """How a run ended: its `report` (None after a fault) or its `fault` (None after a report), the
+    `recording` when one was kept, and a line per output written (`written`)."""
+
+    task: Task
+    plan: Plan
+    options: RunOptions
+    report: Optional[ExecutionReport] = None
+    fault: Optional[ArmFault] = None
+    recording: Optional[RunRecording] = None
+    written: List[str] = field(default_factory=list)
+
+    @property
+    def success(self) -> Optional[bool]:
+        """Landed (True), missed or faulted (False), or not judged (None: the arm reports no object)."""
+        return False if self.fault is not None else self.report.success
+
+    def report_or_fault(self) -> ExecutionReport:
+        """The run's report; its ArmFault raised when it ended in one."""
+        if self.fault is not None:
+            raise self.fault
+        return self.report
+
+    def as_dict(self) -> dict:
+        """The run's JSON report: ExecutionReport.as_dict, or after a fault `fault_report`."""
+        if self.fault is not None:
+            return fault_report(self.task, self.fault, self.options.success_tolerance)
+        return self.report.as_dict()
+
+
+class RunOutput(abc.ABC):
+    """Something a run writes when it ends, landed, missed or faulted."""
+
+    #: Whether it needs every acknowledged waypoint recorded (a bag, a video).
+    records: bool = False
+
+    @abc.abstractmethod
+    def write(self, run: RunResult) -> Optional[str]:
+        """Write it; the line that says where (None: nothing to write for this run)."""
+
+
+class JsonReport(RunOutput):
+    """The run's report as JSON (RunResult.as_dict) at `path`."""
+
+    def __init__(self, path: str):
+        self.path = path
+
+    def write(self, run: RunResult) -> str:
+        write_atomically(self.path, json.dumps(run.as_dict(), indent=1) + "\n")
+        return f"report written to {self.path}"
+
+
+class BagRecording(RunOutput):
+    """The recorded run and its report as one MCAP bag at `path` (bags.RunRecording.write), stamped
+    from `start_ns` (Unix ns; None: when the run started)."""
+
+    records = True
+
+    def __init__(self, path: str, start_ns: Optional[int] = None):
+        require_suffix("a run's bag", path, (".mcap",))
+        self.path = path
+        self.start_ns = start_ns
+
+    def write(self, run: RunResult) -> str:
+        run.recording.write(self.path, run.as_dict(), start_ns=self.start_ns)
+        return f"run recorded to {self.path}"
+
+
+def run_plan(task: Task, plan: Plan, arm: Arm, options: RunOptions = RunOptions(), outputs: Sequence[RunOutput] = (),
+             *, progress: Optional[Progress] = None, keep_recording: bool = False) -> RunResult:
+    """Run `plan` of `task` on `arm` (execute_plan) and write `outputs`. A fault ends the run, not
+    the call: it is the result's `fault`, and the outputs are written for it too. The recording is
+    kept in the result when an output needs it or `keep_recording`. PlanError, before anything
+    moves, when the plan does not belong to the task."""
+    recording = None
+    if keep_recording or any(o.records for o in outputs):
+        recording = RunRecording.for_run(task, plan, options.closed_loop is not None)
+    result = RunResult(task, plan, options, recording=recording)
+    try:
+        result.report = execute_plan(task, plan, arm, options, progress=progress, record=recording)
+    except ArmFault as fault:
+        result.fault = fault
+    for output in outputs:
+        line = output.write(result)
+        if line:
+            result.written.append(line)
+    return result

@@ -1,0 +1,82 @@
+"""A simulated arm in this process, behind the arm port (stablepush.execution.arm): the world of
+each session's scene built on a physics engine (engines.py), as `deviation` alters it. A run
+drives it with calls, no socket; `stablepush sim-arm` (server.py) serves one over TCP.
+"""
+from __future__ import annotations
+
+from typing import Callable, Optional
+
+from stablepush.execution.arm import Arm, ArmError, ArmReady
+from stablepush.execution.stream import ArmWaypoint
+from stablepush.sim.deviation import WorldDeviation
+from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
+from stablepush.sim.scene import simulated_outline
+
+# The scene keys that describe the world; the object's pose at the start may differ on a resume.
+_START_KEYS = ("object_pose", "object_in_grasp")
+
+
+def _world(scene: Optional[dict]) -> Optional[dict]:
+    return None if scene is None else {k: v for k, v in scene.items() if k not in _START_KEYS}
+
+
+class SimulatedArm(Arm):
+    """The simulated arm on `engine` (loaded here: a missing one is `MissingExtra` now, not a fault
+    later), in the world `deviation` makes of each scene. `log(text)` hears of each world built."""
+
+    def __init__(self, engine: str = DEFAULT_ENGINE, deviation: WorldDeviation = WorldDeviation(),
+                 log: Optional[Callable[[str], None]] = None):
+        self.engine = load_engine(engine)
+        self.deviation = deviation
+        self.log = log or (lambda text: None)
+        self.sim = None  # the engine's arm (arm.SimArm or drake_arm.DrakeArm) of the current world
+        self._scene: Optional[dict] = None
+        self._period = 0.01
+
+    @property
+    def name(self) -> str:
+        return f"stablepush sim-arm ({self.engine})"
+
+    def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
+        """A fresh world built from `scene`, or, with `resume` and the scene the one it has, the
+        world as the last session left it. ArmError when no world can be built from it."""
+        self._period = 1.0 / float(rate_hz)
+        if self.sim is not None and resume and _world(scene) == _world(self._scene):
+            self.log("world kept from the previous session (continue)")
+        else:
+            try:
+                sim = make_arm(self.engine, scene, self.deviation)
+            except Exception as exc:  # noqa: BLE001 - any scene no world can be built from is the caller's error
+                raise ArmError(f"hello: cannot build a world from this scene ({type(exc).__name__}: "
+                               f"{' '.join(str(exc).split())[:200]})") from None
+            self.sim, self._scene = sim, scene
+            _, tolerance = simulated_outline(scene["object"]["polygon"])
+            simplified = f"; outline simplified within {tolerance * 1e3:g} mm" if tolerance else ""
+            self.log(f"world built for {scene.get('task', 'a task')} ({sim.describe()}{simplified})")
+        self.connected = True
+        return ArmReady(state=self.sim.state(), arm=self.name, engine=self.engine)
+
+    def move(self, waypoint: ArmWaypoint) -> dict:
+        """Track G to the waypoint over one period. The wrist's force is read during approaches,
+        where the guarded approach reads it: on Drake it costs as much as the step (its contact
+        results), so not on every waypoint. ArmError, the arm stopped, when it cannot follow."""
+        try:
+            self.sim.move_to(waypoint.pose, self._period)
+            return self.sim.state(contact_force=waypoint.phase == "approach")
+        except Exception as exc:  # noqa: BLE001 - a simulator that fails is an arm that cannot go on
+            self.sim.stop()
+            raise ArmError(f"the simulated arm: {' '.join(str(exc).split())[:300]}") from None
+
+    def stop(self) -> Optional[bool]:
+        if self.sim is None:
+            return None
+        self.sim.stop()
+        return True
+
+    def state(self) -> dict:
+        """Where the arm stands now."""
+        return self.sim.state()
+
+    @property
+    def steps_per_second(self) -> float:
+        return self.sim.steps_per_second if self.sim is not None else 0.0
