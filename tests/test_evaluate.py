@@ -292,7 +292,7 @@ def test_evaluate_cli_plans_robust_to_its_spreads_or_says_why_not(tmp_path):
                                     "pad_mu=0.1", "--quiet"])
     assert pegs.exit_code == 1 and "(robust): unreachable" in pegs.output and "point pusher" in pegs.output
     bad = CliRunner().invoke(cli, ["evaluate", task, "--robust", "--vary", "none"])
-    assert bad.exit_code == 2 and "--robust needs spreads" in bad.output
+    assert bad.exit_code == 2 and "--robust: a robust plan needs spreads" in bad.output
     plan = tmp_path / "p.json"
     assert CliRunner().invoke(cli, ["plan", task, "-o", str(plan)]).exit_code == 0
     bad = CliRunner().invoke(cli, ["evaluate", task, "--plan", str(plan), "--robust", "--vary", "pad_mu=0.1"])

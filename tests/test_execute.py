@@ -26,7 +26,7 @@ from conftest import TASKS, shipped
 
 # The bound the end-to-end test holds the simulated run to (the paper's robot: 0.5 mm, 0.5 deg).
 # The paper's robot ended within 0.5 mm and 0.5 deg; the simulated arm does better on these plans
-# (0.04 mm / 0.05 deg and 0.02 mm / 0.03 deg, docs/execution.md), so the tests hold it to 0.2.
+# (0.04 mm / 0.05 deg and 0.02 mm / 0.03 deg, docs/results/execute-shipped.md), so the tests hold it to 0.2.
 FINAL_BOUND_MM = 0.2
 FINAL_BOUND_DEG = 0.2
 
@@ -618,7 +618,7 @@ def test_a_feature_beyond_its_place_is_blamed_not_the_friction():
     with approaches that end where the plan puts the feature: the object rides with the hand about
     0.5 mm into the first push before the feature stops it, then sticks, and ends that much short of
     the goal. The verdict blames the feature (`feature_off`), and the slip after the feature met it
-    is nil. 42 of the 50 misses of this plan's 1,000-trial open loop were this (docs/evaluate.md),
+    is nil. 42 of the 50 misses of this plan's 1,000-trial open loop were this (docs/results/evaluate-1000-trials.md),
     all called `pusher_slipped` before."""
     from stablepush.sim.deviation import WorldDeviation
 
@@ -658,7 +658,7 @@ def test_a_guarded_approach_finds_a_feature_off_its_place_and_the_run_lands(task
 
 @pytest.mark.parametrize("task_file, turn_deg, seated_deg, error_deg, unseated_deg", [
     # the tilted-gravity offset: its 1,000-trial open-loop misses had this feature turned +0.49 to +0.50
-    # deg and ended +0.50 to +0.51 deg off (docs/evaluate.md)
+    # deg and ended +0.50 to +0.51 deg off (docs/results/evaluate-1000-trials.md)
     ("more/tilted-gravity.yaml", 0.5, 0.5, 0.1, 0.51),
     # the pivot: its prism seats at about twice the turn, and ends about -0.2 deg off on features in place too;
     # here at -0.21 or -0.27 deg, which one decided by the last bits of the arm's IK (numpy's BLAS picks its

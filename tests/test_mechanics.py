@@ -245,7 +245,7 @@ def test_released_at_the_offsets_goal_the_prism_is_not_held_and_the_planner_can_
 
     task = shipped("horizontal-offset-high-mu")
     free = plan_task(task)
-    assert free.solved and free.final_hold_ratio < 1.0  # the sim turns it 15 deg on release (docs/execution.md)
+    assert free.solved and free.final_hold_ratio < 1.0  # the sim turns it 15 deg on release (docs/planner.md)
     held = plan_task(task_with("horizontal-offset-high-mu", lambda d: d["planner"].update(min_hold_ratio=1.0)),
                      time_limit=0.5)
     assert not held.solved and "min_hold_ratio" in held.message  # no pose within 0.5 mm of x = 20 holds it

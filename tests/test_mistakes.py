@@ -221,5 +221,5 @@ def test_a_goal_no_push_from_the_start_moves_the_object_toward_is_named_when_the
     assert plan.message.endswith(
         "; the goal lies at dx -20 mm, dz 0 mm, dtheta 0 deg from the start, and no stable push from there moves "
         "the object along -x (none): a plan must go around, if any can (each pusher's stable pushes from the "
-        "start: check --directions)"), plan.message
+        "start: stable_directions)"), plan.message
     assert "the goal lies" not in plan_task(task, time_limit=0.3, explain=False).message

@@ -105,7 +105,7 @@ def test_at_the_pegs_plan_end_no_stable_push_moves_the_cube_back_along_x(cube_pe
     """stable_directions (`stablepush check --directions`): every push it lists is stable by the
     independent LP, and at the end of the pegs' plan (seed 1, 0.245 unit steps past the goal in x)
     neither peg moves the cube along -x by more than a twentieth of a unit step, and only while
-    turning it (+0.99 in theta): an overshoot in x there is beyond any correction (docs/engines.md)."""
+    turning it (+0.99 in theta): an overshoot in x there is beyond any correction (docs/results/engines-cross-engine.md)."""
     from stablepush.task import stable_directions
 
     reference = IndependentModel(cube_pegs)

@@ -44,7 +44,8 @@ class OutputError(StablepushError, OSError):
 
 
 class RunnerError(StablepushError, RuntimeError):
-    """A batch's runner that cannot start: no Ray cluster where its address says."""
+    """A batch's runner that cannot start (no Ray cluster where its address says), or that lost a
+    worker a batch cannot do without."""
 
 
 class ArmFault(StablepushError, RuntimeError):

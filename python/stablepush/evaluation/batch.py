@@ -17,7 +17,7 @@ import os
 import time
 import traceback
 from dataclasses import dataclass
-from typing import Callable, Dict, List, Optional, Tuple
+from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -251,6 +251,41 @@ class Evaluation:
 
     def as_dict(self) -> dict:
         return {"summary": self.summary(), "trials": self.trials}
+
+    def describe(self, written: Sequence[str] = ()) -> List[str]:
+        """The summary in lines, as `stablepush evaluate` prints them: the success rate with its
+        interval, the goal error, the causes of the misses, the speed, the files `written`, and the
+        trials' videos."""
+        s = self.summary()
+        tol = s["tolerance"]
+        within = f"within {tol[0]:g} mm (x and z) and {tol[1]:g} deg"
+        if s["one_world"]:
+            lines = [f"{s['task']}: one world, the model's own (nothing varies): "
+                     f"{'landed' if s['successes'] else 'missed'} {within}; one trial, so no interval"]
+        else:
+            low, high = s["ci95"]
+            lines = [f"{s['task']}: landed {s['successes']} of {s['trials']} trials {within}: {s['success_rate']:.1%} "
+                     f"(95% CI {low:.1%}-{high:.1%})" + (f"; interrupted after {s['trials']} of {s['requested']}"
+                                                         if s["interrupted"] else "")]
+        if s["goal_error_mm"]:
+            mm, deg = s["goal_error_mm"], s["goal_error_deg"]
+            lines.append(f"goal error: median {mm['p50']:.3f} mm / {deg['p50']:.3f} deg, "
+                         f"p95 {mm['p95']:.3f} mm / {deg['p95']:.3f} deg")
+        if s["causes"]:
+            lines.append("misses: " + ", ".join(f"{cause} {count}" for cause, count in sorted(s["causes"].items())))
+        lines.append(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
+                     f"{s['real_time_factor']:.2f}x real time")
+        if written:
+            lines.append(f"written: {', '.join(written)}")
+        return lines + self._video_lines()
+
+    def _video_lines(self) -> List[str]:
+        if not self.batch.video_dir:
+            return []
+        videos = sum(1 for t in self.trials if t.get("video"))
+        failed = sum(1 for t in self.trials if not t["success"])
+        return ([f"videos of {videos} of the {failed} failed trial(s) written to {self.batch.video_dir}"]
+                + [f"  trial {t['trial']}: no video ({t['video_error']})" for t in self.trials if t.get("video_error")])
 
     def rows(self) -> Tuple[List[str], List[list]]:
         """The trials as CSV columns and rows (one trial a row)."""

@@ -72,6 +72,17 @@ class Spreads:
         every trial would run the same world, else all."""
         return 1 if self.one_world else requested
 
+    def describe(self) -> str:
+        """The worlds in words: each spread, or the model's own world when nothing varies."""
+        if self.one_world:
+            return "one world, the model's own (nothing varies)"
+        parts = [f"{key} +-{fraction:.0%}" for key, fraction in self.vary.items() if fraction]
+        if any(self.feature_error):
+            parts.append(f"features off by up to {self.feature_error[0]:g} mm, {self.feature_error[1]:g} deg")
+        if any(self.tracker_noise):
+            parts.append(f"tracker noise {self.tracker_noise[0]:g} mm, {self.tracker_noise[1]:g} deg")
+        return ", ".join(parts)
+
 
 @dataclass(frozen=True)
 class TrialWorld:
@@ -103,6 +114,9 @@ def robust_task(task: Task, spreads: Spreads) -> Task:
     """The task whose `uncertainty` box holds every multiplier the spreads draw: each key the
     larger of the task's fraction and the spread's. A plan of it has every push stable at the box's
     corners, and so in every world of the batch up to the features' offsets and the tracker's noise,
-    which the box does not describe (docs/model.md section 7)."""
+    which the box does not describe (docs/model.md section 7). ValueError when the spreads vary
+    nothing: there is no box to widen the task's to."""
+    if not any(spreads.vary.values()):
+        raise ValueError("a robust plan needs spreads to widen the box to (vary, or the defaults it takes without)")
     box = {key: max(task.uncertainty.get(key, 0.0), spreads.vary.get(key, 0.0)) for key in VARY_KEYS}
     return dataclasses.replace(task, uncertainty={key: value for key, value in box.items() if value > 0.0})

@@ -248,7 +248,7 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     its place has pushed it already, and every push of the contact would carry that error on. In
     the plan's last contact it is corrected past the loop's final tolerance: the contact ends at the
     goal, where an error along the push is one the pusher cannot push back (the hexagon's closed-loop
-    misses, docs/evaluate.md). So it is after the last push of a contact from whose end a correction
+    misses, docs/results/evaluate-1000-trials.md). So it is after the last push of a contact from whose end a correction
     may still switch to another feature (closed_loop.switch_held): past it, the pusher in contact is
     the only one left. `features` is updated in place: the object's pose on the
     feature in contact becomes the measured one (G's pose times the tracked pose in the grasp), so

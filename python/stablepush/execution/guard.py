@@ -3,7 +3,7 @@
 A feature off its place along the approach either pushes the object in the grasp before the
 contact's first push (met early) or lets it ride with the hand into it (met late); every push of
 the contact then carries that error to the goal, where the pusher cannot push it back (the
-hexagon's and the tilted-gravity offset's misses, docs/evaluate.md). So the approach ends slowly
+hexagon's and the tilted-gravity offset's misses, docs/results/evaluate-1000-trials.md). So the approach ends slowly
 (world.GUARD_SPAN at stream.GUARD_SPEED) and the executor watches for the touch there: the arm's
 `contact_force` past `touch_n` (a wrist force-torque sensor, which tells it before the pads slide),
 or, from an arm that reports no force, the tracker's pose in the grasp moved past `touch_mm` or

@@ -109,7 +109,7 @@ class _Stream:
         constant speed, or, with `come_to_rest` (the last push of a contact), along
         s(u) = u + u^2 - u^3: the same speed at the start, none at the end. An arm stopped dead from
         full speed overshoots its lag, and the high-mu offset then sagged 0.2 mm and 0.45 deg in the
-        grasp before the settle hold ended (docs/execution.md, "Measured: plans on the simulated arm").
+        grasp before the settle hold ended (docs/results/execute-shipped.md).
         s'(u) = 1 + 2u - 3u^2 peaks at 4/3, at u = 1/3: the eased push is faster than the stability
         test assumed on its way to rest (docs/execution.md). The push takes the fewest whole periods
         that last `duration` (the model's step time): a rate that does not divide it pushes slower."""

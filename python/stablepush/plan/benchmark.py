@@ -7,13 +7,20 @@ trials run the task with seeds seed, seed + 1, ...; the time is the core's own (
 """
 from __future__ import annotations
 
+import csv
+import dataclasses
+import io
+import json
 import time
 from dataclasses import dataclass
 from typing import Callable, Dict, List, Optional
 
 import numpy as np
 
+from stablepush.errors import RunnerError
+from stablepush.outputs import write_atomically
 from stablepush.plan.search import plan_task
+from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.task.model import Task
 from stablepush.units import MM, is_integer
 
@@ -134,9 +141,13 @@ def planning_trial(task: Task, seed: int, time_limit: Optional[float] = None, im
 
 def bench_planning(task: Task, trials: int, seed: int = 1, time_limit: Optional[float] = None,
                    progress: Optional[Callable[[int], None]] = None,
-                   improve_for: Optional[float] = None) -> "list[PlanningTrial]":
+                   improve_for: Optional[float] = None, runner: Optional[Runner] = None) -> "list[PlanningTrial]":
     """Plan `task` with seeds seed .. seed + trials - 1 (with `improve_for`, an anytime search that
-    goes on that many seconds after its first plan; the trial records both)."""
+    goes on that many seconds after its first plan; the trial records both), here one after the
+    other, or on `runner`'s local processes or Ray (in seed order; RunnerError when a worker is
+    lost). `progress(1)` after each trial."""
+    if runner is not None:
+        return _bench_on_runner(PlanningJob(task, seed, time_limit, improve_for), trials, runner, progress)
     models = task.corner_models()
     out = []
     for k in range(trials):
@@ -155,6 +166,32 @@ class PlanningJob:
     seed: int = 1
     time_limit: Optional[float] = None
     improve_for: Optional[float] = None
+
+
+def _bench_on_runner(job: "PlanningJob", trials: int, runner: Runner,
+                     progress: Optional[Callable[[int], None]]) -> "list[PlanningTrial]":
+    done = {}
+    for k, trial in run_all(run_planning_job, job, range(trials), runner):
+        if isinstance(trial, WorkerLost):
+            raise RunnerError(f"{job.task.name}: planning trial {k} lost its worker ({trial.why})")
+        done[k] = trial
+        if progress is not None:
+            progress(1)
+    return [done[k] for k in sorted(done)]
+
+
+def write_planning_trials(path: str, trials: "list[PlanningTrial]", summaries: "list[dict]") -> None:
+    """Every trial to `path`: .json (trials and the summaries) or else CSV, one row per trial, a
+    list (pusher_sequence) as JSON in its cell, since pusher names may hold any printable character."""
+    records = [dataclasses.asdict(t) for t in trials]
+    if path.lower().endswith(".json"):
+        write_atomically(path, json.dumps({"trials": records, "summary": summaries}, indent=1) + "\n")
+        return
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(records[0]), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows({k: json.dumps(v) if isinstance(v, list) else v for k, v in r.items()} for r in records)
+    write_atomically(path, buffer.getvalue())
 
 
 def run_planning_job(job: PlanningJob, k: int) -> PlanningTrial:

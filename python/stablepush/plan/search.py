@@ -177,7 +177,7 @@ def _toward_goal(task: Task) -> str:
         return ""
     return (f"; the goal lies at dx {gap[0]:g} mm, dz {gap[1]:g} mm, dtheta {gap[2]:g} deg from the start, and no "
             f"stable push from there moves the object along {blocked}: a plan must go around, if any can (each "
-            f"pusher's stable pushes from the start: check --directions)")
+            f"pusher's stable pushes from the start: stable_directions)")
 
 
 def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:
@@ -199,7 +199,7 @@ def _message(outcome: str, stats: dict, ends_at_goal: bool) -> str:
     if outcome == "goal_over_switch_limit":
         return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out with the goal reached only with "
                 f"{stats['switches']} switch-overs (max_switches {stats['max_switches']}); the plan written is that "
-                f"one; allow it with --max-switches {stats['switches']}")
+                f"one; allow it with planner.max_switches: {stats['switches']}")
     if outcome == "invalid_start":
         return "not solved: the pads do not hold the object at the start pose"
     held = (f" where the pads alone hold {stats['min_hold_ratio']:g} times the weight (planner.min_hold_ratio)"

@@ -229,7 +229,7 @@ class DrakeGrasp:
         object, without mass. Drake's sphere-vs-convex query answers a pad point within about 5.5
         times its penetration of a prism's side face through that side, along the direction from
         the prism's centre (the wedge's pad point 0.3 mm inside its heel face pushed the wedge out of
-        the grasp with 7.5 N along x; docs/engines.md). A deep prism's side faces are far from its
+        the grasp with 7.5 N along x; docs/results/engines-cross-engine.md). A deep prism's side faces are far from its
         centre, so the query answers with the face the pad presses on."""
         d, plant = self._d, self.plant
         props = self._properties(OBJECT_MU)  # point contact, as the pads': no hydroelastic mesh

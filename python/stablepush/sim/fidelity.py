@@ -55,7 +55,8 @@ PIVOT_LIMIT_MM = 0.05  # mm the prism may move in the world while the hand turns
 PIVOT_LIMIT_DEG = 0.1  # deg likewise
 ARM_PIVOT_PUSHES = 30  # unit pushes of the pivoting plan (1 deg each) run on the arm
 ARM_PIVOT_LIMIT_MM = 0.05  # mm the arm's pivot may end from its plan
-# deg likewise: 0.09 deg of it is lost in the first 3 pushes, as the arm starts from rest (docs/execution.md)
+# deg likewise: 0.09 deg of it is lost in the first 3 pushes, as the arm starts from rest
+# (docs/results/friction-fidelity.md)
 ARM_PIVOT_LIMIT_DEG = 0.15
 
 

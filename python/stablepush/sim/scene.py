@@ -294,7 +294,7 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
                   impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS),
                   noslip_tolerance=repr(NOSLIP_TOLERANCE), integrator="implicitfast")
     # libccd, not MuJoCo's native CCD: with native CCD the wedge's convex mesh slid 0.6 mm along
-    # its heel stop in 12 pushes that the model, Drake and libccd all hold (docs/engines.md).
+    # its heel stop in 12 pushes that the model, Drake and libccd all hold (docs/results/engines-cross-engine.md).
     root.find("option").append(ET.Element("flag", multiccd="enable", nativeccd="disable"))
     worldbody = root.find("worldbody")
     obj = scene["object"]

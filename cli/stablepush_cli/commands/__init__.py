@@ -1,0 +1,1 @@
+"""The commands, one module each; main.py puts them in the `stablepush` group."""

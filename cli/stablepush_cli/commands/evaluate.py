@@ -1,0 +1,210 @@
+"""`stablepush evaluate`."""
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+
+import click
+
+from stablepush.errors import OutputError
+from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush_cli.common import (
+    EXIT_NOT_SOLVED,
+    check_named_outputs,
+    fail,
+    load_plan_and_task,
+    load_task_file,
+    progressbar,
+    runner_for,
+    say_beside,
+)
+from stablepush_cli.options import (
+    Finite,
+    check_video,
+    parse_ray_address,
+    parse_vary,
+    video_options,
+    video_settings_need,
+)
+
+
+@click.command()
+@click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
+@click.option("--plan", "plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False), default=None,
+              help="The plan to evaluate (checked against the task). Default: plan once from the task.")
+@click.option("--robust", is_flag=True,
+              help="Plan robust to the worlds: the task's uncertainty box widened to the --vary spreads, so every "
+                   "push is stable for every multiplier they draw (docs/model.md section 7). Corrections keep "
+                   "the box. Not with --plan.")
+@click.option("--trials", default=100, show_default=True, type=click.IntRange(min=1, max=1_000_000),
+              help="Number of trials (worlds).")
+@click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
+              help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and outcomes, "
+                   "serially, on workers or on Ray.")
+@click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
+              help="Multiply the task's KEY (pad_mu, pusher_mu, grip_force or mass) in each world by a factor drawn "
+                   "uniformly within 1 +- FRACTION. Repeatable; `--vary none` varies nothing. Default: the task's "
+                   "uncertainty box, else pad_mu and pusher_mu 0.1, grip_force 0.05, mass 0.02, with "
+                   "--feature-error 0.2 0.2 (docs/evaluate.md, 'The worlds').")
+@click.option("--feature-error", nargs=2, type=Finite(min=0), default=None, metavar="MM DEG",
+              help="Place each feature off by up to MM in x and z and DEG about y (uniform). Default: 0.2 0.2 "
+                   "without --vary, else 0 0.")
+@click.option("--tracker-noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0), metavar="MM DEG",
+              help="Standard deviations of the tracker's noise on the pose in the grasp.")
+@click.option("--closed-loop", is_flag=True, help="Run each trial closed loop (re-plan from the tracked pose).")
+@click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
+              help="Find each feature by touch at the end of its approach (as `execute --guard`).")
+@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+              help="The simulated arm's physics engine.")
+@click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None, metavar="MM DEG",
+              help="A trial lands when the object comes to rest within MM (x and z) and DEG of the goal in the "
+                   "grasp, as `execute` judges a run (default: the task's planner.tolerance).")
+@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+              help="Run the trials on K local processes (default: the number of CPUs).")
+@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              callback=parse_ray_address,
+              help="Run the trials on Ray: a local instance, or the cluster at ADDRESS (e.g. 10.0.0.5:6379; see "
+                   "docs/evaluate.md, 'Where the trials run').")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+              help="Write the summary and every trial as JSON.")
+@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row.")
+@click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
+              help="Draw the goal error's CDF against the tolerance, and success over the varied parameters (PNG, "
+                   "PDF or SVG, as the name ends).")
+@click.option("--video-failed", "video_dir", type=click.Path(file_okay=False), default=None, metavar="DIR",
+              help="Draw each failed trial's run as a video, DIR/trial-<i>.mp4 (made if missing; as `execute "
+                   "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv).")
+@video_options("--video-failed")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, vary, feature_error, tracker_noise,
+             closed_loop: bool, guarded: bool, engine: str, success_tolerance, workers, ray_address, json_path,
+             csv_path, png_path, video_dir, video_fps: float, video_size, quiet: bool) -> None:
+    """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
+
+    Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
+    given spreads (default: the task's uncertainty box, else a lab's: see --vary), moves each
+    feature by up to --feature-error and adds --tracker-noise; the plan runs there on the simulated
+    arm (open loop, or --closed-loop) and lands, as `execute` judges a run, when the object comes
+    to rest after the release within the task's tolerance of the goal (or --success-tolerance).
+    The summary gives the success rate with its Wilson 95% interval, the goal error's percentiles
+    and the causes of the misses. Spreads that vary nothing make one world: one trial runs, and no
+    interval is given. A trial that crashes is recorded (cause `crash`) and the batch goes on;
+    Ctrl-C stops it and keeps the trials done.
+
+    \b
+    Exit status: 0 done (whatever the success rate), 1 no plan found, 2 bad input, 130 stopped by
+    Ctrl-C (the trials done are summarized and written).
+
+    \b
+    Examples:
+      stablepush evaluate data/tasks/t-shaped.yaml --trials 100   # a lab's spreads, judged by the task's tolerance
+      stablepush evaluate data/tasks/pivoting.yaml --trials 200 --vary pad_mu=0.15 --vary pusher_mu=0.15 \\
+          --vary grip_force=0.1 --vary mass=0.05 --feature-error 0.5 0.5 --json piv.eval.json --plot piv.png
+      stablepush evaluate data/tasks/t-shaped.yaml --trials 1000 --closed-loop --vary pad_mu=0.15 --ray
+      stablepush evaluate data/tasks/t-shaped.yaml --trials 100 --robust --vary pad_mu=0.15 --vary pusher_mu=0.15
+      stablepush evaluate data/tasks/t-shaped.yaml --trials 20 --vary pad_mu=0.3 --video-failed t-failed
+    """
+    if video_dir:  # before the trials load MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
+        check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video_fps, video_size)
+    else:
+        video_settings_need("--video-failed")
+    from stablepush.evaluation import Batch, write_evaluation
+    from stablepush.evaluation import evaluate as run_evaluation
+    from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
+    from stablepush.runners import default_workers
+
+    require_suffix("--plot", png_path, FIGURE_SUFFIXES)
+    check_named_outputs({"--json": json_path, "--csv": csv_path, "--plot": png_path},
+                  {"TASK.yaml": task_file, "--plan": plan_file})
+    say = say_beside(json_path, csv_path, png_path)
+
+    runner = runner_for(workers, ray_address, default=default_workers())
+    task, plan, spreads = _study(task_file, plan_file, robust, vary, feature_error, tracker_noise)
+    if video_dir:
+        from stablepush.sim.video import video_directory
+
+        try:
+            video_dir = video_directory(video_dir)
+        except OutputError as exc:
+            fail(f"--video-failed {exc}")
+    batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
+                  engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video_fps,
+                  video_size=tuple(video_size))
+    for warning in batch.warnings():
+        click.echo(f"warning: {warning}", err=True)
+    trials = spreads.trials_to_run(trials)  # as evaluate() runs them: the bar and the header say so too
+    if not quiet:
+        box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
+        click.echo(f"{task.name}: {spreads.describe()}", err=True)
+        click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop"
+                   f"{'' if guarded else ', approaches not guarded'} on {engine}, "
+                   f"on {runner.describe()}" + (f"; the plan is robust to {box}" if box else ""), err=True)
+    with _trials_bar(quiet, trials) as progress:
+        result = run_evaluation(batch, trials, runner, progress)
+    write_evaluation(result, json_path, csv_path, png_path)
+    s = result.summary()
+    if not s["trials"]:
+        click.echo("interrupted before any trial finished" if s["interrupted"] else "no trial finished", err=True)
+        sys.exit(130 if s["interrupted"] else EXIT_NOT_SOLVED)
+    for line in result.describe(written=[p for p in (json_path, csv_path, png_path) if p]):
+        say(line)
+    if s["interrupted"]:
+        sys.exit(130)
+
+
+def _study(task_file: str, plan_file, robust: bool, vary, feature_error, tracker_noise):
+    """The task, the plan to evaluate (the one given, else planned here) and the worlds' spreads."""
+    from stablepush.evaluation import Spreads
+
+    if robust and plan_file:
+        fail("--robust plans from the task; a plan given with --plan is evaluated as it is")
+    if plan_file:
+        task, plan = load_plan_and_task(plan_file, task_file)
+    else:
+        task = load_task_file(task_file)
+    try:
+        spreads = Spreads.for_task(task, vary, feature_error, tracker_noise)
+    except ValueError as exc:  # only --vary can be refused here, and Spreads names it `vary`
+        fail(f"--{exc}")
+    if not plan_file:
+        task, plan = _plan_for(task, spreads, robust)
+    return task, plan, spreads
+
+
+@contextlib.contextmanager
+def _trials_bar(quiet: bool, trials: int):
+    """A progress bar over the trials with the success rate so far, as evaluate()'s progress
+    callback; None without a terminal."""
+    bar = progressbar(quiet, length=trials, label="trials", show_pos=True)
+    if bar is None:
+        yield None
+        return
+
+    def progress(record, done) -> None:
+        landed = sum(1 for r in done if r["success"])
+        bar.label = f"landed {landed}/{len(done)} ({landed / len(done):.0%})"
+        bar.update(1)
+
+    try:
+        yield progress
+    finally:
+        bar.render_finish()
+
+
+def _plan_for(task, spreads, robust: bool):
+    """The task to evaluate (robust: its box widened to the spreads) and its plan; exit 1 when none
+    is found."""
+    from stablepush.evaluation import robust_task
+    from stablepush.plan import plan_task
+
+    if robust:
+        try:
+            task = robust_task(task, spreads)
+        except ValueError as exc:
+            fail(f"--robust: {exc}")
+    plan = plan_task(task)
+    if not plan.solved:
+        click.echo(f"{task.name}{' (robust)' if robust else ''}: {plan.message}", err=True)
+        sys.exit(EXIT_NOT_SOLVED)
+    return task, plan

@@ -1,0 +1,262 @@
+"""`stablepush execute`."""
+from __future__ import annotations
+
+import contextlib
+import sys
+
+import click
+
+from stablepush.execution.protocol import DEFAULT_PORT
+from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush_cli.common import (
+    EXIT_ARM_FAULT,
+    EXIT_MISSED,
+    check_named_outputs,
+    fail,
+    load_plan_and_task,
+    progressbar,
+    say_beside,
+)
+from stablepush_cli.options import (
+    Finite,
+    parse_host_port,
+    stamp_option,
+    video_options,
+    video_output,
+    video_settings_need,
+)
+
+
+@click.command()
+@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
+@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
+              help="The task the plan was made for (checked against the plan before anything moves).")
+@click.option("--arm", "arm", default=None, metavar="HOST:PORT", callback=parse_host_port,
+              help=f"The arm server (stablepush.arm/2 protocol, see docs/execution.md). Default: with --sim a "
+                   f"simulated arm started in this process, else 127.0.0.1:{DEFAULT_PORT}.")
+@click.option("--sim", is_flag=True, help="Start a simulated arm here and run the plan on it (see --engine).")
+@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+              help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with stablepush's own "
+                   "Coulomb friction; drake: Drake's contact solver alone decides stick and slip.")
+@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
+              metavar="HZ", help="Waypoints per second of motion. Each push takes the fewest whole periods that "
+                                 "last the task's dynamics.step_time (slower than the model when HZ does not divide "
+                                 "it); the last push of each contact eases to rest, up to 4/3 of the planned "
+                                 "speed on the way (docs/execution.md).")
+@click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
+              help="Continue after plan step STEP (the last confirmed step a fault reported); a simulated arm then "
+                   "keeps the world it has, where every other run starts from a fresh one.")
+@click.option("--pace/--no-pace", default=None,
+              help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
+@click.option("--ack-timeout", default=5.0, show_default=True, type=Finite(min=0.01), metavar="S",
+              help="Give up when the arm server does not reply within S seconds (not with --sim: the simulated "
+                   "arm runs in this process, and a waypoint takes as long as it takes).")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+              help="Write the run's report as JSON: success, tolerance, cause of a miss, engine, final pose in the "
+                   "grasp, slip per contact, corrections, features (on an arm fault: the verdict and where to resume).")
+@click.option("--success-tolerance", "success_tolerance", nargs=2, type=Finite(min=0, min_open=True),
+              default=None, metavar="MM DEG",
+              help="The run lands when the object ends within MM (x and z) and DEG of the goal in the grasp "
+                   "(default: the task's planner.tolerance).")
+@click.option("--record", "record_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mcap",
+              help="Record the run as a ROS 2 bag (one MCAP file): the commanded and measured gripper pose, the "
+                   "object in the world and in the grasp, /tf and /tf_static, the pusher in contact, each correction "
+                   "and the verdict (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
+@stamp_option("--record", "when the run starts")
+@click.option("--video", "video_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mp4",
+              help="Draw the run as a video (H.264 MP4, headless): seen along the gripping axis as the plan figures "
+                   "are, the object, the pads, the features (the pusher in contact highlighted) and the plan's pose "
+                   "at each step as a green ghost (docs/execution.md, 'Video of a run'); needs the object's pose, "
+                   "which a simulated arm reports; drawn on a fault too.")
+@video_options("--video")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("-v", "--verbose", is_flag=True,
+              help="A line per correction of the closed loop and per contact (slip, carry, where the guard found "
+                   "its feature); without, one line sums each up.")
+@click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=Finite(min=0.1, max=10),
+              metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
+                                "the plan against a world whose friction differs from its model.")
+@click.option("--tracker-noise", "tracker_noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0),
+              metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise on the "
+                                     "object's pose in the grasp (x and z in mm, theta in deg).")
+@click.option("--closed-loop", "closed_loop", is_flag=True,
+              help="As the object comes onto each feature and after each push compare the arm's tracked "
+                   "pose in the grasp with the plan's; past --replan-threshold (on the last contact's "
+                   "feature, --final-tolerance) re-plan from the measured pose and continue with the new plan. "
+                   "An arm that reports no tracked pose runs open loop (and says so).")
+@click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
+              help="End each approach slowly and find the feature by touch (the arm's contact force, else its "
+                   "tracked pose in the grasp), then push from where it was found: a feature off its place is "
+                   "found, not pushed into or missed. After a contact's first push, a feature the object rests "
+                   "on turned (past 0.15 deg) is taken as turned for the contact's other pushes. An arm that "
+                   "reports no tracked pose approaches as planned (and says so).")
+@click.option("--replan-threshold", nargs=2, type=Finite(min=0, min_open=True), default=None,
+              metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a re-plan "
+                                     "(default: half the task's goal tolerance).")
+@click.option("--final-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None,
+              metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
+                                     "this close to the goal, and re-plan on the last contact's feature past it "
+                                     "(default: a fifth of the task's goal tolerance).")
+def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
+            ack_timeout: float, json_path, success_tolerance, record_path, stamp_ns, video_path, video_fps: float,
+            video_size, quiet: bool, verbose: bool, mu_scale: float, tracker_noise, closed_loop: bool, guarded: bool,
+            replan_threshold, final_tolerance) -> None:
+    """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
+
+    Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
+    places them, else one station per pusher along y, 150 mm apart and alternating about home).
+    During a push the object rests on its feature while the gripper moves; between pushes the
+    gripper retracts, moves and approaches, and the approach finds the feature by touch (--guard).
+    Waypoints (G's pose in the world, m and a quaternion) go out at --rate as JSON lines over TCP and
+    each is acknowledged with the arm's state.
+
+    The run ends with a verdict: it landed when the object's pose in the grasp is within the task's
+    goal tolerance (or --success-tolerance), exit 0; a completed run that missed exits 5 and names
+    its cause (grasp_lost, correction_not_found, corrections_exhausted, feature_off,
+    pusher_slipped, plan_short, drift). An arm that reports no pose in the grasp gets no verdict (exit 0).
+
+    On a fault (the arm server gone, a malformed or out-of-order reply, an error from the arm) the arm
+    is told to stop, the last confirmed plan step is printed, and the exit status is 3; run again with
+    --resume-from STEP to continue. A plan that does not belong to the task exits 2 before anything moves.
+
+    \b
+    Examples:
+      stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --sim
+      stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --sim --video low-mu.mp4
+      stablepush sim-arm --port 47100 &     # or your robot's bridge
+      stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
+    """
+    from stablepush.execution import ClosedLoop, GuardedApproach, RunOptions, execution_warnings
+    from stablepush.execution.run import BagRecording, JsonReport, run_plan
+    from stablepush.execution.stream import check_resume_from
+    from stablepush.outputs import require_suffix
+
+    require_suffix("--record", record_path, (".mcap",))
+    if stamp_ns is not None and not record_path:
+        fail("--stamp: only with --record (it is the recording's start time)")
+    check_named_outputs({"--json": json_path, "--record": record_path, "--video": video_path},
+                  {"PLAN.json": plan_file, "--task": task_file})
+    task, plan = load_plan_and_task(plan_file, task_file)
+    for warning in execution_warnings(task):
+        click.echo(f"warning: {warning}", err=True)
+    check_resume_from(plan.waypoints, resume_from, field="--resume-from")
+    _only_with("--closed-loop", closed_loop, ("--replan-threshold", replan_threshold),
+               ("--final-tolerance", final_tolerance))
+    _only_with("--sim (a simulated arm started here)", sim and arm is None, ("--engine", engine != DEFAULT_ENGINE),
+               ("--sim-mu-scale", mu_scale != 1.0), ("--tracker-noise", any(tracker_noise)))
+    # The video is made first: the renderer needs MUJOCO_GL=osmesa before the simulated arm loads MuJoCo.
+    video = [video_output("--video", video_path, video_fps, video_size, quiet)] if video_path else []
+    if not video_path:
+        video_settings_need("--video")
+    outputs = ([JsonReport(json_path)] if json_path else []) + (
+        [BagRecording(record_path, stamp_ns)] if record_path else []) + video
+    options = RunOptions(rate_hz=rate_hz, resume_from=resume_from, pace=(not sim) if pace is None else pace,
+                         closed_loop=ClosedLoop.for_task(task, replan_threshold, final_tolerance) if closed_loop
+                         else None,
+                         guard=GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None,
+                         success_tolerance=success_tolerance)
+    target = _arm_for(arm, sim, engine, mu_scale, tracker_noise, ack_timeout, quiet)
+    with _run_progress(task, plan, resume_from, quiet) as progress:
+        run = run_plan(task, plan, target, options, outputs, progress=progress)
+    say = say_beside(json_path, record_path, video_path)
+    if run.fault is not None:
+        _report_fault(run.fault, plan_file, len(plan.waypoints) - 1, run.written)
+    for line in run.report.describe(verbose) + run.written:
+        say(line)
+    if run.report.success is False:
+        sys.exit(EXIT_MISSED)
+
+
+def _only_with(option: str, given: bool, *others) -> None:
+    """Exit 2 when any of `others` ((name, given) pairs) is given without `option`."""
+    named = [name for name, value in others if value]
+    if named and not given:
+        fail(f"{' and '.join(named)}: only with {option}")
+
+
+def _arm_for(arm, sim: bool, engine: str, mu_scale: float, tracker_noise, ack_timeout: float, quiet: bool):
+    """The arm a run goes to: a simulated one in this process (--sim), else the arm server at
+    --arm (or the default port here)."""
+    if sim and arm is None:
+        from stablepush.sim.deviation import WorldDeviation
+        from stablepush.sim.local_arm import SimulatedArm
+
+        deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0],
+                                   tracker_noise_deg=tracker_noise[1])
+        return SimulatedArm(engine, deviation, log=None if quiet else lambda text: click.echo(f"sim-arm: {text}",
+                                                                                             err=True))
+    from stablepush.execution import TcpArm
+
+    host, port = arm or ("127.0.0.1", DEFAULT_PORT)
+    return TcpArm(host, port, ack_timeout)
+
+
+@contextlib.contextmanager
+def _run_progress(task, plan, resume_from: int, quiet: bool):
+    """A progress bar over the plan's steps (a re-plan may change their number), as the progress
+    callback of a run; None without a terminal."""
+    bar = progressbar(quiet, length=len(plan.waypoints) - 1 - resume_from, label=f"{task.name}: step {resume_from}",
+                       show_pos=True)
+    if bar is None:
+        yield None
+        return
+    seen = [resume_from]
+
+    def progress(waypoint, confirmed, total):
+        if total - resume_from != bar.length:  # a re-plan changed the plan's length
+            bar.length = total - resume_from
+        if confirmed > seen[0]:
+            bar.label = f"{task.name}: step {confirmed} ({waypoint.phase})"
+            bar.update(confirmed - seen[0])
+            seen[0] = confirmed
+
+    with bar:
+        yield progress
+
+
+def _report_fault(fault, plan_file: str, last_step: int, written) -> None:
+    """Print how a run ended in an arm fault, and where to resume, then exit 3."""
+    for line in written:
+        click.echo(line)
+    if not fault.connected:
+        click.echo(f"error: {fault.reason}; nothing was sent. Is the arm server running? "
+                   f"(`stablepush sim-arm` serves a simulated arm, or run with --sim)", err=True)
+        sys.exit(EXIT_ARM_FAULT)
+    stopped = {True: "the arm was stopped", None: "the arm could not be reached to stop it"}[fault.arm_stopped]
+    if fault.replanned:  # its steps are the closed loop's, numbered otherwise than the plan file's
+        click.echo(f"error: {fault.reason}; {stopped}; the closed loop had re-planned the run, so no step of "
+                   f"{plan_file} continues it: plan again from where the object is in the grasp (a task whose "
+                   f"start: is the tracked pose)", err=True)
+        sys.exit(EXIT_ARM_FAULT)
+    click.echo(f"error: {fault.reason}; {stopped}; last confirmed step: {fault.last_confirmed_step} of "
+               f"{last_step}", err=True)
+    click.echo(f"continue with: {_resume_command(click.get_current_context(), fault.last_confirmed_step)}", err=True)
+    sys.exit(EXIT_ARM_FAULT)
+
+
+# The options of `execute` that say how a run runs, so a resume keeps them (outputs are left out:
+# a resumed run writes its own).
+RUN_OPTIONS = ("arm", "sim", "engine", "rate_hz", "pace", "ack_timeout", "success_tolerance", "mu_scale",
+               "tracker_noise", "closed_loop", "replan_threshold", "final_tolerance", "guarded")
+
+
+def _resume_command(ctx: click.Context, step: int) -> str:
+    """The command that continues this `execute` from plan step `step`: its arguments and every
+    option of RUN_OPTIONS given other than its default, as typed."""
+    import shlex
+
+    words = ["stablepush", "execute", ctx.params["plan_file"], "--task", ctx.params["task_file"]]
+    for param in ctx.command.params:
+        value = ctx.params.get(param.name)
+        if param.name not in RUN_OPTIONS or value is None or value == param.get_default(ctx):
+            continue
+        if param.name == "arm":
+            words += ["--arm", f"{value[0]}:{value[1]}"]
+        elif param.is_flag and param.secondary_opts:  # --x/--no-x
+            words.append(param.opts[0] if value else param.secondary_opts[0])
+        elif param.is_flag:
+            words.append(param.opts[0])
+        else:
+            words += [param.opts[0], *(f"{v:g}" if isinstance(v, float) else str(v)
+                                       for v in (value if isinstance(value, tuple) else (value,)))]
+    return shlex.join(words + ["--resume-from", str(step)])

@@ -1,0 +1,94 @@
+"""`stablepush reach`."""
+from __future__ import annotations
+
+import json
+
+import click
+
+from stablepush_cli.common import (
+    check_named_outputs,
+    load_task_file,
+    progressbar,
+    runner_for,
+    say_beside,
+)
+from stablepush_cli.options import (
+    SEED,
+    TIME_LIMIT,
+    parse_axis,
+    parse_ray_address,
+)
+
+
+@click.command()
+@click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
+@click.option("--x", "x_axis", callback=parse_axis, default=None, metavar="A:B:N",
+              help="Goal x values, mm: N from A to B (default: the task's goal x alone).")
+@click.option("--z", "z_axis", callback=parse_axis, default=None, metavar="A:B:N", help="Goal z values, mm (likewise).")
+@click.option("--theta", "theta_axis", callback=parse_axis, default=None, metavar="A:B:N",
+              help="Goal theta values, deg (likewise).")
+@click.option("--time-limit", default=1.0, show_default=True, type=TIME_LIMIT,
+              metavar="S", help="Each cell's search time.")
+@click.option("--seed", default=None, type=SEED, help="Planner seed (default: the task's).")
+@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+              help="Plan the cells on K local processes (default: the number of CPUs).")
+@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              callback=parse_ray_address,
+              help="Plan the cells on Ray: a local instance, or the cluster at ADDRESS.")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+              help="Write the map: its cells (goal, verdict, reason, solved, seed, planning time, switch-overs).")
+@click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
+              help="Draw the map in slices of theta, beside the grasp at the start (PNG, PDF or SVG, as the name "
+                   "ends); at most six slices, evenly chosen, the one nearest the start's theta among them (the "
+                   "title says how many of how many).")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, workers, ray_address, json_path,
+          png_path, quiet: bool) -> None:
+    """Map where the pushers can take the object: plan from the task's start to every goal of a grid.
+
+    Each cell is the task with its goal replaced, planned on its own. Its verdict: `reached`,
+    `unreachable` with the reason (decided exactly before any search: no grasp at the goal,
+    every pusher excluded by the uncertainty box, no stable push out of the start or
+    none into the goal's tolerance, a min_hold_ratio the goal cannot meet, or a pad that would
+    have to leave the object on the way), or `not found` within --time-limit. The same seed gives
+    the same map, whichever runner plans it. The task's start must have a grasp; its goal need
+    not, as the grid replaces it.
+
+    \b
+    Example:
+      stablepush reach data/tasks/t-shaped.yaml --x -20:20:9 --z -10:10:5 --theta 0:0:1 \\
+          --json t.reach.json --plot t.reach.png
+    """
+    from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_atomically
+    from stablepush.plan.reach import reach_map
+    from stablepush.runners import default_workers
+
+    require_suffix("--plot", png_path, FIGURE_SUFFIXES)
+    check_named_outputs({"--json": json_path, "--plot": png_path}, {"TASK.yaml": task_file})
+    say = say_beside(json_path, png_path)
+    runner = runner_for(workers, ray_address, default=default_workers())
+    # The grid replaces the goal; its cells say where there is no grasp.
+    task = load_task_file(task_file, goal_in_grasp=False)
+    gx, gz, gth = task.goal
+    axes = [a if a is not None else (g, g, 1) for a, g in ((x_axis, gx), (z_axis, gz), (theta_axis, gth))]
+    count = axes[0][2] * axes[1][2] * axes[2][2]  # reach_map refuses more than plan.reach.MAX_CELLS
+    bar = progressbar(quiet, length=count, label=f"{count} cells", show_pos=True)
+    try:
+        result = reach_map(task, *axes, seed=task.planner["seed"] if seed is None else seed, time_limit=time_limit,
+                           runner=runner, progress=(lambda cell: bar.update(1)) if bar else None)
+    finally:
+        if bar is not None:
+            bar.render_finish()
+    data = result.as_dict()
+    if json_path:
+        write_atomically(json_path, json.dumps(data, indent=1) + "\n")
+    if png_path:
+        from stablepush.viz.figures import reach_figure, save_figure
+
+        save_figure(reach_figure(task, data), png_path)
+    c = data["counts"]
+    say(f"{task.name}: {c['reached']} of {count} goals reached, {c['not found']} not found in {time_limit:g} s, "
+        f"{c['unreachable']} unreachable ({result.wall_s:.1f} s on {result.runner})")
+    written = [p for p in (json_path, png_path) if p]
+    if written:
+        say(f"written: {', '.join(written)}")

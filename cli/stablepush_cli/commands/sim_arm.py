@@ -1,0 +1,63 @@
+"""`stablepush sim-arm`."""
+from __future__ import annotations
+
+import click
+
+from stablepush.execution.protocol import DEFAULT_PORT
+from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush_cli.options import (
+    Finite,
+)
+
+
+@click.command("sim-arm")
+@click.option("--host", default="127.0.0.1", show_default=True, help="Address to listen on.")
+@click.option("--port", default=DEFAULT_PORT, show_default=True, type=click.IntRange(min=0, max=65535),
+              help="Port to listen on (0: any free port, printed).")
+@click.option("--exit-after", type=click.IntRange(min=1), default=None, metavar="N",
+              help="Fault injection for testing executors: die abruptly after N waypoints.")
+@click.option("--mu-scale", "mu_scale", default=1.0, show_default=True, type=Finite(min=0.1, max=10),
+              metavar="S", help="The pads' and features' mu are S times each task's (a world unlike the model).")
+@click.option(
+    "--tracker-noise",
+    "tracker_noise",
+    nargs=2,
+    type=Finite(min=0),
+    default=(0.0, 0.0),
+    metavar="MM DEG",
+    help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).",
+)
+@click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
+              help="Seed of the tracker's noise.")
+@click.option("--idle-timeout", default=30.0, show_default=True, type=Finite(min=0.1, max=3600), metavar="S",
+              help="Drop a client that sends no complete message for S seconds (the arm is stopped).")
+@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+              help="The physics engine. mujoco: pads slide with stablepush's own Coulomb friction; drake: Drake's "
+                   "contact solver alone decides stick and slip (about half MuJoCo's speed).")
+def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, seed: int, idle_timeout: float,
+            engine: str) -> None:
+    """Serve a simulated arm (MuJoCo or Drake) over the arm protocol, until interrupted.
+
+    A 7-joint arm of simple shapes (shipped MJCF) with a parallel-jaw gripper whose pads press with
+    the task's grip force; the executor's hello carries the object, the features and the friction.
+    One session at a time (a second client is told the arm is busy); each starts from a fresh
+    world unless the executor resumes a run (--resume-from). An object outline of more than 64
+    vertices is simplified for the simulated world only (the tolerance is logged).
+    Joint servos track the streamed waypoints by IK; the simulation steps in lock-step with the stream
+    (one waypoint period per waypoint), headless, and reports its steps/s. Each acknowledgement carries
+    the object's pose in the grasp as a tracker would (`object_in_grasp`), with --tracker-noise.
+    """
+    from stablepush.sim.deviation import WorldDeviation
+    from stablepush.sim.server import SimArmServer
+
+    deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1],
+                               seed=seed)
+    server = SimArmServer(host, port, exit_after=exit_after, deviation=deviation, idle_timeout=idle_timeout,
+                          engine=engine)
+    click.echo(f"sim-arm: listening on {server.host}:{server.port} ({engine})", err=True)
+    try:
+        server.serve_forever()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.close()

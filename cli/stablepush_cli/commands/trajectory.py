@@ -1,0 +1,74 @@
+"""`stablepush trajectory`."""
+from __future__ import annotations
+
+import click
+
+from stablepush_cli.common import (
+    check_named_outputs,
+    fail,
+    load_plan_and_task,
+)
+from stablepush_cli.options import (
+    Finite,
+    stamp_option,
+)
+
+
+@click.command()
+@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
+@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
+              help="The task the plan was made for (checked against the plan).")
+@click.option("-o", "--output", "out_path", required=True, type=click.Path(dir_okay=False),
+              metavar="TRAJ.csv|.json|.mcap",
+              help="Where to write the trajectory: CSV (a header, one row per sample), JSON (columns and rows), or a "
+                   "ROS 2 bag in one MCAP file (/tf, /tf_static, the gripper's pose and twist, phase, step and the "
+                   "scene as markers; docs/execution.md, 'ROS 2 bags').")
+@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
+              metavar="HZ", help="Samples per second (the executor streams at this rate). Each push takes the "
+                                 "fewest whole samples that last the task's dynamics.step_time: a rate that does not "
+                                 "divide it pushes slower than the stability test assumed. The last push of each "
+                                 "contact eases to rest, up to 4/3 of the planned speed on the way "
+                                 "(docs/execution.md).")
+@click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default=None,
+              help="Quaternion order in a .csv or .json: xyzw as ROS writes it (the default), wxyz as the arm "
+                   "protocol and MuJoCo do. A .mcap's messages are ROS's own, xyzw.")
+@stamp_option("a .mcap", "now")
+def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str, stamp_ns) -> None:
+    """Write the gripper's timed trajectory for a plan: what the executor streams, for your robot.
+
+    One sample per 1/HZ s: time (s), G's position in the world (m) and orientation (a unit
+    quaternion), its linear (m/s) and angular (rad/s) velocity in the world over the period that
+    ends there, the phase (push, settle, retract, move, approach) and the plan step. The world
+    is the executor's: G starts at the task's environment.home (1 mm back from the first feature
+    when the object starts on it, as the guarded approach starts), each pusher a fixed feature
+    placed as `execute` places it.
+
+    \b
+    Example:
+      stablepush plan data/tasks/t-shaped.yaml -o t.plan.json
+      stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.traj.csv
+      stablepush trajectory t.plan.json --task data/tasks/t-shaped.yaml -o t.mcap   # ros2 bag play, Foxglove
+    """
+    from stablepush.execution import execution_warnings, timed_trajectory
+    from stablepush.outputs import require_suffix, write_atomically
+
+    require_suffix("-o", out_path, (".csv", ".json", ".mcap"))
+    if quat is not None and out_path.lower().endswith(".mcap"):
+        fail(f"--quat {quat}: a ROS 2 bag's quaternions are its message types' own (x, y, z, w); --quat is for "
+              f".csv and .json")
+    if stamp_ns is not None and not out_path.lower().endswith(".mcap"):
+        fail("--stamp: only with a .mcap (a ROS 2 bag; a .csv or .json counts t from 0)")
+    quat = quat or "xyzw"
+    check_named_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
+    task, plan = load_plan_and_task(plan_file, task_file)
+    for warning in execution_warnings(task):  # the stream is the executor's, so is its cell
+        click.echo(f"warning: {warning}", err=True)
+    traj = timed_trajectory(task, plan, rate_hz)
+    if out_path.lower().endswith(".mcap"):
+        from stablepush.execution.bags import write_bag
+
+        write_bag(out_path, task, plan, traj, start_ns=stamp_ns)
+    else:
+        write_atomically(out_path, traj.to_json(quat) if out_path.lower().endswith(".json") else traj.to_csv(quat))
+    click.echo(f"{task.name}: {len(traj)} samples at {rate_hz:g} Hz, {traj.t[-1]:.2f} s, "
+               f"{len(plan.waypoints) - 1} pushes; written to {out_path}")
