@@ -132,7 +132,7 @@ def main() -> None:
             continue
         data["goal"], task, plan = found
         if args.finish_steps:
-            task = dataclasses.replace(task, planner={**task.planner, "finish_steps": 1})
+            task = dataclasses.replace(task, planner=task.planner.replace(finish_steps=1))
             data["planner"] = {**data["planner"], "finish_steps": 1}
             plan = check_plan(task, plan_task(task, seed=1))
             if not plan.solved:  # the same search as goal_for's, under its time limit on a busy machine

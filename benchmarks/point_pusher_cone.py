@@ -63,7 +63,7 @@ def untwisted_course(task, pose, pusher, pad_centre_g, heading_step):
 
 def cone_residual(task, pose, pushers, goal, heading_step):
     """The rest of the way (unit steps) and its distance from the cone of the stable unit pushes."""
-    step_mm, step_deg = task.planner["step"]
+    step_mm, step_deg = task.planner.step
     scale = np.array([step_mm, step_mm, step_deg])
     rest = (np.asarray(goal) - np.asarray(pose)) / scale
     found = stable_directions(task, pose, None, heading_step)["pushers"]

@@ -128,7 +128,7 @@ def goal_for(data: dict, seed: int, index: int, kind: str = "random", tries: int
             task = parse_task(yaml.safe_dump({**data, "goal": target}), source=data["name"])
         except TaskError:  # no grasp at the target (a pad off the object)
             continue
-        unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
+        unit = (task.planner.step[0] * MM, math.radians(task.planner.step[1]))
         far = lambda pose: _core.steps_between(pose_to_si(task.start), pose_to_si(pose), unit) >= MIN_GOAL_STEPS  # noqa: E731
         if kind == "paths":
             end = plan_task(task, seed=VERIFY_SEED, time_limit=0.5).waypoints[-1].pose

@@ -35,7 +35,7 @@ def main() -> None:
           f"switch-overs {sorted({p.stats['switches'] for p in plans})}\n")
     print("| goal heading deg | goal theta deg | solved | median ms | pushers used |")
     print("|---:|---:|---:|---:|---|")
-    planner = dict(task.planner, time_limit=args.time_limit)
+    planner = task.planner.replace(time_limit=args.time_limit)
     for theta in (20, -20):
         for heading in range(0, 360, 45):
             goal = (10 * math.cos(math.radians(heading)), 10 * math.sin(math.radians(heading)), theta)

@@ -14,7 +14,7 @@ from click.testing import CliRunner
 import stablepush as sp
 from stablepush.execution.world import place_features
 from stablepush.frames import grasp_transform, pose_to_matrix
-from stablepush.task.model import PLANNER_DEFAULTS
+from stablepush.task.model import PLANNER_DEFAULTS, PlannerSettings
 from stablepush_cli.main import cli
 
 from conftest import TASKS
@@ -203,16 +203,17 @@ def test_a_task_written_in_code_plans_like_the_file():
     from_file = sp.load_task(path)
     from_mapping = sp.parse_task(yaml.safe_load(path.read_text()), str(path))
     assert from_mapping == from_file
-    bare = dataclasses.replace(from_file, planner={"tolerance": [0.5, 0.5]})
-    assert bare.planner == {**PLANNER_DEFAULTS, "tolerance": [0.5, 0.5]}
+    bare = dataclasses.replace(from_file, planner={"tolerance": [0.5, 0.5]})  # a mapping in the file's form
+    assert bare.planner == PlannerSettings(tolerance=(0.5, 0.5))
+    assert bare.planner.as_dict() == {**PLANNER_DEFAULTS, "tolerance": [0.5, 0.5]}
     assert sp.plan_task(bare, seed=1).waypoints == sp.plan_task(from_file, seed=1).waypoints
     with pytest.raises(sp.TaskError, match="load_task"):
         sp.parse_task(str(path))
     assert sp.parse_task(path.read_bytes(), str(path)) == from_file
     defaults = sp.load_task(TASKS / "more" / "wedge-heel.yaml")  # its file leaves tolerance to the default
-    defaults.planner["tolerance"][0] = 5.0  # a task's lists are its own, not the defaults'
-    assert PLANNER_DEFAULTS["tolerance"] == [1.0, 1.0]
-    assert sp.load_task(TASKS / "more" / "hexagon-offset.yaml").planner["tolerance"] == [1.0, 1.0]
+    with pytest.raises(dataclasses.FrozenInstanceError):  # one task's settings cannot change another's
+        defaults.planner.tolerance = (5.0, 5.0)
+    assert defaults.planner.tolerance == (1.0, 1.0) and PLANNER_DEFAULTS["tolerance"] == [1.0, 1.0]
 
 
 def test_a_goal_with_no_grasp_is_unreachable_at_once():
@@ -301,7 +302,7 @@ def test_the_gripper_quaternion_stream_is_continuous_past_half_a_turn():
     """A plan that turns the object 200 deg: each sample's quaternion is in the hemisphere of the
     one before (no jump to the other sign), and the first has w >= 0."""
     task = sp.load_task(TASKS / "pivoting.yaml")
-    turned = dataclasses.replace(task, goal=(0.0, 0.0, 200.0), planner={**task.planner, "step": [1.0, 5.0]})
+    turned = dataclasses.replace(task, goal=(0.0, 0.0, 200.0), planner=task.planner.replace(step=[1.0, 5.0]))
     traj = sp.trajectory(turned, sp.plan_task(turned, seed=1))
     q = traj.quaternion_wxyz
     assert q[0, 0] >= 0 and (np.sum(q[1:] * q[:-1], axis=1) > 0.99).all()

@@ -314,7 +314,7 @@ def test_every_quaternion_topic_is_continuous_past_half_a_turn(tmp_path):
     from stablepush.execution.bags import write_bag
 
     task = shipped("pivoting")
-    turned = dataclasses.replace(task, goal=(0.0, 0.0, 200.0), planner={**task.planner, "step": [1.0, 5.0]})
+    turned = dataclasses.replace(task, goal=(0.0, 0.0, 200.0), planner=task.planner.replace(step=[1.0, 5.0]))
     plan = check_plan(turned, plan_task(turned, seed=1))
     write_bag(tmp_path / "turn.mcap", turned, plan, timed_trajectory(turned, plan))
     quats = {"gripper": [], "object": []}

@@ -72,7 +72,7 @@ def test_aimed_plans_switch_over_only_where_corrections_may_and_no_more_than_nee
     task = shipped("more/wedge-heel")
     plan = plan_task(task, seed=1)
     record, steps = aim(task, plan.waypoints, ClosedLoop.for_task(task))
-    assert plan.pusher_sequence == ["heel-stop"] and task.planner["max_switches"] == 2
+    assert plan.pusher_sequence == ["heel-stop"] and task.planner.max_switches == 2
     assert record.solved and record.pushers == ["heel-stop", "floor-block"], record
     model = task.build_model()
     holds = [model.hold_ratio(pose_to_si(before.pose), task.pusher_index(before.pusher))

@@ -86,13 +86,13 @@ def recheck(task, plan):
 
 def reaches_goal(task, plan):
     end = plan.waypoints[-1]
-    tol_mm, tol_deg = task.planner["tolerance"]
+    tol_mm, tol_deg = task.planner.tolerance
     gx, gz, gt = task.goal
     return abs(end.x - gx) <= tol_mm and abs(end.z - gz) <= tol_mm and abs(end.theta - gt) <= tol_deg
 
 
 def unit_steps(task, plan):
-    step_mm, step_deg = task.planner["step"]
+    step_mm, step_deg = task.planner.step
     for a, b in zip(plan.waypoints, plan.waypoints[1:]):
         d = math.sqrt(((b.x - a.x) / step_mm) ** 2 + ((b.z - a.z) / step_mm) ** 2 + ((b.theta - a.theta) / step_deg) ** 2)
         assert 0 < d <= 1 + 1e-9
@@ -143,7 +143,7 @@ def test_pivot_turns_the_object_with_a_side_pusher_through_sticking_steps():
 
 def test_large_manipulation_reaches_a_zero_switch_plan_for_nine_of_ten_seeds():
     task = shipped("large-manipulation")
-    assert task.planner["max_switches"] == 0
+    assert task.planner.max_switches == 0
     zero_switch = 0
     for seed in range(1, 11):
         plan = planned("large-manipulation", seed)
@@ -368,7 +368,7 @@ def test_restarts_are_counted_in_tests_so_a_seed_gives_the_same_plan_and_doublin
 
 def _offset(task, plan):
     """The plan's end's largest offset from the goal pose, each coordinate over its tolerance."""
-    end, (tol_mm, tol_deg) = plan.waypoints[-1], task.planner["tolerance"]
+    end, (tol_mm, tol_deg) = plan.waypoints[-1], task.planner.tolerance
     gx, gz, gt = task.goal
     return max(abs(end.x - gx) / tol_mm, abs(end.z - gz) / tol_mm, abs(end.theta - gt) / tol_deg)
 
@@ -386,7 +386,7 @@ def test_finish_steps_take_a_plan_that_ends_short_deeper_into_the_tolerance(name
 
     task = load_task(TASKS / f"{name}.yaml")
     plain = plan_task(task, seed=1)
-    finishing = dataclasses.replace(task, planner={**task.planner, "finish_steps": 1})
+    finishing = dataclasses.replace(task, planner=task.planner.replace(finish_steps=1))
     plan = plan_task(finishing, seed=1)
     assert plain.solved and plan.solved
     head = [(w.x, w.z, w.theta, w.pusher) for w in plain.waypoints]
@@ -410,9 +410,9 @@ def test_pivot_steps_plan_the_pivot_from_off_its_centre_and_are_off_by_default()
 
     task = shipped("pivoting")
     off = task.with_start((0.05, 0.0, 0.0))
-    tight = {**task.planner, "tolerance": [0.2, 0.2]}
+    tight = task.planner.replace(tolerance=[0.2, 0.2])
     assert not plan_task(dataclasses.replace(off, planner=tight), time_limit=0.5).solved
-    plan = plan_task(dataclasses.replace(off, planner={**tight, "pivot_steps": 1}), time_limit=0.5)
+    plan = plan_task(dataclasses.replace(off, planner=tight.replace(pivot_steps=1)), time_limit=0.5)
     assert plan.solved and plan.pusher_sequence == ["left"], plan.message
     end = plan.waypoints[-1].pose
     assert abs(end[2] - 90.0) < 0.2 and math.hypot(end[0], end[1]) < 0.06, end

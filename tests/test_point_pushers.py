@@ -174,7 +174,7 @@ def test_a_pin_plan_ends_at_the_goal_pose_by_two_pushes_on_pin_surfaces():
     assert plan.stats["switches"] == sum(a.pusher != b.pusher for a, b in zip(plan.waypoints[1:], plan.waypoints[2:]))
     check_plan(task, plan)  # the switch-over budget, unit steps, each push in the task's own model
     recheck(task, plan)
-    finishing = plan_task(dataclasses.replace(task, planner={**task.planner, "finish_steps": 1}), seed=1)
+    finishing = plan_task(dataclasses.replace(task, planner=task.planner.replace(finish_steps=1)), seed=1)
     assert [(w.pose, w.pusher) for w in finishing.waypoints] == [(w.pose, w.pusher) for w in plan.waypoints]
     same = ("switches", "feasibility_checks", "iterations")  # the plan's end is searched once
     assert {k: finishing.stats[k] for k in same} == {k: plan.stats[k] for k in same}
@@ -190,7 +190,7 @@ def test_finish_steps_walk_a_pin_plan_to_where_it_can_end_at_the_goal_pose():
     [(task, _)] = _generator().generated_tasks(seed=2, count=5, goals={"pins-2-4": [-6.167, -1.082, 8.373]})
     plain = plan_task(task, seed=3)
     assert plain.solved and not plain.ends_at_goal, plain.message
-    finishing = dataclasses.replace(task, planner={**task.planner, "finish_steps": 1})
+    finishing = dataclasses.replace(task, planner=task.planner.replace(finish_steps=1))
     plan = plan_task(finishing, seed=3)
     assert plan.solved and plan.ends_at_goal, plan.message
     assert plan.waypoints[-1].pose == pytest.approx(task.goal, abs=1e-9)

@@ -764,7 +764,7 @@ def test_check_plan_holds_a_plan_to_the_tasks_min_margin_and_min_hold_ratio(key,
     task = shipped("horizontal-offset-high-mu")
     plan = plan_task(task, seed=1)
     check_plan(task, plan)
-    stricter = dataclasses.replace(task, planner={**task.planner, key: value})
+    stricter = dataclasses.replace(task, planner=task.planner.replace(**{key: value}))
     with pytest.raises(PlanError, match=says):
         check_plan(stricter, plan)
 

@@ -81,7 +81,7 @@ def test_verdicts_past_their_deadline_stop_undecided(monkeypatch):
     monkeypatch.setattr(U.time, "perf_counter", lambda: next(clock))
     assert U.why_unreachable(task, deadline=5.0) is None
     monkeypatch.undo()
-    plan = plan_task(dataclasses.replace(task, planner={**task.planner, "time_limit": 0.2}))
+    plan = plan_task(dataclasses.replace(task, planner=task.planner.replace(time_limit=0.2)))
     assert plan.outcome == "unreachable"  # within its time the verdict decides as before
 
 
@@ -144,7 +144,7 @@ def test_a_turn_tolerance_past_half_a_turn_never_cuts_a_pad_off(turn):
     twice its distance from the object's origin."""
     task = parse_task(dumbbell(9.9))
     assert U.why_unreachable(task) is not None  # the default tolerance: cut off
-    wide = dataclasses.replace(task, planner={**task.planner, "tolerance": [1.0, turn]})
+    wide = dataclasses.replace(task, planner=task.planner.replace(tolerance=[1.0, turn]))
     assert U.why_unreachable(wide) is None
 
 
@@ -155,7 +155,7 @@ def test_a_pad_called_off_near_a_goal_is_off_at_every_pose_within_its_tolerance(
     calls off is off the object (the core's own test) at every one of them. Some goals must be
     called off and some not, so the test decides both."""
     task = parse_task(dumbbell(9.9)) if name == "dumbbell" else shipped(name)
-    task = dataclasses.replace(task, planner={**task.planner, "tolerance": [2.0, 5.0]})
+    task = dataclasses.replace(task, planner=task.planner.replace(tolerance=[2.0, 5.0]))
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     section = task.section()
     model = task.corner_models()[0]
@@ -270,7 +270,7 @@ def test_the_hold_bound_is_never_below_the_cores_hold_ratio_in_the_box(name):
     for trial in range(4):
         tol = (float(rng.uniform(0.1, 3.0)), float(rng.uniform(0.1, 5.0)))
         goal = tuple(np.array(task.goal) + rng.normal(0.0, [2.0, 2.0, 10.0]))
-        t = dataclasses.replace(task, goal=goal, planner={**task.planner, "tolerance": list(tol)})
+        t = dataclasses.replace(task, goal=goal, planner=task.planner.replace(tolerance=list(tol)))
         for model in t.corner_models():
             for pusher in range(len(t.pushers)):
                 bound = U._hold_bound(t, model, pusher)
@@ -293,7 +293,7 @@ def test_a_start_with_a_stable_push_is_never_called_stuck(name):
     rng = np.random.default_rng(7 + len(name))
     task = shipped(name)
     model = task.build_model()
-    step = task.planner["step"]
+    step = task.planner.step
     sampled = 0  # random poses and directions where the core found a stable push
     for _ in range(30):
         q = pose_to_si(tuple(np.array(task.start) + rng.normal(0.0, [3.0, 3.0, 15.0])))
@@ -335,7 +335,7 @@ def test_a_box_with_a_stable_push_anywhere_in_it_is_never_called_stuck(name):
     rng = np.random.default_rng(11 + len(name))
     task = parse_task({"ledge": LEDGE, "centred ledge": CENTRED_LEDGE}[name]) if "ledge" in name else shipped(name)
     model, independent = task.build_model(), IndependentModel(task)
-    step = task.planner["step"]
+    step = task.planner.step
     found = 0
     for _ in range(12):
         centre = np.array(task.start) + rng.normal(0.0, [12.0, 3.0, 15.0])

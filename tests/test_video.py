@@ -150,7 +150,7 @@ def test_the_ghost_follows_the_re_planned_steps(tmp_path):
                           RunOptions(rate_hz=100.0, closed_loop=ClosedLoop.for_task(task)), record=recording)
     taken = [r for r in report.replans if r.solved and r.pushes]
     assert taken
-    unit = (task.planner["step"][0] * 1e-3, np.radians(task.planner["step"][1]))
+    unit = (task.planner.step[0] * 1e-3, np.radians(task.planner.step[1]))
     for r in taken:
         heading = [s.planned for s in recording.samples if s.step == r.after_step + 1]
         assert heading and all(_core.steps_between(pose_to_si(r.measured), pose_to_si(p), unit) <= 1.0 + 1e-6

@@ -21,12 +21,12 @@ from stablepush._core import ContactCase, PushResult
 from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, StablepushError, TaskError
 from stablepush.plan import Plan, PlanOutcome, PusherContact, Waypoint, check_plan, load_plan, plan_task
 from stablepush.plan import write_plan as save_plan
-from stablepush.task import PusherSpec, Task, load_task, parse_task
+from stablepush.task import PlannerSettings, PusherSpec, Task, load_task, parse_task
 from stablepush.task import check_push as check
 
 __version__ = "0.1.0"
 __all__ = ["load_task", "parse_task", "plan_task", "check", "check_plan", "save_plan", "load_plan", "trajectory",
-           "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PusherSpec", "Trajectory",
+           "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PlannerSettings", "PusherSpec", "Trajectory",
            "StablepushError", "TaskError", "PlanError", "OutputError", "ArmFault", "RunnerError", "ContactCase",
            "PlanOutcome", "PushResult"]
 

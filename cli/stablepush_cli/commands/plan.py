@@ -71,7 +71,7 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     check_named_outputs({json_label: json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
     say = say_beside(json_path, csv_path)
     task = load_task_file(task_file)
-    limit = time_limit if time_limit is not None else task.planner["time_limit"]
+    limit = time_limit if time_limit is not None else task.planner.time_limit
     with searching(f"{task.name}: searching (time limit {limit:g} s)", limit, quiet):
         result = plan_task(task, seed=seed, time_limit=time_limit, max_switches=max_switches)
     write_plan(result, json_path, csv_path)

@@ -74,7 +74,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
     count = axes[0][2] * axes[1][2] * axes[2][2]  # reach_map refuses more than plan.reach.MAX_CELLS
     bar = progressbar(quiet, length=count, label=f"{count} cells", show_pos=True)
     try:
-        result = reach_map(task, *axes, seed=task.planner["seed"] if seed is None else seed, time_limit=time_limit,
+        result = reach_map(task, *axes, seed=task.planner.seed if seed is None else seed, time_limit=time_limit,
                            runner=runner, progress=(lambda cell: bar.update(1)) if bar else None)
     finally:
         if bar is not None:

@@ -101,7 +101,7 @@ class ClosedLoop:
     @classmethod
     def for_task(cls, task: Task, threshold: Optional[Sequence[float]] = None,
                  final_tolerance: Optional[Sequence[float]] = None) -> "ClosedLoop":
-        tol = task.planner["tolerance"]
+        tol = task.planner.tolerance
         return cls(
             threshold=tuple(threshold) if threshold else (THRESHOLD_FRACTION * tol[0], THRESHOLD_FRACTION * tol[1]),
             final_tolerance=tuple(final_tolerance)
@@ -216,11 +216,11 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
     if at(end) or at(start):
         return None
     switches = sum(1 for a, b in zip(steps[1:], steps[2:]) if a.pusher != b.pusher)
-    time_limit = min(AIM_TIME_LIMIT, task.planner["time_limit"])
+    time_limit = min(AIM_TIME_LIMIT, task.planner.time_limit)
     elapsed, tried, ended, found = 0.0, [], [], []
-    for budget in range(min(switches, task.planner["max_switches"]), task.planner["max_switches"] + 1):
-        planner = {**task.planner, "tolerance": list(loop.final_tolerance), "time_limit": time_limit,
-                   "max_switches": budget}
+    for budget in range(min(switches, task.planner.max_switches), task.planner.max_switches + 1):
+        planner = task.planner.replace(tolerance=list(loop.final_tolerance), time_limit=time_limit,
+                                       max_switches=budget)
         result = plan_task(dataclasses.replace(task.with_start(start), planner=planner),
                            min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO, explain=False)
         elapsed += result.stats["planning_time_s"]
@@ -322,7 +322,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
     the first plan whose transits are held. Returns the record and the new plan's steps (empty when
     none was found); the first step is the measured pose."""
     tolerance = list(loop.final_tolerance)
-    base = dataclasses.replace(task.with_start(measured), planner={**task.planner, "tolerance": tolerance})
+    base = dataclasses.replace(task.with_start(measured), planner=task.planner.replace(tolerance=tolerance))
     if base.at_goal(base.start):  # off the plan but at the goal already: nothing to correct
         return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
@@ -332,19 +332,19 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
     for attempt in ATTEMPTS:
         least = attempt.transit_hold != TRANSIT_HOLD_RATIO
         own_box = (attempt.robust or least) and bool(task.uncertainty)
-        if own_box or (attempt.pivot_steps and task.planner.get("pivot_steps")):
+        if own_box or (attempt.pivot_steps and task.planner.tuning.get("pivot_steps")):
             continue  # the task's own box is the model and its rule of every attempt; its pivot steps are in all
         if least and not verdict_at_stake:
             continue
-        planner = {**base.planner, "time_limit": min(attempt.time_limit, task.planner["time_limit"])}
-        if attempt.pivot_steps:
-            planner["pivot_steps"] = 1
+        planner = base.planner.replace(time_limit=min(attempt.time_limit, task.planner.time_limit),
+                                       pivot_steps=1 if attempt.pivot_steps else None)
         start = robust if attempt.robust else base
         if attempt.every_pusher:
-            planner["max_switches"] = min(task.planner["max_switches"] + 1, PLANNER_PARAMETER_RANGES["max_switches"][2])
-            candidate = dataclasses.replace(start, planner=planner)
+            most = PLANNER_PARAMETER_RANGES["max_switches"][2]
+            candidate = dataclasses.replace(start, planner=planner.replace(
+                max_switches=int(min(task.planner.max_switches + 1, most))))
         else:
-            candidate = dataclasses.replace(start, pushers=(spec,), planner={**planner, "max_switches": 0})
+            candidate = dataclasses.replace(start, pushers=(spec,), planner=planner.replace(max_switches=0))
         # Every pusher: the search itself switches only where the pads hold, so that a correction
         # may detour to where a switch-over is safe. It holds every model to one factor: the
         # attempt's with the nominal model alone, the corners' 1.0 with the task's uncertainty box

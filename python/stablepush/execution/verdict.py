@@ -65,7 +65,7 @@ class Verdict:
 
 def success_tolerance(task: Task, tolerance: Optional[Sequence[float]] = None) -> Tuple[float, float]:
     """The tolerance (mm, deg) a run of `task` is judged with: `tolerance`, else the task's own."""
-    return _pair(tolerance if tolerance is not None else task.planner["tolerance"])
+    return _pair(tolerance if tolerance is not None else task.planner.tolerance)
 
 
 def within(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[float]) -> bool:

@@ -103,7 +103,7 @@ def at_start_verdict(task: Task) -> dict:
     as `planner.min_hold_ratio` asks (no pusher pushed, so gravity as with G's axes the world's);
     else unreachable where one of the planner's verdicts before its search decides it
     (why_unreachable), and otherwise not found (a plan that pushes away and back is not searched)."""
-    need = float(task.planner.get("min_hold_ratio", 0.0))
+    need = task.planner.min_hold_ratio
     # The models only where a hold is asked for: without one every such goal is reached.
     models = task.corner_models() if need > 0.0 else []
     held = min((m.hold_ratio(pose_to_si(task.start), -1) for m in models), default=float("inf"))

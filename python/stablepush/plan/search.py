@@ -17,8 +17,8 @@ from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.plan.unreachable import why_unreachable
 from stablepush.task.mechanics import blocked_senses
-from stablepush.task.model import Task, require_task
-from stablepush.task.schema import LIMITS, PLANNER_TUNING, number_field, planner_limit, planner_parameter
+from stablepush.task.model import PlannerSettings, Task, require_task
+from stablepush.task.schema import LIMITS, number_field, planner_limit, planner_parameter
 from stablepush.units import MM, pose_from_si, pose_to_si
 
 
@@ -57,19 +57,15 @@ def plan_task(
     TaskError (field `goal`) when the start is already within the tolerance of the goal."""
     require_task(task)
     if task.at_goal(task.start):
-        tolerance = task.planner["tolerance"]
+        tolerance = list(task.planner.tolerance)
         raise TaskError("goal", f"the start {list(task.start)} is already within planner.tolerance {tolerance} of the "
                                 f"goal {list(task.goal)}: there is nothing to plan (a task written in metres? task "
                                 f"files use mm)", task.source)
-    settings = dict(task.planner)
-    if seed is not None:
-        settings["seed"] = planner_parameter("seed", "seed", seed)
-    if max_switches is not None:
-        settings["max_switches"] = planner_parameter("max_switches", "max_switches", max_switches)
-    if time_limit is not None:
-        settings["time_limit"] = planner_limit("time_limit", time_limit)
-    if improve_for is not None:
-        settings["improve_for"] = planner_parameter("improve_for", "improve_for", improve_for)
+    settings = task.planner.replace(
+        seed=None if seed is None else planner_parameter("seed", "seed", seed),
+        max_switches=None if max_switches is None else planner_parameter("max_switches", "max_switches", max_switches),
+        time_limit=None if time_limit is None else planner_limit("time_limit", time_limit),
+        improve_for=None if improve_for is None else planner_parameter("improve_for", "improve_for", improve_for))
     # A hold factor, as planner.min_hold_ratio is (docs/model.md section 3).
     min_transit_hold = number_field("min_transit_hold", min_transit_hold, LIMITS["min_hold_ratio"])
     if models:  # the caller's: they must be this task's
@@ -78,19 +74,17 @@ def plan_task(
     model = models[0]
     began = time.perf_counter()
     # The verdicts are bounded by the search's own limit: past it they stop, undecided.
-    reason = why_unreachable(task, models, deadline=began + float(settings["time_limit"]))
+    reason = why_unreachable(task, models, deadline=began + settings.time_limit)
     if reason is not None:
         return _unreachable(task, models, settings, reason, time.perf_counter() - began)
-    parameters = {"seed": str(settings["seed"]), "max_switches": str(settings["max_switches"])}
-    parameters.update({key: repr(settings[key]) for key in PLANNER_TUNING if key in settings})
     # Ctrl-C stops the search at once (KeyboardInterrupt); signals reach the main thread only.
     raw = _core.plan(models, _core.PlannerSettings(
         start=pose_to_si(task.start), goal=pose_to_si(task.goal),
-        step=(settings["step"][0] * MM, math.radians(settings["step"][1])),
-        tolerance=(settings["tolerance"][0] * MM, math.radians(settings["tolerance"][1])),
-        time_limit=float(settings["time_limit"]), min_margin=float(settings["min_margin"]),
-        sampling_margin=float(settings["sampling_margin"]), min_hold_ratio=float(settings["min_hold_ratio"]),
-        parameters=parameters, min_transit_hold=float(min_transit_hold),
+        step=(settings.step[0] * MM, math.radians(settings.step[1])),
+        tolerance=(settings.tolerance[0] * MM, math.radians(settings.tolerance[1])),
+        time_limit=settings.time_limit, min_margin=settings.min_margin, sampling_margin=settings.sampling_margin,
+        min_hold_ratio=settings.min_hold_ratio, parameters=settings.core_parameters(),
+        min_transit_hold=float(min_transit_hold),
         start_pusher=-1 if start_pusher is None else task.pusher_index(start_pusher, "start_pusher")),
         interruptible=threading.current_thread() is threading.main_thread())
 
@@ -115,15 +109,15 @@ def plan_task(
         "feasibility_checks": int(s.feasibility_checks),
         "switches": int(s.switches),
         "restarts": int(s.restarts),
-        "seed": int(settings["seed"]),
-        "max_switches": int(settings["max_switches"]),
-        "time_limit_s": float(settings["time_limit"]),
+        "seed": settings.seed,
+        "max_switches": settings.max_switches,
+        "time_limit_s": settings.time_limit,
         "pushes": len(waypoints) - 1,
         "path_length_steps": s.length,
         "goal_distance_steps": raw.goal_distance,
-        "min_hold_ratio": float(settings["min_hold_ratio"]),
+        "min_hold_ratio": settings.min_hold_ratio,
     }
-    if "improve_for" in settings:
+    if "improve_for" in settings.tuning:
         # the first plan of an anytime search (planner.improve_for), before the improvement; None: no plan
         # (path_min_margin: the same measure for the returned path, the last push to the goal left out)
         solved_once = math.isfinite(s.first_time_s)
@@ -150,14 +144,14 @@ def plan_task(
                 task_identity=task.identity())
 
 
-def _unreachable(task: Task, models, settings: dict, reason: str, seconds: float) -> Plan:
+def _unreachable(task: Task, models, settings: PlannerSettings, reason: str, seconds: float) -> Plan:
     """The plan of a goal found unreachable before the search: the start alone."""
-    unit = (settings["step"][0] * MM, math.radians(settings["step"][1]))
+    unit = (settings.step[0] * MM, math.radians(settings.step[1]))
     stats = {"planning_time_s": seconds, "iterations": 0, "nodes": 0, "feasibility_checks": 0, "switches": 0,
-             "restarts": 0, "seed": int(settings["seed"]), "max_switches": int(settings["max_switches"]),
-             "time_limit_s": float(settings["time_limit"]), "pushes": 0, "path_length_steps": 0.0,
+             "restarts": 0, "seed": settings.seed, "max_switches": settings.max_switches,
+             "time_limit_s": settings.time_limit, "pushes": 0, "path_length_steps": 0.0,
              "goal_distance_steps": _core.steps_between(pose_to_si(task.start), pose_to_si(task.goal), unit),
-             "min_hold_ratio": float(settings["min_hold_ratio"])}
+             "min_hold_ratio": settings.min_hold_ratio}
     start = pose_to_si(task.start)
     return Plan(task=task.name, solved=False, outcome="unreachable", message=f"unreachable: {reason}",
                 waypoints=[Waypoint(*task.start)], stats=stats,
@@ -170,7 +164,7 @@ def _toward_goal(task: Task) -> str:
     tolerance, in which no stable push from the start moves the object (mechanics.blocked_senses),
     with where the goal lies; "" when there is none. Not a proof that the goal is out of reach (a
     plan may go around, through poses where other pushes are stable): why the search found little."""
-    tol = task.planner["tolerance"]
+    tol = task.planner.tolerance
     gap = tuple(g - s for g, s in zip(task.goal, task.start))  # theta unwrapped, as the planner turns
     blocked = blocked_senses(task, task.start, gap, (tol[0], tol[1]))
     if blocked is None:

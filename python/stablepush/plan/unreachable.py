@@ -116,7 +116,7 @@ def _decide(task: Task, models, on_time) -> Optional[str]:
     # A last push ends within the tolerance, so it starts within it grown by a unit step (a push is
     # checked at its start). Where the pads hold at the goal, or the core finds a push from it,
     # some pusher may finish there and no LP is needed.
-    tol, step = task.planner["tolerance"], task.planner["step"]
+    tol, step = task.planner.tolerance, task.planner.step
     box = ((tol[0] + step[0]) * MM, math.radians(tol[1] + step[1]))
 
     witnessed = {(i, k): on_time() or m.hold_ratio(goal, i) >= 1.0 or _pushes_from(task, m, goal, i)
@@ -127,7 +127,7 @@ def _decide(task: Task, models, on_time) -> Optional[str]:
         return ("no pusher has a stable push that ends within planner.tolerance of the goal (" + ", ".join(
             task.pushers[i].name for i in usable) + "): wherever such a last push would start, the pads do "
             "not hold the object, and no pusher's friction cone can carry what they leave")
-    need = float(task.planner.get("min_hold_ratio", 0.0))
+    need = task.planner.min_hold_ratio
     # The bound is at least the hold at the goal itself: only goals held too little by every pusher need it.
     if need > 0.0 and all(on_time() or min(m.hold_ratio(goal, i) for m in models) < need for i in usable):
         bounds = {i: on_time() or min(_hold_bound(task, m, i) for m in models) for i in usable}
@@ -173,7 +173,7 @@ def _centre_travel(task: Task, centre, pose) -> float:
     over the goal's tolerance box (|do| <= sqrt(2) a in x and z, |dtheta| <= b): at most
     sqrt(2) a + 2 sin(min(b, 180 deg) / 2) |p - o|, the turn's chord, which no turn makes longer
     than 2 |p - o|."""
-    tol = task.planner["tolerance"]
+    tol = task.planner.tolerance
     chord = 2.0 * math.sin(math.radians(min(tol[1], 180.0)) / 2.0)
     return math.sqrt(2.0) * tol[0] + chord * math.hypot(centre[0] - pose[0], centre[1] - pose[1])
 
@@ -237,7 +237,7 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int, box=(0.0, 0.0)
     # The wrench the weight asks of pusher and pads (w_motion's gravity part, docs/model.md section 2).
     w_g = np.array([*_in_gripper(-q[2], -weight), _cross_y(r_cm, -weight)])
     # M xi / dt for a push of at most one unit step (|dx|, |dz| <= L, |dtheta| <= A): a box in O.
-    L, A = task.planner["step"][0] * MM, math.radians(task.planner["step"][1])
+    L, A = task.planner.step[0] * MM, math.radians(task.planner.step[1])
     dt2 = task.step_time ** 2
     arm = float(np.linalg.norm(r_cm))
     force = body.mass * (math.sqrt(2.0) * L + A * arm) / dt2
@@ -275,7 +275,7 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int, box=(0.0, 0.0)
 def _pushes_from(task: Task, model, q: Sequence[float], pusher: int) -> bool:
     """Whether the core finds a stable push of `pusher` from q toward one of the 26 neighbours of a
     unit-step grid: a witness that spares the LP (milliseconds) wherever one is that cheap (microseconds)."""
-    L, A = task.planner["step"][0] * MM, math.radians(task.planner["step"][1])
+    L, A = task.planner.step[0] * MM, math.radians(task.planner.step[1])
     for d in itertools.product((-1.0, 0.0, 1.0), repeat=3):
         norm = math.sqrt(sum(v * v for v in d))
         if norm and model.check(q, (d[0] * L / norm, d[1] * L / norm, d[2] * A / norm), pusher).feasible:
@@ -309,7 +309,7 @@ def _hold_bound(task: Task, model, pusher: int):
     positions = [np.asarray(p, float) for p in model.gripper.point_positions]
     limits = list(model.gripper.point_friction_limits)
     goal = pose_to_si(task.goal)
-    tol = task.planner["tolerance"]
+    tol = task.planner.tolerance
     a, b = tol[0] * MM, math.radians(tol[1])
     body = model.body
     W0 = body.mass * np.asarray(model.gravity_in_gripper(goal, pusher), float)

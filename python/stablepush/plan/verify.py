@@ -106,7 +106,7 @@ def _ends_fault(task: Task, plan: Plan, require_solved: bool) -> Fault:
     if (require_solved or plan.solved) and not task.at_goal(end):
         return (f"waypoints[{len(waypoints) - 1}]",
                 f"the plan ends at {[round(v, 3) for v in end]}, not within planner.tolerance "
-                f"{task.planner['tolerance']} of the task's goal {list(task.goal)}: made for another goal, or cut "
+                f"{list(task.planner.tolerance)} of the task's goal {list(task.goal)}: made for another goal, or cut "
                 f"short?")
     return None
 
@@ -115,8 +115,8 @@ def _pushes_fault(task: Task, waypoints: List[Waypoint], model, corners: Optiona
     """Every push at most one unit step, moving the object, stable (for `model`, the task's, or at
     each of the `corners` of its uncertainty box) with at least the task's min_margin, and ending
     with the pads on the object."""
-    unit = (task.planner["step"][0] * MM, math.radians(task.planner["step"][1]))
-    min_margin = float(task.planner.get("min_margin", 0.0))
+    unit = (task.planner.step[0] * MM, math.radians(task.planner.step[1]))
+    min_margin = task.planner.min_margin
     for i in range(1, len(waypoints)):
         q0, q1 = pose_to_si(waypoints[i - 1].pose), pose_to_si(waypoints[i].pose)
         fault = _step_fault(task, q0, q1, unit)
@@ -135,7 +135,7 @@ def _step_fault(task: Task, q0, q1, unit) -> Optional[str]:
     length = _core.steps_between(q0, q1, unit)
     if length > 1.0 + STEP_SLACK:
         size = f"{length:.3g} unit steps" if math.isfinite(length) else "more unit steps than a double holds"
-        return f"a step of {size} (planner.step {task.planner['step']}); a plan's pushes are at most one unit step"
+        return f"a step of {size} (planner.step {list(task.planner.step)}); a plan's pushes are at most one unit step"
     if max(abs(b - a) for a, b in zip(q0, q1)) < 1e-12:
         return "repeats the pose before it (a push that does not move the object)"
     return None
@@ -157,7 +157,7 @@ def _stability_fault(pusher: str, index: int, q0, q1, model, corners: Optional[l
 
 def _hold_fault(task: Task, waypoints: List[Waypoint], models: list, require_solved: bool) -> Fault:
     """A solved plan's end, where the pads alone hold min_hold_ratio times the weight (in each of `models`)."""
-    min_hold = float(task.planner.get("min_hold_ratio", 0.0))
+    min_hold = task.planner.min_hold_ratio
     if not (require_solved and min_hold > 0 and len(waypoints) > 1):
         return None
     q, last = pose_to_si(waypoints[-1].pose), task.pusher_index(waypoints[-1].pusher)

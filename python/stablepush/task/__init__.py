@@ -1,7 +1,8 @@
 """The task and its model: task files, their validation, meshes, and the stable-push test in file
 units. The layer every other one builds on; it imports nothing of planning or execution."""
 from stablepush.task.mechanics import HEADING_STEP_DEG, check_push, stable_directions
-from stablepush.task.model import PusherSpec, Task
+from stablepush.task.model import PlannerSettings, PusherSpec, Task
 from stablepush.task.schema import load_task, parse_task
 
-__all__ = ["Task", "PusherSpec", "load_task", "parse_task", "check_push", "stable_directions", "HEADING_STEP_DEG"]
+__all__ = ["Task", "PlannerSettings", "PusherSpec", "load_task", "parse_task", "check_push", "stable_directions",
+           "HEADING_STEP_DEG"]

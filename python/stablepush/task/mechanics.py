@@ -94,7 +94,7 @@ def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = N
     q = np.array(pose_to_si(at))
     _require_grasp(model, q.tolist(), at)
     corners = task.corner_models() if task.uncertainty else [model]
-    step_mm, step_deg = task.planner["step"]
+    step_mm, step_deg = task.planner.step
     scale = np.array(pose_to_si((step_mm, step_mm, step_deg)))
     headings = [heading_step * i for i in range(math.ceil(360.0 / heading_step - 1e-9))]  # deg
     elevations = np.radians(np.arange(-90.0 + ELEVATION_GRID_DEG, 90.0, ELEVATION_GRID_DEG))

@@ -5,7 +5,6 @@ core's stable-push model built from it in SI (docs/model.md sections 1-4 and 7).
 """
 from __future__ import annotations
 
-import copy
 import dataclasses
 import json
 import math
@@ -16,7 +15,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from stablepush import _core
 from stablepush.errors import TaskError
-from stablepush.units import MM, G, is_real, mm2_to_si, pose_to_si
+from stablepush.units import MM, G, is_integer, is_real, mm2_to_si, pose_to_si
 
 # How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
 # (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
@@ -34,6 +33,71 @@ PLANNER_DEFAULTS: Dict[str, Any] = {
     "sampling_margin": 5.0,  # unit steps around the start-goal box
     "min_hold_ratio": 0.0,  # the plan must end where the pads alone hold this multiple of the weight (0: off)
 }
+
+
+@dataclass(frozen=True)
+class PlannerSettings:
+    """The task's `planner:` section as a typed value, in file units (docs/model.md section 3):
+    `time_limit` [s], `seed`, `max_switches`, the unit `step` and the goal's `tolerance` (mm, deg),
+    `min_margin` [N], `sampling_margin` [unit steps], `min_hold_ratio` [times the weight], and
+    `tuning`: T-RRT*'s other declared parameters (goal_bias, pivot_steps, ...: their names and
+    ranges are the core's, `_core.TRRT_STAR_PARAMETER_RANGES`), only those given. Made with a
+    field of the wrong shape it raises TypeError or ValueError naming it; the task file's ranges
+    are checked where the file is read (schema.py)."""
+
+    time_limit: float = 10.0
+    seed: int = 1
+    max_switches: int = 1
+    step: Tuple[float, float] = (1.0, 1.0)
+    tolerance: Tuple[float, float] = (1.0, 1.0)
+    min_margin: float = 1e-3
+    sampling_margin: float = 5.0
+    min_hold_ratio: float = 0.0
+    tuning: Dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name in ("time_limit", "min_margin", "sampling_margin", "min_hold_ratio"):
+            _finite(f"planner.{name}", getattr(self, name))
+            object.__setattr__(self, name, float(getattr(self, name)))
+        for name in ("seed", "max_switches"):
+            if isinstance(getattr(self, name), bool) or not is_integer(getattr(self, name)):
+                raise TypeError(f"planner.{name} must be an integer, got {getattr(self, name)!r:.40}")
+            object.__setattr__(self, name, int(getattr(self, name)))
+        for name in ("step", "tolerance"):
+            _finite_vector(f"planner.{name}", getattr(self, name), 2)
+            object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
+        if not isinstance(self.tuning, dict):
+            raise TypeError(f"planner.tuning must be a mapping, got {type(self.tuning).__name__}")
+        for key, value in self.tuning.items():
+            if key not in _core.TRRT_STAR_PARAMETER_RANGES or key in PLANNER_DEFAULTS:
+                raise ValueError(f"planner.{key!s:.40}: not a planner setting")
+            _finite(f"planner.{key}", value)
+
+    @classmethod
+    def from_mapping(cls, values: Dict[str, Any]) -> "PlannerSettings":
+        """The settings of a planner section in the task file's form: its keys, the tuning ones
+        among them; PLANNER_DEFAULTS for those left out."""
+        given = dict(values)
+        tuning = {key: given.pop(key) for key in list(given) if key not in PLANNER_DEFAULTS}
+        return cls(**given, tuning=tuning)
+
+    def replace(self, **changes: Any) -> "PlannerSettings":
+        """These settings with `changes`, any key of the task file's planner section, a tuning one
+        too (a change of None leaves that key as it is)."""
+        return PlannerSettings.from_mapping({**self.as_dict(), **{k: v for k, v in changes.items() if v is not None}})
+
+    def as_dict(self) -> Dict[str, Any]:
+        """The settings in the task file's form (plain values; step and tolerance as lists)."""
+        out: Dict[str, Any] = {name: getattr(self, name) for name in PLANNER_DEFAULTS}
+        out["step"], out["tolerance"] = list(self.step), list(self.tolerance)
+        return {**out, **self.tuning}
+
+    def core_parameters(self) -> Dict[str, str]:
+        """T-RRT*'s declared parameters by name, as text: how an OMPL planner's ParamSet takes them."""
+        return {"seed": str(self.seed), "max_switches": str(self.max_switches),
+                **{key: repr(value) for key, value in self.tuning.items()}}
+
+
 # uncertainty: key -> the task value it widens (+- this fraction of it); a push must be stable for
 # every value in the box (Task.corner_models).
 UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers[].mu", "grip_force": "gripper.grip_force",
@@ -114,7 +178,8 @@ class Task:
     pushers: Tuple[PusherSpec, ...]
     start: Tuple[float, float, float]  # mm, mm, deg
     goal: Tuple[float, float, float]
-    planner: Dict[str, Any] = field(default_factory=dict)  # PLANNER_DEFAULTS fills the keys it leaves out
+    # A mapping in the task file's form is taken as PlannerSettings.from_mapping of it.
+    planner: PlannerSettings = field(default_factory=PlannerSettings)
     environment: Dict[str, Any] = field(default_factory=dict)  # the world around the arm, see ENVIRONMENT_DEFAULTS
     source: Optional[str] = None
     pushes: str = PUSHES[0]  # see PUSHES
@@ -132,10 +197,10 @@ class Task:
         before anything reaches the core."""
         if not isinstance(self.name, str):
             raise TypeError(f"Task.name must be a string, got {type(self.name).__name__}")
-        if not isinstance(self.planner, dict):
-            raise TypeError(f"Task.planner must be a mapping, got {type(self.planner).__name__}")
-        if any(key not in self.planner for key in PLANNER_DEFAULTS):
-            object.__setattr__(self, "planner", {**copy.deepcopy(PLANNER_DEFAULTS), **self.planner})
+        if isinstance(self.planner, dict):
+            object.__setattr__(self, "planner", PlannerSettings.from_mapping(self.planner))
+        if not isinstance(self.planner, PlannerSettings):
+            raise TypeError(f"Task.planner must be PlannerSettings or a mapping, got {type(self.planner).__name__}")
         for name in ("thickness", "mass", "grip_force", "mu", "step_time"):
             _finite(f"Task.{name}", getattr(self, name))
         for name, size in (("gravity", 2), ("start", 3), ("goal", 3)):
@@ -176,8 +241,8 @@ class Task:
         a plan (not its seed or time limit), the uncertainty box and where environment.features
         hold the object. A plan file keeps it (docs/model.md section 5), so a plan whose task
         changed since can say what changed (`stablepush.plan.verify.changes_since_planned`)."""
-        planner = {k: self.planner[k] for k in ("step", "tolerance", "max_switches", "min_margin", "min_hold_ratio")
-                   if k in self.planner}
+        planner = {k: self.planner.as_dict()[k] for k in ("step", "tolerance", "max_switches", "min_margin",
+                                                          "min_hold_ratio")}
         return json_values({
             "name": self.name,
             "object": {"vertices": self.vertices, "thickness": self.thickness, "mass": self.mass, "com": self.com,
@@ -193,7 +258,7 @@ class Task:
     def at_goal(self, pose) -> bool:
         """Whether `pose` (x mm, z mm, theta deg) lies within planner.tolerance of the goal, in each
         coordinate."""
-        tol = self.planner["tolerance"]
+        tol = self.planner.tolerance
         return all(abs(a - b) <= t for a, b, t in zip(pose, self.goal, (tol[0], tol[0], tol[1])))
 
     @property

@@ -25,6 +25,7 @@ from stablepush.task.model import (
     PLANNER_DEFAULTS,
     PUSHES,
     UNCERTAIN,
+    PlannerSettings,
     PusherSpec,
     Task,
     make_gripper,
@@ -453,7 +454,7 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
     environment = _validate_environment(top.get("environment", {}), [p.name for p in pushers])
     # Pads in metres on an object in metres: the object's own warning says so.
     notes.extend(_sub_millimetre(pads if "pads" in grip and not units else (), environment))
-    notes.extend(_in_radians([("start", start), ("goal", goal)], planner["tolerance"][1]))
+    notes.extend(_in_radians([("start", start), ("goal", goal)], planner.tolerance[1]))
     task = Task(
         name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
         grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
@@ -486,7 +487,7 @@ def goal_hold_warnings(task: Task) -> List[str]:
                 f"last feature lets go the object moves in the grasp and the run misses (moved_on_release). "
                 f"Grip harder ({grip}), choose a goal where "
                 f"the pads hold it, or end the run on the feature (environment.end_on_feature: true)"]
-    if float(task.planner["min_hold_ratio"]) >= 1.0:
+    if task.planner.min_hold_ratio >= 1.0:
         return []
     return [f"goal: the pads alone hold the object at the goal only when the last push is by "
             f"{', '.join(n for n in ratios if n not in weak)}{box}; a plan that ends with "
@@ -777,8 +778,8 @@ def planner_limit(path: str, value: Any) -> float:
     return _number(path, value, LIMITS["time_limit"])
 
 
-def _validate_planner(value: Any) -> Dict[str, Any]:
-    """The planner section with defaults filled in; tuning keys appear only when given."""
+def _validate_planner(value: Any) -> PlannerSettings:
+    """The planner section, each key within its range, with defaults for those left out."""
     planner = _mapping("planner", value, [], list(PLANNER_DEFAULTS) + list(PLANNER_PARAMETER_RANGES))
     out = copy.deepcopy(PLANNER_DEFAULTS)  # its lists are the task's own, not the defaults'
     if "time_limit" in planner:
@@ -792,4 +793,4 @@ def _validate_planner(value: Any) -> Dict[str, Any]:
     for key, value in planner.items():
         if key in PLANNER_PARAMETER_RANGES:
             out[key] = planner_parameter(f"planner.{key}", key, value)
-    return out
+    return PlannerSettings.from_mapping(out)
