@@ -367,9 +367,10 @@ class Task:
         ]
         fixed = self.pushes == "against_fixed_features"
         model = _core.StablePushModel(
-            section, body, gripper, pushers, self.gravity, self.step_time, self.friction_polygon_sides,
-            _core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
-            [math.radians(self.feature_angle(p.name)) for p in self.pushers],
+            section=section, body=body, gripper=gripper, pushers=pushers, gravity=self.gravity,
+            step_time=self.step_time, friction_polygon_sides=self.friction_polygon_sides,
+            gravity_frame=_core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
+            feature_angles=[math.radians(self.feature_angle(p.name)) for p in self.pushers],
         )
         _MODEL_INPUTS[model] = self.model_inputs()
         return model
