@@ -158,7 +158,7 @@ def test_a_stream_resumed_on_a_feature_backs_off_that_feature():
     features = place_features(task, steps, every_pusher=True)
     on_b = features[b].object_pose @ np.linalg.inv(grasp_transform(steps[k].pose))
     spliced = list(steps[:k + 1]) + [Waypoint(*steps[k + 1].pose, pusher=c)]
-    retract = task.environment["retract"] * 1e-3
+    retract = task.environment.retract * 1e-3
     for resting_on, normal in ((b, features[b].normal), (None, features[a].normal)):
         points = arm_trajectory(task, spliced, features, 100.0, _pose(on_b), resume_from=k, resting_on=resting_on)
         backing_off = list(itertools.takewhile(lambda w: w.phase == "retract", points))
@@ -252,8 +252,8 @@ def test_default_stations_alternate_about_home_within_reach():
     assert [station_offset(k) for k in range(6)] == [0, 1, -1, 2, -2, 3]
     task = shipped("t-shaped")
     features = place_features(task, [Waypoint(*task.start)], every_pusher=True)
-    home_y = task.environment["home"][1] * 1e-3
-    spacing = task.environment["station_spacing"] * 1e-3
+    home_y = task.environment.home[1] * 1e-3
+    spacing = task.environment.station_spacing * 1e-3
     lanes = sorted(round((f.object_pose[1, 3] - home_y) / spacing) for f in features.values())
     assert lanes == [-2, -1, 0, 1, 2, 3]
 

@@ -229,7 +229,7 @@ class _Run:
             features=[f.as_dict() for f in self.features.values()], wall_time_s=time.perf_counter() - self.started,
             sim_steps_per_s=state.get("steps_per_s"), closed_loop=self.loop_status, guard=self.watch.status,
             replans=self.replans, warnings=execution_warnings(task), engine=self.ready.engine,
-            ends_on_feature=bool(task.environment.get("end_on_feature", False)),
+            ends_on_feature=task.environment.end_on_feature,
         )
         loop = self.options.closed_loop
         report.verdict = judge(task, report, self.options.success_tolerance, loop.max_replans if loop else None)

@@ -146,9 +146,9 @@ def arm_trajectory(
     `resting_on` (default: the one that pushed it there; none at step 0)."""
     check_resume_from(steps, resume_from)
     env = task.environment
-    retract = env["retract"] * MM
-    home = np.asarray(env["home"], float) * MM
-    lane_of = {name: f.object_pose[1, 3] + env["lane_offset"] * MM for name, f in features.items()}
+    retract = env.retract * MM
+    home = np.asarray(env.home, float) * MM
+    lane_of = {name: f.object_pose[1, 3] + env.lane_offset * MM for name, f in features.items()}
     reach = max(math.hypot(x, z) for x, z in task.vertices) * MM
     top = max(max(f.start[2], f.end[2]) for f in features.values())
 
@@ -157,7 +157,7 @@ def arm_trajectory(
     if resting_on is None and resume_from > 0:
         resting_on = steps[resume_from].pusher
     current: Optional[Feature] = features.get(resting_on) if resting_on is not None else None
-    lane = home[1] + env["lane_offset"] * MM
+    lane = home[1] + env.lane_offset * MM
     for contact in contacts_of(steps):
         if contact.last <= resume_from:
             continue
@@ -191,7 +191,7 @@ def arm_trajectory(
                         come_to_rest=i == contact.last)
         current = feature
     stream.hold(SETTLE_TIME, "settle")
-    if current is not None and not env.get("end_on_feature", False):
+    if current is not None and not env.end_on_feature:
         stream.move(translation(current.normal * retract) @ stream.pose, "retract")
         stream.hold(RELEASE_TIME, "retract")
     return stream.points

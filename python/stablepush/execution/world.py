@@ -78,7 +78,7 @@ def place_features(task: Task, steps: Sequence[Waypoint], every_pusher: bool = F
     says otherwise). Gravity in the world is the task's gravity (G's axes are W's at home)."""
     env = task.environment
     section = task.section()
-    home = np.asarray(env["home"], float) * MM
+    home = np.asarray(env.home, float) * MM
     features: Dict[str, Feature] = {}
     contacts = contacts_of(steps)
     if every_pusher:
@@ -87,13 +87,13 @@ def place_features(task: Task, steps: Sequence[Waypoint], every_pusher: bool = F
         name = contact.pusher
         if name in features:
             continue
-        if name in env["features"]:
-            x, y, z, theta = env["features"][name]
+        if name in env.features:
+            x, y, z, theta = env.features[name]
             T_WO = translation(np.array([x, y, z]) * MM)
             T_WO[:3, :3] = rot_y(math.radians(theta))
         else:  # G at the station, turned so that the object has the world orientation the model
             # assumes on this feature (Task.feature_angle): G's turn plus theta is that angle
-            station = home + np.array([0.0, station_offset(len(features)) * env["station_spacing"] * MM, 0.0])
+            station = home + np.array([0.0, station_offset(len(features)) * env.station_spacing * MM, 0.0])
             q_first = steps[contact.first].pose
             T_WG = translation(station)
             T_WG[:3, :3] = rot_y(math.radians(task.feature_angle(name) - q_first[2]))
@@ -123,7 +123,7 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequen
     there, which the run's guarded approach then finds (the executor's world); without it, the
     object starts on that feature (the friction-fidelity rigs, which load it from the start)."""
     body = task.rigid_body()
-    start = translation(np.asarray(task.environment["home"], float) * MM)
+    start = translation(np.asarray(task.environment.home, float) * MM)
     for feature in features.values() if start_clear else ():
         if near_pose(start, feature.object_pose @ np.linalg.inv(grasp_transform(in_grasp))):
             start = translation(feature.normal * GUARD_SPAN) @ start

@@ -175,7 +175,7 @@ def release_note(task: Task, plan: Plan) -> Optional[str]:
     run misses (the verdict's `moved_on_release`); None when they hold it, or when the task's run
     ends on the feature (environment.end_on_feature)."""
     hold = plan.final_hold_ratio
-    if hold >= 1.0 or task.environment.get("end_on_feature", False) or len(plan.waypoints) < 2:
+    if hold >= 1.0 or task.environment.end_on_feature or len(plan.waypoints) < 2:
         return None
     return (f"at the plan's last pose the pads alone hold only {hold:.2f} times the object's weight: when the last "
             f"feature lets go the object moves in the grasp and the run misses (moved_on_release); "

@@ -21,18 +21,22 @@ from stablepush.units import MM, G, is_integer, is_real, mm2_to_si, pose_to_si
 # (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
 # world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
 PUSHES = ("against_fixed_features", "by_moving_pusher")
-# The planner section's keys every task has; a task file (or a Task made in code) that leaves one
-# out gets these (docs/model.md section 3).
-PLANNER_DEFAULTS: Dict[str, Any] = {
-    "time_limit": 10.0,  # s
-    "seed": 1,
-    "max_switches": 1,
-    "step": [1.0, 1.0],  # mm, deg per unit step
-    "tolerance": [1.0, 1.0],  # mm, deg
-    "min_margin": 1e-3,  # N: least depth inside the pusher's cone for a push to count
-    "sampling_margin": 5.0,  # unit steps around the start-goal box
-    "min_hold_ratio": 0.0,  # the plan must end where the pads alone hold this multiple of the weight (0: off)
-}
+def _finite(field: str, value) -> None:
+    if not is_real(value):
+        raise TypeError(f"{field} must be a number, got {type(value).__name__}")
+    try:
+        ok = math.isfinite(float(value))
+    except OverflowError:
+        ok = False
+    if not ok:
+        raise ValueError(f"{field} must be finite, got {value!r:.40}")
+
+
+def _finite_vector(field: str, value, size: int) -> None:
+    if not isinstance(value, (tuple, list)) or len(value) != size:
+        raise TypeError(f"{field} must be {size} numbers, got {value!r:.60}")
+    for v in value:
+        _finite(field, v)
 
 
 @dataclass(frozen=True)
@@ -69,7 +73,7 @@ class PlannerSettings:
         if not isinstance(self.tuning, dict):
             raise TypeError(f"planner.tuning must be a mapping, got {type(self.tuning).__name__}")
         for key, value in self.tuning.items():
-            if key not in _core.TRRT_STAR_PARAMETER_RANGES or key in PLANNER_DEFAULTS:
+            if key not in _core.TRRT_STAR_PARAMETER_RANGES or key in ("seed", "max_switches"):
                 raise ValueError(f"planner.{key!s:.40}: not a planner setting")
             _finite(f"planner.{key}", value)
 
@@ -78,7 +82,8 @@ class PlannerSettings:
         """The settings of a planner section in the task file's form: its keys, the tuning ones
         among them; PLANNER_DEFAULTS for those left out."""
         given = dict(values)
-        tuning = {key: given.pop(key) for key in list(given) if key not in PLANNER_DEFAULTS}
+        named = {f.name for f in dataclasses.fields(cls)} - {"tuning"}
+        tuning = {key: given.pop(key) for key in list(given) if key not in named}
         return cls(**given, tuning=tuning)
 
     def replace(self, **changes: Any) -> "PlannerSettings":
@@ -88,7 +93,7 @@ class PlannerSettings:
 
     def as_dict(self) -> Dict[str, Any]:
         """The settings in the task file's form (plain values; step and tolerance as lists)."""
-        out: Dict[str, Any] = {name: getattr(self, name) for name in PLANNER_DEFAULTS}
+        out: Dict[str, Any] = {f.name: getattr(self, f.name) for f in dataclasses.fields(self) if f.name != "tuning"}
         out["step"], out["tolerance"] = list(self.step), list(self.tolerance)
         return {**out, **self.tuning}
 
@@ -143,6 +148,57 @@ def outline_corners(vertices: Sequence[Tuple[float, float]]) -> Tuple[Tuple[floa
     return tuple(vertices[i] for i in kept)
 
 
+# The planner section's keys every task has, in the task file's form; a task file (or a Task
+# made in code) that leaves one out gets these (docs/model.md section 3).
+PLANNER_DEFAULTS: Dict[str, Any] = PlannerSettings().as_dict()
+
+
+@dataclass(frozen=True)
+class Cell:
+    """The task's `environment:` section, the cell the arm works in, as a typed value (mm and deg in
+    the world frame: x forward, y along the gripping axis at home, z up): G's `home` position (G's
+    axes are the world's there), how far the object backs off a feature (`retract`), how far apart
+    default features stand along y (`station_spacing`) and how far from a feature moves between
+    them run (`lane_offset`), where given features hold the object (`features`: pusher -> [x, y,
+    z, theta about world y]; the others are placed by stablepush.execution.world), and whether a
+    run ends with the object on its last feature (`end_on_feature`). Made with a field of the wrong
+    shape it raises TypeError or ValueError naming it; the file's ranges are checked where the file
+    is read (schema.py)."""
+
+    home: Tuple[float, float, float] = (450.0, 0.0, 300.0)
+    retract: float = 20.0
+    station_spacing: float = 150.0
+    lane_offset: float = 75.0
+    features: Dict[str, Tuple[float, float, float, float]] = field(default_factory=dict)
+    end_on_feature: bool = False
+
+    def __post_init__(self) -> None:
+        _finite_vector("environment.home", self.home, 3)
+        object.__setattr__(self, "home", tuple(float(v) for v in self.home))
+        for name in ("retract", "station_spacing", "lane_offset"):
+            _finite(f"environment.{name}", getattr(self, name))
+            object.__setattr__(self, name, float(getattr(self, name)))
+        if not isinstance(self.end_on_feature, bool):
+            raise TypeError(f"environment.end_on_feature must be true or false, got {self.end_on_feature!r:.40}")
+        if not isinstance(self.features, dict):
+            raise TypeError("environment.features must map pusher names to [x, y, z, theta] (mm, deg)")
+        for name, pose in self.features.items():
+            _finite_vector(f"environment.features.{name}", pose, 4)
+        object.__setattr__(self, "features", {name: tuple(float(v) for v in pose)
+                                              for name, pose in self.features.items()})
+
+    @classmethod
+    def from_mapping(cls, values: Dict[str, Any]) -> "Cell":
+        """The cell of an environment section in the task file's form; defaults for keys left out."""
+        return cls(**values)
+
+    def as_dict(self) -> Dict[str, Any]:
+        """The cell in the task file's form (plain values; lists for vectors)."""
+        return {"home": list(self.home), "retract": self.retract, "station_spacing": self.station_spacing,
+                "lane_offset": self.lane_offset, "features": {k: list(v) for k, v in self.features.items()},
+                "end_on_feature": self.end_on_feature}
+
+
 @dataclass(frozen=True)
 class PusherSpec:
     """A pusher as the task gives it, in O [mm]; `a == b` for a point pusher."""
@@ -180,7 +236,7 @@ class Task:
     goal: Tuple[float, float, float]
     # A mapping in the task file's form is taken as PlannerSettings.from_mapping of it.
     planner: PlannerSettings = field(default_factory=PlannerSettings)
-    environment: Dict[str, Any] = field(default_factory=dict)  # the world around the arm, see ENVIRONMENT_DEFAULTS
+    environment: Cell = field(default_factory=Cell)  # a mapping in the file's form is taken as Cell.from_mapping
     source: Optional[str] = None
     pushes: str = PUSHES[0]  # see PUSHES
     uncertainty: Dict[str, float] = field(default_factory=dict)  # key -> +- fraction of nominal (UNCERTAIN)
@@ -201,6 +257,10 @@ class Task:
             object.__setattr__(self, "planner", PlannerSettings.from_mapping(self.planner))
         if not isinstance(self.planner, PlannerSettings):
             raise TypeError(f"Task.planner must be PlannerSettings or a mapping, got {type(self.planner).__name__}")
+        if isinstance(self.environment, dict):
+            object.__setattr__(self, "environment", Cell.from_mapping(self.environment))
+        if not isinstance(self.environment, Cell):
+            raise TypeError(f"Task.environment must be a Cell or a mapping, got {type(self.environment).__name__}")
         for name in ("thickness", "mass", "grip_force", "mu", "step_time"):
             _finite(f"Task.{name}", getattr(self, name))
         for name, size in (("gravity", 2), ("start", 3), ("goal", 3)):
@@ -223,7 +283,7 @@ class Task:
         """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
         feature: environment.features gives it, else the start's (the executor places the
         features so; stablepush.execution.world.place_features)."""
-        pose = self.environment.get("features", {}).get(pusher)
+        pose = self.environment.features.get(pusher)
         if pose is not None:
             return float(pose[3])
         return float(self.feature_orientations.get(pusher, self.start[2]))
@@ -388,24 +448,6 @@ def require_task(value: Any, field: str = "task") -> Task:
         hint = " (load it first: sp.load_task(path))" if isinstance(value, (str, os.PathLike)) else ""
         raise TypeError(f"{field}: expected a Task, got {type(value).__name__}{hint}")
     return value
-
-
-def _finite(field: str, value) -> None:
-    if not is_real(value):
-        raise TypeError(f"{field} must be a number, got {type(value).__name__}")
-    try:
-        ok = math.isfinite(float(value))
-    except OverflowError:
-        ok = False
-    if not ok:
-        raise ValueError(f"{field} must be finite, got {value!r:.40}")
-
-
-def _finite_vector(field: str, value, size: int) -> None:
-    if not isinstance(value, (tuple, list)) or len(value) != size:
-        raise TypeError(f"{field} must be {size} numbers, got {value!r:.60}")
-    for v in value:
-        _finite(field, v)
 
 
 def json_values(value):

@@ -25,6 +25,7 @@ from stablepush.task.model import (
     PLANNER_DEFAULTS,
     PUSHES,
     UNCERTAIN,
+    Cell,
     PlannerSettings,
     PusherSpec,
     Task,
@@ -74,17 +75,9 @@ LIMITS: Dict[str, Tuple[float, float]] = {  # kind -> (lowest, highest); both in
     "sampling_margin": (0.0, 1e3),  # unit steps
     "min_hold_ratio": (0.0, 1e3),
 }
-# Where the arm works (stablepush.execution): mm in the world frame (x forward, y along the
-# gripping axis at home, z up).
-ENVIRONMENT_DEFAULTS: Dict[str, Any] = {
-    "home": [450.0, 0.0, 300.0],  # G's position at the start; G's axes are the world's there
-    "retract": 20.0,  # how far the object backs off a feature before moving to the next
-    "station_spacing": 150.0,  # default features sit this far apart along y
-    "lane_offset": 75.0,  # moves between features run this far along y from a feature
-    # True: the run ends with the object resting on its last feature (no final retract), and the
-    # verdict judges it there; false: the pads alone must hold it where it was put.
-    "end_on_feature": False,
-}
+# Where the arm works (stablepush.execution): the environment section's keys but `features`, and
+# their defaults (Cell says what each is).
+ENVIRONMENT_DEFAULTS: Dict[str, Any] = {k: v for k, v in Cell().as_dict().items() if k != "features"}
 
 # TRRTstar's declared parameters and their ranges live in the C++ planner (declared once there;
 # its setters refuse values outside them): key -> (kind, lowest, highest). seed and max_switches
@@ -462,7 +455,7 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
         environment=environment, source=source, pushes=pushes, uncertainty=uncertainty,
         warnings=tuple(notes + _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity)),
     )
-    if goal_in_grasp and not environment["end_on_feature"]:
+    if goal_in_grasp and not environment.end_on_feature:
         task = dataclasses.replace(task, warnings=task.warnings + tuple(goal_hold_warnings(task)))
     return task
 
@@ -566,10 +559,10 @@ def _sub_millimetre(pads, environment: Dict[str, Any]) -> List[str]:
     reads as written in metres."""
     out = [f"gripper.pads[{i}].radius: {radius:g} mm" + _in_metres(radius)
            for i, (_, radius) in enumerate(pads) if radius < SUB_MM]
-    out += [f"environment.{key}: {environment[key]:g} mm" + _in_metres(environment[key])
-            for key in ("retract", "station_spacing", "lane_offset") if environment[key] < SUB_MM]
-    places = [("environment.home", environment["home"])]
-    places += [(f"environment.features.{name}", pose[:3]) for name, pose in environment["features"].items()]
+    lengths = {key: getattr(environment, key) for key in ("retract", "station_spacing", "lane_offset")}
+    out += [f"environment.{key}: {value:g} mm" + _in_metres(value) for key, value in lengths.items() if value < SUB_MM]
+    places = [("environment.home", list(environment.home))]
+    places += [(f"environment.features.{name}", list(pose[:3])) for name, pose in environment.features.items()]
     out += [f"{path}: [{', '.join(f'{v:g}' for v in p)}] mm" + _in_metres(p)
             for path, p in places if any(p) and max(map(abs, p)) < SUB_MM]
     return out
@@ -739,7 +732,7 @@ def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str
     return tuple(specs)
 
 
-def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Dict[str, Any]:
+def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Cell:
     """The environment section with defaults filled in. `features` maps a pusher's name to the
     object's world pose [x, y, z mm, theta deg about world y] while it rests on that pusher's
     feature; pushers not listed get a feature placed by the executor (stablepush.execution)."""
@@ -761,7 +754,7 @@ def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Dict[str, 
         _vector(f"environment.features.{name}", pose, 4)
         out["features"][name] = [_number(f"environment.features.{name}[{i}]", v, COORDINATE if i < 3 else ANGLE)
                                  for i, v in enumerate(pose)]
-    return out
+    return Cell.from_mapping(out)
 
 
 def planner_parameter(path: str, key: str, value: Any) -> "int | float":

@@ -1,11 +1,12 @@
-"""The planner section as a typed value (stablepush.PlannerSettings): the task file's form in and
-out, the core's declared parameters, and a field of the wrong shape refused by name."""
+"""The planner and environment sections as typed values (stablepush.PlannerSettings,
+stablepush.task.model.Cell): the task file's form in and out, the core's declared parameters, and
+a field of the wrong shape refused by name."""
 import dataclasses
 
 import pytest
 
 import stablepush as sp
-from stablepush.task.model import PLANNER_DEFAULTS
+from stablepush.task.model import PLANNER_DEFAULTS, Cell
 
 from conftest import shipped
 
@@ -48,3 +49,23 @@ def test_a_task_edited_with_settings_plans_as_one_read_from_its_file():
     from_mapping = dataclasses.replace(task, planner={**task.planner.as_dict(), "tolerance": [0.5, 0.5]})
     assert edited == from_mapping
     assert sp.plan_task(edited, seed=1).waypoints == sp.plan_task(from_mapping, seed=1).waypoints
+
+
+def test_the_environment_section_is_a_typed_cell_that_round_trips():
+    task = shipped("horizontal-offset-high-mu")
+    cell = task.environment
+    assert isinstance(cell, Cell) and cell.home == (450.0, 0.0, 300.0) and cell.end_on_feature is True
+    assert Cell.from_mapping(cell.as_dict()) == cell
+    edited = dataclasses.replace(task, environment={**cell.as_dict(), "retract": 30})
+    assert edited.environment == dataclasses.replace(cell, retract=30.0)
+
+
+@pytest.mark.parametrize("changes, says", [
+    ({"home": [0, 0]}, "environment.home must be 3 numbers"),
+    ({"retract": float("inf")}, "environment.retract must be finite"),
+    ({"end_on_feature": "yes"}, "environment.end_on_feature must be true or false"),
+    ({"features": {"left": [0, 0, 0]}}, "environment.features.left must be 4 numbers"),
+])
+def test_a_cell_of_the_wrong_shape_is_refused_by_name_in_code_too(changes, says):
+    with pytest.raises((TypeError, ValueError), match=says):
+        dataclasses.replace(shipped("pivoting"), environment={**Cell().as_dict(), **changes})
