@@ -27,10 +27,11 @@ class ScriptedArm(Arm):
     """An arm that goes exactly where it is told and reports G there (no tracker, no simulator),
     and fails on waypoint `fail_at` (None: never)."""
 
-    def __init__(self, fail_at=None):
-        self.fail_at = fail_at
+    def __init__(self, fail_at=None, bad_state_at=None, paced=False):
+        self.fail_at, self.bad_state_at, self.paced = fail_at, bad_state_at, paced
         self.moves = []
         self.stops = 0
+        self.closed = False
         self.said_bye = False
 
     def hello(self, scene, rate_hz, resume):
@@ -43,6 +44,8 @@ class ScriptedArm(Arm):
             raise ArmError("the scripted arm refuses this waypoint")
         self.moves.append(waypoint)
         self.pose = list(waypoint.pose)
+        if waypoint.seq == self.bad_state_at:
+            return {"ee_pose": [float("nan")] * 7, "joints": []}
         return {"ee_pose": self.pose, "joints": []}
 
     def stop(self):
@@ -51,6 +54,9 @@ class ScriptedArm(Arm):
 
     def bye(self):
         self.said_bye = True
+
+    def close(self):
+        self.closed = True
 
 
 def test_an_arm_of_a_few_lines_runs_the_plan_to_its_end(low_mu):
@@ -74,6 +80,42 @@ def test_an_arm_error_ends_the_run_in_a_fault_that_stops_the_arm_and_says_where_
     assert arm.stops == 1 and fault.arm_stopped is True and fault.connected and not arm.said_bye
     confirmed = [w.step for w in arm.moves if w.completes]
     assert fault.last_confirmed_step == max(confirmed) and 0 < fault.last_confirmed_step < len(plan.waypoints) - 1
+
+
+def test_a_state_no_arm_could_be_in_is_a_fault_from_any_arm_not_only_over_the_wire(low_mu):
+    task, plan = low_mu
+    arm = ScriptedArm(bad_state_at=50)
+    with pytest.raises(ArmFault, match="state.ee_pose") as caught:
+        execute_plan(task, plan, arm, RunOptions(rate_hz=100.0))
+    assert caught.value.arm_stopped is True and arm.stops == 1 and arm.closed
+
+
+def test_anything_else_that_ends_a_run_stops_the_arm_and_lets_it_go(low_mu):
+    task, plan = low_mu
+    arm = ScriptedArm()
+
+    def progress(waypoint, confirmed, total):
+        if waypoint.seq == 40:
+            raise ValueError("a bug in the caller's callback")
+
+    with pytest.raises(ValueError, match="a bug"):
+        execute_plan(task, plan, arm, RunOptions(rate_hz=100.0), progress=progress)
+    assert arm.stops == 1 and arm.closed and not arm.said_bye
+
+
+def test_a_run_is_paced_as_the_arm_says_unless_told(low_mu, monkeypatch):
+    """A real arm's bridge moves in real time (TcpArm.paced), a simulator on its own clock."""
+    from stablepush.execution import executor
+
+    task, plan = low_mu
+    slept = []
+    monkeypatch.setattr(executor.time, "sleep", lambda s: slept.append(s))
+    execute_plan(task, plan, ScriptedArm(paced=True), RunOptions(rate_hz=1000.0))
+    assert len(slept) > 100
+    slept.clear()
+    execute_plan(task, plan, ScriptedArm(paced=True), RunOptions(rate_hz=1000.0, pace=False))
+    execute_plan(task, plan, ScriptedArm(), RunOptions(rate_hz=1000.0))
+    assert slept == [] and TcpArm.paced is True and RunOptions().pace is None
 
 
 def test_run_plan_writes_its_report_after_a_fault_too(low_mu, tmp_path):
@@ -117,6 +159,43 @@ def test_the_simulated_arm_in_this_process_and_over_the_protocol_run_the_same(lo
         d.pop("wall_time_s"), d.pop("sim_steps_per_s")
     assert a == b
     assert local.engine == "mujoco" and local.final_in_grasp is not None and local.replans == []
+
+
+@pytest.mark.slow
+def test_a_resume_on_the_same_simulated_arm_keeps_its_world_and_lands(low_mu):
+    """A run that faults part-way and resumes from its last confirmed step on the same in-process
+    arm continues in the world it had (the object where the fault left it), and lands."""
+    from stablepush.sim.local_arm import SimulatedArm
+
+    task, plan = low_mu
+    said = []
+    sim = SimulatedArm(log=said.append)
+
+    class Faulting(Arm):
+        """The simulated arm, refusing waypoint 400 of the first session."""
+
+        def __init__(self, inner, fail_at=None):
+            self.inner, self.fail_at = inner, fail_at
+
+        def hello(self, scene, rate_hz, resume):
+            ready = self.inner.hello(scene, rate_hz, resume)
+            self.connected = True
+            return ready
+
+        def move(self, waypoint):
+            if waypoint.seq == self.fail_at:
+                raise ArmError("the link dropped")
+            return self.inner.move(waypoint)
+
+        def stop(self):
+            return self.inner.stop()
+
+    with pytest.raises(ArmFault) as caught:
+        execute_plan(task, plan, Faulting(sim, fail_at=400), RunOptions(rate_hz=100.0))
+    step = caught.value.last_confirmed_step
+    report = execute_plan(task, plan, Faulting(sim), RunOptions(rate_hz=100.0, resume_from=step))
+    assert sum("world built" in line for line in said) == 1 and any("world kept" in line for line in said), said
+    assert report.resumed_from == step and report.success is True, report.verdict
 
 
 def test_the_engine_neutral_parts_and_the_drake_arm_load_no_mujoco():

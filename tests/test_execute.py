@@ -196,6 +196,28 @@ def test_nothing_listening_is_a_clear_fault(high_mu_plan):
     assert "stablepush sim-arm" in result.output and "--sim" in result.output and "--resume-from" not in result.output
 
 
+def test_a_fault_report_on_standard_output_is_json_alone(high_mu_plan, tmp_path):
+    """`--json /dev/stdout | jq .` after a fault: the lines that say what was written go to stderr."""
+    plan, task = high_mu_plan
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    run = subprocess.run([sys.executable, "-m", "stablepush_cli.main", "execute", plan, "--task", task, "--arm",
+                          f"127.0.0.1:{port}", "--quiet", "--json", "/dev/stdout"], capture_output=True, text=True)
+    assert run.returncode == 3, run.stderr
+    assert json.loads(run.stdout)["cause"] == "arm_fault"
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--sim", "--arm", "127.0.0.1:47100"], "--sim and --arm: choose one"),
+    (["--sim", "--ack-timeout", "9"], "--ack-timeout: only with an arm server"),
+])
+def test_options_for_another_arm_are_refused_not_ignored(high_mu_plan, args, says):
+    plan, task = high_mu_plan
+    result = CliRunner().invoke(cli, ["execute", plan, "--task", task, "--quiet", *args])
+    assert result.exit_code == 2 and says in result.output, result.output
+
+
 class FakeArm:
     """An arm server that misbehaves after `good` acknowledgements, and records whether it was
     told to stop."""

@@ -115,25 +115,34 @@ def check_video(option: str, path: str, fps: float, size) -> None:
         fail(f"{option}: {exc}")
 
 
+class VideoBar:
+    """A progress bar on stderr over a video's frames, as RunVideo's progress callback; `close()`
+    ends it whether or not the video was finished."""
+
+    def __init__(self, path: str):
+        self.path = path
+        self.bar = None
+
+    def __call__(self, done: int, frames: int) -> None:
+        if self.bar is None:
+            self.bar = click.progressbar(length=frames, label=f"video {self.path}", file=sys.stderr, show_pos=True)
+            self.bar.__enter__()
+        self.bar.update(1)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(None, None, None)
+            self.bar = None
+
+
 def video_output(option: str, path: str, fps: float, size, quiet: bool):
-    """The run's video as an output (stablepush.sim.video.RunVideo), with a progress bar on stderr;
-    exit 2 naming `option` for one that could not be written. Loads MuJoCo for headless rendering
-    (MUJOCO_GL=osmesa), so call it before the simulated arm starts."""
+    """The run's video as an output (stablepush.sim.video.RunVideo), with a VideoBar unless
+    `quiet`; exit 2 naming `option` for one that could not be written. Loads MuJoCo for headless
+    rendering (MUJOCO_GL=osmesa), so call it before the simulated arm starts."""
     check_video(option, path, fps, size)
     from stablepush.sim.video import RunVideo
 
-    bar = None
-
-    def progress(done: int, frames: int) -> None:
-        nonlocal bar
-        if bar is None:
-            bar = click.progressbar(length=frames, label=f"video {path}", file=sys.stderr, show_pos=True)
-            bar.__enter__()
-        bar.update(1)
-        if done == frames:
-            bar.__exit__(None, None, None)
-
-    return RunVideo(path, fps, size, progress=None if quiet else progress)
+    return RunVideo(path, fps, size, progress=None if quiet else VideoBar(path))
 
 
 def parse_host_port(_ctx, _param, value):

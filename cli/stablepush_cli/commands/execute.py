@@ -7,6 +7,7 @@ import sys
 import click
 
 from stablepush.execution.protocol import DEFAULT_PORT
+from stablepush.execution.tcp_arm import DEFAULT_ACK_TIMEOUT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush_cli.common import (
     EXIT_ARM_FAULT,
@@ -44,11 +45,12 @@ from stablepush_cli.options import (
                                  "it); the last push of each contact eases to rest, up to 4/3 of the planned "
                                  "speed on the way (docs/execution.md).")
 @click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
-              help="Continue after plan step STEP (the last confirmed step a fault reported); a simulated arm then "
-                   "keeps the world it has, where every other run starts from a fresh one.")
+              help="Continue after plan step STEP (the last confirmed step a fault reported). A `stablepush sim-arm` "
+                   "server then keeps the world it has; --sim starts a fresh one, the object where step STEP "
+                   "leaves it.")
 @click.option("--pace/--no-pace", default=None,
               help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
-@click.option("--ack-timeout", default=5.0, show_default=True, type=Finite(min=0.01), metavar="S",
+@click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True, type=Finite(min=0.01), metavar="S",
               help="Give up when the arm server does not reply within S seconds (not with --sim: the simulated "
                    "arm runs in this process, and a waypoint takes as long as it takes).")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
@@ -107,8 +109,9 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     places them, else one station per pusher along y, 150 mm apart and alternating about home).
     During a push the object rests on its feature while the gripper moves; between pushes the
     gripper retracts, moves and approaches, and the approach finds the feature by touch (--guard).
-    Waypoints (G's pose in the world, m and a quaternion) go out at --rate as JSON lines over TCP and
-    each is acknowledged with the arm's state.
+    Waypoints (G's pose in the world, m and a quaternion) go out at --rate, each acknowledged with
+    the arm's state: to a simulated arm in this process (--sim), or as JSON lines over TCP to an arm
+    server (--arm: a real arm's bridge, or `stablepush sim-arm`).
 
     The run ends with a verdict: it landed when the object's pose in the grasp is within the task's
     goal tolerance (or --success-tolerance), exit 0; a completed run that missed exits 5 and names
@@ -127,7 +130,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
     """
     from stablepush.execution import ClosedLoop, GuardedApproach, RunOptions, execution_warnings
-    from stablepush.execution.run import BagRecording, JsonReport, run_plan
+    from stablepush.execution.run import BagRecording, JsonReport, recording_for, run_plan
     from stablepush.execution.stream import check_resume_from
     from stablepush.outputs import require_suffix
 
@@ -142,29 +145,49 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     check_resume_from(plan.waypoints, resume_from, field="--resume-from")
     _only_with("--closed-loop", closed_loop, ("--replan-threshold", replan_threshold),
                ("--final-tolerance", final_tolerance))
-    _only_with("--sim (a simulated arm started here)", sim and arm is None, ("--engine", engine != DEFAULT_ENGINE),
+    if sim and arm is not None:
+        fail("--sim and --arm: choose one (a simulated arm started here, or the arm server at HOST:PORT)")
+    _only_with("--sim (a simulated arm started here)", sim, ("--engine", engine != DEFAULT_ENGINE),
                ("--sim-mu-scale", mu_scale != 1.0), ("--tracker-noise", any(tracker_noise)))
+    _only_with("an arm server (--arm, or no --sim)", not sim, ("--ack-timeout", _given("ack_timeout")))
     # The video is made first: the renderer needs MUJOCO_GL=osmesa before the simulated arm loads MuJoCo.
     video = [video_output("--video", video_path, video_fps, video_size, quiet)] if video_path else []
     if not video_path:
         video_settings_need("--video")
-    outputs = ([JsonReport(json_path)] if json_path else []) + (
-        [BagRecording(record_path, stamp_ns)] if record_path else []) + video
-    options = RunOptions(rate_hz=rate_hz, resume_from=resume_from, pace=(not sim) if pace is None else pace,
+    named = ([("--json", JsonReport(json_path))] if json_path else []) + (
+        [("--record", BagRecording(record_path, stamp_ns))] if record_path else []) + [("--video", v) for v in video]
+    outputs = [output for _, output in named]
+    options = RunOptions(rate_hz=rate_hz, resume_from=resume_from, pace=pace,
                          closed_loop=ClosedLoop.for_task(task, replan_threshold, final_tolerance) if closed_loop
                          else None,
                          guard=GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None,
                          success_tolerance=success_tolerance)
     target = _arm_for(arm, sim, engine, mu_scale, tracker_noise, ack_timeout, quiet)
     with _run_progress(task, plan, resume_from, quiet) as progress:
-        run = run_plan(task, plan, target, options, outputs, progress=progress)
+        run = run_plan(task, plan, target, options, progress=progress,
+                       recording=recording_for(task, plan, options, outputs))
+    try:  # after the run's bar has ended: the video draws its own
+        run.write(outputs)
+    finally:
+        for output in video:
+            if output.progress is not None:
+                output.progress.close()
     say = say_beside(json_path, record_path, video_path)
-    if run.fault is not None:
-        _report_fault(run.fault, plan_file, len(plan.waypoints) - 1, run.written)
-    for line in run.report.describe(verbose) + run.written:
+    lines = run.written if run.fault is not None else run.report.describe(verbose) + run.written
+    for line in lines:
         say(line)
+    for output, error in run.failed:  # as each would have been refused before the run, named by its option
+        fail(f"{next(name for name, o in named if o is output)} {error}")
+    if run.fault is not None:
+        _report_fault(run.fault, plan_file, len(plan.waypoints) - 1, sim)
     if run.report.success is False:
         sys.exit(EXIT_MISSED)
+
+
+def _given(name: str) -> bool:
+    """Whether option `name` was given on the command line (not its default)."""
+    source = click.get_current_context().get_parameter_source(name)
+    return source is click.core.ParameterSource.COMMANDLINE
 
 
 def _only_with(option: str, given: bool, *others) -> None:
@@ -214,10 +237,11 @@ def _run_progress(task, plan, resume_from: int, quiet: bool):
         yield progress
 
 
-def _report_fault(fault, plan_file: str, last_step: int, written) -> None:
+def _report_fault(fault, plan_file: str, last_step: int, sim: bool) -> None:
     """Print how a run ended in an arm fault, and where to resume, then exit 3."""
-    for line in written:
-        click.echo(line)
+    if not fault.connected and sim:
+        click.echo(f"error: {fault.reason}; nothing moved", err=True)
+        sys.exit(EXIT_ARM_FAULT)
     if not fault.connected:
         click.echo(f"error: {fault.reason}; nothing was sent. Is the arm server running? "
                    f"(`stablepush sim-arm` serves a simulated arm, or run with --sim)", err=True)

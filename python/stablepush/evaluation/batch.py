@@ -124,14 +124,14 @@ def run_trial(batch: Batch, trial: int) -> dict:
     world = batch.world(trial)
     started = time.perf_counter()
     record = {"trial": trial, "world": world.as_dict()}
-    recording = None
+    # Made before the run, so that a trial that crashes part-way still has what it ran to draw.
+    recording = RunRecording() if batch.video_dir else None
     try:
         loop = ClosedLoop.for_task(batch.task) if batch.closed_loop else None
         options = RunOptions(rate_hz=RATE_HZ, closed_loop=loop, guard=guard_of(batch),
                              success_tolerance=batch.tolerance)
         arm = SimulatedArm(batch.engine, deviation_of(batch, world))
-        run = run_plan(batch.task, batch.plan, arm, options, keep_recording=bool(batch.video_dir))
-        recording = run.recording
+        run = run_plan(batch.task, batch.plan, arm, options, recording=recording)
         if run.fault is not None:  # the simulated arm failed (a simulator blow-up, an unreachable pose): stopped
             record.update(_not_run("arm_fault", str(run.fault)))
         else:
@@ -151,16 +151,13 @@ def run_trial(batch: Batch, trial: int) -> dict:
     return record
 
 
-def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: Optional[RunRecording], record: dict):
+def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: RunRecording, record: dict):
     """Draw a failed trial's recorded run in its own world (features where this trial put them)
     into video_dir/trial-<i>.mp4 and return the path; None, with `video_error` in the record, when
     it cannot be drawn (no waypoint was acknowledged, say). Never raises: the trial's record stands."""
     from stablepush.sim.video import render_run, run_scene
 
     path = os.path.join(batch.video_dir, f"trial-{trial}.mp4")
-    if recording is None:
-        record["video_error"] = "the trial crashed before its run was recorded"
-        return None
     try:
         scene = deviation_of(batch, world).apply(run_scene(batch.task, batch.plan, batch.closed_loop))
         render_run(path, batch.task, scene, recording.samples, fps=batch.video_fps, size=batch.video_size)

@@ -42,9 +42,12 @@ class Arm(abc.ABC):
     """One session with an arm: `hello`, then `move` per waypoint, then `bye`; `stop` at any time
     after `hello`. Used as a context manager, it is closed at the end of the block."""
 
-    #: Whether anything reached the arm: False until `hello` got through (a fault before it means
+    #: Whether the arm was reached: False until `hello` reached it (a fault before that means
     #: nothing was sent, and nothing moved).
     connected: bool = False
+    #: Whether a run holds the stream to its rate in wall-clock time by default (RunOptions.pace
+    #: None): a real arm moves in real time; a simulator keeps its own clock.
+    paced: bool = False
 
     @abc.abstractmethod
     def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:

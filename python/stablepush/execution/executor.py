@@ -21,7 +21,7 @@ from stablepush.errors import ArmFault
 from stablepush.execution.arm import Arm, ArmError, ArmReady
 from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan, switch_held
 from stablepush.execution.guard import GuardedApproach, GuardWatch, measured_pose
-from stablepush.execution.protocol import DEFAULT_RATE_HZ
+from stablepush.execution.protocol import DEFAULT_RATE_HZ, ProtocolError, check_state
 from stablepush.execution.report import ContactRecord, ExecutionReport
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from, contact_first, renumbered
 from stablepush.execution.verdict import judge, within
@@ -53,6 +53,16 @@ def execution_warnings(task: Task) -> List[str]:
     return []
 
 
+def _checked(state: dict, kind: str) -> dict:
+    """`state` once it is one to act on (protocol.check_state: finite, within reach, a unit
+    quaternion), from any arm; ArmError otherwise."""
+    try:
+        check_state(state, kind)
+    except (ProtocolError, KeyError, TypeError) as exc:
+        raise ArmError(f"{exc}" if isinstance(exc, ProtocolError) else f"{kind}: a malformed state ({exc})") from None
+    return state
+
+
 def _off_command(reported: Sequence[float], commanded: Sequence[float]) -> bool:
     """Whether a reported pose of G is farther than FOLLOW_LIMIT from the commanded one."""
     a, b = pose_to_matrix(reported), pose_to_matrix(commanded)
@@ -64,7 +74,8 @@ def _off_command(reported: Sequence[float], commanded: Sequence[float]) -> bool:
 class RunOptions:
     """How a run runs. `rate_hz`: waypoints per second. `resume_from`: the plan step to start from
     (after a fault). `pace`: hold the stream to rate_hz in wall-clock time (a real arm); without it
-    waypoints go as fast as they are acknowledged (a simulator keeps its own clock). `closed_loop`:
+    waypoints go as fast as they are acknowledged (a simulator keeps its own clock); None: as the
+    arm says (`Arm.paced`). `closed_loop`:
     compare the tracked pose with the plan and re-plan past its threshold (closed_loop.py; None:
     open loop). `guard`: end each approach by finding its feature by touch (guard.py; None: the
     approaches end where the plan puts the features). `success_tolerance` (mm, deg): the verdict's
@@ -72,7 +83,7 @@ class RunOptions:
 
     rate_hz: float = DEFAULT_RATE_HZ
     resume_from: int = 0
-    pace: bool = False
+    pace: Optional[bool] = None
     closed_loop: Optional[ClosedLoop] = None
     guard: Optional[GuardedApproach] = GuardedApproach()
     success_tolerance: Optional[Tuple[float, float]] = None
@@ -107,6 +118,12 @@ def execute_plan(task: Task, plan: Plan, arm: Arm, options: RunOptions = RunOpti
         replanned = run.replanned_from is not None and run.last_confirmed > run.replanned_from
         raise ArmFault(reason, run.last_confirmed, arm.stop() if arm.connected else None,
                        connected=arm.connected, replanned=replanned) from None
+    except BaseException:  # anything else (a bug, Ctrl-C) ends the run too: the arm holds still first
+        if arm.connected:
+            arm.stop()
+        raise
+    finally:
+        arm.close()
     return run.report(arm)
 
 
@@ -144,17 +161,18 @@ class _Run:
         o = self.options
         scene = scene_description(self.task, self.features, self.steps[o.resume_from].pose)
         self.ready = arm.hello(scene, o.rate_hz, resume=o.resume_from > 0)
-        self.state = self.ready.state
+        self.state = _checked(self.ready.state, "ready")
+        pace = arm.paced if o.pace is None else o.pace
         self.pending = deque(arm_trajectory(self.task, self.steps, self.features, o.rate_hz,
                                             self.state["ee_pose"], o.resume_from))
         next_time = time.perf_counter()
         while self.pending:
             w = self.pending.popleft()
             self.watch.before(w, self.state)
-            if o.pace:  # one period after the last send, never sooner: an arm that stalled is not caught up in a burst
+            if pace:  # one period after the last send, never sooner: an arm that stalled is not caught up in a burst
                 next_time = max(next_time + 1.0 / o.rate_hz, time.perf_counter())
                 time.sleep(max(0.0, next_time - time.perf_counter()))
-            self._acknowledged(w, arm.move(w))
+            self._acknowledged(w, _checked(arm.move(w), "ack"))
         arm.bye()
 
     def _acknowledged(self, w: ArmWaypoint, state: dict) -> None:
@@ -277,8 +295,6 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     return spliced, points
 
 
-
-
 def _pusher_point(task: Task, pusher: str) -> np.ndarray:
     """The middle of the pusher's segment in O, homogeneous [m]."""
     spec = task.pushers[task.pusher_index(pusher)]
@@ -298,7 +314,6 @@ def _rode_with_hand(task: Task, pusher: str, before: dict, after: dict) -> Optio
     if hand < 1e-7:  # m: the hand stood still, which tells nothing
         return None
     return float(np.linalg.norm((p1 - rode)[:3])) <= RIDE_FRACTION * hand
-
 
 
 def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Waypoint], step: int,

@@ -117,7 +117,7 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
         raise ProtocolError(f"hello: rate_hz must be between {RATE_HZ[0]:g} and {RATE_HZ[1]:g}, "
                             f"got {message['rate_hz']}")
     if "state" in fields[kind]:
-        _check_state(message["state"], kind)
+        check_state(message["state"], kind)
     if kind in ("hello", "ready") and message["protocol"] not in SUPPORTED_PROTOCOLS:
         raise ProtocolError(f"{kind}: protocol {message['protocol']!r} is not one of {', '.join(SUPPORTED_PROTOCOLS)}")
     return message
@@ -128,7 +128,7 @@ def _check_pose(pose: Any, what: str) -> None:
         raise ProtocolError(f"{what} must be 7 finite numbers [x, y, z, qw, qx, qy, qz]")
 
 
-def _check_state(state: dict, kind: str) -> None:
+def check_state(state: dict, kind: str) -> None:
     """A server's `state`: ee_pose 7 finite numbers within ARM_REACH_M of the base with a unit
     quaternion; object_in_grasp, when given, x, z within GRASP_REACH_MM and theta within
     GRASP_TURN_DEG; contact_force, when given, 3 finite numbers within MAX_CONTACT_FORCE_N. Values

@@ -66,7 +66,7 @@ class ExecutionReport:
     guard: str = "off"  # the guarded approach (guard.py): "off", "on", or "no tracker"
     replans: List[Replan] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)  # execution_warnings(task)
-    engine: Optional[str] = None  # the simulator that ran it, as the arm server says ("mujoco"); None for an arm
+    engine: Optional[str] = None  # the simulator that ran it, as the arm says ("mujoco"); None for a real arm
     verdict: Optional[Verdict] = None  # whether it landed, and why not (stablepush.execution.verdict)
     ends_on_feature: bool = False  # the task's environment.end_on_feature: no release at the end
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 import abc
 import json
 from dataclasses import dataclass, field
-from typing import List, Optional, Sequence
+from typing import List, Optional, Sequence, Tuple
 
-from stablepush.errors import ArmFault
+from stablepush.errors import ArmFault, OutputError
 from stablepush.execution.arm import Arm
 from stablepush.execution.bags import RunRecording
 from stablepush.execution.executor import Progress, RunOptions, execute_plan
@@ -24,7 +24,8 @@ from stablepush.task.model import Task
 @dataclass
 class RunResult:
     """How a run ended: its `report` (None after a fault) or its `fault` (None after a report), the
-    `recording` when one was kept, and a line per output written (`written`)."""
+    `recording` when one was kept, a line per output written (`written`), and each output that
+    could not be written with its error (`failed`)."""
 
     task: Task
     plan: Plan
@@ -33,6 +34,7 @@ class RunResult:
     fault: Optional[ArmFault] = None
     recording: Optional[RunRecording] = None
     written: List[str] = field(default_factory=list)
+    failed: List[Tuple["RunOutput", OutputError]] = field(default_factory=list)
 
     @property
     def success(self) -> Optional[bool]:
@@ -51,6 +53,18 @@ class RunResult:
             return fault_report(self.task, self.fault, self.options.success_tolerance)
         return self.report.as_dict()
 
+    def write(self, outputs: Sequence["RunOutput"]) -> None:
+        """Write each of `outputs`: a line each in `written`, or, for one that cannot be written
+        (OutputError), the error in `failed`; one output's failure does not keep the others back."""
+        for output in outputs:
+            try:
+                line = output.write(self)
+            except OutputError as exc:
+                self.failed.append((output, exc))
+                continue
+            if line:
+                self.written.append(line)
+
 
 class RunOutput(abc.ABC):
     """Something a run writes when it ends, landed, missed or faulted."""
@@ -60,7 +74,8 @@ class RunOutput(abc.ABC):
 
     @abc.abstractmethod
     def write(self, run: RunResult) -> Optional[str]:
-        """Write it; the line that says where (None: nothing to write for this run)."""
+        """Write it; the line that says where (None: nothing to write for this run). OutputError
+        when it cannot be written."""
 
 
 class JsonReport(RunOutput):
@@ -90,22 +105,24 @@ class BagRecording(RunOutput):
         return f"run recorded to {self.path}"
 
 
+def recording_for(task: Task, plan: Plan, options: RunOptions, outputs: Sequence[RunOutput]) -> Optional[RunRecording]:
+    """A recording of the run when one of `outputs` needs it (a bag, a video), else None."""
+    if not any(output.records for output in outputs):
+        return None
+    return RunRecording.for_run(task, plan, options.closed_loop is not None)
+
+
 def run_plan(task: Task, plan: Plan, arm: Arm, options: RunOptions = RunOptions(), outputs: Sequence[RunOutput] = (),
-             *, progress: Optional[Progress] = None, keep_recording: bool = False) -> RunResult:
-    """Run `plan` of `task` on `arm` (execute_plan) and write `outputs`. A fault ends the run, not
-    the call: it is the result's `fault`, and the outputs are written for it too. The recording is
-    kept in the result when an output needs it or `keep_recording`. PlanError, before anything
-    moves, when the plan does not belong to the task."""
-    recording = None
-    if keep_recording or any(o.records for o in outputs):
-        recording = RunRecording.for_run(task, plan, options.closed_loop is not None)
+             *, progress: Optional[Progress] = None, recording: Optional[RunRecording] = None) -> RunResult:
+    """Run `plan` of `task` on `arm` (execute_plan) and write `outputs` (RunResult.write). A fault
+    ends the run, not the call: it is the result's `fault`, and the outputs are written for it
+    too. The run is recorded into `recording`, else into one of its own when an output needs it
+    (`recording_for`). PlanError, before anything moves, when the plan does not belong to the task."""
+    recording = recording if recording is not None else recording_for(task, plan, options, outputs)
     result = RunResult(task, plan, options, recording=recording)
     try:
         result.report = execute_plan(task, plan, arm, options, progress=progress, record=recording)
     except ArmFault as fault:
         result.fault = fault
-    for output in outputs:
-        line = output.write(result)
-        if line:
-            result.written.append(line)
+    result.write(outputs)
     return result

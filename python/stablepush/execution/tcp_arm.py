@@ -16,7 +16,10 @@ STOP_WITHIN = 2.0  # s to wait for the arm to confirm a stop (replies that keep 
 
 
 class TcpArm(Arm):
-    """The arm server at host:port, each reply within `ack_timeout` s. It connects on `hello`."""
+    """The arm server at host:port, each reply within `ack_timeout` s. It connects on `hello`; a
+    run is paced by default (a real arm's bridge moves in real time)."""
+
+    paced = True
 
     def __init__(self, host: str, port: int, ack_timeout: float = DEFAULT_ACK_TIMEOUT):
         self.host, self.port = host, port

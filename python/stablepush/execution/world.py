@@ -1,5 +1,5 @@
 """The plan in the world: where the features that act as pushers sit, and the scene a simulated
-arm builds from them. No sockets here (`executor.py`) and no simulation (`stablepush.sim`).
+arm builds from them. No arm here (`executor.py` drives one) and no simulation (`stablepush.sim`).
 
 World frame W: x forward, z up, y along the gripping axis at the home pose, where G's axes are
 W's. A feature is fixed in W; during a push the object rests on it while the gripper moves

@@ -15,7 +15,7 @@ from stablepush.errors import OutputError, PlanError
 from stablepush.inputs import read_capped
 from stablepush.outputs import is_stream, same_file, write_files
 from stablepush.plan.plan import (
-    Fault,
+    FieldFault,
     Plan,
     PlanOutcome,
     PusherContact,
@@ -196,7 +196,7 @@ _KIND_NAMES = {str: "a string", bool: "a boolean", dict: "a mapping", list: "a l
 _REQUIRED = {"task": str, "solved": bool, "stats": dict, "waypoints": list}
 
 
-def _fields_fault(data) -> Fault:
+def _fields_fault(data) -> FieldFault:
     """The format, the fields every plan has and their kinds."""
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         return "format", f"not a {FORMAT} file"
@@ -211,7 +211,7 @@ def _fields_fault(data) -> Fault:
     return None
 
 
-def _outcome_fault(data: dict) -> Fault:
+def _outcome_fault(data: dict) -> FieldFault:
     """The outcome, one of PlanOutcome's, and `solved` agreeing with it (absent or empty: not checked)."""
     outcome = data.get("outcome")
     if not outcome:
@@ -225,7 +225,7 @@ def _outcome_fault(data: dict) -> Fault:
     return None
 
 
-def _stats_fault(stats: dict) -> Fault:
+def _stats_fault(stats: dict) -> FieldFault:
     """The counts among the stats, whole numbers within STATS_COUNTS."""
     for key, largest in STATS_COUNTS.items():
         value = stats.get(key)
@@ -234,7 +234,7 @@ def _stats_fault(stats: dict) -> Fault:
     return None
 
 
-def _waypoints_fault(waypoints: list) -> Fault:
+def _waypoints_fault(waypoints: list) -> FieldFault:
     """The start and at most MAX_WAYPOINTS - 1 pushes, each waypoint as a Waypoint takes it."""
     if not waypoints:
         return "waypoints", "empty; a plan's first waypoint is its start"
@@ -248,7 +248,7 @@ def _waypoints_fault(waypoints: list) -> Fault:
     return None
 
 
-def _waypoint_fault(w) -> Fault:
+def _waypoint_fault(w) -> FieldFault:
     """One waypoint: a mapping whose fields Waypoint would take ('' names the waypoint itself)."""
     if not isinstance(w, dict):
         return "", f"must be a mapping, got {value_kind(w)}"
@@ -266,7 +266,7 @@ def _waypoint_fault(w) -> Fault:
     return None
 
 
-def _extras_fault(data: dict) -> Fault:
+def _extras_fault(data: dict) -> FieldFault:
     """The optional fields beside the waypoints: final_hold, uncertainty, task_identity and ends_at."""
     hold = data.get("final_hold")
     if hold is not None and not (isinstance(hold, dict) and (hold.get("ratio") is None
@@ -282,7 +282,7 @@ def _extras_fault(data: dict) -> Fault:
     return None
 
 
-def _identity_fault(identity) -> Fault:
+def _identity_fault(identity) -> FieldFault:
     """The task_identity record: null, or the task's fields with their digest."""
     if identity is None:
         return None

@@ -19,7 +19,7 @@ import numpy as np
 from stablepush.errors import PlanError
 from stablepush.units import is_finite_real, is_real
 
-Fault = Optional[Tuple[str, str]]  # (field, reason) of the first check that fails; None when all pass
+FieldFault = Optional[Tuple[str, str]]  # (field, reason) of the first check that fails; None when all pass
 
 
 @dataclass(frozen=True)
@@ -67,7 +67,7 @@ class Waypoint:
         return (self.x, self.z, self.theta)
 
 
-def waypoint_fault(fields: Mapping[str, Any]) -> Fault:
+def waypoint_fault(fields: Mapping[str, Any]) -> FieldFault:
     """What is wrong with a waypoint's fields, by Waypoint's names (a Waypoint's own, or a plan
     file's waypoint, which may lack a pose field), other than its contact: the first fault as
     (field, reason), None when there is none. Reasons are in JSON's words (null), as a plan file's

@@ -8,7 +8,7 @@ from typing import List, Optional
 
 from stablepush import _core
 from stablepush.errors import PlanError
-from stablepush.plan.plan import Fault, Plan, Waypoint, require_plan
+from stablepush.plan.plan import FieldFault, Plan, Waypoint, require_plan
 from stablepush.task.model import Task, require_task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import MM, pose_to_si
@@ -47,7 +47,7 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     return plan
 
 
-def _record_fault(task: Task, plan: Plan, require_solved: bool) -> Fault:
+def _record_fault(task: Task, plan: Plan, require_solved: bool) -> FieldFault:
     """The plan's own record: for this task by name, as the task is now, solved when that is required."""
     if not isinstance(plan.task, str):
         return "task", f"must be the task's name, got {type(plan.task).__name__}"
@@ -65,7 +65,7 @@ def _record_fault(task: Task, plan: Plan, require_solved: bool) -> Fault:
     return None
 
 
-def _waypoints_fault(task: Task, waypoints: List[Waypoint], require_solved: bool) -> Fault:
+def _waypoints_fault(task: Task, waypoints: List[Waypoint], require_solved: bool) -> FieldFault:
     """Waypoints, the start and (solved) at least one push, each push by a pusher of the task."""
     for i, w in enumerate(waypoints):
         if not isinstance(w, Waypoint):
@@ -82,7 +82,7 @@ def _waypoints_fault(task: Task, waypoints: List[Waypoint], require_solved: bool
     return None
 
 
-def _switches_fault(plan: Plan) -> Fault:
+def _switches_fault(plan: Plan) -> FieldFault:
     """Each switch-over is a transit between features (hundreds of trajectory samples): no more than
     the plan's own budget, itself within the planner's range. The search extends only nodes within
     the budget, so a node it reports unsolved (the partial path's end, or a goal reached over the
@@ -97,7 +97,7 @@ def _switches_fault(plan: Plan) -> Fault:
     return None
 
 
-def _ends_fault(task: Task, plan: Plan, require_solved: bool) -> Fault:
+def _ends_fault(task: Task, plan: Plan, require_solved: bool) -> FieldFault:
     """The plan starts at the task's start and, solved, ends within its tolerance of the goal."""
     waypoints = plan.waypoints
     if max(abs(a - b) for a, b in zip(waypoints[0].pose, task.start)) > START_SLACK:
@@ -111,7 +111,7 @@ def _ends_fault(task: Task, plan: Plan, require_solved: bool) -> Fault:
     return None
 
 
-def _pushes_fault(task: Task, waypoints: List[Waypoint], model, corners: Optional[list]) -> Fault:
+def _pushes_fault(task: Task, waypoints: List[Waypoint], model, corners: Optional[list]) -> FieldFault:
     """Every push at most one unit step, moving the object, stable (for `model`, the task's, or at
     each of the `corners` of its uncertainty box) with at least the task's min_margin, and ending
     with the pads on the object."""
@@ -155,7 +155,7 @@ def _stability_fault(pusher: str, index: int, q0, q1, model, corners: Optional[l
     return None
 
 
-def _hold_fault(task: Task, waypoints: List[Waypoint], models: list, require_solved: bool) -> Fault:
+def _hold_fault(task: Task, waypoints: List[Waypoint], models: list, require_solved: bool) -> FieldFault:
     """A solved plan's end, where the pads alone hold min_hold_ratio times the weight (in each of `models`)."""
     min_hold = task.planner.min_hold_ratio
     if not (require_solved and min_hold > 0 and len(waypoints) > 1):

@@ -1,5 +1,6 @@
 """The simulated arm: a MuJoCo scene (scene.py) whose joint servos track end-effector poses by
-damped least-squares IK. It knows nothing of sockets; `stablepush.sim.server` puts it on one.
+damped least-squares IK (tracking.py). It knows nothing of runs: `local_arm.SimulatedArm` puts it
+behind the arm port, and `server.py` serves that over TCP.
 
 Poses are (x, y, z, qw, qx, qy, qz) in the world [m]; the end effector is the gripper frame G,
 midway between the pads.

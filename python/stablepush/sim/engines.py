@@ -1,7 +1,7 @@
 """The physics engines a simulated arm can run on, by name: MuJoCo (`arm.py`, whose sliding pad
 friction is stablepush's own Coulomb law, `friction.py`) and Drake (`drake_arm.py`, whose contact
 solver alone decides stick and slip). Both build the same arm, grasp and world from a scene
-description and answer to the same calls, so the server, the executor and the fidelity contract
+description and answer to the same calls, so the in-process arm (local_arm.py), the executor and the fidelity contract
 never ask which one they have. Importing this module loads neither engine.
 """
 from __future__ import annotations

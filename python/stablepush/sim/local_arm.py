@@ -12,8 +12,8 @@ from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
 from stablepush.sim.scene import simulated_outline
 
-# The scene keys that describe the world; the object's pose at the start may differ on a resume.
-_START_KEYS = ("object_pose", "object_in_grasp")
+# The scene keys that say where a run starts, not what the world is: a resume starts elsewhere.
+_START_KEYS = ("object_pose", "object_in_grasp", "gripper_pose")
 
 
 def _world(scene: Optional[dict]) -> Optional[dict]:

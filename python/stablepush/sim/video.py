@@ -143,25 +143,25 @@ def run_scene(task: Task, plan: Plan, closed_loop: bool = False, resume_from: in
 
 class RunVideo(RunOutput):
     """A run drawn into `path` (.mp4) at `fps` and `size` (render_run), in the world its arm was
-    given (run_scene; `scene` when the arm's world departed from it), after a fault too when any
-    waypoint was acknowledged. `progress(frames done, frames)` after each frame. Checked when made
-    (OutputError, MissingExtra), so a video that could not be written is refused before the run."""
+    given (run_scene), after a fault too when any waypoint was acknowledged. `progress(frames done,
+    frames)` after each frame. Checked when made (ValueError for fps and size; OutputError,
+    MissingExtra for the path), so a video that could not be written is refused before the run."""
 
     records = True
 
     def __init__(self, path: str, fps: float = DEFAULT_FPS, size: Tuple[int, int] = DEFAULT_SIZE,
-                 progress: Optional[Callable[[int, int], None]] = None, scene: Optional[dict] = None):
+                 progress: Optional[Callable[[int, int], None]] = None):
         check_fps(fps)
         check_size(tuple(size))
         check_video_path(path)
-        self.path, self.fps, self.size, self.progress, self.scene = path, fps, tuple(size), progress, scene
+        self.path, self.fps, self.size, self.progress = path, fps, tuple(size), progress
         self.info: Optional[VideoInfo] = None
 
     def write(self, run: RunResult) -> Optional[str]:
         if run.fault is not None and not run.recording.samples:
             return None
         closed_loop = run.options.closed_loop is not None
-        scene = self.scene or run_scene(run.task, run.plan, closed_loop, run.options.resume_from)
+        scene = run_scene(run.task, run.plan, closed_loop, run.options.resume_from)
         info = self.info = render_run(self.path, run.task, scene, run.recording.samples, fps=self.fps,
                                       size=self.size, progress=self.progress)
         return (f"video written to {self.path}: {info.frames} frames, {info.width}x{info.height} at {info.fps:g} "

@@ -21,6 +21,8 @@ from stablepush.units import MM, G, is_integer, is_real, mm2_to_si, pose_to_si
 # (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
 # world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
 PUSHES = ("against_fixed_features", "by_moving_pusher")
+
+
 def _finite(field: str, value) -> None:
     if not is_real(value):
         raise TypeError(f"{field} must be a number, got {type(value).__name__}")
@@ -72,6 +74,7 @@ class PlannerSettings:
             object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
         if not isinstance(self.tuning, dict):
             raise TypeError(f"planner.tuning must be a mapping, got {type(self.tuning).__name__}")
+        object.__setattr__(self, "tuning", dict(self.tuning))  # its own: the caller's mapping may change
         for key, value in self.tuning.items():
             if key not in _core.TRRT_STAR_PARAMETER_RANGES or key in ("seed", "max_switches"):
                 raise ValueError(f"planner.{key!s:.40}: not a planner setting")
@@ -190,6 +193,10 @@ class Cell:
     @classmethod
     def from_mapping(cls, values: Dict[str, Any]) -> "Cell":
         """The cell of an environment section in the task file's form; defaults for keys left out."""
+        named = {f.name for f in dataclasses.fields(cls)}
+        unknown = [key for key in values if key not in named]
+        if unknown:
+            raise ValueError(f"environment.{unknown[0]!s:.40}: not a setting of the cell ({', '.join(sorted(named))})")
         return cls(**values)
 
     def as_dict(self) -> Dict[str, Any]:

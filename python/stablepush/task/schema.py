@@ -83,7 +83,6 @@ ENVIRONMENT_DEFAULTS: Dict[str, Any] = {k: v for k, v in Cell().as_dict().items(
 # its setters refuse values outside them): key -> (kind, lowest, highest). seed and max_switches
 # are among them; the rest are tuning keys, written to the plan only when the task gives them.
 PLANNER_PARAMETER_RANGES: Dict[str, Tuple[str, float, float]] = dict(_core.TRRT_STAR_PARAMETER_RANGES)
-PLANNER_TUNING = {k: v for k, v in PLANNER_PARAMETER_RANGES.items() if k not in ("seed", "max_switches")}
 
 
 # ---------------------------------------------------------------------------------------------
