@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # The tests, as CI runs them (.ci/run): set up (system packages, a virtual environment, the
 # package with its test extras), then lint, the import layers, the C++ unit tests and the Python
-# suite. Extra arguments go to pytest (e.g. -m "not slow" for the fast set).
+# suite. Extra arguments go to pytest (e.g. -m "not slow" for the fast set); they come after the
+# defaults, so `-n 0` runs the suite in one process and `-n 4` on four workers.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh --test
 venv="${STABLEPUSH_VENV:-.venv}"
-export PATH="$PWD/$venv/bin:$PATH"
+case "$venv" in /*) ;; *) venv="$PWD/$venv" ;; esac  # STABLEPUSH_VENV may be absolute too
+export PATH="$venv/bin:$PATH"
 
 echo "test: ruff" >&2
 ruff check .
@@ -22,4 +24,8 @@ if [ -f cpp/tests/CMakeLists.txt ]; then
 fi
 echo "test: pytest" >&2
 # From the repo, the tests import the installed package, never python/ itself.
-python -m pytest -q "$@"
+# pytest-xdist: one worker per core (-n auto; PYTEST_XDIST_AUTO_NUM_WORKERS=N sets another count).
+# worksteal: a worker that runs out takes half of another's queue, so the minute-long tests (the
+# fuzz campaign, Drake's closed loop, the README walk-through) need no ordering by hand. The 15
+# slowest tests are listed, so that one that grows shows in CI's log.
+python -m pytest -q -n auto --dist worksteal --durations=15 "$@"

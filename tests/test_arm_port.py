@@ -137,7 +137,7 @@ def test_a_bridge_that_is_not_there_is_a_fault_before_anything_was_sent(low_mu):
         free.bind(("127.0.0.1", 0))
         port = free.getsockname()[1]
     with pytest.raises(ArmFault, match="cannot reach the arm server") as caught:
-        execute_plan(task, plan, TcpArm("127.0.0.1", port, 1.0), RunOptions(rate_hz=100.0))
+        execute_plan(task, plan, TcpArm("127.0.0.1", port, 1.0), RunOptions(rate_hz=100.0, pace=False))
     assert caught.value.connected is False and caught.value.arm_stopped is None
 
 
@@ -153,7 +153,7 @@ def test_the_simulated_arm_in_this_process_and_over_the_protocol_run_the_same(lo
     world = WorldDeviation(mu_scale=0.9, tracker_noise_mm=0.02, seed=3)
     local = execute_plan(task, plan, SimulatedArm(deviation=world), RunOptions(rate_hz=100.0))
     with running_sim_arm(log=lambda text: None, deviation=world) as server:
-        remote = execute_plan(task, plan, TcpArm(server.host, server.port, 120.0), RunOptions(rate_hz=100.0))
+        remote = execute_plan(task, plan, TcpArm(server.host, server.port, 120.0), RunOptions(rate_hz=100.0, pace=False))
     a, b = local.as_dict(), remote.as_dict()
     for d in (a, b):
         d.pop("wall_time_s"), d.pop("sim_steps_per_s")

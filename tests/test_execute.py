@@ -102,7 +102,7 @@ def test_t_shape_end_to_end_through_two_switch_overs():
     task = shipped("t-shaped")
     plan = check_plan(task, plan_task(task, seed=1))
     with running_sim_arm(log=lambda text: None) as server:
-        report = execute_plan(task, plan, TcpArm(server.host, server.port), RunOptions(rate_hz=100.0))
+        report = execute_plan(task, plan, TcpArm(server.host, server.port), RunOptions(rate_hz=100.0, pace=False))
     assert [c.pusher for c in report.contacts] == ["left", "under-web", "left"]
     # 0.09 mm measured with Coulomb friction on the sliding pad points (1.0 mm was allowed before they slid right)
     assert report.final_error["distance"] < FINAL_BOUND_MM and abs(report.final_error["theta"]) < FINAL_BOUND_DEG
@@ -276,7 +276,7 @@ def test_bad_replies_stop_the_arm_and_name_the_last_step(bad_reply, says):
     plan = check_plan(task, plan_task(task, seed=1))
     arm = FakeArm(good=91, bad_reply=bad_reply)  # the approach's 51 waypoints and 4 pushes of 10
     with pytest.raises(ArmFault) as fault:
-        execute_plan(task, plan, TcpArm("127.0.0.1", arm.port, 5.0), RunOptions(rate_hz=100.0))
+        execute_plan(task, plan, TcpArm("127.0.0.1", arm.port, 5.0), RunOptions(rate_hz=100.0, pace=False))
     assert says in fault.value.reason
     assert fault.value.last_confirmed_step == 4
     assert fault.value.arm_stopped is True and arm.stopped
@@ -440,7 +440,7 @@ def test_closed_loop_on_an_arm_without_a_tracker_runs_open_loop_and_says_so():
     task = shipped("horizontal-offset-high-mu")
     plan = check_plan(task, plan_task(task, seed=1))
     arm = FakeArm(good=10**9, bad_reply=None)  # acknowledges everything, reports no object_in_grasp
-    report = execute_plan(task, plan, TcpArm("127.0.0.1", arm.port), RunOptions(rate_hz=100.0, closed_loop=ClosedLoop.for_task(task)))
+    report = execute_plan(task, plan, TcpArm("127.0.0.1", arm.port), RunOptions(rate_hz=100.0, pace=False, closed_loop=ClosedLoop.for_task(task)))
     assert report.closed_loop == "no tracker" and report.replans == []
     assert report.guard == "no tracker" and all(c.found_mm is None for c in report.contacts)
     assert report.last_confirmed_step == 20 and report.final_error is None
@@ -738,7 +738,7 @@ def test_an_arm_that_never_moves_ends_the_run_in_a_fault_and_is_stopped():
     task = shipped("horizontal-offset-high-mu")
     arm = FakeArm(good=10**9, bad_reply=None, frozen=True)
     with pytest.raises(ArmFault, match="not following") as fault:
-        execute_plan(task, check_plan(task, plan_task(task, seed=1)), TcpArm("127.0.0.1", arm.port), RunOptions(rate_hz=100.0))
+        execute_plan(task, check_plan(task, plan_task(task, seed=1)), TcpArm("127.0.0.1", arm.port), RunOptions(rate_hz=100.0, pace=False))
     assert arm.stopped and fault.value.last_confirmed_step < 20
 
 

@@ -547,7 +547,7 @@ def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu
             replies = [decode(line, "server") for line in half.makefile("rb")]
             assert replies[0]["type"] == "ready" and [r["seq"] for r in replies[1:]] == list(range(20))
         time.sleep(0.2)
-        report = execute_plan(task, plan, TcpArm(server.host, server.port), RunOptions(rate_hz=100.0))
+        report = execute_plan(task, plan, TcpArm(server.host, server.port), RunOptions(rate_hz=100.0, pace=False))
         assert report.last_confirmed_step == len(plan.waypoints) - 1 and report.final_error["distance"] < 0.5
     finally:
         server.close()
@@ -568,7 +568,7 @@ def test_the_executor_holds_its_ack_deadline_against_a_trickling_arm(high_mu_run
     threading.Thread(target=trickle, daemon=True).start()
     started = time.monotonic()
     with pytest.raises(ArmFault, match="no complete message from the arm server .* within 1 s"):
-        execute_plan(task, plan, TcpArm("127.0.0.1", listener.getsockname()[1], 1.0), RunOptions(rate_hz=100.0))
+        execute_plan(task, plan, TcpArm("127.0.0.1", listener.getsockname()[1], 1.0), RunOptions(rate_hz=100.0, pace=False))
     assert time.monotonic() - started < 5.0  # the deadline plus the stop's 2 s, not the trickle's 8 s
     listener.close()
 
@@ -603,7 +603,7 @@ def test_bad_arm_states_end_in_an_arm_fault_and_a_stop(high_mu_run, state, says)
 
     threading.Thread(target=arm, daemon=True).start()
     with pytest.raises(ArmFault, match=says) as fault:
-        execute_plan(task, plan, TcpArm("127.0.0.1", listener.getsockname()[1], 2.0), RunOptions(rate_hz=100.0))
+        execute_plan(task, plan, TcpArm("127.0.0.1", listener.getsockname()[1], 2.0), RunOptions(rate_hz=100.0, pace=False))
     time.sleep(0.1)
     assert stops and json.loads(stops[0])["type"] == "stop"
     assert fault.value.last_confirmed_step == 0
@@ -823,7 +823,7 @@ def test_generated_hostile_arm_states_end_in_a_report_or_a_fault_with_a_stop(hig
 
     threading.Thread(target=arm, daemon=True).start()
     try:
-        report = execute_plan(task, plan, TcpArm("127.0.0.1", listener.getsockname()[1], 2.0), RunOptions(rate_hz=100.0, closed_loop=ClosedLoop.for_task(task)))
+        report = execute_plan(task, plan, TcpArm("127.0.0.1", listener.getsockname()[1], 2.0), RunOptions(rate_hz=100.0, pace=False, closed_loop=ClosedLoop.for_task(task)))
         # A run that ends in a report took the hostile state in its stride: every step confirmed, the
         # arm never told to stop, and a report that strict JSON writes (no nan or inf let through).
         assert report.last_confirmed_step == report.total_steps and not stops, (report.last_confirmed_step, stops)
