@@ -32,8 +32,15 @@ from stablepush_cli.options import (
 @click.option("--quat", type=click.Choice(["xyzw", "wxyz"]), default=None,
               help="Quaternion order in a .csv or .json: xyzw as ROS writes it (the default), wxyz as the arm "
                    "protocol and MuJoCo do. A .mcap's messages are ROS's own, xyzw.")
+@click.option("--joints", is_flag=True,
+              help="The shipped simulated arm's joint positions (rad), once every sample is checked: within the "
+                   "joints' limits and reach, each joint under 2.5 rad/s, every link clear of the features and the "
+                   "floor; a plan the arm cannot follow exits 2 naming the first sample, the joint or the link. A "
+                   ".csv or .json holds them instead of G's poses (a column per joint); a .mcap adds /joint_states "
+                   "and a trajectory_msgs/JointTrajectory (/stablepush/joint_trajectory). Needs the [sim] extra.")
 @stamp_option("a .mcap", "now")
-def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str, stamp_ns) -> None:
+def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str, joints: bool,
+               stamp_ns) -> None:
     """Write the gripper's timed trajectory for a plan: what the executor streams, for your robot.
 
     One sample per 1/HZ s: time (s), G's position in the world (m) and orientation (a unit
@@ -58,16 +65,30 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
               f".csv and .json")
     if stamp_ns is not None and not out_path.lower().endswith(".mcap"):
         fail("--stamp: only with a .mcap (a ROS 2 bag; a .csv or .json counts t from 0)")
+    if joints and quat is not None:
+        fail("--joints: joint positions have no quaternions; --quat is for the gripper's poses")
     quat = quat or "xyzw"
     check_named_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = load_plan_and_task(plan_file, task_file)
     for warning in execution_warnings(task):  # the stream is the executor's, so is its cell
         click.echo(f"warning: {warning}", err=True)
+    path = None
+    if joints:
+        from stablepush.sim.joint_path import joint_path
+
+        path = joint_path(task, plan, rate_hz)
+        if not out_path.lower().endswith(".mcap"):
+            write_atomically(out_path, path.to_json() if out_path.lower().endswith(".json") else path.to_csv())
+            click.echo(f"{task.name}: {path.describe()}; written to {out_path}")
+            return
     traj = timed_trajectory(task, plan, rate_hz)
     if out_path.lower().endswith(".mcap"):
         from stablepush.execution.bags import write_bag
 
-        write_bag(out_path, task, plan, traj, start_ns=stamp_ns)
+        write_bag(out_path, task, plan, traj, start_ns=stamp_ns,
+                  joints=None if path is None else (path.joints, path.q))
+        if path is not None:
+            click.echo(f"{task.name}: {path.describe()}")
     else:
         write_atomically(out_path, traj.to_json(quat) if out_path.lower().endswith(".json") else traj.to_csv(quat))
     click.echo(f"{task.name}: {len(traj)} samples at {rate_hz:g} Hz, {traj.t[-1]:.2f} s, "

@@ -126,18 +126,30 @@ def object_in_gripper(task: Task, plan: Plan, trajectory: Trajectory) -> np.ndar
     return out
 
 
+JOINT_TOPICS = {
+    "/joint_states": "sensor_msgs/msg/JointState",
+    "/stablepush/joint_trajectory": "trajectory_msgs/msg/JointTrajectory",
+}
+
+
 def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajectory,
-              start_ns: Optional[int] = None) -> None:
+              start_ns: Optional[int] = None, joints: Optional[Tuple[Sequence[str], np.ndarray]] = None) -> None:
     """Write the trajectory of `plan` as one MCAP file at `path`, each sample stamped `start_ns`
-    (Unix ns, `parse_stamp`; default: now) plus its time. PlanError unless the plan is the task's
-    as it is now (stablepush.plan.verify.check_plan)."""
+    (Unix ns, `parse_stamp`; default: now) plus its time. With `joints` (the joint names, and one row
+    of positions [rad] per sample of the trajectory: stablepush.sim.joint_path), also the arm's
+    `/joint_states` per sample and, once at the start, the whole `/stablepush/joint_trajectory`
+    (trajectory_msgs/JointTrajectory, each point's time_from_start its sample's t), what
+    ros2_control's joint_trajectory_controller takes. PlanError unless the plan is the task's as it
+    is now (stablepush.plan.verify.check_plan)."""
     check_plan(task, plan)
     start_ns = time.time_ns() if start_ns is None else start_ns
     T_GO = object_in_gripper(task, plan, trajectory)
     steps = list(plan.waypoints)
     features = place_features(task, steps)
-    with _mcap(path, TOPICS) as (T, write):
+    with _mcap(path, {**TOPICS, **(JOINT_TOPICS if joints is not None else {})}) as (T, write):
         start = _time(T, start_ns)
+        if joints is not None:
+            write("/stablepush/joint_trajectory", start_ns, _joint_trajectory(T, start, trajectory, joints))
         write(TF_STATIC, start_ns, _static_transforms(T, start, features.values()))
         write("/stablepush/scene", start_ns, T["visualization_msgs/msg/MarkerArray"](
             markers=_scene_markers(T, start, task, features.values())))
@@ -160,6 +172,23 @@ def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajec
                     angular=_vector3(T, trajectory.angular_velocity[i]))))
             write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=trajectory.phase[i]))
             write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(trajectory.step[i])))
+            if joints is not None:
+                write("/joint_states", ns, T["sensor_msgs/msg/JointState"](
+                    header=_header(T, stamp, ""), name=list(joints[0]),
+                    position=np.asarray(joints[1][i], float), velocity=np.zeros(0), effort=np.zeros(0)))
+
+
+def _joint_trajectory(T, stamp, trajectory: Trajectory, joints: Tuple[Sequence[str], np.ndarray]):
+    """The joint positions of every sample as one JointTrajectory, time_from_start each sample's t."""
+    points = []
+    for t, q in zip(trajectory.t, joints[1]):
+        ns = int(round(float(t) * 1e9))
+        points.append(T["trajectory_msgs/msg/JointTrajectoryPoint"](
+            positions=np.asarray(q, float), velocities=np.zeros(0), accelerations=np.zeros(0), effort=np.zeros(0),
+            time_from_start=T["builtin_interfaces/msg/Duration"](sec=ns // 1_000_000_000,
+                                                                 nanosec=ns % 1_000_000_000)))
+    return T["trajectory_msgs/msg/JointTrajectory"](header=_header(T, stamp, ""), joint_names=list(joints[0]),
+                                                    points=points)
 
 
 def _continuous(poses: Sequence[Optional[Sequence[float]]]) -> List[Optional[List[float]]]:

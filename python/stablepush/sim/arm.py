@@ -116,37 +116,49 @@ class SimulatedGrasp:
         return self.steps / self.step_wall_time if self.step_wall_time > 0 else 0.0
 
 
+class ArmKinematics:
+    """The arm's forward kinematics on a MuJoCo model of its scene, for IK (ik.Kinematics): q [rad]
+    of ARM_JOINTS -> G's rotation and position in the world [m] and its Jacobian (linear rows over
+    angular), computed on scratch data so the simulation's state is not touched. `lower` and `upper`
+    are the joints' limits [rad]."""
+
+    def __init__(self, model):
+        m = self.model = model
+        joints = [m.joint(j).id for j in scene_mod.ARM_JOINTS]
+        self.qpos_adr = np.array([m.jnt_qposadr[j] for j in joints])
+        self.dof_adr = np.array([m.jnt_dofadr[j] for j in joints])
+        self.lower, self.upper = m.jnt_range[joints, 0].copy(), m.jnt_range[joints, 1].copy()
+        self.site = m.site(scene_mod.GRIPPER_SITE).id
+        self.data = mujoco.MjData(m)
+        self._jacp = np.zeros((3, m.nv))
+        self._jacr = np.zeros((3, m.nv))
+
+    def __call__(self, q: np.ndarray):
+        d = self.data
+        d.qpos[self.qpos_adr] = q
+        mujoco.mj_kinematics(self.model, d)
+        mujoco.mj_comPos(self.model, d)
+        mujoco.mj_jacSite(self.model, d, self._jacp, self._jacr, self.site)
+        J = np.vstack([self._jacp, self._jacr])[:, self.dof_adr]
+        return d.site_xmat[self.site].reshape(3, 3), d.site_xpos[self.site].copy(), J
+
+
 class SimArm(TrackingArm, SimulatedGrasp):
     """The arm, the grasp and the world of one scene description (as `deviation` alters it)."""
 
     def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
         super().__init__(scene, deviation)
         m = self.model
-        self._arm_qpos = np.array([m.jnt_qposadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
-        self._arm_dof = np.array([m.jnt_dofadr[m.joint(j).id] for j in scene_mod.ARM_JOINTS])
+        self._kinematics = ArmKinematics(m)
+        self._arm_qpos, self._arm_dof = self._kinematics.qpos_adr, self._kinematics.dof_adr
         self._arm_act = np.array([m.actuator(j).id for j in scene_mod.ARM_JOINTS])
-        self._scratch = mujoco.MjData(m)
-        joints = [m.joint(j).id for j in scene_mod.ARM_JOINTS]
-        self._lower, self._upper = m.jnt_range[joints, 0], m.jnt_range[joints, 1]
-        self._jacp = np.zeros((3, m.nv))
-        self._jacr = np.zeros((3, m.nv))
+        self._lower, self._upper = self._kinematics.lower, self._kinematics.upper
 
         home = self._find_home()
         self.data.qpos[self._arm_qpos] = home
         self._set_servos(home)
         mujoco.mj_forward(m, self.data)
         self.advance(SETTLE_TIME)
-
-    # -- kinematics ---------------------------------------------------------------------------
-
-    def _kinematics(self, q: np.ndarray):
-        d = self._scratch
-        d.qpos[self._arm_qpos] = q
-        mujoco.mj_kinematics(self.model, d)
-        mujoco.mj_comPos(self.model, d)
-        mujoco.mj_jacSite(self.model, d, self._jacp, self._jacr, self._site)
-        J = np.vstack([self._jacp, self._jacr])[:, self._arm_dof]
-        return d.site_xmat[self._site].reshape(3, 3), d.site_xpos[self._site].copy(), J
 
     # -- simulation ---------------------------------------------------------------------------
 

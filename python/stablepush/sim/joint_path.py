@@ -1,0 +1,220 @@
+"""The arm's joints along a plan's timed trajectory: whether the arm can follow the plan at all,
+decided before any motion, and the joint trajectory a lab's controllers take (ros2_control's
+joint_trajectory_controller, MoveIt's execution).
+
+Every sample of the timed trajectory (execution.trajectory: the executor's stream) is solved for
+the arm's joint positions (ik.solve_ik, each from the sample before, so the path stays on one
+branch) on the MuJoCo model of the run's scene (scene.build_mjcf: the shipped arm, arm.xml, its
+jaws, the object and the features where the executor places them). The cell check refuses a plan
+(CellError, a PlanError: exit 2) at the first sample where
+- no joint positions within the arm's limits put G within FK_TOLERANCE of the sample's pose
+  (out of reach, or a joint at its limit: named, with how far G stays off);
+- a joint would move faster than MAX_JOINT_SPEED between two samples (a branch flip, or a
+  motion the joints cannot make);
+- a link of the arm comes closer than LINK_CLEARANCE to a feature or the floor (named, with the
+  distance; the jaws and pads, which hold the object and stand FEATURE_CLEARANCE clear of the
+  features along y by construction, are left out).
+Poses are (x, y, z, qw, qx, qy, qz) in the world [m]; joint angles in rad.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from dataclasses import dataclass
+from typing import List, Sequence, Tuple
+
+import numpy as np
+
+from stablepush.errors import PlanError
+from stablepush.execution.trajectory import Trajectory, timed_trajectory
+from stablepush.execution.world import place_features, scene_description
+from stablepush.frames import pose_to_matrix
+from stablepush.plan.plan import Plan
+from stablepush.plan.verify import check_plan
+from stablepush.sim import ik
+from stablepush.sim import scene as scene_mod
+from stablepush.sim.arm import ArmKinematics
+from stablepush.sim.friction import mujoco
+from stablepush.task.model import Task
+
+# G through the joints' forward kinematics stays this close to each sample (m, rad): the joint
+# trajectory reproduces the Cartesian one within 0.01 mm and 0.01 deg.
+FK_TOLERANCE = (1e-5, math.radians(0.01))
+# rad/s a joint of the shipped arm may turn (its MJCF gives no velocity limits; a 7-joint
+# collaborative arm's slowest joints turn about 2.5 rad/s).
+MAX_JOINT_SPEED = 2.5
+LINK_CLEARANCE = 0.0  # m a link of the arm keeps from a feature or the floor (0: touching is refused)
+CLEARANCE_SEEN = 0.05  # m: distances past this are not measured (mj_geomDistance's distmax)
+# The arm's bodies whose geoms are its links for the clearance check: those the joints move, less
+# the jaws (their fingers hold the object and the pads touch it).
+_JAW_BODIES = ("finger_pos", "finger_neg")
+
+
+class CellError(PlanError):
+    """A plan the arm cannot follow in its cell, found before any motion: `sample` (its index in
+    the timed trajectory), `t` [s], `step` (the plan step) and why."""
+
+    def __init__(self, sample: int, t: float, step: int, phase: str, reason: str):
+        self.sample, self.t, self.step = sample, t, step
+        super().__init__("", f"the arm cannot follow the plan: at t {t:.2f} s (sample {sample}, plan step {step}, "
+                             f"{phase}) {reason}")
+
+
+@dataclass(frozen=True)
+class JointPath:
+    """The arm's joint positions `q` [rad] (one row per sample, a column per joint of `joints`)
+    at times `t` [s], with each sample's phase and plan step, and how closely they carry out the
+    Cartesian trajectory: the largest error of G through forward kinematics (`fk_error_mm`,
+    `fk_error_deg`), the fastest joint (`peak_speed`, rad/s), and the least clearance of a link
+    (`clearance_mm`, from `nearest`: link body and feature or floor)."""
+
+    joints: Tuple[str, ...]
+    t: np.ndarray
+    q: np.ndarray
+    phase: List[str]
+    step: np.ndarray
+    fk_error_mm: float
+    fk_error_deg: float
+    peak_speed: float
+    clearance_mm: float
+    nearest: Tuple[str, str]
+
+    def __len__(self) -> int:
+        return len(self.t)
+
+    def columns(self) -> List[str]:
+        return ["t"] + [f"{name}_rad" for name in self.joints] + ["phase", "step"]
+
+    def rows(self) -> List[list]:
+        return [[float(t), *(float(v) for v in q), phase, int(step)]
+                for t, q, phase, step in zip(self.t, self.q, self.phase, self.step)]
+
+    def to_csv(self) -> str:
+        buffer = io.StringIO()
+        writer = csv.writer(buffer, lineterminator="\n")
+        writer.writerow(self.columns())
+        writer.writerows(self.rows())
+        return buffer.getvalue()
+
+    def to_json(self) -> str:
+        return json.dumps({"joints": list(self.joints), "units": {"t": "s", "q": "rad"}, "columns": self.columns(),
+                           "rows": self.rows()}) + "\n"
+
+    def describe(self) -> str:
+        clear = (f"least clearance {self.clearance_mm:.1f} mm ({self.nearest[0]} to {self.nearest[1]})"
+                 if self.clearance_mm < CLEARANCE_SEEN * 1e3 else
+                 f"every link over {CLEARANCE_SEEN * 1e3:g} mm from the features and the floor")
+        return (f"{len(self)} samples on {len(self.joints)} joints; G through the joints within "
+                f"{self.fk_error_mm:.5f} mm, {self.fk_error_deg:.5f} deg; fastest joint {self.peak_speed:.2f} rad/s "
+                f"(at most {MAX_JOINT_SPEED:g}); {clear}")
+
+
+def joint_path(task: Task, plan: Plan, rate_hz: float = 100.0) -> JointPath:
+    """The shipped arm's joints along the plan's timed trajectory, once the plan is shown to belong
+    to the task (check_plan) and the arm can follow it in its cell (CellError otherwise)."""
+    plan = check_plan(task, plan)
+    steps = list(plan.waypoints)
+    scene = scene_description(task, place_features(task, steps), steps[0].pose)
+    traj = timed_trajectory(task, plan, rate_hz)
+    return _Solver(scene).solve(traj)
+
+
+class _Solver:
+    """IK, limits, speed and clearance along one trajectory, on the MuJoCo model of its scene."""
+
+    def __init__(self, scene: dict):
+        model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene))
+        self.kin = ArmKinematics(model)
+        self.model, self.data = model, self.kin.data
+        self.home = self._solve(scene["gripper_pose"], ik.HOME_GUESS, ik.HOME_GUESS, 1000)
+        links = _link_bodies(model)
+        self.link_geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] in links]
+        self.obstacles = [model.geom(scene_mod.feature_geom(f["pusher"])).id for f in scene["features"]]
+        self.obstacles.append(model.geom("floor").id)
+
+    def _solve(self, pose: Sequence[float], q_start: np.ndarray, home: np.ndarray, iterations: int):
+        q, _ = ik.solve_ik(self.kin, pose, q_start, home, self.kin.lower, self.kin.upper, iterations)
+        return q
+
+    def solve(self, traj: Trajectory) -> JointPath:
+        q_prev = self.home
+        rows, worst = [], (0.0, 0.0)
+        peak, least, nearest = 0.0, math.inf, ("", "")
+        dt = 1.0 / traj.rate_hz
+        for i in range(len(traj)):
+            pose = [*traj.position[i], *traj.quaternion_wxyz[i]]
+            q = self._solve(pose, q_prev, self.home, ik.IK_ITERATIONS)
+            off = self._fk_error(q, pose)
+            if off[0] > FK_TOLERANCE[0] or off[1] > FK_TOLERANCE[1]:  # near the edge of reach: look harder
+                q = self._solve(pose, q, self.home, 20 * ik.IK_ITERATIONS)
+                off = self._fk_error(q, pose)
+            where = (i, float(traj.t[i]), int(traj.step[i]), traj.phase[i])
+            if off[0] > FK_TOLERANCE[0] or off[1] > FK_TOLERANCE[1]:
+                raise CellError(*where, self._why_unreached(q, off))
+            speed = np.abs(q - q_prev) / dt
+            if i > 0 and speed.max() > MAX_JOINT_SPEED:
+                k = int(np.argmax(speed))
+                raise CellError(*where, f"joint {scene_mod.ARM_JOINTS[k]} would turn {speed[k]:.2f} rad/s, past "
+                                        f"{MAX_JOINT_SPEED:g} rad/s (a branch flip, or a motion too fast for it)")
+            clearance, pair = self._clearance(q)
+            if clearance < LINK_CLEARANCE:
+                raise CellError(*where, f"link {pair[0]} runs {-clearance * 1e3:.1f} mm into {pair[1]}")
+            if clearance < least:
+                least, nearest = clearance, pair
+            peak = max(peak, float(speed.max())) if i > 0 else peak
+            worst = (max(worst[0], off[0]), max(worst[1], off[1]))
+            rows.append(q)
+            q_prev = q
+        return JointPath(joints=scene_mod.ARM_JOINTS, t=np.asarray(traj.t), q=np.array(rows), phase=list(traj.phase),
+                         step=np.asarray(traj.step), fk_error_mm=worst[0] * 1e3, fk_error_deg=math.degrees(worst[1]),
+                         peak_speed=peak, clearance_mm=least * 1e3, nearest=nearest)
+
+    def _fk_error(self, q: np.ndarray, pose: Sequence[float]) -> Tuple[float, float]:
+        """How far G through the joints' forward kinematics is from `pose`: (m, rad)."""
+        R, p, _ = self.kin(q)
+        target = pose_to_matrix(pose)
+        return float(np.linalg.norm(target[:3, 3] - p)), float(np.linalg.norm(ik.rotation_vector(target[:3, :3] @ R.T)))
+
+    def _why_unreached(self, q: np.ndarray, off: Tuple[float, float]) -> str:
+        at_limit = [name for name, v, lo, hi in zip(scene_mod.ARM_JOINTS, q, self.kin.lower, self.kin.upper)
+                    if min(v - lo, hi - v) < 1e-6]
+        limits = f"; at its limit: joint {', '.join(at_limit)}" if at_limit else ""
+        return (f"no joint positions within the arm's limits put G there: it stays {off[0] * 1e3:.3f} mm, "
+                f"{math.degrees(off[1]):.3f} deg off{limits}")
+
+    def _clearance(self, q: np.ndarray) -> Tuple[float, Tuple[str, str]]:
+        """The least distance [m] from a link to an obstacle at joint positions `q`, and which."""
+        self.kin(q)  # places the scratch data's geoms
+        least, pair = math.inf, ("", "")
+        fromto = np.zeros(6)
+        for g in self.link_geoms:
+            for o in self.obstacles:
+                d = mujoco.mj_geomDistance(self.model, self.data, g, o, CLEARANCE_SEEN, fromto)
+                if d < least:
+                    least, pair = d, (self.model.body(self.model.geom_bodyid[g]).name, self.model.geom(o).name)
+        return least, pair
+
+
+def _link_bodies(model) -> set:
+    """The bodies the arm's joints move, less the jaws."""
+    moved = set()
+    for j in scene_mod.ARM_JOINTS:
+        moved.add(int(model.jnt_bodyid[model.joint(j).id]))
+    for b in range(model.nbody):  # and every body below one of them
+        parent = b
+        while parent != 0 and parent not in moved:
+            parent = int(model.body_parentid[parent])
+        if parent in moved:
+            moved.add(b)
+    jaws = {model.body(name).id for name in _JAW_BODIES if _has_body(model, name)}
+    return {b for b in moved if b not in jaws and model.body(b).name != scene_mod.OBJECT_BODY}
+
+
+def _has_body(model, name: str) -> bool:
+    try:
+        model.body(name)
+    except KeyError:
+        return False
+    return True

@@ -1,0 +1,135 @@
+"""The shipped arm's joints along a plan (stablepush.sim.joint_path): the joint trajectory
+reproduces the Cartesian one through forward kinematics computed apart from the solver, moves
+continuously, and a plan the arm cannot follow in its cell is refused before any motion, naming
+where and why."""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import stablepush as sp
+from stablepush.frames import pose_to_matrix
+from stablepush.plan import plan_task
+from stablepush_cli.main import cli
+
+from conftest import TASKS, shipped
+
+mujoco = pytest.importorskip("mujoco")
+
+
+def _forward(task, plan, path):
+    """G's world pose [4x4] at each sample, through MuJoCo's own kinematics of a fresh model."""
+    from stablepush.execution.world import place_features, scene_description
+    from stablepush.sim import scene as scene_mod
+
+    scene = scene_description(task, place_features(task, list(plan.waypoints)), plan.waypoints[0].pose)
+    model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene))
+    data = mujoco.MjData(model)
+    adr = [model.jnt_qposadr[model.joint(j).id] for j in path.joints]
+    site = model.site(scene_mod.GRIPPER_SITE).id
+    for q in path.q:
+        data.qpos[adr] = q
+        mujoco.mj_kinematics(model, data)
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = data.site_xmat[site].reshape(3, 3), data.site_xpos[site]
+        yield T
+
+
+@pytest.mark.parametrize("name", ["horizontal-offset-low-mu", "horizontal-offset-high-mu", "t-shaped",
+                                  "large-manipulation"])
+def test_the_joint_trajectory_reproduces_the_cartesian_one_and_moves_continuously(name):
+    from stablepush.sim.joint_path import MAX_JOINT_SPEED, joint_path
+
+    task = shipped(name)
+    plan = plan_task(task, seed=1)
+    path = joint_path(task, plan)
+    traj = sp.trajectory(task, plan)
+    assert len(path) == len(traj) and path.q.shape == (len(traj), 7)
+    for T, p, q in zip(_forward(task, plan, path), traj.position, traj.quaternion_wxyz):
+        target = pose_to_matrix([*p, *q])
+        assert np.linalg.norm(T[:3, 3] - target[:3, 3]) < 1e-5  # 0.01 mm
+        cos = (np.trace(T[:3, :3].T @ target[:3, :3]) - 1) / 2
+        assert math.degrees(math.acos(min(1.0, cos))) < 0.01
+    speed = np.abs(np.diff(path.q, axis=0)).max() * traj.rate_hz
+    assert speed <= MAX_JOINT_SPEED and path.peak_speed == pytest.approx(speed)
+
+
+def test_a_feature_out_of_the_arms_reach_is_refused_before_any_motion():
+    """On the straight move out to a feature 1.5 m away the elbow straightens toward its singularity:
+    the check stops where the first joint would have to turn too fast, before G leaves the reach."""
+    from stablepush.sim.joint_path import CellError, joint_path
+
+    task = shipped("horizontal-offset-high-mu")
+    far = dataclasses.replace(task, environment={**task.environment.as_dict(), "features": {"left": [1500, 0, 300, 0]}})
+    with pytest.raises(CellError, match=r"\(sample \d+, plan step 0, move\) (joint j\d would turn|no joint positions)"):
+        joint_path(far, plan_task(far, seed=1))
+    beyond = dataclasses.replace(far, environment={**far.environment.as_dict(), "home": [1400, 0, 300]})
+    with pytest.raises(CellError, match="no joint positions within the arm's limits put G there: it stays"):
+        joint_path(beyond, plan_task(beyond, seed=1))  # G's start itself lies out of reach
+
+
+def test_a_link_through_a_fixture_is_refused_naming_the_link_and_the_fixture(tmp_path):
+    """The pivot's plan: after its last push the gripper, turned 90 deg, retracts with its wrist
+    (link6) 1 mm into the left feature's solid (10 mm deep behind its face). The simulated arm
+    does not collide its links, so a run on it lands; the cell check says what a real cell would."""
+    task_file = TASKS / "pivoting.yaml"
+    plan_file = tmp_path / "p.json"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["plan", str(task_file), "-o", str(plan_file)]).exit_code == 0
+    result = runner.invoke(cli, ["trajectory", str(plan_file), "--task", str(task_file), "-o",
+                                 str(tmp_path / "p.csv"), "--joints"])
+    assert result.exit_code == 2, result.output
+    assert "link link6 runs 1.0 mm into feature_left" in result.output and "retract" in result.output
+    assert not (tmp_path / "p.csv").exists()
+
+
+def test_joints_are_written_as_columns_and_other_outputs_are_refused(tmp_path):
+    task_file = TASKS / "t-shaped.yaml"
+    plan_file = tmp_path / "t.json"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["plan", str(task_file), "-o", str(plan_file)]).exit_code == 0
+    out = tmp_path / "t.csv"
+    result = runner.invoke(cli, ["trajectory", str(plan_file), "--task", str(task_file), "-o", str(out), "--joints"])
+    assert result.exit_code == 0, result.output
+    header = out.read_text().splitlines()[0].split(",")
+    assert header == ["t"] + [f"j{k}_rad" for k in range(1, 8)] + ["phase", "step"]
+    quat = runner.invoke(cli, ["trajectory", str(plan_file), "--task", str(task_file), "-o", str(out), "--joints",
+                               "--quat", "wxyz"])
+    assert quat.exit_code == 2 and "--joints" in quat.output
+
+
+def test_the_bags_joint_trajectory_read_back_by_rosbags_carries_out_the_gripper_poses(tmp_path):
+    """Read with rosbags' own reader (not our writer): the JointTrajectory's points, through forward
+    kinematics, are the bag's gripper poses; /joint_states holds the same positions, sample by sample."""
+    from rosbags.highlevel import AnyReader
+
+    task_file = TASKS / "horizontal-offset-low-mu.yaml"
+    plan_file, bag = tmp_path / "p.json", tmp_path / "p.mcap"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["plan", str(task_file), "-o", str(plan_file)]).exit_code == 0
+    result = runner.invoke(cli, ["trajectory", str(plan_file), "--task", str(task_file), "-o", str(bag), "--joints"])
+    assert result.exit_code == 0, result.output
+    with AnyReader([bag]) as reader:
+        def messages(topic):
+            connections = [c for c in reader.connections if c.topic == topic]
+            return [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages(connections=connections)]
+
+        (trajectory,) = messages("/stablepush/joint_trajectory")
+        states = messages("/joint_states")
+        poses = messages("/stablepush/gripper_pose")
+    assert list(trajectory.joint_names) == [f"j{k}" for k in range(1, 8)] == list(states[0].name)
+    times = [p.time_from_start.sec + p.time_from_start.nanosec * 1e-9 for p in trajectory.points]
+    assert all(b > a for a, b in zip(times, times[1:])) and len(states) == len(poses) == len(times)
+    task = sp.load_task(task_file)
+    plan = sp.load_plan(plan_file)
+    path = dataclasses.make_dataclass("Path", ["joints", "q"])(
+        [f"j{k}" for k in range(1, 8)], np.array([p.positions for p in trajectory.points]))
+    for T, pose, state, point in zip(_forward(task, plan, path), poses, states, trajectory.points):
+        assert np.allclose(state.position, point.positions)
+        p, q = pose.pose.position, pose.pose.orientation
+        target = pose_to_matrix([p.x, p.y, p.z, q.w, q.x, q.y, q.z])
+        assert np.linalg.norm(T[:3, 3] - target[:3, 3]) < 1e-5
+        cos = (np.trace(T[:3, :3].T @ target[:3, :3]) - 1) / 2
+        assert math.degrees(math.acos(min(1.0, cos))) < 0.01
