@@ -38,7 +38,15 @@ from stablepush_cli.options import (
                    "push is stable for every multiplier they draw (docs/model.md section 7). Corrections keep "
                    "the box. Not with --plan.")
 @click.option("--trials", default=100, show_default=True, type=click.IntRange(min=1, max=1_000_000),
-              help="Number of trials (worlds).")
+              help="Number of trials (worlds); with --target, the most to run.")
+@click.option("--target", "target", default=None, type=Finite(min=0, max=1, min_open=True, max_open=True),
+              metavar="RATE", help="Decide whether the plan lands at least RATE of the time (e.g. 0.99), and stop "
+                                   "as soon as the evidence does: a sequential probability ratio test, valid however "
+                                   "early it stops (docs/evaluate.md). A rate one point below RATE is called above "
+                                   "with probability at most 1 - --confidence, and one at RATE below likewise.")
+@click.option("--confidence", default=0.95, show_default=True, type=Finite(min=0.5, max=1, min_open=True,
+                                                                                 max_open=True),
+              metavar="C", help="With --target: the decision's confidence.")
 @click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
               help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and outcomes, "
                    "serially, on workers or on Ray.")
@@ -77,9 +85,10 @@ from stablepush_cli.options import (
                    "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv).")
 @video_options("--video-failed")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, vary, feature_error, tracker_noise,
-             closed_loop: bool, guarded: bool, engine: str, success_tolerance, workers, ray_address, json_path,
-             csv_path, png_path, video_dir, video_fps: float, video_size, quiet: bool) -> None:
+def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confidence: float, seed: int, vary,
+             feature_error, tracker_noise, closed_loop: bool, guarded: bool, engine: str, success_tolerance, workers,
+             ray_address, json_path, csv_path, png_path, video_dir, video_fps: float, video_size,
+             quiet: bool) -> None:
     """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
 
     Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
@@ -105,6 +114,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
       stablepush evaluate data/tasks/t-shaped.yaml --trials 100 --robust --vary pad_mu=0.15 --vary pusher_mu=0.15
       stablepush evaluate data/tasks/t-shaped.yaml --trials 20 --vary pad_mu=0.3 --video-failed t-failed
     """
+    test = _test(target, confidence)
     if video_dir:  # before the trials load MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
         check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video_fps, video_size)
     else:
@@ -141,7 +151,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, seed: int, va
                    f"{'' if guarded else ', approaches not guarded'} on {engine}, "
                    f"on {runner.describe()}" + (f"; the plan is robust to {box}" if box else ""), err=True)
     with _trials_bar(quiet, trials) as progress:
-        result = run_evaluation(batch, trials, runner, progress)
+        result = run_evaluation(batch, trials, runner, progress, test=test)
     write_evaluation(result, json_path, csv_path, png_path)
     s = result.summary()
     if not s["trials"]:
@@ -208,3 +218,17 @@ def _plan_for(task, spreads, robust: bool):
         click.echo(f"{task.name}{' (robust)' if robust else ''}: {plan.message}", err=True)
         sys.exit(EXIT_NOT_SOLVED)
     return task, plan
+
+
+def _test(target, confidence: float):
+    """The sequential test --target asks for (None without it)."""
+    from stablepush.evaluation import SequentialTest
+
+    if target is None:
+        if click.get_current_context().get_parameter_source("confidence") is click.core.ParameterSource.COMMANDLINE:
+            fail("--confidence: only with --target")
+        return None
+    try:
+        return SequentialTest(target, confidence)
+    except ValueError as exc:
+        fail(f"--target: {exc}")

@@ -1,6 +1,7 @@
 """A plan's measured success rate over many perturbed worlds (`stablepush evaluate`): the worlds
-(worlds.py) and the batch that runs one trial per world (batch.py) where `stablepush.runners`
-says: here, on local processes or on Ray."""
+(worlds.py), the batch that runs one trial per world (batch.py) where `stablepush.runners`
+says: here, on local processes or on Ray, and the sequential decision that may stop it early
+(sequential.py)."""
 from stablepush.evaluation.batch import (
     Batch,
     Evaluation,
@@ -9,7 +10,8 @@ from stablepush.evaluation.batch import (
     wilson_interval,
     write_evaluation,
 )
+from stablepush.evaluation.sequential import SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world, robust_task
 
-__all__ = ["Batch", "Evaluation", "Spreads", "TrialWorld", "VARY_KEYS", "draw_world",
+__all__ = ["Batch", "Evaluation", "SequentialTest", "Spreads", "TrialWorld", "VARY_KEYS", "draw_world",
            "evaluate", "robust_task", "run_trial", "wilson_interval", "write_evaluation"]

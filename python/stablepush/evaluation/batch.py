@@ -21,6 +21,7 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from stablepush.evaluation.sequential import SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.bags import RunRecording
 from stablepush.execution.closed_loop import ClosedLoop
@@ -178,16 +179,21 @@ def _crashed(batch: Batch, trial: int, why: str) -> dict:
 
 
 def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
-             progress: Optional[Callable[[dict, List[dict]], None]] = None) -> "Evaluation":
+             progress: Optional[Callable[[dict, List[dict]], None]] = None,
+             test: Optional[SequentialTest] = None) -> "Evaluation":
     """Run trials 0 .. trials-1 of `batch` on `runner`; `progress(record, done)` after each. Ctrl-C
     (KeyboardInterrupt) stops the batch and keeps the trials done (`interrupted`). When every world
     is the model's own (Spreads.one_world) one trial says all there is: it alone runs, and the
-    summary gives no interval."""
+    summary gives no interval. With a sequential `test` (sequential.py), `trials` is a cap: the
+    study stops once the test decides. It is asked after each trial in the order of the trials'
+    numbers (a trial that finishes early on another worker waits for those before it), since a
+    test asked in the order trials happen to finish could be swayed by how long each kind takes."""
     trials = batch.spreads.trials_to_run(trials)
     source = run_all(run_trial, batch, range(trials), runner)
     started = time.perf_counter()
     done: List[dict] = []
     interrupted = False
+    decision = _Decision(test)
     try:
         for i, record in source:
             if isinstance(record, WorkerLost):
@@ -195,6 +201,8 @@ def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
             done.append(record)
             if progress is not None:
                 progress(record, done)
+            if decision.add(record):
+                break
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -203,7 +211,34 @@ def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
             close()
     done.sort(key=lambda r: r["trial"])
     return Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started, runner=runner.describe(),
-                      requested=trials, interrupted=interrupted)
+                      requested=trials, interrupted=interrupted, decision=decision.as_dict())
+
+
+class _Decision:
+    """A sequential test fed the trials in the order of their numbers."""
+
+    def __init__(self, test: Optional[SequentialTest]):
+        self.test = test
+        self.waiting: Dict[int, bool] = {}
+        self.next = self.successes = 0
+        self.verdict: Optional[str] = None
+
+    def add(self, record: dict) -> bool:
+        """Take a finished trial; whether the test has decided."""
+        if self.test is None or self.verdict is not None:
+            return self.verdict is not None
+        self.waiting[record["trial"]] = bool(record["success"])
+        while self.next in self.waiting and self.verdict is None:
+            self.successes += self.waiting.pop(self.next)
+            self.next += 1
+            self.verdict = self.test.decide(self.successes, self.next)
+        return self.verdict is not None
+
+    def as_dict(self) -> Optional[dict]:
+        if self.test is None:
+            return None
+        return {**self.test.as_dict(), "decision": self.verdict or "undecided", "trials": self.next,
+                "successes": self.successes}
 
 
 @dataclass(frozen=True)
@@ -214,6 +249,7 @@ class Evaluation:
     runner: str
     requested: int
     interrupted: bool = False
+    decision: Optional[dict] = None  # the sequential test's: its settings, decision, and the trials it took
 
     def summary(self) -> dict:
         """Counts, the success rate with its Wilson 95% interval, goal-error percentiles (mm and
@@ -244,6 +280,7 @@ class Evaluation:
             "causes": causes, "crashed": causes.get("crash", 0),
             "wall_s": self.wall_s, "runner": self.runner,
             "robot_time_s": robot_time, "real_time_factor": robot_time / self.wall_s if self.wall_s > 0 else None,
+            "decision": self.decision,
         }
 
     def as_dict(self) -> dict:
@@ -268,6 +305,12 @@ class Evaluation:
             mm, deg = s["goal_error_mm"], s["goal_error_deg"]
             lines.append(f"goal error: median {mm['p50']:.3f} mm / {deg['p50']:.3f} deg, "
                          f"p95 {mm['p95']:.3f} mm / {deg['p95']:.3f} deg")
+        if s["decision"] is not None:
+            d = s["decision"]
+            said = {"above": "it lands at least", "below": "it lands less than",
+                    "undecided": "undecided whether it lands at least"}[d["decision"]]
+            lines.append(f"decision: {d['decision']}: {said} {d['target']:.1%} of the time ({d['confidence']:.0%} "
+                         f"confidence, {d['method']}), after the first {d['trials']} trials ({d['successes']} landed)")
         if s["causes"]:
             lines.append("misses: " + ", ".join(f"{cause} {count}" for cause, count in sorted(s["causes"].items())))
         lines.append(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
