@@ -12,7 +12,7 @@ by touch (`guarded`, the default) or end where the plan puts it (`plain`: `evalu
     python3 benchmarks/evaluate_tasks.py [TASK.yaml ...] [--trials 100] [--seed 1] [--workers 2 | --ray [ADDRESS]]
                                          [--plans nominal robust] [--loop open closed]
                                          [--approach guarded plain] [--engine mujoco]
-                                         [--tolerance MM DEG] [--json OUT.json]
+                                         [--tolerance MM DEG] [--target RATE [--confidence C]] [--json OUT.json]
 
 `--json` keeps each row's missed trials, to look into why they missed.
 """
@@ -24,7 +24,7 @@ from typing import Optional
 
 from shipped import shipped_tasks
 
-from stablepush.evaluation import Batch, Spreads, evaluate, robust_task
+from stablepush.evaluation import Batch, SequentialTest, Spreads, evaluate, robust_task
 from stablepush.plan import check_plan, plan_task
 from stablepush.runners import Runner, default_workers
 from stablepush.sim.engines import ENGINES
@@ -45,6 +45,10 @@ def main() -> None:
     parser.add_argument("--engine", choices=ENGINES, default="mujoco")
     parser.add_argument("--tolerance", nargs=2, type=float, default=None, metavar=("MM", "DEG"),
                         help="judge the trials by this tolerance (default: each task's planner.tolerance)")
+    parser.add_argument("--target", type=float, default=None, metavar="RATE",
+                        help="decide whether each row lands at least RATE of the time and stop it when decided "
+                             "(evaluate --target); --trials is then the cap")
+    parser.add_argument("--confidence", type=float, default=0.95, help="with --target (default 0.95)")
     parser.add_argument("--json", type=Path, default=None,
                         help="every row's summary, with its missed trials' records under `missed` (trial, world, "
                              "verdict, replans: enough to run one again), as JSON")
@@ -70,12 +74,15 @@ def main() -> None:
                 batch = Batch(task=task, plan=plan, spreads=SPREADS, seed=args.seed, closed_loop=loop == "closed",
                               guarded=approach == "guarded", engine=args.engine, tolerance=args.tolerance)
                 progress = progress_line(f"{task.name} {kind}", f"{loop} {approach}", args.trials)
-                evaluation = evaluate(batch, args.trials, runner, progress=progress)
+                test = SequentialTest(args.target, args.confidence) if args.target is not None else None
+                evaluation = evaluate(batch, args.trials, runner, progress=progress, test=test)
                 s = evaluation.summary()
                 missed = [t for t in evaluation.trials if not t["success"]]
                 summaries.append({**s, "plan": kind, "approach": approach, "missed": missed})
                 mm, deg = s["goal_error_mm"] or {}, s["goal_error_deg"] or {}
                 misses = ", ".join(f"{k} {v}" for k, v in sorted(s["causes"].items())) or "-"
+                if s["decision"] is not None:
+                    misses += f"; decision {s['decision']['decision']} after {s['decision']['trials']} trials"
                 tol = s["tolerance"]
                 print(f"| {task.name} | {kind} | {loop} | {approach} | {tol[0]:g} mm, {tol[1]:g} deg "
                       f"| {s['successes']}/{s['trials']} "
