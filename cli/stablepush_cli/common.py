@@ -36,6 +36,11 @@ def fail(message: str) -> None:
     sys.exit(EXIT_BAD_INPUT)
 
 
+def given(name: str) -> bool:
+    """Whether the running command's option `name` was given on the command line (not defaulted)."""
+    return click.get_current_context().get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE
+
+
 OUTPUTS = "stablepush.outputs"  # click's shared Context.meta: the command's outputs, option -> path
 
 

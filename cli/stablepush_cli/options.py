@@ -13,6 +13,7 @@ from stablepush.extras import MissingExtra
 from stablepush.task.schema import LIMITS, PLANNER_PARAMETER_RANGES
 from stablepush_cli.common import (
     fail,
+    given,
 )
 
 
@@ -89,11 +90,9 @@ def video_options(which: str):
 
 def video_settings_need(option: str) -> None:
     """Exit 2 when --video-fps or --video-size is given without `option` (they would do nothing)."""
-    ctx = click.get_current_context()
-    given = [f"--video-{name}" for name in ("fps", "size")
-             if ctx.get_parameter_source(f"video_{name}") is click.core.ParameterSource.COMMANDLINE]
-    if given:
-        fail(f"{' and '.join(given)}: only with {option}")
+    named = [f"--video-{name}" for name in ("fps", "size") if given(f"video_{name}")]
+    if named:
+        fail(f"{' and '.join(named)}: only with {option}")
 
 
 def check_video(option: str, path: str, fps: float, size) -> None:

@@ -7,6 +7,7 @@ import click
 
 from stablepush.task import HEADING_STEP_DEG, check_push, stable_directions
 from stablepush_cli.common import (
+    given,
     load_task_file,
 )
 from stablepush_cli.options import (
@@ -29,8 +30,7 @@ from stablepush_cli.options import (
                    f"({HEADING_STEP_DEG[0]:g}-{HEADING_STEP_DEG[1]:g}).")
 @click.option("--pusher", default=None, metavar="NAME", help="Test only this pusher (default: every pusher).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object keyed by pusher name.")
-@click.pass_context
-def check(ctx: click.Context, task_file: str, at, move, directions: bool, heading_step: float, pusher,
+def check(task_file: str, at, move, directions: bool, heading_step: float, pusher,
           as_json: bool) -> None:
     """Is moving the object by --move from --at a stable push, pusher by pusher?
 
@@ -53,7 +53,7 @@ def check(ctx: click.Context, task_file: str, at, move, directions: bool, headin
     """
     if (move is None) == (not directions):
         raise click.UsageError("give --move DX DZ DTH, or --directions (one of the two)")
-    if not directions and ctx.get_parameter_source("heading_step") is click.core.ParameterSource.COMMANDLINE:
+    if not directions and given("heading_step"):
         raise click.UsageError("--heading-step: only with --directions")
     task = load_task_file(task_file)
     at = at if at else task.start

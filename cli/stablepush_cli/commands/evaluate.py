@@ -13,6 +13,7 @@ from stablepush_cli.common import (
     EXIT_NOT_SOLVED,
     check_named_outputs,
     fail,
+    given,
     load_plan_and_task,
     load_task_file,
     progressbar,
@@ -225,7 +226,7 @@ def _test(target, confidence: float):
     from stablepush.evaluation import SequentialTest
 
     if target is None:
-        if click.get_current_context().get_parameter_source("confidence") is click.core.ParameterSource.COMMANDLINE:
+        if given("confidence"):
             fail("--confidence: only with --target")
         return None
     try:

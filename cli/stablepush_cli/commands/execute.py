@@ -14,6 +14,7 @@ from stablepush_cli.common import (
     EXIT_MISSED,
     check_named_outputs,
     fail,
+    given,
     load_plan_and_task,
     progressbar,
     say_beside,
@@ -149,7 +150,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
         fail("--sim and --arm: choose one (a simulated arm started here, or the arm server at HOST:PORT)")
     _only_with("--sim (a simulated arm started here)", sim, ("--engine", engine != DEFAULT_ENGINE),
                ("--sim-mu-scale", mu_scale != 1.0), ("--tracker-noise", any(tracker_noise)))
-    _only_with("an arm server (--arm, or no --sim)", not sim, ("--ack-timeout", _given("ack_timeout")))
+    _only_with("an arm server (--arm, or no --sim)", not sim, ("--ack-timeout", given("ack_timeout")))
     # The video is made first: the renderer needs MUJOCO_GL=osmesa before the simulated arm loads MuJoCo.
     video = [video_output("--video", video_path, video_fps, video_size, quiet)] if video_path else []
     if not video_path:
@@ -183,11 +184,6 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     if run.report.success is False:
         sys.exit(EXIT_MISSED)
 
-
-def _given(name: str) -> bool:
-    """Whether option `name` was given on the command line (not its default)."""
-    source = click.get_current_context().get_parameter_source(name)
-    return source is click.core.ParameterSource.COMMANDLINE
 
 
 def _only_with(option: str, given: bool, *others) -> None:

@@ -72,16 +72,16 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
     task, plan = load_plan_and_task(plan_file, task_file)
     for warning in execution_warnings(task):  # the stream is the executor's, so is its cell
         click.echo(f"warning: {warning}", err=True)
+    traj = timed_trajectory(task, plan, rate_hz)
     path = None
     if joints:
         from stablepush.sim.joint_path import joint_path
 
-        path = joint_path(task, plan, rate_hz)
+        path = joint_path(task, plan, rate_hz, traj)
         if not out_path.lower().endswith(".mcap"):
             write_atomically(out_path, path.to_json() if out_path.lower().endswith(".json") else path.to_csv())
             click.echo(f"{task.name}: {path.describe()}; written to {out_path}")
             return
-    traj = timed_trajectory(task, plan, rate_hz)
     if out_path.lower().endswith(".mcap"):
         from stablepush.execution.bags import write_bag
 

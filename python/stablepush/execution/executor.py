@@ -124,7 +124,7 @@ def execute_plan(task: Task, plan: Plan, arm: Arm, options: RunOptions = RunOpti
         raise
     finally:
         arm.close()
-    return run.report(arm)
+    return run.report()
 
 
 class _Run:
@@ -237,7 +237,7 @@ class _Run:
             self.pending = renumbered(w, self.options.rate_hz, new_points)
             self.replanned_from = w.step if self.replanned_from is None else min(self.replanned_from, w.step)
 
-    def report(self, arm: Arm) -> ExecutionReport:
+    def report(self) -> ExecutionReport:
         task, steps, state = self.task, self.steps, self.state
         report = ExecutionReport(
             task=task.name, resumed_from=self.options.resume_from, last_confirmed_step=self.last_confirmed,

@@ -23,7 +23,7 @@ import io
 import json
 import math
 from dataclasses import dataclass
-from typing import List, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -111,14 +111,14 @@ class JointPath:
                 f"(at most {MAX_JOINT_SPEED:g}); {clear}")
 
 
-def joint_path(task: Task, plan: Plan, rate_hz: float = 100.0) -> JointPath:
-    """The shipped arm's joints along the plan's timed trajectory, once the plan is shown to belong
-    to the task (check_plan) and the arm can follow it in its cell (CellError otherwise)."""
+def joint_path(task: Task, plan: Plan, rate_hz: float = 100.0, trajectory: Optional[Trajectory] = None) -> JointPath:
+    """The shipped arm's joints along the plan's timed trajectory at `rate_hz` (`trajectory`, when
+    the caller has it already), once the plan is shown to belong to the task (check_plan) and the
+    arm can follow it in its cell (CellError otherwise)."""
     plan = check_plan(task, plan)
     steps = list(plan.waypoints)
     scene = scene_description(task, place_features(task, steps), steps[0].pose)
-    traj = timed_trajectory(task, plan, rate_hz)
-    return _Solver(scene).solve(traj)
+    return _Solver(scene).solve(trajectory if trajectory is not None else timed_trajectory(task, plan, rate_hz))
 
 
 class _Solver:
@@ -208,13 +208,5 @@ def _link_bodies(model) -> set:
             parent = int(model.body_parentid[parent])
         if parent in moved:
             moved.add(b)
-    jaws = {model.body(name).id for name in _JAW_BODIES if _has_body(model, name)}
+    jaws = {model.body(name).id for name in _JAW_BODIES}
     return {b for b in moved if b not in jaws and model.body(b).name != scene_mod.OBJECT_BODY}
-
-
-def _has_body(model, name: str) -> bool:
-    try:
-        model.body(name)
-    except KeyError:
-        return False
-    return True
