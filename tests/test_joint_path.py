@@ -40,7 +40,8 @@ def _forward(task, plan, path):
 @pytest.mark.parametrize("name", ["horizontal-offset-low-mu", "horizontal-offset-high-mu", "t-shaped",
                                   "large-manipulation"])
 def test_the_joint_trajectory_reproduces_the_cartesian_one_and_moves_continuously(name):
-    from stablepush.sim.joint_path import MAX_JOINT_SPEED, joint_path
+    from stablepush.sim.joint_path import joint_path
+    from stablepush.task.model import Robot
 
     task = shipped(name)
     plan = plan_task(task, seed=1)
@@ -53,7 +54,7 @@ def test_the_joint_trajectory_reproduces_the_cartesian_one_and_moves_continuousl
         cos = (np.trace(T[:3, :3].T @ target[:3, :3]) - 1) / 2
         assert math.degrees(math.acos(min(1.0, cos))) < 0.01
     speed = np.abs(np.diff(path.q, axis=0)).max() * traj.rate_hz
-    assert speed <= MAX_JOINT_SPEED and path.peak_speed == pytest.approx(speed)
+    assert speed <= Robot().max_joint_speed and path.peak_speed == pytest.approx(speed)
 
 
 def test_a_feature_out_of_the_arms_reach_is_refused_before_any_motion():

@@ -8,36 +8,40 @@ midway between the pads.
 from __future__ import annotations
 
 import time
-from typing import Callable, Dict, Sequence
+from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
 
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.friction import CoulombPadFriction, mujoco
+from stablepush.sim.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.sim.tracking import SETTLE_TIME, TrackingArm, in_grasp
+from stablepush.task.model import Robot
 
 
 class SimulatedGrasp:
     """A scene's grasp in MuJoCo, shared by the arm and the friction-fidelity rig (`fidelity.py`):
-    the model (`scene.build_mjcf`), the jaws closed on the object with the grip force, the pad
-    friction (friction.py) stepped with the physics, and the read-outs of the grasp."""
+    the model (`scene.build_mjcf`, with the arm of `robot`), the jaws closed on the object with the
+    grip force, the pad friction (friction.py) stepped with the physics, and the read-outs of the
+    grasp."""
 
-    def __init__(self, scene: dict, kinematic_hand: bool = False):
-        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, kinematic_hand=kinematic_hand))
+    def __init__(self, scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None):
+        self.arm = arm_model(robot)
+        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, kinematic_hand, robot))
         self.data = mujoco.MjData(self.model)
         m = self.model
-        self._site = m.site(scene_mod.GRIPPER_SITE).id
+        self._site = m.site(GRIPPER_SITE).id
         self._object = m.body(scene_mod.OBJECT_BODY).id
         self._object_qpos = m.jnt_qposadr[m.joint(scene_mod.OBJECT_BODY).id]
         self.pad_friction = CoulombPadFriction(m, scene_mod.pad_geoms(m))
         self.steps = 0
         self.step_wall_time = 0.0
-        fingers = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.FINGER_JOINTS]
+        fingers = [m.jnt_qposadr[m.joint(j).id] for j in FINGER_JOINTS]
         self.data.qpos[fingers] = scene["object"]["thickness"] / 2
         self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene["object_pose"]
         # close: the servos saturate at the grip force
-        self.data.ctrl[[m.actuator(j).id for j in scene_mod.FINGER_JOINTS]] = 0.0
+        self.data.ctrl[[m.actuator(j).id for j in FINGER_JOINTS]] = 0.0
         self._pad_geoms = set(scene_mod.pad_geoms(m))
         if kinematic_hand:
             self._hand_qpos = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
@@ -118,17 +122,19 @@ class SimulatedGrasp:
 
 class ArmKinematics:
     """The arm's forward kinematics on a MuJoCo model of its scene, for IK (ik.Kinematics): q [rad]
-    of ARM_JOINTS -> G's rotation and position in the world [m] and its Jacobian (linear rows over
-    angular), computed on scratch data so the simulation's state is not touched. `lower` and `upper`
-    are the joints' limits [rad]."""
+    of the arm's `joints` (base to flange) -> G's rotation and position in the world [m] and its
+    Jacobian (linear rows over angular), computed on scratch data so the simulation's state is not
+    touched. `lower` and `upper` are the joints' limits [rad] (infinite for an unlimited joint)."""
 
-    def __init__(self, model):
+    def __init__(self, model, joints: Sequence[str]):
         m = self.model = model
-        joints = [m.joint(j).id for j in scene_mod.ARM_JOINTS]
-        self.qpos_adr = np.array([m.jnt_qposadr[j] for j in joints])
-        self.dof_adr = np.array([m.jnt_dofadr[j] for j in joints])
-        self.lower, self.upper = m.jnt_range[joints, 0].copy(), m.jnt_range[joints, 1].copy()
-        self.site = m.site(scene_mod.GRIPPER_SITE).id
+        ids = [m.joint(j).id for j in joints]
+        self.qpos_adr = np.array([m.jnt_qposadr[j] for j in ids])
+        self.dof_adr = np.array([m.jnt_dofadr[j] for j in ids])
+        limited = m.jnt_limited[ids].astype(bool)
+        self.lower = np.where(limited, m.jnt_range[ids, 0], -np.inf)
+        self.upper = np.where(limited, m.jnt_range[ids, 1], np.inf)
+        self.site = m.site(GRIPPER_SITE).id
         self.data = mujoco.MjData(m)
         self._jacp = np.zeros((3, m.nv))
         self._jacr = np.zeros((3, m.nv))
@@ -144,14 +150,15 @@ class ArmKinematics:
 
 
 class SimArm(TrackingArm, SimulatedGrasp):
-    """The arm, the grasp and the world of one scene description (as `deviation` alters it)."""
+    """The arm of `robot` (the shipped arm when None), the grasp and the world of one scene
+    description (as `deviation` alters it)."""
 
-    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(scene, deviation)
+    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation(), robot: Optional[Robot] = None):
+        super().__init__(scene, deviation, robot)
         m = self.model
-        self._kinematics = ArmKinematics(m)
+        self._kinematics = ArmKinematics(m, self.arm.joints)
         self._arm_qpos, self._arm_dof = self._kinematics.qpos_adr, self._kinematics.dof_adr
-        self._arm_act = np.array([m.actuator(j).id for j in scene_mod.ARM_JOINTS])
+        self._arm_act = np.array([m.actuator(j).id for j in self.arm.joints])
         self._lower, self._upper = self._kinematics.lower, self._kinematics.upper
 
         home = self._find_home()

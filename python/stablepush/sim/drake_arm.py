@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import time
 import xml.etree.ElementTree as ET
-from typing import Callable, Dict, Sequence
+from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
 
@@ -39,7 +39,9 @@ from stablepush.extras import require
 from stablepush.frames import pose_to_matrix
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.deviation import WorldDeviation
+from stablepush.sim.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.sim.tracking import SETTLE_TIME, TrackingArm, in_grasp
+from stablepush.task.model import Robot
 
 DRAKE_TIMESTEP = 0.000125  # s (the friction-fidelity contract fails at 0.2 ms: module docstring)
 DRAKE_APPROXIMATION = "lagged"  # DiscreteContactApproximation: sap, similar or lagged
@@ -78,12 +80,13 @@ class DrakeGrasp:
 
     engine = "drake"
 
-    def __init__(self, scene: dict, kinematic_hand: bool = False):
+    def __init__(self, scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None):
         d = _drake()
         self._d = d
         self.timestep = time_step = DRAKE_TIMESTEP
         approximation = DRAKE_APPROXIMATION
-        tree = scene_mod.arm_tree(scene, kinematic_hand)
+        self.arm = arm_model(robot)
+        tree = scene_mod.arm_tree(scene, kinematic_hand, robot)
         if kinematic_hand:
             # Drake keeps a joint's armature only on an actuated joint: a heavy hand stands in for
             # the hand joints' (the pads' forces must not move it within a step).
@@ -107,11 +110,11 @@ class DrakeGrasp:
             actuator = plant.GetJointActuatorByName(position.get("name"), self._arm)
             actuator.set_controller_gains(d.PdControllerGains(p=float(position.get("kp")),
                                                               d=float(position.get("kv", "0"))))
-        pos_joint, neg_joint = (plant.GetJointByName(j, self._arm) for j in scene_mod.FINGER_JOINTS)
+        pos_joint, neg_joint = (plant.GetJointByName(j, self._arm) for j in FINGER_JOINTS)
         plant.AddCouplerConstraint(joint0=neg_joint, joint1=pos_joint, gear_ratio=1.0)
         self._gravcomp_bodies = [plant.GetBodyByName(b.get("name"), self._arm).index()
                                  for b in tree.iter("body") if b.get("gravcomp") == "1"]
-        site = next(tree.iter("site"))
+        site = tree.find(f".//site[@name='{GRIPPER_SITE}']")
         parent = next(b for b in tree.iter("body") if site in list(b))
         X_BG = d.RigidTransform(d.Quaternion(_vector(site.get("quat", "1 0 0 0"))), _vector(site.get("pos", "0 0 0")))
         hand = plant.GetBodyByName(parent.get("name"), self._arm)
@@ -158,7 +161,7 @@ class DrakeGrasp:
         plant.SetFreeBodyPose(self.plant_context, self._object_body, X_WO)
         for joint in (pos_joint, neg_joint):
             joint.set_translation(self.plant_context, scene["object"]["thickness"] / 2)
-        self._finger_servos = [self._servo_index(j) for j in scene_mod.FINGER_JOINTS]
+        self._finger_servos = [self._servo_index(j) for j in FINGER_JOINTS]
         if kinematic_hand:
             self._hand = [plant.GetJointByName(j, self._arm) for j in scene_mod.HAND_JOINTS]
             self.simulator.Initialize()
@@ -357,12 +360,12 @@ class DrakeArm(TrackingArm, DrakeGrasp):
     """The arm, the grasp and the world of one scene description (as `deviation` alters it), in
     Drake; the same interface as `arm.SimArm` (move_to, advance, stop, state, solve_ik)."""
 
-    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(scene, deviation)
+    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation(), robot: Optional[Robot] = None):
+        super().__init__(scene, deviation, robot)
         plant = self.plant
-        joints = [plant.GetJointByName(j, self._arm) for j in scene_mod.ARM_JOINTS]
+        joints = [plant.GetJointByName(j, self._arm) for j in self.arm.joints]
         self._arm_q = np.array([j.position_start() for j in joints])
-        self._arm_servos = [self._servo_index(j) for j in scene_mod.ARM_JOINTS]
+        self._arm_servos = [self._servo_index(j) for j in self.arm.joints]
         self._lower = np.array([j.position_lower_limits()[0] for j in joints])
         self._upper = np.array([j.position_upper_limits()[0] for j in joints])
         self._scratch = plant.CreateDefaultContext()

@@ -28,9 +28,10 @@ def load_engine(engine: str) -> str:
     return engine
 
 
-def make_arm(engine: str, scene: dict, deviation=None):
+def make_arm(engine: str, scene: dict, deviation=None, robot=None):
     """The simulated arm of `scene` on `engine` (SimArm or DrakeArm), in the world `deviation`
-    (a `deviation.WorldDeviation`; None: the task's own)."""
+    (a `deviation.WorldDeviation`; None: the task's own), the arm of `robot` (a
+    task.model.Robot; None: the shipped arm)."""
     from stablepush.sim.arm import SimArm
     from stablepush.sim.deviation import WorldDeviation
 
@@ -38,8 +39,8 @@ def make_arm(engine: str, scene: dict, deviation=None):
     if check_engine(engine) == "drake":
         from stablepush.sim.drake_arm import DrakeArm
 
-        return DrakeArm(scene, deviation)
-    return SimArm(scene, deviation)
+        return DrakeArm(scene, deviation, robot)
+    return SimArm(scene, deviation, robot)
 
 
 def make_grasp(engine: str, scene: dict):

@@ -18,7 +18,8 @@ IK_ITERATIONS = 50
 IK_TOLERANCE = 1e-9  # m (and rad) of pose error
 IK_REACH = 1e-3  # m (and rad): a waypoint whose IK ends farther off than this is out of the arm's reach
 POSTURE_GAIN = 0.05  # null-space pull toward the home posture per IK iteration
-HOME_GUESS = np.array([0.0, 0.35, 0.0, 1.9, 0.0, 0.89, 0.0])  # rad, hand pointing down in front of the base
+HOME_TOLERANCE = 1e-6  # m (and rad): the home posture puts G this close to the start pose
+HOME_ITERATIONS = 1000
 
 # q -> (R_WG 3x3, p_WG [m], J 6 x n_joints: G's angular velocity over linear velocity rows as
 # [linear; angular] of the world frame)
@@ -58,6 +59,28 @@ def solve_ik(kinematics: Kinematics, pose: Sequence[float], q_start: np.ndarray,
         dq += null_space @ (POSTURE_GAIN * (home_posture - q))
         q = np.clip(q + dq, lower, upper)
     return q, error
+
+
+def find_home(kinematics: Kinematics, pose: Sequence[float], guesses: Sequence[np.ndarray], lower: np.ndarray,
+              upper: np.ndarray) -> Tuple[np.ndarray, float]:
+    """The home posture [rad]: joint angles within [lower, upper] that put G at `pose`, by IK from
+    each of `guesses` (pulled toward that guess in the null space); of those that end within
+    HOME_TOLERANCE, the one farthest from a singularity (the largest manipulability,
+    sqrt(det(J J^T))), which leaves the arm room to follow the plan on one branch. With its pose
+    error (m and rad, one norm: the least found when none ends within it)."""
+    best: Tuple[np.ndarray, float] = (np.asarray(guesses[0], float), np.inf)
+    chosen, dexterity = None, -1.0
+    for guess in guesses:
+        guess = np.clip(np.asarray(guess, float), lower, upper)
+        q, error = solve_ik(kinematics, pose, guess, guess, lower, upper, HOME_ITERATIONS)
+        if error >= HOME_TOLERANCE:
+            best = min(best, (q, error), key=lambda b: b[1])
+            continue
+        J = kinematics(q)[2]
+        manipulability = float(np.sqrt(max(np.linalg.det(J @ J.T), 0.0)))
+        if manipulability > dexterity:
+            chosen, dexterity = (q, error), manipulability
+    return chosen if chosen is not None else best
 
 
 def unreachable(pose: Sequence[float], error: float) -> ValueError:

@@ -9,8 +9,8 @@ jaws, the object and the features where the executor places them). The cell chec
 (CellError, a PlanError: exit 2) at the first sample where
 - no joint positions within the arm's limits put G within FK_TOLERANCE of the sample's pose
   (out of reach, or a joint at its limit: named, with how far G stays off);
-- a joint would move faster than MAX_JOINT_SPEED between two samples (a branch flip, or a
-  motion the joints cannot make);
+- a joint would move faster than its speed limit between two samples (a branch flip, or a
+  motion the joints cannot make; the URDF's `limit velocity`, else robot.max_joint_speed);
 - a link of the arm comes closer than LINK_CLEARANCE to a feature or the floor (named, with the
   distance; the jaws and pads, which hold the object and stand FEATURE_CLEARANCE clear of the
   features along y by construction, are left out).
@@ -37,14 +37,12 @@ from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.arm import ArmKinematics
 from stablepush.sim.friction import mujoco
-from stablepush.task.model import Task
+from stablepush.sim.robot import arm_model
+from stablepush.task.model import Robot, Task
 
 # G through the joints' forward kinematics stays this close to each sample (m, rad): the joint
 # trajectory reproduces the Cartesian one within 0.01 mm and 0.01 deg.
 FK_TOLERANCE = (1e-5, math.radians(0.01))
-# rad/s a joint of the shipped arm may turn (its MJCF gives no velocity limits; a 7-joint
-# collaborative arm's slowest joints turn about 2.5 rad/s).
-MAX_JOINT_SPEED = 2.5
 LINK_CLEARANCE = 0.0  # m a link of the arm keeps from a feature or the floor (0: touching is refused)
 CLEARANCE_SEEN = 0.05  # m: distances past this are not measured (mj_geomDistance's distmax)
 # The arm's bodies whose geoms are its links for the clearance check: those the joints move, less
@@ -108,28 +106,33 @@ class JointPath:
                  f"every link over {CLEARANCE_SEEN * 1e3:g} mm from the features and the floor")
         return (f"{len(self)} samples on {len(self.joints)} joints; G through the joints within "
                 f"{self.fk_error_mm:.5f} mm, {self.fk_error_deg:.5f} deg; fastest joint {self.peak_speed:.2f} rad/s "
-                f"(at most {MAX_JOINT_SPEED:g}); {clear}")
+                f"(within its limit); {clear}")
 
 
-def joint_path(task: Task, plan: Plan, rate_hz: float = 100.0, trajectory: Optional[Trajectory] = None) -> JointPath:
-    """The shipped arm's joints along the plan's timed trajectory at `rate_hz` (`trajectory`, when
-    the caller has it already), once the plan is shown to belong to the task (check_plan) and the
-    arm can follow it in its cell (CellError otherwise)."""
+def joint_path(task: Task, plan: Plan, rate_hz: float = 100.0, trajectory: Optional[Trajectory] = None,
+               robot: Optional[Robot] = None) -> JointPath:
+    """The joints of `robot` (the task's environment.robot when None) along the plan's timed
+    trajectory at `rate_hz` (`trajectory`, when the caller has it already), once the plan is shown
+    to belong to the task (check_plan) and the arm can follow it in its cell (CellError otherwise)."""
     plan = check_plan(task, plan)
     steps = list(plan.waypoints)
     scene = scene_description(task, place_features(task, steps), steps[0].pose)
-    return _Solver(scene).solve(trajectory if trajectory is not None else timed_trajectory(task, plan, rate_hz))
+    robot = robot if robot is not None else task.environment.robot
+    return _Solver(scene, robot).solve(trajectory if trajectory is not None else timed_trajectory(task, plan, rate_hz))
 
 
 class _Solver:
     """IK, limits, speed and clearance along one trajectory, on the MuJoCo model of its scene."""
 
-    def __init__(self, scene: dict):
-        model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene))
-        self.kin = ArmKinematics(model)
+    def __init__(self, scene: dict, robot: Robot):
+        self.arm = arm_model(robot)
+        model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, robot=robot))
+        self.kin = ArmKinematics(model, self.arm.joints)
         self.model, self.data = model, self.kin.data
-        self.home = self._solve(scene["gripper_pose"], ik.HOME_GUESS, ik.HOME_GUESS, 1000)
-        links = _link_bodies(model)
+        # out of reach, the first sample says so (CellError) from the nearest posture found
+        self.home, _ = ik.find_home(self.kin, scene["gripper_pose"], self.arm.home_guesses, self.kin.lower,
+                                    self.kin.upper)
+        links = _link_bodies(model, self.arm.joints)
         self.link_geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] in links]
         self.obstacles = [model.geom(scene_mod.feature_geom(f["pusher"])).id for f in scene["features"]]
         self.obstacles.append(model.geom("floor").id)
@@ -154,10 +157,10 @@ class _Solver:
             if off[0] > FK_TOLERANCE[0] or off[1] > FK_TOLERANCE[1]:
                 raise CellError(*where, self._why_unreached(q, off))
             speed = np.abs(q - q_prev) / dt
-            if i > 0 and speed.max() > MAX_JOINT_SPEED:
-                k = int(np.argmax(speed))
-                raise CellError(*where, f"joint {scene_mod.ARM_JOINTS[k]} would turn {speed[k]:.2f} rad/s, past "
-                                        f"{MAX_JOINT_SPEED:g} rad/s (a branch flip, or a motion too fast for it)")
+            if i > 0 and np.any(speed > self.arm.max_speed):
+                k = int(np.argmax(speed / self.arm.max_speed))
+                raise CellError(*where, f"joint {self.arm.joints[k]} would turn {speed[k]:.2f} rad/s, past its "
+                                        f"{self.arm.max_speed[k]:g} rad/s (a branch flip, or a motion too fast for it)")
             clearance, pair = self._clearance(q)
             if clearance < LINK_CLEARANCE:
                 raise CellError(*where, f"link {pair[0]} runs {-clearance * 1e3:.1f} mm into {pair[1]}")
@@ -167,7 +170,7 @@ class _Solver:
             worst = (max(worst[0], off[0]), max(worst[1], off[1]))
             rows.append(q)
             q_prev = q
-        return JointPath(joints=scene_mod.ARM_JOINTS, t=np.asarray(traj.t), q=np.array(rows), phase=list(traj.phase),
+        return JointPath(joints=self.arm.joints, t=np.asarray(traj.t), q=np.array(rows), phase=list(traj.phase),
                          step=np.asarray(traj.step), fk_error_mm=worst[0] * 1e3, fk_error_deg=math.degrees(worst[1]),
                          peak_speed=peak, clearance_mm=least * 1e3, nearest=nearest)
 
@@ -178,7 +181,7 @@ class _Solver:
         return float(np.linalg.norm(target[:3, 3] - p)), float(np.linalg.norm(ik.rotation_vector(target[:3, :3] @ R.T)))
 
     def _why_unreached(self, q: np.ndarray, off: Tuple[float, float]) -> str:
-        at_limit = [name for name, v, lo, hi in zip(scene_mod.ARM_JOINTS, q, self.kin.lower, self.kin.upper)
+        at_limit = [name for name, v, lo, hi in zip(self.arm.joints, q, self.kin.lower, self.kin.upper)
                     if min(v - lo, hi - v) < 1e-6]
         limits = f"; at its limit: joint {', '.join(at_limit)}" if at_limit else ""
         return (f"no joint positions within the arm's limits put G there: it stays {off[0] * 1e3:.3f} mm, "
@@ -197,10 +200,10 @@ class _Solver:
         return least, pair
 
 
-def _link_bodies(model) -> set:
+def _link_bodies(model, joints: Sequence[str]) -> set:
     """The bodies the arm's joints move, less the jaws."""
     moved = set()
-    for j in scene_mod.ARM_JOINTS:
+    for j in joints:
         moved.add(int(model.jnt_bodyid[model.joint(j).id]))
     for b in range(model.nbody):  # and every body below one of them
         parent = b

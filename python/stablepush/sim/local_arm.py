@@ -10,7 +10,9 @@ from stablepush.execution.arm import Arm, ArmError, ArmReady
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
+from stablepush.sim.robot import arm_model
 from stablepush.sim.scene import simulated_outline
+from stablepush.task.model import Robot
 
 # The scene keys that say where a run starts, not what the world is: a resume starts elsewhere.
 _START_KEYS = ("object_pose", "object_in_grasp", "gripper_pose")
@@ -21,12 +23,15 @@ def _world(scene: Optional[dict]) -> Optional[dict]:
 
 
 class SimulatedArm(Arm):
-    """The simulated arm on `engine` (loaded here: a missing one is `MissingExtra` now, not a fault
-    later), in the world `deviation` makes of each scene. `log(text)` hears of each world built."""
+    """The simulated arm of `robot` (a task.model.Robot; None: the shipped arm) on `engine`
+    (loaded here: a missing one is `MissingExtra` now, not a fault later), in the world
+    `deviation` makes of each scene. `log(text)` hears of each world built."""
 
     def __init__(self, engine: str = DEFAULT_ENGINE, deviation: WorldDeviation = WorldDeviation(),
-                 log: Optional[Callable[[str], None]] = None):
+                 log: Optional[Callable[[str], None]] = None, robot: Optional[Robot] = None):
         self.engine = load_engine(engine)
+        self.robot = robot if robot is not None else Robot()
+        arm_model(self.robot)  # a model that cannot carry the jaws is the caller's error now (RobotError)
         self.deviation = deviation
         self.log = log or (lambda text: None)
         self.sim = None  # the engine's arm (arm.SimArm or drake_arm.DrakeArm) of the current world
@@ -45,7 +50,7 @@ class SimulatedArm(Arm):
             self.log("world kept from the previous session (continue)")
         else:
             try:
-                sim = make_arm(self.engine, scene, self.deviation)
+                sim = make_arm(self.engine, scene, self.deviation, self.robot)
             except Exception as exc:  # noqa: BLE001 - any scene no world can be built from is the caller's error
                 raise ArmError(f"hello: cannot build a world from this scene ({type(exc).__name__}: "
                                f"{' '.join(str(exc).split())[:200]})") from None

@@ -22,17 +22,14 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from pathlib import Path
-from typing import List, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from stablepush.frames import pose_to_matrix, quat_about_y
+from stablepush.sim.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
+from stablepush.task.model import Robot
 
-ARM_XML = Path(__file__).with_name("arm.xml")
-ARM_JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6", "j7")
-FINGER_JOINTS = ("finger_pos", "finger_neg")
-GRIPPER_SITE = "G"
 OBJECT_BODY = "object"
 MAX_SIM_VERTICES = 64  # the simulated object's outline; more are simplified away (simulated_outline)
 PAD_PREFIX = "pad_"  # pad point geoms are named pad_<finger>_<pad>_<point>
@@ -185,13 +182,14 @@ def mjcf_numbers(values) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
-def arm_tree(scene: dict, kinematic_hand: bool = False) -> ET.Element:
-    """The shipped arm (arm.xml) as an MJCF element tree, its finger servos capped at the scene's
-    grip force; with `kinematic_hand` the arm is replaced by a hand at the scene's gripper pose that
-    moves in G's plane through three joints (HAND_JOINTS) whose motion the caller prescribes: the
-    same fingers, pads and contacts without the arm, for measuring friction alone (`fidelity.py`).
-    Both engines read the arm from this tree (MuJoCo whole, Drake through its MJCF parser)."""
-    root = ET.parse(ARM_XML).getroot()
+def arm_tree(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None) -> ET.Element:
+    """The arm of `robot` (robot.arm_model: the shipped arm when None) as an MJCF element tree, its
+    finger servos capped at the scene's grip force; with `kinematic_hand` the shipped arm is
+    replaced by a hand at the scene's gripper pose that moves in G's plane through three joints
+    (HAND_JOINTS) whose motion the caller prescribes: the same fingers, pads and contacts without
+    the arm, for measuring friction alone (`fidelity.py`). Both engines read the arm from this tree
+    (MuJoCo whole, Drake through its MJCF parser)."""
+    root = arm_model(None if kinematic_hand else robot).arm_tree()
     if kinematic_hand:
         _replace_arm_by_kinematic_hand(root, scene["gripper_pose"])
     # The finger servos close toward y = 0 and press with at most the grip force.
@@ -285,10 +283,11 @@ def _reflex_corners_in_world(polygon: Sequence[Sequence[float]], object_pose: Se
             if _cross(polygon[k - 1], v, polygon[(k + 1) % n]) < -1e-15]  # a right turn, as _is_convex counts one
 
 
-def build_mjcf(scene: dict, kinematic_hand: bool = False) -> str:
+def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None) -> str:
     """The complete MJCF of a scene description (see `stablepush.execution.protocol`): `arm_tree`
-    plus the solver options, the pad points, the held object, the features and the contact pairs."""
-    root = arm_tree(scene, kinematic_hand)
+    of `robot` plus the solver options, the pad points, the held object, the features and the
+    contact pairs."""
+    root = arm_tree(scene, kinematic_hand, robot)
     gx, gz = scene["gravity"]
     ET.SubElement(root, "option", timestep=repr(TIMESTEP), gravity=mjcf_numbers((gx, 0.0, gz)), cone="elliptic",
                   impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS),

@@ -36,17 +36,20 @@ class TrackingArm:
     next's over the waypoint period (`_set_servos`, `_run`), and the report with the tracker's
     noise. Mixed in before the engine's grasp class, whose constructor takes the altered scene."""
 
-    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation()):
-        super().__init__(deviation.apply(scene))
+    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation(), robot=None):
+        super().__init__(deviation.apply(scene), robot=robot)
         self.scene = scene
         self.deviation = deviation
         self._tracker_rng = np.random.default_rng(deviation.seed)
 
     def _find_home(self) -> np.ndarray:
         """The joint angles [rad] that put G at the scene's gripper pose: the posture IK's
-        null space pulls toward, and the servos' first target."""
-        self.home_posture = ik.HOME_GUESS.copy()
-        self.home_posture = self.solve_ik(self.scene["gripper_pose"], ik.HOME_GUESS, strict=True, iterations=1000)
+        null space pulls toward, and the servos' first target (ik.find_home from the arm's
+        guesses)."""
+        self.home_posture, error = ik.find_home(self._kinematics, self.scene["gripper_pose"], self.arm.home_guesses,
+                                                self._lower, self._upper)
+        if error > ik.HOME_TOLERANCE:
+            raise ik.unreachable(self.scene["gripper_pose"], error)
         self.target = self.home_posture.copy()
         return self.home_posture
 

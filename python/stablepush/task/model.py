@@ -157,14 +157,71 @@ PLANNER_DEFAULTS: Dict[str, Any] = PlannerSettings().as_dict()
 
 
 @dataclass(frozen=True)
+class Robot:
+    """The arm a plan runs on, as the task's `environment.robot` section gives it: `model`, a URDF
+    or MJCF file of the arm (None: the shipped arm, stablepush/sim/arm.xml), `flange`, the link
+    (body) the project's jaws mount on, `tcp`, the grasp frame G in the flange's frame (x, y, z mm
+    and the fixed-axis roll, pitch, yaw deg of a URDF `rpy`), `base`, the arm's base in the world
+    (x, y, z mm and yaw deg about the world's z), and `max_joint_speed` [rad/s, or m/s for a
+    sliding joint], the limit of a joint whose model gives none (URDF `limit velocity` is read).
+    Made with a field of the wrong shape it raises TypeError or ValueError naming it."""
+
+    model: Optional[str] = None
+    flange: str = "hand"
+    tcp: Tuple[float, float, float, float, float, float] = (0.0, 0.0, 110.0, 0.0, 180.0, 0.0)
+    base: Tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    max_joint_speed: float = 2.5
+
+    def __post_init__(self) -> None:
+        if self.model is not None and (not isinstance(self.model, str) or not self.model):
+            raise TypeError(f"environment.robot.model must be a file name, got {self.model!r:.60}")
+        if not isinstance(self.flange, str) or not self.flange:
+            raise TypeError(f"environment.robot.flange must be a link name, got {self.flange!r:.60}")
+        _finite_vector("environment.robot.tcp", self.tcp, 6)
+        _finite_vector("environment.robot.base", self.base, 4)
+        _finite("environment.robot.max_joint_speed", self.max_joint_speed)
+        if not self.max_joint_speed > 0:
+            raise ValueError(f"environment.robot.max_joint_speed must be positive, got {self.max_joint_speed!r:.40}")
+        object.__setattr__(self, "tcp", tuple(float(v) for v in self.tcp))
+        object.__setattr__(self, "base", tuple(float(v) for v in self.base))
+        object.__setattr__(self, "max_joint_speed", float(self.max_joint_speed))
+
+    @property
+    def shipped(self) -> bool:
+        """Whether this is the shipped arm (no model file)."""
+        return self.model is None
+
+    @classmethod
+    def from_mapping(cls, values: Dict[str, Any]) -> "Robot":
+        """The robot of an environment.robot section in the task file's form; defaults for keys
+        left out (a model without a flange or tcp has no sensible default: the schema asks)."""
+        named = {f.name for f in dataclasses.fields(cls)}
+        unknown = [key for key in values if key not in named]
+        if unknown:
+            raise ValueError(f"environment.robot.{unknown[0]!s:.40}: not a setting of the robot "
+                             f"({', '.join(sorted(named))})")
+        return cls(**values)
+
+    def replace(self, **changes: Any) -> "Robot":
+        """This robot with the fields given not None changed (a command line's options)."""
+        return dataclasses.replace(self, **{k: v for k, v in changes.items() if v is not None})
+
+    def as_dict(self) -> Dict[str, Any]:
+        """The robot in the task file's form (plain values; lists for vectors)."""
+        return {"model": self.model, "flange": self.flange, "tcp": list(self.tcp), "base": list(self.base),
+                "max_joint_speed": self.max_joint_speed}
+
+
+@dataclass(frozen=True)
 class Cell:
     """The task's `environment:` section, the cell the arm works in, as a typed value (mm and deg in
     the world frame: x forward, y along the gripping axis at home, z up): G's `home` position (G's
     axes are the world's there), how far the object backs off a feature (`retract`), how far apart
     default features stand along y (`station_spacing`) and how far from a feature moves between
     them run (`lane_offset`), where given features hold the object (`features`: pusher -> [x, y,
-    z, theta about world y]; the others are placed by stablepush.execution.world), and whether a
-    run ends with the object on its last feature (`end_on_feature`). Made with a field of the wrong
+    z, theta about world y]; the others are placed by stablepush.execution.world), whether a
+    run ends with the object on its last feature (`end_on_feature`), and the arm (`robot`, a
+    Robot; the shipped arm when the task names none). Made with a field of the wrong
     shape it raises TypeError or ValueError naming it; the file's ranges are checked where the file
     is read (schema.py)."""
 
@@ -174,9 +231,14 @@ class Cell:
     lane_offset: float = 75.0
     features: Dict[str, Tuple[float, float, float, float]] = field(default_factory=dict)
     end_on_feature: bool = False
+    robot: Robot = field(default_factory=Robot)
 
     def __post_init__(self) -> None:
         _finite_vector("environment.home", self.home, 3)
+        if isinstance(self.robot, dict):
+            object.__setattr__(self, "robot", Robot.from_mapping(self.robot))
+        if not isinstance(self.robot, Robot):
+            raise TypeError(f"environment.robot must be a Robot or a mapping, got {type(self.robot).__name__}")
         object.__setattr__(self, "home", tuple(float(v) for v in self.home))
         for name in ("retract", "station_spacing", "lane_offset"):
             _finite(f"environment.{name}", getattr(self, name))
@@ -203,7 +265,7 @@ class Cell:
         """The cell in the task file's form (plain values; lists for vectors)."""
         return {"home": list(self.home), "retract": self.retract, "station_spacing": self.station_spacing,
                 "lane_offset": self.lane_offset, "features": {k: list(v) for k, v in self.features.items()},
-                "end_on_feature": self.end_on_feature}
+                "end_on_feature": self.end_on_feature, "robot": self.robot.as_dict()}
 
 
 @dataclass(frozen=True)

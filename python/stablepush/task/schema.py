@@ -28,6 +28,7 @@ from stablepush.task.model import (
     Cell,
     PlannerSettings,
     PusherSpec,
+    Robot,
     Task,
     make_gripper,
     outline_corners,
@@ -77,7 +78,9 @@ LIMITS: Dict[str, Tuple[float, float]] = {  # kind -> (lowest, highest); both in
 }
 # Where the arm works (stablepush.execution): the environment section's keys but `features`, and
 # their defaults (Cell says what each is).
-ENVIRONMENT_DEFAULTS: Dict[str, Any] = {k: v for k, v in Cell().as_dict().items() if k != "features"}
+ENVIRONMENT_DEFAULTS: Dict[str, Any] = {k: v for k, v in Cell().as_dict().items() if k not in ("features", "robot")}
+# The file names a robot model by one of these endings (MuJoCo compiles both; Drake parses both).
+ROBOT_MODEL_SUFFIXES = (".urdf", ".xml", ".mjcf")
 
 # TRRTstar's declared parameters and their ranges live in the C++ planner (declared once there;
 # its setters refuse values outside them): key -> (kind, lowest, highest). seed and max_switches
@@ -443,7 +446,7 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
                          f"{', '.join('uncertainty.' + key for key in widened)} (its stable pushes move with pad mu "
                          f"x grip force and with mass; "
                          f"a width in pusher_mu alone is fine): plans will not use it")
-    environment = _validate_environment(top.get("environment", {}), [p.name for p in pushers])
+    environment = _validate_environment(top.get("environment", {}), [p.name for p in pushers], source)
     # Pads in metres on an object in metres: the object's own warning says so.
     notes.extend(_sub_millimetre(pads if "pads" in grip and not units else (), environment))
     notes.extend(_in_radians([("start", start), ("goal", goal)], planner.tolerance[1]))
@@ -731,11 +734,11 @@ def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str
     return tuple(specs)
 
 
-def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Cell:
+def _validate_environment(value: Any, pusher_names: Sequence[str], source: Optional[str] = None) -> Cell:
     """The environment section with defaults filled in. `features` maps a pusher's name to the
     object's world pose [x, y, z mm, theta deg about world y] while it rests on that pusher's
     feature; pushers not listed get a feature placed by the executor (stablepush.execution)."""
-    env = _mapping("environment", value, [], list(ENVIRONMENT_DEFAULTS) + ["features"])
+    env = _mapping("environment", value, [], list(ENVIRONMENT_DEFAULTS) + ["features", "robot"])
     out: Dict[str, Any] = {key: env.get(key, default) for key, default in ENVIRONMENT_DEFAULTS.items()}
     out["home"] = list(_vector("environment.home", out["home"], 3, COORDINATE))
     for key in ("retract", "lane_offset", "station_spacing"):
@@ -753,7 +756,51 @@ def _validate_environment(value: Any, pusher_names: Sequence[str]) -> Cell:
         _vector(f"environment.features.{name}", pose, 4)
         out["features"][name] = [_number(f"environment.features.{name}[{i}]", v, COORDINATE if i < 3 else ANGLE)
                                  for i, v in enumerate(pose)]
+    if "robot" in env:
+        out["robot"] = robot_section(env["robot"], source)
     return Cell.from_mapping(out)
+
+
+def robot_section(value: Any, source: Optional[str] = None) -> Robot:
+    """The environment.robot section as a Robot: `model` a URDF or MJCF file (relative to the task
+    file's folder), with the `flange` it mounts the jaws on and the `tcp` (both required with a
+    model: no default fits another arm), `base` and `max_joint_speed` [rad/s] optional."""
+    robot = _mapping("environment.robot", value, [], ["model", "flange", "tcp", "base", "max_joint_speed"])
+    out: Dict[str, Any] = {}
+    if "model" in robot:
+        out["model"] = robot_model_file("environment.robot.model", robot["model"], source)
+        for key in ("flange", "tcp"):
+            if key not in robot:
+                raise TaskError(f"environment.robot.{key}", "is required with a robot model (the shipped arm's "
+                                                            "does not fit another arm)")
+    if "flange" in robot:
+        out["flange"] = _name("environment.robot.flange", robot["flange"])
+    if "tcp" in robot:
+        tcp = _vector("environment.robot.tcp", robot["tcp"], 6)
+        out["tcp"] = [_number(f"environment.robot.tcp[{i}]", v, COORDINATE if i < 3 else ANGLE)
+                      for i, v in enumerate(tcp)]
+    if "base" in robot:
+        base = _vector("environment.robot.base", robot["base"], 4)
+        out["base"] = [_number(f"environment.robot.base[{i}]", v, COORDINATE if i < 3 else ANGLE)
+                       for i, v in enumerate(base)]
+    if "max_joint_speed" in robot:
+        out["max_joint_speed"] = _number("environment.robot.max_joint_speed", robot["max_joint_speed"], (1e-3, 1e3))
+    return Robot.from_mapping(out)
+
+
+def robot_model_file(field: str, value: Any, source: Optional[str] = None) -> str:
+    """A robot model's file name, relative to the folder of `source` (a task file) when not
+    absolute: an existing .urdf, .xml or .mjcf file."""
+    if not isinstance(value, str) or not value.strip():
+        raise TaskError(field, f"must name a URDF or MJCF file, got {_shown(value)}")
+    path = Path(value).expanduser()
+    if not path.is_absolute() and source:
+        path = Path(source).parent / path
+    if path.suffix.lower() not in ROBOT_MODEL_SUFFIXES:
+        raise TaskError(field, f"{value!r:.80} is not a URDF or MJCF file (it ends {', '.join(ROBOT_MODEL_SUFFIXES)})")
+    if not path.is_file():
+        raise TaskError(field, f"no file {str(path)!r:.120}")
+    return str(path.resolve())
 
 
 def planner_parameter(path: str, key: str, value: Any) -> "int | float":

@@ -1,0 +1,295 @@
+"""The arm of a run as the simulators and the cell check build it: a `task.model.Robot` (the
+shipped arm, or a lab's URDF or MJCF with its flange, TCP and base) made into one MJCF tree of the
+arm with the project's jaws mounted at G, plus what the tree alone does not say: the arm's joints
+from its base to the flange, their speed limits and where IK starts looking for the home posture.
+
+A lab's model is compiled by MuJoCo (which reads URDF and MJCF alike) and saved back as MJCF, so
+both engines read one tree: MuJoCo whole, Drake through its MJCF parser. In that tree
+- the arm stands in a body `arm_base` at the robot's base pose in the world;
+- G (the site GRIPPER_SITE) and the shipped arm's jaws (FINGER_JOINTS, their servos and their
+  coupling) hang from the flange at the TCP, X_FG = Trans(tcp[:3]) Rot(rpy(tcp[3:]));
+- every joint from the base to the flange gets a position servo named after it, stiff as the
+  shipped arm's, and every body is carried by gravity compensation (gravcomp), as the shipped
+  arm's are; the model's own actuators, sensors and keyframes are dropped;
+- no geom of the arm collides in the simulation (contype 0): the cell check (joint_path.py)
+  measures the links' clearance from the fixtures and the floor before any motion instead.
+Lengths in m, angles in rad in the tree; the Robot's fields are mm and deg.
+"""
+from __future__ import annotations
+
+import copy
+import functools
+import math
+import os
+import tempfile
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+
+from stablepush.errors import StablepushError
+from stablepush.frames import matrix_to_pose
+from stablepush.task.model import Robot
+from stablepush.units import MM
+
+ARM_XML = Path(__file__).with_name("arm.xml")
+SHIPPED_JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6", "j7")
+SHIPPED_HOME_GUESS = np.array([0.0, 0.35, 0.0, 1.9, 0.0, 0.89, 0.0])  # rad, hand down in front of the base
+FINGER_JOINTS = ("finger_pos", "finger_neg")
+GRIPPER_SITE = "G"
+BASE_BODY = "arm_base"
+# The servos of a lab's arm: as stiff as the shipped arm's middle joints (its kp 20,000-60,000
+# N m/rad), with its joint damping and armature where the model gives less.
+SERVO_KP = 40000.0  # N m/rad (N/m for a sliding joint)
+SERVO_KV = 200.0  # N m s/rad
+JOINT_DAMPING = 2.0  # N m s/rad
+JOINT_ARMATURE = 0.05  # kg m^2
+HOME_STARTS = 24  # seeded joint vectors IK starts from to find a lab's arm's home posture
+# What of a lab's model the run has no use for, or replaces by its own.
+_DROPPED = ("actuator", "sensor", "keyframe", "contact", "option")
+
+
+class RobotError(StablepushError):
+    """A robot model that cannot carry the project's jaws (no such file or flange, a model MuJoCo
+    cannot compile, a floating base): names the field."""
+
+    exit_code = 2
+
+    def __init__(self, field: str, message: str):
+        self.field = field
+        super().__init__(f"{field}: {message}")
+
+
+@dataclass
+class ArmModel:
+    """One arm made ready for a scene: `tree`, the MJCF of the arm with G and the jaws (a copy per
+    call of `arm_tree`), `joints`, the arm's joints from base to flange, `max_speed` per joint
+    [rad/s or m/s], and `home_guesses`, joint vectors [rad] IK starts from to find the home
+    posture, best first."""
+
+    tree: ET.Element
+    joints: Tuple[str, ...]
+    max_speed: np.ndarray
+    home_guesses: Tuple[np.ndarray, ...]
+
+    def arm_tree(self) -> ET.Element:
+        """A fresh copy of the tree, for a scene builder to add to."""
+        return copy.deepcopy(self.tree)
+
+
+def arm_model(robot: Optional[Robot] = None) -> ArmModel:
+    """The arm of `robot` (None or the default Robot: the shipped arm, arm.xml as it is). A lab's
+    model is compiled once per file version and robot (cached): a study's trials share it."""
+    robot = robot or Robot()
+    if robot.shipped and robot == Robot():
+        return _shipped()
+    stamp = os.stat(robot.model).st_mtime_ns if robot.model else 0
+    return _built(robot, stamp)
+
+
+@functools.lru_cache(maxsize=1)
+def _shipped() -> ArmModel:
+    tree = ET.parse(ARM_XML).getroot()
+    speeds = np.full(len(SHIPPED_JOINTS), Robot().max_joint_speed)
+    return ArmModel(tree, SHIPPED_JOINTS, speeds, (SHIPPED_HOME_GUESS,))
+
+
+@functools.lru_cache(maxsize=8)
+def _built(robot: Robot, _stamp: int) -> ArmModel:
+    if robot.shipped:  # the shipped arm on another flange, TCP or base
+        root = ET.parse(ARM_XML).getroot()
+        hand = root.find(".//body[@name='hand']")
+        for child in [c for c in hand if c.tag in ("site", "body")]:
+            hand.remove(child)  # its G and jaws: remounted at the robot's TCP
+        velocity: Dict[str, float] = {}
+    else:
+        root = _compiled(robot.model)
+        velocity = _urdf_velocity_limits(robot.model)
+        for tag in _DROPPED:
+            for element in root.findall(tag):
+                root.remove(element)
+    _mount_on_base(root, robot.base)
+    flange = _flange(root, robot.flange)
+    joints = _chain_joints(root, flange)
+    if not robot.shipped:
+        _servo(root, joints)
+    _mount_jaws(root, flange, robot.tcp)
+    names = tuple(j.get("name") for j in joints)
+    speeds = np.array([velocity.get(name) or robot.max_joint_speed for name in names])
+    return ArmModel(root, names, speeds, _home_guesses(joints, robot.shipped))
+
+
+def _compiled(path: str) -> ET.Element:
+    """The model at `path` (URDF or MJCF) compiled by MuJoCo and saved as MJCF: one form for both
+    engines, defaults and includes resolved, every angle in radians. A URDF keeps its fixed links
+    (fusestatic off: a flange is often one) and its collision geometry."""
+    from stablepush.extras import require
+
+    mujoco = require("mujoco", "environment.robot.model (MuJoCo compiles a lab's URDF or MJCF for both engines)")
+    text = Path(path).read_text()
+    folder = str(Path(path).resolve().parent)
+    try:
+        if Path(path).suffix.lower() == ".urdf":
+            urdf = ET.fromstring(text)
+            extension = urdf.find("mujoco")
+            if extension is None:
+                extension = ET.SubElement(urdf, "mujoco")
+            compiler = extension.find("compiler")
+            if compiler is None:
+                compiler = ET.SubElement(extension, "compiler")
+            compiler.set("fusestatic", "false")
+            compiler.set("discardvisual", "true")
+            compiler.set("meshdir", compiler.get("meshdir", folder))
+            model = mujoco.MjModel.from_xml_string(ET.tostring(urdf, encoding="unicode"))
+        else:
+            model = mujoco.MjModel.from_xml_path(path)
+    except (ValueError, ET.ParseError) as exc:
+        raise RobotError("environment.robot.model", f"MuJoCo cannot compile {path!r:.120}: "
+                                                    f"{' '.join(str(exc).split())[:300]}") from None
+    with tempfile.TemporaryDirectory() as scratch:
+        saved = os.path.join(scratch, "robot.xml")
+        mujoco.mj_saveLastXML(saved, model)
+        root = ET.parse(saved).getroot()
+    compiler = root.find("compiler")
+    if compiler is None:
+        compiler = ET.SubElement(root, "compiler")
+    for key in ("meshdir", "texturedir"):  # files stay where the model's folder has them
+        compiler.set(key, str(Path(folder, compiler.get(key, ""))))
+    compiler.set("angle", "radian")
+    return root
+
+
+def _urdf_velocity_limits(path: str) -> Dict[str, float]:
+    """A URDF's joints' `limit velocity` [rad/s or m/s] by name (MuJoCo keeps none); {} for MJCF,
+    which has no such field."""
+    if Path(path).suffix.lower() != ".urdf":
+        return {}
+    out = {}
+    for joint in ET.parse(path).getroot().iter("joint"):
+        limit = joint.find("limit")
+        if limit is not None and limit.get("velocity") and float(limit.get("velocity")) > 0:
+            out[joint.get("name")] = float(limit.get("velocity"))
+    return out
+
+
+def _mount_on_base(root: ET.Element, base: Tuple[float, ...]) -> None:
+    """Everything in the model's world body moves into BASE_BODY at `base` (x, y, z mm, yaw deg)."""
+    worldbody = root.find("worldbody")
+    x, y, z, yaw = base
+    half = math.radians(yaw) / 2
+    mount = ET.Element("body", name=BASE_BODY, pos=_numbers((x * MM, y * MM, z * MM)),
+                       quat=_numbers((math.cos(half), 0.0, 0.0, math.sin(half))))
+    for child in list(worldbody):
+        if child.tag in ("light", "camera") or child.get("type") == "plane":  # the world's, not the arm's
+            continue
+        worldbody.remove(child)
+        mount.append(child)
+    worldbody.insert(0, mount)
+    if root.find(".//geom[@name='floor']") is None:
+        ET.SubElement(worldbody, "geom", name="floor", type="plane", size="1 1 0.01", rgba="0.9 0.9 0.9 1",
+                      contype="0", conaffinity="0")
+
+
+def _flange(root: ET.Element, name: str) -> ET.Element:
+    flange = root.find(f".//body[@name='{name}']") if "'" not in name else None
+    if flange is None:
+        bodies = [b.get("name") for b in root.iter("body") if b.get("name") and b.get("name") != BASE_BODY]
+        raise RobotError("environment.robot.flange", f"the model has no link {name!r:.60} (its links: "
+                                                     f"{', '.join(bodies)[:300]})")
+    return flange
+
+
+def _chain_joints(root: ET.Element, flange: ET.Element) -> List[ET.Element]:
+    """The hinge and slide joints on the way from the world to `flange`, base first."""
+    parent = {child: body for body in root.iter() for child in body}
+    chain, body = [], flange
+    while body is not None and body.tag == "body":
+        chain.append(body)
+        body = parent.get(body)
+    joints = []
+    for body in reversed(chain):
+        for joint in body:
+            if joint.tag == "freejoint" or (joint.tag == "joint" and joint.get("type") in ("free", "ball")):
+                raise RobotError("environment.robot.model", f"link {body.get('name')!r} has a "
+                                                            f"{joint.get('type', 'free')} joint: an arm's joints "
+                                                            f"turn or slide about one axis")
+            if joint.tag == "joint":
+                if not joint.get("name"):
+                    raise RobotError("environment.robot.model", f"a joint of link {body.get('name')!r} has no name "
+                                                                f"(a joint trajectory names every joint)")
+                joints.append(joint)
+    if not joints:
+        raise RobotError("environment.robot.flange", f"no joint moves link {flange.get('name')!r}")
+    return joints
+
+
+def _servo(root: ET.Element, joints: List[ET.Element]) -> None:
+    """A position servo per arm joint, every body carried by gravcomp, no arm geom colliding."""
+    for joint in joints:
+        joint.set("damping", repr(max(float(joint.get("damping", "0")), JOINT_DAMPING)))
+        joint.set("armature", repr(max(float(joint.get("armature", "0")), JOINT_ARMATURE)))
+    actuators = ET.SubElement(root, "actuator")
+    for joint in joints:
+        ET.SubElement(actuators, "position", name=joint.get("name"), joint=joint.get("name"), kp=repr(SERVO_KP),
+                      kv=repr(SERVO_KV))
+    for body in root.iter("body"):
+        body.set("gravcomp", "1")
+    for geom in root.iter("geom"):
+        geom.set("contype", "0")
+        geom.set("conaffinity", "0")
+
+
+def _mount_jaws(root: ET.Element, flange: ET.Element, tcp: Tuple[float, ...]) -> None:
+    """G and the shipped arm's jaws (their bodies, servos and coupling) on `flange` at `tcp`."""
+    from scipy.spatial.transform import Rotation
+
+    shipped = ET.parse(ARM_XML).getroot()
+    hand = shipped.find(".//body[@name='hand']")
+    X_FG = np.eye(4)
+    X_FG[:3, :3] = Rotation.from_euler("xyz", tcp[3:], degrees=True).as_matrix()
+    X_FG[:3, 3] = np.asarray(tcp[:3]) * MM
+    pose = matrix_to_pose(X_FG)
+    for child in hand:
+        if child.tag in ("site", "body"):
+            child.set("pos", _numbers(pose[:3]))
+            child.set("quat", _numbers(pose[3:]))
+            flange.append(child)
+    actuators = root.find("actuator")
+    if actuators is None:
+        actuators = ET.SubElement(root, "actuator")
+    for finger in FINGER_JOINTS:  # the shipped arm has them already
+        if actuators.find(f"position[@name='{finger}']") is None:
+            actuators.append(shipped.find(f".//actuator/position[@name='{finger}']"))
+    if root.find("equality") is None:
+        ET.SubElement(root, "equality")
+    if root.find("equality/joint[@joint1='finger_neg']") is None:
+        root.find("equality").append(shipped.find("equality/joint"))
+
+
+def _home_guesses(joints: List[ET.Element], shipped: bool) -> Tuple[np.ndarray, ...]:
+    """Where IK starts looking for the home posture: the shipped arm's known posture; for a lab's
+    arm, the middle of each joint's range, zero, then HOME_STARTS seeded draws within the ranges."""
+    if shipped:
+        return (SHIPPED_HOME_GUESS,)
+    lower, upper = joint_ranges(joints)
+    lo, hi = np.maximum(lower, -math.pi), np.minimum(upper, math.pi)
+    rng = np.random.default_rng(0)
+    return (np.clip((lo + hi) / 2, lower, upper), np.clip(np.zeros(len(joints)), lower, upper),
+            *(rng.uniform(lo, hi) for _ in range(HOME_STARTS)))
+
+
+def joint_ranges(joints: List[ET.Element]) -> Tuple[np.ndarray, np.ndarray]:
+    """Each joint's [lower, upper] from its MJCF `range` (unlimited: -inf, inf)."""
+    lower, upper = [], []
+    for joint in joints:
+        limited = joint.get("range") is not None and joint.get("limited", "auto") != "false"
+        a, b = (float(v) for v in joint.get("range").split()) if limited else (-math.inf, math.inf)
+        lower.append(a)
+        upper.append(b)
+    return np.array(lower), np.array(upper)
+
+
+def _numbers(values) -> str:
+    return " ".join(repr(float(v)) for v in values)
