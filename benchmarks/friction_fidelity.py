@@ -3,6 +3,10 @@ the arm's contact setting against the contract's limits, and, with --stiff, the 
 replaced (the solver's stiff friction on every pad point, sliding or not).
 
     python3 benchmarks/friction_fidelity.py [--engine mujoco|drake] [--stiff]
+        [--robot FILE --flange LINK --tcp X Y Z RX RY RZ [--base X Y Z YAW]]
+
+The rigs hold the jaws on a kinematic hand; --robot runs the contract's last part, the pivot on
+the arm, on that arm (docs/execution.md, "Bring your own arm").
 """
 import argparse
 import time
@@ -11,13 +15,18 @@ from shipped import TASKS
 
 from stablepush.sim import fidelity, friction
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
-from stablepush.task import check_push, load_task
+from stablepush.task import check_push, load_task, with_robot
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--stiff", action="store_true", help="measure the solver's stiff pad friction alone (no pad point ever slides with explicit friction)")
     parser.add_argument("--engine", choices=ENGINES, default=DEFAULT_ENGINE, help="the physics engine (default mujoco)")
+    parser.add_argument("--robot", metavar="FILE", help="the arm of the pivot on the arm: a URDF or MJCF file")
+    parser.add_argument("--flange", metavar="LINK", help="with --robot: the link the jaws mount on")
+    parser.add_argument("--tcp", nargs=6, type=float, metavar=("X", "Y", "Z", "RX", "RY", "RZ"),
+                        help="with --robot: G in the flange's frame, mm and rpy deg")
+    parser.add_argument("--base", nargs=4, type=float, metavar=("X", "Y", "Z", "YAW"), help="the arm's base, mm and deg")
     args = parser.parse_args()
     engine = args.engine
     if args.stiff and engine != "mujoco":
@@ -50,7 +59,9 @@ def main() -> None:
         print(f"| pivoting, left pusher mu {mu} | {'stable' if stable else 'not stable'} | {r.moved_mm:.3f} "
               f"| {r.rotated_deg:+.3f} |", flush=True)
     print()
-    r = fidelity.pivot_on_arm(pivoting, engine=engine)
+    on_arm = with_robot(pivoting, args.robot, args.flange, args.tcp, args.base)
+    print(f"arm: {on_arm.environment.robot.model or 'the shipped arm'}")
+    r = fidelity.pivot_on_arm(on_arm, engine=engine)
     print(
         f"Pivot on the arm, first {r.pushes} pushes of the pivoting plan: {r.error_mm:.3f} mm, {r.error_deg:+.3f} deg "
         f"from the plan (limits {fidelity.ARM_PIVOT_LIMIT_MM} mm, {fidelity.ARM_PIVOT_LIMIT_DEG} deg), {r.steps_per_s:.0f} steps/s"

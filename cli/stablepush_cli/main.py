@@ -10,7 +10,19 @@ from pathlib import Path
 import click
 
 from stablepush.errors import OutputError, StablepushError
-from stablepush_cli.commands import bench, check, cone, evaluate, execute, plan, reach, show, sim_arm, trajectory
+from stablepush_cli.commands import (
+    bench,
+    check,
+    check_cell,
+    cone,
+    evaluate,
+    execute,
+    plan,
+    reach,
+    show,
+    sim_arm,
+    trajectory,
+)
 from stablepush_cli.common import (
     EXIT_INTERNAL,
     EXIT_PIPE_CLOSED,
@@ -66,8 +78,8 @@ def cli() -> None:
     """
 
 
-for command in (bench.bench, check.check, cone.cone, evaluate.evaluate, execute.execute, plan.plan, reach.reach,
-                show.show, sim_arm.sim_arm, trajectory.trajectory):
+for command in (bench.bench, check.check, check_cell.check_cell, cone.cone, evaluate.evaluate, execute.execute,
+                plan.plan, reach.reach, show.show, sim_arm.sim_arm, trajectory.trajectory):
     cli.add_command(command)
 
 

@@ -195,3 +195,20 @@ def parse_axis(_ctx, param, value):
         return grid_axis(param.name, (start, stop, count), (low, high))
     except TaskError as exc:
         raise click.BadParameter(exc.reason) from None
+
+
+def robot_options(f):
+    """--robot, --flange, --tcp and --base: the arm the command moves, over the task's
+    environment.robot (stablepush.task.with_robot checks them)."""
+    f = click.option("--base", nargs=4, type=float, default=None, metavar="X Y Z YAW",
+                     help="The arm's base in the world: mm, and deg about the world's z (default: the task's "
+                          "environment.robot.base, else 0 0 0 0).")(f)
+    f = click.option("--tcp", nargs=6, type=float, default=None, metavar="X Y Z RX RY RZ",
+                     help="G, the grasp frame midway between the pads, in the flange's frame: mm, and fixed-axis "
+                          "roll, pitch, yaw in deg as a URDF rpy. Required with --robot.")(f)
+    f = click.option("--flange", default=None, metavar="LINK",
+                     help="The link (URDF) or body (MJCF) the project's jaws mount on. Required with --robot.")(f)
+    return click.option("--robot", "robot_model", default=None, metavar="FILE.urdf|.xml",
+                        type=click.Path(dir_okay=False),
+                        help="The arm as a URDF or MJCF file (default: the task's environment.robot, else the "
+                             "shipped 7-joint arm); docs/execution.md, 'Bring your own arm'.")(f)

@@ -21,14 +21,14 @@ from stablepush._core import ContactCase, PushResult
 from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, StablepushError, TaskError
 from stablepush.plan import Plan, PlanOutcome, PusherContact, Waypoint, check_plan, load_plan, plan_task
 from stablepush.plan import write_plan as save_plan
-from stablepush.task import PlannerSettings, PusherSpec, Task, load_task, parse_task
+from stablepush.task import Cell, PlannerSettings, PusherSpec, Robot, Task, load_task, parse_task
 from stablepush.task import check_push as check
 
 __version__ = "0.1.0"
 __all__ = ["load_task", "parse_task", "plan_task", "check", "check_plan", "save_plan", "load_plan", "trajectory",
-           "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PlannerSettings", "PusherSpec", "Trajectory",
-           "StablepushError", "TaskError", "PlanError", "OutputError", "ArmFault", "RunnerError", "ContactCase",
-           "PlanOutcome", "PushResult"]
+           "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PlannerSettings", "PusherSpec", "Cell", "Robot",
+           "Trajectory", "StablepushError", "TaskError", "PlanError", "OutputError", "ArmFault", "RunnerError",
+           "ContactCase", "PlanOutcome", "PushResult", "joint_path"]
 
 
 # Loaded when first used, so that `import stablepush` (and the CLI's start-up) does not pay for
@@ -37,6 +37,7 @@ _LAZY = {
     "plan_figure": ("stablepush.viz.figures", "plan_figure"),
     "trajectory": ("stablepush.execution.trajectory", "plan_trajectory"),
     "Trajectory": ("stablepush.execution.trajectory", "Trajectory"),
+    "joint_path": ("stablepush.sim.joint_path", "joint_path"),
 }
 
 

@@ -9,6 +9,7 @@ import click
 
 from stablepush.errors import OutputError
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.task import with_robot
 from stablepush_cli.common import (
     EXIT_NOT_SOLVED,
     check_named_outputs,
@@ -25,6 +26,7 @@ from stablepush_cli.options import (
     check_video,
     parse_ray_address,
     parse_vary,
+    robot_options,
     video_options,
     video_settings_need,
 )
@@ -86,10 +88,11 @@ from stablepush_cli.options import (
                    "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv).")
 @video_options("--video-failed")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
+@robot_options
 def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confidence: float, seed: int, vary,
              feature_error, tracker_noise, closed_loop: bool, guarded: bool, engine: str, success_tolerance, workers,
              ray_address, json_path, csv_path, png_path, video_dir, video_fps: float, video_size,
-             quiet: bool) -> None:
+             quiet: bool, robot_model, flange, tcp, base) -> None:
     """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
 
     Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
@@ -132,6 +135,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
 
     runner = runner_for(workers, ray_address, default=default_workers())
     task, plan, spreads = _study(task_file, plan_file, robust, vary, feature_error, tracker_noise)
+    task = with_robot(task, robot_model, flange, tcp, base)
     if video_dir:
         from stablepush.sim.video import video_directory
 

@@ -9,6 +9,7 @@ import click
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.execution.tcp_arm import DEFAULT_ACK_TIMEOUT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.task import with_robot
 from stablepush_cli.common import (
     EXIT_ARM_FAULT,
     EXIT_MISSED,
@@ -22,6 +23,7 @@ from stablepush_cli.common import (
 from stablepush_cli.options import (
     Finite,
     parse_host_port,
+    robot_options,
     stamp_option,
     video_options,
     video_output,
@@ -100,10 +102,11 @@ from stablepush_cli.options import (
               metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
                                      "this close to the goal, and re-plan on the last contact's feature past it "
                                      "(default: a fifth of the task's goal tolerance).")
+@robot_options
 def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
             ack_timeout: float, json_path, success_tolerance, record_path, stamp_ns, video_path, video_fps: float,
             video_size, quiet: bool, verbose: bool, mu_scale: float, tracker_noise, closed_loop: bool, guarded: bool,
-            replan_threshold, final_tolerance) -> None:
+            replan_threshold, final_tolerance, robot_model, flange, tcp, base) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -121,7 +124,10 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
 
     On a fault (the arm server gone, a malformed or out-of-order reply, an error from the arm) the arm
     is told to stop, the last confirmed plan step is printed, and the exit status is 3; run again with
-    --resume-from STEP to continue. A plan that does not belong to the task exits 2 before anything moves.
+    --resume-from STEP to continue. A plan that does not belong to the task exits 2 before anything moves,
+    and so does one the arm cannot follow in its cell: the simulated arm, or an arm server with --robot
+    (or the task's environment.robot), is checked for reach, joint limits and speeds, and links clear of
+    the features and the floor at every sample first (as `stablepush check-cell` checks).
 
     \b
     Examples:
@@ -141,6 +147,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     check_named_outputs({"--json": json_path, "--record": record_path, "--video": video_path},
                   {"PLAN.json": plan_file, "--task": task_file})
     task, plan = load_plan_and_task(plan_file, task_file)
+    task = with_robot(task, robot_model, flange, tcp, base)
     for warning in execution_warnings(task):
         click.echo(f"warning: {warning}", err=True)
     check_resume_from(plan.waypoints, resume_from, field="--resume-from")
@@ -163,7 +170,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
                          else None,
                          guard=GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None,
                          success_tolerance=success_tolerance)
-    target = _arm_for(arm, sim, engine, mu_scale, tracker_noise, ack_timeout, quiet)
+    target = _arm_for(arm, sim, engine, mu_scale, tracker_noise, ack_timeout, quiet, task.environment.robot)
     with _run_progress(task, plan, resume_from, quiet) as progress:
         run = run_plan(task, plan, target, options, progress=progress,
                        recording=recording_for(task, plan, options, outputs))
@@ -193,9 +200,9 @@ def _only_with(option: str, given: bool, *others) -> None:
         fail(f"{' and '.join(named)}: only with {option}")
 
 
-def _arm_for(arm, sim: bool, engine: str, mu_scale: float, tracker_noise, ack_timeout: float, quiet: bool):
-    """The arm a run goes to: a simulated one in this process (--sim), else the arm server at
-    --arm (or the default port here)."""
+def _arm_for(arm, sim: bool, engine: str, mu_scale: float, tracker_noise, ack_timeout: float, quiet: bool, robot):
+    """The arm a run goes to: a simulated `robot` in this process (--sim), else the arm server at
+    --arm (or the default port here), checked against `robot` when one is named."""
     if sim and arm is None:
         from stablepush.sim.deviation import WorldDeviation
         from stablepush.sim.local_arm import SimulatedArm
@@ -203,11 +210,13 @@ def _arm_for(arm, sim: bool, engine: str, mu_scale: float, tracker_noise, ack_ti
         deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0],
                                    tracker_noise_deg=tracker_noise[1])
         return SimulatedArm(engine, deviation, log=None if quiet else lambda text: click.echo(f"sim-arm: {text}",
-                                                                                             err=True))
+                                                                                             err=True), robot=robot)
     from stablepush.execution import TcpArm
 
     host, port = arm or ("127.0.0.1", DEFAULT_PORT)
-    return TcpArm(host, port, ack_timeout)
+    from stablepush.sim.joint_path import modelled
+
+    return modelled(TcpArm(host, port, ack_timeout), robot)
 
 
 @contextlib.contextmanager

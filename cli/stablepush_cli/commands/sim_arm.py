@@ -5,8 +5,10 @@ import click
 
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.task import Robot, robot_with
 from stablepush_cli.options import (
     Finite,
+    robot_options,
 )
 
 
@@ -34,12 +36,14 @@ from stablepush_cli.options import (
 @click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
               help="The physics engine. mujoco: pads slide with stablepush's own Coulomb friction; drake: Drake's "
                    "contact solver alone decides stick and slip (about half MuJoCo's speed).")
+@robot_options
 def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, seed: int, idle_timeout: float,
-            engine: str) -> None:
+            engine: str, robot_model, flange, tcp, base) -> None:
     """Serve a simulated arm (MuJoCo or Drake) over the arm protocol, until interrupted.
 
-    A 7-joint arm of simple shapes (shipped MJCF) with a parallel-jaw gripper whose pads press with
-    the task's grip force; the executor's hello carries the object, the features and the friction.
+    A 7-joint arm of simple shapes (shipped MJCF), or yours (--robot, --flange, --tcp, --base), with
+    the project's parallel-jaw gripper whose pads press with the task's grip force; the executor's
+    hello carries the object, the features and the friction.
     One session at a time (a second client is told the arm is busy); each starts from a fresh
     world unless the executor resumes a run (--resume-from). An object outline of more than 64
     vertices is simplified for the simulated world only (the tolerance is logged).
@@ -52,8 +56,9 @@ def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, se
 
     deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1],
                                seed=seed)
+    robot = robot_with(Robot(), robot_model, flange, tcp, base)
     server = SimArmServer(host, port, exit_after=exit_after, deviation=deviation, idle_timeout=idle_timeout,
-                          engine=engine)
+                          engine=engine, robot=robot)
     click.echo(f"sim-arm: listening on {server.host}:{server.port} ({engine})", err=True)
     try:
         server.serve_forever()

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import click
 
+from stablepush.task import with_robot
 from stablepush_cli.common import (
     check_named_outputs,
     fail,
@@ -10,6 +11,7 @@ from stablepush_cli.common import (
 )
 from stablepush_cli.options import (
     Finite,
+    robot_options,
     stamp_option,
 )
 
@@ -33,14 +35,16 @@ from stablepush_cli.options import (
               help="Quaternion order in a .csv or .json: xyzw as ROS writes it (the default), wxyz as the arm "
                    "protocol and MuJoCo do. A .mcap's messages are ROS's own, xyzw.")
 @click.option("--joints", is_flag=True,
-              help="The shipped simulated arm's joint positions (rad), once every sample is checked: within the "
-                   "joints' limits and reach, each joint under 2.5 rad/s, every link clear of the features and the "
-                   "floor; a plan the arm cannot follow exits 2 naming the first sample, the joint or the link. A "
+              help="The arm's joint positions (rad: the shipped arm, or --robot, or the task's environment.robot), "
+                   "once every sample is checked: within the joints' limits and reach, each joint under its speed "
+                   "limit, every link clear of the features and the floor; a plan the arm cannot follow exits 2 "
+                   "naming the first sample, the joint or the link. A "
                    ".csv or .json holds them instead of G's poses (a column per joint); a .mcap adds /joint_states "
                    "and a trajectory_msgs/JointTrajectory (/stablepush/joint_trajectory). Needs the [sim] extra.")
 @stamp_option("a .mcap", "now")
+@robot_options
 def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str, joints: bool,
-               stamp_ns) -> None:
+               stamp_ns, robot_model, flange, tcp, base) -> None:
     """Write the gripper's timed trajectory for a plan: what the executor streams, for your robot.
 
     One sample per 1/HZ s: time (s), G's position in the world (m) and orientation (a unit
@@ -65,11 +69,14 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
               f".csv and .json")
     if stamp_ns is not None and not out_path.lower().endswith(".mcap"):
         fail("--stamp: only with a .mcap (a ROS 2 bag; a .csv or .json counts t from 0)")
+    if not joints and any(v is not None for v in (robot_model, flange, tcp, base)):
+        fail("--robot, --flange, --tcp and --base: only with --joints (G's poses are the same for every arm)")
     if joints and quat is not None:
         fail("--joints: joint positions have no quaternions; --quat is for the gripper's poses")
     quat = quat or "xyzw"
     check_named_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
     task, plan = load_plan_and_task(plan_file, task_file)
+    task = with_robot(task, robot_model, flange, tcp, base)
     for warning in execution_warnings(task):  # the stream is the executor's, so is its cell
         click.echo(f"warning: {warning}", err=True)
     traj = timed_trajectory(task, plan, rate_hz)

@@ -131,7 +131,7 @@ def run_trial(batch: Batch, trial: int) -> dict:
         loop = ClosedLoop.for_task(batch.task) if batch.closed_loop else None
         options = RunOptions(rate_hz=RATE_HZ, closed_loop=loop, guard=guard_of(batch),
                              success_tolerance=batch.tolerance)
-        arm = SimulatedArm(batch.engine, deviation_of(batch, world))
+        arm = SimulatedArm(batch.engine, deviation_of(batch, world), robot=batch.task.environment.robot)
         run = run_plan(batch.task, batch.plan, arm, options, recording=recording)
         if run.fault is not None:  # the simulated arm failed (a simulator blow-up, an unreachable pose): stopped
             record.update(_not_run("arm_fault", str(run.fault)))

@@ -18,9 +18,13 @@ from __future__ import annotations
 
 import abc
 from dataclasses import dataclass
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 from stablepush.execution.stream import ArmWaypoint
+
+if TYPE_CHECKING:
+    from stablepush.plan.plan import Plan
+    from stablepush.task.model import Task
 
 
 class ArmError(Exception):
@@ -48,6 +52,13 @@ class Arm(abc.ABC):
     #: Whether a run holds the stream to its rate in wall-clock time by default (RunOptions.pace
     #: None): a real arm moves in real time; a simulator keeps its own clock.
     paced: bool = False
+
+    def check_cell(self, task: "Task", plan: "Plan", rate_hz: float) -> None:
+        """Refuse, before any motion, a plan this arm cannot follow in its cell: a PlanError naming
+        the first sample of the timed trajectory it cannot reach, the joint past its limit or the
+        link in a fixture (stablepush.sim.joint_path.CellError). An arm that has a model of itself
+        checks here (the simulated arm, the joint-trajectory bridge); this default knows none and
+        lets every plan pass (`stablepush check-cell --robot` asks the same of a model)."""
 
     @abc.abstractmethod
     def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:

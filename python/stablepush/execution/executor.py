@@ -105,10 +105,13 @@ def execute_plan(task: Task, plan: Plan, arm: Arm, options: RunOptions = RunOpti
     called per ack, and `record(waypoint, state, pusher)` with the arm's state and the pusher in
     contact (None between contacts; `bags.RunRecording`).
     PlanError before anything is sent when the plan does not belong to the task as it is now
-    (stablepush.plan.verify.check_plan) or has no push after `resume_from`; ArmFault when the arm
-    cannot go on (it is told to stop, and the fault names the last plan step it confirmed)."""
-    steps: List[Waypoint] = list(check_plan(task, plan).waypoints)
+    (stablepush.plan.verify.check_plan), has no push after `resume_from`, or is one the arm cannot
+    follow in its cell (`Arm.check_cell`); ArmFault when the arm cannot go on (it is told to stop,
+    and the fault names the last plan step it confirmed)."""
+    plan = check_plan(task, plan)
+    steps: List[Waypoint] = list(plan.waypoints)
     check_resume_from(steps, options.resume_from)
+    arm.check_cell(task, plan, options.rate_hz)
     run = _Run(task, steps, options, progress, record)
     try:
         run.stream(arm)

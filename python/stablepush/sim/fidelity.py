@@ -224,7 +224,8 @@ class ArmPivotResult:
 
 def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1,
                  engine: str = DEFAULT_ENGINE) -> ArmPivotResult:
-    """Run the first `pushes` pushes of `task`'s plan (seed `seed`) on the simulated arm, open loop."""
+    """Run the first `pushes` pushes of `task`'s plan (seed `seed`) on the simulated arm (the
+    task's environment.robot), open loop."""
     from stablepush.execution.run import RunOptions, run_plan  # a run on the arm, not the rig's
     from stablepush.sim.local_arm import SimulatedArm
 
@@ -233,6 +234,7 @@ def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1,
     # a plan of the task it is given (check_plan).
     first = dataclasses.replace(task, goal=tuple(full.waypoints[pushes].pose))
     plan = dataclasses.replace(full, waypoints=full.waypoints[:pushes + 1], task_identity=first.identity())
-    report = run_plan(first, plan, SimulatedArm(engine), RunOptions(rate_hz=100.0)).report_or_fault()
+    arm = SimulatedArm(engine, robot=task.environment.robot)
+    report = run_plan(first, plan, arm, RunOptions(rate_hz=100.0)).report_or_fault()
     return ArmPivotResult(pushes=len(plan.waypoints) - 1, error_mm=report.final_error["distance"],
                           error_deg=report.final_error["theta"], steps_per_s=report.sim_steps_per_s)

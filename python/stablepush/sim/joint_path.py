@@ -22,12 +22,15 @@ import csv
 import io
 import json
 import math
+import os
 from dataclasses import dataclass
-from typing import List, Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from stablepush.errors import PlanError
+from stablepush.execution.arm import Arm, ArmReady
+from stablepush.execution.stream import ArmWaypoint
 from stablepush.execution.trajectory import Trajectory, timed_trajectory
 from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import pose_to_matrix
@@ -55,9 +58,14 @@ class CellError(PlanError):
     the timed trajectory), `t` [s], `step` (the plan step) and why."""
 
     def __init__(self, sample: int, t: float, step: int, phase: str, reason: str):
-        self.sample, self.t, self.step = sample, t, step
+        self.sample, self.t, self.step, self.phase, self.reason = sample, t, step, phase, reason
         super().__init__("", f"the arm cannot follow the plan: at t {t:.2f} s (sample {sample}, plan step {step}, "
                              f"{phase}) {reason}")
+
+    def verdict(self) -> dict:
+        """The refusal as plain JSON values (`stablepush check-cell --json`)."""
+        return {"follows": False, "sample": self.sample, "t": self.t, "step": self.step, "phase": self.phase,
+                "reason": self.reason}
 
 
 @dataclass(frozen=True)
@@ -100,6 +108,14 @@ class JointPath:
         return json.dumps({"joints": list(self.joints), "units": {"t": "s", "q": "rad"}, "columns": self.columns(),
                            "rows": self.rows()}) + "\n"
 
+    def verdict(self) -> dict:
+        """That the arm follows the plan, with the figures of `describe`, as plain JSON values."""
+        seen = self.clearance_mm < CLEARANCE_SEEN * 1e3
+        return {"follows": True, "joints": list(self.joints), "samples": len(self), "fk_error_mm": self.fk_error_mm,
+                "fk_error_deg": self.fk_error_deg, "peak_joint_speed": self.peak_speed,
+                "least_clearance_mm": self.clearance_mm if seen else None,
+                "nearest": list(self.nearest) if seen else None}
+
     def describe(self) -> str:
         clear = (f"least clearance {self.clearance_mm:.1f} mm ({self.nearest[0]} to {self.nearest[1]})"
                  if self.clearance_mm < CLEARANCE_SEEN * 1e3 else
@@ -119,6 +135,26 @@ def joint_path(task: Task, plan: Plan, rate_hz: float = 100.0, trajectory: Optio
     scene = scene_description(task, place_features(task, steps), steps[0].pose)
     robot = robot if robot is not None else task.environment.robot
     return _Solver(scene, robot).solve(trajectory if trajectory is not None else timed_trajectory(task, plan, rate_hz))
+
+
+_CHECKED: Dict[str, JointPath] = {}  # checked_path's answers by what they rest on
+_CHECKED_KEPT = 8
+
+
+def checked_path(task: Task, plan: Plan, rate_hz: float, robot: Robot) -> JointPath:
+    """joint_path, remembered for the cell, plan, rate and robot it was asked of: a study's trials
+    run one plan in one cell, and ask once per process."""
+    key = json.dumps([task.identity(), task.environment.as_dict(), [list(w.pose) for w in plan.waypoints],
+                      rate_hz, robot.as_dict(), _model_stamp(robot)], default=str)
+    if key not in _CHECKED:
+        if len(_CHECKED) >= _CHECKED_KEPT:
+            _CHECKED.pop(next(iter(_CHECKED)))
+        _CHECKED[key] = joint_path(task, plan, rate_hz, robot=robot)
+    return _CHECKED[key]
+
+
+def _model_stamp(robot: Robot) -> int:
+    return os.stat(robot.model).st_mtime_ns if robot.model else 0
 
 
 class _Solver:
@@ -213,3 +249,45 @@ def _link_bodies(model, joints: Sequence[str]) -> set:
             moved.add(b)
     jaws = {model.body(name).id for name in _JAW_BODIES}
     return {b for b in moved if b not in jaws and model.body(b).name != scene_mod.OBJECT_BODY}
+
+
+def modelled(arm: Arm, robot: Robot) -> Arm:
+    """`arm` checked against `robot` before any motion (ModelledArm), when the task or the command
+    line names an arm; else `arm` as it is: a server's arm is not the shipped one by default."""
+    return arm if robot == Robot() else ModelledArm(arm, robot)
+
+
+class ModelledArm(Arm):
+    """An arm (a real arm's server over TCP, most often) with the model of it that the lab gave
+    (`robot`): every call goes to `arm`, and `check_cell` refuses, before any motion, a plan the
+    model says it cannot follow (checked_path)."""
+
+    def __init__(self, arm: Arm, robot: Robot):
+        self.arm, self.robot = arm, robot
+        arm_model(robot)  # a model that cannot carry the jaws is the caller's error now (RobotError)
+
+    @property
+    def connected(self) -> bool:  # type: ignore[override]
+        return self.arm.connected
+
+    @property
+    def paced(self) -> bool:  # type: ignore[override]
+        return self.arm.paced
+
+    def check_cell(self, task: Task, plan: Plan, rate_hz: float) -> None:
+        checked_path(task, plan, rate_hz, self.robot)
+
+    def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
+        return self.arm.hello(scene, rate_hz, resume)
+
+    def move(self, waypoint: ArmWaypoint) -> dict:
+        return self.arm.move(waypoint)
+
+    def stop(self) -> Optional[bool]:
+        return self.arm.stop()
+
+    def bye(self) -> None:
+        self.arm.bye()
+
+    def close(self) -> None:
+        self.arm.close()

@@ -8,11 +8,12 @@ from typing import Callable, Optional
 
 from stablepush.execution.arm import Arm, ArmError, ArmReady
 from stablepush.execution.stream import ArmWaypoint
+from stablepush.plan.plan import Plan
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
 from stablepush.sim.robot import arm_model
 from stablepush.sim.scene import simulated_outline
-from stablepush.task.model import Robot
+from stablepush.task.model import Robot, Task
 
 # The scene keys that say where a run starts, not what the world is: a resume starts elsewhere.
 _START_KEYS = ("object_pose", "object_in_grasp", "gripper_pose")
@@ -41,6 +42,20 @@ class SimulatedArm(Arm):
     @property
     def name(self) -> str:
         return f"stablepush sim-arm ({self.engine})"
+
+    def check_cell(self, task: Task, plan: Plan, rate_hz: float) -> None:
+        """The arm's joints along the plan (joint_path.checked_path): CellError, before any
+        motion, where it cannot follow. The check runs on MuJoCo's kinematics: on Drake without
+        MuJoCo installed it is skipped, and the log says so."""
+        import importlib.util
+
+        if importlib.util.find_spec("mujoco") is None:
+            self.log("the cell is not checked: the check runs on MuJoCo, which is not installed ([sim])")
+            return
+        from stablepush.sim.joint_path import checked_path
+
+        path = checked_path(task, plan, rate_hz, self.robot)
+        self.log(f"cell checked: {path.describe()}")
 
     def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
         """A fresh world built from `scene`, or, with `resume` and the scene the one it has, the

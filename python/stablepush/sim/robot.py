@@ -29,7 +29,7 @@ from typing import Dict, List, Optional, Tuple
 
 import numpy as np
 
-from stablepush.errors import StablepushError
+from stablepush.errors import TaskError
 from stablepush.frames import matrix_to_pose
 from stablepush.task.model import Robot
 from stablepush.units import MM
@@ -51,15 +51,9 @@ HOME_STARTS = 24  # seeded joint vectors IK starts from to find a lab's arm's ho
 _DROPPED = ("actuator", "sensor", "keyframe", "contact", "option")
 
 
-class RobotError(StablepushError):
-    """A robot model that cannot carry the project's jaws (no such file or flange, a model MuJoCo
-    cannot compile, a floating base): names the field."""
-
-    exit_code = 2
-
-    def __init__(self, field: str, message: str):
-        self.field = field
-        super().__init__(f"{field}: {message}")
+class RobotError(TaskError):
+    """A robot model that cannot carry the project's jaws (a model MuJoCo cannot compile, no such
+    flange, a floating base, an unnamed joint): names the field of environment.robot."""
 
 
 @dataclass
@@ -142,6 +136,9 @@ def _compiled(path: str) -> ET.Element:
             compiler.set("fusestatic", "false")
             compiler.set("discardvisual", "true")
             compiler.set("meshdir", compiler.get("meshdir", folder))
+            for link in urdf.iter("link"):  # named, so MuJoCo need not warn of each unnamed one
+                for k, collision in enumerate(link.iter("collision")):
+                    collision.set("name", collision.get("name") or f"{link.get('name')}_collision{k}")
             model = mujoco.MjModel.from_xml_string(ET.tostring(urdf, encoding="unicode"))
         else:
             model = mujoco.MjModel.from_xml_path(path)

@@ -52,17 +52,18 @@ def check_scene_size(scene: dict) -> None:
 
 
 class SimArmServer:
-    """Serves the simulated arm on host:port (port 0 picks a free one; see `.port`)."""
+    """Serves the simulated arm of `robot` (a task.model.Robot; None: the shipped arm) on
+    host:port (port 0 picks a free one; see `.port`)."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, log: Callable[[str], None] = None,
                  exit_after: Optional[int] = None, deviation: WorldDeviation = WorldDeviation(),
-                 idle_timeout: float = DEFAULT_IDLE_TIMEOUT, engine: str = DEFAULT_ENGINE):
+                 idle_timeout: float = DEFAULT_IDLE_TIMEOUT, engine: str = DEFAULT_ENGINE, robot=None):
         self.log = log or (lambda text: print(f"sim-arm: {text}", file=sys.stderr, flush=True))
         self.exit_after = exit_after  # fault injection: die abruptly after this many waypoints
         self.idle_timeout = idle_timeout
         # One arm for every session, so that a session may continue the last one's world; its engine
         # is loaded here: a missing one is the caller's to hear of (MissingExtra), not a hello's.
-        self.arm = SimulatedArm(engine, deviation, log=self.log)
+        self.arm = SimulatedArm(engine, deviation, log=self.log, robot=robot)
         self.engine = self.arm.engine
         self._waypoints = 0
         self._session = threading.Lock()
@@ -189,11 +190,11 @@ def _send_quietly(connection: socket.socket, message: dict) -> None:
 
 @contextmanager
 def running_sim_arm(log: Optional[Callable[[str], None]] = None, deviation: WorldDeviation = WorldDeviation(),
-                    engine: str = DEFAULT_ENGINE) -> Iterator[SimArmServer]:
+                    engine: str = DEFAULT_ENGINE, robot=None) -> Iterator[SimArmServer]:
     """A simulated arm on `engine` served from a thread of this process on a free localhost port,
     for the length of the `with` block: a client of the protocol to test against (a run in this
     process drives `local_arm.SimulatedArm` without a socket)."""
-    server = SimArmServer(log=log, deviation=deviation, engine=engine)
+    server = SimArmServer(log=log, deviation=deviation, engine=engine, robot=robot)
     server.start_in_thread()
     try:
         yield server

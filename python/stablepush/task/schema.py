@@ -788,6 +788,30 @@ def robot_section(value: Any, source: Optional[str] = None) -> Robot:
     return Robot.from_mapping(out)
 
 
+def with_robot(task: Task, model: Optional[str] = None, flange: Optional[str] = None,
+               tcp: Optional[Sequence[float]] = None, base: Optional[Sequence[float]] = None) -> Task:
+    """`task` on another arm: its environment.robot changed as `robot_with` changes it (a command
+    line's --robot, --flange, --tcp and --base)."""
+    if model is None and flange is None and tcp is None and base is None:
+        return task
+    cell = dataclasses.replace(task.environment, robot=robot_with(task.environment.robot, model, flange, tcp, base))
+    return dataclasses.replace(task, environment=cell)
+
+
+def robot_with(robot: Robot, model: Optional[str] = None, flange: Optional[str] = None,
+               tcp: Optional[Sequence[float]] = None, base: Optional[Sequence[float]] = None) -> Robot:
+    """`robot` with the fields given changed, checked as the task file's are: another model must
+    come with its flange and tcp; a relative model file is taken from the working folder."""
+    section = {k: v for k, v in robot.as_dict().items() if v is not None}
+    if model is not None:
+        section = {k: v for k, v in section.items() if k not in ("flange", "tcp")}
+        section["model"] = model
+    changes = {"flange": flange, "tcp": None if tcp is None else list(tcp),
+               "base": None if base is None else list(base)}
+    section.update({k: v for k, v in changes.items() if v is not None})
+    return robot_section(section)
+
+
 def robot_model_file(field: str, value: Any, source: Optional[str] = None) -> str:
     """A robot model's file name, relative to the folder of `source` (a task file) when not
     absolute: an existing .urdf, .xml or .mjcf file."""
