@@ -72,10 +72,13 @@ def test_a_feature_out_of_the_arms_reach_is_refused_before_any_motion():
 
 
 def test_a_link_through_a_fixture_is_refused_naming_the_link_and_the_fixture(tmp_path):
-    """The pivot's plan: after its last push the gripper, turned 90 deg, retracts with its wrist
-    (link6) 1 mm into the left feature's solid (10 mm deep behind its face). The simulated arm
-    does not collide its links, so a run on it lands; the cell check says what a real cell would."""
-    task_file = TASKS / "pivoting.yaml"
+    """The pivot with the default 20 mm retract (the shipped task retracts 10 mm for this): after its
+    last push the gripper, turned 90 deg, retracts with its wrist (link6) 1 mm into the left
+    feature's solid, which stands between the jaws. The simulated arm does not collide its links;
+    the cell check says what a real cell would: `trajectory --joints` writes nothing, and `execute`
+    exits 2 before the arm is reached (no world built)."""
+    task_file = tmp_path / "pivot20.yaml"
+    task_file.write_text((TASKS / "pivoting.yaml").read_text().replace("retract: 10", "retract: 20"))
     plan_file = tmp_path / "p.json"
     runner = CliRunner()
     assert runner.invoke(cli, ["plan", str(task_file), "-o", str(plan_file)]).exit_code == 0
@@ -84,6 +87,9 @@ def test_a_link_through_a_fixture_is_refused_naming_the_link_and_the_fixture(tmp
     assert result.exit_code == 2, result.output
     assert "link link6 runs 1.0 mm into feature_left" in result.output and "retract" in result.output
     assert not (tmp_path / "p.csv").exists()
+    run = runner.invoke(cli, ["execute", str(plan_file), "--task", str(task_file), "--sim"])
+    assert run.exit_code == 2 and "link link6 runs 1.0 mm into feature_left" in run.output, run.output
+    assert "world built" not in run.output
 
 
 def test_joints_are_written_as_columns_and_other_outputs_are_refused(tmp_path):
