@@ -114,6 +114,20 @@ def test_a_generated_arm_runs_a_shipped_task_open_loop_within_half_a_millimetre(
     assert run.report.success and error["distance"] <= 0.5 and abs(error["theta"]) <= 0.5, error
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ["mujoco", "drake"])
+@pytest.mark.parametrize("name", list(ARMS))
+def test_a_generated_arm_passes_the_friction_contracts_pivot_on_the_arm(arms, name, engine):
+    """The contract's last part on the lab's arm: the first 30 deg of the pivot, on its servos."""
+    if engine == "drake":
+        pytest.importorskip("pydrake.all")
+    from stablepush.sim import fidelity
+
+    result = fidelity.pivot_on_arm(_on(arms[name], "pivoting"), engine=engine)
+    assert result.error_mm <= fidelity.ARM_PIVOT_LIMIT_MM, result
+    assert abs(result.error_deg) <= fidelity.ARM_PIVOT_LIMIT_DEG, result
+
+
 @pytest.mark.parametrize("name", list(ARMS))
 def test_the_joint_trajectory_through_the_labs_own_model_reproduces_the_cartesian_one(arms, name):
     from stablepush.sim.joint_path import joint_path

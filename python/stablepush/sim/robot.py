@@ -43,9 +43,9 @@ BASE_BODY = "arm_base"
 # The servos of a lab's arm: as stiff as the shipped arm's middle joints (its kp 20,000-60,000
 # N m/rad), with its joint damping and armature where the model gives less.
 SERVO_KP = 40000.0  # N m/rad (N/m for a sliding joint)
-SERVO_KV = 200.0  # N m s/rad
+SERVO_KV = 300.0  # N m s/rad
 JOINT_DAMPING = 2.0  # N m s/rad
-JOINT_ARMATURE = 0.05  # kg m^2
+JOINT_ARMATURE = 0.2  # kg m^2
 HOME_STARTS = 24  # seeded joint vectors IK starts from to find a lab's arm's home posture
 # What of a lab's model the run has no use for, or replaces by its own.
 _DROPPED = ("actuator", "sensor", "keyframe", "contact", "option")
