@@ -344,3 +344,38 @@ def test_a_model_that_cannot_carry_the_jaws_is_refused_naming_why(tmp_path, mode
     robot = Robot(model=str(path), flange=flange)
     with pytest.raises(RobotError, match=match):
         SimulatedArm(robot=robot)
+
+
+def test_the_sim_arm_server_serves_a_labs_arm_and_a_run_over_tcp_lands(arms):
+    """`stablepush sim-arm --robot ...` in a thread: a run over the protocol, checked against the
+    same model first (ModelledArm), lands."""
+    from stablepush.execution import TcpArm
+    from stablepush.execution.run import RunOptions, run_plan
+    from stablepush.sim.joint_path import ModelledArm, modelled
+    from stablepush.sim.server import running_sim_arm
+
+    task = _on(arms["7-joint MJCF"])
+    robot = task.environment.robot
+    assert modelled(TcpArm("127.0.0.1", 1), Robot()).__class__ is TcpArm  # no model named: not checked
+    plan = plan_task(task, seed=1)
+    with running_sim_arm(log=lambda text: None, robot=robot) as server:
+        arm = modelled(TcpArm(server.host, server.port), robot)
+        assert isinstance(arm, ModelledArm)
+        run = run_plan(task, plan, arm, RunOptions(pace=False, success_tolerance=(0.5, 0.5)))
+    assert run.fault is None and run.report.success, run.fault
+
+
+@pytest.mark.slow
+def test_evaluate_runs_its_trials_on_the_arm_it_is_given(arms, tmp_path):
+    """Every trial's world is built on the lab's arm: a robot whose flange the model lacks is
+    refused before any trial, and a good one lands the trials."""
+    arm = arms["6-joint URDF"]
+    task_file = TASKS / f"{TASK}.yaml"
+    runner = CliRunner()
+    common = ["evaluate", str(task_file), "--trials", "2", "--workers", "1", "--quiet", "--robot", arm["model"],
+              "--tcp", *map(str, arm["tcp"])]
+    refused = runner.invoke(cli, [*common, "--flange", "link9"])
+    assert refused.exit_code == 2 and "no link 'link9'" in refused.output, refused.output
+    result = runner.invoke(cli, [*common, "--flange", arm["flange"], "--json", str(tmp_path / "e.json")])
+    assert result.exit_code == 0, result.output
+    assert "landed 2 of 2" in result.output

@@ -63,9 +63,12 @@ class Batch:
     video_size: Tuple[int, int] = (640, 480)
 
     def __post_init__(self):
-        # Refused here, before any trial runs, rather than once per trial as a crash.
+        # Refused here, before any trial runs, rather than once per trial as a crash: a plan not of
+        # the task, a tolerance out of range, a robot that cannot carry the jaws (RobotError) or a
+        # plan it cannot follow in its cell (CellError).
         check_plan(self.task, self.plan)
         success_tolerance(self.task, self.tolerance)
+        SimulatedArm(self.engine, robot=self.task.environment.robot).check_cell(self.task, self.plan, RATE_HZ)
 
     @property
     def judged_with(self) -> Tuple[float, float]:
