@@ -3,7 +3,7 @@ the arm's contact setting against the contract's limits, and, with --stiff, the 
 replaced (the solver's stiff friction on every pad point, sliding or not).
 
     python3 benchmarks/friction_fidelity.py [--engine mujoco|drake] [--stiff]
-        [--robot FILE --flange LINK --tcp X Y Z RX RY RZ [--base X Y Z YAW]]
+        [--robot FILE --flange LINK --tcp X Y Z RX RY RZ [--base X Y Z YAW]] [--timestep-ms MS]
 
 The rigs hold the jaws on a kinematic hand; --robot runs the contract's last part, the pivot on
 the arm, on that arm (docs/execution.md, "Bring your own arm").
@@ -13,7 +13,7 @@ import time
 
 from shipped import TASKS
 
-from stablepush.sim import fidelity, friction
+from stablepush.sim import fidelity, friction, scene
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import check_push, load_task, with_robot
 
@@ -22,6 +22,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--stiff", action="store_true", help="measure the solver's stiff pad friction alone (no pad point ever slides with explicit friction)")
     parser.add_argument("--engine", choices=ENGINES, default=DEFAULT_ENGINE, help="the physics engine (default mujoco)")
+    parser.add_argument("--timestep-ms", type=float, default=None, metavar="MS",
+                        help="MuJoCo's time step for this run (default: sim.scene.TIMESTEP, the contract's)")
     parser.add_argument("--robot", metavar="FILE", help="the arm of the pivot on the arm: a URDF or MJCF file")
     parser.add_argument("--flange", metavar="LINK", help="with --robot: the link the jaws mount on")
     parser.add_argument("--tcp", nargs=6, type=float, metavar=("X", "Y", "Z", "RX", "RY", "RZ"),
@@ -33,8 +35,12 @@ def main() -> None:
         parser.error("--stiff is MuJoCo's setting: the pads' friction is Drake's own")
     if args.stiff:
         friction.SLIDE_SPEED = float("inf")
+    if args.timestep_ms is not None:
+        if engine != "mujoco":
+            parser.error("--timestep-ms is MuJoCo's step (Drake's is drake_arm.DRAKE_TIMESTEP)")
+        scene.TIMESTEP = args.timestep_ms / 1e3
     started = time.perf_counter()
-    print(f"engine: {engine}\n")
+    print(f"engine: {engine}" + (f", {scene.TIMESTEP * 1e3:g} ms step" if engine == "mujoco" else "") + "\n")
     print("| wall load | pad speed mm/s | creep um per mm (limit) | pad friction / mu N | pad drop-out steps | steps/s |")
     print("|---:|---:|---:|---:|---:|---:|")
     for load in (0.5, 0.9):

@@ -22,7 +22,6 @@ import csv
 import io
 import json
 import math
-import os
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence, Tuple
 
@@ -40,7 +39,7 @@ from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.arm import ArmKinematics
 from stablepush.sim.friction import mujoco
-from stablepush.sim.robot import arm_model
+from stablepush.sim.robot import arm_model, model_stamp
 from stablepush.task.model import Robot, Task
 
 # G through the joints' forward kinematics stays this close to each sample (m, rad): the joint
@@ -145,16 +144,12 @@ def checked_path(task: Task, plan: Plan, rate_hz: float, robot: Robot) -> JointP
     """joint_path, remembered for the cell, plan, rate and robot it was asked of: a study's trials
     run one plan in one cell, and ask once per process."""
     key = json.dumps([task.identity(), task.environment.as_dict(), [list(w.pose) for w in plan.waypoints],
-                      rate_hz, robot.as_dict(), _model_stamp(robot)], default=str)
+                      rate_hz, robot.as_dict(), model_stamp(robot)], default=str)
     if key not in _CHECKED:
         if len(_CHECKED) >= _CHECKED_KEPT:
             _CHECKED.pop(next(iter(_CHECKED)))
         _CHECKED[key] = joint_path(task, plan, rate_hz, robot=robot)
     return _CHECKED[key]
-
-
-def _model_stamp(robot: Robot) -> int:
-    return os.stat(robot.model).st_mtime_ns if robot.model else 0
 
 
 class _Solver:

@@ -79,8 +79,13 @@ def arm_model(robot: Optional[Robot] = None) -> ArmModel:
     robot = robot or Robot()
     if robot.shipped and robot == Robot():
         return _shipped()
-    stamp = os.stat(robot.model).st_mtime_ns if robot.model else 0
-    return _built(robot, stamp)
+    return _built(robot, model_stamp(robot))
+
+
+def model_stamp(robot: Robot) -> int:
+    """Which version of the robot's model file it is (its modification time, ns; 0: the shipped
+    arm): what a cache of anything built from it keys on."""
+    return os.stat(robot.model).st_mtime_ns if robot.model else 0
 
 
 @functools.lru_cache(maxsize=1)
