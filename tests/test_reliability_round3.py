@@ -4,16 +4,98 @@ import dataclasses
 import time
 
 import pytest
+from click.testing import CliRunner
 
 import stablepush as sp
-from stablepush.errors import TaskError
+from stablepush.errors import SettingError, TaskError
+from stablepush.evaluation import batch as batch_mod
+from stablepush.execution.guard import GuardedApproach
 from stablepush.plan.files import MAX_WAYPOINTS
+from stablepush_cli.main import cli
 
-from conftest import shipped
+from conftest import TASKS, shipped
+
+HIGH_MU = TASKS / "horizontal-offset-high-mu.yaml"
+
+
+@pytest.fixture(scope="module")
+def high_mu_plan(tmp_path_factory):
+    path = tmp_path_factory.mktemp("plans") / "high-mu.plan.json"
+    sp.save_plan(sp.plan_task(shipped("horizontal-offset-high-mu")), str(path))
+    return path
 
 
 def _with_step(task, step):
     return dataclasses.replace(task, planner=task.planner.replace(step=step))
+
+
+# -- 1. tracker noise and the guard; crashed trials ------------------------------------------------
+
+@pytest.mark.parametrize("noise", [("1", "0"), ("0", "1"), ("0.126", "0")])
+def test_a_tracker_noise_the_guard_cannot_tell_a_touch_from_is_refused_naming_the_option(high_mu_plan, noise):
+    """It exited 4 ("guard touch_mm must lie in [0.001, 0.5], got 4.0"): the guard reads a touch past
+    four standard deviations of the noise, at most 0.5 mm and 0.5 deg."""
+    result = CliRunner().invoke(cli, ["execute", str(high_mu_plan), "--task", str(HIGH_MU), "--sim",
+                                      "--tracker-noise", *noise])
+    assert result.exit_code == 2, result.output
+    assert "error: --tracker-noise:" in result.output and "--no-guard" in result.output
+    assert "internal error" not in result.output
+
+
+def test_evaluate_refuses_such_a_noise_before_any_trial(high_mu_plan, monkeypatch):
+    """Every trial crashed, and the run said "landed 0 of 2" with exit 0."""
+    monkeypatch.setattr(batch_mod, "run_plan", lambda *a, **k: pytest.fail("a trial ran"))
+    result = CliRunner().invoke(cli, ["evaluate", str(HIGH_MU), "--plan", str(high_mu_plan), "--trials", "2",
+                                      "--workers", "1", "--tracker-noise", "0.5", "0", "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert "error: --tracker-noise:" in result.output
+
+
+def test_the_guard_takes_every_noise_up_to_its_limit_and_the_api_refuses_past_it_by_field():
+    guard = GuardedApproach.for_tracker_noise(0.125, 0.125)
+    assert (guard.touch_mm, guard.touch_deg, guard.seat_deg) == (0.5, 0.5, 0.5)
+    for noise in [(0.1251, 0.0), (0.0, 0.1251), (float("nan"), 0.0), (float("inf"), 0.0)]:
+        with pytest.raises(SettingError) as caught:
+            GuardedApproach.for_tracker_noise(*noise)
+        assert caught.value.field == "tracker_noise"
+
+
+def test_crashed_trials_are_errors_not_misses_and_the_run_fails(high_mu_plan, monkeypatch, tmp_path):
+    """A crashing trial counted as a miss: every trial crashed and evaluate printed "landed 0 of 2"
+    with exit 0, a false 0% success rate."""
+    def crash(*args, **kw):
+        raise RuntimeError("the simulator blew up")
+
+    monkeypatch.setattr(batch_mod, "run_plan", crash)
+    out = tmp_path / "eval.json"
+    result = CliRunner().invoke(cli, ["evaluate", str(HIGH_MU), "--plan", str(high_mu_plan), "--trials", "2",
+                                      "--workers", "1", "--vary", "pad_mu=0.1", "--json", str(out), "--quiet"])
+    assert result.exit_code == 4, result.output
+    assert "landed 0 of" not in result.output and "0.0%" not in result.output
+    assert "error: 2 of 2 trials crashed" in result.output
+    summary = __import__("json").loads(out.read_text())["summary"]
+    assert summary["crashed"] == 2 and summary["crashed_trials"] == [0, 1]
+    assert summary["success_rate"] is None and summary["ci95"] is None and summary["causes"] == {}
+
+
+def test_a_crashed_trial_is_left_out_of_the_rate_and_the_decision(monkeypatch):
+    def landed_but_one(batch, trial):
+        record = {"trial": trial, "world": batch.world(trial).as_dict(), "goal_error": None, "final_error": None,
+                  "replans": 0, "sim_time_s": 1.0, "wall_s": 0.1, "verdict": None, "error": None,
+                  "success": trial != 1, "cause": None}
+        if trial == 1:
+            record.update(cause="crash", error="RuntimeError: the simulator blew up")
+        return record
+
+    monkeypatch.setattr(batch_mod, "run_trial", landed_but_one)
+    task = shipped("horizontal-offset-high-mu")
+    batch = batch_mod.Batch(task=task, plan=sp.plan_task(task), spreads=batch_mod.Spreads(vary={"pad_mu": 0.01}))
+    result = batch_mod.evaluate(batch, 3, batch_mod.Runner(workers=1), test=batch_mod.SequentialTest(0.5, 0.9))
+    s = result.summary()
+    assert (s["trials"], s["judged"], s["crashed"], s["successes"]) == (3, 2, 1, 2)
+    assert s["success_rate"] == 1.0 and s["causes"] == {}
+    assert (s["decision"]["trials"], s["decision"]["successes"]) == (2, 2)
+    assert any(line.startswith("crashed: 1 of 3 trials") for line in result.describe())
 
 
 # -- 6. steps too small for a plan file, and the time limit ----------------------------------------

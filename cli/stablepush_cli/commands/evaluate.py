@@ -7,9 +7,10 @@ import sys
 
 import click
 
-from stablepush.errors import OutputError
+from stablepush.errors import OutputError, SettingError
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush_cli.common import (
+    EXIT_INTERNAL,
     EXIT_NOT_SOLVED,
     check_named_outputs,
     fail,
@@ -99,11 +100,13 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     to rest after the release within the task's tolerance of the goal (or --success-tolerance).
     The summary gives the success rate with its Wilson 95% interval, the goal error's percentiles
     and the causes of the misses. Spreads that vary nothing make one world: one trial runs, and no
-    interval is given. A trial that crashes is recorded (cause `crash`) and the batch goes on;
-    Ctrl-C stops it and keeps the trials done.
+    interval is given. A trial that crashes (an internal error) is recorded (cause `crash`), left
+    out of the rate, and the batch goes on, to exit 4; Ctrl-C stops it and keeps the trials done.
 
     \b
-    Exit status: 0 done (whatever the success rate), 1 no plan found, 2 bad input, 130 stopped by
+    Exit status: 0 done (whatever the success rate), 1 no plan found, 2 bad input (a --tracker-noise
+    the guard cannot tell a touch from: at most 0.125 mm and 0.125 deg, or --no-guard), 4 a trial
+    crashed (the trials are summarized and written, each crash with its error), 130 stopped by
     Ctrl-C (the trials done are summarized and written).
 
     \b
@@ -139,9 +142,12 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
             video_dir = video_directory(video_dir)
         except OutputError as exc:
             fail(f"--video-failed {exc}")
-    batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
-                  engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video_fps,
-                  video_size=tuple(video_size))
+    try:
+        batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
+                      engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video_fps,
+                      video_size=tuple(video_size))
+    except SettingError as exc:  # the tracker's noise, past what the guard can tell a touch from
+        fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
     for warning in batch.warnings():
         click.echo(f"warning: {warning}", err=True)
     trials = spreads.trials_to_run(trials)  # as evaluate() runs them: the bar and the header say so too
@@ -160,6 +166,10 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         sys.exit(130 if s["interrupted"] else EXIT_NOT_SOLVED)
     for line in result.describe(written=[p for p in (json_path, csv_path, png_path) if p]):
         say(line)
+    if s["crashed"]:  # internal errors: no rate stands for the trials asked for
+        click.echo(f"error: {s['crashed']} of {s['trials']} trials crashed (internal errors, a bug; each trial's "
+                   f"error is in its record): the success rate is over the {s['judged']} that did not", err=True)
+        sys.exit(EXIT_INTERNAL)
     if s["interrupted"]:
         sys.exit(130)
 

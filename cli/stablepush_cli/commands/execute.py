@@ -6,6 +6,7 @@ import sys
 
 import click
 
+from stablepush.errors import SettingError
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.execution.tcp_arm import DEFAULT_ACK_TIMEOUT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
@@ -158,11 +159,14 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     named = ([("--json", JsonReport(json_path))] if json_path else []) + (
         [("--record", BagRecording(record_path, stamp_ns))] if record_path else []) + [("--video", v) for v in video]
     outputs = [output for _, output in named]
+    try:
+        guard = GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None
+    except SettingError as exc:  # a noise the guard cannot tell a touch from
+        fail(f"--tracker-noise: {exc.reason}")
     options = RunOptions(rate_hz=rate_hz, resume_from=resume_from, pace=pace,
                          closed_loop=ClosedLoop.for_task(task, replan_threshold, final_tolerance) if closed_loop
                          else None,
-                         guard=GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None,
-                         success_tolerance=success_tolerance)
+                         guard=guard, success_tolerance=success_tolerance)
     target = _arm_for(arm, sim, engine, mu_scale, tracker_noise, ack_timeout, quiet)
     with _run_progress(task, plan, resume_from, quiet) as progress:
         run = run_plan(task, plan, target, options, progress=progress,
