@@ -1,6 +1,7 @@
 """Reliability, round three (issue 61): each class of fault found, at its root, with the input that
 showed it. Fast: nothing here runs the simulated arm."""
 import dataclasses
+import math
 import time
 
 import pytest
@@ -8,6 +9,7 @@ from click.testing import CliRunner
 
 import stablepush as sp
 from stablepush.errors import SettingError, TaskError
+from stablepush.evaluation import Spreads, draw_world
 from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.guard import GuardedApproach
 from stablepush.plan.files import MAX_WAYPOINTS
@@ -127,3 +129,27 @@ def test_a_long_plan_is_made_within_its_time_limit_and_written(tmp_path):
     assert plan.solved and len(plan.waypoints) > 9_800
     sp.save_plan(plan, str(tmp_path / "long.plan.json"))
     assert len(sp.load_plan(str(tmp_path / "long.plan.json")).waypoints) == len(plan.waypoints)
+
+
+# -- 2. a spread of -0 -----------------------------------------------------------------------------
+
+def test_a_spread_of_minus_zero_is_zero():
+    """`--vary mass=-0` passed the range check, then numpy refused uniform(0, -0): exit 4."""
+    spreads = Spreads(vary={"mass": -0.0, "pad_mu": 0.1}, feature_error=(-0.0, -0.0), tracker_noise=(-0.0, 0.0))
+    assert math.copysign(1.0, spreads.vary["mass"]) == 1.0 and spreads.feature_error == (0.0, 0.0)
+    world = draw_world(1, 0, spreads, ["left"])
+    assert world.multipliers["mass"] == 1.0 and world.feature_offsets["left"] == (0.0, 0.0, 0.0)
+
+
+def test_evaluate_takes_vary_minus_zero(high_mu_plan, monkeypatch):
+    def drawn_and_landed(batch, trial):  # the worlds are drawn as a trial draws them; nothing is simulated
+        return {"trial": trial, "world": batch.world(trial).as_dict(), "goal_error": None, "final_error": None,
+                "replans": 0, "sim_time_s": 1.0, "wall_s": 0.1, "verdict": None, "error": None, "success": True,
+                "cause": None}
+
+    monkeypatch.setattr(batch_mod, "run_trial", drawn_and_landed)
+    result = CliRunner().invoke(cli, ["evaluate", str(HIGH_MU), "--plan", str(high_mu_plan), "--trials", "2",
+                                      "--workers", "1", "--vary", "mass=-0", "--vary", "pad_mu=0.1",
+                                      "--feature-error", "-0", "0", "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert "landed 2 of 2" in result.output

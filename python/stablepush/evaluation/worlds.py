@@ -38,6 +38,11 @@ class Spreads:
     tracker_noise: Tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self):
+        # -0.0 passes the range checks but makes numpy's uniform(0, -0) refuse "high - low < 0": every
+        # spread is taken as the non-negative number it is (x + 0.0 is 0.0 for -0.0, x for any other).
+        object.__setattr__(self, "vary", {key: fraction + 0.0 for key, fraction in dict(self.vary).items()})
+        for name in ("feature_error", "tracker_noise"):
+            object.__setattr__(self, name, tuple(v + 0.0 for v in getattr(self, name)))
         for key, fraction in self.vary.items():
             if key not in VARY_KEYS:
                 raise ValueError(f"vary: unknown key {key!r} (one of {', '.join(VARY_KEYS)})")
