@@ -8,11 +8,12 @@ import pytest
 from click.testing import CliRunner
 
 import stablepush as sp
-from stablepush.errors import SettingError, TaskError
+from stablepush.errors import RunnerError, SettingError, TaskError
 from stablepush.evaluation import Spreads, draw_world
 from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.guard import GuardedApproach
 from stablepush.plan.files import MAX_WAYPOINTS
+from stablepush.runners import Runner, run_all
 from stablepush_cli.main import cli
 
 from conftest import TASKS, shipped
@@ -153,3 +154,34 @@ def test_evaluate_takes_vary_minus_zero(high_mu_plan, monkeypatch):
                                       "--feature-error", "-0", "0", "--quiet"])
     assert result.exit_code == 0, result.output
     assert "landed 2 of 2" in result.output
+
+
+# -- 3. a Ray that cannot start ------------------------------------------------------------------
+
+@pytest.mark.parametrize("address", [None, "local", "auto"])
+def test_a_ray_that_cannot_start_is_a_runner_error_naming_its_address(monkeypatch, address):
+    """`reach ... --ray local` on a loaded machine exited 4 after 32 s: ray.init raises a bare
+    Exception when its node times out during startup."""
+    ray = pytest.importorskip("ray")
+    stopped = []
+
+    def times_out(*args, **kw):
+        raise Exception("The current node timed out during startup. This could happen because some of the raylet "
+                        "failed to startup or the GCS has become overloaded.")
+
+    monkeypatch.setattr(ray, "init", times_out)
+    monkeypatch.setattr(ray, "shutdown", lambda: stopped.append(1))
+    monkeypatch.setattr(ray, "is_initialized", lambda: False)
+    with pytest.raises(RunnerError) as caught:
+        list(run_all(_square, None, [1, 2], Runner(ray=True, ray_address=address)))
+    assert "timed out during startup" in str(caught.value) and stopped
+    assert (f"Ray at {address} (--ray {address})" if address else "a local Ray instance (--ray)") in str(caught.value)
+    grid = ["--x", "-1:1:2", "--z", "0:0:1", "--time-limit", "0.05"]
+    result = CliRunner().invoke(cli, ["reach", str(HIGH_MU), *grid, "--ray", *([address] if address else []),
+                                      "--json", "/dev/null"])
+    assert result.exit_code == 2, result.output
+    assert result.output.startswith("error: cannot start or join") and "internal error" not in result.output
+
+
+def _square(_shared, i):
+    return i * i

@@ -9,6 +9,7 @@ Results arrive as they finish, as (i, result); a job whose worker died arrives a
 """
 from __future__ import annotations
 
+import contextlib
 import os
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
@@ -155,9 +156,16 @@ def probe_ray_head(address: Optional[str]) -> None:
 
 
 def _join_ray(ray, address: Optional[str]) -> None:
-    """ray.init, with a head that does not answer (or an address Ray refuses) a RunnerError at once."""
+    """ray.init, with a head that does not answer (or an address Ray refuses) a RunnerError at once,
+    and any other failure to start or join it a RunnerError too, naming the address: a local
+    instance on a loaded machine times out with a bare Exception ("The current node timed out
+    during startup", after Ray's own 30 s), which was an internal error."""
     probe_ray_head(address)
     try:
         ray.init(address=address, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
-    except (ConnectionError, ValueError) as exc:
-        raise RunnerError(f"cannot join Ray at {address or 'a local instance'}: {exc}") from None
+    except Exception as exc:  # noqa: BLE001 - Ray raises bare Exceptions; whatever it is, Ray did not start
+        with contextlib.suppress(Exception):  # noqa: BLE001 - what it did start, it stops
+            ray.shutdown()
+        text = " ".join(str(exc).split())[:300] or type(exc).__name__
+        where, option = (f"Ray at {address}", f"--ray {address}") if address else ("a local Ray instance", "--ray")
+        raise RunnerError(f"cannot start or join {where} ({option}): {text}") from None
