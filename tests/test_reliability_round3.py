@@ -8,7 +8,7 @@ import pytest
 from click.testing import CliRunner
 
 import stablepush as sp
-from stablepush.errors import RunnerError, SettingError, TaskError
+from stablepush.errors import OutputError, RunnerError, SettingError, TaskError
 from stablepush.evaluation import Spreads, draw_world
 from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.guard import GuardedApproach
@@ -185,3 +185,47 @@ def test_a_ray_that_cannot_start_is_a_runner_error_naming_its_address(monkeypatc
 
 def _square(_shared, i):
     return i * i
+
+
+# -- 5. output names that name no file -------------------------------------------------------------
+
+@pytest.mark.parametrize("name", ["out.json/", ""])
+def test_the_api_refuses_an_output_name_that_names_no_file(tmp_path, monkeypatch, name):
+    """`out.json/` was written as the file out.json (and the CLI said "written to out.json/")."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "out").mkdir()
+    plan = sp.plan_task(shipped("horizontal-offset-high-mu"))
+    with pytest.raises(OutputError, match="names a directory|an empty file name|ends in '/'"):
+        sp.save_plan(plan, name)
+    with pytest.raises(OutputError):
+        sp.save_plan(plan, "fine.json", name)  # an empty CSV name wrote no CSV without a word
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def _output_cases(plan_file, tmp_path):
+    """(option, the command up to it, a file name the option takes)."""
+    task = str(HIGH_MU)
+    grid = ["--x", "-1:1:2", "--z", "0:0:1", "--time-limit", "0.05"]
+    return [
+        ("-o", ["plan", task, "-o"], "out.json"),
+        ("--csv", ["plan", task, "-o", str(tmp_path / "p.json"), "--csv"], "out.csv"),
+        ("--json", ["reach", task, *grid, "--json"], "out.json"),
+        ("-o", ["trajectory", str(plan_file), "--task", task, "-o"], "out.csv"),
+        ("--record", ["execute", str(plan_file), "--task", task, "--sim", "--record"], "out.mcap"),
+        ("--json", ["execute", str(plan_file), "--task", task, "--sim", "--json"], "out.json"),
+        ("--json", ["evaluate", task, "--plan", str(plan_file), "--trials", "1", "--json"], "out.json"),
+    ]
+
+
+@pytest.mark.parametrize("ending", ["/", "/.", None])
+def test_every_command_refuses_an_output_name_that_names_no_file_naming_the_option(high_mu_plan, tmp_path,
+                                                                                   monkeypatch, ending):
+    """`plan t.yaml -o out.json/` said "written to out.json/" and made the file out.json (so did reach
+    --json, trajectory -o, execute --record); `--json ""` wrote nothing without a word."""
+    monkeypatch.chdir(tmp_path)
+    for option, args, good in _output_cases(high_mu_plan, tmp_path):
+        name = "" if ending is None else good + ending
+        result = CliRunner().invoke(cli, args + [name])
+        assert result.exit_code == 2, (args, name, result.output)
+        assert result.output.startswith(f"error: {option} "), (args, name, result.output)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []

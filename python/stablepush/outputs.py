@@ -45,6 +45,9 @@ def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
 def _writable(path: Union[str, Path]):
     """(target, "stream" or "replace", the replaced file's permissions or None) for an output path,
     by write_files' rules; OutputError naming the path where it would refuse."""
+    fault = _not_a_file_name(path)
+    if fault is not None:
+        raise OutputError(f"{str(path)!r}: {fault}", output=path)
     try:  # the path as given: /dev/stdout into a pipe resolves to no file name, but stats as the pipe
         mode = os.stat(path).st_mode
     except FileNotFoundError:
@@ -61,6 +64,22 @@ def _writable(path: Union[str, Path]):
     if not os.access(target.parent, os.W_OK | os.X_OK):  # a new file is made in it, then renamed
         raise OutputError(f"{path}: the directory {target.parent} is not writable", output=path)
     return target, "replace", stat.S_IMODE(mode) if mode is not None else None
+
+
+def _not_a_file_name(path: Union[str, Path]) -> Optional[str]:
+    """Why `path`, as given, names no file to write, or None. A name that ends in a slash (or in
+    `.` or `..`) names a directory: `out.json/` was written as the file out.json, and said so; an
+    empty name was taken as no output at all, and nothing was written."""
+    text = os.fsdecode(os.fspath(path)) if isinstance(path, (str, bytes, os.PathLike)) else None
+    if text is None:
+        return f"an output is a path, not {type(path).__name__}"
+    if not text:
+        return "an empty file name; name the file to write"
+    if text.endswith(os.sep) or (os.altsep and text.endswith(os.altsep)):
+        return f"ends in {text[-1]!r}, so it names a directory; name the file to write (without the {text[-1]})"
+    if os.path.basename(text) in (".", ".."):
+        return "names a directory; name the file to write"
+    return None
 
 
 def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
@@ -107,6 +126,12 @@ def require_suffix(name: str, path: Optional[Union[str, Path]], suffixes) -> Non
 def same_file(a: Union[str, Path], b: Union[str, Path]) -> bool:
     """Whether two paths name one file (as check_outputs tells them: hard links and symlinks too)."""
     return _identity(a) == _identity(b)
+
+
+def check_output(path: Union[str, Path]) -> None:
+    """OutputError naming `path` unless write_files could write it (for a writer of its own, such as
+    a bag's, which renames a file made elsewhere into place)."""
+    _writable(path)
 
 
 def is_stream(path: Union[str, Path]) -> bool:

@@ -393,16 +393,16 @@ def write_evaluation(evaluation: Evaluation, json_path: Optional[str] = None, cs
 
     from stablepush.outputs import write_atomically
 
-    if json_path:
+    if json_path is not None:
         write_atomically(json_path, json.dumps(evaluation.as_dict(), indent=1) + "\n")
-    if csv_path:
+    if csv_path is not None:
         header, rows = evaluation.rows()
         buffer = io.StringIO()
         writer = csv.writer(buffer, lineterminator="\n")
         writer.writerow(header)
         writer.writerows(rows)
         write_atomically(csv_path, buffer.getvalue())
-    if png_path:
+    if png_path is not None:
         from stablepush.viz.figures import evaluation_figure, save_figure
 
         save_figure(evaluation_figure(evaluation.summary(), evaluation.trials), png_path)
