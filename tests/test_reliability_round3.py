@@ -6,9 +6,11 @@ import time
 
 import pytest
 from click.testing import CliRunner
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import stablepush as sp
-from stablepush.errors import OutputError, RunnerError, SettingError, TaskError
+from stablepush.errors import OutputError, RunnerError, SettingError, StablepushError, TaskError
 from stablepush.evaluation import Spreads, draw_world
 from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.guard import GuardedApproach
@@ -229,3 +231,47 @@ def test_every_command_refuses_an_output_name_that_names_no_file_naming_the_opti
         assert result.exit_code == 2, (args, name, result.output)
         assert result.output.startswith(f"error: {option} "), (args, name, result.output)
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+# -- 4. an edited Task ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("field", ["uncertainty", "feature_orientations"])
+@pytest.mark.parametrize("value", [None, (), [], "pad_mu"])
+def test_a_task_edited_with_a_field_of_the_wrong_type_is_refused_naming_it(field, value):
+    """`sp.check(dataclasses.replace(task, uncertainty=None), ...)` escaped as an AttributeError."""
+    with pytest.raises(TypeError, match=f"Task.{field}"):
+        dataclasses.replace(shipped("horizontal-offset-low-mu"), **{field: value})
+
+
+WRONG_TYPED = st.one_of(
+    st.none(), st.booleans(), st.integers(min_value=-2**70, max_value=2**70), st.floats(),
+    st.text(max_size=5), st.binary(max_size=3), st.builds(object),
+    st.tuples(st.text(max_size=2)), st.lists(st.one_of(st.none(), st.text(max_size=2)), max_size=3),
+    st.lists(st.floats(allow_nan=True), min_size=2, max_size=4).map(tuple),
+    st.dictionaries(st.text(max_size=8), st.one_of(st.none(), st.floats(), st.text(max_size=2)), max_size=2),
+    st.dictionaries(st.sampled_from(["pad_mu", "mass", "left"]), st.floats(), min_size=1, max_size=2),
+)
+TASK_FIELDS = [f.name for f in dataclasses.fields(sp.Task)]
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(field=st.sampled_from(TASK_FIELDS), value=WRONG_TYPED)
+def test_every_task_field_edited_to_any_type_is_refused_by_name_or_taken(field, value):
+    """Every field of a Task, replaced by a value of any type: the Task refuses it naming the field
+    (TypeError or ValueError), or takes it, and then sp.check and sp.plan_task answer or raise a
+    StablepushError, TypeError or ValueError, never anything else."""
+    base = _LOW_MU
+    try:
+        task = dataclasses.replace(base, **{field: value})
+    except (TypeError, ValueError) as exc:
+        assert field in str(exc), (field, value, exc)
+        return
+    for call in (lambda: sp.check(task, at=task.start, move=(0.1, 0.0, 0.0)),
+                 lambda: sp.plan_task(task, time_limit=0.01, explain=False)):
+        try:
+            call()
+        except (StablepushError, TypeError, ValueError):
+            pass
+
+
+_LOW_MU = shipped("horizontal-offset-low-mu")
