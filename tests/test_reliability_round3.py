@@ -1,7 +1,10 @@
 """Reliability, round three (issue 61): each class of fault found, at its root, with the input that
 showed it. Fast: nothing here runs the simulated arm."""
 import dataclasses
+import json
 import math
+import re
+import socket
 import time
 
 import pytest
@@ -14,6 +17,7 @@ from stablepush.errors import OutputError, RunnerError, SettingError, Stablepush
 from stablepush.evaluation import Spreads, draw_world
 from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.guard import GuardedApproach
+from stablepush.execution.protocol import PROTOCOL, ProtocolError, decode, encode
 from stablepush.plan.files import MAX_WAYPOINTS
 from stablepush.runners import Runner, run_all
 from stablepush_cli.main import cli
@@ -78,7 +82,7 @@ def test_crashed_trials_are_errors_not_misses_and_the_run_fails(high_mu_plan, mo
     assert result.exit_code == 4, result.output
     assert "landed 0 of" not in result.output and "0.0%" not in result.output
     assert "error: 2 of 2 trials crashed" in result.output
-    summary = __import__("json").loads(out.read_text())["summary"]
+    summary = json.loads(out.read_text())["summary"]
     assert summary["crashed"] == 2 and summary["crashed_trials"] == [0, 1]
     assert summary["success_rate"] is None and summary["ci95"] is None and summary["causes"] == {}
 
@@ -275,3 +279,84 @@ def test_every_task_field_edited_to_any_type_is_refused_by_name_or_taken(field, 
 
 
 _LOW_MU = shipped("horizontal-offset-low-mu")
+
+
+# -- 8. the arm server's hello -------------------------------------------------------------------
+
+def _scene(name="horizontal-offset-high-mu"):
+    from stablepush.execution.world import place_features, scene_description
+
+    task = shipped(name) if "/" not in name else sp.load_task(TASKS / name)
+    plan = sp.plan_task(task, time_limit=0.5)
+    return scene_description(task, place_features(task, plan.waypoints), task.start)
+
+
+def _hello_line(scene):
+    return encode({"type": "hello", "protocol": PROTOCOL, "rate_hz": 100, "scene": scene})
+
+
+def _impossible(edit):
+    scene = json.loads(json.dumps(_HIGH_MU_SCENE))
+    edit(scene)
+    return scene
+
+
+IMPOSSIBLE_HELLOS = [  # (what, the edit, what the error names)
+    ("a negative pad mu", lambda s: s["gripper"].update(mu=-1), "scene.gripper.mu"),
+    ("a pad mu of 1e300", lambda s: s["gripper"].update(mu=1e300), "scene.gripper.mu"),
+    ("a normal [0, 0, 0]", lambda s: s["features"][0].update(normal=[0, 0, 0]), "scene.features[0].normal"),
+    ("a feature mu of 1e300", lambda s: s["features"][0].update(mu=1e300), "scene.features[0].mu"),
+    ("a feature mu of 1e-300", lambda s: s["features"][0].update(mu=1e-300), "scene.features[0].mu"),
+    ("no pads", lambda s: s["gripper"].update(pads=[]), "scene.gripper.pads"),
+    ("a grip force of 1e300", lambda s: s["gripper"].update(grip_force=1e300), "scene.gripper.grip_force"),
+    ("a grip force of 0", lambda s: s["gripper"].update(grip_force=0), "scene.gripper.grip_force"),
+    ("a negative mass", lambda s: s["object"].update(mass=-0.2), "scene.object.mass"),
+    ("a zero inertia", lambda s: s["object"].update(inertia=0), "scene.object.inertia"),
+    ("a thickness of 1 km", lambda s: s["object"].update(thickness=1000.0), "scene.object.thickness"),
+    ("a vertex at 1e9 m", lambda s: s["object"]["polygon"][0].__setitem__(0, 1e9), "scene.object.polygon[0][0]"),
+    ("two vertices", lambda s: s["object"].update(polygon=s["object"]["polygon"][:2]), "scene.object.polygon"),
+    ("a pad of radius 0", lambda s: s["gripper"]["pads"][0].update(radius=0), "scene.gripper.pads[0].radius"),
+    ("254 pad points", lambda s: s["gripper"].update(pad_rings=6), "254 pad points"),
+    ("gravity of 1e6", lambda s: s.update(gravity=[0, 1e6]), "scene.gravity[1]"),
+    ("a feature's pose no pose", lambda s: s["features"][0].update(object_pose=[0, 0, 0, 0, 0, 0, 0]),
+     "scene.features[0].object_pose"),
+    ("a feature without a pusher", lambda s: s["features"][0].pop("pusher"), "scene.features[0]"),
+    ("no gravity", lambda s: s.pop("gravity"), "scene has no 'gravity'"),
+    ("a string for the mass", lambda s: s["object"].update(mass="0.2"), "scene.object.mass"),
+]
+
+
+@pytest.mark.parametrize("what, edit, says", IMPOSSIBLE_HELLOS, ids=[case[0] for case in IMPOSSIBLE_HELLOS])
+def test_a_hello_whose_scene_no_world_can_be_built_from_is_refused_naming_the_field(what, edit, says):
+    """The sim-arm built worlds from these and answered `ready`."""
+    with pytest.raises(ProtocolError, match=re.escape(says)):
+        decode(_hello_line(_impossible(edit)), "client")
+
+
+@pytest.mark.parametrize("name", ["horizontal-offset-high-mu", "pivoting", "t-shaped", "more/tilted-gravity.yaml",
+                                  "more/hexagon-offset.yaml"])
+def test_the_executors_own_hellos_are_taken(name):
+    assert decode(_hello_line(_scene(name)), "client")["type"] == "hello"
+
+
+def test_the_sim_arm_answers_each_impossible_hello_with_an_error_and_then_serves(tmp_path):
+    from stablepush.sim.server import SimArmServer
+
+    server = SimArmServer(log=lambda text: None, idle_timeout=3.0)
+    server.start_in_thread()
+
+    def exchange(scene):
+        with socket.create_connection((server.host, server.port), timeout=30) as conn:
+            conn.sendall(_hello_line(scene) + encode({"type": "bye"}))
+            return decode(conn.makefile("rb").readline(), "server")
+
+    try:
+        for what, edit, says in IMPOSSIBLE_HELLOS:
+            reply = exchange(_impossible(edit))
+            assert reply["type"] == "error" and says in reply["message"], (what, reply)
+        assert exchange(_HIGH_MU_SCENE)["type"] == "ready"
+    finally:
+        server.close()
+
+
+_HIGH_MU_SCENE = _scene()
