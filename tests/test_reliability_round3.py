@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import stablepush as sp
+from stablepush import runners
 from stablepush.errors import OutputError, RunnerError, SettingError, StablepushError, TaskError
 from stablepush.evaluation import Spreads, draw_world
 from stablepush.evaluation import batch as batch_mod
@@ -360,3 +361,44 @@ def test_the_sim_arm_answers_each_impossible_hello_with_an_error_and_then_serves
 
 
 _HIGH_MU_SCENE = _scene()
+
+
+# -- 9. workers, Unicode digits, a CSV over a task file -------------------------------------------
+
+class _InlinePool:
+    """A ProcessPoolExecutor that records how many workers it was asked for and runs each job here."""
+
+    asked = []
+
+    def __init__(self, max_workers):
+        _InlinePool.asked.append(max_workers)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    def submit(self, job, *args):
+        from concurrent.futures import Future
+
+        future = Future()
+        future.set_result(job(*args))
+        return future
+
+
+def test_workers_are_capped_at_the_jobs_and_at_a_few_per_cpu(monkeypatch):
+    """`reach --workers 1000` for 2 cells started 1,000 processes."""
+    monkeypatch.setattr(runners, "ProcessPoolExecutor", _InlinePool)
+    _InlinePool.asked.clear()
+    assert sorted(r for _, r in run_all(_square, None, [1, 2], Runner(workers=1000))) == [1, 4]
+    assert _InlinePool.asked == [2]
+    assert sorted(r for _, r in run_all(_square, None, range(5000), Runner(workers=1000)))[-1] == 4999 ** 2
+    assert _InlinePool.asked == [2, runners.max_workers()]
+    assert runners.max_workers() == runners.WORKERS_PER_CPU * runners.default_workers()
+    result = CliRunner().invoke(cli, ["reach", str(HIGH_MU), "--x", "-1:1:2", "--z", "0:0:1", "--time-limit", "0.05",
+                                      "--workers", "1000"])
+    assert result.exit_code == 0, result.output
+    assert _InlinePool.asked[-1] == 2 and "on 2 local processes" in result.output
+    with pytest.raises(ValueError, match="workers"):
+        Runner(workers=0)

@@ -21,6 +21,9 @@ from stablepush.extras import require
 Job = Callable[[Any, int], Any]
 # How long joining a Ray cluster may wait for its head to answer: Ray itself retries for minutes.
 RAY_CONNECT_TIMEOUT_S = 5.0
+# Local worker processes per CPU at most: each job keeps a CPU busy (a simulation, a search), so
+# more only share the CPUs (and each costs a process's memory); `--workers 1000` started 1,000.
+WORKERS_PER_CPU = 2
 
 
 def check_ray_address(address: Optional[str]) -> Optional[str]:
@@ -52,17 +55,31 @@ class Runner:
     ray_address: Optional[str] = None
 
     def __post_init__(self):
+        if isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1:
+            raise ValueError(f"workers must be a whole number from 1, got {self.workers!r:.40}")
         check_ray_address(self.ray_address)
 
-    def describe(self) -> str:
+    def processes(self, jobs: int) -> int:
+        """How many local processes a batch of `jobs` runs on: `workers`, but no more than the jobs
+        nor than max_workers()."""
+        return max(1, min(self.workers, jobs, max_workers()))
+
+    def describe(self, jobs: Optional[int] = None) -> str:
+        """Where the jobs run, in words; with `jobs`, the processes a batch of them runs on."""
         if self.ray:
             return f"Ray ({self.ray_address or 'local instance'})"
-        return "this process" if self.workers <= 1 else f"{self.workers} local processes"
+        workers = self.processes(self.workers if jobs is None else jobs)
+        return "this process" if workers <= 1 else f"{workers} local processes"
 
 
 def default_workers() -> int:
     """The machine's CPU count."""
     return max(1, os.cpu_count() or 1)
+
+
+def max_workers() -> int:
+    """The most local worker processes a batch starts: WORKERS_PER_CPU per CPU."""
+    return WORKERS_PER_CPU * default_workers()
 
 
 @dataclass(frozen=True)
@@ -78,8 +95,9 @@ def run_all(job: Job, shared: Any, indices: Iterable[int], runner: Runner) -> It
     indices = list(indices)
     if runner.ray:
         return _ray(job, shared, indices, runner.ray_address)
-    if runner.workers > 1 and len(indices) > 1:
-        return _processes(job, shared, indices, runner.workers)
+    workers = runner.processes(len(indices))
+    if workers > 1:
+        return _processes(job, shared, indices, workers)
     return ((i, job(shared, i)) for i in indices)
 
 

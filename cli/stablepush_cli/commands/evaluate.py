@@ -156,7 +156,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         click.echo(f"{task.name}: {spreads.describe()}", err=True)
         click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop"
                    f"{'' if guarded else ', approaches not guarded'} on {engine}, "
-                   f"on {runner.describe()}" + (f"; the plan is robust to {box}" if box else ""), err=True)
+                   f"on {runner.describe(trials)}" + (f"; the plan is robust to {box}" if box else ""), err=True)
     with _trials_bar(quiet, trials) as progress:
         result = run_evaluation(batch, trials, runner, progress, test=test)
     write_evaluation(result, json_path, csv_path, png_path)

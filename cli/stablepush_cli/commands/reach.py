@@ -80,9 +80,9 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
         if bar is not None:
             bar.render_finish()
     data = result.as_dict()
-    if json_path:
+    if json_path is not None:
         write_atomically(json_path, json.dumps(data, indent=1) + "\n")
-    if png_path:
+    if png_path is not None:
         from stablepush.viz.figures import reach_figure, save_figure
 
         save_figure(reach_figure(task, data), png_path)

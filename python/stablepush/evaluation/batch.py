@@ -217,7 +217,7 @@ def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
         if close is not None:
             close()
     done.sort(key=lambda r: r["trial"])
-    return Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started, runner=runner.describe(),
+    return Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started, runner=runner.describe(trials),
                       requested=trials, interrupted=interrupted, decision=decision.as_dict())
 
 
