@@ -402,3 +402,24 @@ def test_workers_are_capped_at_the_jobs_and_at_a_few_per_cpu(monkeypatch):
     assert _InlinePool.asked[-1] == 2 and "on 2 local processes" in result.output
     with pytest.raises(ValueError, match="workers"):
         Runner(workers=0)
+
+
+# Each evaluate here would fail fast once parsed (--robust with --plan), and never start its trials.
+_FAST_FAIL = ["--robust", "--plan", "none.plan.json"]
+
+
+@pytest.mark.parametrize("args, option", [
+    (["reach", str(HIGH_MU), "--x", "-1:1:٣", "--z", "0:0:1"], "--x"),
+    (["reach", str(HIGH_MU), "--x", "-١:1:3", "--z", "0:0:1"], "--x"),
+    (["reach", str(HIGH_MU), "--x", "-1:1:３", "--z", "0:0:1"], "--x"),
+    (["evaluate", str(HIGH_MU), "--vary", "mass=٠.١", *_FAST_FAIL], "--vary"),
+    (["evaluate", str(HIGH_MU), "--trials", "٣", *_FAST_FAIL], "--trials"),
+    (["evaluate", str(HIGH_MU), "--tracker-noise", "٠", "0", *_FAST_FAIL], "--tracker-noise"),
+    (["evaluate", str(HIGH_MU), "--ray", "127.0.0.1:٦٣٧٩", *_FAST_FAIL], "--ray"),
+    (["check", str(HIGH_MU), "--move", "١", "0", "0"], "--move"),
+])
+def test_numbers_in_other_scripts_digits_are_refused_naming_the_option(args, option):
+    """Python reads "٣" as 3: `--x -1:1:٣` made an axis of three values, `--vary mass=٠.١` a spread of 0.1."""
+    result = CliRunner().invoke(cli, args)
+    assert result.exit_code == 2, result.output
+    assert f"Invalid value for '{option}" in result.output

@@ -33,7 +33,7 @@ def check_ray_address(address: Optional[str]) -> Optional[str]:
     if address is None or address in ("auto", "local"):
         return address
     host, port = _host_port(address)
-    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+    if not host or not (port.isascii() and port.isdigit()) or not 0 < int(port) < 65536:  # "٦٣٧٩" is no port
         raise ValueError(f"expected HOST:PORT of a running Ray head (e.g. 10.0.0.5:6379, or ray://HOST:10001), "
                          f"'auto' or 'local'; got {address!r}")
     return address

@@ -23,6 +23,7 @@ from stablepush_cli.common import (
 )
 from stablepush_cli.options import (
     Finite,
+    Whole,
     check_video,
     parse_ray_address,
     parse_vary,
@@ -39,7 +40,7 @@ from stablepush_cli.options import (
               help="Plan robust to the worlds: the task's uncertainty box widened to the --vary spreads, so every "
                    "push is stable for every multiplier they draw (docs/model.md section 7). Corrections keep "
                    "the box. Not with --plan.")
-@click.option("--trials", default=100, show_default=True, type=click.IntRange(min=1, max=1_000_000),
+@click.option("--trials", default=100, show_default=True, type=Whole(min=1, max=1_000_000),
               help="Number of trials (worlds); with --target, the most to run.")
 @click.option("--target", "target", default=None, type=Finite(min=0, max=1, min_open=True, max_open=True),
               metavar="RATE", help="Decide whether the plan lands at least RATE of the time (e.g. 0.99), and stop "
@@ -49,7 +50,7 @@ from stablepush_cli.options import (
 @click.option("--confidence", default=0.95, show_default=True, type=Finite(min=0.5, max=1, min_open=True,
                                                                                  max_open=True),
               metavar="C", help="With --target: the decision's confidence.")
-@click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
+@click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
               help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and outcomes, "
                    "serially, on workers or on Ray.")
 @click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
@@ -70,7 +71,7 @@ from stablepush_cli.options import (
 @click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None, metavar="MM DEG",
               help="A trial lands when the object comes to rest within MM (x and z) and DEG of the goal in the "
                    "grasp, as `execute` judges a run (default: the task's planner.tolerance).")
-@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
               help="Run the trials on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
               callback=parse_ray_address,

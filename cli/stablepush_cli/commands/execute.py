@@ -22,6 +22,7 @@ from stablepush_cli.common import (
 )
 from stablepush_cli.options import (
     Finite,
+    Whole,
     parse_host_port,
     stamp_option,
     video_options,
@@ -46,7 +47,7 @@ from stablepush_cli.options import (
                                  "last the task's dynamics.step_time (slower than the model when HZ does not divide "
                                  "it); the last push of each contact eases to rest, up to 4/3 of the planned "
                                  "speed on the way (docs/execution.md).")
-@click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
+@click.option("--resume-from", "resume_from", default=0, type=Whole(min=0), metavar="STEP",
               help="Continue after plan step STEP (the last confirmed step a fault reported). A `stablepush sim-arm` "
                    "server then keeps the world it has; --sim starts a fresh one, the object where step STEP "
                    "leaves it.")
