@@ -423,3 +423,22 @@ def test_numbers_in_other_scripts_digits_are_refused_naming_the_option(args, opt
     result = CliRunner().invoke(cli, args)
     assert result.exit_code == 2, result.output
     assert f"Invalid value for '{option}" in result.output
+
+
+def test_the_library_writes_no_output_over_a_task_or_mesh_file_it_read(tmp_path):
+    """`sp.save_plan(plan, "x.json", "t.yaml")` wrote a CSV over the task file: the CLI refused
+    that, the library did not."""
+    (tmp_path / "tasks").mkdir()
+    (tmp_path / "meshes").mkdir()
+    task_file = tmp_path / "tasks" / "t.yaml"
+    mesh_file = tmp_path / "meshes" / "l-bracket.stl"
+    task_file.write_text((TASKS / "more" / "l-bracket-mesh.yaml").read_text().replace("../../meshes", "../meshes"))
+    mesh_file.write_bytes((TASKS.parent / "meshes" / "l-bracket.stl").read_bytes())
+    before = task_file.read_bytes(), mesh_file.read_bytes()
+    task = sp.load_task(str(task_file))
+    plan = sp.plan_task(task, time_limit=0.5)
+    for json_path, csv_path in ((tmp_path / "x.json", task_file), (task_file, None), (tmp_path / "x.json", mesh_file)):
+        with pytest.raises(OutputError, match="this process read; refusing to write over it"):
+            sp.save_plan(plan, str(json_path), None if csv_path is None else str(csv_path))
+    assert (task_file.read_bytes(), mesh_file.read_bytes()) == before and not (tmp_path / "x.json").exists()
+    sp.save_plan(plan, str(tmp_path / "x.json"), str(tmp_path / "x.csv"))  # other files are written as ever

@@ -9,11 +9,25 @@ import signal
 import stat
 import threading
 from pathlib import Path
-from typing import Mapping, Optional, Union
+from typing import Dict, Mapping, Optional, Tuple, Union
 
 from stablepush.errors import OutputError
 
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")  # what a figure is written as, by the file name's ending
+# The files this process has read a task from (task files and their meshes): file identity -> what
+# it is. write_files never replaces one, whoever asks (sp.save_plan(plan, "x.json", "t.yaml") wrote
+# a CSV over the task file; the CLI's own check of its inputs was not in the library).
+_INPUTS: Dict[Tuple[int, int], str] = {}
+
+
+def protect_input(path: Union[str, Path], what: str) -> None:
+    """Remember that `path` (as it is now) is an input, `what` says which ("the task file"), so
+    that no output of this process replaces it."""
+    try:
+        info = os.stat(path)
+    except OSError:
+        return
+    _INPUTS[(info.st_dev, info.st_ino)] = what
 
 
 def default_output(input_file: Union[str, Path], suffix: str) -> str:
@@ -42,9 +56,10 @@ def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
         _write_and_rename(plan)
 
 
-def _writable(path: Union[str, Path]):
+def _writable(path: Union[str, Path], inputs_read: bool = True):
     """(target, "stream" or "replace", the replaced file's permissions or None) for an output path,
-    by write_files' rules; OutputError naming the path where it would refuse."""
+    by write_files' rules; OutputError naming the path where it would refuse (`inputs_read`: also
+    where it is an input this process read, protect_input)."""
     fault = _not_a_file_name(path)
     if fault is not None:
         raise OutputError(f"{str(path)!r}: {fault}", output=path)
@@ -59,6 +74,9 @@ def _writable(path: Union[str, Path]):
     target = Path(os.path.realpath(path))
     if mode is not None and not stat.S_ISREG(mode):
         raise OutputError(f"{path}: not a regular file; refusing to replace it", output=path)
+    read = _INPUTS.get(_identity(path)) if mode is not None and inputs_read else None
+    if read is not None:
+        raise OutputError(f"{path}: {_read_input(read)}", output=path)
     if not target.parent.is_dir():
         raise OutputError(f"{path}: the directory {target.parent} does not exist", output=path)
     if not os.access(target.parent, os.W_OK | os.X_OK):  # a new file is made in it, then renamed
@@ -96,7 +114,7 @@ def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
         if path is None:
             continue
         try:
-            _, how, _ = _writable(path)
+            _, how, _ = _writable(path, inputs_read=False)  # the inputs named here are said so first
         except OutputError as exc:
             raise OutputError(f"{name} {exc}") from None
         if how == "stream":
@@ -104,7 +122,13 @@ def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
         key = _identity(path)
         if key in seen:
             raise OutputError(f"{name} {path}: is {seen[key]}")
+        if key in _INPUTS:
+            raise OutputError(f"{name} {path}: {_read_input(_INPUTS[key])}")
         seen[key] = f"also the output of {name}; give each output a file of its own"
+
+
+def _read_input(what: str) -> str:
+    return f"is {what} this process read; refusing to write over it"
 
 
 def require_suffix(name: str, path: Optional[Union[str, Path]], suffixes) -> None:
