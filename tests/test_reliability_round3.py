@@ -442,3 +442,18 @@ def test_the_library_writes_no_output_over_a_task_or_mesh_file_it_read(tmp_path)
             sp.save_plan(plan, str(json_path), None if csv_path is None else str(csv_path))
     assert (task_file.read_bytes(), mesh_file.read_bytes()) == before and not (tmp_path / "x.json").exists()
     sp.save_plan(plan, str(tmp_path / "x.json"), str(tmp_path / "x.csv"))  # other files are written as ever
+
+
+# -- found by tests/test_fuzz_options.py -----------------------------------------------------------
+
+def test_an_ack_timeout_no_socket_can_wait_is_refused_naming_the_option(high_mu_plan):
+    """`execute --arm HOST:PORT --ack-timeout 1e308` was an internal error: a socket's timeout past
+    about 1e10 s overflows the platform's time_t."""
+    from stablepush.execution import TcpArm
+
+    result = CliRunner().invoke(cli, ["execute", str(high_mu_plan), "--task", str(HIGH_MU), "--arm", "127.0.0.1:1",
+                                      "--ack-timeout", "1e308"])
+    assert result.exit_code == 2 and "Invalid value for '--ack-timeout'" in result.output, result.output
+    for timeout in (1e308, 0.0, float("nan"), "5"):
+        with pytest.raises(SettingError, match="ack_timeout"):
+            TcpArm("127.0.0.1", 1, timeout)

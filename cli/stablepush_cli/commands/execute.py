@@ -8,7 +8,7 @@ import click
 
 from stablepush.errors import SettingError
 from stablepush.execution.protocol import DEFAULT_PORT
-from stablepush.execution.tcp_arm import DEFAULT_ACK_TIMEOUT
+from stablepush.execution.tcp_arm import ACK_TIMEOUT_RANGE, DEFAULT_ACK_TIMEOUT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush_cli.common import (
     EXIT_ARM_FAULT,
@@ -53,7 +53,8 @@ from stablepush_cli.options import (
                    "leaves it.")
 @click.option("--pace/--no-pace", default=None,
               help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
-@click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True, type=Finite(min=0.01), metavar="S",
+@click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True, type=Finite(*ACK_TIMEOUT_RANGE),
+              metavar="S",
               help="Give up when the arm server does not reply within S seconds (not with --sim: the simulated "
                    "arm runs in this process, and a waypoint takes as long as it takes).")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
