@@ -457,3 +457,16 @@ def test_an_ack_timeout_no_socket_can_wait_is_refused_naming_the_option(high_mu_
     for timeout in (1e308, 0.0, float("nan"), "5"):
         with pytest.raises(SettingError, match="ack_timeout"):
             TcpArm("127.0.0.1", 1, timeout)
+
+
+@pytest.mark.parametrize("option, values", [("--feature-error", ["0.9", "1e308"]), ("--feature-error", ["1e5", "0"]),
+                                            ("--tracker-noise", ["0", "4000"])])
+def test_spreads_past_the_task_files_bounds_are_refused_naming_the_option(high_mu_plan, monkeypatch, option, values):
+    """`evaluate --feature-error 0.9 1e308` overflowed numpy's uniform draw in every trial: exit 4."""
+    monkeypatch.setattr(batch_mod, "run_plan", lambda *a, **k: pytest.fail("a trial ran"))
+    result = CliRunner().invoke(cli, ["evaluate", str(HIGH_MU), "--plan", str(high_mu_plan), "--trials", "2",
+                                      "--workers", "1", "--no-guard", option, *values, "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert result.output.startswith(f"error: {option}: must be 2 numbers, not negative, at most 10000 mm and 3600 deg")
+    with pytest.raises(SettingError):
+        Spreads(feature_error=(0.0,))

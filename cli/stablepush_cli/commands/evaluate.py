@@ -187,7 +187,9 @@ def _study(task_file: str, plan_file, robust: bool, vary, feature_error, tracker
         task = load_task_file(task_file)
     try:
         spreads = Spreads.for_task(task, vary, feature_error, tracker_noise)
-    except ValueError as exc:  # only --vary can be refused here, and Spreads names it `vary`
+    except SettingError as exc:  # --feature-error or --tracker-noise past its bound
+        fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
+    except ValueError as exc:  # --vary, which Spreads names `vary`
         fail(f"--{exc}")
     if not plan_file:
         task, plan = _plan_for(task, spreads, robust)
