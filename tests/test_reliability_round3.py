@@ -59,6 +59,10 @@ def test_evaluate_refuses_such_a_noise_before_any_trial(high_mu_plan, monkeypatc
                                       "--workers", "1", "--tracker-noise", "0.5", "0", "--quiet"])
     assert result.exit_code == 2, result.output
     assert "error: --tracker-noise:" in result.output
+    monkeypatch.setattr(sp.plan, "plan_task", lambda *a, **k: pytest.fail("a plan was searched for"))
+    result = CliRunner().invoke(cli, ["evaluate", str(HIGH_MU), "--trials", "2", "--tracker-noise", "0", "0.2",
+                                      "--quiet"])
+    assert result.exit_code == 2 and "error: --tracker-noise:" in result.output, result.output
 
 
 def test_the_guard_takes_every_noise_up_to_its_limit_and_the_api_refuses_past_it_by_field():

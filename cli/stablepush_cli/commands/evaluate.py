@@ -135,6 +135,13 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     say = say_beside(json_path, csv_path, png_path)
 
     runner = runner_for(workers, ray_address, default=default_workers())
+    if guarded:  # before a plan is searched for; Batch refuses it as well
+        from stablepush.execution import GuardedApproach
+
+        try:
+            GuardedApproach.for_tracker_noise(*tracker_noise)
+        except SettingError as exc:
+            fail(f"--tracker-noise: {exc.reason}")
     task, plan, spreads = _study(task_file, plan_file, robust, vary, feature_error, tracker_noise)
     if video_dir:
         from stablepush.sim.video import video_directory
