@@ -128,12 +128,12 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
     if kind == "hello" and not RATE_HZ[0] <= message["rate_hz"] <= RATE_HZ[1]:
         raise ProtocolError(f"hello: rate_hz must be between {RATE_HZ[0]:g} and {RATE_HZ[1]:g}, "
                             f"got {message['rate_hz']}")
-    if kind == "hello":
-        check_scene(message["scene"])
     if "state" in fields[kind]:
         check_state(message["state"], kind)
     if kind in ("hello", "ready") and message["protocol"] not in SUPPORTED_PROTOCOLS:
         raise ProtocolError(f"{kind}: protocol {message['protocol']!r} is not one of {', '.join(SUPPORTED_PROTOCOLS)}")
+    if kind == "hello":  # after its version: a hello of another protocol may describe its world otherwise
+        check_scene(message["scene"])
     return message
 
 
