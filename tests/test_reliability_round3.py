@@ -474,3 +474,21 @@ def test_spreads_past_the_task_files_bounds_are_refused_naming_the_option(high_m
     assert result.output.startswith(f"error: {option}: must be 2 numbers, not negative, at most 10000 mm and 3600 deg")
     with pytest.raises(SettingError):
         Spreads(feature_error=(0.0,))
+
+
+def test_the_evaluation_figure_draws_a_study_of_crashes_and_of_one_world():
+    """A study whose every trial crashed has no rate (None) and no interval, and a study of one world
+    no interval: the figure's title unpacked both."""
+    from stablepush.viz.figures import evaluation_figure
+
+    task = shipped("horizontal-offset-high-mu")
+    batch = batch_mod.Batch(task=task, plan=sp.plan_task(task), spreads=Spreads(vary={"pad_mu": 0.1}))
+    crashed = [{"trial": i, "world": batch.world(i).as_dict(), **batch_mod._not_run("crash", "RuntimeError: x"),
+                "wall_s": 0.0} for i in range(2)]
+    evaluation = batch_mod.Evaluation(batch=batch, trials=crashed, wall_s=1.0, runner="this process", requested=2)
+    figure = evaluation_figure(evaluation.summary(), crashed)
+    assert figure.axes[0].get_title().endswith("all 2 trials crashed")
+    one = dataclasses.replace(batch, spreads=Spreads())
+    landed = [{**crashed[0], "cause": None, "success": True, "error": None}]
+    summary = batch_mod.Evaluation(batch=one, trials=landed, wall_s=1.0, runner="this process", requested=1).summary()
+    assert "1/1 landed (100.0%)" in evaluation_figure(summary, landed).axes[0].get_title()
