@@ -10,7 +10,7 @@ from pathlib import Path
 
 import click
 
-from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, TaskError
+from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, SettingError, TaskError
 from stablepush.extras import MissingExtra
 from stablepush.task import load_task
 
@@ -26,6 +26,7 @@ EXIT_STATUS = (
     (PlanError, EXIT_BAD_INPUT),
     (OutputError, EXIT_BAD_INPUT),
     (RunnerError, EXIT_BAD_INPUT),
+    (SettingError, EXIT_BAD_INPUT),
     (MissingExtra, EXIT_BAD_INPUT),  # an optional part of the package that the command needs
     (ArmFault, EXIT_ARM_FAULT),
 )

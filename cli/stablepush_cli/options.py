@@ -17,22 +17,48 @@ from stablepush_cli.common import (
 )
 
 
+def ascii_number(text: str) -> bool:
+    """Whether `text` is written in ASCII: Python's float() and int() read any script's digits
+    ("٣" is 3, "３" too), which a command line should not take for a number."""
+    return text.isascii()
+
+
 class Finite(click.FloatRange):
     """A number in a range that is also finite: click's FloatRange compares with < and >, which
-    nan passes, and an unbounded side lets inf through."""
+    nan passes, and an unbounded side lets inf through. Written in ASCII digits (ascii_number)."""
 
     name = "finite float range"
 
     def convert(self, value, param, ctx):
+        if isinstance(value, str) and not ascii_number(value):
+            self.fail(f"{value!r} is not a number written in ASCII digits.", param, ctx)
         number = super().convert(value, param, ctx)
         if not math.isfinite(number):
             self.fail(f"{value!r} is not a finite number.", param, ctx)
         return number
 
 
+class Real(click.types.FloatParamType):
+    """click's float, written in ASCII digits (ascii_number); nan and inf are the library's to refuse."""
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str) and not ascii_number(value):
+            self.fail(f"{value!r} is not a number written in ASCII digits.", param, ctx)
+        return super().convert(value, param, ctx)
+
+
+class Whole(click.IntRange):
+    """click's IntRange, written in ASCII digits (ascii_number)."""
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, str) and not ascii_number(value):
+            self.fail(f"{value!r} is not a whole number written in ASCII digits.", param, ctx)
+        return super().convert(value, param, ctx)
+
+
 # The planner's own ranges, so that a value out of them is refused naming the option, before any work.
-SEED = click.IntRange(0, int(PLANNER_PARAMETER_RANGES["seed"][2]))
-MAX_SWITCHES = click.IntRange(0, int(PLANNER_PARAMETER_RANGES["max_switches"][2]))
+SEED = Whole(0, int(PLANNER_PARAMETER_RANGES["seed"][2]))
+MAX_SWITCHES = Whole(0, int(PLANNER_PARAMETER_RANGES["max_switches"][2]))
 TIME_LIMIT = Finite(*LIMITS["time_limit"])
 
 
@@ -70,7 +96,7 @@ def stamp_option(which: str, default: str):
 def parse_video_size(_ctx, _param, value: str):
     """--video-size WxH as (width, height) pixels (the library checks the numbers)."""
     width, sep, height = value.lower().partition("x")
-    if not sep or not width.strip().isdigit() or not height.strip().isdigit():
+    if not sep or not ascii_number(value) or not width.strip().isdigit() or not height.strip().isdigit():
         raise click.BadParameter(f"expected WIDTHxHEIGHT in pixels (e.g. 640x480), got {value!r}")
     return int(width), int(height)
 
@@ -149,7 +175,7 @@ def parse_host_port(_ctx, _param, value):
     if value is None:
         return None
     host, sep, port = value.rpartition(":")
-    if not sep or not port.isdigit() or not 0 < int(port) < 65536:
+    if not sep or not ascii_number(port) or not port.isdigit() or not 0 < int(port) < 65536:
         raise click.BadParameter(f"expected HOST:PORT with a port from 1 to 65535, got {value!r}")
     return host or "127.0.0.1", int(port)
 
@@ -165,6 +191,8 @@ def parse_vary(_ctx, _param, values):
     for value in values:
         key, sep, fraction = value.partition("=")
         try:
+            if not ascii_number(fraction):
+                raise ValueError(fraction)
             out[key.strip()] = float(fraction)
         except ValueError:
             sep = ""
@@ -185,6 +213,8 @@ def parse_axis(_ctx, param, value):
     low, high = ANGLE if param.name == "theta_axis" else COORDINATE
     parts = value.split(":")
     try:
+        if not ascii_number(value):
+            raise ValueError(value)
         start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
         if len(parts) != 3 or not 1 <= count <= MAX_AXIS or not (low <= start <= high and low <= stop <= high):
             raise ValueError

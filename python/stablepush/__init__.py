@@ -12,13 +12,13 @@
 Units at this level are the task file's: mm, degrees, grams, newtons; a Trajectory's are the arm's,
 SI in the world frame. `stablepush.plan` is the planning subpackage (search, plan files, checks,
 reach maps). Every error raised on purpose is a `StablepushError` (TaskError, PlanError,
-OutputError, ArmFault, RunnerError).
+OutputError, ArmFault, RunnerError, SettingError).
 
 The package's layers, each importing only those below it (docs/architecture.md):
 `sim`, `viz` > `execution` > `plan` > `task` > `units`, `frames`, `errors`, `outputs`, `_core`.
 """
 from stablepush._core import ContactCase, PushResult
-from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, StablepushError, TaskError
+from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, SettingError, StablepushError, TaskError
 from stablepush.plan import Plan, PlanOutcome, PusherContact, Waypoint, check_plan, load_plan, plan_task
 from stablepush.plan import write_plan as save_plan
 from stablepush.task import Cell, PlannerSettings, PusherSpec, Robot, Task, load_task, parse_task
@@ -28,7 +28,7 @@ __version__ = "0.1.0"
 __all__ = ["load_task", "parse_task", "plan_task", "check", "check_plan", "save_plan", "load_plan", "trajectory",
            "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PlannerSettings", "PusherSpec", "Cell", "Robot",
            "Trajectory", "StablepushError", "TaskError", "PlanError", "OutputError", "ArmFault", "RunnerError",
-           "ContactCase", "PlanOutcome", "PushResult", "joint_path"]
+           "SettingError", "ContactCase", "PlanOutcome", "PushResult", "joint_path"]
 
 
 # Loaded when first used, so that `import stablepush` (and the CLI's start-up) does not pay for

@@ -33,6 +33,12 @@ class PlanError(_FieldError):
     """A plan file that is not a valid plan, or a plan that does not belong to the task."""
 
 
+class SettingError(_FieldError):
+    """A setting of a run or a study that cannot be used: a command's option or an argument of the
+    API (the tracker's noise beyond what the guarded approach can tell a touch from, say), named by
+    its field."""
+
+
 class OutputError(StablepushError, OSError):
     """An output file that cannot, or must not, be written (the path is in the message). `output`:
     the path as the caller gave it, when writing it failed (a full disk, /dev/full), so that a

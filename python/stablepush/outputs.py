@@ -9,11 +9,25 @@ import signal
 import stat
 import threading
 from pathlib import Path
-from typing import Mapping, Optional, Union
+from typing import Dict, Mapping, Optional, Tuple, Union
 
 from stablepush.errors import OutputError
 
 FIGURE_SUFFIXES = (".png", ".pdf", ".svg")  # what a figure is written as, by the file name's ending
+# The files this process has read a task from (task files and their meshes): file identity -> what
+# it is. write_files never replaces one, whoever asks (sp.save_plan(plan, "x.json", "t.yaml") wrote
+# a CSV over the task file; the CLI's own check of its inputs was not in the library).
+_INPUTS: Dict[Tuple[int, int], str] = {}
+
+
+def protect_input(path: Union[str, Path], what: str) -> None:
+    """Remember that `path` (as it is now) is an input, `what` says which ("the task file"), so
+    that no output of this process replaces it."""
+    try:
+        info = os.stat(path)
+    except OSError:
+        return
+    _INPUTS[(info.st_dev, info.st_ino)] = what
 
 
 def default_output(input_file: Union[str, Path], suffix: str) -> str:
@@ -42,9 +56,13 @@ def write_files(files: Mapping[Union[str, Path], Union[str, bytes]]) -> None:
         _write_and_rename(plan)
 
 
-def _writable(path: Union[str, Path]):
+def _writable(path: Union[str, Path], inputs_read: bool = True):
     """(target, "stream" or "replace", the replaced file's permissions or None) for an output path,
-    by write_files' rules; OutputError naming the path where it would refuse."""
+    by write_files' rules; OutputError naming the path where it would refuse (`inputs_read`: also
+    where it is an input this process read, protect_input)."""
+    fault = _not_a_file_name(path)
+    if fault is not None:
+        raise OutputError(f"{str(path)!r}: {fault}", output=path)
     try:  # the path as given: /dev/stdout into a pipe resolves to no file name, but stats as the pipe
         mode = os.stat(path).st_mode
     except FileNotFoundError:
@@ -56,11 +74,30 @@ def _writable(path: Union[str, Path]):
     target = Path(os.path.realpath(path))
     if mode is not None and not stat.S_ISREG(mode):
         raise OutputError(f"{path}: not a regular file; refusing to replace it", output=path)
+    read = _INPUTS.get(_identity(path)) if mode is not None and inputs_read else None
+    if read is not None:
+        raise OutputError(f"{path}: {_read_input(read)}", output=path)
     if not target.parent.is_dir():
         raise OutputError(f"{path}: the directory {target.parent} does not exist", output=path)
     if not os.access(target.parent, os.W_OK | os.X_OK):  # a new file is made in it, then renamed
         raise OutputError(f"{path}: the directory {target.parent} is not writable", output=path)
     return target, "replace", stat.S_IMODE(mode) if mode is not None else None
+
+
+def _not_a_file_name(path: Union[str, Path]) -> Optional[str]:
+    """Why `path`, as given, names no file to write, or None. A name that ends in a slash (or in
+    `.` or `..`) names a directory: `out.json/` was written as the file out.json, and said so; an
+    empty name was taken as no output at all, and nothing was written."""
+    text = os.fsdecode(os.fspath(path)) if isinstance(path, (str, bytes, os.PathLike)) else None
+    if text is None:
+        return f"an output is a path, not {type(path).__name__}"
+    if not text:
+        return "an empty file name; name the file to write"
+    if text.endswith(os.sep) or (os.altsep and text.endswith(os.altsep)):
+        return f"ends in {text[-1]!r}, so it names a directory; name the file to write (without the {text[-1]})"
+    if os.path.basename(text) in (".", ".."):
+        return "names a directory; name the file to write"
+    return None
 
 
 def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
@@ -77,7 +114,7 @@ def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
         if path is None:
             continue
         try:
-            _, how, _ = _writable(path)
+            _, how, _ = _writable(path, inputs_read=False)  # the inputs named here are said so first
         except OutputError as exc:
             raise OutputError(f"{name} {exc}") from None
         if how == "stream":
@@ -85,7 +122,13 @@ def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
         key = _identity(path)
         if key in seen:
             raise OutputError(f"{name} {path}: is {seen[key]}")
+        if key in _INPUTS:
+            raise OutputError(f"{name} {path}: {_read_input(_INPUTS[key])}")
         seen[key] = f"also the output of {name}; give each output a file of its own"
+
+
+def _read_input(what: str) -> str:
+    return f"is {what} this process read; refusing to write over it"
 
 
 def require_suffix(name: str, path: Optional[Union[str, Path]], suffixes) -> None:
@@ -107,6 +150,12 @@ def require_suffix(name: str, path: Optional[Union[str, Path]], suffixes) -> Non
 def same_file(a: Union[str, Path], b: Union[str, Path]) -> bool:
     """Whether two paths name one file (as check_outputs tells them: hard links and symlinks too)."""
     return _identity(a) == _identity(b)
+
+
+def check_output(path: Union[str, Path]) -> None:
+    """OutputError naming `path` unless write_files could write it (for a writer of its own, such as
+    a bag's, which renames a file made elsewhere into place)."""
+    _writable(path)
 
 
 def is_stream(path: Union[str, Path]) -> bool:

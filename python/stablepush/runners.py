@@ -9,6 +9,7 @@ Results arrive as they finish, as (i, result); a job whose worker died arrives a
 """
 from __future__ import annotations
 
+import contextlib
 import os
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
@@ -20,6 +21,9 @@ from stablepush.extras import require
 Job = Callable[[Any, int], Any]
 # How long joining a Ray cluster may wait for its head to answer: Ray itself retries for minutes.
 RAY_CONNECT_TIMEOUT_S = 5.0
+# Local worker processes per CPU at most: each job keeps a CPU busy (a simulation, a search), so
+# more only share the CPUs (and each costs a process's memory); `--workers 1000` started 1,000.
+WORKERS_PER_CPU = 2
 
 
 def check_ray_address(address: Optional[str]) -> Optional[str]:
@@ -29,7 +33,7 @@ def check_ray_address(address: Optional[str]) -> Optional[str]:
     if address is None or address in ("auto", "local"):
         return address
     host, port = _host_port(address)
-    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+    if not host or not (port.isascii() and port.isdigit()) or not 0 < int(port) < 65536:  # "٦٣٧٩" is no port
         raise ValueError(f"expected HOST:PORT of a running Ray head (e.g. 10.0.0.5:6379, or ray://HOST:10001), "
                          f"'auto' or 'local'; got {address!r}")
     return address
@@ -51,17 +55,31 @@ class Runner:
     ray_address: Optional[str] = None
 
     def __post_init__(self):
+        if isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1:
+            raise ValueError(f"workers must be a whole number from 1, got {self.workers!r:.40}")
         check_ray_address(self.ray_address)
 
-    def describe(self) -> str:
+    def processes(self, jobs: int) -> int:
+        """How many local processes a batch of `jobs` runs on: `workers`, but no more than the jobs
+        nor than max_workers()."""
+        return max(1, min(self.workers, jobs, max_workers()))
+
+    def describe(self, jobs: Optional[int] = None) -> str:
+        """Where the jobs run, in words; with `jobs`, the processes a batch of them runs on."""
         if self.ray:
             return f"Ray ({self.ray_address or 'local instance'})"
-        return "this process" if self.workers <= 1 else f"{self.workers} local processes"
+        workers = self.processes(self.workers if jobs is None else jobs)
+        return "this process" if workers <= 1 else f"{workers} local processes"
 
 
 def default_workers() -> int:
     """The machine's CPU count."""
     return max(1, os.cpu_count() or 1)
+
+
+def max_workers() -> int:
+    """The most local worker processes a batch starts: WORKERS_PER_CPU per CPU."""
+    return WORKERS_PER_CPU * default_workers()
 
 
 @dataclass(frozen=True)
@@ -77,8 +95,9 @@ def run_all(job: Job, shared: Any, indices: Iterable[int], runner: Runner) -> It
     indices = list(indices)
     if runner.ray:
         return _ray(job, shared, indices, runner.ray_address)
-    if runner.workers > 1 and len(indices) > 1:
-        return _processes(job, shared, indices, runner.workers)
+    workers = runner.processes(len(indices))
+    if workers > 1:
+        return _processes(job, shared, indices, workers)
     return ((i, job(shared, i)) for i in indices)
 
 
@@ -155,9 +174,16 @@ def probe_ray_head(address: Optional[str]) -> None:
 
 
 def _join_ray(ray, address: Optional[str]) -> None:
-    """ray.init, with a head that does not answer (or an address Ray refuses) a RunnerError at once."""
+    """ray.init, with a head that does not answer (or an address Ray refuses) a RunnerError at once,
+    and any other failure to start or join it a RunnerError too, naming the address: a local
+    instance on a loaded machine times out with a bare Exception ("The current node timed out
+    during startup", after Ray's own 30 s), which was an internal error."""
     probe_ray_head(address)
     try:
         ray.init(address=address, include_dashboard=False, logging_level="ERROR", log_to_driver=False)
-    except (ConnectionError, ValueError) as exc:
-        raise RunnerError(f"cannot join Ray at {address or 'a local instance'}: {exc}") from None
+    except Exception as exc:  # noqa: BLE001 - Ray raises bare Exceptions; whatever it is, Ray did not start
+        with contextlib.suppress(Exception):  # noqa: BLE001 - what it did start, it stops
+            ray.shutdown()
+        text = " ".join(str(exc).split())[:300] or type(exc).__name__
+        where, option = (f"Ray at {address}", f"--ray {address}") if address else ("a local Ray instance", "--ray")
+        raise RunnerError(f"cannot start or join {where} ({option}): {text}") from None

@@ -15,6 +15,7 @@ from stablepush_cli.options import (
     SEED,
     TIME_LIMIT,
     Finite,
+    Whole,
     parse_ray_address,
 )
 
@@ -26,7 +27,7 @@ from stablepush_cli.options import (
     "--trials",
     default=10,
     show_default=True,
-    type=click.IntRange(min=1),
+    type=Whole(min=1),
     help="Planning runs per task (seeds seed, seed+1, ...).",
 )
 @click.option("--seed", default=1, show_default=True, type=SEED, help="First seed.")
@@ -35,13 +36,13 @@ from stablepush_cli.options import (
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), default=None,
               help="Also write every trial to this file: .csv (one row per trial) or .json (trials and summary).")
 @click.option(
-    "-n", "--count", default=200_000, show_default=True, type=click.IntRange(min=1, max=10**9),
+    "-n", "--count", default=200_000, show_default=True, type=Whole(min=1, max=10**9),
     help="With --checks: checks per contact case and task (timed in batches of up to 2,000).",
 )
 @click.option("--improve-for", type=Finite(min=0), default=None, metavar="S",
               help="Anytime planning: keep improving S seconds after the first plan (planner.improve_for), "
                    "and report the first and the improved plans.")
-@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
               help="Run the planning trials on K local processes (default: one after the other, here). "
                    "Times are each search's own, so they compare across runners; parallel runs share the CPUs.")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",

@@ -12,14 +12,15 @@ from stablepush_cli.common import (
 )
 from stablepush_cli.options import (
     Finite,
+    Real,
 )
 
 
 @click.command()
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
-@click.option("--at", "at", nargs=3, type=float, default=None, metavar="X Z TH",
+@click.option("--at", "at", nargs=3, type=Real(), default=None, metavar="X Z TH",
               help="Object pose in the grasp: x mm, z mm, theta deg. Default: the task's start.")
-@click.option("--move", nargs=3, type=float, default=None, metavar="DX DZ DTH",
+@click.option("--move", nargs=3, type=Real(), default=None, metavar="DX DZ DTH",
               help="Unit motion of the object over one step: dx mm, dz mm, dtheta deg.")
 @click.option("--directions", is_flag=True,
               help="Instead of --move: every direction in which a pusher can push the object one unit step "

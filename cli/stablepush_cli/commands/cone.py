@@ -31,8 +31,8 @@ def cone(task_file: str, pusher: str, png_path) -> None:
 
     task = load_task_file(task_file)
     task.pusher_index(pusher)
-    png_label = "-o" if png_path else "the default -o"
-    png_path = png_path or default_output(task_file, f".{pusher}.cone.png")
+    png_label = "-o" if png_path is not None else "the default -o"
+    png_path = png_path if png_path is not None else default_output(task_file, f".{pusher}.cone.png")
     require_suffix(png_label, png_path, FIGURE_SUFFIXES)
     check_named_outputs({png_label: png_path}, {"TASK.yaml": task_file})
     figures.save_figure(figures.cone_figure(task, pusher), png_path)

@@ -7,10 +7,11 @@ import sys
 
 import click
 
-from stablepush.errors import OutputError
+from stablepush.errors import OutputError, SettingError
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import with_robot
 from stablepush_cli.common import (
+    EXIT_INTERNAL,
     EXIT_NOT_SOLVED,
     check_named_outputs,
     fail,
@@ -23,6 +24,7 @@ from stablepush_cli.common import (
 )
 from stablepush_cli.options import (
     Finite,
+    Whole,
     check_video,
     parse_ray_address,
     parse_vary,
@@ -40,7 +42,7 @@ from stablepush_cli.options import (
               help="Plan robust to the worlds: the task's uncertainty box widened to the --vary spreads, so every "
                    "push is stable for every multiplier they draw (docs/model.md section 7). Corrections keep "
                    "the box. Not with --plan.")
-@click.option("--trials", default=100, show_default=True, type=click.IntRange(min=1, max=1_000_000),
+@click.option("--trials", default=100, show_default=True, type=Whole(min=1, max=1_000_000),
               help="Number of trials (worlds); with --target, the most to run.")
 @click.option("--target", "target", default=None, type=Finite(min=0, max=1, min_open=True, max_open=True),
               metavar="RATE", help="Decide whether the plan lands at least RATE of the time (e.g. 0.99), and stop "
@@ -50,7 +52,7 @@ from stablepush_cli.options import (
 @click.option("--confidence", default=0.95, show_default=True, type=Finite(min=0.5, max=1, min_open=True,
                                                                                  max_open=True),
               metavar="C", help="With --target: the decision's confidence.")
-@click.option("--seed", default=1, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
+@click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
               help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and outcomes, "
                    "serially, on workers or on Ray.")
 @click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
@@ -71,7 +73,7 @@ from stablepush_cli.options import (
 @click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None, metavar="MM DEG",
               help="A trial lands when the object comes to rest within MM (x and z) and DEG of the goal in the "
                    "grasp, as `execute` judges a run (default: the task's planner.tolerance).")
-@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
               help="Run the trials on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
               callback=parse_ray_address,
@@ -102,11 +104,13 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     to rest after the release within the task's tolerance of the goal (or --success-tolerance).
     The summary gives the success rate with its Wilson 95% interval, the goal error's percentiles
     and the causes of the misses. Spreads that vary nothing make one world: one trial runs, and no
-    interval is given. A trial that crashes is recorded (cause `crash`) and the batch goes on;
-    Ctrl-C stops it and keeps the trials done.
+    interval is given. A trial that crashes (an internal error) is recorded (cause `crash`), left
+    out of the rate, and the batch goes on, to exit 4; Ctrl-C stops it and keeps the trials done.
 
     \b
-    Exit status: 0 done (whatever the success rate), 1 no plan found, 2 bad input, 130 stopped by
+    Exit status: 0 done (whatever the success rate), 1 no plan found, 2 bad input (a --tracker-noise
+    the guard cannot tell a touch from: at most 0.125 mm and 0.125 deg, or --no-guard), 4 a trial
+    crashed (the trials are summarized and written, each crash with its error), 130 stopped by
     Ctrl-C (the trials done are summarized and written).
 
     \b
@@ -134,6 +138,13 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     say = say_beside(json_path, csv_path, png_path)
 
     runner = runner_for(workers, ray_address, default=default_workers())
+    if guarded:  # before a plan is searched for; Batch refuses it as well
+        from stablepush.execution import GuardedApproach
+
+        try:
+            GuardedApproach.for_tracker_noise(*tracker_noise)
+        except SettingError as exc:
+            fail(f"--tracker-noise: {exc.reason}")
     task, plan, spreads = _study(task_file, plan_file, robust, vary, feature_error, tracker_noise)
     task = with_robot(task, robot_model, flange, tcp, base)
     if video_dir:
@@ -143,9 +154,12 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
             video_dir = video_directory(video_dir)
         except OutputError as exc:
             fail(f"--video-failed {exc}")
-    batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
-                  engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video_fps,
-                  video_size=tuple(video_size))
+    try:
+        batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
+                      engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video_fps,
+                      video_size=tuple(video_size))
+    except SettingError as exc:  # the tracker's noise, past what the guard can tell a touch from
+        fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
     for warning in batch.warnings():
         click.echo(f"warning: {warning}", err=True)
     trials = spreads.trials_to_run(trials)  # as evaluate() runs them: the bar and the header say so too
@@ -154,7 +168,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         click.echo(f"{task.name}: {spreads.describe()}", err=True)
         click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop"
                    f"{'' if guarded else ', approaches not guarded'} on {engine}, "
-                   f"on {runner.describe()}" + (f"; the plan is robust to {box}" if box else ""), err=True)
+                   f"on {runner.describe(trials)}" + (f"; the plan is robust to {box}" if box else ""), err=True)
     with _trials_bar(quiet, trials) as progress:
         result = run_evaluation(batch, trials, runner, progress, test=test)
     write_evaluation(result, json_path, csv_path, png_path)
@@ -164,6 +178,10 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         sys.exit(130 if s["interrupted"] else EXIT_NOT_SOLVED)
     for line in result.describe(written=[p for p in (json_path, csv_path, png_path) if p]):
         say(line)
+    if s["crashed"]:  # internal errors: no rate stands for the trials asked for
+        click.echo(f"error: {s['crashed']} of {s['trials']} trials crashed (internal errors, a bug; each trial's "
+                   f"error is in its record): the success rate is over the {s['judged']} that did not", err=True)
+        sys.exit(EXIT_INTERNAL)
     if s["interrupted"]:
         sys.exit(130)
 
@@ -180,7 +198,9 @@ def _study(task_file: str, plan_file, robust: bool, vary, feature_error, tracker
         task = load_task_file(task_file)
     try:
         spreads = Spreads.for_task(task, vary, feature_error, tracker_noise)
-    except ValueError as exc:  # only --vary can be refused here, and Spreads names it `vary`
+    except SettingError as exc:  # --feature-error or --tracker-noise past its bound
+        fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
+    except ValueError as exc:  # --vary, which Spreads names `vary`
         fail(f"--{exc}")
     if not plan_file:
         task, plan = _plan_for(task, spreads, robust)

@@ -6,8 +6,9 @@ import sys
 
 import click
 
+from stablepush.errors import SettingError
 from stablepush.execution.protocol import DEFAULT_PORT
-from stablepush.execution.tcp_arm import DEFAULT_ACK_TIMEOUT
+from stablepush.execution.tcp_arm import ACK_TIMEOUT_RANGE, DEFAULT_ACK_TIMEOUT
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import with_robot
 from stablepush_cli.common import (
@@ -22,6 +23,7 @@ from stablepush_cli.common import (
 )
 from stablepush_cli.options import (
     Finite,
+    Whole,
     parse_host_port,
     robot_options,
     stamp_option,
@@ -47,13 +49,14 @@ from stablepush_cli.options import (
                                  "last the task's dynamics.step_time (slower than the model when HZ does not divide "
                                  "it); the last push of each contact eases to rest, up to 4/3 of the planned "
                                  "speed on the way (docs/execution.md).")
-@click.option("--resume-from", "resume_from", default=0, type=click.IntRange(min=0), metavar="STEP",
+@click.option("--resume-from", "resume_from", default=0, type=Whole(min=0), metavar="STEP",
               help="Continue after plan step STEP (the last confirmed step a fault reported). A `stablepush sim-arm` "
                    "server then keeps the world it has; --sim starts a fresh one, the object where step STEP "
                    "leaves it.")
 @click.option("--pace/--no-pace", default=None,
               help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
-@click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True, type=Finite(min=0.01), metavar="S",
+@click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True, type=Finite(*ACK_TIMEOUT_RANGE),
+              metavar="S",
               help="Give up when the arm server does not reply within S seconds (not with --sim: the simulated "
                    "arm runs in this process, and a waypoint takes as long as it takes).")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
@@ -165,11 +168,14 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     named = ([("--json", JsonReport(json_path))] if json_path else []) + (
         [("--record", BagRecording(record_path, stamp_ns))] if record_path else []) + [("--video", v) for v in video]
     outputs = [output for _, output in named]
+    try:
+        guard = GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None
+    except SettingError as exc:  # a noise the guard cannot tell a touch from
+        fail(f"--tracker-noise: {exc.reason}")
     options = RunOptions(rate_hz=rate_hz, resume_from=resume_from, pace=pace,
                          closed_loop=ClosedLoop.for_task(task, replan_threshold, final_tolerance) if closed_loop
                          else None,
-                         guard=GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None,
-                         success_tolerance=success_tolerance)
+                         guard=guard, success_tolerance=success_tolerance)
     target = _arm_for(arm, sim, engine, mu_scale, tracker_noise, ack_timeout, quiet, task.environment.robot)
     with _run_progress(task, plan, resume_from, quiet) as progress:
         run = run_plan(task, plan, target, options, progress=progress,

@@ -66,8 +66,8 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
     from stablepush.plan import plan_task, write_plan
     from stablepush.plan.verify import release_note
 
-    json_label = "-o" if json_path else "the default -o"
-    json_path = json_path or default_output(task_file, ".plan.json")
+    json_label = "-o" if json_path is not None else "the default -o"
+    json_path = json_path if json_path is not None else default_output(task_file, ".plan.json")
     check_named_outputs({json_label: json_path, "--csv": csv_path}, {"TASK.yaml": task_file})
     say = say_beside(json_path, csv_path)
     task = load_task_file(task_file)

@@ -15,6 +15,7 @@ from stablepush_cli.common import (
 from stablepush_cli.options import (
     SEED,
     TIME_LIMIT,
+    Whole,
     parse_axis,
     parse_ray_address,
 )
@@ -30,7 +31,7 @@ from stablepush_cli.options import (
 @click.option("--time-limit", default=1.0, show_default=True, type=TIME_LIMIT,
               metavar="S", help="Each cell's search time.")
 @click.option("--seed", default=None, type=SEED, help="Planner seed (default: the task's).")
-@click.option("--workers", type=click.IntRange(min=1, max=1024), default=None, metavar="K",
+@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
               help="Plan the cells on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
               callback=parse_ray_address,
@@ -80,9 +81,9 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
         if bar is not None:
             bar.render_finish()
     data = result.as_dict()
-    if json_path:
+    if json_path is not None:
         write_atomically(json_path, json.dumps(data, indent=1) + "\n")
-    if png_path:
+    if png_path is not None:
         from stablepush.viz.figures import reach_figure, save_figure
 
         save_figure(reach_figure(task, data), png_path)

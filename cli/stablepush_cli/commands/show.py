@@ -35,8 +35,8 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
     from stablepush.viz import figures
 
-    png_label = "-o" if png_path else "the default -o"
-    png_path = png_path or beside(plan_file, (".json", ".plan"), ".png")
+    png_label = "-o" if png_path is not None else "the default -o"
+    png_path = png_path if png_path is not None else beside(plan_file, (".json", ".plan"), ".png")
     require_suffix(png_label, png_path, FIGURE_SUFFIXES)
     require_suffix("--gif", gif_path, (".gif",))
     check_named_outputs({png_label: png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})

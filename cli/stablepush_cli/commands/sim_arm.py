@@ -8,15 +8,16 @@ from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import Robot, robot_with
 from stablepush_cli.options import (
     Finite,
+    Whole,
     robot_options,
 )
 
 
 @click.command("sim-arm")
 @click.option("--host", default="127.0.0.1", show_default=True, help="Address to listen on.")
-@click.option("--port", default=DEFAULT_PORT, show_default=True, type=click.IntRange(min=0, max=65535),
+@click.option("--port", default=DEFAULT_PORT, show_default=True, type=Whole(min=0, max=65535),
               help="Port to listen on (0: any free port, printed).")
-@click.option("--exit-after", type=click.IntRange(min=1), default=None, metavar="N",
+@click.option("--exit-after", type=Whole(min=1), default=None, metavar="N",
               help="Fault injection for testing executors: die abruptly after N waypoints.")
 @click.option("--mu-scale", "mu_scale", default=1.0, show_default=True, type=Finite(min=0.1, max=10),
               metavar="S", help="The pads' and features' mu are S times each task's (a world unlike the model).")
@@ -29,7 +30,7 @@ from stablepush_cli.options import (
     metavar="MM DEG",
     help="Standard deviations of the tracker's noise on object_in_grasp (x, z mm; theta deg).",
 )
-@click.option("--seed", default=0, show_default=True, type=click.IntRange(min=0, max=2**32 - 1),
+@click.option("--seed", default=0, show_default=True, type=Whole(min=0, max=2**32 - 1),
               help="Seed of the tracker's noise.")
 @click.option("--idle-timeout", default=30.0, show_default=True, type=Finite(min=0.1, max=3600), metavar="S",
               help="Drop a client that sends no complete message for S seconds (the arm is stopped).")

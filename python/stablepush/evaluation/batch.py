@@ -68,6 +68,7 @@ class Batch:
         # plan it cannot follow in its cell (CellError).
         check_plan(self.task, self.plan)
         success_tolerance(self.task, self.tolerance)
+        guard_of(self)  # a tracker noise the guard cannot tell a touch from: SettingError (tracker_noise)
         SimulatedArm(self.engine, robot=self.task.environment.robot).check_cell(self.task, self.plan, RATE_HZ)
 
     @property
@@ -121,9 +122,10 @@ def guard_of(batch: Batch) -> Optional[GuardedApproach]:
 
 def run_trial(batch: Batch, trial: int) -> dict:
     """Run trial `trial` and return its record. A trial whose arm faults is recorded with cause
-    `arm_fault`, one that raises anything else as `crash` (`error` says what); neither ends the
-    batch. With `batch.video_dir`, the run is recorded in memory and, when the trial failed, drawn
-    into video_dir/trial-<i>.mp4 (`video`: its path; None for a trial that landed, or when it could
+    `arm_fault` (a miss), one that raises anything else as `crash` (`error` says what: an internal
+    error, not a miss; Evaluation.summary leaves it out of the rate); neither ends the batch. With
+    `batch.video_dir`, the run is recorded in memory and, when the trial failed, drawn into
+    video_dir/trial-<i>.mp4 (`video`: its path; None for a trial that landed, or when it could
     not be drawn, `video_error` then says why)."""
     world = batch.world(trial)
     started = time.perf_counter()
@@ -177,6 +179,11 @@ def _not_run(cause: str, error: str) -> dict:
             "sim_time_s": 0.0, "error": error}
 
 
+def crashed(record: dict) -> bool:
+    """Whether a trial's record is of a crash (an internal error, or a lost worker): not a miss."""
+    return record.get("cause") == "crash"
+
+
 def _crashed(batch: Batch, trial: int, why: str) -> dict:
     return {"trial": trial, "world": batch.world(trial).as_dict(), **_not_run("crash", why), "wall_s": 0.0}
 
@@ -213,7 +220,7 @@ def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
         if close is not None:
             close()
     done.sort(key=lambda r: r["trial"])
-    return Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started, runner=runner.describe(),
+    return Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started, runner=runner.describe(trials),
                       requested=trials, interrupted=interrupted, decision=decision.as_dict())
 
 
@@ -223,24 +230,28 @@ class _Decision:
     def __init__(self, test: Optional[SequentialTest]):
         self.test = test
         self.waiting: Dict[int, bool] = {}
-        self.next = self.successes = 0
+        self.next = self.successes = self.judged = 0
         self.verdict: Optional[str] = None
 
     def add(self, record: dict) -> bool:
         """Take a finished trial; whether the test has decided."""
         if self.test is None or self.verdict is not None:
             return self.verdict is not None
-        self.waiting[record["trial"]] = bool(record["success"])
+        # A crashed trial is no evidence either way (an internal error, not a miss): it is passed over.
+        self.waiting[record["trial"]] = None if crashed(record) else bool(record["success"])
         while self.next in self.waiting and self.verdict is None:
-            self.successes += self.waiting.pop(self.next)
+            landed = self.waiting.pop(self.next)
             self.next += 1
-            self.verdict = self.test.decide(self.successes, self.next)
+            if landed is not None:
+                self.judged += 1
+                self.successes += landed
+                self.verdict = self.test.decide(self.successes, self.judged)
         return self.verdict is not None
 
     def as_dict(self) -> Optional[dict]:
         if self.test is None:
             return None
-        return {**self.test.as_dict(), "decision": self.verdict or "undecided", "trials": self.next,
+        return {**self.test.as_dict(), "decision": self.verdict or "undecided", "trials": self.judged,
                 "successes": self.successes}
 
 
@@ -257,22 +268,26 @@ class Evaluation:
     def summary(self) -> dict:
         """Counts, the success rate with its Wilson 95% interval, goal-error percentiles (mm and
         |deg|, over the trials that ran to the end), the causes of the misses, and the speed:
-        robot time simulated per wall second."""
+        robot time simulated per wall second. A crashed trial (an internal error) is neither a
+        landing nor a miss: the rate and its interval are over the trials that did not crash
+        (`judged`), and the crashed ones are counted (`crashed`) and listed (`crashed_trials`)."""
         n = len(self.trials)
+        crashes = [t["trial"] for t in self.trials if crashed(t)]
+        judged = n - len(crashes)
         successes = sum(1 for t in self.trials if t["success"])
         ran = [t for t in self.trials if t["goal_error"] is not None]
         distance = np.array([t["goal_error"]["distance"] for t in ran])
         angle = np.array([abs(t["goal_error"]["theta"]) for t in ran])
         causes: Dict[str, int] = {}
         for t in self.trials:
-            if not t["success"]:
+            if not t["success"] and not crashed(t):
                 causes[str(t["cause"])] = causes.get(str(t["cause"]), 0) + 1
         robot_time = sum(t["sim_time_s"] for t in self.trials)
         return {
             "task": self.batch.task.name, "trials": n, "requested": self.requested, "interrupted": self.interrupted,
-            "successes": successes, "success_rate": successes / n if n else None,
+            "judged": judged, "successes": successes, "success_rate": successes / judged if judged else None,
             # one world: every trial would be this one, so a rate over them says nothing more
-            "ci95": None if not n or self.batch.spreads.one_world else list(wilson_interval(successes, n)),
+            "ci95": None if not judged or self.batch.spreads.one_world else list(wilson_interval(successes, judged)),
             "tolerance": list(self.batch.judged_with), "one_world": self.batch.spreads.one_world,
             "closed_loop": self.batch.closed_loop, "guarded": self.batch.guarded,
             "engine": self.batch.engine, "seed": self.batch.seed,
@@ -280,7 +295,7 @@ class Evaluation:
             "vary": dict(self.batch.spreads.vary), "feature_error": list(self.batch.spreads.feature_error),
             "tracker_noise": list(self.batch.spreads.tracker_noise),
             "goal_error_mm": _percentiles(distance), "goal_error_deg": _percentiles(angle),
-            "causes": causes, "crashed": causes.get("crash", 0),
+            "causes": causes, "crashed": len(crashes), "crashed_trials": crashes,
             "wall_s": self.wall_s, "runner": self.runner,
             "robot_time_s": robot_time, "real_time_factor": robot_time / self.wall_s if self.wall_s > 0 else None,
             "decision": self.decision,
@@ -296,12 +311,14 @@ class Evaluation:
         s = self.summary()
         tol = s["tolerance"]
         within = f"within {tol[0]:g} mm (x and z) and {tol[1]:g} deg"
-        if s["one_world"]:
+        if not s["judged"]:
+            lines = [f"{s['task']}: no trial ran to a verdict: {'the' if s['trials'] == 1 else 'every'} trial crashed"]
+        elif s["one_world"]:
             lines = [f"{s['task']}: one world, the model's own (nothing varies): "
                      f"{'landed' if s['successes'] else 'missed'} {within}; one trial, so no interval"]
         else:
             low, high = s["ci95"]
-            lines = [f"{s['task']}: landed {s['successes']} of {s['trials']} trials {within}: {s['success_rate']:.1%} "
+            lines = [f"{s['task']}: landed {s['successes']} of {s['judged']} trials {within}: {s['success_rate']:.1%} "
                      f"(95% CI {low:.1%}-{high:.1%})" + (f"; interrupted after {s['trials']} of {s['requested']}"
                                                          if s["interrupted"] else "")]
         if s["goal_error_mm"]:
@@ -316,6 +333,11 @@ class Evaluation:
                          f"confidence, {d['method']}), after the first {d['trials']} trials ({d['successes']} landed)")
         if s["causes"]:
             lines.append("misses: " + ", ".join(f"{cause} {count}" for cause, count in sorted(s["causes"].items())))
+        if s["crashed"]:
+            first = next(t for t in self.trials if crashed(t))
+            lines.append(f"crashed: {s['crashed']} of {s['trials']} trials (internal errors, not misses: left out of "
+                         f"the rate; each trial's `error` says what), the first, trial {first['trial']}: "
+                         f"{first['error']}")
         lines.append(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
                      f"{s['real_time_factor']:.2f}x real time")
         if written:
@@ -374,16 +396,16 @@ def write_evaluation(evaluation: Evaluation, json_path: Optional[str] = None, cs
 
     from stablepush.outputs import write_atomically
 
-    if json_path:
+    if json_path is not None:
         write_atomically(json_path, json.dumps(evaluation.as_dict(), indent=1) + "\n")
-    if csv_path:
+    if csv_path is not None:
         header, rows = evaluation.rows()
         buffer = io.StringIO()
         writer = csv.writer(buffer, lineterminator="\n")
         writer.writerow(header)
         writer.writerows(rows)
         write_atomically(csv_path, buffer.getvalue())
-    if png_path:
+    if png_path is not None:
         from stablepush.viz.figures import evaluation_figure, save_figure
 
         save_figure(evaluation_figure(evaluation.summary(), evaluation.trials), png_path)

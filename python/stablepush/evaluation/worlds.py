@@ -10,13 +10,14 @@ those multipliers, for a plan every push of which is stable in every such world.
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field
 from typing import Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
+from stablepush.errors import SettingError
 from stablepush.task.model import UNCERTAIN, Task
+from stablepush.task.schema import MAX_ANGLE, MAX_COORDINATE
 
 VARY_KEYS = tuple(UNCERTAIN)  # pad_mu, pusher_mu, grip_force, mass: the keys of a task's uncertainty box
 MAX_FRACTION = 0.9  # a spread of +-90% at most: every multiplier stays positive (the box's own limit)
@@ -25,6 +26,9 @@ MAX_FRACTION = 0.9  # a spread of +-90% at most: every multiplier stays positive
 # 0.2 mm and 0.2 deg (a dial gauge and a square). docs/evaluate.md, "The worlds".
 DEFAULT_VARY = {"pad_mu": 0.1, "pusher_mu": 0.1, "grip_force": 0.05, "mass": 0.02}
 DEFAULT_FEATURE_ERROR = (0.2, 0.2)  # mm, deg
+# The most a feature may be off, or the tracker's noise (mm, deg): the task file's bounds on coordinates
+# and angles (`--feature-error 0.9 1e308` overflowed numpy's uniform draw: an internal error).
+SPREAD_LIMITS = (MAX_COORDINATE, MAX_ANGLE)
 
 
 @dataclass(frozen=True)
@@ -38,14 +42,21 @@ class Spreads:
     tracker_noise: Tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self):
+        # -0.0 passes the range checks but makes numpy's uniform(0, -0) refuse "high - low < 0": every
+        # spread is taken as the non-negative number it is (x + 0.0 is 0.0 for -0.0, x for any other).
+        object.__setattr__(self, "vary", {key: fraction + 0.0 for key, fraction in dict(self.vary).items()})
+        for name in ("feature_error", "tracker_noise"):
+            object.__setattr__(self, name, tuple(v + 0.0 for v in getattr(self, name)))
         for key, fraction in self.vary.items():
             if key not in VARY_KEYS:
                 raise ValueError(f"vary: unknown key {key!r} (one of {', '.join(VARY_KEYS)})")
             if not 0.0 <= fraction <= MAX_FRACTION:
                 raise ValueError(f"vary: {key} must be a fraction from 0 to {MAX_FRACTION:g}, got {fraction:g}")
         for name, pair in (("feature_error", self.feature_error), ("tracker_noise", self.tracker_noise)):
-            if not all(0.0 <= v < math.inf for v in pair):  # written so that nan fails it too
-                raise ValueError(f"{name} must be finite and not negative, got {tuple(pair)}")
+            if len(pair) != 2 or not all(0.0 <= v <= most for v, most in zip(pair, SPREAD_LIMITS)):  # nan fails too
+                raise SettingError(name, f"must be 2 numbers, not negative, at most {SPREAD_LIMITS[0]:g} mm and "
+                                         f"{SPREAD_LIMITS[1]:g} deg (the task file's bounds on coordinates and "
+                                         f"angles), got {tuple(pair)}")
 
     @classmethod
     def for_task(cls, task: Task, vary: Optional[Dict[str, float]] = None,

@@ -46,6 +46,7 @@ from stablepush.execution.trajectory import Trajectory, continuous_quaternions
 from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.extras import require
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix
+from stablepush.outputs import check_output
 from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
 from stablepush.task.model import Task
@@ -214,6 +215,7 @@ def _mcap(path: Union[str, Path], topics: dict):
     from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE)
+    check_output(path)  # as given: Path() drops a trailing slash, and "r.mcap/" was written as r.mcap
     path = Path(path)
     try:  # the bag is written beside its output, so that the last move is a rename
         scratch_directory = tempfile.TemporaryDirectory(dir=path.parent if path.parent.exists() else None)

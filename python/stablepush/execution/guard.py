@@ -34,6 +34,7 @@ from typing import Dict, List, Mapping, Optional, Sequence
 
 import numpy as np
 
+from stablepush.errors import SettingError
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, contact_first, past_touch, renumbered
 from stablepush.execution.world import RESTING_ANGLE, Feature
 from stablepush.frames import angle_about_y, grasp_transform, pose_to_matrix, rot_y
@@ -45,6 +46,10 @@ from stablepush.units import MM, angle_difference_deg
 # fires on noise; the reach is travel into where the plan says a feature is, so it stays short.
 GUARD_PARAMETER_RANGES = {"touch_mm": (0.001, 0.5), "touch_deg": (0.001, 0.5), "touch_n": (0.01, 50.0),
                           "reach_mm": (0.0, 2.0), "hold_s": (0.0, 1.0), "seat_deg": (0.0, 2.0)}
+# The thresholds read from the tracker, each kept this many standard deviations of its noise clear of it,
+# and which of the noise's (mm, deg) it is held clear of.
+NOISE_SIGMAS = 4.0
+NOISE_THRESHOLDS = {"touch_mm": 0, "touch_deg": 1, "seat_deg": 1}
 
 
 @dataclass(frozen=True)
@@ -72,15 +77,29 @@ class GuardedApproach:
         for name, (low, high) in GUARD_PARAMETER_RANGES.items():
             value = getattr(self, name)
             if not low <= value <= high:
-                raise ValueError(f"guard {name} must lie in [{low:g}, {high:g}], got {value!r}")
+                raise SettingError(f"guard.{name}", f"must lie in [{low:g}, {high:g}], got {value!r}")
 
     @classmethod
     def for_tracker_noise(cls, noise_mm: float = 0.0, noise_deg: float = 0.0) -> "GuardedApproach":
-        """The default guard with its touch and seat thresholds no lower than four standard deviations
-        of the tracker's noise (mm, deg), so that noise alone does not read as a touch or a turn."""
+        """The default guard with its touch and seat thresholds no lower than NOISE_SIGMAS standard
+        deviations of the tracker's noise (mm, deg), so that noise alone does not read as a touch or
+        a turn. SettingError (field `tracker_noise`) for a noise that would lift a threshold past its
+        range (GUARD_PARAMETER_RANGES): a touch read only after the object has moved that far in the
+        grasp is no touch, and the contact would start from a pose the noise makes up. Run such a
+        tracker unguarded."""
+        noise = (noise_mm, noise_deg)
         default = cls()
-        return cls(touch_mm=max(default.touch_mm, 4 * noise_mm), touch_deg=max(default.touch_deg, 4 * noise_deg),
-                   seat_deg=max(default.seat_deg, 4 * noise_deg))
+        most = [min(GUARD_PARAMETER_RANGES[name][1] for name, w in NOISE_THRESHOLDS.items() if w == which)
+                / NOISE_SIGMAS for which in (0, 1)]
+        if not all(0.0 <= v <= m for v, m in zip(noise, most)):  # written so that nan fails it too
+            raise SettingError("tracker_noise", f"{noise_mm:g} mm / {noise_deg:g} deg is more than the guarded "
+                                                f"approach can tell a touch from: it reads the touch past "
+                                                f"{NOISE_SIGMAS:g} standard deviations of the noise, at most "
+                                                f"{most[0] * NOISE_SIGMAS:g} mm and {most[1] * NOISE_SIGMAS:g} deg "
+                                                f"from where the slow end began, so a noise of at most {most[0]:g} mm "
+                                                f"and {most[1]:g} deg; run unguarded (--no-guard)")
+        return cls(**{name: max(getattr(default, name), NOISE_SIGMAS * noise[which])
+                      for name, which in NOISE_THRESHOLDS.items()})
 
     def met(self, before: Mapping[str, float], now: Mapping[str, float], force=None) -> bool:
         """Whether the feature has met the object: the arm's `contact_force` (N) past touch_n when

@@ -51,10 +51,22 @@ import json
 import math
 import socket
 import time
-from typing import Any, Dict
+from typing import Any, Dict, Optional
 
 from stablepush import strict_json
 from stablepush.strict_json import is_finite_number
+from stablepush.task.schema import (
+    ANGLE,
+    COORDINATE,
+    LIMITS,
+    MAX_PAD_POINTS,
+    MAX_PAD_RINGS,
+    MAX_PADS,
+    MAX_PUSHERS,
+    MAX_VERTICES,
+    MIN_POSITIVE_MU,
+)
+from stablepush.units import MM, G
 
 PROTOCOL = "stablepush.arm/2"
 SUPPORTED_PROTOCOLS = ("stablepush.arm/1", PROTOCOL)
@@ -120,6 +132,8 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
         check_state(message["state"], kind)
     if kind in ("hello", "ready") and message["protocol"] not in SUPPORTED_PROTOCOLS:
         raise ProtocolError(f"{kind}: protocol {message['protocol']!r} is not one of {', '.join(SUPPORTED_PROTOCOLS)}")
+    if kind == "hello":  # after its version: a hello of another protocol may describe its world otherwise
+        check_scene(message["scene"])
     return message
 
 
@@ -158,6 +172,121 @@ def _check_placed(pose: list, what: str) -> None:
         raise ProtocolError(f"{what} is more than {ARM_REACH_M:g} m from the arm's base")
     if abs(math.sqrt(sum(v * v for v in pose[3:])) - 1.0) > 1e-3:
         raise ProtocolError(f"{what}: the quaternion is not of unit length")
+
+
+# A hello's scene (world.scene_description, SI units) within the task file's own ranges (schema.LIMITS,
+# in mm, g and N there): kind -> (lowest, highest), converted once.
+_SCENE_RANGES = {
+    "position": (COORDINATE[0] * MM, COORDINATE[1] * MM),  # m: polygon, com, pad centres, feature ends
+    "length": (LIMITS["length"][0] * MM, LIMITS["length"][1] * MM),  # m: thickness, pad radii
+    "mass": (LIMITS["mass"][0] * G, LIMITS["mass"][1] * G),  # kg
+    "inertia": LIMITS["inertia"],  # kg m^2
+    "force": LIMITS["force"],  # N
+    "mu": LIMITS["mu"],
+    "gravity": LIMITS["gravity"],  # m/s^2
+    "position_mm": COORDINATE,  # mm: the object's x and z in the grasp
+}
+UNIT_NORMAL_TOLERANCE = 1e-3  # a feature's normal is of unit length to this
+
+
+def check_scene(scene: dict) -> None:
+    """A hello's `scene` (world.scene_description) as a world can be built from: every number finite
+    and within the task file's own range for it (schema.LIMITS, in SI), the counts within the task
+    file's caps (vertices, pads, pad rings and their points, features), each feature's normal a
+    unit vector and its object pose a pose; ProtocolError naming the field otherwise. A simulator
+    built worlds from a gripper mu of -1, a normal [0, 0, 0], a mu of 1e300 or no pads."""
+    _fields("scene", scene, ("gravity", "object", "gripper", "features", "gripper_pose", "object_pose"))
+    _numbers("scene.gravity", scene["gravity"], 2, "gravity")
+    obj = scene["object"]
+    _fields("scene.object", obj, ("polygon", "thickness", "mass", "com", "inertia"))
+    _count("scene.object.polygon", obj["polygon"], 3, MAX_VERTICES)
+    for i, point in enumerate(obj["polygon"]):
+        _numbers(f"scene.object.polygon[{i}]", point, 2, "position")
+    _number("scene.object.thickness", obj["thickness"], "length")
+    _number("scene.object.mass", obj["mass"], "mass")
+    _numbers("scene.object.com", obj["com"], 2, "position")
+    _number("scene.object.inertia", obj["inertia"], "inertia")
+    gripper = scene["gripper"]
+    _fields("scene.gripper", gripper, ("grip_force", "mu", "pad_rings", "pads"))
+    _number("scene.gripper.grip_force", gripper["grip_force"], "force")
+    _friction("scene.gripper.mu", gripper["mu"])
+    rings = gripper["pad_rings"]
+    if isinstance(rings, bool) or not isinstance(rings, int) or not 0 <= rings <= MAX_PAD_RINGS:
+        raise ProtocolError(f"hello: scene.gripper.pad_rings must be an integer from 0 to {MAX_PAD_RINGS}, "
+                            f"got {_shown(rings)}")
+    _count("scene.gripper.pads", gripper["pads"], 1, MAX_PADS)
+    points = len(gripper["pads"]) * (1 + 3 * rings * (rings + 1))
+    if points > MAX_PAD_POINTS:
+        raise ProtocolError(f"hello: scene.gripper: {len(gripper['pads'])} pads of {rings} rings make {points} pad "
+                            f"points; at most {MAX_PAD_POINTS}")
+    for i, pad in enumerate(gripper["pads"]):
+        _fields(f"scene.gripper.pads[{i}]", pad, ("center", "radius"))
+        _numbers(f"scene.gripper.pads[{i}].center", pad["center"], 2, "position")
+        _number(f"scene.gripper.pads[{i}].radius", pad["radius"], "length")
+    _count("scene.features", scene["features"], 0, MAX_PUSHERS)
+    for i, feature in enumerate(scene["features"]):
+        _check_feature(f"scene.features[{i}]", feature)
+    for name in ("gripper_pose", "object_pose"):
+        _check_pose(scene[name], f"hello: scene.{name}")
+        _check_placed(scene[name], f"hello: scene.{name}")
+    if "object_in_grasp" in scene:
+        tracked = scene["object_in_grasp"]
+        _numbers("scene.object_in_grasp", tracked, 3, "position_mm")
+        if not (ANGLE[0] <= tracked[2] <= ANGLE[1]):
+            raise ProtocolError(f"hello: scene.object_in_grasp[2] must be from {ANGLE[0]:g} to {ANGLE[1]:g} deg")
+
+
+def _check_feature(path: str, feature: Any) -> None:
+    _fields(path, feature, ("pusher", "from", "to", "normal", "mu", "object_pose"))
+    if not isinstance(feature["pusher"], str):
+        raise ProtocolError(f"hello: {path}.pusher must be a string")
+    _numbers(f"{path}.from", feature["from"], 3, "position")
+    _numbers(f"{path}.to", feature["to"], 3, "position")
+    _numbers(f"{path}.normal", feature["normal"], 3, None)
+    if abs(math.sqrt(sum(v * v for v in feature["normal"])) - 1.0) > UNIT_NORMAL_TOLERANCE:
+        raise ProtocolError(f"hello: {path}.normal must be a unit vector, got {_shown(feature['normal'])}")
+    _friction(f"{path}.mu", feature["mu"])
+    _check_pose(feature["object_pose"], f"hello: {path}.object_pose")
+    _check_placed(feature["object_pose"], f"hello: {path}.object_pose")
+
+
+def _fields(path: str, value: Any, names) -> None:
+    if not isinstance(value, dict):
+        raise ProtocolError(f"hello: {path} must be an object")
+    missing = [name for name in names if name not in value]
+    if missing:
+        raise ProtocolError(f"hello: {path} has no {', '.join(repr(m) for m in missing)}")
+
+
+def _count(path: str, value: Any, least: int, most: int) -> None:
+    if not isinstance(value, list) or not least <= len(value) <= most:
+        raise ProtocolError(f"hello: {path} must be a list of {least} to {most}, got {_shown(value)}")
+
+
+def _number(path: str, value: Any, kind: Optional[str]) -> None:
+    low, high = (-math.inf, math.inf) if kind is None else _SCENE_RANGES[kind]
+    if not is_finite_number(value) or not low <= value <= high:
+        raise ProtocolError(f"hello: {path} must be a finite number" + (f" from {low:g} to {high:g}" if kind else "")
+                            + f", got {_shown(value)}")
+
+
+def _numbers(path: str, value: Any, n: int, kind: Optional[str]) -> None:
+    if not isinstance(value, list) or len(value) != n:
+        raise ProtocolError(f"hello: {path} must be a list of {n} numbers, got {_shown(value)}")
+    for i, v in enumerate(value):
+        _number(f"{path}[{i}]", v, kind)
+
+
+def _friction(path: str, value: Any) -> None:
+    """A friction coefficient as a task file takes one (schema._friction): 0, or MIN_POSITIVE_MU up."""
+    _number(path, value, "mu")
+    if 0.0 < value < MIN_POSITIVE_MU:
+        raise ProtocolError(f"hello: {path} must be 0 (frictionless) or at least {MIN_POSITIVE_MU:g}, got {value:g}")
+
+
+def _shown(value: Any) -> str:
+    text = json.dumps(value, allow_nan=True, default=repr) if not isinstance(value, str) else repr(value)
+    return text if len(text) <= 60 else text[:60] + "..."
 
 
 class LineReader:

@@ -7,11 +7,16 @@ import socket
 import time
 from typing import Optional
 
+from stablepush.errors import SettingError
 from stablepush.execution.arm import Arm, ArmError, ArmReady
 from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.execution.stream import ArmWaypoint
+from stablepush.units import is_finite_real
 
 DEFAULT_ACK_TIMEOUT = 5.0  # s to wait for any reply
+# s: the replies' deadline may be set within this; a socket's timeout past about 1e10 s overflows the
+# platform's time_t (`--ack-timeout 1e308` was an internal error), and an hour is an arm gone.
+ACK_TIMEOUT_RANGE = (0.01, 3600.0)
 STOP_WITHIN = 2.0  # s to wait for the arm to confirm a stop (replies that keep coming do not extend it)
 
 
@@ -22,9 +27,13 @@ class TcpArm(Arm):
     paced = True
 
     def __init__(self, host: str, port: int, ack_timeout: float = DEFAULT_ACK_TIMEOUT):
+        low, high = ACK_TIMEOUT_RANGE
+        if not is_finite_real(ack_timeout) or not low <= ack_timeout <= high:
+            raise SettingError("ack_timeout", f"must be a number of seconds from {low:g} to {high:g}, "
+                                              f"got {ack_timeout!r:.40}")
         self.host, self.port = host, port
         self.where = f"the arm server at {host}:{port}"
-        self.timeout = ack_timeout
+        self.timeout = float(ack_timeout)
         self.sock: Optional[socket.socket] = None
         self.connected = False
 

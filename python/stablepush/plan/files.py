@@ -116,11 +116,11 @@ def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union
         except ValueError:
             raise PlanError(key, "holds a number that is not finite (NaN or infinity), which JSON has not", source)
     files = {json_path: text}
-    if csv_path and same_file(csv_path, json_path):
+    if csv_path is not None and same_file(csv_path, json_path):
         if not is_stream(json_path):
             raise OutputError(f"{csv_path}: the CSV would overwrite the plan file; give it another name")
         files[json_path] += plan_to_csv(plan)  # one stream: the JSON, then the CSV
-    elif csv_path:
+    elif csv_path is not None:
         files[csv_path] = plan_to_csv(plan)
     write_files(files)
 

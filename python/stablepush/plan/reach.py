@@ -196,4 +196,4 @@ def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_lim
             progress(cell)
     return ReachMap(task=task.name, start=tuple(task.start), axes=dict(zip(("x", "z", "theta"), map(list, job.axes))),
                     seed=job.seed, time_limit=job.time_limit, cells=cells, wall_s=time.perf_counter() - started,
-                    runner=runner.describe())
+                    runner=runner.describe(len(cells)))

@@ -14,6 +14,7 @@ from typing import List, Optional
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.frames import direction_in_gripper, point_in_gripper
+from stablepush.plan.files import MAX_WAYPOINTS
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.plan.unreachable import why_unreachable
 from stablepush.task.mechanics import blocked_senses
@@ -70,6 +71,7 @@ def plan_task(
     min_transit_hold = number_field("min_transit_hold", min_transit_hold, LIMITS["min_hold_ratio"])
     if models:  # the caller's: they must be this task's
         task.check_models(models)
+    _check_push_cap(task, settings)
     models = models or task.corner_models()
     model = models[0]
     began = time.perf_counter()
@@ -89,15 +91,20 @@ def plan_task(
         interruptible=threading.current_thread() is threading.main_thread())
 
     names = task.pusher_names
+    raw_waypoints = raw.waypoints  # a copy of the core's vector on each access: taken once
+    if len(raw_waypoints) > MAX_WAYPOINTS:  # refused before the waypoints are made: 0.04 ms each
+        raise TaskError("planner.step", f"the plan found takes {len(raw_waypoints) - 1:,} pushes of "
+                                        f"{_step_text(settings)}, more than a plan holds ({MAX_PUSHES:,}): take a "
+                                        f"larger step", task.source)
     waypoints: List[Waypoint] = []
-    for k, w in enumerate(raw.waypoints):
+    for k, w in enumerate(raw_waypoints):
         pose = tuple(float(v) for v in pose_from_si(w.pose))
         if w.pusher < 0:
             waypoints.append(Waypoint(*pose))
         else:
             waypoints.append(Waypoint(*pose, pusher=names[w.pusher], margin=float(w.margin), case=w.contact_case.name,
                                       contact=contact_in_gripper(task, model, w.pusher, pose),
-                                      margin_per_normal=_margin_per_normal(models, raw.waypoints[k - 1].pose, w.pose,
+                                      margin_per_normal=_margin_per_normal(models, raw_waypoints[k - 1].pose, w.pose,
                                                                            w.pusher)))
 
     outcome = raw.outcome.name
@@ -142,6 +149,32 @@ def plan_task(
                 final_hold_ratio=min(m.hold_ratio(last_q, last_pusher) for m in models),
                 uncertainty=dict(task.uncertainty), ends_at_goal=bool(raw.ends_at_goal),
                 task_identity=task.identity())
+
+
+MAX_PUSHES = MAX_WAYPOINTS - 1  # the pushes a plan file holds: its waypoints less the start
+
+
+def _step_text(settings: PlannerSettings) -> str:
+    return f"{settings.step[0]:g} mm / {settings.step[1]:g} deg"
+
+
+def _check_push_cap(task: Task, settings: PlannerSettings) -> None:
+    """TaskError (planner.step) when the unit step is too small for any plan within MAX_PUSHES to
+    come within the tolerance of the goal: a unit push moves the object at most one unit step
+    (the core's distance, Euclidean over x/step, z/step and theta/step), so no plan is shorter than
+    the distance from the start to the tolerance box about the goal, in unit steps. Refused before
+    the search, which would otherwise run its time out and make a plan no file can hold."""
+    step, tol = settings.step, settings.tolerance
+    gap = [max(0.0, abs(g - s) - t) / u for g, s, t, u in
+           zip(task.goal, task.start, (tol[0], tol[0], tol[1]), (step[0], step[0], step[1]))]
+    fewest = math.ceil(math.sqrt(sum(v * v for v in gap)) - 1e-9)
+    if fewest > MAX_PUSHES:
+        scale = fewest / MAX_PUSHES
+        raise TaskError("planner.step", f"{_step_text(settings)} is too small for this goal: every plan takes at "
+                                        f"least {fewest:,} pushes to come within the tolerance, and a plan holds "
+                                        f"at most {MAX_PUSHES:,} (a step of at least {step[0] * scale:.3g} mm / "
+                                        f"{step[1] * scale:.3g} deg, or more for a plan that is not straight)",
+                        task.source)
 
 
 def _unreachable(task: Task, models, settings: PlannerSettings, reason: str, seconds: float) -> Plan:

@@ -15,7 +15,7 @@ import socket
 import sys
 import threading
 from contextlib import contextmanager
-from typing import Any, Callable, Iterator, Optional
+from typing import Callable, Iterator, Optional
 
 from stablepush.execution.arm import ArmError
 from stablepush.execution.protocol import LineReader, ProtocolError, decode, encode
@@ -23,32 +23,9 @@ from stablepush.execution.stream import ArmWaypoint
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE
 from stablepush.sim.local_arm import SimulatedArm
-from stablepush.task.schema import MAX_PAD_RINGS, MAX_PADS, MAX_PUSHERS, MAX_VERTICES
 
 DEFAULT_IDLE_TIMEOUT = 30.0  # s a client may stay silent within a session
 BUSY_WAIT = 2.0  # s a new client waits for a session to end before it is told the arm is busy
-
-
-def check_scene_size(scene: dict) -> None:
-    """Refuse a hello's scene whose counts would make the world unbounded to build (ProtocolError):
-    the task files' own caps on vertices, pads, pad rings and features. Its values are checked as
-    the world is built."""
-    def count(path: str, value: Any, most: int) -> None:
-        if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= most:
-            raise ProtocolError(f"hello: scene.{path} must be an integer from 0 to {most}, got {str(value)[:40]}")
-
-    def length(path: str, value: Any, most: int) -> None:
-        if not isinstance(value, list):
-            raise ProtocolError(f"hello: scene.{path} must be a list")
-        count(f"{path} (its length)", len(value), most)
-
-    obj, gripper = scene.get("object"), scene.get("gripper")
-    if not isinstance(obj, dict) or not isinstance(gripper, dict):
-        raise ProtocolError("hello: scene.object and scene.gripper must be objects")
-    length("object.polygon", obj.get("polygon"), MAX_VERTICES)
-    count("gripper.pad_rings", gripper.get("pad_rings"), MAX_PAD_RINGS)
-    length("gripper.pads", gripper.get("pads"), MAX_PADS)
-    length("features", scene.get("features"), MAX_PUSHERS)
 
 
 class SimArmServer:
@@ -135,7 +112,6 @@ class SimArmServer:
                 if not greeted and kind != "hello":
                     raise ProtocolError(f"expected hello first, got {kind!r}")
                 if kind == "hello":
-                    check_scene_size(message["scene"])
                     ready = self.arm.hello(message["scene"], message["rate_hz"], message.get("continue") is True)
                     greeted = True
                     expected_seq = 0

@@ -16,6 +16,7 @@ import numpy as np
 
 from stablepush.errors import TaskError
 from stablepush.inputs import read_capped
+from stablepush.outputs import protect_input
 
 G_PER_CM3 = 1e-3  # g/mm^3 per g/cm^3
 # Read by trimesh from bytes capped here (a binary STL of 1.3 million triangles), in these formats
@@ -98,6 +99,7 @@ def _read_solid(trimesh, path: Path, field: str):
                                          f"(by its extension)")
     try:
         data = read_capped(path, MAX_MESH_BYTES)
+        protect_input(path, "a mesh file")
     except (OSError, ValueError) as exc:
         raise TaskError(f"{field}.file", f"cannot read {path}: {exc}") from None
     try:

@@ -34,6 +34,26 @@ def _finite(field: str, value) -> None:
         raise ValueError(f"{field} must be finite, got {value!r:.40}")
 
 
+def _integer(field: str, value) -> None:
+    if isinstance(value, bool) or not is_integer(value):
+        raise TypeError(f"{field} must be an integer, got {value!r:.40}")
+
+
+def _string_mapping_of_numbers(field: str, value, keys=None) -> Dict[str, float]:
+    """`value` as a new dict of names to finite floats (TypeError or ValueError naming the field;
+    `keys`: the names it may hold)."""
+    if not isinstance(value, dict):
+        raise TypeError(f"{field} must be a mapping of names to numbers, got {type(value).__name__}")
+    out = {}
+    for key, v in value.items():
+        if not isinstance(key, str) or (keys is not None and key not in keys):
+            allowed = f" (one of {', '.join(keys)})" if keys is not None else ""
+            raise ValueError(f"{field}: {key!r:.40} is not a name it takes{allowed}")
+        _finite(f"{field}.{key}", v)
+        out[key] = float(v)
+    return out
+
+
 def _finite_vector(field: str, value, size: int) -> None:
     if not isinstance(value, (tuple, list)) or len(value) != size:
         raise TypeError(f"{field} must be {size} numbers, got {value!r:.60}")
@@ -278,6 +298,16 @@ class PusherSpec:
     mu: float
     points: int
 
+    def __post_init__(self) -> None:
+        """The shape of the fields (TypeError or ValueError naming the field), as Task's."""
+        if not isinstance(self.name, str):
+            raise TypeError(f"PusherSpec.name must be a string, got {type(self.name).__name__}")
+        for end in ("a", "b"):
+            _finite_vector(f"pushers.{self.name:.40}.{end}", getattr(self, end), 2)
+            object.__setattr__(self, end, tuple(float(v) for v in getattr(self, end)))
+        _finite(f"pushers.{self.name:.40}.mu", self.mu)
+        _integer(f"pushers.{self.name:.40}.points", self.points)
+
     @property
     def is_point(self) -> bool:
         return self.a == self.b
@@ -347,6 +377,30 @@ class Task:
             _finite(f"Task.pads[{i}] radius", pad[1])
         if not isinstance(self.pushers, (tuple, list)) or not all(isinstance(p, PusherSpec) for p in self.pushers):
             raise TypeError("Task.pushers must be a sequence of PusherSpec")
+        self._check_the_other_fields()
+
+    def _check_the_other_fields(self) -> None:
+        """The fields __post_init__ has not checked: each one's type, named (an edited Task with
+        uncertainty=None, say, escaped from sp.check and sp.plan_task as an AttributeError)."""
+        if self.com is not None:  # a numpy array too, taken as the pair it holds
+            com = self.com.tolist() if getattr(self.com, "ndim", None) == 1 else self.com
+            _finite_vector("Task.com", com, 2)
+            object.__setattr__(self, "com", tuple(float(v) for v in com))
+        if self.inertia is not None:
+            _finite("Task.inertia", self.inertia)
+        _integer("Task.pad_rings", self.pad_rings)
+        _integer("Task.friction_polygon_sides", self.friction_polygon_sides)
+        if self.source is not None and not isinstance(self.source, str):
+            raise TypeError(f"Task.source must be a string or None, got {type(self.source).__name__}")
+        if not isinstance(self.pushes, str) or self.pushes not in PUSHES:
+            raise ValueError(f"Task.pushes must be one of {', '.join(PUSHES)}, got {self.pushes!r:.40}")
+        object.__setattr__(self, "uncertainty", _string_mapping_of_numbers("Task.uncertainty", self.uncertainty,
+                                                                           tuple(UNCERTAIN)))
+        object.__setattr__(self, "feature_orientations",
+                           _string_mapping_of_numbers("Task.feature_orientations", self.feature_orientations))
+        if not isinstance(self.warnings, (tuple, list)) or not all(isinstance(w, str) for w in self.warnings):
+            raise TypeError(f"Task.warnings must be a sequence of strings, got {self.warnings!r:.40}")
+        object.__setattr__(self, "warnings", tuple(self.warnings))
 
     def feature_angle(self, pusher: str) -> float:
         """The object's world orientation (deg about the world's y) while it rests on `pusher`'s

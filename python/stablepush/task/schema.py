@@ -20,6 +20,7 @@ import yaml
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.inputs import read_capped
+from stablepush.outputs import protect_input
 from stablepush.task.model import (
     ON_BOUNDARY,
     PLANNER_DEFAULTS,
@@ -326,6 +327,7 @@ def load_task(path: "str | Path", goal_in_grasp: bool = True) -> Task:
     source = str(path)
     try:
         text = read_capped(path, MAX_TASK_BYTES).decode("utf-8")
+        protect_input(path, "a task file")
     except ValueError as exc:  # not a regular file, too large, or not UTF-8
         raise TaskError("", f"cannot read the task file: {exc}", source) from None
     except OSError as exc:

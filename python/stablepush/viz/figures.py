@@ -283,12 +283,15 @@ def evaluation_figure(summary: dict, trials: Sequence[dict]) -> Figure:
     cdf.set_xlabel("goal error / tolerance")
     cdf.set_ylabel("fraction of trials")
     cdf.set_ylim(0, 1.02)
-    if summary["trials"]:
-        rate, (low, high) = summary["success_rate"], summary["ci95"]
-        cdf.set_title(f"{summary['task']}: {summary['successes']}/{summary['trials']} landed "
-                      f"({rate:.1%}, 95% CI {low:.1%}-{high:.1%})", fontsize=10)
-    else:  # stopped before any trial finished: the axes, and no rate
-        cdf.set_title(f"{summary['task']}: no trial finished", fontsize=10)
+    judged, crashed = summary.get("judged", summary["trials"]), summary.get("crashed", 0)
+    if judged:  # the rate is over the trials that did not crash; one world has no interval
+        ci = summary["ci95"]
+        interval = f", 95% CI {ci[0]:.1%}-{ci[1]:.1%}" if ci else ""
+        cdf.set_title(f"{summary['task']}: {summary['successes']}/{judged} landed ({summary['success_rate']:.1%}"
+                      f"{interval})" + (f"; {crashed} crashed" if crashed else ""), fontsize=10)
+    else:  # stopped before any trial finished, or every one crashed: the axes, and no rate
+        cdf.set_title(f"{summary['task']}: " + (f"all {crashed} trials crashed" if crashed else "no trial finished"),
+                      fontsize=10)
     if ran:
         cdf.legend(fontsize=8, loc="lower right")
     spreads = sorted(summary["vary"], key=lambda k: -summary["vary"][k])[:2]
