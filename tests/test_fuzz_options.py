@@ -144,10 +144,13 @@ class _NoWorld:
     """The simulated arm, refusing to build its world: a run faults at its hello (exit 3) once every
     option has been taken, without a simulation."""
 
-    def __init__(self, engine="mujoco", deviation=None, log=None):
+    def __init__(self, engine="mujoco", deviation=None, log=None, robot=None):
         self.engine, self.deviation, self.connected = engine, deviation, False
 
     name = "fuzz arm"
+
+    def check_cell(self, task, plan, rate_hz):
+        return None
 
     def hello(self, scene, rate_hz, resume):
         raise ArmError("fuzz: no world is built here")
