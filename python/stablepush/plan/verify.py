@@ -155,6 +155,22 @@ def _stability_fault(pusher: str, index: int, q0, q1, model, corners: Optional[l
     return None
 
 
+def plan_margin(task: Task, plan: Plan) -> float:
+    """The least margin [N] of any push of the plan in the stable-push test (docs/model.md section
+    3): over every corner of the task's uncertainty box when it has one. How much friction, force
+    or weight may change before some push of the plan stops sticking; inf for a plan of no push."""
+    model = task.build_model()
+    corners = task.corner_models() if task.uncertainty else None
+    least = math.inf
+    for w0, w1 in zip(plan.waypoints, plan.waypoints[1:]):
+        q0, q1 = pose_to_si(w0.pose), pose_to_si(w1.pose)
+        dq = tuple(b - a for a, b in zip(q0, q1))
+        index = task.pusher_index(w1.pusher)
+        verdict = _core.worst_case(corners, q0, dq, index) if corners else model.check(q0, dq, index)
+        least = min(least, verdict.margin)
+    return least
+
+
 def _hold_fault(task: Task, waypoints: List[Waypoint], models: list, require_solved: bool) -> FieldFault:
     """A solved plan's end, where the pads alone hold min_hold_ratio times the weight (in each of `models`)."""
     min_hold = task.planner.min_hold_ratio

@@ -1,0 +1,5 @@
+"""Fixture layouts: from a part and a regrasp to ranked layouts, each a task with a verified plan
+(`stablepush design`; layouts.py)."""
+from stablepush.design.layouts import DEFAULT_RANK, RANK_KEYS, Design, DesignStudy, design, layout_task, parse_rank
+
+__all__ = ["design", "layout_task", "parse_rank", "Design", "DesignStudy", "RANK_KEYS", "DEFAULT_RANK"]

@@ -1,0 +1,209 @@
+"""Where should the fixtures go: from a part, a grasp, a start and a goal to a ranked set of
+fixture layouts, each a complete task with a verified plan (`stablepush design`).
+
+A design file is a task file whose `candidates` stand in for its `pushers` (schema.load_design):
+every edge and convex corner of the part's section, or pushers listed. A layout is a set of at
+most `max_fixtures` candidates. The search
+1. prunes every candidate whose cone holds no stable push, from the start, that brings the object
+   nearer the goal (mechanics.stable_directions, distances in unit steps): a layout none of whose
+   candidates can make such a first push is not planned (a plan that must first push away from
+   the goal is lost to this; the count is reported);
+2. plans every other layout (plan_task with the task's seed, time limit and uncertainty box: a
+   robust plan where the task has one) and checks the plan against its task (check_plan);
+3. measures each solved layout: pushes, switch-overs, planning time, the least margin of its
+   pushes over the uncertainty box (verify.plan_margin), and where each fixture stands in the
+   world at the start (execution.world.place_features: the task's environment.features);
+4. ranks them (RANK_KEYS, `rank`), then for the best `reach_top` a small reach map around the
+   goal (REACH_CELLS cells, REACH_SPAN tolerances either side in x and z): the share of nearby
+   goals the layout also reaches, and ranks again.
+Layouts run on a `runners.Runner` (here, local processes or Ray), each deterministic for the seed.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+
+from stablepush.errors import TaskError
+from stablepush.execution.world import place_features
+from stablepush.frames import angle_about_y
+from stablepush.plan import check_plan, plan_task
+from stablepush.plan.reach import reach_map
+from stablepush.plan.verify import plan_margin
+from stablepush.runners import Runner, WorkerLost, run_all
+from stablepush.task.mechanics import stable_directions
+from stablepush.task.model import Task
+from stablepush.task.schema import parse_task
+
+# What a layout is ranked by, each best first: the key, and +1 where less is better, -1 more.
+RANK_KEYS: Dict[str, int] = {"fixtures": 1, "switches": 1, "pushes": 1, "margin": -1, "reach": -1, "time": 1}
+DEFAULT_RANK = ("fixtures", "switches", "margin", "pushes", "reach", "time")
+REACH_CELLS = 3  # per axis (x and z) of the reach map around the goal
+REACH_SPAN = 2.0  # planner.tolerance either side of the goal
+REACH_TIME_LIMIT = 1.0  # s a cell of that map may plan
+
+
+def parse_rank(text: str) -> Tuple[str, ...]:
+    """A ranking rule: keys of RANK_KEYS, comma-separated, most important first."""
+    keys = tuple(k.strip() for k in text.split(",") if k.strip())
+    unknown = [k for k in keys if k not in RANK_KEYS]
+    if not keys or unknown:
+        raise TaskError("rank", f"keys from {', '.join(RANK_KEYS)}, comma-separated, got {text!r:.80}")
+    return keys
+
+
+@dataclass
+class Design:
+    """One layout: its pushers (candidate names), the task made of them, and what was measured."""
+
+    pushers: Tuple[str, ...]
+    task: Optional[Task] = None
+    solved: bool = False
+    reason: str = ""
+    pushes: Optional[int] = None
+    switches: Optional[int] = None
+    planning_time_s: Optional[float] = None
+    margin_n: Optional[float] = None
+    reach: Optional[float] = None  # share of the goals around the goal it also reaches (None: not measured)
+    features: Dict[str, List[float]] = field(default_factory=dict)  # pusher -> [x, y, z mm, theta deg]
+    task_file: Optional[str] = None
+
+    def key(self, rank: Sequence[str]) -> tuple:
+        values = {"fixtures": len(self.pushers), "switches": self.switches, "pushes": self.pushes,
+                  "margin": self.margin_n, "reach": self.reach, "time": self.planning_time_s}
+        return (not self.solved,) + tuple(math.inf if values[k] is None else RANK_KEYS[k] * values[k] for k in rank)
+
+    def as_dict(self) -> Dict[str, Any]:
+        return {"pushers": list(self.pushers), "solved": self.solved, "reason": self.reason or None,
+                "pushes": self.pushes, "switches": self.switches, "planning_time_s": self.planning_time_s,
+                "margin_n": self.margin_n, "reach": self.reach, "features": self.features,
+                "task_file": self.task_file}
+
+
+@dataclass
+class DesignStudy:
+    """The search's result: the designs, best first (solved ones), and what was not planned."""
+
+    candidates: List[str]
+    designs: List[Design]
+    pruned_candidates: List[str]
+    layouts_searched: int
+    layouts_pruned: int
+    rank: Tuple[str, ...]
+    failed: List[Design] = field(default_factory=list)  # planned, not solved
+
+    @property
+    def verdict(self) -> str:
+        """One line: the best design, or why there is none."""
+        if self.designs:
+            best = self.designs[0]
+            return (f"best layout: {' + '.join(best.pushers)} ({best.pushes} pushes, {best.switches} switch-overs, "
+                    f"margin {best.margin_n:.3f} N)")
+        if not self.layouts_searched:
+            return (f"no layout of the candidates can do it: none of them ({', '.join(self.pruned_candidates)}) has a "
+                    f"stable push from the start toward the goal")
+        return (f"no layout of the candidates can do it: {self.layouts_searched} layouts planned, none solved "
+                f"(e.g. {' + '.join(self.failed[0].pushers)}: {self.failed[0].reason})")
+
+    def as_dict(self) -> Dict[str, Any]:
+        return {"candidates": self.candidates, "pruned_candidates": self.pruned_candidates,
+                "layouts_searched": self.layouts_searched, "layouts_pruned": self.layouts_pruned,
+                "rank": list(self.rank), "verdict": self.verdict, "designs": [d.as_dict() for d in self.designs],
+                "unsolved": [d.as_dict() for d in self.failed]}
+
+
+@dataclass(frozen=True)
+class _Job:
+    """What every layout's planning shares (sent once per worker)."""
+
+    task: Dict[str, Any]
+    candidates: Tuple[Dict[str, Any], ...]
+    source: Optional[str]
+    layouts: Tuple[Tuple[int, ...], ...]
+
+
+def layout_task(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], source: Optional[str] = None) -> Task:
+    """The task of one layout: the design's task with these pushers."""
+    return parse_task({**task, "pushers": [dict(p) for p in pushers]}, source)
+
+
+def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: Optional[str] = None,
+           max_fixtures: int = 2, rank: Sequence[str] = DEFAULT_RANK, reach_top: int = 3,
+           runner: Optional[Runner] = None, progress: Optional[Callable[[Design], None]] = None) -> DesignStudy:
+    """Search the layouts of at most `max_fixtures` of `candidates` (schema.load_design) and rank
+    the solved ones by `rank` (keys of RANK_KEYS); the best `reach_top` get a reach map around the
+    goal. `progress(design)` after each layout is planned."""
+    if not 1 <= max_fixtures <= len(candidates):
+        raise TaskError("max_fixtures", f"must lie in 1-{len(candidates)} (the candidates), got {max_fixtures}")
+    everything = layout_task(task, candidates, source)  # every candidate checked once, on the part
+    useful = [i for i, c in enumerate(candidates) if _pushes_toward_goal(everything, c["name"])]
+    layouts = [combo for size in range(1, max_fixtures + 1)
+               for combo in itertools.combinations(range(len(candidates)), size) if set(combo) & set(useful)]
+    total = sum(math.comb(len(candidates), k) for k in range(1, max_fixtures + 1))
+    job = _Job(task, tuple(candidates), source, tuple(layouts))
+    runner = runner or Runner()
+    results: List[Design] = []
+    for i, result in run_all(_plan_layout, job, range(len(layouts)), runner):
+        if isinstance(result, WorkerLost):
+            result = Design(tuple(candidates[k]["name"] for k in layouts[i]), reason=f"worker lost: {result.why}")
+        results.append(result)
+        if progress is not None:
+            progress(result)
+    results.sort(key=lambda d: d.pushers)  # in the layouts' order, whichever worker finished first
+    solved = sorted((d for d in results if d.solved), key=lambda d: d.key(rank))
+    for d in solved[:reach_top]:
+        d.reach = _reach_near_goal(d.task, runner)
+    solved.sort(key=lambda d: d.key(rank))
+    return DesignStudy(candidates=[c["name"] for c in candidates], designs=solved,
+                       pruned_candidates=[c["name"] for i, c in enumerate(candidates) if i not in useful],
+                       layouts_searched=len(layouts), layouts_pruned=total - len(layouts), rank=tuple(rank),
+                       failed=[d for d in results if not d.solved])
+
+
+def _pushes_toward_goal(task: Task, pusher: str) -> bool:
+    """Whether `pusher` has a stable push from the start that brings the object nearer the goal
+    (in unit steps), in the task's uncertainty box when it has one."""
+    step_mm, step_deg = task.planner.step
+    to_goal = [(g - s) / u for g, s, u in zip(task.goal, task.start, (step_mm, step_mm, step_deg))]
+    pushes = stable_directions(task, task.start, pusher)["pushers"].get(pusher, [])
+    for push in pushes:
+        move = [m / u for m, u in zip(push["move"], (step_mm, step_mm, step_deg))]
+        if sum(a * b for a, b in zip(move, to_goal)) > 0:
+            return True
+    return False
+
+
+def _plan_layout(job: _Job, i: int) -> Design:
+    pushers = [job.candidates[k] for k in job.layouts[i]]
+    d = Design(tuple(p["name"] for p in pushers))
+    try:
+        d.task = layout_task(job.task, pushers, job.source)
+    except TaskError as exc:  # the goal's grasp or the part's checks refuse it with these pushers
+        d.reason = str(exc)
+        return d
+    plan = plan_task(d.task)
+    d.planning_time_s = plan.stats.get("planning_time_s")
+    if not plan.solved:
+        d.reason = plan.message or "not solved within the time limit"
+        return d
+    plan = check_plan(d.task, plan)
+    d.solved = True
+    d.pushes = len(plan.waypoints) - 1
+    d.switches = max(0, len(plan.pusher_sequence) - 1)
+    d.margin_n = plan_margin(d.task, plan)
+    for name, feature in place_features(d.task, list(plan.waypoints)).items():
+        T = feature.object_pose
+        d.features[name] = [float(T[0, 3] * 1e3), float(T[1, 3] * 1e3), float(T[2, 3] * 1e3),
+                            math.degrees(angle_about_y(T[:3, :3]))]
+    return d
+
+
+def _reach_near_goal(task: Task, runner: Runner) -> float:
+    """The share of goals on a REACH_CELLS x REACH_CELLS grid around the goal (REACH_SPAN
+    tolerances either side in x and z, the goal's theta) that the layout also reaches."""
+    tol = task.planner.tolerance[0] * REACH_SPAN
+    gx, gz, gt = task.goal
+    cells = reach_map(task, (gx - tol, gx + tol, REACH_CELLS), (gz - tol, gz + tol, REACH_CELLS), (gt, gt, 1),
+                      seed=task.planner.seed, time_limit=REACH_TIME_LIMIT, runner=runner).cells
+    return sum(1 for c in cells if c["solved"]) / len(cells)
