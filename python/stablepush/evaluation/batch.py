@@ -31,7 +31,7 @@ from stablepush.execution.run import run_plan
 from stablepush.execution.verdict import success_tolerance, tolerance_used, within
 from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
-from stablepush.runners import Runner, WorkerLost, run_all
+from stablepush.runners import Runner, WorkerLost, run_all, this_node
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.local_arm import SimulatedArm
 from stablepush.task.model import Task
@@ -122,9 +122,10 @@ def guard_of(batch: Batch) -> Optional[GuardedApproach]:
 def run_trial(batch: Batch, trial: int) -> dict:
     """Run trial `trial` and return its record. A trial whose arm faults is recorded with cause
     `arm_fault`, one that raises anything else as `crash` (`error` says what); neither ends the
-    batch. With `batch.video_dir`, the run is recorded in memory and, when the trial failed, drawn
-    into video_dir/trial-<i>.mp4 (`video`: its path; None for a trial that landed, or when it could
-    not be drawn, `video_error` then says why)."""
+    batch; `node` says where it ran (stablepush.runners.this_node). With `batch.video_dir`, the run
+    is recorded in memory and, when the trial failed, drawn into video_dir/trial-<i>.mp4 (`video`:
+    its path; None for a trial that landed, or when it could not be drawn, `video_error` then says
+    why)."""
     world = batch.world(trial)
     started = time.perf_counter()
     record = {"trial": trial, "world": world.as_dict()}
@@ -150,6 +151,7 @@ def run_trial(batch: Batch, trial: int) -> dict:
         where = f"{os.path.basename(last.filename)}:{last.lineno}"
         record.update(_not_run("crash", f"{type(exc).__name__}: {exc} ({where})"))
     record["wall_s"] = time.perf_counter() - started
+    record["node"] = this_node()
     if batch.video_dir:
         record["video"] = None if record["success"] else _failed_trial_video(batch, trial, world, recording, record)
     return record
@@ -178,7 +180,8 @@ def _not_run(cause: str, error: str) -> dict:
 
 
 def _crashed(batch: Batch, trial: int, why: str) -> dict:
-    return {"trial": trial, "world": batch.world(trial).as_dict(), **_not_run("crash", why), "wall_s": 0.0}
+    return {"trial": trial, "world": batch.world(trial).as_dict(), **_not_run("crash", why), "wall_s": 0.0,
+            "node": None}  # where it was lost is not known
 
 
 def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
@@ -268,6 +271,10 @@ class Evaluation:
             if not t["success"]:
                 causes[str(t["cause"])] = causes.get(str(t["cause"]), 0) + 1
         robot_time = sum(t["sim_time_s"] for t in self.trials)
+        nodes: Dict[str, int] = {}  # where the trials ran (a trial whose worker was lost has no node)
+        for t in self.trials:
+            if t["node"] is not None:
+                nodes[t["node"]] = nodes.get(t["node"], 0) + 1
         return {
             "task": self.batch.task.name, "trials": n, "requested": self.requested, "interrupted": self.interrupted,
             "successes": successes, "success_rate": successes / n if n else None,
@@ -281,7 +288,7 @@ class Evaluation:
             "tracker_noise": list(self.batch.spreads.tracker_noise),
             "goal_error_mm": _percentiles(distance), "goal_error_deg": _percentiles(angle),
             "causes": causes, "crashed": causes.get("crash", 0),
-            "wall_s": self.wall_s, "runner": self.runner,
+            "wall_s": self.wall_s, "runner": self.runner, "nodes": dict(sorted(nodes.items())),
             "robot_time_s": robot_time, "real_time_factor": robot_time / self.wall_s if self.wall_s > 0 else None,
             "decision": self.decision,
         }
@@ -316,7 +323,8 @@ class Evaluation:
                          f"confidence, {d['method']}), after the first {d['trials']} trials ({d['successes']} landed)")
         if s["causes"]:
             lines.append("misses: " + ", ".join(f"{cause} {count}" for cause, count in sorted(s["causes"].items())))
-        lines.append(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
+        over = f" over {len(s['nodes'])} nodes" if len(s["nodes"]) > 1 else ""
+        lines.append(f"{s['wall_s']:.1f} s on {s['runner']}{over}: {s['robot_time_s']:.0f} s of robot time, "
                      f"{s['real_time_factor']:.2f}x real time")
         if written:
             lines.append(f"written: {', '.join(written)}")
@@ -337,7 +345,7 @@ class Evaluation:
         header = (["trial", "success", "cause"] + list(VARY_KEYS)
                   + [f"{name}_{c}" for name in offsets for c in ("dx_mm", "dz_mm", "dtheta_deg")]
                   + [f"{short}_{c}" for _, short in errors for c in ("x_mm", "z_mm", "theta_deg", "distance_mm")]
-                  + ["replans", "sim_time_s", "wall_s", "verdict", "error"]
+                  + ["replans", "sim_time_s", "wall_s", "verdict", "error", "node"]
                   + (["video", "video_error"] if self.batch.video_dir else []))
         rows = []
         for t in self.trials:
@@ -345,7 +353,8 @@ class Evaluation:
             rows.append([t["trial"], t["success"], t["cause"] or ""] + [w[k] for k in VARY_KEYS]
                         + [v for name in offsets for v in w["feature_offsets"].get(name, ("", "", ""))]
                         + [(t[which] or {}).get(c, "") for which, _ in errors for c in ("x", "z", "theta", "distance")]
-                        + [t["replans"], t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or ""]
+                        + [t["replans"], t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or "",
+                           t["node"] or ""]
                         + ([t.get("video") or "", t.get("video_error") or ""] if self.batch.video_dir else []))
         return header, rows
 
