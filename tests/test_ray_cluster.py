@@ -114,29 +114,29 @@ def test_reach_on_a_two_node_cluster_gives_the_map_of_one_worker_and_names_each_
 
 class _Watch:
     """Which trials each node runs, sampled every 50 ms from its workers' process titles; kills the
-    second node's raylet once a trial has run on it for `after_s`."""
+    second node's raylet once it has finished `finished` trials and run another for `after_s`."""
 
-    def __init__(self, cluster: Cluster, after_s: float = 0.5):
-        self.cluster, self.after_s = cluster, after_s
+    def __init__(self, cluster: Cluster, finished: int = 1, after_s: float = 0.5):
+        self.cluster, self.finished, self.after_s = cluster, finished, after_s
         self.seen = {k: {} for k in range(len(cluster.nodes))}  # node -> trial name -> first seen [s]
         self.killed_at, self.in_flight = None, []
 
     def sample(self, now: float) -> None:
+        running = {}
         for k, node in enumerate(self.cluster.nodes):
-            if k == 1 and self.killed_at is not None:
-                continue
-            for name in node.task_names("run_trial["):
+            running[k] = node.task_names("run_trial[") if k == 0 or self.killed_at is None else []
+            for name in running[k]:
                 self.seen[k].setdefault(name, now)
-        running = self.cluster.nodes[1].task_names("run_trial[") if self.killed_at is None else []
-        if running and min(now - self.seen[1][n] for n in running) >= self.after_s:
+        ready = len(self.seen[1]) - len(running[1]) >= self.finished
+        if running[1] and ready and min(now - self.seen[1][n] for n in running[1]) >= self.after_s:
             os.kill(self.cluster.nodes[1].raylet_pid(), signal.SIGKILL)
-            self.killed_at, self.in_flight = now, sorted(running)
+            self.killed_at, self.in_flight = now, sorted(running[1])
 
 
 def test_a_node_lost_mid_study_costs_no_trial_and_counts_none_twice(one_worker):
     cluster = Cluster(nodes=2, num_cpus=1)  # its own: this test kills a node
     try:
-        head_id = cluster.nodes[0].node_id()
+        head_id, lost_id = cluster.nodes[0].node_id(), cluster.nodes[1].node_id()
         task = shipped("horizontal-offset-low-mu")
         batch = Batch(task=task, plan=check_plan(task, plan_task(task)), spreads=SPREADS, seed=1)  # as the CLI's
         done = {}
@@ -150,15 +150,19 @@ def test_a_node_lost_mid_study_costs_no_trial_and_counts_none_twice(one_worker):
         assert not study.is_alive(), "the study did not end within 120 s of losing a node"
     finally:
         cluster.stop()
-    assert watch.killed_at is not None, "no trial ran on the second node: nothing was lost"
+    assert watch.killed_at is not None, "the second node ran too few trials: nothing was lost"
     trials = done["result"].trials
     assert [t["trial"] for t in trials] == list(range(TRIALS))  # each trial once
     assert not [t for t in trials if t["cause"] == "crash"] and done["result"].summary()["crashed"] == 0
     assert [_outcome(t) for t in trials] == [_outcome(t) for t in one_worker]
     retried = [name for name in watch.in_flight if watch.seen[0].get(name, -1) > watch.killed_at]
     assert retried == watch.in_flight  # each trial in flight on the lost node ran again on the head
+    number = {name: int(name[len("run_trial["):-1]) for name in watch.seen[1]}
     for name in watch.in_flight:
-        assert trials[int(name[len("run_trial["):-1])]["node"].endswith(head_id)
-    print(f"\nnode lost {watch.killed_at:.1f} s into the study, running {watch.in_flight}; run again on the head at "
-          f"{[round(watch.seen[0][n], 1) for n in retried]} s; {len(trials)} trials, each once, none crashed; "
+        assert trials[number[name]]["node"].endswith(head_id)
+    finished = sorted(number[n] for n in watch.seen[1] if n not in watch.in_flight)  # before the node was lost
+    assert finished and all(trials[i]["node"].endswith(lost_id) for i in finished)  # kept, not run again
+    print(f"\nnode lost {watch.killed_at:.1f} s into the study, after trials {finished}, running {watch.in_flight}; "
+          f"run again on the head at {[round(watch.seen[0][n], 1) for n in retried]} s; {len(trials)} trials, each "
+          f"once, none crashed; "
           f"{done['result'].wall_s:.1f} s; per node: {done['result'].summary()['nodes']}")
