@@ -158,7 +158,7 @@ def test_the_summary_follows_from_the_trials():
     """success_rate = successes / trials; ci95 is Wilson's interval (checked against its formula)."""
     trials = [{"trial": i, "success": i % 4 != 0, "cause": None if i % 4 else "pusher_slipped",
                "goal_error": {"x": 0.1 * i, "z": 0.0, "theta": -0.01 * i, "distance": 0.1 * i}, "sim_time_s": 2.0,
-               "world": {}, "node": "local:test"} for i in range(40)]
+               "world": {}} for i in range(40)]
     evaluation = Evaluation(batch=_batch(), trials=trials, wall_s=4.0, runner="this process", requested=40)
     s = evaluation.summary()
     assert (s["trials"], s["successes"]) == (40, 30) and s["success_rate"] == 0.75

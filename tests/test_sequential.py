@@ -50,7 +50,7 @@ def _synthetic(rate, seed=7):
         landed = bool(np.random.default_rng([seed, i]).random() < rate)
         return {"trial": i, "world": {"feature_offsets": {}}, "success": landed, "cause": None if landed else "drift",
                 "goal_error": {"x": 0.0, "z": 0.0, "theta": 0.0, "distance": 0.0}, "final_error": None,
-                "replans": 0, "sim_time_s": 1.0, "wall_s": 0.0, "verdict": "", "error": None, "node": "local:test"}
+                "replans": 0, "sim_time_s": 1.0, "wall_s": 0.0, "verdict": "", "error": None}
     return run_trial
 
 

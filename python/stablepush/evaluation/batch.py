@@ -271,9 +271,9 @@ class Evaluation:
             if not t["success"]:
                 causes[str(t["cause"])] = causes.get(str(t["cause"]), 0) + 1
         robot_time = sum(t["sim_time_s"] for t in self.trials)
-        nodes: Dict[str, int] = {}  # where the trials ran (a trial whose worker was lost has no node)
+        nodes: Dict[str, int] = {}  # where the trials ran; a trial whose worker was lost has no node (None)
         for t in self.trials:
-            if t["node"] is not None:
+            if t.get("node") is not None:
                 nodes[t["node"]] = nodes.get(t["node"], 0) + 1
         return {
             "task": self.batch.task.name, "trials": n, "requested": self.requested, "interrupted": self.interrupted,
@@ -354,7 +354,7 @@ class Evaluation:
                         + [v for name in offsets for v in w["feature_offsets"].get(name, ("", "", ""))]
                         + [(t[which] or {}).get(c, "") for which, _ in errors for c in ("x", "z", "theta", "distance")]
                         + [t["replans"], t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or "",
-                           t["node"] or ""]
+                           t.get("node") or ""]
                         + ([t.get("video") or "", t.get("video_error") or ""] if self.batch.video_dir else []))
         return header, rows
 
