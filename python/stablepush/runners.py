@@ -6,11 +6,14 @@ runs.
 A job is `job(shared, i)` for i in the batch's indices: a module-level function (so that workers
 can import it), `shared` picklable and sent once per worker (Ray: once per cluster, `ray.put`).
 Results arrive as they finish, as (i, result); a job whose worker died arrives as (i, WorkerLost).
+On Ray a job lost with its worker or node (not one that raised) is run again, up to RAY_TASK_RETRIES
+times, on the nodes left, and arrives once. `this_node()` says, inside a job, which node runs it.
 """
 from __future__ import annotations
 
 import contextlib
 import os
+import socket
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from typing import Any, Callable, Iterable, Iterator, Optional, Tuple
@@ -24,6 +27,11 @@ RAY_CONNECT_TIMEOUT_S = 5.0
 # Local worker processes per CPU at most: each job keeps a CPU busy (a simulation, a search), so
 # more only share the CPUs (and each costs a process's memory); `--workers 1000` started 1,000.
 WORKERS_PER_CPU = 2
+# How many times Ray runs a job again whose worker process or node was lost (a job that raises is
+# not run again: its error is its result). Each index still arrives once.
+RAY_TASK_RETRIES = 3
+# The node the Ray job running in this process is on ("ray:IP/NODE_ID"); None outside a Ray job.
+_ray_node: Optional[str] = None
 
 
 def check_ray_address(address: Optional[str]) -> Optional[str]:
@@ -89,6 +97,21 @@ class WorkerLost:
     why: str
 
 
+def this_node() -> str:
+    """Where the job calling it runs: "ray:IP/NODE_ID" on a Ray node (its IP and Ray's node id, as
+    `ray status` and `ray list nodes` name it), else "local:HOSTNAME" (this process or a local
+    worker process)."""
+    return _ray_node or f"local:{socket.gethostname()}"
+
+
+def _on_ray_node(job: Job, shared: Any, i: int) -> Any:
+    """job(shared, i) as a Ray task, with this_node() naming the node it runs on."""
+    ray = require("ray", "a Ray task")
+    global _ray_node
+    _ray_node = f"ray:{ray.util.get_node_ip_address()}/{ray.get_runtime_context().get_node_id()}"
+    return job(shared, i)
+
+
 def run_all(job: Job, shared: Any, indices: Iterable[int], runner: Runner) -> Iterator[Tuple[int, Any]]:
     """Run job(shared, i) for every index on `runner`, yielding (i, result) as each finishes.
     Closing the iterator (or Ctrl-C in the caller) cancels the jobs not yet started."""
@@ -136,9 +159,11 @@ def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterat
     if started_here:
         _join_ray(ray, address)
     try:
-        remote = ray.remote(max_retries=0)(job)
+        # Retried where its worker or node was lost (the job ran again on a node left), not where it raised.
+        remote = ray.remote(max_retries=RAY_TASK_RETRIES, retry_exceptions=False)(_on_ray_node)
         shared_ref = ray.put(shared)
-        refs = {remote.remote(shared_ref, i): i for i in indices}
+        name = getattr(job, "__name__", "job")
+        refs = {remote.options(name=f"{name}[{i}]").remote(job, shared_ref, i): i for i in indices}
         try:
             while refs:
                 done, _ = ray.wait(list(refs), num_returns=1)
@@ -146,7 +171,7 @@ def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterat
                     i = refs.pop(ref)
                     try:
                         result = ray.get(ref)
-                    except ray.exceptions.RayError as exc:  # the worker died, or Ray lost the task
+                    except ray.exceptions.RayError as exc:  # lost RAY_TASK_RETRIES + 1 times, or it raised
                         result = WorkerLost(f"{type(exc).__name__}: {str(exc)[:200]}")
                     yield i, result
         except BaseException:

@@ -31,7 +31,7 @@ from stablepush.execution.run import run_plan
 from stablepush.execution.verdict import success_tolerance, tolerance_used, within
 from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
-from stablepush.runners import Runner, WorkerLost, run_all
+from stablepush.runners import Runner, WorkerLost, run_all, this_node
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.local_arm import SimulatedArm
 from stablepush.task.model import Task
@@ -123,10 +123,10 @@ def guard_of(batch: Batch) -> Optional[GuardedApproach]:
 def run_trial(batch: Batch, trial: int) -> dict:
     """Run trial `trial` and return its record. A trial whose arm faults is recorded with cause
     `arm_fault` (a miss), one that raises anything else as `crash` (`error` says what: an internal
-    error, not a miss; Evaluation.summary leaves it out of the rate); neither ends the batch. With
-    `batch.video_dir`, the run is recorded in memory and, when the trial failed, drawn into
-    video_dir/trial-<i>.mp4 (`video`: its path; None for a trial that landed, or when it could
-    not be drawn, `video_error` then says why)."""
+    error, not a miss; Evaluation.summary leaves it out of the rate); neither ends the batch; `node`
+    says where it ran (stablepush.runners.this_node). With `batch.video_dir`, the run is recorded in
+    memory and, when the trial failed, drawn into video_dir/trial-<i>.mp4 (`video`: its path; None
+    for a trial that landed, or when it could not be drawn, `video_error` then says why)."""
     world = batch.world(trial)
     started = time.perf_counter()
     record = {"trial": trial, "world": world.as_dict()}
@@ -152,6 +152,7 @@ def run_trial(batch: Batch, trial: int) -> dict:
         where = f"{os.path.basename(last.filename)}:{last.lineno}"
         record.update(_not_run("crash", f"{type(exc).__name__}: {exc} ({where})"))
     record["wall_s"] = time.perf_counter() - started
+    record["node"] = this_node()
     if batch.video_dir:
         record["video"] = None if record["success"] else _failed_trial_video(batch, trial, world, recording, record)
     return record
@@ -185,7 +186,8 @@ def crashed(record: dict) -> bool:
 
 
 def _crashed(batch: Batch, trial: int, why: str) -> dict:
-    return {"trial": trial, "world": batch.world(trial).as_dict(), **_not_run("crash", why), "wall_s": 0.0}
+    return {"trial": trial, "world": batch.world(trial).as_dict(), **_not_run("crash", why), "wall_s": 0.0,
+            "node": None}  # where it was lost is not known
 
 
 def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
@@ -283,6 +285,10 @@ class Evaluation:
             if not t["success"] and not crashed(t):
                 causes[str(t["cause"])] = causes.get(str(t["cause"]), 0) + 1
         robot_time = sum(t["sim_time_s"] for t in self.trials)
+        nodes: Dict[str, int] = {}  # where the trials ran; a trial whose worker was lost has no node (None)
+        for t in self.trials:
+            if t.get("node") is not None:
+                nodes[t["node"]] = nodes.get(t["node"], 0) + 1
         return {
             "task": self.batch.task.name, "trials": n, "requested": self.requested, "interrupted": self.interrupted,
             "judged": judged, "successes": successes, "success_rate": successes / judged if judged else None,
@@ -296,7 +302,7 @@ class Evaluation:
             "tracker_noise": list(self.batch.spreads.tracker_noise),
             "goal_error_mm": _percentiles(distance), "goal_error_deg": _percentiles(angle),
             "causes": causes, "crashed": len(crashes), "crashed_trials": crashes,
-            "wall_s": self.wall_s, "runner": self.runner,
+            "wall_s": self.wall_s, "runner": self.runner, "nodes": dict(sorted(nodes.items())),
             "robot_time_s": robot_time, "real_time_factor": robot_time / self.wall_s if self.wall_s > 0 else None,
             "decision": self.decision,
         }
@@ -338,7 +344,8 @@ class Evaluation:
             lines.append(f"crashed: {s['crashed']} of {s['trials']} trials (internal errors, not misses: left out of "
                          f"the rate; each trial's `error` says what), the first, trial {first['trial']}: "
                          f"{first['error']}")
-        lines.append(f"{s['wall_s']:.1f} s on {s['runner']}: {s['robot_time_s']:.0f} s of robot time, "
+        over = f" over {len(s['nodes'])} nodes" if len(s["nodes"]) > 1 else ""
+        lines.append(f"{s['wall_s']:.1f} s on {s['runner']}{over}: {s['robot_time_s']:.0f} s of robot time, "
                      f"{s['real_time_factor']:.2f}x real time")
         if written:
             lines.append(f"written: {', '.join(written)}")
@@ -359,7 +366,7 @@ class Evaluation:
         header = (["trial", "success", "cause"] + list(VARY_KEYS)
                   + [f"{name}_{c}" for name in offsets for c in ("dx_mm", "dz_mm", "dtheta_deg")]
                   + [f"{short}_{c}" for _, short in errors for c in ("x_mm", "z_mm", "theta_deg", "distance_mm")]
-                  + ["replans", "sim_time_s", "wall_s", "verdict", "error"]
+                  + ["replans", "sim_time_s", "wall_s", "verdict", "error", "node"]
                   + (["video", "video_error"] if self.batch.video_dir else []))
         rows = []
         for t in self.trials:
@@ -367,7 +374,8 @@ class Evaluation:
             rows.append([t["trial"], t["success"], t["cause"] or ""] + [w[k] for k in VARY_KEYS]
                         + [v for name in offsets for v in w["feature_offsets"].get(name, ("", "", ""))]
                         + [(t[which] or {}).get(c, "") for which, _ in errors for c in ("x", "z", "theta", "distance")]
-                        + [t["replans"], t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or ""]
+                        + [t["replans"], t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or "",
+                           t.get("node") or ""]
                         + ([t.get("video") or "", t.get("video_error") or ""] if self.batch.video_dir else []))
         return header, rows
 

@@ -119,10 +119,13 @@ def at_start_verdict(task: Task) -> dict:
 
 
 def reach_cell(job: ReachJob, i: int) -> dict:
-    """Plan cell i of the map and give its verdict (module docstring)."""
+    """Plan cell i of the map and give its verdict (module docstring); `node` says where it was
+    planned (stablepush.runners.this_node)."""
+    from stablepush.runners import this_node
+
     goal = job.goals[i]
     cell = {"goal": list(goal), "seed": job.seed, "solved": False, "planning_time_s": 0.0, "switches": None,
-            "pushes": None, "outcome": None, "verdict": None, "reason": None}
+            "pushes": None, "outcome": None, "verdict": None, "reason": None, "node": this_node()}
     task = dataclasses.replace(job.task, goal=tuple(goal))
     off = pads_off_near(task, goal)
     if off:
@@ -148,7 +151,7 @@ def reach_cell(job: ReachJob, i: int) -> dict:
 class ReachMap:
     """A reach map: the task's name and start, the grid's axes, the seed and each cell's time limit
     [s], its cells in the order of ReachJob.goals (each a dict: goal, verdict, reason, solved, seed,
-    planning_time_s, switches, pushes, outcome), the wall time [s] and the runner that planned it."""
+    planning_time_s, switches, pushes, outcome, node), the wall time [s] and the runner that planned it."""
 
     task: str
     start: Tuple[float, float, float]
@@ -190,7 +193,7 @@ def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_lim
         if isinstance(cell, WorkerLost):
             cell = {"goal": list(job.goals[i]), "seed": job.seed, "solved": False, "planning_time_s": 0.0,
                     "switches": None, "pushes": None, "outcome": "worker_lost", "verdict": "not found",
-                    "reason": cell.why}
+                    "reason": cell.why, "node": None}
         cells[i] = cell
         if progress is not None:
             progress(cell)

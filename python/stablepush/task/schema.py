@@ -402,7 +402,8 @@ def candidate_pushers(value: Any, task: Mapping[str, Any], source: Optional[str]
     return candidates
 
 
-CORNER_INSET = 1.0  # mm along an edge from a corner, where a corner's point-pusher candidates sit (at most a quarter of it)
+# mm along an edge from a corner where its point-pusher candidates sit (at most a quarter of the edge)
+CORNER_INSET = 1.0
 
 
 def _toward(corner, neighbour) -> List[float]:
