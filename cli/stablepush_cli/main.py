@@ -15,6 +15,7 @@ from stablepush_cli.commands import (
     check,
     check_cell,
     cone,
+    design,
     evaluate,
     execute,
     plan,
@@ -78,8 +79,8 @@ def cli() -> None:
     """
 
 
-for command in (bench.bench, check.check, check_cell.check_cell, cone.cone, evaluate.evaluate, execute.execute,
-                plan.plan, reach.reach, show.show, sim_arm.sim_arm, trajectory.trajectory):
+for command in (bench.bench, check.check, check_cell.check_cell, cone.cone, design.design, evaluate.evaluate,
+                execute.execute, plan.plan, reach.reach, show.show, sim_arm.sim_arm, trajectory.trajectory):
     cli.add_command(command)
 
 

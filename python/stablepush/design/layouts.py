@@ -121,6 +121,7 @@ class _Job:
     candidates: Tuple[Dict[str, Any], ...]
     source: Optional[str]
     layouts: Tuple[Tuple[int, ...], ...]
+    time_limit: Optional[float]
 
 
 def layout_task(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], source: Optional[str] = None) -> Task:
@@ -130,18 +131,21 @@ def layout_task(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], source:
 
 def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: Optional[str] = None,
            max_fixtures: int = 2, rank: Sequence[str] = DEFAULT_RANK, reach_top: int = 3,
-           runner: Optional[Runner] = None, progress: Optional[Callable[[Design], None]] = None) -> DesignStudy:
-    """Search the layouts of at most `max_fixtures` of `candidates` (schema.load_design) and rank
-    the solved ones by `rank` (keys of RANK_KEYS); the best `reach_top` get a reach map around the
-    goal. `progress(design)` after each layout is planned."""
-    if not 1 <= max_fixtures <= len(candidates):
-        raise TaskError("max_fixtures", f"must lie in 1-{len(candidates)} (the candidates), got {max_fixtures}")
+           time_limit: Optional[float] = None, runner: Optional[Runner] = None,
+           progress: Optional[Callable[[Design], None]] = None) -> DesignStudy:
+    """Search the layouts of at most `max_fixtures` of `candidates` (schema.load_design), each
+    planned within `time_limit` s (None: the task's planner.time_limit), and rank the solved ones
+    by `rank` (keys of RANK_KEYS); the best `reach_top` get a reach map around the goal.
+    `progress(design)` after each layout is planned."""
+    if max_fixtures < 1:
+        raise TaskError("max_fixtures", f"must be at least 1, got {max_fixtures}")
+    max_fixtures = min(max_fixtures, len(candidates))
     everything = layout_task(task, candidates, source)  # every candidate checked once, on the part
     useful = [i for i, c in enumerate(candidates) if _pushes_toward_goal(everything, c["name"])]
     layouts = [combo for size in range(1, max_fixtures + 1)
                for combo in itertools.combinations(range(len(candidates)), size) if set(combo) & set(useful)]
     total = sum(math.comb(len(candidates), k) for k in range(1, max_fixtures + 1))
-    job = _Job(task, tuple(candidates), source, tuple(layouts))
+    job = _Job(task, tuple(candidates), source, tuple(layouts), time_limit)
     runner = runner or Runner()
     results: List[Design] = []
     for i, result in run_all(_plan_layout, job, range(len(layouts)), runner):
@@ -175,14 +179,21 @@ def _pushes_toward_goal(task: Task, pusher: str) -> bool:
 
 
 def _plan_layout(job: _Job, i: int) -> Design:
-    pushers = [job.candidates[k] for k in job.layouts[i]]
+    return measure_layout(job.task, [job.candidates[k] for k in job.layouts[i]], job.source, job.time_limit)
+
+
+def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], source: Optional[str] = None,
+                   time_limit: Optional[float] = None) -> Design:
+    """One layout planned (within `time_limit` s; None: the task's) and checked, with what the
+    ranking reads: pushes, switch-overs, planning time, the least margin and the fixtures' places.
+    A task's own pushers measured so can be ranked among the designs."""
     d = Design(tuple(p["name"] for p in pushers))
     try:
-        d.task = layout_task(job.task, pushers, job.source)
+        d.task = layout_task(task, pushers, source)
     except TaskError as exc:  # the goal's grasp or the part's checks refuse it with these pushers
         d.reason = str(exc)
         return d
-    plan = plan_task(d.task)
+    plan = plan_task(d.task, time_limit=time_limit)
     d.planning_time_s = plan.stats.get("planning_time_s")
     if not plan.solved:
         d.reason = plan.message or "not solved within the time limit"
@@ -207,3 +218,13 @@ def _reach_near_goal(task: Task, runner: Runner) -> float:
     cells = reach_map(task, (gx - tol, gx + tol, REACH_CELLS), (gz - tol, gz + tol, REACH_CELLS), (gt, gt, 1),
                       seed=task.planner.seed, time_limit=REACH_TIME_LIMIT, runner=runner).cells
     return sum(1 for c in cells if c["solved"]) / len(cells)
+
+
+def design_task(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], d: Design) -> Dict[str, Any]:
+    """A design as a complete task in the task file's form: the design file's task with the
+    layout's pushers, and environment.features where its plan puts each fixture (what `plan`,
+    `execute` and `evaluate` take unchanged)."""
+    by_name = {c["name"]: c for c in candidates}
+    environment = dict(task.get("environment") or {})
+    environment["features"] = {name: [round(v, 6) for v in pose] for name, pose in d.features.items()}
+    return {**task, "pushers": [dict(by_name[name]) for name in d.pushers], "environment": environment}

@@ -1,0 +1,103 @@
+"""`stablepush design`."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from stablepush_cli.common import (
+    EXIT_NOT_SOLVED,
+    check_named_outputs,
+    progressbar,
+    runner_for,
+    say_beside,
+)
+from stablepush_cli.options import (
+    TIME_LIMIT,
+    Whole,
+    parse_ray_address,
+)
+
+
+@click.command()
+@click.argument("design_file", metavar="DESIGN.yaml", type=click.Path(dir_okay=False))
+@click.option("--max-fixtures", default=2, show_default=True, type=Whole(min=1, max=4), metavar="K",
+              help="Layouts of 1 to K fixtures.")
+@click.option("--rank", "rank_text", default=None, metavar="KEYS",
+              help="The ranking rule: keys, most important first, from fixtures, switches, pushes (fewer first), "
+                   "margin, reach (more first) and time. Default: fixtures,switches,margin,pushes,reach,time.")
+@click.option("--time-limit", default=2.0, show_default=True, type=TIME_LIMIT, metavar="S",
+              help="Each layout's search time (the task's planner.time_limit is not used: there are many layouts).")
+@click.option("--reach-top", default=3, show_default=True, type=Whole(min=0, max=100), metavar="N",
+              help="The best N designs get a 3x3 reach map around the goal (2 tolerances either side in x and z), "
+                   "and are ranked again with it.")
+@click.option("--out", "out_dir", default=None, type=click.Path(file_okay=False), metavar="DIR",
+              help="Where each design's task file goes (design-1.yaml is the best). Default: DESIGN.designs/ "
+                   "beside the design file.")
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+              help="Write the ranked designs (`designs`, best first, each with its `task_file`), the unsolved "
+                   "layouts and the verdict.")
+@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
+              help="Plan the layouts on K local processes (default: the number of CPUs).")
+@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              callback=parse_ray_address, help="Plan the layouts on Ray: a local instance, or the cluster at ADDRESS.")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, reach_top: int, out_dir, json_path,
+           workers, ray_address, quiet: bool) -> None:
+    """Find where the fixtures should go: rank layouts of candidate pushers by their plans.
+
+    DESIGN.yaml is a task file whose `candidates` stand in for its `pushers`: `candidates: {mu:
+    0.5}` makes every edge of the part's section a segment pusher and puts two point pushers
+    beside every convex corner, with that mu; a list of pusher entries gives them. Each layout of
+    up to --max-fixtures candidates whose pushers can push the object toward the goal from the
+    start is planned (robust where the task has an uncertainty box) and checked; the solved ones
+    are ranked (--rank) and written as complete task files, with the features where the plan puts
+    them (environment.features), that `plan`, `execute` and `evaluate` take unchanged. Exit 1 when
+    no layout of the candidates can do the regrasp, with the reason.
+
+    \b
+    Example:
+      stablepush design data/designs/offset-low-mu.design.yaml --json offset.designs.json
+      stablepush plan data/designs/offset-low-mu.designs/design-1.yaml -o best.plan.json
+    """
+    import yaml
+
+    from stablepush.design import DEFAULT_RANK, design_task, parse_rank
+    from stablepush.design import design as search
+    from stablepush.outputs import write_files
+    from stablepush.runners import default_workers
+    from stablepush.task.schema import load_design
+
+    rank = parse_rank(rank_text) if rank_text is not None else DEFAULT_RANK
+    out = Path(out_dir) if out_dir is not None else Path(design_file).with_suffix(".designs")
+    check_named_outputs({"--json": json_path}, {"DESIGN.yaml": design_file})
+    task, candidates = load_design(design_file)
+    runner = runner_for(workers, ray_address, default=default_workers())
+    bar = progressbar(quiet, length=None, label="layouts planned", show_pos=True)
+    try:
+        study = search(task, candidates, source=design_file, max_fixtures=max_fixtures, rank=rank,
+                       reach_top=reach_top, time_limit=time_limit, runner=runner,
+                       progress=(lambda d: bar.update(1)) if bar else None)
+    finally:
+        if bar is not None:
+            bar.render_finish()
+    files = {}
+    for k, d in enumerate(study.designs, start=1):
+        d.task_file = str(out / f"design-{k}.yaml")
+        files[d.task_file] = yaml.safe_dump(design_task(task, candidates, d), sort_keys=False)
+    if json_path is not None:
+        files[json_path] = json.dumps(study.as_dict(), indent=1) + "\n"
+    if study.designs:
+        out.mkdir(parents=True, exist_ok=True)
+    write_files(files)
+    say = say_beside(json_path)
+    say(f"{len(candidates)} candidates, {study.layouts_searched} layouts planned, {study.layouts_pruned} pruned "
+        f"(no stable push toward the goal from the start: {', '.join(study.pruned_candidates) or 'none'})")
+    for k, d in enumerate(study.designs, start=1):
+        reach = f"{d.reach:.0%}" if d.reach is not None else "-"
+        say(f"{k}. {' + '.join(d.pushers)}: {d.pushes} pushes, {d.switches} switch-overs, margin {d.margin_n:.3f} N, "
+            f"reach near the goal {reach}, planned in {d.planning_time_s:.3f} s -> {d.task_file}")
+    say(study.verdict)
+    if not study.designs:
+        raise SystemExit(EXIT_NOT_SOLVED)

@@ -1,0 +1,160 @@
+"""`stablepush design`: fixture layouts from candidates. Every design it reports plans again from
+its own task file and each push of the plan agrees with the independent LP (tests/independent_lp.py);
+on generated parts, grips and goals too; a regrasp no layout can do is said to be so, with the
+reason; the shipped offset's design is at least as good as the task's own layout by the ranking."""
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from click.testing import CliRunner
+
+import stablepush as sp
+from stablepush.design import DEFAULT_RANK, design, design_task, measure_layout
+from stablepush.errors import TaskError
+from stablepush.runners import Runner
+from stablepush.task.schema import load_design
+from stablepush.units import pose_to_si
+from stablepush_cli.main import cli
+
+from conftest import ROOT, TASKS
+from independent_lp import IndependentModel
+
+DESIGN = ROOT / "data" / "designs" / "offset-low-mu.design.yaml"
+BAND_N = 1e-6  # N: pushes this close to their cone's boundary are not compared with the LP
+
+
+def _agrees_with_the_independent_lp(task, plan) -> None:
+    reference = IndependentModel(task)
+    model = task.build_model()
+    for w0, w1 in zip(plan.waypoints, plan.waypoints[1:]):
+        q0, q1 = pose_to_si(w0.pose), pose_to_si(w1.pose)
+        dq = tuple(b - a for a, b in zip(q0, q1))
+        index = task.pusher_index(w1.pusher)
+        if abs(model.check(q0, dq, index).margin) <= BAND_N:
+            continue
+        assert reference.stable(q0, dq, index)[0], (w0.pose, w1.pose, w1.pusher)
+
+
+def _replanned_and_verified(task_mapping: dict, source) -> None:
+    """The design's task file as written, planned again and every push checked by the LP."""
+    task = sp.parse_task(yaml.safe_dump(task_mapping), str(source))
+    plan = sp.plan_task(task, time_limit=2)
+    assert plan.solved, plan.message
+    sp.check_plan(task, plan)
+    _agrees_with_the_independent_lp(task, plan)
+
+
+def test_candidates_are_the_sections_edges_and_points_beside_its_convex_corners():
+    task, candidates = load_design(DESIGN)
+    names = [c["name"] for c in candidates]
+    assert names[:4] == ["edge0", "edge1", "edge2", "edge3"] and len(names) == 4 + 8
+    corner = next(c for c in candidates if c["name"] == "corner0b")  # 1 mm from (-50, -12.5) toward (50, -12.5)
+    assert corner["at"] == pytest.approx([-49.0, -12.5]) and corner["mu"] == 0.2
+    assert "pushers" not in task
+
+
+@pytest.mark.slow
+def test_the_offset_design_is_at_least_as_good_as_the_tasks_own_layout_and_verifies(tmp_path):
+    task, candidates = load_design(DESIGN)
+    study = design(task, candidates, source=str(DESIGN), time_limit=2.0, reach_top=0, runner=Runner(workers=2))
+    assert study.designs, study.verdict
+    own_task = yaml.safe_load((TASKS / "horizontal-offset-low-mu.yaml").read_text())
+    own = measure_layout(task, own_task["pushers"], str(DESIGN), time_limit=2.0)
+    assert own.solved and study.designs[0].key(DEFAULT_RANK) <= own.key(DEFAULT_RANK), (study.designs[0], own)
+    for d in study.designs:
+        _replanned_and_verified(design_task(task, candidates, d), DESIGN)
+
+
+def _generated_design(rng) -> dict:
+    """A convex part (4-6 corners, 50-120 mm), gripped at its middle by two small pads, a goal a few
+    mm and degrees away; every edge and corner of it a candidate."""
+    n = int(rng.integers(4, 7))
+    # spread round the origin (every gap under half a turn), so the part holds the pads' centre
+    angles = (np.arange(n) + rng.uniform(-0.3, 0.3, n)) * 2 * math.pi / n
+    radius = rng.uniform(25, 60)
+    polygon = [[round(float(radius * rng.uniform(0.8, 1.0) * math.cos(a)), 3),
+                round(float(radius * rng.uniform(0.8, 1.0) * math.sin(a)), 3)] for a in angles]
+    return {
+        "name": "generated",
+        "object": {"shape": "polygon", "polygon": polygon, "thickness": 20, "mass": float(rng.uniform(80, 300))},
+        "gripper": {"grip_force": float(rng.uniform(8, 20)), "mu": float(rng.uniform(0.4, 0.8)),
+                    "pads": [{"center": [0, 0], "radius": 5}, {"center": [0, 0], "radius": 5}]},
+        "gravity": [0, -9.81],
+        "candidates": {"mu": float(rng.uniform(0.3, 0.8))},
+        "start": [0, 0, 0],
+        "goal": [round(float(rng.uniform(-8, 8)), 2), round(float(rng.uniform(-5, 5)), 2),
+                 round(float(rng.uniform(-15, 15)), 1)],
+        "planner": {"tolerance": [1, 1]},
+    }
+
+
+@pytest.mark.parametrize("seed", [3, 8, 21])
+def test_every_design_of_a_generated_part_plans_and_verifies(tmp_path, seed):
+    rng = np.random.default_rng(seed)
+    path = tmp_path / "generated.design.yaml"
+    path.write_text(yaml.safe_dump(_generated_design(rng)))
+    try:
+        task, candidates = load_design(path)
+    except TaskError as exc:  # a draw whose goal leaves the pads off the part: refused by name, as a task is
+        assert exc.field.startswith(("goal", "object")), exc
+        return
+    study = design(task, candidates, source=str(path), max_fixtures=1, time_limit=0.5, reach_top=0)
+    if not study.designs:
+        assert study.verdict.startswith("no layout of the candidates can do it: "), study.verdict
+        return
+    for d in study.designs:
+        assert d.solved and d.margin_n >= 0 and len(d.features) == len(d.pushers)
+        _replanned_and_verified(design_task(task, candidates, d), path)
+
+
+def test_a_regrasp_no_layout_can_do_is_said_so_with_the_reason(tmp_path):
+    data = yaml.safe_load(DESIGN.read_text())
+    data["candidates"] = [{"name": "right", "from": [50, -12.5], "to": [50, 12.5], "mu": 0.2}]
+    path = tmp_path / "right-only.design.yaml"
+    path.write_text(yaml.safe_dump(data))
+    result = CliRunner().invoke(cli, ["design", str(path), "--quiet", "--json", str(tmp_path / "d.json")])
+    assert result.exit_code == 1, result.output
+    assert ("no layout of the candidates can do it: none of them (right) has a stable push from the start toward "
+            "the goal") in result.output
+    assert yaml.safe_load((tmp_path / "d.json").read_text())["designs"] == []
+
+
+def test_the_design_command_writes_task_files_that_plan_unchanged(tmp_path):
+    data = yaml.safe_load(DESIGN.read_text())
+    data["candidates"] = [{"name": "left", "from": [-50, -12.5], "to": [-50, 12.5], "mu": 0.2},
+                          {"name": "bottom", "from": [-50, -12.5], "to": [50, -12.5], "mu": 0.2}]
+    path = tmp_path / "two.design.yaml"
+    path.write_text(yaml.safe_dump(data))
+    out = tmp_path / "designs"
+    runner = CliRunner()
+    result = runner.invoke(cli, ["design", str(path), "--quiet", "--out", str(out), "--json", str(tmp_path / "d.json"),
+                                 "--reach-top", "1"])
+    assert result.exit_code == 0, result.output
+    report = yaml.safe_load((tmp_path / "d.json").read_text())
+    best = report["designs"][0]
+    assert best["pushers"] == ["left", "bottom"] and best["reach"] is not None
+    assert Path(best["task_file"]) == out / "design-1.yaml"
+    planned = runner.invoke(cli, ["plan", best["task_file"], "-o", str(tmp_path / "p.json")])
+    assert planned.exit_code == 0, planned.output
+    features = yaml.safe_load(Path(best["task_file"]).read_text())["environment"]["features"]
+    assert set(features) == {"left", "bottom"}
+
+
+@pytest.mark.parametrize("text, field", [
+    ("pushers: []\ncandidates: {mu: 0.2}", "pushers"),
+    ("", "candidates"),
+    ("candidates: {mu: -1}", "candidates.mu"),
+    ("candidates: []", "candidates"),
+    ("candidates: [{name: nowhere, at: [500, 0], mu: 0.2}]", "pushers[0]"),
+])
+def test_a_bad_design_file_is_refused_naming_the_field(tmp_path, text, field):
+    data = yaml.safe_load(DESIGN.read_text())
+    data.pop("candidates")
+    data.update(yaml.safe_load(text) or {})
+    path = tmp_path / "bad.design.yaml"
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(TaskError) as refused:
+        load_design(path)
+    assert f": {field}" in str(refused.value), str(refused.value)
