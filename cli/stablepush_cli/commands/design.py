@@ -33,8 +33,8 @@ from stablepush_cli.options import (
               help="The best N designs get a 3x3 reach map around the goal (2 tolerances either side in x and z), "
                    "and are ranked again with it.")
 @click.option("--out", "out_dir", default=None, type=click.Path(file_okay=False), metavar="DIR",
-              help="Where each design's task file goes (design-1.yaml is the best). Default: DESIGN.designs/ "
-                   "beside the design file.")
+              help="Where each design's task file goes (design-1.yaml is the best). Default: NAME.designs/ beside "
+                   "the design file NAME.design.yaml.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the ranked designs (`designs`, best first, each with its `task_file`), the unsolved "
                    "layouts and the verdict.")
@@ -70,7 +70,9 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     from stablepush.task.schema import load_design
 
     rank = parse_rank(rank_text) if rank_text is not None else DEFAULT_RANK
-    out = Path(out_dir) if out_dir is not None else Path(design_file).with_suffix(".designs")
+    name = Path(design_file).name
+    stem = name[:-len(".design.yaml")] if name.endswith(".design.yaml") else Path(design_file).stem
+    out = Path(out_dir) if out_dir is not None else Path(design_file).parent / f"{stem}.designs"
     check_named_outputs({"--json": json_path}, {"DESIGN.yaml": design_file})
     task, candidates = load_design(design_file)
     runner = runner_for(workers, ray_address, default=default_workers())
