@@ -69,13 +69,20 @@ class Design:
     features: Dict[str, List[float]] = field(default_factory=dict)  # pusher -> [x, y, z mm, theta deg]
     task_file: Optional[str] = None
 
+    @property
+    def fixtures(self) -> int:
+        """The fixtures the layout needs: the pushers its plan uses (those of a task's own layout
+        that the plan leaves alone need not be built)."""
+        return len(self.features) if self.solved else len(self.pushers)
+
     def key(self, rank: Sequence[str]) -> tuple:
-        values = {"fixtures": len(self.pushers), "switches": self.switches, "pushes": self.pushes,
+        values = {"fixtures": self.fixtures, "switches": self.switches, "pushes": self.pushes,
                   "margin": self.margin_n, "reach": self.reach, "time": self.planning_time_s}
         return (not self.solved,) + tuple(math.inf if values[k] is None else RANK_KEYS[k] * values[k] for k in rank)
 
     def as_dict(self) -> Dict[str, Any]:
-        return {"pushers": list(self.pushers), "solved": self.solved, "reason": self.reason or None,
+        return {"pushers": list(self.pushers), "fixtures": self.fixtures, "solved": self.solved,
+                "reason": self.reason or None,
                 "pushes": self.pushes, "switches": self.switches, "planning_time_s": self.planning_time_s,
                 "margin_n": self.margin_n, "reach": self.reach, "features": self.features,
                 "task_file": self.task_file}
