@@ -38,13 +38,15 @@ from stablepush_cli.options import (
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the ranked designs (`designs`, best first, each with its `task_file`), the unsolved "
                    "layouts and the verdict.")
+@click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
+              help="Draw the best three layouts side by side (PNG, PDF or SVG).")
 @click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
               help="Plan the layouts on K local processes (default: the number of CPUs).")
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
               callback=parse_ray_address, help="Plan the layouts on Ray: a local instance, or the cluster at ADDRESS.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, reach_top: int, out_dir, json_path,
-           workers, ray_address, quiet: bool) -> None:
+           png_path, workers, ray_address, quiet: bool) -> None:
     """Find where the fixtures should go: rank layouts of candidate pushers by their plans.
 
     DESIGN.yaml is a task file whose `candidates` stand in for its `pushers`: `candidates: {mu:
@@ -65,7 +67,7 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
 
     from stablepush.design import DEFAULT_RANK, design_task, parse_rank
     from stablepush.design import design as search
-    from stablepush.outputs import write_files
+    from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_files
     from stablepush.runners import default_workers
     from stablepush.task.schema import load_design
 
@@ -73,7 +75,8 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     name = Path(design_file).name
     stem = name[:-len(".design.yaml")] if name.endswith(".design.yaml") else Path(design_file).stem
     out = Path(out_dir) if out_dir is not None else Path(design_file).parent / f"{stem}.designs"
-    check_named_outputs({"--json": json_path}, {"DESIGN.yaml": design_file})
+    require_suffix("--plot", png_path, FIGURE_SUFFIXES)
+    check_named_outputs({"--json": json_path, "--plot": png_path}, {"DESIGN.yaml": design_file})
     task, candidates = load_design(design_file)
     runner = runner_for(workers, ray_address, default=default_workers())
     bar = progressbar(quiet, length=None, label="layouts planned", show_pos=True)
@@ -93,13 +96,23 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     if study.designs:
         out.mkdir(parents=True, exist_ok=True)
     write_files(files)
-    say = say_beside(json_path)
+    if png_path is not None and study.designs:
+        from stablepush.viz.figures import layouts_figure, save_figure
+
+        top = [{"task": d.task, "rank": k, "label": _figures(d)} for k, d in enumerate(study.designs[:3], start=1)]
+        save_figure(layouts_figure(top, f"{study.designs[0].task.name}: the best layouts"), png_path)
+    say = say_beside(json_path, png_path)
     say(f"{len(candidates)} candidates, {study.layouts_searched} layouts planned, {study.layouts_pruned} pruned "
         f"(no stable push toward the goal from the start: {', '.join(study.pruned_candidates) or 'none'})")
     for k, d in enumerate(study.designs, start=1):
-        reach = f"{d.reach:.0%}" if d.reach is not None else "-"
-        say(f"{k}. {' + '.join(d.pushers)}: {d.pushes} pushes, {d.switches} switch-overs, margin {d.margin_n:.3f} N, "
-            f"reach near the goal {reach}, planned in {d.planning_time_s:.3f} s -> {d.task_file}")
+        reach = f", reach near the goal {d.reach:.0%}" if d.reach is not None else ""
+        arm = "" if d.arm is None else (", the arm follows it" if d.arm["follows"] else
+                                        f", the arm cannot follow it ({d.arm['reason']})")
+        say(f"{k}. {_figures(d)}{reach}{arm}, planned in {d.planning_time_s:.3f} s -> {d.task_file}")
     say(study.verdict)
     if not study.designs:
         raise SystemExit(EXIT_NOT_SOLVED)
+
+
+def _figures(d) -> str:
+    return f"{' + '.join(d.pushers)}: {d.pushes} pushes, {d.switches} switch-overs, margin {d.margin_n:.3f} N"

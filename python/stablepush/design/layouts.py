@@ -11,8 +11,9 @@ most `max_fixtures` candidates. The search
 2. plans every other layout (plan_task with the task's seed, time limit and uncertainty box: a
    robust plan where the task has one) and checks the plan against its task (check_plan);
 3. measures each solved layout: pushes, switch-overs, planning time, the least margin of its
-   pushes over the uncertainty box (verify.plan_margin), and where each fixture stands in the
-   world at the start (execution.world.place_features: the task's environment.features);
+   pushes over the uncertainty box (verify.plan_margin), where each fixture stands in the world at
+   the start (execution.world.place_features: the task's environment.features), and, where the
+   task names its arm (environment.robot), whether the arm can follow the plan (sim.joint_path);
 4. ranks them (RANK_KEYS, `rank`), then for the best `reach_top` a small reach map around the
    goal (REACH_CELLS cells, REACH_SPAN tolerances either side in x and z): the share of nearby
    goals the layout also reaches, and ranks again.
@@ -33,7 +34,7 @@ from stablepush.plan.reach import reach_map
 from stablepush.plan.verify import plan_margin
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.task.mechanics import stable_directions
-from stablepush.task.model import Task
+from stablepush.task.model import Robot, Task
 from stablepush.task.schema import parse_task
 
 # What a layout is ranked by, each best first: the key, and +1 where less is better, -1 more.
@@ -67,6 +68,9 @@ class Design:
     margin_n: Optional[float] = None
     reach: Optional[float] = None  # share of the goals around the goal it also reaches (None: not measured)
     features: Dict[str, List[float]] = field(default_factory=dict)  # pusher -> [x, y, z mm, theta deg]
+    # Whether the task's arm (environment.robot, when it names one) can follow the plan in the cell
+    # (joint_path: follows, or the first sample it cannot and why); None: no arm named.
+    arm: Optional[Dict[str, Any]] = None
     task_file: Optional[str] = None
 
     @property
@@ -84,7 +88,7 @@ class Design:
         return {"pushers": list(self.pushers), "fixtures": self.fixtures, "solved": self.solved,
                 "reason": self.reason or None,
                 "pushes": self.pushes, "switches": self.switches, "planning_time_s": self.planning_time_s,
-                "margin_n": self.margin_n, "reach": self.reach, "features": self.features,
+                "margin_n": self.margin_n, "reach": self.reach, "features": self.features, "arm": self.arm,
                 "task_file": self.task_file}
 
 
@@ -214,7 +218,19 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
         T = feature.object_pose
         d.features[name] = [float(T[0, 3] * 1e3), float(T[1, 3] * 1e3), float(T[2, 3] * 1e3),
                             math.degrees(angle_about_y(T[:3, :3]))]
+    if d.task.environment.robot != Robot():
+        d.arm = _arm_follows(d.task, plan)
     return d
+
+
+def _arm_follows(task: Task, plan) -> Dict[str, Any]:
+    """The cell check of the task's arm on the plan (sim.joint_path), as its JSON verdict."""
+    from stablepush.sim.joint_path import CellError, joint_path
+
+    try:
+        return joint_path(task, plan).verdict()
+    except CellError as refusal:
+        return refusal.verdict()
 
 
 def _reach_near_goal(task: Task, runner: Runner) -> float:

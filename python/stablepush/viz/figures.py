@@ -356,3 +356,31 @@ def reach_figure(task: Task, reach: dict) -> Figure:
                  f"{reach['time_limit_s']:g} s, {counts['unreachable']} unreachable (seed {reach['seed']}){drawn}",
                  fontsize=10)
     return fig
+
+
+def layouts_figure(layouts: Sequence[dict], title: str = "") -> Figure:
+    """Fixture layouts side by side (`stablepush design --plot`): for each, the part's section in
+    O at the start (mm), the layout's fixtures drawn on it (a segment pusher as a thick line, a
+    point pusher as a dot) and its figures as the panel's title. `layouts`: dicts with `task` (a
+    Task with the layout's pushers), `rank`, `label` (e.g. the pushers and figures)."""
+    fig = Figure(figsize=(4.2 * max(1, len(layouts)), 4.2))
+    for k, layout in enumerate(layouts):
+        ax = fig.add_subplot(1, max(1, len(layouts)), k + 1)
+        task = layout["task"]
+        outline = np.array(list(task.vertices) + [task.vertices[0]], float)
+        ax.fill(outline[:, 0], outline[:, 1], color="0.85", edgecolor="0.3")
+        for pusher in task.pushers:
+            colour = _colour(task, pusher.name)
+            if pusher.is_point:
+                ax.plot([pusher.a[0]], [pusher.a[1]], "o", color=colour, markersize=8)
+            else:
+                ax.plot([pusher.a[0], pusher.b[0]], [pusher.a[1], pusher.b[1]], "-", color=colour, linewidth=5)
+            ax.annotate(pusher.name, ((pusher.a[0] + pusher.b[0]) / 2, (pusher.a[1] + pusher.b[1]) / 2), fontsize=8,
+                        color=colour, xytext=(4, 4), textcoords="offset points")
+        ax.set_aspect("equal")
+        ax.set_title(f"{layout['rank']}. " + "\n".join(textwrap.wrap(layout["label"], 40)), fontsize=9)
+        ax.set_xlabel("x (mm, in O)")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
