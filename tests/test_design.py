@@ -125,16 +125,20 @@ def test_the_design_command_writes_task_files_that_plan_unchanged(tmp_path):
     data = yaml.safe_load(DESIGN.read_text())
     data["candidates"] = [{"name": "left", "from": [-50, -12.5], "to": [-50, 12.5], "mu": 0.2},
                           {"name": "bottom", "from": [-50, -12.5], "to": [50, -12.5], "mu": 0.2}]
+    data["environment"]["robot"] = {"model": str(ROOT / "data" / "arms" / "six-joint.urdf"), "flange": "tool0",
+                                    "tcp": [0, 0, 110, 0, 180, 0]}
     path = tmp_path / "two.design.yaml"
     path.write_text(yaml.safe_dump(data))
     out = tmp_path / "designs"
     runner = CliRunner()
     result = runner.invoke(cli, ["design", str(path), "--quiet", "--out", str(out), "--json", str(tmp_path / "d.json"),
-                                 "--reach-top", "1"])
+                                 "--reach-top", "1", "--plot", str(tmp_path / "top.png")])
     assert result.exit_code == 0, result.output
     report = yaml.safe_load((tmp_path / "d.json").read_text())
     best = report["designs"][0]
     assert best["pushers"] == ["left", "bottom"] and best["reach"] is not None
+    assert best["arm"]["follows"] is True and "the arm follows it" in result.output  # the task names its arm
+    assert (tmp_path / "top.png").stat().st_size > 1000
     assert Path(best["task_file"]) == out / "design-1.yaml"
     planned = runner.invoke(cli, ["plan", best["task_file"], "-o", str(tmp_path / "p.json")])
     assert planned.exit_code == 0, planned.output
