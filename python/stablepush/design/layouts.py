@@ -14,9 +14,10 @@ most `max_fixtures` candidates. The search
    pushes over the uncertainty box (verify.plan_margin), where each fixture stands in the world at
    the start (execution.world.place_features: the task's environment.features), and, where the
    task names its arm (environment.robot), whether the arm can follow the plan (sim.joint_path);
-4. ranks them (RANK_KEYS, `rank`), then for the best `reach_top` a small reach map around the
-   goal (REACH_CELLS cells, REACH_SPAN tolerances either side in x and z): the share of nearby
-   goals the layout also reaches, and ranks again.
+4. ranks them (RANK_KEYS, `rank`), keeps the best of each set of fixtures its plan uses, then
+   for the best `reach_top` a small reach map around the goal (REACH_CELLS cells, REACH_SPAN
+   tolerances either side in x and z): the share of nearby goals the layout also reaches, and
+   ranks again.
 Layouts run on a `runners.Runner` (here, local processes or Ray), each deterministic for the seed.
 """
 from __future__ import annotations
@@ -166,7 +167,7 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
         if progress is not None:
             progress(result)
     results.sort(key=lambda d: d.pushers)  # in the layouts' order, whichever worker finished first
-    solved = sorted((d for d in results if d.solved), key=lambda d: d.key(rank))
+    solved = _distinct(sorted((d for d in results if d.solved), key=lambda d: d.key(rank)))
     for d in solved[:reach_top]:
         d.reach = _reach_near_goal(d.task, runner)
     solved.sort(key=lambda d: d.key(rank))
@@ -174,6 +175,18 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
                        pruned_candidates=[c["name"] for i, c in enumerate(candidates) if i not in useful],
                        layouts_searched=len(layouts), layouts_pruned=total - len(layouts), rank=tuple(rank),
                        failed=[d for d in results if not d.solved])
+
+
+def _distinct(ranked: List[Design]) -> List[Design]:
+    """The best design of each set of fixtures used: a layout whose plan leaves one of its pushers
+    alone is the smaller layout again, and is not listed twice."""
+    seen, out = set(), []
+    for d in ranked:
+        used = frozenset(d.features)
+        if used not in seen:
+            seen.add(used)
+            out.append(d)
+    return out
 
 
 def _pushes_toward_goal(task: Task, pusher: str) -> bool:
