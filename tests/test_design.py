@@ -125,8 +125,10 @@ def test_the_design_command_writes_task_files_that_plan_unchanged(tmp_path):
     data = yaml.safe_load(DESIGN.read_text())
     data["candidates"] = [{"name": "left", "from": [-50, -12.5], "to": [-50, 12.5], "mu": 0.2},
                           {"name": "bottom", "from": [-50, -12.5], "to": [50, -12.5], "mu": 0.2}]
-    data["environment"]["robot"] = {"model": str(ROOT / "data" / "arms" / "six-joint.urdf"), "flange": "tool0",
-                                    "tcp": [0, 0, 110, 0, 180, 0]}
+    (tmp_path / "arms").mkdir()
+    (tmp_path / "arms" / "six.urdf").write_text((ROOT / "data" / "arms" / "six-joint.urdf").read_text())
+    # named relative to the design file: the task files written one folder down still find it
+    data["environment"]["robot"] = {"model": "arms/six.urdf", "flange": "tool0", "tcp": [0, 0, 110, 0, 180, 0]}
     path = tmp_path / "two.design.yaml"
     path.write_text(yaml.safe_dump(data))
     out = tmp_path / "designs"

@@ -90,7 +90,7 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     files = {}
     for k, d in enumerate(study.designs, start=1):
         d.task_file = str(out / f"design-{k}.yaml")
-        files[d.task_file] = yaml.safe_dump(design_task(task, candidates, d), sort_keys=False)
+        files[d.task_file] = yaml.safe_dump(design_task(task, candidates, d, design_file), sort_keys=False)
     if json_path is not None:
         files[json_path] = json.dumps(study.as_dict(), indent=1) + "\n"
     if study.designs:

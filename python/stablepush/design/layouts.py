@@ -25,6 +25,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from stablepush.errors import TaskError
@@ -256,11 +257,21 @@ def _reach_near_goal(task: Task, runner: Runner) -> float:
     return sum(1 for c in cells if c["solved"]) / len(cells)
 
 
-def design_task(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], d: Design) -> Dict[str, Any]:
+def design_task(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], d: Design,
+                source: Optional[str] = None) -> Dict[str, Any]:
     """A design as a complete task in the task file's form: the design file's task with the
     layout's pushers, and environment.features where its plan puts each fixture (what `plan`,
-    `execute` and `evaluate` take unchanged)."""
+    `execute` and `evaluate` take unchanged). Files the design file `source` names relative to
+    itself (a mesh, a robot model) are named absolutely, so the task file reads them anywhere."""
     by_name = {c["name"]: c for c in candidates}
     environment = dict(task.get("environment") or {})
     environment["features"] = {name: [round(v, 6) for v in pose] for name, pose in d.features.items()}
-    return {**task, "pushers": [dict(by_name[name]) for name in d.pushers], "environment": environment}
+    out = {**task, "pushers": [dict(by_name[name]) for name in d.pushers], "environment": environment}
+    if source is not None:
+        folder = Path(source).resolve().parent
+        if isinstance(out.get("object"), dict) and isinstance(out["object"].get("file"), str):
+            out["object"] = {**out["object"], "file": str(folder / out["object"]["file"])}
+        robot = environment.get("robot")
+        if isinstance(robot, dict) and isinstance(robot.get("model"), str):
+            environment["robot"] = {**robot, "model": str(folder / robot["model"])}
+    return out
