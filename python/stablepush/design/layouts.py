@@ -179,15 +179,14 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
 
 
 def _distinct(ranked: List[Design]) -> List[Design]:
-    """The best design of each set of fixtures used: a layout whose plan leaves one of its pushers
-    alone is the smaller layout again, and is not listed twice."""
-    seen, out = set(), []
+    """One design per set of fixtures its plan uses, the smallest layout of it (a layout whose
+    plan leaves one of its pushers alone is the smaller layout again), in ranked order."""
+    best: Dict[frozenset, Design] = {}
     for d in ranked:
         used = frozenset(d.features)
-        if used not in seen:
-            seen.add(used)
-            out.append(d)
-    return out
+        if used not in best or len(d.pushers) < len(best[used].pushers):
+            best[used] = d
+    return [d for d in ranked if best[frozenset(d.features)] is d]
 
 
 def _pushes_toward_goal(task: Task, pusher: str) -> bool:
