@@ -104,3 +104,9 @@ def slerp(q0: np.ndarray, q1: np.ndarray, s: float) -> np.ndarray:
 def quat_about_y(angle: float) -> Tuple[float, float, float, float]:
     """(w, x, y, z) of a right-handed rotation by `angle` rad about +y."""
     return (math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0)
+
+
+def turn(a: Sequence[float], b: Sequence[float], c: Sequence[float]) -> float:
+    """The z of (b - a) x (c - a) for points in a plane: > 0 where a -> b -> c turns left
+    (counterclockwise), < 0 right, 0 on one line."""
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])

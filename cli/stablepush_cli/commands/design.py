@@ -63,18 +63,14 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
       stablepush design data/designs/offset-low-mu.design.yaml --json offset.designs.json
       stablepush plan data/designs/offset-low-mu.designs/design-1.yaml -o best.plan.json
     """
-    import yaml
-
-    from stablepush.design import DEFAULT_RANK, design_task, parse_rank
+    from stablepush.design import DEFAULT_RANK, design_files, designs_folder, parse_rank
     from stablepush.design import design as search
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_files
     from stablepush.runners import default_workers
     from stablepush.task.schema import load_design
 
     rank = parse_rank(rank_text) if rank_text is not None else DEFAULT_RANK
-    name = Path(design_file).name
-    stem = name[:-len(".design.yaml")] if name.endswith(".design.yaml") else Path(design_file).stem
-    out = Path(out_dir) if out_dir is not None else Path(design_file).parent / f"{stem}.designs"
+    out = Path(out_dir) if out_dir is not None else designs_folder(design_file)
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_named_outputs({"--json": json_path, "--plot": png_path}, {"DESIGN.yaml": design_file})
     task, candidates = load_design(design_file)
@@ -87,10 +83,7 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     finally:
         if bar is not None:
             bar.render_finish()
-    files = {}
-    for k, d in enumerate(study.designs, start=1):
-        d.task_file = str(out / f"design-{k}.yaml")
-        files[d.task_file] = yaml.safe_dump(design_task(task, candidates, d, design_file), sort_keys=False)
+    files = design_files(study, task, candidates, out, design_file)
     if json_path is not None:
         files[json_path] = json.dumps(study.as_dict(), indent=1) + "\n"
     if study.designs:

@@ -104,18 +104,13 @@ class JointTrajectoryArm(Arm):
         """IK from the last command to the waypoint's pose, checked against the limits and speeds
         of the model, sent as one trajectory point over the period; the state read back."""
         kin = self._kinematics
-        q, error = ik.solve_ik(kin, waypoint.pose, self._command, self._home, kin.lower, kin.upper)
-        if error > ik.IK_REACH:
-            q, error = ik.solve_ik(kin, waypoint.pose, self._command, self._home, kin.lower, kin.upper,
-                                   10 * ik.IK_ITERATIONS)
+        q, error = ik.follow(kin, waypoint.pose, self._command, self._home, kin.lower, kin.upper)
         if error > ik.IK_REACH:
             raise ArmError(f"the arm cannot reach the pose of plan step {waypoint.step} ({waypoint.phase}): IK "
                            f"stays {error * 1e3:.3f} mm off")
-        speed = np.abs(q - self._command) / self._period
-        if np.any(speed > self.arm.max_speed):
-            k = int(np.argmax(speed / self.arm.max_speed))
-            raise ArmError(f"joint {self.arm.joints[k]} would turn {speed[k]:.2f}/s, past its "
-                           f"{self.arm.max_speed[k]:g}/s (plan step {waypoint.step}, {waypoint.phase})")
+        fast = self.arm.too_fast(self._command, q, self._period)
+        if fast is not None:
+            raise ArmError(f"{fast} (plan step {waypoint.step}, {waypoint.phase})")
         self._call("send", [float(v) for v in q], self._period)
         self._command = q
         return self._state(self._read(), waypoint.phase == "approach")

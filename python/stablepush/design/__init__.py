@@ -6,11 +6,13 @@ from stablepush.design.layouts import (
     Design,
     DesignStudy,
     design,
+    design_files,
     design_task,
+    designs_folder,
     layout_task,
     measure_layout,
     parse_rank,
 )
 
-__all__ = ["design", "design_task", "layout_task", "measure_layout", "parse_rank", "Design", "DesignStudy",
-           "RANK_KEYS", "DEFAULT_RANK"]
+__all__ = ["design", "design_files", "designs_folder", "design_task", "layout_task", "measure_layout", "parse_rank",
+           "Design", "DesignStudy", "RANK_KEYS", "DEFAULT_RANK"]

@@ -154,7 +154,8 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
         raise TaskError("max_fixtures", f"must be at least 1, got {max_fixtures}")
     max_fixtures = min(max_fixtures, len(candidates))
     everything = layout_task(task, candidates, source)  # every candidate checked once, on the part
-    useful = [i for i, c in enumerate(candidates) if _pushes_toward_goal(everything, c["name"])]
+    toward = _pushers_toward_goal(everything)
+    useful = [i for i, c in enumerate(candidates) if c["name"] in toward]
     layouts = [combo for size in range(1, max_fixtures + 1)
                for combo in itertools.combinations(range(len(candidates)), size) if set(combo) & set(useful)]
     total = sum(math.comb(len(candidates), k) for k in range(1, max_fixtures + 1))
@@ -189,17 +190,14 @@ def _distinct(ranked: List[Design]) -> List[Design]:
     return [d for d in ranked if best[frozenset(d.features)] is d]
 
 
-def _pushes_toward_goal(task: Task, pusher: str) -> bool:
-    """Whether `pusher` has a stable push from the start that brings the object nearer the goal
-    (in unit steps), in the task's uncertainty box when it has one."""
-    step_mm, step_deg = task.planner.step
-    to_goal = [(g - s) / u for g, s, u in zip(task.goal, task.start, (step_mm, step_mm, step_deg))]
-    pushes = stable_directions(task, task.start, pusher)["pushers"].get(pusher, [])
-    for push in pushes:
-        move = [m / u for m, u in zip(push["move"], (step_mm, step_mm, step_deg))]
-        if sum(a * b for a, b in zip(move, to_goal)) > 0:
-            return True
-    return False
+def _pushers_toward_goal(task: Task) -> set:
+    """The pushers with a stable push from the start that brings the object nearer the goal (in
+    unit steps), in the task's uncertainty box when it has one (one stable_directions for all)."""
+    unit = (*(task.planner.step[0],) * 2, task.planner.step[1])
+    to_goal = [(g - s) / u for g, s, u in zip(task.goal, task.start, unit)]
+    pushes = stable_directions(task, task.start)["pushers"]
+    return {name for name, moves in pushes.items()
+            if any(sum(m / u * t for m, u, t in zip(push["move"], unit, to_goal)) > 0 for push in moves)}
 
 
 def _plan_layout(job: _Job, i: int) -> Design:
@@ -274,3 +272,22 @@ def design_task(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], d: D
         if isinstance(robot, dict) and isinstance(robot.get("model"), str):
             environment["robot"] = {**robot, "model": str(folder / robot["model"])}
     return out
+
+
+def designs_folder(design_file: str) -> Path:
+    """Where a design file's designs go by default: NAME.designs/ beside NAME.design.yaml."""
+    path = Path(design_file)
+    stem = path.name[:-len(".design.yaml")] if path.name.endswith(".design.yaml") else path.stem
+    return path.parent / f"{stem}.designs"
+
+
+def design_files(study: DesignStudy, task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], folder: Path,
+                 source: Optional[str] = None) -> Dict[str, str]:
+    """Each design as a task file, `folder`/design-<rank>.yaml (its `task_file` set): path -> YAML."""
+    import yaml
+
+    files = {}
+    for k, d in enumerate(study.designs, start=1):
+        d.task_file = str(Path(folder) / f"design-{k}.yaml")
+        files[d.task_file] = yaml.safe_dump(design_task(task, candidates, d, source), sort_keys=False)
+    return files

@@ -61,6 +61,18 @@ def solve_ik(kinematics: Kinematics, pose: Sequence[float], q_start: np.ndarray,
     return q, error
 
 
+def follow(kinematics: Kinematics, pose: Sequence[float], q_last: np.ndarray, home_posture: np.ndarray,
+           lower: np.ndarray, upper: np.ndarray) -> Tuple[np.ndarray, float]:
+    """The joints for the next pose of a stream: solve_ik from the last command `q_last`, and,
+    where that ends farther off than IK_REACH (slow to converge near the edge of reach), again
+    from `q_last` with ten times the iterations. With the pose error left (past IK_REACH: the
+    pose is out of reach, `unreachable`)."""
+    q, error = solve_ik(kinematics, pose, q_last, home_posture, lower, upper)
+    if error > IK_REACH:
+        q, error = solve_ik(kinematics, pose, q_last, home_posture, lower, upper, 10 * IK_ITERATIONS)
+    return q, error
+
+
 def find_home(kinematics: Kinematics, pose: Sequence[float], guesses: Sequence[np.ndarray], lower: np.ndarray,
               upper: np.ndarray) -> Tuple[np.ndarray, float]:
     """The home posture [rad]: joint angles within [lower, upper] that put G at `pose`, by IK from

@@ -188,10 +188,9 @@ class _Solver:
             if off[0] > FK_TOLERANCE[0] or off[1] > FK_TOLERANCE[1]:
                 raise CellError(*where, self._why_unreached(q, off))
             speed = np.abs(q - q_prev) / dt
-            if i > 0 and np.any(speed > self.arm.max_speed):
-                k = int(np.argmax(speed / self.arm.max_speed))
-                raise CellError(*where, f"joint {self.arm.joints[k]} would turn {speed[k]:.2f} rad/s, past its "
-                                        f"{self.arm.max_speed[k]:g} rad/s (a branch flip, or a motion too fast for it)")
+            fast = self.arm.too_fast(q_prev, q, dt) if i > 0 else None
+            if fast is not None:
+                raise CellError(*where, f"{fast} (a branch flip, or a motion too fast for it)")
             clearance, pair = self._clearance(q)
             if clearance < LINK_CLEARANCE:
                 raise CellError(*where, f"link {pair[0]} runs {-clearance * 1e3:.1f} mm into {pair[1]}")

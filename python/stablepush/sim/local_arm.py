@@ -8,6 +8,7 @@ from typing import Callable, Optional
 
 from stablepush.execution.arm import Arm, ArmError, ArmReady
 from stablepush.execution.stream import ArmWaypoint
+from stablepush.extras import MissingExtra, require
 from stablepush.plan.plan import Plan
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
@@ -47,9 +48,9 @@ class SimulatedArm(Arm):
         """The arm's joints along the plan (joint_path.checked_path): CellError, before any
         motion, where it cannot follow. The check runs on MuJoCo's kinematics: on Drake without
         MuJoCo installed it is skipped, and the log says so."""
-        import importlib.util
-
-        if importlib.util.find_spec("mujoco") is None:
+        try:
+            require("mujoco", "the cell check")
+        except MissingExtra:
             self.log("the cell is not checked: the check runs on MuJoCo, which is not installed ([sim])")
             return
         from stablepush.sim.joint_path import checked_path

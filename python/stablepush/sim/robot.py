@@ -68,6 +68,15 @@ class ArmModel:
     max_speed: np.ndarray
     home_guesses: Tuple[np.ndarray, ...]
 
+    def too_fast(self, q_from: np.ndarray, q_to: np.ndarray, dt: float) -> Optional[str]:
+        """Why moving the joints from `q_from` to `q_to` in `dt` s is past a joint's speed limit:
+        the joint furthest past its own (max_speed), named with its speed; None within them."""
+        speed = np.abs(np.asarray(q_to) - np.asarray(q_from)) / dt
+        if not np.any(speed > self.max_speed):
+            return None
+        k = int(np.argmax(speed / self.max_speed))
+        return f"joint {self.joints[k]} would turn {speed[k]:.2f} rad/s, past its {self.max_speed[k]:g} rad/s"
+
     def arm_tree(self) -> ET.Element:
         """A fresh copy of the tree, for a scene builder to add to."""
         return copy.deepcopy(self.tree)
@@ -77,7 +86,7 @@ def arm_model(robot: Optional[Robot] = None) -> ArmModel:
     """The arm of `robot` (None or the default Robot: the shipped arm, arm.xml as it is). A lab's
     model is compiled once per file version and robot (cached): a study's trials share it."""
     robot = robot or Robot()
-    if robot.shipped and robot == Robot():
+    if robot == Robot():
         return _shipped()
     return _built(robot, model_stamp(robot))
 

@@ -26,7 +26,7 @@ from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from stablepush.frames import pose_to_matrix, quat_about_y
+from stablepush.frames import pose_to_matrix, quat_about_y, turn
 from stablepush.sim.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.task.model import Robot
 
@@ -99,7 +99,7 @@ def convex_pieces(polygon: Sequence[Sequence[float]]) -> List[List[Tuple[float, 
     while len(index) > 3:
         for k in range(len(index)):
             i, j, after = index[k - 1], index[k], index[(k + 1) % len(index)]
-            if _cross(pts[i], pts[j], pts[after]) <= 0:
+            if turn(pts[i], pts[j], pts[after]) <= 0:
                 continue
             if any(_in_triangle(pts[m], pts[i], pts[j], pts[after]) for m in index if m not in (i, j, after)):
                 continue
@@ -126,17 +126,13 @@ def convex_pieces(polygon: Sequence[Sequence[float]]) -> List[List[Tuple[float, 
     return [_drop_collinear([pts[i] for i in piece]) for piece in pieces]
 
 
-def _cross(a, b, c) -> float:
-    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-
-
 def _in_triangle(p, a, b, c) -> bool:
-    return _cross(a, b, p) >= 0 and _cross(b, c, p) >= 0 and _cross(c, a, p) >= 0
+    return turn(a, b, p) >= 0 and turn(b, c, p) >= 0 and turn(c, a, p) >= 0
 
 
 def _is_convex(pts) -> bool:
     n = len(pts)
-    return all(_cross(pts[i - 1], pts[i], pts[(i + 1) % n]) >= -1e-15 for i in range(n))
+    return all(turn(pts[i - 1], pts[i], pts[(i + 1) % n]) >= -1e-15 for i in range(n))
 
 
 def _merge(p: List[int], q: List[int]):
@@ -152,7 +148,7 @@ def _merge(p: List[int], q: List[int]):
 
 def _drop_collinear(pts):
     n = len(pts)
-    return [pts[i] for i in range(n) if abs(_cross(pts[i - 1], pts[i], pts[(i + 1) % n])) > 1e-15]
+    return [pts[i] for i in range(n) if abs(turn(pts[i - 1], pts[i], pts[(i + 1) % n])) > 1e-15]
 
 
 def _axis_aligned_rectangle(piece) -> bool:
@@ -282,7 +278,7 @@ def _reflex_corners_in_world(polygon: Sequence[Sequence[float]], object_pose: Se
     deg, in W with the object at `object_pose` (x, y, z, qw, qx, qy, qz)."""
     n, T_WO = len(polygon), pose_to_matrix(object_pose)
     return [(T_WO @ np.array([v[0], 0.0, v[1], 1.0]))[:3] for k, v in enumerate(polygon)
-            if _cross(polygon[k - 1], v, polygon[(k + 1) % n]) < -1e-15]  # a right turn, as _is_convex counts one
+            if turn(polygon[k - 1], v, polygon[(k + 1) % n]) < -1e-15]  # a right turn, as _is_convex counts one
 
 
 def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None) -> str:

@@ -53,14 +53,10 @@ class TrackingArm:
         self.target = self.home_posture.copy()
         return self.home_posture
 
-    def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, strict: bool = False,
-                 iterations: int = ik.IK_ITERATIONS) -> np.ndarray:
-        """Joint angles [rad] that put G at `pose`, from `q_start`."""
-        q, error = ik.solve_ik(self._kinematics, pose, q_start, self.home_posture, self._lower, self._upper,
-                               iterations)
-        if strict and error > 1e-6:
-            raise ik.unreachable(pose, error)
-        self.ik_error = error
+    def solve_ik(self, pose: Sequence[float], q_start: np.ndarray, iterations: int = ik.IK_ITERATIONS) -> np.ndarray:
+        """Joint angles [rad] that put G at `pose`, from `q_start` (the pose error left: `ik_error`)."""
+        q, self.ik_error = ik.solve_ik(self._kinematics, pose, q_start, self.home_posture, self._lower, self._upper,
+                                       iterations)
         return q
 
     def advance(self, duration: float, target: Optional[np.ndarray] = None) -> None:
@@ -76,9 +72,8 @@ class TrackingArm:
         """Track G toward `pose` over `duration` s (one streamed waypoint period). ValueError, the
         arm held where it is, when no joint angles within the limits put G there (IK_REACH):
         driven there anyway, the servos fight the limits and the arm leaves the stream."""
-        q = self.solve_ik(pose, self.target)
-        if self.ik_error > ik.IK_REACH:  # slow to converge near the edge of reach: look harder first
-            q = self.solve_ik(pose, self.target, iterations=10 * ik.IK_ITERATIONS)
+        q, self.ik_error = ik.follow(self._kinematics, pose, self.target, self.home_posture, self._lower,
+                                     self._upper)
         if self.ik_error > ik.IK_REACH:
             raise ik.unreachable(pose, self.ik_error)
         self.advance(duration, q)

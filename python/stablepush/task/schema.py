@@ -19,6 +19,7 @@ import yaml
 
 from stablepush import _core
 from stablepush.errors import TaskError
+from stablepush.frames import turn
 from stablepush.inputs import read_capped
 from stablepush.outputs import protect_input
 from stablepush.task.model import (
@@ -380,19 +381,18 @@ def candidate_pushers(value: Any, task: Mapping[str, Any], source: Optional[str]
     if isinstance(value, list):
         if not value:
             raise TaskError("candidates", "an empty list: give at least one pusher entry")
-        _validate_pushers(value, _section_of(task, source), [])
+        _validate_pushers(value, _core.CrossSection([mm2_to_si(v) for v in _corners_of(task, source)]), [])
         return [dict(entry) for entry in value]
     spec = _mapping("candidates", value, ["mu"], ["points"])
     mu = _friction("candidates.mu", spec["mu"])
     points = _integer("candidates.points", spec.get("points", DEFAULT_PUSHER_POINTS), 2, MAX_PUSHER_POINTS)
-    vertices, *_ = _validate_object(_mapping("", task, ["object"], list(task))["object"], source, [])
-    corners = outline_corners(vertices)
+    corners = _corners_of(task, source)
     n = len(corners)
     edges = [{"name": f"edge{k}", "from": list(corners[k]), "to": list(corners[(k + 1) % n]), "mu": mu,
               "points": points} for k in range(n)]
     convex = []
     for k in range(n):  # at a corner itself a point contact's normal is not defined: just beside it
-        if _cross(corners[k - 1], corners[k], corners[(k + 1) % n]) > 0:
+        if turn(corners[k - 1], corners[k], corners[(k + 1) % n]) > 0:
             for side, neighbour in (("a", corners[k - 1]), ("b", corners[(k + 1) % n])):
                 convex.append({"name": f"corner{k}{side}", "at": _toward(corners[k], neighbour), "mu": mu})
     candidates = edges + convex
@@ -414,13 +414,10 @@ def _toward(corner, neighbour) -> List[float]:
     return [corner[0] + dx / length * inset, corner[1] + dz / length * inset]
 
 
-def _section_of(task: Mapping[str, Any], source: Optional[str]) -> "_core.CrossSection":
+def _corners_of(task: Mapping[str, Any], source: Optional[str]) -> Tuple[Tuple[float, float], ...]:
+    """The corners of a task mapping's object section (mm, counterclockwise), its object checked."""
     vertices, *_ = _validate_object(_mapping("", task, ["object"], list(task))["object"], source, [])
-    return _core.CrossSection([mm2_to_si(v) for v in outline_corners(vertices)])
-
-
-def _cross(a, b, c) -> float:
-    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    return outline_corners(vertices)
 
 
 def parse_task(text: "str | Mapping[str, Any]", source: Optional[str] = None, goal_in_grasp: bool = True) -> Task:
