@@ -1,7 +1,8 @@
 """`stablepush design`: fixture layouts from candidates. Every design it reports plans again from
 its own task file and each push of the plan agrees with the independent LP (tests/independent_lp.py);
 on generated parts, grips and goals too; a regrasp no layout can do is said to be so, with the
-reason; the shipped offset's design is at least as good as the task's own layout by the ranking."""
+reason; the shipped offset's design is at least as good as the task's own layout by the ranking;
+the best designs' measured odds rank them, and their task files land the same trials."""
 import math
 from pathlib import Path
 
@@ -11,8 +12,18 @@ import yaml
 from click.testing import CliRunner
 
 import stablepush as sp
-from stablepush.design import DEFAULT_RANK, design, design_task, measure_layout
+from stablepush.design import (
+    DEFAULT_RANK,
+    Design,
+    design,
+    design_task,
+    evaluate_designs,
+    layout_task,
+    measure_layout,
+    parse_rank,
+)
 from stablepush.errors import TaskError
+from stablepush.evaluation import Batch, Spreads, evaluate
 from stablepush.runners import Runner
 from stablepush.task.schema import load_design
 from stablepush.units import pose_to_si
@@ -164,3 +175,65 @@ def test_a_bad_design_file_is_refused_naming_the_field(tmp_path, text, field):
     with pytest.raises(TaskError) as refused:
         load_design(path)
     assert f": {field}" in str(refused.value), str(refused.value)
+
+
+def test_the_rank_puts_a_layout_the_arm_cannot_follow_below_and_measured_odds_first():
+    follows = Design(("a", "b"), solved=True, pushes=9, switches=1, margin_n=0.1, features={"a": [], "b": []},
+                     arm={"follows": True})
+    cannot = Design(("c",), solved=True, pushes=3, switches=0, margin_n=2.0, features={"c": []},
+                    arm={"follows": False, "reason": "joint 2 at its limit"})
+    assert follows.key(DEFAULT_RANK) < cannot.key(DEFAULT_RANK)  # fewer fixtures, but the arm cannot follow it
+    follows.success = {"success_rate": 0.6, "successes": 6, "judged": 10, "ci95": [0.31, 0.83]}
+    cannot.success = {"success_rate": 0.9, "successes": 9, "judged": 10, "ci95": [0.6, 0.98]}
+    not_measured = Design(("d",), solved=True, pushes=1, switches=0, margin_n=5.0, features={"d": []})
+    rank = ("success",) + DEFAULT_RANK
+    assert sorted([not_measured, follows, cannot], key=lambda d: d.key(rank)) == [cannot, follows, not_measured]
+    assert parse_rank("margin, success", measured=True) == ("margin", "success")
+    for text in ("success", "margin,margin", "speed"):
+        with pytest.raises(TaskError, match="rank"):
+            parse_rank(text)
+
+
+def _pivot_design():
+    """The shipped pivot with its pushers taken away: its edges and corners are the candidates."""
+    path = TASKS / "pivoting.yaml"
+    data = yaml.safe_load(path.read_text())
+    mu = min(p["mu"] for p in data.pop("pushers"))
+    data["environment"].pop("features", None)
+    data["candidates"] = {"mu": mu}
+    return data, path
+
+
+@pytest.mark.slow
+def test_evaluate_ranks_the_best_designs_by_their_odds_in_the_same_worlds(tmp_path):
+    data, source = _pivot_design()
+    path = tmp_path / "pivot.design.yaml"
+    path.write_text(yaml.safe_dump(data))
+    task, candidates = load_design(path)
+    runner = Runner(workers=2)
+    study = design(task, candidates, source=str(path), max_fixtures=1, time_limit=1.0, reach_top=0, runner=runner)
+    assert len(study.designs) > 3, study.verdict
+    spreads = Spreads.for_task(layout_task(task, candidates, str(path)), {"pad_mu": 0.3, "pusher_mu": 0.3})
+    evaluate_designs(study, 3, spreads, top=3, seed=5, runner=runner)
+    assert study.rank[0] == "success" and study.evaluated["trials"] == 3
+    measured = [d for d in study.designs if d.success is not None]
+    assert study.designs[:3] == measured and all(d.success["trials"] == 3 for d in measured)
+    assert [d.key(study.rank) for d in study.designs] == sorted(d.key(study.rank) for d in study.designs)
+    # The best design's task file, as written, run in the same worlds: the same trials land.
+    best = study.designs[0]
+    written = sp.parse_task(yaml.safe_dump(design_task(task, candidates, best, str(path))), str(path))
+    again = evaluate(Batch(task=written, plan=best.plan, spreads=spreads, seed=5), 3, runner).summary()
+    assert again["successes"] == best.success["successes"]
+
+
+@pytest.mark.parametrize("args, says", [
+    (["--vary", "pad_mu=0.2"], "--vary: only with --evaluate N"),
+    (["--closed-loop"], "--closed-loop: only with --evaluate N"),
+    (["--rank", "success,margin"], "rank"),
+    (["--evaluate", "2", "--vary", "pad_mu=2"], "--vary"),
+    (["--evaluate", "2", "--feature-error", "1e9", "0"], "--feature-error"),
+])
+def test_the_odds_options_are_refused_before_the_search(tmp_path, args, says):
+    result = CliRunner().invoke(cli, ["design", str(DESIGN), "--quiet", "--out", str(tmp_path / "d"), *args])
+    assert result.exit_code == 2, result.output
+    assert says in result.output and "layouts planned" not in result.output

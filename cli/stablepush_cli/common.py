@@ -80,6 +80,27 @@ def progressbar(quiet: bool, **options):
 
 
 @contextlib.contextmanager
+def landings_bar(quiet: bool, trials: int):
+    """A progress bar over `trials` simulated trials, labelled with the landings so far; yields
+    `landed(done, prefix="")`, to call after each trial with the trial records done so far, or
+    None without a terminal."""
+    bar = progressbar(quiet, length=trials, label="trials", show_pos=True)
+    if bar is None:
+        yield None
+        return
+
+    def landed(done, prefix: str = "") -> None:
+        n = sum(1 for r in done if r["success"])
+        bar.label = f"{prefix}landed {n}/{len(done)} ({n / len(done):.0%})"
+        bar.update(1)
+
+    try:
+        yield landed
+    finally:
+        bar.render_finish()
+
+
+@contextlib.contextmanager
 def searching(label: str, seconds: float, quiet: bool):
     """While the block searches (with the GIL released in the core): from its first second on, a
     bar of the time spent against its limit, on a terminal."""

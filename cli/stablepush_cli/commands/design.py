@@ -2,22 +2,33 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import click
 
+from stablepush.errors import SettingError
+from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush_cli.common import (
+    EXIT_INTERNAL,
     EXIT_NOT_SOLVED,
     check_named_outputs,
+    fail,
+    given,
+    landings_bar,
     progressbar,
     runner_for,
     say_beside,
 )
 from stablepush_cli.options import (
     TIME_LIMIT,
+    Finite,
     Whole,
     parse_ray_address,
+    parse_vary,
 )
+
+ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine", "seed")
 
 
 @click.command()
@@ -25,13 +36,30 @@ from stablepush_cli.options import (
 @click.option("--max-fixtures", default=2, show_default=True, type=Whole(min=1, max=4), metavar="K",
               help="Layouts of 1 to K fixtures.")
 @click.option("--rank", "rank_text", default=None, metavar="KEYS",
-              help="The ranking rule: keys, most important first, from fixtures, switches, pushes (fewer first), "
-                   "margin, reach (more first) and time. Default: fixtures,switches,margin,pushes,reach,time.")
+              help="The ranking rule: keys, most important first, from arm (the task's arm follows the plan "
+                   "first), fixtures, switches, pushes (fewer first), margin, reach (more first), time, and "
+                   "success (with --evaluate). Default: arm,fixtures,switches,margin,pushes,reach,time; with "
+                   "--evaluate, success first unless the rule places it.")
 @click.option("--time-limit", default=2.0, show_default=True, type=TIME_LIMIT, metavar="S",
               help="Each layout's search time (the task's planner.time_limit is not used: there are many layouts).")
 @click.option("--reach-top", default=3, show_default=True, type=Whole(min=0, max=100), metavar="N",
               help="The best N designs get a 3x3 reach map around the goal (2 tolerances either side in x and z), "
                    "and are ranked again with it.")
+@click.option("--evaluate", "trials", default=None, type=Whole(min=1, max=100_000), metavar="N",
+              help="Run each of the best --evaluate-top designs' plans through `evaluate`, N trials each in the "
+                   "same worlds, and rank them by their measured success rate first.")
+@click.option("--evaluate-top", default=3, show_default=True, type=Whole(min=1, max=100), metavar="K",
+              help="With --evaluate: how many of the best designs to evaluate.")
+@click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
+              help="With --evaluate: the worlds' spreads, as `evaluate --vary` (default: the design file's "
+                   "uncertainty box, else a lab's).")
+@click.option("--feature-error", nargs=2, type=Finite(min=0), default=None, metavar="MM DEG",
+              help="With --evaluate: place each fixture off by up to MM and DEG, as `evaluate --feature-error`.")
+@click.option("--closed-loop", is_flag=True, help="With --evaluate: run the trials closed loop.")
+@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+              help="With --evaluate: the simulated arm's physics engine.")
+@click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
+              help="With --evaluate: the worlds' seed (every design runs in the same worlds).")
 @click.option("--out", "out_dir", default=None, type=click.Path(file_okay=False), metavar="DIR",
               help="Where each design's task file goes (design-1.yaml is the best). Default: NAME.designs/ beside "
                    "the design file NAME.design.yaml.")
@@ -45,8 +73,9 @@ from stablepush_cli.options import (
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
               callback=parse_ray_address, help="Plan the layouts on Ray: a local instance, or the cluster at ADDRESS.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, reach_top: int, out_dir, json_path,
-           png_path, workers, ray_address, quiet: bool) -> None:
+def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, reach_top: int, trials, evaluate_top: int,
+           vary, feature_error, closed_loop: bool, engine: str, seed: int, out_dir, json_path, png_path, workers,
+           ray_address, quiet: bool) -> None:
     """Find where the fixtures should go: rank layouts of candidate pushers by their plans.
 
     DESIGN.yaml is a task file whose `candidates` stand in for its `pushers`: `candidates: {mu:
@@ -55,25 +84,34 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     up to --max-fixtures candidates whose pushers can push the object toward the goal from the
     start is planned (robust where the task has an uncertainty box) and checked; the solved ones
     are ranked (--rank) and written as complete task files, with the features where the plan puts
-    them (environment.features), that `plan`, `execute` and `evaluate` take unchanged. Exit 1 when
-    no layout of the candidates can do the regrasp, with the reason.
+    them (environment.features), that `plan`, `execute` and `evaluate` take unchanged. With
+    --evaluate N, the best designs' plans each run N trials in the same simulated worlds, and the
+    designs are ranked by their measured success rate first. Exit 1 when no layout of the
+    candidates can do the regrasp, with the reason.
 
     \b
-    Example:
+    Exit status: 0 designs found, 1 none, 2 bad input, 4 an evaluation trial crashed (an internal
+    error; everything is written), 130 the evaluation stopped by Ctrl-C (the designs measured so
+    far are ranked and written).
+
+    \b
+    Examples:
       stablepush design data/designs/offset-low-mu.design.yaml --json offset.designs.json
       stablepush plan data/designs/offset-low-mu.designs/design-1.yaml -o best.plan.json
+      stablepush design data/designs/offset-low-mu.design.yaml --evaluate 20 --vary pad_mu=0.2
     """
-    from stablepush.design import DEFAULT_RANK, design_files, designs_folder, parse_rank
+    from stablepush.design import DEFAULT_RANK, design_files, designs_folder, evaluate_designs, layout_task, parse_rank
     from stablepush.design import design as search
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_files
     from stablepush.runners import default_workers
     from stablepush.task.schema import load_design
 
-    rank = parse_rank(rank_text) if rank_text is not None else DEFAULT_RANK
+    rank = parse_rank(rank_text, measured=trials is not None) if rank_text is not None else DEFAULT_RANK
     out = Path(out_dir) if out_dir is not None else designs_folder(design_file)
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_named_outputs({"--json": json_path, "--plot": png_path}, {"DESIGN.yaml": design_file})
     task, candidates = load_design(design_file)
+    spreads = _spreads(layout_task(task, candidates, design_file), trials, vary, feature_error)
     runner = runner_for(workers, ray_address, default=default_workers())
     bar = progressbar(quiet, length=None, label="layouts planned", show_pos=True)
     try:
@@ -83,6 +121,13 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     finally:
         if bar is not None:
             bar.render_finish()
+    if spreads is not None and study.designs:
+        with landings_bar(quiet, trials * min(evaluate_top, len(study.designs))) as landed:
+            ranked = list(study.designs)
+            evaluate_designs(study, trials, spreads, top=evaluate_top, seed=seed, closed_loop=closed_loop,
+                             engine=engine, runner=runner,
+                             progress=(lambda d, record, done: landed(done, f"design {ranked.index(d) + 1}: "))
+                             if landed else None)
     files = design_files(study, task, candidates, out, design_file)
     if json_path is not None:
         files[json_path] = json.dumps(study.as_dict(), indent=1) + "\n"
@@ -101,10 +146,38 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
         reach = f", reach near the goal {d.reach:.0%}" if d.reach is not None else ""
         arm = "" if d.arm is None else (", the arm follows it" if d.arm["follows"] else
                                         f", the arm cannot follow it ({d.arm['reason']})")
-        say(f"{k}. {_figures(d)}{reach}{arm}, planned in {d.planning_time_s:.3f} s -> {d.task_file}")
+        say(f"{k}. {_figures(d)}{reach}{arm}{d.odds()}, planned in {d.planning_time_s:.3f} s -> {d.task_file}")
+    if study.evaluated is not None:
+        e = study.evaluated
+        say(f"odds: the best {e['top']} designs, {e['trials']} trials each in the same worlds ({e['spreads']}; "
+            f"seed {e['seed']}, {'closed' if e['closed_loop'] else 'open'} loop on {e['engine']})")
     say(study.verdict)
     if not study.designs:
         raise SystemExit(EXIT_NOT_SOLVED)
+    crashed = sum(d.success.get("crashed", 0) for d in study.designs if d.success)
+    if crashed:
+        click.echo(f"error: {crashed} evaluation trials crashed (internal errors, a bug): each design's rate is "
+                   f"over the trials that did not", err=True)
+        sys.exit(EXIT_INTERNAL)
+    if study.interrupted:
+        sys.exit(130)
+
+
+def _spreads(everything, trials, vary, feature_error):
+    """The worlds --evaluate draws (None without it): the design's spreads, checked before the search."""
+    from stablepush.evaluation import Spreads
+
+    if trials is None:
+        named = [name for name in ODDS_OPTIONS if given(name)]
+        if named:
+            fail(f"--{named[0].replace('_', '-')}: only with --evaluate N")
+        return None
+    try:
+        return Spreads.for_task(everything, vary, feature_error)
+    except SettingError as exc:  # --feature-error past its bound
+        fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
+    except ValueError as exc:  # --vary, which Spreads names `vary`
+        fail(f"--{exc}")
 
 
 def _figures(d) -> str:

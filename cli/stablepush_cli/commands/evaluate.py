@@ -1,7 +1,6 @@
 """`stablepush evaluate`."""
 from __future__ import annotations
 
-import contextlib
 import os
 import sys
 
@@ -16,9 +15,9 @@ from stablepush_cli.common import (
     check_named_outputs,
     fail,
     given,
+    landings_bar,
     load_plan_and_task,
     load_task_file,
-    progressbar,
     runner_for,
     say_beside,
 )
@@ -169,8 +168,9 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop"
                    f"{'' if guarded else ', approaches not guarded'} on {engine}, "
                    f"on {runner.describe(trials)}" + (f"; the plan is robust to {box}" if box else ""), err=True)
-    with _trials_bar(quiet, trials) as progress:
-        result = run_evaluation(batch, trials, runner, progress, test=test)
+    with landings_bar(quiet, trials) as landed:
+        result = run_evaluation(batch, trials, runner, (lambda record, done: landed(done)) if landed else None,
+                                test=test)
     write_evaluation(result, json_path, csv_path, png_path)
     s = result.summary()
     if not s["trials"]:
@@ -205,26 +205,6 @@ def _study(task_file: str, plan_file, robust: bool, vary, feature_error, tracker
     if not plan_file:
         task, plan = _plan_for(task, spreads, robust)
     return task, plan, spreads
-
-
-@contextlib.contextmanager
-def _trials_bar(quiet: bool, trials: int):
-    """A progress bar over the trials with the success rate so far, as evaluate()'s progress
-    callback; None without a terminal."""
-    bar = progressbar(quiet, length=trials, label="trials", show_pos=True)
-    if bar is None:
-        yield None
-        return
-
-    def progress(record, done) -> None:
-        landed = sum(1 for r in done if r["success"])
-        bar.label = f"landed {landed}/{len(done)} ({landed / len(done):.0%})"
-        bar.update(1)
-
-    try:
-        yield progress
-    finally:
-        bar.render_finish()
 
 
 def _plan_for(task, spreads, robust: bool):

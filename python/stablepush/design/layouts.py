@@ -17,7 +17,9 @@ most `max_fixtures` candidates. The search
 4. ranks them (RANK_KEYS, `rank`), keeps the best of each set of fixtures its plan uses, then
    for the best `reach_top` a small reach map around the goal (REACH_CELLS cells, REACH_SPAN
    tolerances either side in x and z): the share of nearby goals the layout also reaches, and
-   ranks again.
+   ranks again;
+5. optionally (odds.evaluate_designs) runs the best designs' plans through `evaluate` and ranks
+   them by their measured success rate first.
 Layouts run on a `runners.Runner` (here, local processes or Ray), each deterministic for the seed.
 """
 from __future__ import annotations
@@ -32,6 +34,7 @@ from stablepush.errors import TaskError
 from stablepush.execution.world import place_features
 from stablepush.frames import angle_about_y
 from stablepush.plan import check_plan, plan_task
+from stablepush.plan.plan import Plan
 from stablepush.plan.reach import reach_map
 from stablepush.plan.verify import plan_margin
 from stablepush.runners import Runner, WorkerLost, run_all
@@ -40,19 +43,26 @@ from stablepush.task.model import Robot, Task
 from stablepush.task.schema import parse_task
 
 # What a layout is ranked by, each best first: the key, and +1 where less is better, -1 more.
-RANK_KEYS: Dict[str, int] = {"fixtures": 1, "switches": 1, "pushes": 1, "margin": -1, "reach": -1, "time": 1}
-DEFAULT_RANK = ("fixtures", "switches", "margin", "pushes", "reach", "time")
+# `arm`: 0 where the task's arm follows the plan, 1 where it cannot (no arm named: not a key);
+# `success`: the rate measured by odds.evaluate_designs (not measured: ranks last).
+RANK_KEYS: Dict[str, int] = {"arm": 1, "fixtures": 1, "switches": 1, "pushes": 1, "margin": -1, "reach": -1,
+                             "time": 1, "success": -1}
+DEFAULT_RANK = ("arm", "fixtures", "switches", "margin", "pushes", "reach", "time")
 REACH_CELLS = 3  # per axis (x and z) of the reach map around the goal
 REACH_SPAN = 2.0  # planner.tolerance either side of the goal
 REACH_TIME_LIMIT = 1.0  # s a cell of that map may plan
 
 
-def parse_rank(text: str) -> Tuple[str, ...]:
-    """A ranking rule: keys of RANK_KEYS, comma-separated, most important first."""
+def parse_rank(text: str, measured: bool = False) -> Tuple[str, ...]:
+    """A ranking rule: keys of RANK_KEYS, comma-separated, most important first, each at most
+    once; `success` only where the designs' odds are `measured` (odds.evaluate_designs)."""
     keys = tuple(k.strip() for k in text.split(",") if k.strip())
     unknown = [k for k in keys if k not in RANK_KEYS]
-    if not keys or unknown:
-        raise TaskError("rank", f"keys from {', '.join(RANK_KEYS)}, comma-separated, got {text!r:.80}")
+    if not keys or unknown or len(set(keys)) < len(keys):
+        raise TaskError("rank", f"keys from {', '.join(RANK_KEYS)}, comma-separated, each once, got {text!r:.80}")
+    if "success" in keys and not measured:
+        raise TaskError("rank", "`success` is measured by evaluating the designs (--evaluate N); without it "
+                                "no design has a success rate to rank by")
     return keys
 
 
@@ -74,6 +84,10 @@ class Design:
     # (joint_path: follows, or the first sample it cannot and why); None: no arm named.
     arm: Optional[Dict[str, Any]] = None
     task_file: Optional[str] = None
+    plan: Optional[Plan] = field(default=None, repr=False)
+    # The plan's measured odds (odds.evaluate_designs): trials, successes, success_rate with its ci95,
+    # the misses' causes; or `refused` where the arm cannot follow it. None: not evaluated.
+    success: Optional[Dict[str, Any]] = None
 
     @property
     def fixtures(self) -> int:
@@ -82,16 +96,28 @@ class Design:
         return len(self.features) if self.solved else len(self.pushers)
 
     def key(self, rank: Sequence[str]) -> tuple:
-        values = {"fixtures": self.fixtures, "switches": self.switches, "pushes": self.pushes,
-                  "margin": self.margin_n, "reach": self.reach, "time": self.planning_time_s}
+        values = {"arm": None if self.arm is None else int(not self.arm["follows"]), "fixtures": self.fixtures,
+                  "switches": self.switches, "pushes": self.pushes, "margin": self.margin_n, "reach": self.reach,
+                  "time": self.planning_time_s, "success": (self.success or {}).get("success_rate")}
         return (not self.solved,) + tuple(math.inf if values[k] is None else RANK_KEYS[k] * values[k] for k in rank)
+
+    def odds(self) -> str:
+        """The measured odds in words (", landed 19 of 20 trials (84-99%)"), or why none were
+        measured; "" where the design was not evaluated."""
+        if self.success is None:
+            return ""
+        if "refused" in self.success:
+            return f", not evaluated: {self.success['refused']}"
+        s, ci = self.success, self.success["ci95"]
+        interval = f" ({ci[0]:.0%}-{ci[1]:.0%})" if ci else ""
+        return f", landed {s['successes']} of {s['judged']} trials{interval}"
 
     def as_dict(self) -> Dict[str, Any]:
         return {"pushers": list(self.pushers), "fixtures": self.fixtures, "solved": self.solved,
                 "reason": self.reason or None,
                 "pushes": self.pushes, "switches": self.switches, "planning_time_s": self.planning_time_s,
                 "margin_n": self.margin_n, "reach": self.reach, "features": self.features, "arm": self.arm,
-                "task_file": self.task_file}
+                "success": self.success, "task_file": self.task_file}
 
 
 @dataclass
@@ -105,6 +131,8 @@ class DesignStudy:
     layouts_pruned: int
     rank: Tuple[str, ...]
     failed: List[Design] = field(default_factory=list)  # planned, not solved
+    evaluated: Optional[Dict[str, Any]] = None  # how the odds were measured (odds.evaluate_designs); None: not
+    interrupted: bool = False  # the odds' trials stopped by Ctrl-C
 
     @property
     def verdict(self) -> str:
@@ -112,7 +140,7 @@ class DesignStudy:
         if self.designs:
             best = self.designs[0]
             return (f"best layout: {' + '.join(best.pushers)} ({best.pushes} pushes, {best.switches} switch-overs, "
-                    f"margin {best.margin_n:.3f} N)")
+                    f"margin {best.margin_n:.3f} N{best.odds()})")
         if not self.layouts_searched:
             return (f"no layout of the candidates can do it: none of them ({', '.join(self.pruned_candidates)}) has a "
                     f"stable push from the start toward the goal")
@@ -122,7 +150,8 @@ class DesignStudy:
     def as_dict(self) -> Dict[str, Any]:
         return {"candidates": self.candidates, "pruned_candidates": self.pruned_candidates,
                 "layouts_searched": self.layouts_searched, "layouts_pruned": self.layouts_pruned,
-                "rank": list(self.rank), "verdict": self.verdict, "designs": [d.as_dict() for d in self.designs],
+                "rank": list(self.rank), "verdict": self.verdict, "evaluated": self.evaluated,
+                "interrupted": self.interrupted, "designs": [d.as_dict() for d in self.designs],
                 "unsolved": [d.as_dict() for d in self.failed]}
 
 
@@ -220,7 +249,7 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
     if not plan.solved:
         d.reason = plan.message or "not solved within the time limit"
         return d
-    plan = check_plan(d.task, plan)
+    d.plan = plan = check_plan(d.task, plan)
     d.solved = True
     d.pushes = len(plan.waypoints) - 1
     d.switches = max(0, len(plan.pusher_sequence) - 1)
