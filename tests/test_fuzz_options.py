@@ -1,4 +1,4 @@
-"""Options fuzzed: `evaluate`, `reach`, `trajectory` and `execute` run through click's CliRunner with
+"""Options fuzzed: `evaluate`, `reach`, `trajectory`, `execute` and `design` run through click's CliRunner with
 options drawn at random (a fixed seed; the cases are generated each run, not replayed from a list)
 from values that are legal, at the edges of their ranges, or hostile (NaN, infinities, -0,
 negative, huge, another script's digits, empty, a trailing slash, the wrong kind). Every case must
@@ -7,11 +7,13 @@ library's StablepushError or click's usage error.
 
 Kept fast (some seconds): the trials of `evaluate` draw their worlds and land without a
 simulation, `execute`'s simulated arm refuses to build its world (a fault, exit 3, after every
-option has been taken), and `reach` searches for at most 0.01 s a cell on this process."""
+option has been taken), `reach` searches for at most 0.01 s a cell on this process, and `design`
+mostly 0.05 s a layout of two candidates."""
 import random
 import shlex
 
 import pytest
+import yaml
 from click.testing import CliRunner
 
 import stablepush as sp
@@ -133,6 +135,32 @@ def _execute(rng, tmp_path):
     return args + _some(rng, options)
 
 
+def _design(rng, tmp_path):
+    args = ["design", str(tmp_path / "two.design.yaml"), "--quiet"]
+    options = {
+        "--max-fixtures": lambda: [_whole(rng)],
+        "--rank": lambda: [rng.choice(["margin", "success", "arm,fixtures", "margin,margin", "speed", "", ",",
+                                       "success,margin", "time,reach,pushes"])],
+        "--reach-top": lambda: [rng.choice(["0", "1", "-1", "x", "٢", "101", ""])],
+        "--evaluate": lambda: [rng.choice(["1", "2", "0", "-1", "٣", "x", "1e2", "100001"])],
+        "--evaluate-top": lambda: [rng.choice(["1", "3", "0", "101", "x"])],
+        "--vary": lambda: [f"{rng.choice(['pad_mu', 'mass', 'heat', '', 'none'])}={_number(rng)}"],
+        "--feature-error": lambda: [_number(rng), _number(rng)],
+        "--seed": lambda: [_whole(rng)],
+        "--engine": lambda: [rng.choice(["mujoco", "drake", "bullet", ""])],
+        "--closed-loop": lambda: [],
+        "--out": lambda: [_output(rng, tmp_path, [""])],
+        "--json": lambda: [_output(rng, tmp_path, [".json"])],
+        "--plot": lambda: [_output(rng, tmp_path, [".png", ".svg", ".jpg"])],
+        "--workers": lambda: [rng.choice(["1", "0", "-2", "x", "٢", ""])],
+        "--ray": lambda: [rng.choice(["127.0.0.1:1", "notanaddress", "ray://"])],
+    }
+    args += _some(rng, options)
+    time_limit = ["--time-limit", rng.choice(["0.05", "0", "-1", "nan", "inf", "1e-7", "٠.١", "", "x"])]
+    return args + (time_limit if rng.random() < 0.3 else ["--time-limit", "0.05"]) + (
+        [] if "--workers" in args else ["--workers", "1"]) + ([] if "--reach-top" in args else ["--reach-top", "0"])
+
+
 def _some(rng, options):
     out = []
     for name in rng.sample(sorted(options), rng.randint(0, min(4, len(options)))):
@@ -181,9 +209,12 @@ def test_fuzzed_options_never_end_in_an_internal_error(tmp_path, monkeypatch, se
     monkeypatch.chdir(tmp_path)
     (tmp_path / "task.yaml").write_text(HIGH_MU.read_text())
     sp.save_plan(sp.plan_task(shipped("horizontal-offset-high-mu")), str(tmp_path / "task.plan.json"))
+    design = yaml.safe_load(HIGH_MU.read_text())
+    design["candidates"] = [p for p in design.pop("pushers") if p["name"] in ("left", "bottom")]
+    (tmp_path / "two.design.yaml").write_text(yaml.safe_dump(design))
     rng = random.Random(seed)
     statuses = {}
-    for make in (_evaluate, _reach, _trajectory, _execute):
+    for make in (_evaluate, _reach, _trajectory, _execute, _design):
         for _ in range(CASES_PER_COMMAND):
             args = make(rng, tmp_path)
             result = CliRunner().invoke(cli, args)
