@@ -117,6 +117,7 @@ def test_every_design_of_a_generated_part_plans_and_verifies(tmp_path, seed):
         return
     for d in study.designs:
         assert d.solved and d.margin_n >= 0 and len(d.features) == len(d.pushers)
+        assert d.points == sum(1 for name in d.features if name.startswith("corner")) and 0 <= d.end_used <= 1
         _replanned_and_verified(design_task(task, candidates, d), path)
 
 
@@ -177,7 +178,7 @@ def test_a_bad_design_file_is_refused_naming_the_field(tmp_path, text, field):
     assert f": {field}" in str(refused.value), str(refused.value)
 
 
-def test_the_rank_puts_a_layout_the_arm_cannot_follow_below_and_measured_odds_first():
+def test_the_rank_puts_the_arm_first_then_fixtures_point_pushers_and_the_plans_end_and_measured_odds_first():
     follows = Design(("a", "b"), solved=True, pushes=9, switches=1, margin_n=0.1, features={"a": [], "b": []},
                      arm={"follows": True})
     cannot = Design(("c",), solved=True, pushes=3, switches=0, margin_n=2.0, features={"c": []},
@@ -189,6 +190,19 @@ def test_the_rank_puts_a_layout_the_arm_cannot_follow_below_and_measured_odds_fi
     rank = ("success",) + DEFAULT_RANK
     assert sorted([not_measured, follows, cannot], key=lambda d: d.key(rank)) == [cannot, follows, not_measured]
     assert parse_rank("margin, success", measured=True) == ("margin", "success")
+    # Among layouts of as many fixtures, one that leans on a point pusher ranks below one that does
+    # not, whatever its margin (a point pusher's push is robust to nothing, docs/planner.md); then
+    # the plan that ends nearer its goal first (an open-loop run lands where it ends plus its drift).
+    inside = Design(("e",), solved=True, pushes=5, switches=0, margin_n=0.1, features={"e": []}, end_used=0.0,
+                    points=0)
+    nearer_edge = Design(("f",), solved=True, pushes=5, switches=0, margin_n=3.0, features={"f": []},
+                         end_used=0.6, points=0)
+    on_a_point = Design(("g",), solved=True, pushes=5, switches=0, margin_n=3.0, features={"g": []}, end_used=0.0,
+                        points=1)
+    two_fixtures = Design(("h", "i"), solved=True, pushes=5, switches=0, margin_n=3.0, features={"h": [], "i": []},
+                          end_used=0.0, points=0)
+    assert (sorted([two_fixtures, on_a_point, nearer_edge, inside], key=lambda d: d.key(DEFAULT_RANK))
+            == [inside, nearer_edge, on_a_point, two_fixtures])
     for text in ("success", "margin,margin", "speed"):
         with pytest.raises(TaskError, match="rank"):
             parse_rank(text)

@@ -37,8 +37,9 @@ ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine"
               help="Layouts of 1 to K fixtures.")
 @click.option("--rank", "rank_text", default=None, metavar="KEYS",
               help="The ranking rule: keys, most important first, from arm (the task's arm follows the plan "
-                   "first), fixtures, switches, pushes (fewer first), margin, reach (more first), time, and "
-                   "success (with --evaluate). Default: arm,fixtures,switches,margin,pushes,reach,time; with "
+                   "first), fixtures, points (point pushers used), end (the plan's end's offset from the goal over "
+                   "the tolerance), switches, pushes (less first), margin, reach (more first), time, and success "
+                   "(with --evaluate). Default: arm,fixtures,points,end,switches,margin,pushes,reach,time; with "
                    "--evaluate, success first unless the rule places it.")
 @click.option("--time-limit", default=2.0, show_default=True, type=TIME_LIMIT, metavar="S",
               help="Each layout's search time (the task's planner.time_limit is not used: there are many layouts).")
@@ -149,7 +150,8 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
         say(f"{k}. {_figures(d)}{reach}{arm}{d.odds()}, planned in {d.planning_time_s:.3f} s -> {d.task_file}")
     if study.evaluated is not None:
         e = study.evaluated
-        say(f"odds: the best {e['top']} designs, {e['trials']} trials each in the same worlds ({e['spreads']}; "
+        which = "the best design" if e["top"] == 1 else f"the best {e['top']} designs"
+        say(f"odds: {which}, {e['trials']} trials each in the same worlds ({e['spreads']}; "
             f"seed {e['seed']}, {'closed' if e['closed_loop'] else 'open'} loop on {e['engine']})")
     say(study.verdict)
     if not study.designs:

@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from stablepush.errors import TaskError
+from stablepush.execution.verdict import tolerance_used
 from stablepush.execution.world import place_features
 from stablepush.frames import angle_about_y
 from stablepush.plan import check_plan, plan_task
@@ -44,10 +45,14 @@ from stablepush.task.schema import parse_task
 
 # What a layout is ranked by, each best first: the key, and +1 where less is better, -1 more.
 # `arm`: 0 where the task's arm follows the plan, 1 where it cannot (no arm named: not a key);
+# `points`: the point pushers the plan uses (a point pusher's stable push cannot be robust to the
+# pads' mu, the grip or the mass, docs/planner.md, so its margin is the model's alone);
+# `end`: how far from the goal the plan ends, its largest coordinate over the tolerance (0 at the
+# goal, 1 at the tolerance's edge): an open-loop run lands where the plan ends plus its drift;
 # `success`: the rate measured by odds.evaluate_designs (not measured: ranks last).
-RANK_KEYS: Dict[str, int] = {"arm": 1, "fixtures": 1, "switches": 1, "pushes": 1, "margin": -1, "reach": -1,
-                             "time": 1, "success": -1}
-DEFAULT_RANK = ("arm", "fixtures", "switches", "margin", "pushes", "reach", "time")
+RANK_KEYS: Dict[str, int] = {"arm": 1, "end": 1, "fixtures": 1, "points": 1, "switches": 1, "pushes": 1,
+                             "margin": -1, "reach": -1, "time": 1, "success": -1}
+DEFAULT_RANK = ("arm", "fixtures", "points", "end", "switches", "margin", "pushes", "reach", "time")
 REACH_CELLS = 3  # per axis (x and z) of the reach map around the goal
 REACH_SPAN = 2.0  # planner.tolerance either side of the goal
 REACH_TIME_LIMIT = 1.0  # s a cell of that map may plan
@@ -66,7 +71,7 @@ def parse_rank(text: str, measured: bool = False) -> Tuple[str, ...]:
     return keys
 
 
-@dataclass
+@dataclass(eq=False)  # a design is the one result it is: compared, hashed and found in lists by identity
 class Design:
     """One layout: its pushers (candidate names), the task made of them, and what was measured."""
 
@@ -76,6 +81,8 @@ class Design:
     reason: str = ""
     pushes: Optional[int] = None
     switches: Optional[int] = None
+    end_used: Optional[float] = None  # the plan's end's largest offset from the goal over the tolerance (1: its edge)
+    points: Optional[int] = None  # point pushers the plan uses
     planning_time_s: Optional[float] = None
     margin_n: Optional[float] = None
     reach: Optional[float] = None  # share of the goals around the goal it also reaches (None: not measured)
@@ -96,9 +103,11 @@ class Design:
         return len(self.features) if self.solved else len(self.pushers)
 
     def key(self, rank: Sequence[str]) -> tuple:
-        values = {"arm": None if self.arm is None else int(not self.arm["follows"]), "fixtures": self.fixtures,
-                  "switches": self.switches, "pushes": self.pushes, "margin": self.margin_n, "reach": self.reach,
-                  "time": self.planning_time_s, "success": (self.success or {}).get("success_rate")}
+        values = {"arm": None if self.arm is None else int(not self.arm["follows"]),
+                  "end": self.end_used, "fixtures": self.fixtures,
+                  "points": self.points, "switches": self.switches, "pushes": self.pushes, "margin": self.margin_n,
+                  "reach": self.reach, "time": self.planning_time_s,
+                  "success": (self.success or {}).get("success_rate")}
         return (not self.solved,) + tuple(math.inf if values[k] is None else RANK_KEYS[k] * values[k] for k in rank)
 
     def odds(self) -> str:
@@ -115,7 +124,8 @@ class Design:
     def as_dict(self) -> Dict[str, Any]:
         return {"pushers": list(self.pushers), "fixtures": self.fixtures, "solved": self.solved,
                 "reason": self.reason or None,
-                "pushes": self.pushes, "switches": self.switches, "planning_time_s": self.planning_time_s,
+                "pushes": self.pushes, "switches": self.switches, "end_used": self.end_used, "points": self.points,
+                "planning_time_s": self.planning_time_s,
                 "margin_n": self.margin_n, "reach": self.reach, "features": self.features, "arm": self.arm,
                 "success": self.success, "task_file": self.task_file}
 
@@ -254,10 +264,13 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
     d.pushes = len(plan.waypoints) - 1
     d.switches = max(0, len(plan.pusher_sequence) - 1)
     d.margin_n = plan_margin(d.task, plan)
+    end = plan.waypoints[-1].pose
+    d.end_used = tolerance_used({"x": end[0], "z": end[1], "theta": end[2]}, d.task.goal, d.task.planner.tolerance)
     for name, feature in place_features(d.task, list(plan.waypoints)).items():
         T = feature.object_pose
         d.features[name] = [float(T[0, 3] * 1e3), float(T[1, 3] * 1e3), float(T[2, 3] * 1e3),
                             math.degrees(angle_about_y(T[:3, :3]))]
+    d.points = sum(1 for p in d.task.pushers if p.is_point and p.name in d.features)
     if d.task.environment.robot != Robot():
         d.arm = _arm_follows(d.task, plan)
     return d
