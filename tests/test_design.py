@@ -208,6 +208,17 @@ def test_the_rank_puts_the_arm_first_then_fixtures_point_pushers_and_the_plans_e
             parse_rank(text)
 
 
+@pytest.mark.parametrize("path", sorted((ROOT / "data" / "designs").glob("*.design.yaml")), ids=lambda p: p.stem)
+def test_every_shipped_design_file_loads_and_keeps_its_tasks_regrasp(path):
+    task, candidates = load_design(path)
+    assert candidates and "pushers" not in task
+    twin = TASKS / f"{task['name']}.yaml"
+    assert twin.exists(), twin
+    own = yaml.safe_load(twin.read_text())
+    for key in ("object", "gripper", "gravity", "start", "goal"):
+        assert task[key] == own[key], key
+
+
 def _pivot_design():
     """The shipped pivot with its pushers taken away: its edges and corners are the candidates."""
     path = TASKS / "pivoting.yaml"
