@@ -10,10 +10,11 @@ most `max_fixtures` candidates. The search
    the goal is lost to this; the count is reported);
 2. plans every other layout (plan_task with the task's seed, time limit and uncertainty box: a
    robust plan where the task has one) and checks the plan against its task (check_plan);
-3. measures each solved layout: pushes, switch-overs, planning time, the least margin of its
-   pushes over the uncertainty box (verify.plan_margin), where each fixture stands in the world at
-   the start (execution.world.place_features: the task's environment.features), and, where the
-   task names its arm (environment.robot), whether the arm can follow the plan (sim.joint_path);
+3. measures each solved layout: pushes, switch-overs, the point pushers it uses, how far from the
+   goal its plan ends, planning time, the least margin of its pushes over the uncertainty box
+   (verify.plan_margin), where each fixture stands in the world at the start
+   (execution.world.place_features: the task's environment.features), and, where the task names
+   its arm (environment.robot), whether the arm can follow the plan (sim.joint_path);
 4. ranks them (RANK_KEYS, `rank`), keeps the best of each set of fixtures its plan uses, then
    for the best `reach_top` a small reach map around the goal (REACH_CELLS cells, REACH_SPAN
    tolerances either side in x and z): the share of nearby goals the layout also reaches, and
@@ -50,8 +51,8 @@ from stablepush.task.schema import parse_task
 # `end`: how far from the goal the plan ends, its largest coordinate over the tolerance (0 at the
 # goal, 1 at the tolerance's edge): an open-loop run lands where the plan ends plus its drift;
 # `success`: the rate measured by odds.evaluate_designs (not measured: ranks last).
-RANK_KEYS: Dict[str, int] = {"arm": 1, "end": 1, "fixtures": 1, "points": 1, "switches": 1, "pushes": 1,
-                             "margin": -1, "reach": -1, "time": 1, "success": -1}
+RANK_KEYS: Dict[str, int] = {"arm": 1, "fixtures": 1, "points": 1, "end": 1, "switches": 1, "margin": -1,
+                             "pushes": 1, "reach": -1, "time": 1, "success": -1}
 DEFAULT_RANK = ("arm", "fixtures", "points", "end", "switches", "margin", "pushes", "reach", "time")
 REACH_CELLS = 3  # per axis (x and z) of the reach map around the goal
 REACH_SPAN = 2.0  # planner.tolerance either side of the goal
@@ -103,15 +104,14 @@ class Design:
         return len(self.features) if self.solved else len(self.pushers)
 
     def key(self, rank: Sequence[str]) -> tuple:
-        values = {"arm": None if self.arm is None else int(not self.arm["follows"]),
-                  "end": self.end_used, "fixtures": self.fixtures,
-                  "points": self.points, "switches": self.switches, "pushes": self.pushes, "margin": self.margin_n,
-                  "reach": self.reach, "time": self.planning_time_s,
+        values = {"arm": None if self.arm is None else int(not self.arm["follows"]), "fixtures": self.fixtures,
+                  "points": self.points, "end": self.end_used, "switches": self.switches, "margin": self.margin_n,
+                  "pushes": self.pushes, "reach": self.reach, "time": self.planning_time_s,
                   "success": (self.success or {}).get("success_rate")}
         return (not self.solved,) + tuple(math.inf if values[k] is None else RANK_KEYS[k] * values[k] for k in rank)
 
     def odds(self) -> str:
-        """The measured odds in words (", landed 19 of 20 trials (84-99%)"), or why none were
+        """The measured odds in words (", landed 19 of 20 trials (76%-99%)"), or why none were
         measured; "" where the design was not evaluated."""
         if self.success is None:
             return ""
