@@ -79,6 +79,19 @@ def progressbar(quiet: bool, **options):
     return click.progressbar(file=sys.stderr, **options)
 
 
+def study_spreads(task, vary, feature_error, tracker_noise=(0.0, 0.0)):
+    """The worlds a study draws (evaluation.Spreads.for_task), a bad --vary, --feature-error or
+    --tracker-noise refused naming the option."""
+    from stablepush.evaluation import Spreads
+
+    try:
+        return Spreads.for_task(task, vary, feature_error, tracker_noise)
+    except SettingError as exc:  # --feature-error or --tracker-noise past its bound
+        fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
+    except ValueError as exc:  # --vary, which Spreads names `vary`
+        fail(f"--{exc}")
+
+
 @contextlib.contextmanager
 def landings_bar(quiet: bool, trials: int):
     """A progress bar over `trials` simulated trials, labelled with the landings so far; yields

@@ -7,7 +7,6 @@ from pathlib import Path
 
 import click
 
-from stablepush.errors import SettingError
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush_cli.common import (
     EXIT_INTERNAL,
@@ -19,6 +18,7 @@ from stablepush_cli.common import (
     progressbar,
     runner_for,
     say_beside,
+    study_spreads,
 )
 from stablepush_cli.options import (
     TIME_LIMIT,
@@ -101,7 +101,7 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
       stablepush plan data/designs/offset-low-mu.designs/design-1.yaml -o best.plan.json
       stablepush design data/designs/offset-low-mu.design.yaml --evaluate 20 --vary pad_mu=0.2
     """
-    from stablepush.design import DEFAULT_RANK, design_files, designs_folder, evaluate_designs, layout_task, parse_rank
+    from stablepush.design import DEFAULT_RANK, design_files, designs_folder, evaluate_designs, parse_rank
     from stablepush.design import design as search
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_files
     from stablepush.runners import default_workers
@@ -112,7 +112,7 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_named_outputs({"--json": json_path, "--plot": png_path}, {"DESIGN.yaml": design_file})
     task, candidates = load_design(design_file)
-    spreads = _spreads(layout_task(task, candidates, design_file), trials, vary, feature_error)
+    spreads = _spreads(task, candidates, design_file, trials, vary, feature_error)
     runner = runner_for(workers, ray_address, default=default_workers())
     bar = progressbar(quiet, length=None, label="layouts planned", show_pos=True)
     try:
@@ -165,21 +165,16 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
         sys.exit(130)
 
 
-def _spreads(everything, trials, vary, feature_error):
+def _spreads(task, candidates, design_file: str, trials, vary, feature_error):
     """The worlds --evaluate draws (None without it): the design's spreads, checked before the search."""
-    from stablepush.evaluation import Spreads
+    from stablepush.design import layout_task
 
     if trials is None:
         named = [name for name in ODDS_OPTIONS if given(name)]
         if named:
             fail(f"--{named[0].replace('_', '-')}: only with --evaluate N")
         return None
-    try:
-        return Spreads.for_task(everything, vary, feature_error)
-    except SettingError as exc:  # --feature-error past its bound
-        fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
-    except ValueError as exc:  # --vary, which Spreads names `vary`
-        fail(f"--{exc}")
+    return study_spreads(layout_task(task, candidates, design_file), vary, feature_error)
 
 
 def _figures(d) -> str:

@@ -20,6 +20,7 @@ from stablepush_cli.common import (
     load_task_file,
     runner_for,
     say_beside,
+    study_spreads,
 )
 from stablepush_cli.options import (
     Finite,
@@ -188,20 +189,13 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
 
 def _study(task_file: str, plan_file, robust: bool, vary, feature_error, tracker_noise):
     """The task, the plan to evaluate (the one given, else planned here) and the worlds' spreads."""
-    from stablepush.evaluation import Spreads
-
     if robust and plan_file:
         fail("--robust plans from the task; a plan given with --plan is evaluated as it is")
     if plan_file:
         task, plan = load_plan_and_task(plan_file, task_file)
     else:
         task = load_task_file(task_file)
-    try:
-        spreads = Spreads.for_task(task, vary, feature_error, tracker_noise)
-    except SettingError as exc:  # --feature-error or --tracker-noise past its bound
-        fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
-    except ValueError as exc:  # --vary, which Spreads names `vary`
-        fail(f"--{exc}")
+    spreads = study_spreads(task, vary, feature_error, tracker_noise)
     if not plan_file:
         task, plan = _plan_for(task, spreads, robust)
     return task, plan, spreads
