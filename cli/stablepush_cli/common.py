@@ -95,16 +95,16 @@ def study_spreads(task, vary, feature_error, tracker_noise=(0.0, 0.0)):
 @contextlib.contextmanager
 def landings_bar(quiet: bool, trials: int):
     """A progress bar over `trials` simulated trials, labelled with the landings so far; yields
-    `landed(done, prefix="")`, to call after each trial with the trial records done so far, or
-    None without a terminal."""
+    `landed(done, prefix="", suffix="")`, to call after each trial with the trial records done so
+    far (and words before and after the count), or None without a terminal."""
     bar = progressbar(quiet, length=trials, label="trials", show_pos=True)
     if bar is None:
         yield None
         return
 
-    def landed(done, prefix: str = "") -> None:
+    def landed(done, prefix: str = "", suffix: str = "") -> None:
         n = sum(1 for r in done if r["success"])
-        bar.label = f"{prefix}landed {n}/{len(done)} ({n / len(done):.0%})"
+        bar.label = f"{prefix}landed {n}/{len(done)} ({n / len(done):.0%}){suffix}"
         bar.update(1)
 
     try:

@@ -42,13 +42,16 @@ from stablepush_cli.options import (
               help="Plan robust to the worlds: the task's uncertainty box widened to the --vary spreads, so every "
                    "push is stable for every multiplier they draw (docs/model.md section 7). Corrections keep "
                    "the box. Not with --plan.")
-@click.option("--trials", default=100, show_default=True, type=Whole(min=1, max=1_000_000),
-              help="Number of trials (worlds); with --target, the most to run.")
+@click.option("--trials", default=None, type=Whole(min=1, max=1_000_000),
+              help="Number of trials (worlds)  [default: 100]. With --target, the most to run  [default: the most "
+                   "trials the test is expected to take at any success rate, a cap it decides within "
+                   "(docs/evaluate.md)].")
 @click.option("--target", "target", default=None, type=Finite(min=0, max=1, min_open=True, max_open=True),
               metavar="RATE", help="Decide whether the plan lands at least RATE of the time (e.g. 0.99), and stop "
                                    "as soon as the evidence does: a sequential probability ratio test, valid however "
                                    "early it stops (docs/evaluate.md). A rate one point below RATE is called above "
-                                   "with probability at most 1 - --confidence, and one at RATE below likewise.")
+                                   "with probability at most 1 - --confidence, and one at RATE below likewise; so "
+                                   "RATE lies strictly between 0.01 and 1.")
 @click.option("--confidence", default=0.95, show_default=True, type=Finite(min=0.5, max=1, min_open=True,
                                                                                  max_open=True),
               metavar="C", help="With --target: the decision's confidence.")
@@ -127,7 +130,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video_fps, video_size)
     else:
         video_settings_need("--video-failed")
-    from stablepush.evaluation import Batch, write_evaluation
+    from stablepush.evaluation import Batch, decision_state, study_trials, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
     from stablepush.runners import default_workers
@@ -162,16 +165,18 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
     for warning in batch.warnings():
         click.echo(f"warning: {warning}", err=True)
-    trials = spreads.trials_to_run(trials)  # as evaluate() runs them: the bar and the header say so too
+    if test is not None and trials is not None and test.cap_warning(trials):
+        click.echo(f"warning: --trials {trials}: {test.cap_warning(trials)}", err=True)
+    trials = study_trials(spreads, trials, test)  # as evaluate() runs them: the bar and the header say so too
     if not quiet:
         box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
         click.echo(f"{task.name}: {spreads.describe()}", err=True)
-        click.echo(f"{task.name}: {trials} trials, {'closed' if closed_loop else 'open'} loop"
+        click.echo(f"{task.name}: {'up to ' if test else ''}{trials} trials, {'closed' if closed_loop else 'open'} loop"
                    f"{'' if guarded else ', approaches not guarded'} on {engine}, "
                    f"on {runner.describe(trials)}" + (f"; the plan is robust to {box}" if box else ""), err=True)
     with landings_bar(quiet, trials) as landed:
-        result = run_evaluation(batch, trials, runner, (lambda record, done: landed(done)) if landed else None,
-                                test=test)
+        result = run_evaluation(batch, trials, runner, (lambda record, done: landed(
+            done, suffix=f"; {decision_state(test, done)}" if test else "")) if landed else None, test=test)
     write_evaluation(result, json_path, csv_path, png_path)
     s = result.summary()
     if not s["trials"]:
@@ -229,5 +234,5 @@ def _test(target, confidence: float):
         return None
     try:
         return SequentialTest(target, confidence)
-    except ValueError as exc:
-        fail(f"--target: {exc}")
+    except SettingError as exc:
+        fail(f"--{exc.field}: {exc.reason}")

@@ -5,13 +5,15 @@ says: here, on local processes or on Ray, and the sequential decision that may s
 from stablepush.evaluation.batch import (
     Batch,
     Evaluation,
+    decision_state,
     evaluate,
     run_trial,
+    study_trials,
     wilson_interval,
     write_evaluation,
 )
 from stablepush.evaluation.sequential import SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world, robust_task
 
-__all__ = ["Batch", "Evaluation", "SequentialTest", "Spreads", "TrialWorld", "VARY_KEYS", "draw_world",
-           "evaluate", "robust_task", "run_trial", "wilson_interval", "write_evaluation"]
+__all__ = ["Batch", "Evaluation", "SequentialTest", "Spreads", "TrialWorld", "VARY_KEYS", "decision_state",
+           "draw_world", "evaluate", "robust_task", "run_trial", "study_trials", "wilson_interval", "write_evaluation"]

@@ -40,6 +40,7 @@ from stablepush.units import angle_difference_deg
 RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
 PERCENTILES = (50, 90, 95, 99)
 EDGE = 0.9  # of the success tolerance: an open-loop plan ending this far out is warned of
+DEFAULT_TRIALS = 100  # a study's trials when none are named and no sequential test sets the cap
 
 
 @dataclass(frozen=True)
@@ -190,17 +191,27 @@ def _crashed(batch: Batch, trial: int, why: str) -> dict:
             "node": None}  # where it was lost is not known
 
 
-def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
+def study_trials(spreads: Spreads, trials: Optional[int] = None, test: Optional[SequentialTest] = None) -> int:
+    """The trials a study runs (at most, with a `test`): `trials` when given, else the test's
+    default cap (SequentialTest.default_cap: one it decides within), else DEFAULT_TRIALS; one where
+    every world is the model's own (Spreads.trials_to_run)."""
+    if trials is None:
+        trials = test.default_cap() if test is not None else DEFAULT_TRIALS
+    return spreads.trials_to_run(trials)
+
+
+def evaluate(batch: Batch, trials: Optional[int] = None, runner: Runner = Runner(),
              progress: Optional[Callable[[dict, List[dict]], None]] = None,
              test: Optional[SequentialTest] = None) -> "Evaluation":
-    """Run trials 0 .. trials-1 of `batch` on `runner`; `progress(record, done)` after each. Ctrl-C
-    (KeyboardInterrupt) stops the batch and keeps the trials done (`interrupted`). When every world
-    is the model's own (Spreads.one_world) one trial says all there is: it alone runs, and the
-    summary gives no interval. With a sequential `test` (sequential.py), `trials` is a cap: the
-    study stops once the test decides. It is asked after each trial in the order of the trials'
-    numbers (a trial that finishes early on another worker waits for those before it), since a
-    test asked in the order trials happen to finish could be swayed by how long each kind takes."""
-    trials = batch.spreads.trials_to_run(trials)
+    """Run trials 0 .. trials-1 of `batch` on `runner` (None: study_trials' default);
+    `progress(record, done)` after each. Ctrl-C (KeyboardInterrupt) stops the batch and keeps the
+    trials done (`interrupted`). When every world is the model's own (Spreads.one_world) one trial
+    says all there is: it alone runs, and the summary gives no interval. With a sequential `test`
+    (sequential.py), `trials` is a cap: the study stops once the test decides. It is asked after
+    each trial in the order of the trials' numbers (a trial that finishes early on another worker
+    waits for those before it), since a test asked in the order trials happen to finish could be
+    swayed by how long each kind takes; decision_state(test, done) is where it stands."""
+    trials = study_trials(batch.spreads, trials, test)
     source = run_all(run_trial, batch, range(trials), runner)
     started = time.perf_counter()
     done: List[dict] = []
@@ -224,6 +235,17 @@ def evaluate(batch: Batch, trials: int, runner: Runner = Runner(),
     done.sort(key=lambda r: r["trial"])
     return Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started, runner=runner.describe(trials),
                       requested=trials, interrupted=interrupted, decision=decision.as_dict())
+
+
+def decision_state(test: SequentialTest, done: Sequence[dict]) -> str:
+    """Where `test` stands on the trial records `done` (finished in any order), as evaluate() feeds
+    it: the trials in the order of their numbers up to the first not yet finished, in words
+    (SequentialTest.state), for a progress line."""
+    decision = _Decision(test)
+    for record in sorted(done, key=lambda r: r["trial"]):
+        if decision.add(record):
+            break
+    return test.state(decision.successes, decision.judged)
 
 
 class _Decision:
