@@ -163,3 +163,13 @@ def test_angles_are_compared_within_one_turn():
     assert v.success is True and "theta -0.20 deg" in v.detail
     assert report.final_error["theta"] == pytest.approx(-0.2) and report.goal_error["theta"] == pytest.approx(-0.2)
     assert within({"x": 20.0, "z": 0.0, "theta": 179.9}, (20.0, 0.0, -179.9), (0.5, 0.5))
+
+
+def test_execute_help_lists_every_cause_a_report_can_give():
+    from click.testing import CliRunner
+
+    from stablepush_cli.main import cli
+
+    result = CliRunner().invoke(cli, ["execute", "--help"])
+    assert result.exit_code == 0, result.output
+    assert f"is one of {', '.join(CAUSES)} (docs/execution.md)" in " ".join(result.output.split())

@@ -9,6 +9,7 @@ import click
 from stablepush.errors import SettingError
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.execution.tcp_arm import ACK_TIMEOUT_RANGE, DEFAULT_ACK_TIMEOUT
+from stablepush.execution.verdict import CAUSES
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import with_robot
 from stablepush_cli.common import (
@@ -31,6 +32,15 @@ from stablepush_cli.options import (
     video_output,
     video_settings_need,
 )
+
+
+def _help_with(**values):
+    """Fill the command's docstring's {name} fields before click reads it as the help: lists the
+    library defines (the causes of a miss) are then written once."""
+    def fill(command):
+        command.__doc__ = command.__doc__.format(**values)
+        return command
+    return fill
 
 
 @click.command()
@@ -106,6 +116,7 @@ from stablepush_cli.options import (
                                      "this close to the goal, and re-plan on the last contact's feature past it "
                                      "(default: a fifth of the task's goal tolerance).")
 @robot_options
+@_help_with(causes=", ".join(CAUSES))
 def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
             ack_timeout: float, json_path, success_tolerance, record_path, stamp_ns, video_path, video_fps: float,
             video_size, quiet: bool, verbose: bool, mu_scale: float, tracker_noise, closed_loop: bool, guarded: bool,
@@ -122,8 +133,9 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
 
     The run ends with a verdict: it landed when the object's pose in the grasp is within the task's
     goal tolerance (or --success-tolerance), exit 0; a completed run that missed exits 5 and names
-    its cause (grasp_lost, correction_not_found, corrections_exhausted, feature_off,
-    pusher_slipped, plan_short, drift). An arm that reports no pose in the grasp gets no verdict (exit 0).
+    its cause. The report's `cause` is one of {causes} (docs/execution.md): the first that
+    applies to a miss; not_measured where the arm reports no pose in the grasp, which gets no
+    verdict (exit 0); arm_fault on a fault (below).
 
     On a fault (the arm server gone, a malformed or out-of-order reply, an error from the arm) the arm
     is told to stop, the last confirmed plan step is printed, and the exit status is 3; run again with
