@@ -244,13 +244,16 @@ def test_a_recorded_run_reads_back_with_its_corrections_and_verdict(tmp_path):
     assert result.exit_code in (0, 5), result.output
     run = json.loads(report.read_text())
     messages = {}
-    with Reader(bag) as reader:
-        assert {c.topic: c.msgtype for c in reader.connections} == RUN_TOPICS
+    with Reader(bag) as reader:  # the shipped arm's joints; it is MJCF, with no URDF for /robot_description
+        assert {c.topic: c.msgtype for c in reader.connections} == {**RUN_TOPICS,
+                                                                    "/joint_states": "sensor_msgs/msg/JointState"}
         for connection, stamp, raw in reader.messages():
             messages.setdefault(connection.topic, []).append(STORE.deserialize_cdr(raw, connection.msgtype))
     for topic in ("/tf", "/stablepush/commanded_pose", "/stablepush/gripper_pose", "/stablepush/object_pose",
-                  "/stablepush/object_in_grasp", "/stablepush/pusher", "/stablepush/phase", "/stablepush/step"):
+                  "/stablepush/object_in_grasp", "/stablepush/pusher", "/stablepush/phase", "/stablepush/step",
+                  "/joint_states"):
         assert len(messages[topic]) == run["waypoints"], topic
+    assert all(list(m.name) == [f"j{k}" for k in range(1, 8)] for m in messages["/joint_states"])
     corrections = [json.loads(m.data) for m in messages.get("/stablepush/correction", [])]
     assert run["replans"] and corrections == run["replans"]
     (verdict,) = [json.loads(m.data) for m in messages["/stablepush/verdict"]]
@@ -279,7 +282,7 @@ def test_a_recorded_run_is_stamped_from_its_start_with_the_features_static(tmp_p
     assert qos.durability == QosDurability.TRANSIENT_LOCAL
     ((_, static),) = messages["/tf_static"]
     assert {(t.header.frame_id, t.child_frame_id) for t in static.transforms} == {
-        ("world", "feature_bottom"), ("world", "feature_left")}
+        ("world", "feature_bottom"), ("world", "feature_left"), ("world", "link0")}
     pairs = _header_stamps(messages)
     assert len(pairs) > len(messages["/tf"]) and all(record == header for record, header in pairs)
     bad = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--record", str(tmp_path / "x.mcap"),

@@ -101,7 +101,8 @@ def test_joints_are_written_as_columns_and_other_outputs_are_refused(tmp_path):
     result = runner.invoke(cli, ["trajectory", str(plan_file), "--task", str(task_file), "-o", str(out), "--joints"])
     assert result.exit_code == 0, result.output
     header = out.read_text().splitlines()[0].split(",")
-    assert header == ["t"] + [f"j{k}_rad" for k in range(1, 8)] + ["phase", "step"]
+    assert header == (["t"] + [f"j{k}_rad{unit}" for unit in ("", "_s", "_s2") for k in range(1, 8)]
+                      + ["phase", "step"])
     quat = runner.invoke(cli, ["trajectory", str(plan_file), "--task", str(task_file), "-o", str(out), "--joints",
                                "--quat", "wxyz"])
     assert quat.exit_code == 2 and "--joints" in quat.output
@@ -140,3 +141,53 @@ def test_the_bags_joint_trajectory_read_back_by_rosbags_carries_out_the_gripper_
         assert np.linalg.norm(T[:3, 3] - target[:3, 3]) < 1e-5
         cos = (np.trace(T[:3, :3].T @ target[:3, :3]) - 1) / 2
         assert math.degrees(math.acos(min(1.0, cos))) < 0.01
+
+
+def _central(t, values):
+    """d values / dt at the inner samples from their neighbours, as a test writes it out."""
+    return (values[2:] - values[:-2]) / (t[2:] - t[:-2])[:, None]
+
+
+def test_the_bags_joint_trajectory_carries_velocities_and_accelerations_of_its_timing_in_the_base_link(tmp_path):
+    """Issue 68, item 5: read back with rosbags, each JointTrajectory point's velocities are the
+    positions' change over time_from_start (central differences; the first from the start at rest
+    at t = 0, where G's start pose puts the joints), its accelerations the velocities' likewise, both
+    zero at the last point, where the arm stays; the trajectory is given in the arm's base link
+    (arm.xml's link0); /joint_states carries the same velocities; the CSV the same numbers."""
+    import csv
+
+    from rosbags.highlevel import AnyReader
+
+    from stablepush.sim.joint_path import joint_path
+
+    task_file = TASKS / "horizontal-offset-low-mu.yaml"
+    plan_file, bag, table = tmp_path / "p.json", tmp_path / "p.mcap", tmp_path / "p.csv"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["plan", str(task_file), "-o", str(plan_file)]).exit_code == 0
+    for out in (bag, table):
+        result = runner.invoke(cli, ["trajectory", str(plan_file), "--task", str(task_file), "-o", str(out), "--joints"])
+        assert result.exit_code == 0, result.output
+    with AnyReader([bag]) as reader:
+        connections = [c for c in reader.connections if c.topic in ("/stablepush/joint_trajectory", "/joint_states")]
+        read = {}
+        for c, _, raw in reader.messages(connections=connections):
+            read.setdefault(c.topic, []).append(reader.deserialize(raw, c.msgtype))
+    (trajectory,), states = read["/stablepush/joint_trajectory"], read["/joint_states"]
+    assert trajectory.header.frame_id == "link0"
+    t = np.array([p.time_from_start.sec + p.time_from_start.nanosec * 1e-9 for p in trajectory.points])
+    q = np.array([p.positions for p in trajectory.points])
+    qd = np.array([p.velocities for p in trajectory.points])
+    qdd = np.array([p.accelerations for p in trajectory.points])
+    assert qd.shape == qdd.shape == q.shape
+    assert np.abs(qd).max() > 0.1  # the arm moves
+    assert np.allclose(qd[1:-1], _central(t, q), atol=1e-9)
+    assert np.allclose(qdd[1:-1], _central(t, qd), atol=1e-6)
+    assert not qd[-1].any() and not qdd[-1].any()
+    task, plan = sp.load_task(task_file), sp.load_plan(plan_file)
+    start = joint_path(task, plan).start
+    assert np.allclose(qd[0], (q[1] - start) / t[1], atol=1e-9)
+    assert np.allclose(qdd[0], qd[1] / t[1], atol=1e-6)
+    assert np.allclose([s.velocity for s in states], qd)
+    rows = list(csv.DictReader(table.open()))
+    assert np.allclose([[float(r[f"j{k}_rad_s"]) for k in range(1, 8)] for r in rows], qd)
+    assert np.allclose([[float(r[f"j{k}_rad_s2"]) for k in range(1, 8)] for r in rows], qdd)

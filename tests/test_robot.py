@@ -257,6 +257,98 @@ def test_the_reference_bridge_runs_a_plan_on_a_joint_level_interface(arms):
     assert run.report.success and joints.sent == run.report.waypoints
 
 
+def _bag_messages(bag):
+    """topic -> (its connection, its messages), read back with rosbags' own reader."""
+    from rosbags.highlevel import AnyReader
+
+    out = {}
+    with AnyReader([bag]) as reader:
+        for connection in reader.connections:
+            out[connection.topic] = (connection, [reader.deserialize(raw, connection.msgtype) for _, _, raw in
+                                                  reader.messages(connections=[connection])])
+    return out
+
+
+def _base_transform(messages):
+    (static,) = messages["/tf_static"][1]
+    (base,) = [t for t in static.transforms if t.child_frame_id == "base"]
+    assert base.header.frame_id == "world"
+    return base.transform
+
+
+def test_a_run_on_a_labs_arm_records_its_joints_and_its_urdf_for_a_viewer(arms, tmp_path):
+    """Issue 68, item 5: a run through the joint-level bridge, recorded (BagRecording) and read back
+    with rosbags: /joint_states names the URDF's joints with the positions the arm reported at each
+    waypoint, /robot_description holds the URDF's text once, offered transient local as
+    robot_state_publisher offers it, and /tf_static puts the URDF's root link where the robot
+    stands; `trajectory --joints -o X.mcap` gives its JointTrajectory in that link and the URDF too."""
+    pytest.importorskip("rosbags")
+    from rosbags.interfaces import QosDurability
+
+    from stablepush.bridge import JointInterface, JointTrajectoryArm
+    from stablepush.execution.run import BagRecording, RunOptions, run_plan
+
+    arm = arms["6-joint URDF"]
+    task = _on(arm)
+    plan = plan_task(task, seed=1)
+    joints = _SimulatedJoints(task, plan)
+    JointInterface.register(_SimulatedJoints)
+    bag = tmp_path / "run.mcap"
+    run = run_plan(task, plan, JointTrajectoryArm(joints, task.environment.robot),
+                   RunOptions(pace=False, success_tolerance=(0.5, 0.5)), [BagRecording(str(bag))])
+    assert run.fault is None and run.written, run.fault
+    messages = _bag_messages(bag)
+    connection, states = messages["/joint_states"]
+    assert connection.msgtype == "sensor_msgs/msg/JointState" and len(states) == run.report.waypoints
+    assert all(list(s.name) == [f"joint_{i}" for i in range(1, 7)] for s in states)
+    reported = np.array([s.joints for s in run.recording.samples])
+    assert np.allclose([s.position for s in states], reported) and np.ptp(reported, axis=0).max() > 0.1
+    connection, (description,) = messages["/robot_description"]
+    assert connection.msgtype == "std_msgs/msg/String" and description.data == open(arm["model"]).read()
+    (qos,) = connection.ext.offered_qos_profiles
+    assert qos.durability == QosDurability.TRANSIENT_LOCAL
+    base = _base_transform(messages)
+    x, y, z, yaw = arm["base"]
+    assert [base.translation.x, base.translation.y, base.translation.z] == pytest.approx([x / 1e3, y / 1e3, z / 1e3])
+    assert [base.rotation.w, base.rotation.z] == pytest.approx([math.cos(math.radians(yaw) / 2),
+                                                                math.sin(math.radians(yaw) / 2)])
+
+    task_file = TASKS / f"{TASK}.yaml"
+    plan_file, planned = tmp_path / "p.json", tmp_path / "j.mcap"
+    assert CliRunner().invoke(cli, ["plan", str(task_file), "-o", str(plan_file)]).exit_code == 0
+    result = CliRunner().invoke(cli, ["trajectory", str(plan_file), "--task", str(task_file), "--joints", "-o",
+                                      str(planned), "--robot", arm["model"], "--flange", arm["flange"], "--tcp",
+                                      *map(str, arm["tcp"]), "--base", *map(str, arm["base"])])
+    assert result.exit_code == 0, result.output
+    messages = _bag_messages(planned)
+    (trajectory,) = messages["/stablepush/joint_trajectory"][1]
+    assert trajectory.header.frame_id == "base"
+    assert messages["/robot_description"][1][0].data == open(arm["model"]).read()
+    assert _base_transform(messages).translation.x == pytest.approx(arm["base"][0] / 1e3)
+
+
+def test_a_run_on_an_mjcf_arm_records_its_joints_and_no_urdf(arms, tmp_path):
+    """An MJCF arm has no URDF to give a viewer: its run's bag has /joint_states (and its base link
+    in /tf_static), and no /robot_description."""
+    pytest.importorskip("rosbags")
+    from stablepush.execution.run import BagRecording, RunOptions, run_plan
+    from stablepush.sim.local_arm import SimulatedArm
+    from stablepush.sim.robot import arm_model
+
+    task = _on(arms["7-joint MJCF"])
+    plan = plan_task(task, seed=1)
+    bag = tmp_path / "run.mcap"
+    run = run_plan(task, plan, SimulatedArm(robot=task.environment.robot), RunOptions(), [BagRecording(str(bag))])
+    assert run.fault is None and run.written
+    messages = _bag_messages(bag)
+    assert "/robot_description" not in messages
+    names = arm_model(task.environment.robot).joints
+    assert len(names) == 7 and all(tuple(s.name) == names for s in messages["/joint_states"][1])
+    assert len(messages["/joint_states"][1]) == run.report.waypoints
+    (static,) = messages["/tf_static"][1]
+    assert arm_model(task.environment.robot).base_link in {t.child_frame_id for t in static.transforms}
+
+
 def test_the_bridge_refuses_an_interface_of_other_joints_and_ends_a_failing_one_in_a_fault(arms):
     from stablepush.bridge import JointTrajectoryArm
     from stablepush.errors import ArmFault

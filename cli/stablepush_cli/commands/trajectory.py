@@ -93,7 +93,7 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
         from stablepush.execution.bags import write_bag
 
         write_bag(out_path, task, plan, traj, start_ns=stamp_ns,
-                  joints=None if path is None else (path.joints, path.q))
+                  joints=None if path is None else path.samples())
         if path is not None:
             click.echo(f"{task.name}: {path.describe()}")
     else:

@@ -17,7 +17,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from stablepush.execution.arm import Arm, ArmError, ArmReady
+from stablepush.execution.arm import Arm, ArmError, ArmReady, RobotDescription
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.frames import matrix_to_pose
 from stablepush.plan.plan import Plan
@@ -26,7 +26,7 @@ from stablepush.sim import scene as scene_mod
 from stablepush.sim.arm import ArmKinematics
 from stablepush.sim.friction import mujoco
 from stablepush.sim.joint_path import checked_path
-from stablepush.sim.robot import arm_model
+from stablepush.sim.robot import arm_model, robot_description
 from stablepush.task.model import Robot, Task
 
 
@@ -85,6 +85,9 @@ class JointTrajectoryArm(Arm):
 
     def check_cell(self, task: Task, plan: Plan, rate_hz: float) -> None:
         checked_path(task, plan, rate_hz, self.robot)
+
+    def robot_description(self) -> RobotDescription:
+        return robot_description(self.robot)
 
     def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
         """The arm's kinematics in the scene's world (its base where the robot says) and the arm's

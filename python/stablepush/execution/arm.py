@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import abc
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Optional
+from typing import TYPE_CHECKING, Optional, Tuple
 
 from stablepush.execution.stream import ArmWaypoint
 
@@ -42,6 +42,19 @@ class ArmReady:
     engine: Optional[str] = None
 
 
+@dataclass(frozen=True)
+class RobotDescription:
+    """What a viewer needs to draw an arm from its joints: the arm's `joints` as its model names
+    them (base to flange, the order of the state's `joints`), its model's `base_link` (the frame a
+    joint trajectory is given in) at `base_pose` in the world ([x, y, z, qw, qx, qy, qz], m), and
+    the URDF's text (`urdf`; None when the model is MJCF, which ROS viewers do not read)."""
+
+    joints: Tuple[str, ...]
+    base_link: str
+    base_pose: Tuple[float, ...]
+    urdf: Optional[str] = None
+
+
 class Arm(abc.ABC):
     """One session with an arm: `hello`, then `move` per waypoint, then `bye`; `stop` at any time
     after `hello`. Used as a context manager, it is closed at the end of the block."""
@@ -59,6 +72,11 @@ class Arm(abc.ABC):
         link in a fixture (stablepush.sim.joint_path.CellError). An arm that has a model of itself
         checks here (the simulated arm, the joint-trajectory bridge); this default knows none and
         lets every plan pass (`stablepush check-cell --robot` asks the same of a model)."""
+
+    def robot_description(self) -> Optional[RobotDescription]:
+        """The arm's model, for a recording to draw the arm from the state's `joints`; None when
+        this arm has none (an arm server not checked against a model names no joints)."""
+        return None
 
     @abc.abstractmethod
     def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:

@@ -42,6 +42,7 @@ from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, 
 import numpy as np
 
 from stablepush.errors import OutputError
+from stablepush.execution.arm import RobotDescription
 from stablepush.execution.trajectory import Trajectory, continuous_quaternions
 from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.extras import require
@@ -131,27 +132,42 @@ JOINT_TOPICS = {
     "/joint_states": "sensor_msgs/msg/JointState",
     "/stablepush/joint_trajectory": "trajectory_msgs/msg/JointTrajectory",
 }
+ROBOT_DESCRIPTION = "/robot_description"
+
+
+class JointSamples(NamedTuple):
+    """The arm's joints at each sample of a trajectory (stablepush.sim.joint_path.JointPath.samples):
+    their `names`, and one row per sample of `positions` [rad], `velocities` [rad/s] and
+    `accelerations` [rad/s^2]; `robot`, the arm's model (its base link, its URDF)."""
+
+    names: Sequence[str]
+    positions: np.ndarray
+    velocities: np.ndarray
+    accelerations: np.ndarray
+    robot: RobotDescription
 
 
 def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajectory,
-              start_ns: Optional[int] = None, joints: Optional[Tuple[Sequence[str], np.ndarray]] = None) -> None:
+              start_ns: Optional[int] = None, joints: Optional[JointSamples] = None) -> None:
     """Write the trajectory of `plan` as one MCAP file at `path`, each sample stamped `start_ns`
-    (Unix ns, `parse_stamp`; default: now) plus its time. With `joints` (the joint names, and one row
-    of positions [rad] per sample of the trajectory: stablepush.sim.joint_path), also the arm's
-    `/joint_states` per sample and, once at the start, the whole `/stablepush/joint_trajectory`
-    (trajectory_msgs/JointTrajectory, each point's time_from_start its sample's t), what
-    ros2_control's joint_trajectory_controller takes. PlanError unless the plan is the task's as it
-    is now (stablepush.plan.verify.check_plan)."""
+    (Unix ns, `parse_stamp`; default: now) plus its time. With `joints` (one row per sample of the
+    trajectory), also the arm's `/joint_states` per sample and, once at the start, the whole
+    `/stablepush/joint_trajectory` (trajectory_msgs/JointTrajectory in the arm's base link, each
+    point's time_from_start its sample's t, with its velocities and accelerations), what
+    ros2_control's joint_trajectory_controller takes, and the arm for a viewer (`_robot_topics`).
+    PlanError unless the plan is the task's as it is now (stablepush.plan.verify.check_plan)."""
     check_plan(task, plan)
     start_ns = time.time_ns() if start_ns is None else start_ns
     T_GO = object_in_gripper(task, plan, trajectory)
     steps = list(plan.waypoints)
     features = place_features(task, steps)
-    with _mcap(path, {**TOPICS, **(JOINT_TOPICS if joints is not None else {})}) as (T, write):
+    robot = joints.robot if joints is not None else None
+    with _mcap(path, {**TOPICS, **(JOINT_TOPICS if joints is not None else {}), **_robot_topics(robot)}) as (T, write):
         start = _time(T, start_ns)
         if joints is not None:
             write("/stablepush/joint_trajectory", start_ns, _joint_trajectory(T, start, trajectory, joints))
-        write(TF_STATIC, start_ns, _static_transforms(T, start, features.values()))
+            _write_robot(T, write, start_ns, robot)
+        write(TF_STATIC, start_ns, _static_transforms(T, start, features.values(), robot))
         write("/stablepush/scene", start_ns, T["visualization_msgs/msg/MarkerArray"](
             markers=_scene_markers(T, start, task, features.values())))
         scene = scene_description(task, features, steps[0].pose)
@@ -174,22 +190,39 @@ def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajec
             write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=trajectory.phase[i]))
             write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(trajectory.step[i])))
             if joints is not None:
-                write("/joint_states", ns, T["sensor_msgs/msg/JointState"](
-                    header=_header(T, stamp, ""), name=list(joints[0]),
-                    position=np.asarray(joints[1][i], float), velocity=np.zeros(0), effort=np.zeros(0)))
+                write("/joint_states", ns, _joint_state(T, stamp, joints.names, joints.positions[i],
+                                                        joints.velocities[i]))
 
 
-def _joint_trajectory(T, stamp, trajectory: Trajectory, joints: Tuple[Sequence[str], np.ndarray]):
-    """The joint positions of every sample as one JointTrajectory, time_from_start each sample's t."""
+def _joint_state(T, stamp, names: Sequence[str], positions, velocities=()):
+    return T["sensor_msgs/msg/JointState"](header=_header(T, stamp, ""), name=list(names),
+                                           position=np.asarray(positions, float),
+                                           velocity=np.asarray(velocities, float), effort=np.zeros(0))
+
+
+def _joint_trajectory(T, stamp, trajectory: Trajectory, joints: JointSamples):
+    """Every sample's joints as one JointTrajectory in the arm's base link, time_from_start each
+    sample's t."""
     points = []
-    for t, q in zip(trajectory.t, joints[1]):
+    for t, q, qd, qdd in zip(trajectory.t, joints.positions, joints.velocities, joints.accelerations):
         ns = int(round(float(t) * 1e9))
         points.append(T["trajectory_msgs/msg/JointTrajectoryPoint"](
-            positions=np.asarray(q, float), velocities=np.zeros(0), accelerations=np.zeros(0), effort=np.zeros(0),
-            time_from_start=T["builtin_interfaces/msg/Duration"](sec=ns // 1_000_000_000,
-                                                                 nanosec=ns % 1_000_000_000)))
-    return T["trajectory_msgs/msg/JointTrajectory"](header=_header(T, stamp, ""), joint_names=list(joints[0]),
-                                                    points=points)
+            positions=np.asarray(q, float), velocities=np.asarray(qd, float), accelerations=np.asarray(qdd, float),
+            effort=np.zeros(0), time_from_start=T["builtin_interfaces/msg/Duration"](sec=ns // 1_000_000_000,
+                                                                                     nanosec=ns % 1_000_000_000)))
+    return T["trajectory_msgs/msg/JointTrajectory"](header=_header(T, stamp, joints.robot.base_link),
+                                                    joint_names=list(joints.names), points=points)
+
+
+def _robot_topics(robot: Optional[RobotDescription]) -> dict:
+    """`/robot_description` (std_msgs/String) when the arm's model is a URDF."""
+    return {ROBOT_DESCRIPTION: "std_msgs/msg/String"} if robot is not None and robot.urdf is not None else {}
+
+
+def _write_robot(T, write, ns: int, robot: RobotDescription) -> None:
+    """The URDF once, at the start, as robot_state_publisher offers it (transient local: `_mcap`)."""
+    if robot.urdf is not None:
+        write(ROBOT_DESCRIPTION, ns, T["std_msgs/msg/String"](data=robot.urdf))
 
 
 def _continuous(poses: Sequence[Optional[Sequence[float]]]) -> List[Optional[List[float]]]:
@@ -225,7 +258,7 @@ def _mcap(path: Union[str, Path], topics: dict):
         bag = Path(scratch) / "bag"
         with Writer(bag, version=8, storage_plugin=StoragePlugin.MCAP) as writer:
             connections = {topic: writer.add_connection(topic, kind, typestore=store,
-                                                        offered_qos_profiles=_static_qos() if topic == TF_STATIC
+                                                        offered_qos_profiles=_latched_qos() if topic in LATCHED
                                                         else ())
                            for topic, kind in topics.items()}
 
@@ -239,9 +272,15 @@ def _mcap(path: Union[str, Path], topics: dict):
             raise OutputError(f"{path}: cannot write the bag ({exc.strerror or exc})", output=path) from None
 
 
-def _static_qos() -> list:
-    """The QoS tf2's static broadcaster offers on /tf_static (reliable, transient local, the last
-    message kept), recorded so that `ros2 bag play` offers it too: a late listener gets the frames."""
+# Topics published once that a late listener still gets: tf2's static broadcaster and
+# robot_state_publisher offer them transient local.
+LATCHED = (TF_STATIC, ROBOT_DESCRIPTION)
+
+
+def _latched_qos() -> list:
+    """The QoS tf2's static broadcaster offers on /tf_static, and robot_state_publisher on
+    /robot_description (reliable, transient local, the last message kept), recorded so that
+    `ros2 bag play` offers it too: a late listener gets the frames and the arm."""
     from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 
     default = QosTime(0, 0)  # no deadline, lifespan or lease
@@ -281,12 +320,15 @@ def _transform(T, stamp, parent: str, child: str, p, q_wxyz):
         transform=T["geometry_msgs/msg/Transform"](translation=_vector3(T, p), rotation=_quaternion(T, q_wxyz)))
 
 
-def _static_transforms(T, stamp, features: Iterable[Feature]):
-    """/tf_static's message: world -> each feature's frame (feature_transform)."""
+def _static_transforms(T, stamp, features: Iterable[Feature], robot: Optional[RobotDescription] = None):
+    """/tf_static's message: world -> each feature's frame (feature_transform), and world -> the
+    arm's base link where the robot stands, when there is an arm."""
     transforms = []
     for feature in features:
         pose = matrix_to_pose(feature_transform(feature))
         transforms.append(_transform(T, stamp, WORLD, feature_frame(feature.pusher), pose[:3], pose[3:]))
+    if robot is not None and robot.base_link != WORLD:  # a URDF rooted at a link named world is ours already
+        transforms.append(_transform(T, stamp, WORLD, robot.base_link, robot.base_pose[:3], robot.base_pose[3:]))
     return T["tf2_msgs/msg/TFMessage"](transforms=transforms)
 
 
@@ -353,7 +395,8 @@ class RunSample(NamedTuple):
     """One acknowledged waypoint of a recorded run. Poses are [x, y, z, qw, qx, qy, qz] in W (m);
     `object_pose` is None when the arm does not report it (a real arm), `object_in_grasp`
     ({x, z mm, theta deg}) when it has no tracker; `planned` is the plan's pose in the grasp at
-    `step` (x mm, z mm, theta deg), in the plan being followed (re-planned after a correction)."""
+    `step` (x mm, z mm, theta deg), in the plan being followed (re-planned after a correction);
+    `joints` the arm's joint positions as it reports them [rad], None when it reports none."""
 
     t: float  # s, the stream's time
     commanded: List[float]
@@ -364,6 +407,7 @@ class RunSample(NamedTuple):
     phase: str
     step: int
     planned: Optional[Tuple[float, float, float]]
+    joints: Optional[List[float]] = None
 
 
 class RunRecording:
@@ -375,11 +419,16 @@ class RunRecording:
     the tracker's, in gripper), `/tf` world -> gripper -> object, the pusher in contact ("" between
     contacts), phase and step; each correction of the closed loop (`/stablepush/correction`, JSON,
     at the step after which it was made) and the run's report (`/stablepush/verdict`, JSON, at the
-    end). Pass it to `execute_plan(record=...)`."""
+    end). With the arm's model (`robot`: run_plan takes it from the arm), also the arm's joints as
+    it reports them (`/joint_states`, at each sample whose joints are the model's), its base link
+    in `/tf_static` and its URDF (`/robot_description`, once, transient local), from which a viewer
+    draws the arm; an MJCF model has no URDF, and its bag has the joints and the base link alone.
+    Pass it to `execute_plan(record=...)`."""
 
-    def __init__(self, features: Iterable[Feature] = ()):
+    def __init__(self, features: Iterable[Feature] = (), robot: Optional[RobotDescription] = None):
         self.samples: List[RunSample] = []
         self.features = list(features)
+        self.robot = robot
         self.started_ns = time.time_ns()  # Unix ns; at the first sample, when the stream's time began
 
     @classmethod
@@ -391,9 +440,18 @@ class RunRecording:
     def __call__(self, waypoint, state: dict, pusher) -> None:
         if not self.samples:
             self.started_ns = time.time_ns() - int(round(waypoint.t * 1e9))
+        joints = state.get("joints")
         self.samples.append(RunSample(waypoint.t, list(waypoint.pose), list(state["ee_pose"]), state.get("object_pose"),
                                       state.get("object_in_grasp"), pusher or "", waypoint.phase, waypoint.step,
-                                      waypoint.planned))
+                                      waypoint.planned, None if joints is None else [float(v) for v in joints]))
+
+    def joint_samples(self) -> List[int]:
+        """The samples whose reported joints are the arm model's (as many), in order; none without
+        a model."""
+        if self.robot is None:
+            return []
+        count = len(self.robot.joints)
+        return [k for k, s in enumerate(self.samples) if s.joints is not None and len(s.joints) == count]
 
     def write(self, path: Union[str, Path], report: dict, start_ns: Optional[int] = None) -> None:
         """Write the recording and `report` (ExecutionReport.as_dict, or a fault's report) as one
@@ -406,10 +464,15 @@ class RunRecording:
         world_poses = _continuous([s.object_pose for s in samples])
         grasp_poses = _continuous([None if s.object_in_grasp is None else matrix_to_pose(grasp_transform(
             (s.object_in_grasp["x"], s.object_in_grasp["z"], s.object_in_grasp["theta"]))) for s in samples])
-        with _mcap(path, RUN_TOPICS) as (T, write):
-            write(TF_STATIC, start_ns, _static_transforms(T, _time(T, start_ns), self.features))
+        with_joints = set(self.joint_samples())
+        topics = {**RUN_TOPICS, **({"/joint_states": JOINT_TOPICS["/joint_states"]} if with_joints else {}),
+                  **_robot_topics(self.robot)}
+        with _mcap(path, topics) as (T, write):
+            write(TF_STATIC, start_ns, _static_transforms(T, _time(T, start_ns), self.features, self.robot))
+            if self.robot is not None:
+                _write_robot(T, write, start_ns, self.robot)
             last_ns, end_of_step = start_ns, {}
-            for k, (t, _, _, _, _, pusher, phase, step, _) in enumerate(samples):
+            for k, (t, _, _, _, _, pusher, phase, step, _, joints) in enumerate(samples):
                 commanded, reported, in_world, held = (commanded_poses[k], reported_poses[k], world_poses[k],
                                                        grasp_poses[k])
                 ns = last_ns = start_ns + int(round(t * 1e9))
@@ -431,6 +494,8 @@ class RunRecording:
                 write("/stablepush/pusher", ns, T["std_msgs/msg/String"](data=pusher))
                 write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=phase))
                 write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(step)))
+                if k in with_joints:
+                    write("/joint_states", ns, _joint_state(T, stamp, self.robot.joints, joints))
             for correction in report.get("replans") or []:
                 ns = end_of_step.get(correction["after_step"], last_ns)
                 write("/stablepush/correction", ns, T["std_msgs/msg/String"](data=json.dumps(correction)))

@@ -117,8 +117,11 @@ def run_plan(task: Task, plan: Plan, arm: Arm, options: RunOptions = RunOptions(
     """Run `plan` of `task` on `arm` (execute_plan) and write `outputs` (RunResult.write). A fault
     ends the run, not the call: it is the result's `fault`, and the outputs are written for it
     too. The run is recorded into `recording`, else into one of its own when an output needs it
-    (`recording_for`). PlanError, before anything moves, when the plan does not belong to the task."""
+    (`recording_for`), with the arm's model when the arm has one (Arm.robot_description). PlanError,
+    before anything moves, when the plan does not belong to the task."""
     recording = recording if recording is not None else recording_for(task, plan, options, outputs)
+    if recording is not None and recording.robot is None:
+        recording.robot = arm.robot_description()
     result = RunResult(task, plan, options, recording=recording)
     try:
         result.report = execute_plan(task, plan, arm, options, progress=progress, record=recording)

@@ -28,7 +28,8 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from stablepush.errors import PlanError
-from stablepush.execution.arm import Arm, ArmReady
+from stablepush.execution.arm import Arm, ArmReady, RobotDescription
+from stablepush.execution.bags import JointSamples
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.execution.trajectory import Trajectory, timed_trajectory
 from stablepush.execution.world import place_features, scene_description
@@ -39,7 +40,7 @@ from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.arm import ArmKinematics
 from stablepush.sim.friction import mujoco
-from stablepush.sim.robot import arm_model, model_stamp
+from stablepush.sim.robot import arm_model, model_stamp, robot_description
 from stablepush.task.model import Robot, Task
 
 # G through the joints' forward kinematics stays this close to each sample (m, rad): the joint
@@ -73,7 +74,9 @@ class JointPath:
     at times `t` [s], with each sample's phase and plan step, and how closely they carry out the
     Cartesian trajectory: the largest error of G through forward kinematics (`fk_error_mm`,
     `fk_error_deg`), the fastest joint (`peak_speed`, rad/s), and the least clearance of a link
-    (`clearance_mm`, from `nearest`: link body and feature or floor)."""
+    (`clearance_mm`, from `nearest`: link body and feature or floor). `start` is where the joints
+    stand, at rest, at t = 0 (the stream's start pose, before its first sample), and `robot` the
+    arm's model as a bag names it (its base link, its URDF)."""
 
     joints: Tuple[str, ...]
     t: np.ndarray
@@ -85,16 +88,40 @@ class JointPath:
     peak_speed: float
     clearance_mm: float
     nearest: Tuple[str, str]
+    start: np.ndarray
+    robot: RobotDescription
 
     def __len__(self) -> int:
         return len(self.t)
 
+    def velocities(self) -> np.ndarray:
+        """Each joint's velocity [rad/s] at each sample, as a controller that is handed the samples
+        needs it: the finite difference of the positions over their times (central, second order;
+        the first sample's from the start at t = 0), zero at the last sample, where the stream ends
+        and the arm stays."""
+        v = _derivative(self.t, self.q, self.start)
+        v[-1] = 0.0
+        return v
+
+    def accelerations(self) -> np.ndarray:
+        """Each joint's acceleration [rad/s^2] at each sample: the finite difference of
+        `velocities` as they do of the positions, from rest at t = 0, zero at the last sample."""
+        a = _derivative(self.t, self.velocities(), np.zeros(len(self.joints)))
+        a[-1] = 0.0
+        return a
+
+    def samples(self) -> JointSamples:
+        """The joints as a bag writes them (bags.write_bag)."""
+        return JointSamples(self.joints, self.q, self.velocities(), self.accelerations(), self.robot)
+
     def columns(self) -> List[str]:
-        return ["t"] + [f"{name}_rad" for name in self.joints] + ["phase", "step"]
+        return (["t"] + [f"{name}_rad" for name in self.joints] + [f"{name}_rad_s" for name in self.joints]
+                + [f"{name}_rad_s2" for name in self.joints] + ["phase", "step"])
 
     def rows(self) -> List[list]:
-        return [[float(t), *(float(v) for v in q), phase, int(step)]
-                for t, q, phase, step in zip(self.t, self.q, self.phase, self.step)]
+        return [[float(t), *(float(v) for v in q), *(float(v) for v in qd), *(float(v) for v in qdd), phase, int(step)]
+                for t, q, qd, qdd, phase, step in zip(self.t, self.q, self.velocities(), self.accelerations(),
+                                                      self.phase, self.step)]
 
     def to_csv(self) -> str:
         buffer = io.StringIO()
@@ -104,7 +131,8 @@ class JointPath:
         return buffer.getvalue()
 
     def to_json(self) -> str:
-        return json.dumps({"joints": list(self.joints), "units": {"t": "s", "q": "rad"}, "columns": self.columns(),
+        units = {"t": "s", "q": "rad", "qd": "rad/s", "qdd": "rad/s^2"}
+        return json.dumps({"joints": list(self.joints), "units": units, "columns": self.columns(),
                            "rows": self.rows()}) + "\n"
 
     def verdict(self) -> dict:
@@ -122,6 +150,13 @@ class JointPath:
         return (f"{len(self)} samples on {len(self.joints)} joints; G through the joints within "
                 f"{self.fk_error_mm:.5f} mm, {self.fk_error_deg:.5f} deg; fastest joint {self.peak_speed:.2f} rad/s "
                 f"(within its limit); {clear}")
+
+
+def _derivative(t: np.ndarray, values: np.ndarray, at_zero: np.ndarray) -> np.ndarray:
+    """d values / dt at each of the times `t`, with `at_zero` the value at t = 0 before them
+    (np.gradient: central differences, second order on uneven times too)."""
+    times = np.concatenate([[0.0], np.asarray(t, float)])
+    return np.gradient(np.vstack([at_zero, values]), times, axis=0)[1:]
 
 
 def joint_path(task: Task, plan: Plan, rate_hz: float = 100.0, trajectory: Optional[Trajectory] = None,
@@ -157,6 +192,7 @@ class _Solver:
 
     def __init__(self, scene: dict, robot: Robot):
         self.arm = arm_model(robot)
+        self.robot = robot_description(robot)
         model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, robot=robot))
         self.kin = ArmKinematics(model, self.arm.joints)
         self.model, self.data = model, self.kin.data
@@ -202,7 +238,8 @@ class _Solver:
             q_prev = q
         return JointPath(joints=self.arm.joints, t=np.asarray(traj.t), q=np.array(rows), phase=list(traj.phase),
                          step=np.asarray(traj.step), fk_error_mm=worst[0] * 1e3, fk_error_deg=math.degrees(worst[1]),
-                         peak_speed=peak, clearance_mm=least * 1e3, nearest=nearest)
+                         peak_speed=peak, clearance_mm=least * 1e3, nearest=nearest, start=self.home,
+                         robot=self.robot)
 
     def _fk_error(self, q: np.ndarray, pose: Sequence[float]) -> Tuple[float, float]:
         """How far G through the joints' forward kinematics is from `pose`: (m, rad)."""
@@ -270,6 +307,9 @@ class ModelledArm(Arm):
 
     def check_cell(self, task: Task, plan: Plan, rate_hz: float) -> None:
         checked_path(task, plan, rate_hz, self.robot)
+
+    def robot_description(self) -> RobotDescription:
+        return robot_description(self.robot)
 
     def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
         return self.arm.hello(scene, rate_hz, resume)

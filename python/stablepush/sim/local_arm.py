@@ -6,13 +6,13 @@ from __future__ import annotations
 
 from typing import Callable, Optional
 
-from stablepush.execution.arm import Arm, ArmError, ArmReady
+from stablepush.execution.arm import Arm, ArmError, ArmReady, RobotDescription
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.extras import MissingExtra, require
 from stablepush.plan.plan import Plan
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
-from stablepush.sim.robot import arm_model
+from stablepush.sim.robot import arm_model, robot_description
 from stablepush.sim.scene import simulated_outline
 from stablepush.task.model import Robot, Task
 
@@ -43,6 +43,9 @@ class SimulatedArm(Arm):
     @property
     def name(self) -> str:
         return f"stablepush sim-arm ({self.engine})"
+
+    def robot_description(self) -> RobotDescription:
+        return robot_description(self.robot)
 
     def check_cell(self, task: Task, plan: Plan, rate_hz: float) -> None:
         """The arm's joints along the plan (joint_path.checked_path): CellError, before any

@@ -30,7 +30,8 @@ from typing import Dict, List, Optional, Tuple
 import numpy as np
 
 from stablepush.errors import TaskError
-from stablepush.frames import matrix_to_pose
+from stablepush.execution.arm import RobotDescription
+from stablepush.frames import matrix_to_pose, pose_to_matrix
 from stablepush.task.model import Robot
 from stablepush.units import MM
 
@@ -61,12 +62,17 @@ class ArmModel:
     """One arm made ready for a scene: `tree`, the MJCF of the arm with G and the jaws (a copy per
     call of `arm_tree`), `joints`, the arm's joints from base to flange, `max_speed` per joint
     [rad/s or m/s], and `home_guesses`, joint vectors [rad] IK starts from to find the home
-    posture, best first."""
+    posture, best first; `base_link`, the model's link the chain to the flange starts from (a
+    URDF's root link), at `base_pose` in the world ([x, y, z, qw, qx, qy, qz], m); `urdf`, the
+    text of a URDF model (None for MJCF)."""
 
     tree: ET.Element
     joints: Tuple[str, ...]
     max_speed: np.ndarray
     home_guesses: Tuple[np.ndarray, ...]
+    base_link: str = ""
+    base_pose: Tuple[float, ...] = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+    urdf: Optional[str] = None
 
     def too_fast(self, q_from: np.ndarray, q_to: np.ndarray, dt: float) -> Optional[str]:
         """Why moving the joints from `q_from` to `q_to` in `dt` s is past a joint's speed limit:
@@ -101,7 +107,8 @@ def model_stamp(robot: Robot) -> int:
 def _shipped() -> ArmModel:
     tree = ET.parse(ARM_XML).getroot()
     speeds = np.full(len(SHIPPED_JOINTS), Robot().max_joint_speed)
-    return ArmModel(tree, SHIPPED_JOINTS, speeds, (SHIPPED_HOME_GUESS,))
+    base = tree.find("worldbody/body")
+    return ArmModel(tree, SHIPPED_JOINTS, speeds, (SHIPPED_HOME_GUESS,), base.get("name"), _body_pose(base))
 
 
 @functools.lru_cache(maxsize=8)
@@ -126,7 +133,26 @@ def _built(robot: Robot, _stamp: int) -> ArmModel:
     _mount_jaws(root, flange, robot.tcp)
     names = tuple(j.get("name") for j in joints)
     speeds = np.array([velocity.get(name) or robot.max_joint_speed for name in names])
-    return ArmModel(root, names, speeds, _home_guesses(joints, robot.shipped))
+    mount = root.find(f"worldbody/body[@name='{BASE_BODY}']")
+    base = next(body for body in mount if body.tag == "body" and flange in body.iter("body"))
+    urdf = Path(robot.model).read_text() if robot.model and Path(robot.model).suffix.lower() == ".urdf" else None
+    return ArmModel(root, names, speeds, _home_guesses(joints, robot.shipped), base.get("name"),
+                    matrix_to_pose(pose_to_matrix(_body_pose(mount)) @ pose_to_matrix(_body_pose(base))), urdf)
+
+
+def _body_pose(body: ET.Element) -> List[float]:
+    """A body's pose in its parent ([x, y, z, qw, qx, qy, qz]) from its pos and quat (MuJoCo saves
+    a compiled model's orientations as quat)."""
+    pos = [float(v) for v in body.get("pos", "0 0 0").split()]
+    quat = [float(v) for v in body.get("quat", "1 0 0 0").split()]
+    return [*pos, *quat]
+
+
+def robot_description(robot: Optional[Robot] = None) -> RobotDescription:
+    """The arm of `robot` as a recording describes it (execution.arm.RobotDescription): its
+    joints, its base link where the robot stands, and its URDF when the model is one."""
+    arm = arm_model(robot)
+    return RobotDescription(arm.joints, arm.base_link, tuple(float(v) for v in arm.base_pose), arm.urdf)
 
 
 def _compiled(path: str) -> ET.Element:
