@@ -262,3 +262,26 @@ def test_the_odds_options_are_refused_before_the_search(tmp_path, args, says):
     result = CliRunner().invoke(cli, ["design", str(DESIGN), "--quiet", "--out", str(tmp_path / "d"), *args])
     assert result.exit_code == 2, result.output
     assert says in result.output and "layouts planned" not in result.output
+
+
+
+def test_the_design_command_says_how_many_layouts_gave_no_plan_and_why_grouped(tmp_path):
+    data = yaml.safe_load(DESIGN.read_text())
+    data["candidates"] = [{"name": "left", "from": [-50, -12.5], "to": [-50, 12.5], "mu": 0.2},
+                          {"name": "right", "from": [50, 12.5], "to": [50, -12.5], "mu": 0.2},
+                          {"name": "top", "from": [50, 12.5], "to": [-50, 12.5], "mu": 0.2}]
+    # a feature for one candidate: every layout without it is refused (a slip a design file can make)
+    data["environment"]["features"] = {"top": [0, 0, 300, 0]}
+    path = tmp_path / "three.design.yaml"
+    path.write_text(yaml.safe_dump(data))
+    result = CliRunner().invoke(cli, ["design", str(path), "--quiet", "--time-limit", "0.5", "--reach-top", "0",
+                                      "--workers", "1", "--json", str(tmp_path / "d.json")])
+    assert result.exit_code == 1, result.output
+    assert "of the 3 layouts planned, 0 solved and 3 gave no plan:" in result.output
+    assert ("  2: the layout's task was refused (left, left + right); e.g. left: environment.features.top: no pusher "
+            "named 'top' (the task has left)") in result.output
+    assert "  1: the search ran out of time before the goal, the best partial path " in result.output
+    groups = yaml.safe_load((tmp_path / "d.json").read_text())["no_plan"]
+    assert [(g["outcome"], g["layouts"], g["pushers"]) for g in groups] == [
+        ("refused", 2, [["left"], ["left", "right"]]), ("time_limit", 1, [["left", "top"]])]
+    assert groups[0]["end_steps"] is None and groups[1]["end_steps"][0] > 0

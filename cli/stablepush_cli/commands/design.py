@@ -66,7 +66,7 @@ ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine"
                    "the design file NAME.design.yaml.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the ranked designs (`designs`, best first, each with its `task_file`), the unsolved "
-                   "layouts and the verdict.")
+                   "layouts (`unsolved`, and grouped by why: `no_plan`) and the verdict.")
 @click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
               help="Draw the best three layouts side by side (PNG, PDF or SVG).")
 @click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
@@ -143,6 +143,8 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     say = say_beside(json_path, png_path)
     say(f"{len(candidates)} candidates, {study.layouts_searched} layouts planned, {study.layouts_pruned} pruned "
         f"(no stable push toward the goal from the start: {', '.join(study.pruned_candidates) or 'none'})")
+    for line in study.describe_no_plan():
+        say(line)
     for k, d in enumerate(study.designs, start=1):
         reach = f", reach near the goal {d.reach:.0%}" if d.reach is not None else ""
         arm = "" if d.arm is None else (", the arm follows it" if d.arm["follows"] else

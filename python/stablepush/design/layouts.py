@@ -57,6 +57,17 @@ DEFAULT_RANK = ("arm", "fixtures", "points", "end", "switches", "margin", "pushe
 REACH_CELLS = 3  # per axis (x and z) of the reach map around the goal
 REACH_SPAN = 2.0  # planner.tolerance either side of the goal
 REACH_TIME_LIMIT = 1.0  # s a cell of that map may plan
+# Why a planned layout gave no plan, by its `outcome` (the plan's PlanOutcome, or the two of the
+# design search's own), in words; an outcome not listed is named as it is.
+NO_PLAN_REASONS: Dict[str, str] = {
+    "time_limit": "the search ran out of time before the goal",
+    "goal_over_switch_limit": "the goal reached only with more switch-overs than planner.max_switches",
+    "invalid_start": "the pads do not hold the object at the start",
+    "unreachable": "the goal is out of the layout's reach",
+    "refused": "the layout's task was refused",
+    "worker_lost": "the worker planning it was lost",
+}
+NO_PLAN_EXAMPLE = ("refused", "unreachable", "worker_lost")  # whose words need a layout's own reason beside them
 
 
 def parse_rank(text: str, measured: bool = False) -> Tuple[str, ...]:
@@ -80,6 +91,8 @@ class Design:
     task: Optional[Task] = None
     solved: bool = False
     reason: str = ""
+    outcome: Optional[str] = None  # unsolved: a key of NO_PLAN_REASONS (the plan's outcome, refused, worker_lost)
+    end_steps: Optional[float] = None  # unsolved: how far from the goal the search's best path ended (unit steps)
     pushes: Optional[int] = None
     switches: Optional[int] = None
     end_used: Optional[float] = None  # the plan's end's largest offset from the goal over the tolerance (1: its edge)
@@ -123,7 +136,7 @@ class Design:
 
     def as_dict(self) -> Dict[str, Any]:
         return {"pushers": list(self.pushers), "fixtures": self.fixtures, "solved": self.solved,
-                "reason": self.reason or None,
+                "reason": self.reason or None, "outcome": self.outcome, "end_steps": self.end_steps,
                 "pushes": self.pushes, "switches": self.switches, "end_used": self.end_used, "points": self.points,
                 "planning_time_s": self.planning_time_s,
                 "margin_n": self.margin_n, "reach": self.reach, "features": self.features, "arm": self.arm,
@@ -157,9 +170,47 @@ class DesignStudy:
         return (f"no layout of the candidates can do it: {self.layouts_searched} layouts planned, none solved "
                 f"(e.g. {' + '.join(self.failed[0].pushers)}: {self.failed[0].reason})")
 
+    def no_plan(self) -> List[Dict[str, Any]]:
+        """The layouts planned that gave no plan, grouped by why (their `outcome`), the largest group
+        first: the outcome, why in words (NO_PLAN_REASONS), how many layouts and which, the span of
+        unit steps from the goal their searches' best paths ended at (None where none was
+        searched), and one layout's own reason as an example."""
+        groups: Dict[str, List[Design]] = {}
+        for d in self.failed:
+            groups.setdefault(d.outcome or "unknown", []).append(d)
+        out = []
+        for outcome, designs in sorted(groups.items(), key=lambda g: (-len(g[1]), g[0])):
+            ends = [d.end_steps for d in designs if d.end_steps is not None]
+            out.append({"outcome": outcome, "why": NO_PLAN_REASONS.get(outcome, outcome), "layouts": len(designs),
+                        "pushers": [list(d.pushers) for d in designs],
+                        "end_steps": [min(ends), max(ends)] if ends else None,
+                        "example": {"pushers": list(designs[0].pushers), "reason": designs[0].reason}})
+        return out
+
+    def describe_no_plan(self) -> List[str]:
+        """How many layouts were planned and solved, and why the others gave no plan (no_plan), in
+        lines: the count first, then a line a group with up to three of its layouts."""
+        if not self.layouts_searched:
+            return []
+        solved = self.layouts_searched - len(self.failed)
+        lines = [f"of the {self.layouts_searched} layouts planned, {solved} solved and {len(self.failed)} gave no "
+                 f"plan" + (":" if self.failed else "")]
+        for g in self.no_plan():
+            ends = g["end_steps"]
+            span = "" if ends is None else (f", the best partial path{'s' if g['layouts'] > 1 else ''} "
+                                            f"{ends[0]:.1f}{'' if ends[1] == ends[0] else f'-{ends[1]:.1f}'} unit "
+                                            f"steps from it")
+            named = ", ".join(" + ".join(p) for p in g["pushers"][:3]) + (", ..." if g["layouts"] > 3 else "")
+            example = g["example"]
+            for_one = (f"; e.g. {' + '.join(example['pushers'])}: {example['reason']}"
+                       if g["outcome"] in NO_PLAN_EXAMPLE else "")
+            lines.append(f"  {g['layouts']}: {g['why']}{span} ({named}){for_one}")
+        return lines
+
     def as_dict(self) -> Dict[str, Any]:
         return {"candidates": self.candidates, "pruned_candidates": self.pruned_candidates,
                 "layouts_searched": self.layouts_searched, "layouts_pruned": self.layouts_pruned,
+                "no_plan": self.no_plan(),
                 "rank": list(self.rank), "verdict": self.verdict, "evaluated": self.evaluated,
                 "interrupted": self.interrupted, "designs": [d.as_dict() for d in self.designs],
                 "unsolved": [d.as_dict() for d in self.failed]}
@@ -203,7 +254,8 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
     results: List[Design] = []
     for i, result in run_all(_plan_layout, job, range(len(layouts)), runner):
         if isinstance(result, WorkerLost):
-            result = Design(tuple(candidates[k]["name"] for k in layouts[i]), reason=f"worker lost: {result.why}")
+            result = Design(tuple(candidates[k]["name"] for k in layouts[i]), reason=f"worker lost: {result.why}",
+                            outcome="worker_lost")
         results.append(result)
         if progress is not None:
             progress(result)
@@ -252,12 +304,15 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
     try:
         d.task = layout_task(task, pushers, source)
     except TaskError as exc:  # the goal's grasp or the part's checks refuse it with these pushers
-        d.reason = str(exc)
+        d.reason, d.outcome = str(exc), "refused"
         return d
     plan = plan_task(d.task, time_limit=time_limit)
     d.planning_time_s = plan.stats.get("planning_time_s")
     if not plan.solved:
         d.reason = plan.message or "not solved within the time limit"
+        d.outcome = plan.outcome
+        if plan.outcome == "time_limit":  # its best partial path; other outcomes' paths are not partial
+            d.end_steps = plan.stats.get("goal_distance_steps")
         return d
     d.plan = plan = check_plan(d.task, plan)
     d.solved = True
