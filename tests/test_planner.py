@@ -385,6 +385,7 @@ def test_finish_steps_take_a_plan_that_ends_short_deeper_into_the_tolerance(name
     import dataclasses
 
     task = load_task(TASKS / f"{name}.yaml")
+    task = dataclasses.replace(task, planner=task.planner.replace(end_within=1.0))  # finish steps alone
     plain = plan_task(task, seed=1)
     finishing = dataclasses.replace(task, planner=task.planner.replace(finish_steps=1))
     plan = plan_task(finishing, seed=1)
@@ -417,3 +418,77 @@ def test_pivot_steps_plan_the_pivot_from_off_its_centre_and_are_off_by_default()
     end = plan.waypoints[-1].pose
     assert abs(end[2] - 90.0) < 0.2 and math.hypot(end[0], end[1]) < 0.06, end
     recheck(off, plan)  # every push stable by the independent LP
+
+
+# ---------------------------------------------------------------------------------------------
+# The plan's end within planner.end_within of the tolerance, and searches bounded by a count.
+
+SHIPPED_NAMES = sorted(str(p.relative_to(TASKS))[:-5] for p in list(TASKS.glob("*.yaml")) + list(TASKS.glob("more/*.yaml")))
+
+
+@pytest.mark.parametrize("name", SHIPPED_NAMES)
+def test_shipped_plans_end_within_half_their_tolerance(name):
+    """By default (planner.end_within 0.5) a plan's end lies within half the tolerance in x, z and
+    theta, each over its own tolerance: a plan at the tolerance's edge (the wedge's first ended at
+    0.79 of it, the large manipulation's at 0.98) leaves an open-loop run no room for drift. The
+    share is in the plan's stats, and the plan is a checked plan of its task."""
+    from stablepush.plan import check_plan
+    from stablepush.units import tolerance_used
+
+    task = load_task(TASKS / f"{name}.yaml")
+    for seed in (1, 2, 3):
+        plan = plan_task(task, seed=seed)
+        assert plan.solved, (name, seed, plan.message)
+        used = tolerance_used(plan.waypoints[-1].pose, task.goal, task.planner.tolerance)
+        assert used <= 0.5 + 1e-9, (name, seed, used)
+        assert plan.stats["end_used"] == pytest.approx(used)
+        assert plan.ends_at_goal or f"using {used:.2f} of its tolerance" in plan.message
+        check_plan(task, plan)
+
+
+def test_a_plan_whose_deeper_search_finds_none_keeps_its_first_and_says_how_deep_it_got():
+    """Where no plan ending within planner.end_within is found within the deeper search's count of
+    tests, the first plan stands, its stats record the search, and its message says so."""
+    import dataclasses
+
+    task = shipped("large-manipulation")
+    first = plan_task(dataclasses.replace(task, planner=task.planner.replace(end_within=1.0)), seed=1)
+    narrow = dataclasses.replace(task, planner=task.planner.replace(end_within=0.01, check_limit=20000))
+    plan = plan_task(narrow, seed=1)
+    assert plan.solved and not plan.ends_at_goal
+    assert [w.pose for w in plan.waypoints] == [w.pose for w in first.waypoints]
+    deeper = plan.stats["deeper"]
+    assert deeper["solved"] is False and deeper["check_limit"] == 20000 and deeper["check_limit_reached"]
+    assert plan.stats["feasibility_checks"] == first.stats["feasibility_checks"] + deeper["feasibility_checks"]
+    assert "a search for a plan ending within 0.01 of it ran out after" in plan.message
+
+
+def test_end_within_1_plans_to_the_tolerance_edge_as_before():
+    import dataclasses
+
+    task = shipped("large-manipulation")
+    plan = plan_task(dataclasses.replace(task, planner=task.planner.replace(end_within=1.0)), seed=1)
+    assert plan.solved and "deeper" not in plan.stats and plan.stats["end_used"] > 0.9
+
+
+@pytest.mark.parametrize("bad", [0, -0.5, 1.5, "half"])
+def test_end_within_out_of_its_range_is_refused_naming_it(bad):
+    from stablepush.errors import TaskError
+
+    with pytest.raises(TaskError, match="planner.end_within"):
+        task_with("t-shaped", lambda d: d["planner"].update(end_within=bad))
+
+
+def test_a_search_bounded_by_checks_stops_at_the_count_whatever_its_time():
+    """planner.check_limit bounds the search by stable-push tests, a count, so an unsolved search
+    ends at the same tree on any machine: the same seed gives the same partial path, and the plan
+    says the count ended it (not the time limit)."""
+    task = task_with("large-manipulation", lambda d: d["planner"].update(check_limit=3000, time_limit=1000))
+    plans = [plan_task(task, seed=1) for _ in range(2)]
+    for plan in plans:
+        assert plan.outcome == "time_limit" and plan.stats["check_limit_reached"]
+        assert 3000 <= plan.stats["feasibility_checks"] < 3000 + 500
+        assert "check limit (3,000 stable-push tests)" in plan.message
+    assert [w.pose for w in plans[0].waypoints] == [w.pose for w in plans[1].waypoints]
+    timed = plan_task(task_with("large-manipulation", lambda d: d["planner"].update(time_limit=1e-4)), seed=1)
+    assert timed.outcome == "time_limit" and not timed.stats["check_limit_reached"]

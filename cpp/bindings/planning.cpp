@@ -134,6 +134,8 @@ void expose_planning(py::module_& m) {
       .def_readonly("switches", &PlanStats::switches)
       .def_readonly("length", &PlanStats::length, "[unit steps]")
       .def_readonly("restarts", &PlanStats::restarts)
+      .def_readonly("check_limit_reached", &PlanStats::check_limit_reached,
+                    "the search stopped at check_limit (a count), not at the time limit")
       .def_readonly("first_time_s", &PlanStats::first_time_s, "when the first plan was found [s]; NaN: none")
       .def_readonly("first_switches", &PlanStats::first_switches)
       .def_readonly("first_length", &PlanStats::first_length, "[unit steps]")

@@ -347,6 +347,7 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   plan.stats.feasibility_checks = validator->feasibility_checks();
   plan.stats.switches = cost.switches + finish_switches;
   plan.stats.restarts = planner.restarts();
+  plan.stats.check_limit_reached = planner.check_limit_reached();
   plan.stats.first_time_s =
       planner.first_solution_time() >= 0.0 ? planner.first_solution_time() : std::numeric_limits<double>::quiet_NaN();
   plan.stats.first_switches = planner.first_solution_cost().switches;

@@ -34,6 +34,7 @@ const std::map<std::string, ParameterRange>& trrt_star_parameter_ranges() {
       {"restart_checks", {true, 0.0, 1e12}},  // stable-push tests before a restart (0: never)
       {"pivot_steps", {true, 0.0, 1.0}},      // 1: descents turn about the pads' centres
       {"finish_steps", {true, 0.0, 1.0}},     // 1: the last pusher goes on toward the goal pose
+      {"check_limit", {true, 0.0, 1e15}},     // stable-push tests a solve may make (0: no bound)
   };
   return ranges;
 }
@@ -87,6 +88,8 @@ TRRTstar::TRRTstar(const ob::SpaceInformationPtr& si) : ob::Planner(si, "TRRTsta
                        range_text("improve_for"));
   declareParam<long long>("restart_checks", this, &TRRTstar::setRestartChecks, &TRRTstar::getRestartChecks,
                           range_text("restart_checks"));
+  declareParam<long long>("check_limit", this, &TRRTstar::setCheckLimit, &TRRTstar::getCheckLimit,
+                          range_text("check_limit"));
   // What OMPL's benchmarking and planner-data tools read while a solve runs.
   addPlannerProgressProperty("iterations INTEGER", [this] { return std::to_string(iterations_); });
   addPlannerProgressProperty("nodes INTEGER", [this] { return std::to_string(nodes_.size()); });
@@ -379,8 +382,19 @@ ob::PlannerStatus TRRTstar::solve(const ob::PlannerTerminationCondition& ptc) {
     begin_attempt(start_pose);
   }
 
-  // The search stops when the caller's condition fires or the anytime phase is over.
-  const ob::PlannerTerminationCondition stop = ob::plannerOrTerminationCondition(ptc, anytime_over());
+  // The search stops when the caller's condition fires, the anytime phase is over or the search has
+  // made check_limit stable-push tests. The count is a function of the search alone, so a search that
+  // check_limit ends gives the same answer on any machine under any load; the caller's (wall time)
+  // is then a guard, and check_limit_reached() tells which of them ended it.
+  check_limit_reached_ = false;
+  const std::uint64_t checks_began = validator_->feasibility_checks();
+  const ob::PlannerTerminationCondition counted([this, checks_began] {
+    if (check_limit_ == 0 || validator_->feasibility_checks() - checks_began < check_limit_) return false;
+    check_limit_reached_ = true;
+    return true;
+  });
+  const ob::PlannerTerminationCondition stop =
+      ob::plannerOrTerminationCondition(ob::plannerOrTerminationCondition(counted, ptc), anytime_over());
 
   // Restarts against the long tail (restart_checks): a search that has made that many stable-push
   // tests without a plan starts again from the start with fresh streams and twice the budget, so

@@ -63,7 +63,7 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
       stablepush plan data/tasks/horizontal-offset-low-mu.yaml -o low-mu.plan.json --csv low-mu.csv
     """
     from stablepush.outputs import default_output
-    from stablepush.plan import plan_task, write_plan
+    from stablepush.plan import end_text, plan_task, write_plan
     from stablepush.plan.verify import release_note
 
     json_label = "-o" if json_path is not None else "the default -o"
@@ -85,9 +85,7 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
             f"{s['pushes']} pushes, "
             f"{s['switches']} switch-over(s), pushers {' -> '.join(result.pusher_sequence) or '(none)'}; "
             f"{s['iterations']} iterations, {s['nodes']} nodes, {s['feasibility_checks']} checks")
-        say("ends at the goal pose" if result.ends_at_goal else
-            f"ends within tolerance, {s['goal_distance_steps']:.2f} unit steps from the goal (a last push to "
-            f"the goal itself is not a stable push)")
+        say("ends " + end_text(s, result.ends_at_goal, task.planner.end_within))
         say(f"plan written to {json_path}" + (f" and {csv_path}" if csv_path else ""))
     note = release_note(task, result)
     if note:

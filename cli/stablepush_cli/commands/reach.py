@@ -28,8 +28,12 @@ from stablepush_cli.options import (
 @click.option("--z", "z_axis", callback=parse_axis, default=None, metavar="A:B:N", help="Goal z values, mm (likewise).")
 @click.option("--theta", "theta_axis", callback=parse_axis, default=None, metavar="A:B:N",
               help="Goal theta values, deg (likewise).")
-@click.option("--time-limit", default=1.0, show_default=True, type=TIME_LIMIT,
-              metavar="S", help="Each cell's search time.")
+@click.option("--checks", "check_limit", default=1_000_000, show_default=True, type=Whole(min=0, max=10**15),
+              metavar="N", help="Stable-push tests each cell's search may make: a count, so the map is the same on "
+                                "any machine under any load (0: --time-limit alone bounds it).")
+@click.option("--time-limit", default=10.0, show_default=True, type=TIME_LIMIT,
+              metavar="S", help="Each cell's search time, a guard past --checks: a cell it stops is counted in the "
+                                "summary (its verdict may differ on a less loaded machine).")
 @click.option("--seed", default=None, type=SEED, help="Planner seed (default: the task's).")
 @click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
               help="Plan the cells on K local processes (default: the number of CPUs).")
@@ -43,16 +47,16 @@ from stablepush_cli.options import (
                    "ends); at most six slices, evenly chosen, the one nearest the start's theta among them (the "
                    "title says how many of how many).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, workers, ray_address, json_path,
-          png_path, quiet: bool) -> None:
+def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_limit: float, seed, workers, ray_address,
+          json_path, png_path, quiet: bool) -> None:
     """Map where the pushers can take the object: plan from the task's start to every goal of a grid.
 
     Each cell is the task with its goal replaced, planned on its own. Its verdict: `reached`,
     `unreachable` with the reason (decided exactly before any search: no grasp at the goal,
     every pusher excluded by the uncertainty box, no stable push out of the start or
     none into the goal's tolerance, a min_hold_ratio the goal cannot meet, or a pad that would
-    have to leave the object on the way), or `not found` within --time-limit. The same seed gives
-    the same map, whichever runner plans it. The task's start must have a grasp; its goal need
+    have to leave the object on the way), or `not found` within --checks (or --time-limit). The
+    same seed gives the same map, whichever runner plans it. The task's start must have a grasp; its goal need
     not, as the grid replaces it.
 
     \b
@@ -76,7 +80,8 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
     bar = progressbar(quiet, length=count, label=f"{count} cells", show_pos=True)
     try:
         result = reach_map(task, *axes, seed=task.planner.seed if seed is None else seed, time_limit=time_limit,
-                           runner=runner, progress=(lambda cell: bar.update(1)) if bar else None)
+                           check_limit=check_limit, runner=runner,
+                           progress=(lambda cell: bar.update(1)) if bar else None)
     finally:
         if bar is not None:
             bar.render_finish()
@@ -88,8 +93,12 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, time_limit: float, seed, w
 
         save_figure(reach_figure(task, data), png_path)
     c = data["counts"]
-    say(f"{task.name}: {c['reached']} of {count} goals reached, {c['not found']} not found in {time_limit:g} s, "
+    bound = f"{check_limit:,} tests" if check_limit else f"{time_limit:g} s"
+    say(f"{task.name}: {c['reached']} of {count} goals reached, {c['not found']} not found in {bound}, "
         f"{c['unreachable']} unreachable ({result.wall_s:.1f} s on {result.runner})")
+    if data["guard_fired"]:
+        click.echo(f"warning: {data['guard_fired']} cell(s) stopped at --time-limit {time_limit:g} s before their "
+                   f"{check_limit:,} tests: their verdict may differ on a less loaded machine", err=True)
     written = [p for p in (json_path, png_path) if p]
     if written:
         say(f"written: {', '.join(written)}")

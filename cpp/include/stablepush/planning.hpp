@@ -69,6 +69,10 @@ struct PlanStats {
   int switches = 0;
   double length = 0.0;    ///< [unit steps]
   unsigned restarts = 0;  ///< times the search started again (TRRTstar's restart_checks)
+  /// The search stopped at TRRTstar's check_limit: a count, so the same on any machine. An
+  /// unsolved plan without it stopped at the time limit (or a StopFlag), which depends on the
+  /// machine's speed and load.
+  bool check_limit_reached = false;
   /// The first path the search found (TRRTstar's improve_for; the search's own path without it),
   /// before the plan's end (Plan::ends_at_goal, finish_steps): when [s into the search, NaN when
   /// none], its switch-overs, length [unit steps] and least margin [N].

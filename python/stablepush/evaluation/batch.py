@@ -147,7 +147,9 @@ def run_trial(batch: Batch, trial: int) -> dict:
                           replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
                           cause=report.verdict.cause if report.verdict else None,
                           verdict=report.verdict.detail if report.verdict else None,
-                          sim_time_s=report.waypoints / RATE_HZ, error=None)
+                          sim_time_s=report.waypoints / RATE_HZ, error=None,
+                          # corrections whose search the wall-time guard stopped: this trial may differ elsewhere
+                          wall_guard=sum(1 for r in report.replans if r.guard_fired))
     except Exception as exc:  # noqa: BLE001 - a crashed trial is a result, not the end of the batch
         last = traceback.extract_tb(exc.__traceback__)[-1]
         where = f"{os.path.basename(last.filename)}:{last.lineno}"
@@ -327,6 +329,9 @@ class Evaluation:
             "wall_s": self.wall_s, "runner": self.runner, "nodes": dict(sorted(nodes.items())),
             "robot_time_s": robot_time, "real_time_factor": robot_time / self.wall_s if self.wall_s > 0 else None,
             "decision": self.decision,
+            # trials a correction's search was stopped by its wall-time guard in, not by its count of
+            # tests: their outcome may depend on the machine's load (docs/evaluate.md)
+            "wall_guard_trials": [t["trial"] for t in self.trials if t.get("wall_guard")],
         }
 
     def as_dict(self) -> dict:
@@ -366,6 +371,11 @@ class Evaluation:
             lines.append(f"crashed: {s['crashed']} of {s['trials']} trials (internal errors, not misses: left out of "
                          f"the rate; each trial's `error` says what), the first, trial {first['trial']}: "
                          f"{first['error']}")
+        if s["wall_guard_trials"]:
+            guarded = s["wall_guard_trials"]
+            lines.append(f"warning: in {len(guarded)} trial(s) ({', '.join(map(str, guarded[:10]))}) a correction's "
+                         f"search ran into its wall-time guard before its count of tests: those outcomes may differ "
+                         f"on a less loaded machine (run fewer workers)")
         over = f" over {len(s['nodes'])} nodes" if len(s["nodes"]) > 1 else ""
         lines.append(f"{s['wall_s']:.1f} s on {s['runner']}{over}: {s['robot_time_s']:.0f} s of robot time, "
                      f"{s['real_time_factor']:.2f}x real time")

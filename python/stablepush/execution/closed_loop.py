@@ -62,12 +62,17 @@ from stablepush.units import angle_difference_deg, pose_to_si
 
 THRESHOLD_FRACTION = 0.5  # default threshold: this fraction of the task's goal tolerance
 FINAL_FRACTION = 0.2  # default final tolerance: this fraction of the task's goal tolerance
-KEEP_PUSHER_TIME_LIMIT = 0.05  # s for the re-plan with the current pusher alone
-REPLAN_TIME_LIMIT = 0.5  # s for the re-plan with every pusher (or the task's limit, if lower)
-# s for each of the aim's searches, before the first push (or the task's limit, if lower): nothing
-# waits on it, and the robust large manipulation's took 0.35-0.76 s, so 0.5 s made its outcome
-# depend on how busy the machine was.
-AIM_TIME_LIMIT = 2.0
+# The corrections' searches are bounded by stable-push tests, a count, so that a seed's run is the
+# same on any machine under any load; their wall time is only a guard (GUARD_TIME_LIMIT), and a
+# search it stops is reported (Replan.guard_fired). A correction that is found takes few tests (tens
+# to thousands); a search that finds none runs its budget out: on 2 cores of 2026 about 1 M tests a
+# second for line pushers, about 0.1 M for point pushers.
+KEEP_PUSHER_CHECKS = 50_000  # for the re-plan with the current pusher alone
+REPLAN_CHECKS = 500_000  # for the re-plan with every pusher
+# for each of the aim's searches, before the first push: nothing waits on it (the robust large
+# manipulation's takes 0.35-0.76 s of tests)
+AIM_CHECKS = 2_000_000
+GUARD_TIME_LIMIT = 30.0  # s: a search's wall time, past any of the budgets above on a working machine
 MAX_REPLANS = 20  # per run: a world that keeps undoing the corrections is reported, not chased
 MAX_FAILED_REPLANS = 3  # per run: past this, a pose the planner cannot leave is reported, not retried
 # A correction may carry the object between features only where the pads hold this multiple of its
@@ -140,6 +145,8 @@ class Replan:
     failure: Optional[str] = None  # one line: how many searches, how they ended (each in `tried`)
     attempt: Optional[str] = None  # how the correction taken was searched for (_Attempt.describe)
     tried: List[str] = field(default_factory=list)  # each failed search, and how it ended
+    # a search stopped at GUARD_TIME_LIMIT before its count: this correction may differ on another machine
+    guard_fired: bool = False
 
 
     def as_dict(self) -> dict:
@@ -216,16 +223,16 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
     if at(end) or at(start):
         return None
     switches = sum(1 for a, b in zip(steps[1:], steps[2:]) if a.pusher != b.pusher)
-    time_limit = min(AIM_TIME_LIMIT, task.planner.time_limit)
-    elapsed, tried, ended, found = 0.0, [], [], []
+    elapsed, tried, ended, found, guarded = 0.0, [], [], [], False
     for budget in range(min(switches, task.planner.max_switches), task.planner.max_switches + 1):
-        planner = task.planner.replace(tolerance=list(loop.final_tolerance), time_limit=time_limit,
-                                       max_switches=budget)
+        planner = counted(task.planner, AIM_CHECKS).replace(tolerance=list(loop.final_tolerance), max_switches=budget)
         result = plan_task(dataclasses.replace(task.with_start(start), planner=planner),
-                           min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO, explain=False)
+                           min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO, explain=False,
+                           deepen=False)
         elapsed += result.stats["planning_time_s"]
+        guarded = guarded or guard_fired(result)
         if not result.solved:
-            tried.append(f"{budget} switch-over(s) in {time_limit * 1e3:g} ms: {result.outcome}")
+            tried.append(f"{budget} switch-over(s) in {AIM_CHECKS:,} tests: {_ended_by(result)}")
             ended.append(result.outcome)
         elif not _transits_held(task, result.waypoints, result.waypoints[1].pusher):
             tried.append(_unheld_note(result.pusher_sequence, TRANSIT_HOLD_RATIO))
@@ -237,7 +244,8 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
     record = Replan(after_step=0, measured=tuple(start), planned=tuple(end), solved=bool(found),
                     pushers=result.pusher_sequence if found else [], pushes=max(len(found) - 1, 0),
                     kept_pusher=False, planning_ms=elapsed * 1e3, trigger="plan_short",
-                    failure=None if found else _summed_up(ended, notes), tried=[] if found else tried + notes)
+                    failure=None if found else _summed_up(ended, notes), tried=[] if found else tried + notes,
+                    guard_fired=guarded)
     return record, found
 
 
@@ -258,7 +266,7 @@ def no_way_back(task: Task, pose: Sequence[float], tolerance: Tuple[float, float
 
 # How a failed search ended, as its one-line summary counts it (_summed_up): a Plan.outcome, or the
 # transit rule refusing the plan found.
-_ENDED = {"time_limit": "out of time", "unreachable": "unreachable", "goal_over_switch_limit": "over the switch-overs",
+_ENDED = {"time_limit": "out of tests", "unreachable": "unreachable", "goal_over_switch_limit": "over the switch-overs",
           "invalid_start": "no grasp at the start", "transit": "a transit the pads do not hold"}
 
 
@@ -291,7 +299,7 @@ class _Attempt:
     the planner's pivot steps, or without."""
 
     every_pusher: bool
-    time_limit: float  # s
+    checks: int  # stable-push tests the search may make
     robust: bool
     pivot_steps: bool = False
     transit_hold: float = TRANSIT_HOLD_RATIO
@@ -302,14 +310,14 @@ class _Attempt:
         pivot = ", pivot steps" if self.pivot_steps else ""
         hold = f", switch-overs where the pads hold {self.transit_hold:g} times the weight" \
             if self.every_pusher and self.transit_hold != TRANSIT_HOLD_RATIO else ""
-        return f"{who}{robust}{pivot}{hold} in {self.time_limit * 1e3:g} ms"
+        return f"{who}{robust}{pivot}{hold} in {self.checks:,} tests"
 
 
 # Robust first, and the pusher in contact first: no switch-over, the object stays on its feature;
 # the same with pivot steps when none of those is found; last, switch-overs where the pads hold less.
 ATTEMPTS = tuple(_Attempt(every, limit, robust, pivot) for pivot in (False, True) for robust in (True, False)
-                 for every, limit in ((False, KEEP_PUSHER_TIME_LIMIT), (True, REPLAN_TIME_LIMIT))) \
-    + (_Attempt(True, REPLAN_TIME_LIMIT, robust=False, transit_hold=TRANSIT_HOLD_RATIO_LEAST),)
+                 for every, limit in ((False, KEEP_PUSHER_CHECKS), (True, REPLAN_CHECKS))) \
+    + (_Attempt(True, REPLAN_CHECKS, robust=False, transit_hold=TRANSIT_HOLD_RATIO_LEAST),)
 
 
 def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop, after_step: int,
@@ -327,7 +335,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
     spec = task.pushers[task.pusher_index(pusher)]
-    elapsed, tried, ended, steps, found_by = 0.0, [], [], [], None
+    elapsed, tried, ended, steps, found_by, guarded = 0.0, [], [], [], None, False
     robust = dataclasses.replace(base, uncertainty={"pusher_mu": CORRECTION_MU_SPREAD, "pad_mu": CORRECTION_MU_SPREAD})
     for attempt in ATTEMPTS:
         least = attempt.transit_hold != TRANSIT_HOLD_RATIO
@@ -336,8 +344,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
             continue  # the task's own box is the model and its rule of every attempt; its pivot steps are in all
         if least and not verdict_at_stake:
             continue
-        planner = base.planner.replace(time_limit=min(attempt.time_limit, task.planner.time_limit),
-                                       pivot_steps=1 if attempt.pivot_steps else None)
+        planner = counted(base.planner, attempt.checks).replace(pivot_steps=1 if attempt.pivot_steps else None)
         start = robust if attempt.robust else base
         if attempt.every_pusher:
             most = PLANNER_PARAMETER_RANGES["max_switches"][2]
@@ -352,11 +359,11 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         # robust attempts' box too (its pads' mu is 15% lower at two of them: the stricter rule, as
         # measured).
         transit_hold = (1.0 if task.uncertainty else attempt.transit_hold) if attempt.every_pusher else 0.0
-        result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher, explain=False)
+        result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher, explain=False, deepen=False)
         elapsed += result.stats["planning_time_s"]
+        guarded = guarded or guard_fired(result)
         if not result.solved:
-            why = result.message if result.outcome == "unreachable" else result.outcome  # the reason, decided at once
-            tried.append(f"{attempt.describe(pusher)}: {why}")
+            tried.append(f"{attempt.describe(pusher)}: {_ended_by(result)}")
             ended.append(result.outcome)
             continue
         if not _transits_held(task, result.waypoints, pusher, attempt.transit_hold):
@@ -370,5 +377,26 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
                     pushers=result.pusher_sequence if steps else [], pushes=max(len(steps) - 1, 0),
                     kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3,
                     trigger=trigger, failure=None if steps else _summed_up(ended, notes), attempt=found_by,
-                    tried=[] if steps else tried + notes)
+                    tried=[] if steps else tried + notes, guard_fired=guarded)
     return record, steps
+
+
+def counted(planner, checks: int):
+    """`planner` (PlannerSettings) bounded by `checks` stable-push tests (the task's own check_limit,
+    when lower), with GUARD_TIME_LIMIT as its wall-time guard."""
+    own = int(planner.tuning.get("check_limit", 0))
+    return planner.replace(check_limit=min(checks, own) if own else checks, time_limit=GUARD_TIME_LIMIT)
+
+
+def guard_fired(plan) -> bool:
+    """Whether `plan`'s search was stopped by its wall time, not by its count of tests."""
+    return plan.outcome == "time_limit" and not plan.stats.get("check_limit_reached", False)
+
+
+def _ended_by(plan) -> str:
+    """How a search that found no plan ended, in a few words (an unreachable goal with its reason)."""
+    if plan.outcome == "unreachable":
+        return plan.message  # the reason, decided at once
+    if plan.outcome == "time_limit":
+        return "out of tests" if plan.stats.get("check_limit_reached") else "stopped by the wall-time guard"
+    return plan.outcome

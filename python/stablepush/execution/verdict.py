@@ -34,6 +34,7 @@ import math
 from dataclasses import dataclass
 from typing import Dict, Optional, Sequence, Tuple
 
+from stablepush import units
 from stablepush.task.model import Task
 from stablepush.units import angle_difference_deg, pose_to_si
 
@@ -77,8 +78,7 @@ def within(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[fl
 def tolerance_used(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[float]) -> float:
     """The largest of `pose`'s offsets from `goal` in x, z (mm) and theta (deg), each over its
     `tolerance`: at most 1 within it (`within`), 0 at the goal."""
-    return max(abs(pose["x"] - goal[0]) / tolerance[0], abs(pose["z"] - goal[1]) / tolerance[0],
-               abs(angle_difference_deg(pose["theta"], goal[2])) / tolerance[1])
+    return units.tolerance_used((pose["x"], pose["z"], pose["theta"]), goal, tolerance)
 
 
 def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,

@@ -1,8 +1,9 @@
 """Where the pushers can take the object (`stablepush reach`): the task's start planned to every
 goal of a grid of poses in the grasp, the task otherwise unchanged, each cell on its own, where
 `stablepush.runners` says (here, local processes or Ray). A cell's plan depends on the task, the
-goal and the seed alone, so the same seed gives the same map on every runner, but for what the
-time limit decides (a `not found` cell's partial path, a goal found only near the limit).
+goal, the seed and the count of stable-push tests each cell may make, so the same seed gives the
+same map on every runner under any load, but for a cell whose time limit, a guard, fired first
+(`guard_fired`).
 
 Each cell ends with a verdict:
 - `reached`: a plan reaches the goal within the task's tolerance and switch-over budget;
@@ -13,7 +14,8 @@ Each cell ends with a verdict:
   before its search (`stablepush.plan.unreachable`: every pusher excluded by the uncertainty box,
   no stable push out of the start, none that ends within the goal's tolerance, the goal not held
   well enough anywhere in its tolerance, a pad that would have to leave the object);
-- `not found`: the search ran out of time (`outcome` says how: `time_limit`, or
+- `not found`: the search ran out of its stable-push tests (`check_limit`) or its time (`outcome`
+  says how: `time_limit`, with `guard_fired` when the time stopped it first, or
   `goal_over_switch_limit` when the goal was reached with more switch-overs than allowed), or the
   goal is within the tolerance of the start where the pads do not hold the object as
   `planner.min_hold_ratio` asks, and nothing decides it (`outcome` `at_start`; see at_start_verdict).
@@ -53,6 +55,11 @@ def axis_values(axis: Axis) -> List[float]:
     return [float(v) for v in values]
 
 
+# Stable-push tests a cell's search may make (planner.check_limit): about a second of a line-pusher
+# task's search on 2 cores of 2026, ten for point pushers.
+REACH_CHECKS = 1_000_000
+
+
 @dataclass(frozen=True)
 class ReachJob:
     """A reach map's shared part: the task, the goals of the grid (x fastest, then z, then
@@ -63,9 +70,13 @@ class ReachJob:
     seed: int
     time_limit: float
     axes: Tuple[Axis, ...] = ()  # the grid's (from, to, count) in x, z, theta, when made by `grid`
+    # stable-push tests each cell's search may make: a count, so a cell's verdict is the same on any
+    # machine; the time limit is then a guard, and a cell it stops says so (`guard_fired`)
+    check_limit: int = REACH_CHECKS
 
     @classmethod
-    def grid(cls, task: Task, x: Axis, z: Axis, theta: Axis, seed: int, time_limit: float) -> "ReachJob":
+    def grid(cls, task: Task, x: Axis, z: Axis, theta: Axis, seed: int, time_limit: float,
+             check_limit: int = REACH_CHECKS) -> "ReachJob":
         """The job of the grid x by z by theta; TaskError naming the axis, `seed` or `time_limit` when
         one is out of its range (the task file's pose bounds; at most MAX_AXIS values an axis and
         MAX_CELLS cells)."""
@@ -75,7 +86,8 @@ class ReachJob:
             raise TaskError("x, z, theta", f"{x[2] * z[2] * theta[2]} cells; at most {MAX_CELLS}")
         goals = tuple((gx, gz, gth) for gth in axis_values(theta) for gz in axis_values(z) for gx in axis_values(x))
         return cls(task=task, goals=goals, seed=planner_parameter("seed", "seed", seed),
-                   time_limit=planner_limit("time_limit", time_limit), axes=(x, z, theta))
+                   time_limit=planner_limit("time_limit", time_limit), axes=(x, z, theta),
+                   check_limit=planner_parameter("check_limit", "check_limit", check_limit))
 
 
 def grid_axis(name: str, axis, bound: Tuple[float, float]) -> Axis:
@@ -125,7 +137,8 @@ def reach_cell(job: ReachJob, i: int) -> dict:
 
     goal = job.goals[i]
     cell = {"goal": list(goal), "seed": job.seed, "solved": False, "planning_time_s": 0.0, "switches": None,
-            "pushes": None, "outcome": None, "verdict": None, "reason": None, "node": this_node()}
+            "pushes": None, "outcome": None, "verdict": None, "reason": None, "node": this_node(),
+            "guard_fired": False}
     task = dataclasses.replace(job.task, goal=tuple(goal))
     off = pads_off_near(task, goal)
     if off:
@@ -134,10 +147,11 @@ def reach_cell(job: ReachJob, i: int) -> dict:
                           f"goal: no grasp there"}
     if task.at_goal(task.start):
         return {**cell, **at_start_verdict(task)}
-    plan = plan_task(task, seed=job.seed, time_limit=job.time_limit)
+    plan = plan_task(task, seed=job.seed, time_limit=job.time_limit, check_limit=job.check_limit or None)
     s = plan.stats
     cell.update(solved=plan.solved, planning_time_s=s["planning_time_s"], switches=s["switches"],
-                pushes=s["pushes"], outcome=plan.outcome)
+                pushes=s["pushes"], outcome=plan.outcome,
+                guard_fired=plan.outcome == "time_limit" and not s["check_limit_reached"])
     if plan.solved:
         cell["verdict"] = "reached"
     elif plan.outcome in ("invalid_start", "unreachable"):  # the verdict says it: the reason alone
@@ -161,6 +175,7 @@ class ReachMap:
     cells: List[dict]
     wall_s: float
     runner: str
+    check_limit: int = REACH_CHECKS
 
     def counts(self) -> dict:
         """How many cells have each verdict: reached, unreachable, not found."""
@@ -172,20 +187,27 @@ class ReachMap:
     def as_dict(self) -> dict:
         """The map as `stablepush reach --json` writes it (plain data; the cells under `cells`)."""
         return {"task": self.task, "start": list(self.start), "axes": self.axes, "seed": self.seed,
-                "time_limit_s": self.time_limit, "counts": self.counts(), "wall_s": self.wall_s,
-                "runner": self.runner, "cells": self.cells}
+                "time_limit_s": self.time_limit, "check_limit": self.check_limit, "counts": self.counts(),
+                "guard_fired": self.guard_fired(), "wall_s": self.wall_s, "runner": self.runner, "cells": self.cells}
+
+    def guard_fired(self) -> int:
+        """Cells whose search the time limit stopped before its count of tests: their verdict may
+        differ on a less loaded machine."""
+        return sum(1 for c in self.cells if c.get("guard_fired"))
 
 
-def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_limit: float = 1.0,
-              runner=None, progress=None) -> ReachMap:
-    """The reach map of `task` over the grid x by z by theta (each (from, to, count)); `runner` a
-    `stablepush.runners.Runner` (None: here); `progress(cell)` after each cell."""
+def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_limit: float = 10.0,
+              runner=None, progress=None, check_limit: int = REACH_CHECKS) -> ReachMap:
+    """The reach map of `task` over the grid x by z by theta (each (from, to, count)), each cell's
+    search bounded by `check_limit` stable-push tests (0: by `time_limit` [s] alone, which then
+    decides what a machine's load may change); `runner` a `stablepush.runners.Runner` (None: here);
+    `progress(cell)` after each cell."""
     import time
 
     from stablepush.runners import Runner, WorkerLost, run_all
 
     require_task(task)
-    job = ReachJob.grid(task, x, z, theta, seed, time_limit)
+    job = ReachJob.grid(task, x, z, theta, seed, time_limit, check_limit)
     runner = runner or Runner()
     started = time.perf_counter()
     cells: List[Optional[dict]] = [None] * len(job.goals)
@@ -199,4 +221,4 @@ def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_lim
             progress(cell)
     return ReachMap(task=task.name, start=tuple(task.start), axes=dict(zip(("x", "z", "theta"), map(list, job.axes))),
                     seed=job.seed, time_limit=job.time_limit, cells=cells, wall_s=time.perf_counter() - started,
-                    runner=runner.describe(len(cells)))
+                    runner=runner.describe(len(cells)), check_limit=job.check_limit)

@@ -20,7 +20,7 @@ from stablepush.plan.unreachable import why_unreachable
 from stablepush.task.mechanics import blocked_senses
 from stablepush.task.model import PlannerSettings, Task, require_task
 from stablepush.task.schema import LIMITS, number_field, planner_limit, planner_parameter
-from stablepush.units import MM, pose_from_si, pose_to_si
+from stablepush.units import MM, pose_from_si, pose_to_si, tolerance_used
 
 
 def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, pose_mm_deg) -> PusherContact:
@@ -38,10 +38,12 @@ def plan_task(
     time_limit: Optional[float] = None,
     max_switches: Optional[int] = None,
     improve_for: Optional[float] = None,
+    check_limit: Optional[int] = None,
     models: "Optional[List[_core.StablePushModel]]" = None,
     min_transit_hold: float = 0.0,
     start_pusher: Optional[str] = None,
     explain: bool = True,
+    deepen: bool = True,
 ) -> Plan:
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
     task's planner section (which has defaults for every key). `models` are the task's
@@ -55,6 +57,11 @@ def plan_task(
     ran out of time, `explain` names in the message the senses toward the goal in which no stable
     push from the start moves the object (_toward_goal: some 0.05 s; the closed loop's re-plans,
     which read the outcome alone, leave it out).
+    A solved plan whose end uses more than planner.end_within of the tolerance in some coordinate
+    (units.tolerance_used) is planned again to that share of the tolerance (`deepen`; _deeper),
+    within DEEPER_CHECKS stable-push tests: a plan that ends at the tolerance's edge leaves an
+    open-loop run no room for a real push's drift. Where that search finds none, the first plan
+    stands and its stats say how deep it got (`end_used`, `deeper`).
     TaskError (field `goal`) when the start is already within the tolerance of the goal."""
     require_task(task)
     if task.at_goal(task.start):
@@ -66,7 +73,8 @@ def plan_task(
         seed=None if seed is None else planner_parameter("seed", "seed", seed),
         max_switches=None if max_switches is None else planner_parameter("max_switches", "max_switches", max_switches),
         time_limit=None if time_limit is None else planner_limit("time_limit", time_limit),
-        improve_for=None if improve_for is None else planner_parameter("improve_for", "improve_for", improve_for))
+        improve_for=None if improve_for is None else planner_parameter("improve_for", "improve_for", improve_for),
+        check_limit=None if check_limit is None else planner_parameter("check_limit", "check_limit", check_limit))
     # A hold factor, as planner.min_hold_ratio is (docs/model.md section 3).
     min_transit_hold = number_field("min_transit_hold", min_transit_hold, LIMITS["min_hold_ratio"])
     if models:  # the caller's: they must be this task's
@@ -79,17 +87,13 @@ def plan_task(
     reason = why_unreachable(task, models, deadline=began + settings.time_limit)
     if reason is not None:
         return _unreachable(task, models, settings, reason, time.perf_counter() - began)
-    # Ctrl-C stops the search at once (KeyboardInterrupt); signals reach the main thread only.
-    raw = _core.plan(models, _core.PlannerSettings(
-        start=pose_to_si(task.start), goal=pose_to_si(task.goal),
-        step=(settings.step[0] * MM, math.radians(settings.step[1])),
-        tolerance=(settings.tolerance[0] * MM, math.radians(settings.tolerance[1])),
-        time_limit=settings.time_limit, min_margin=settings.min_margin, sampling_margin=settings.sampling_margin,
-        min_hold_ratio=settings.min_hold_ratio, parameters=settings.core_parameters(),
-        min_transit_hold=float(min_transit_hold),
-        start_pusher=-1 if start_pusher is None else task.pusher_index(start_pusher, "start_pusher")),
-        interruptible=threading.current_thread() is threading.main_thread())
-
+    pusher_at_start = -1 if start_pusher is None else task.pusher_index(start_pusher, "start_pusher")
+    raw = _search(task, models, settings, settings.tolerance, min_transit_hold, pusher_at_start)
+    deep = None
+    if deepen and raw.outcome.name == "goal_reached" and settings.end_within < 1.0:
+        deep = _deeper(task, models, settings, raw, min_transit_hold, pusher_at_start)
+        if deep is not None:
+            raw = deep.pop("raw") or raw
     names = task.pusher_names
     raw_waypoints = raw.waypoints  # a copy of the core's vector on each access: taken once
     if len(raw_waypoints) > MAX_WAYPOINTS:  # refused before the waypoints are made: 0.04 ms each
@@ -123,7 +127,15 @@ def plan_task(
         "path_length_steps": s.length,
         "goal_distance_steps": raw.goal_distance,
         "min_hold_ratio": settings.min_hold_ratio,
+        # the search stopped at planner.check_limit (a count: the same on any machine), not at its time limit
+        "check_limit_reached": bool(s.check_limit_reached),
     }
+    if outcome == "goal_reached":
+        stats["end_used"] = tolerance_used(waypoints[-1].pose, task.goal, task.planner.tolerance)
+    if deep is not None:
+        stats["deeper"] = deep
+        stats["feasibility_checks"] += deep["feasibility_checks"] if not deep["solved"] else deep["first_checks"]
+        stats["planning_time_s"] = time.perf_counter() - began
     if "improve_for" in settings.tuning:
         # the first plan of an anytime search (planner.improve_for), before the improvement; None: no plan
         # (path_min_margin: the same measure for the returned path, the last push to the goal left out)
@@ -141,7 +153,7 @@ def plan_task(
         stats["path_min_margin"] = s.path_min_margin if solved_once else None
     last = waypoints[-1]
     last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1
-    message = _message(outcome, stats, bool(raw.ends_at_goal))
+    message = _message(outcome, stats, bool(raw.ends_at_goal), settings)
     if outcome == "time_limit" and explain:
         message += _toward_goal(task)
     return Plan(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
@@ -152,6 +164,43 @@ def plan_task(
 
 
 MAX_PUSHES = MAX_WAYPOINTS - 1  # the pushes a plan file holds: its waypoints less the start
+# The stable-push tests the deeper search (planner.end_within) may make: a count, so that whether
+# it finds a plan is the same on any machine. The shipped tasks' deeper searches take 0.3k-80k.
+DEEPER_CHECKS = 200_000
+
+
+def _search(task: Task, models, settings: PlannerSettings, tolerance, min_transit_hold: float, start_pusher: int,
+            check_limit: int = 0):
+    """The core's T-RRT* from the task's start to its goal within `tolerance` (mm, deg)."""
+    parameters = settings.core_parameters()
+    if check_limit:
+        parameters["check_limit"] = str(check_limit)
+    # Ctrl-C stops the search at once (KeyboardInterrupt); signals reach the main thread only.
+    return _core.plan(models, _core.PlannerSettings(
+        start=pose_to_si(task.start), goal=pose_to_si(task.goal),
+        step=(settings.step[0] * MM, math.radians(settings.step[1])),
+        tolerance=(tolerance[0] * MM, math.radians(tolerance[1])),
+        time_limit=settings.time_limit, min_margin=settings.min_margin, sampling_margin=settings.sampling_margin,
+        min_hold_ratio=settings.min_hold_ratio, parameters=parameters, min_transit_hold=float(min_transit_hold),
+        start_pusher=start_pusher), interruptible=threading.current_thread() is threading.main_thread())
+
+
+def _deeper(task: Task, models, settings: PlannerSettings, first, min_transit_hold: float, start_pusher: int):
+    """When `first` (a solved core plan) ends beyond planner.end_within of the tolerance, the search
+    again to that share of it, within DEEPER_CHECKS tests (or the task's own check_limit, if lower)
+    and the time limit as a guard: a record of it (`solved`, `end_within`, its tests; `raw`, its plan,
+    when solved), or None when the first plan ends deep enough."""
+    share = settings.end_within
+    if tolerance_used(pose_from_si(first.waypoints[-1].pose), task.goal, settings.tolerance) <= share + 1e-9:
+        return None
+    limit = min(DEEPER_CHECKS, int(settings.tuning.get("check_limit", 0)) or DEEPER_CHECKS)
+    raw = _search(task, models, settings, (settings.tolerance[0] * share, settings.tolerance[1] * share),
+                  min_transit_hold, start_pusher, check_limit=limit)
+    solved = raw.outcome.name == "goal_reached"
+    return {"end_within": share, "solved": solved, "check_limit": limit,
+            "feasibility_checks": int(raw.stats.feasibility_checks),
+            "first_checks": int(first.stats.feasibility_checks),
+            "check_limit_reached": bool(raw.stats.check_limit_reached), "raw": raw if solved else None}
 
 
 def _step_text(settings: PlannerSettings) -> str:
@@ -216,20 +265,38 @@ def _margin_per_normal(models, q0, q1, pusher: int) -> Optional[float]:
     return float(r.margin / normal_force) if normal_force > 0 else None
 
 
-def _message(outcome: str, stats: dict, ends_at_goal: bool) -> str:
+def _message(outcome: str, stats: dict, ends_at_goal: bool, settings: PlannerSettings) -> str:
     if outcome == "goal_reached":
-        end = ("ending at the goal" if ends_at_goal else
-               f"ending within tolerance, {stats['goal_distance_steps']:.2f} unit steps from the goal (a last push "
-               f"to the goal itself is not stable)")
         return (f"solved in {stats['planning_time_s'] * 1e3:.1f} ms: {stats['pushes']} pushes, "
-                f"{stats['switches']} switch-over(s), {end}")
+                f"{stats['switches']} switch-over(s), ending {end_text(stats, ends_at_goal, settings.end_within)}")
     if outcome == "goal_over_switch_limit":
         return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out with the goal reached only with "
                 f"{stats['switches']} switch-overs (max_switches {stats['max_switches']}); the plan written is that "
                 f"one; allow it with planner.max_switches: {stats['switches']}")
     if outcome == "invalid_start":
         return "not solved: the pads do not hold the object at the start pose"
+    if stats["check_limit_reached"]:
+        return (f"not solved: the check limit ({settings.tuning['check_limit']:,.0f} stable-push tests) ran out before "
+                f"the goal was reached; the best partial path ends {stats['goal_distance_steps']:.1f} unit steps "
+                f"from the goal")
     held = (f" where the pads alone hold {stats['min_hold_ratio']:g} times the weight (planner.min_hold_ratio)"
             if stats["min_hold_ratio"] > 0 else "")
     return (f"not solved: the time limit ({stats['time_limit_s']:g} s) ran out before the goal was reached{held}; "
             f"the best partial path ends {stats['goal_distance_steps']:.1f} unit steps from the goal")
+
+
+def end_text(stats: dict, ends_at_goal: bool, end_within: float) -> str:
+    """Where a solved plan ends (the words after "ends"), from its stats: at the goal pose, or
+    within the tolerance at the share of it its end uses (`end_used`), and, where the deeper search
+    for a plan ending within `end_within` of it (planner.end_within) found none, how far it went."""
+    if ends_at_goal:
+        return "at the goal pose"
+    end = f"within tolerance, {stats['goal_distance_steps']:.2f} unit steps from the goal"
+    if stats.get("end_used") is not None:
+        end += f", using {stats['end_used']:.2f} of its tolerance"
+    deeper = stats.get("deeper")
+    if deeper is not None and not deeper["solved"]:
+        why = "ran out" if deeper["check_limit_reached"] else "found none"
+        end += (f"; a search for a plan ending within {end_within:g} of it {why} after "
+                f"{deeper['feasibility_checks']:,} stable-push tests")
+    return end + " (a last push to the goal itself is not stable)"

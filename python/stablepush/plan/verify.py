@@ -10,6 +10,7 @@ from stablepush import _core
 from stablepush.errors import PlanError
 from stablepush.plan.plan import FieldFault, Plan, Waypoint, require_plan
 from stablepush.task.model import Task, require_task
+from stablepush.task.release import needed_hold_ratio
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import MM, pose_to_si
 
@@ -189,14 +190,16 @@ def release_note(task: Task, plan: Plan) -> Optional[str]:
     """What a run of `plan` meets when its last feature lets go, when the pads alone do not hold
     the object at the plan's end (its `final_hold_ratio` under 1): it moves in the grasp and the
     run misses (the verdict's `moved_on_release`); None when they hold it, or when the task's run
-    ends on the feature (environment.end_on_feature)."""
+    ends on the feature (environment.end_on_feature). The min_hold_ratio it gives is the one that
+    holds the release's load too (task.release.needed_hold_ratio)."""
     hold = plan.final_hold_ratio
     if hold >= 1.0 or task.environment.end_on_feature or len(plan.waypoints) < 2:
         return None
+    need = needed_hold_ratio(task, task.pusher_names)
     return (f"at the plan's last pose the pads alone hold only {hold:.2f} times the object's weight: when the last "
             f"feature lets go the object moves in the grasp and the run misses (moved_on_release); "
-            f"planner.min_hold_ratio: 1 asks for a pose they hold, environment.end_on_feature: true ends the run "
-            f"on the feature")
+            f"planner.min_hold_ratio: {need:g} asks for a pose they hold (the weight and the arm's acceleration as "
+            f"it lets go), environment.end_on_feature: true ends the run on the feature")
 
 
 def changes_since_planned(task: Task, plan: Plan) -> List[str]:

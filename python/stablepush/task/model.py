@@ -65,7 +65,9 @@ def _finite_vector(field: str, value, size: int) -> None:
 class PlannerSettings:
     """The task's `planner:` section as a typed value, in file units (docs/model.md section 3):
     `time_limit` [s], `seed`, `max_switches`, the unit `step` and the goal's `tolerance` (mm, deg),
-    `min_margin` [N], `sampling_margin` [unit steps], `min_hold_ratio` [times the weight], and
+    `min_margin` [N], `sampling_margin` [unit steps], `min_hold_ratio` [times the weight],
+    `end_within` (the share of the tolerance, in each coordinate, a plan's end should lie within:
+    plan.search makes a deeper search where the first plan ends further out), and
     `tuning`: T-RRT*'s other declared parameters (goal_bias, pivot_steps, ...: their names and
     ranges are the core's, `_core.TRRT_STAR_PARAMETER_RANGES`), only those given. Made with a
     field of the wrong shape it raises TypeError or ValueError naming it; the task file's ranges
@@ -79,10 +81,11 @@ class PlannerSettings:
     min_margin: float = 1e-3
     sampling_margin: float = 5.0
     min_hold_ratio: float = 0.0
+    end_within: float = 0.5
     tuning: Dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        for name in ("time_limit", "min_margin", "sampling_margin", "min_hold_ratio"):
+        for name in ("time_limit", "min_margin", "sampling_margin", "min_hold_ratio", "end_within"):
             _finite(f"planner.{name}", getattr(self, name))
             object.__setattr__(self, name, float(getattr(self, name)))
         for name in ("seed", "max_switches"):

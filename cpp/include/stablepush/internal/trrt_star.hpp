@@ -171,6 +171,14 @@ class TRRTstar : public ompl::base::Planner {
     restart_checks_ = static_cast<std::uint64_t>(checked("restart_checks", static_cast<double>(checks)));
   }
   long long getRestartChecks() const { return static_cast<long long>(restart_checks_); }
+  /// The stable-push tests a solve may make before it stops as at its time limit (0: no bound). A
+  /// search bounded so answers the same on any machine: wall time is then only a guard.
+  void setCheckLimit(long long checks) {
+    check_limit_ = static_cast<std::uint64_t>(checked("check_limit", static_cast<double>(checks)));
+  }
+  long long getCheckLimit() const { return static_cast<long long>(check_limit_); }
+  /// Whether the last solve stopped at check_limit (rather than at the caller's condition).
+  bool check_limit_reached() const { return check_limit_reached_; }
   /// Restarts in the last solve.
   unsigned restarts() const { return restarts_; }
 
@@ -384,6 +392,8 @@ class TRRTstar : public ompl::base::Planner {
   bool pivot_steps_ = false;
   bool finish_steps_ = false;
   std::uint64_t restart_checks_ = 5000;
+  std::uint64_t check_limit_ = 0;
+  bool check_limit_reached_ = false;
   unsigned restarts_ = 0;
 
   double temperature_ = 0.0;
