@@ -119,11 +119,13 @@ def test_a_goal_the_pads_cannot_hold_is_told_at_load_with_what_to_change():
     released = parse_task(task_text("horizontal-offset-high-mu").replace("end_on_feature: true", "end_on_feature: false"))
     (warning,) = [w for w in released.warnings if w.startswith("goal:")]
     assert "the pads alone hold only 0.91 times the object's weight at the goal" in warning
-    assert "moved_on_release" in warning and "gripper.grip_force 11.1 N or more" in warning
+    # 11.1 N holds the weight at the goal; 14.8 N holds it through the release (the arm's
+    # acceleration as it backs off, anywhere within the tolerance: task/release.py).
+    assert "moved_on_release" in warning and "gripper.grip_force 14.8 N or more" in warning
     assert "environment.end_on_feature: true" in warning
-    # Gripped 11.1 N, they hold it (hold_ratio is linear in the grip force): no warning.
+    # Gripped 14.8 N, they hold it (hold_ratio is linear in the grip force): no warning.
     firm = parse_task(task_text("horizontal-offset-high-mu").replace("end_on_feature: true", "end_on_feature: false")
-                      .replace("grip_force: 10 ", "grip_force: 11.1 "))
+                      .replace("grip_force: 10 ", "grip_force: 14.8 "))
     assert min(firm.goal_hold_ratios().values()) >= 1.0 and not any(w.startswith("goal:") for w in firm.warnings)
     # The bottom feature turned 90 deg in the world: with its gravity the pads hold the goal (4.29
     # times the weight), with the side pushers' not; min_hold_ratio: 1 is the cure, and once given,

@@ -52,6 +52,10 @@ FEATURE_ROD_RADIUS = 0.001  # m, the rod of a point pusher's feature
 # the adjacent face, lies in that face's path on the approach (the T's web feature over its
 # flange). A real fixture must stop short too, by more than its placement error.
 FEATURE_CORNER_GAP = 0.001
+# The jaw servos' spring at the object's faces, in grip forces: at 2 they stay at their cap (the
+# grip force) until each jaw has closed by a quarter of the thickness, and while they close at
+# under grip force / kv.
+JAW_SATURATION = 2.0
 
 
 def pad_points(center: Sequence[float], radius: float, rings: int) -> List[Tuple[float, float]]:
@@ -190,12 +194,17 @@ def arm_tree(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] =
     root = arm_model(None if kinematic_hand else robot).arm_tree()
     if kinematic_hand:
         _replace_arm_by_kinematic_hand(root, scene["gripper_pose"])
-    # The finger servos close toward y = 0 and press with at most the grip force.
+    # The finger servos close toward y = 0 and press with at most the grip force. They press with
+    # exactly that only while saturated: at the object's faces, half its thickness from y = 0,
+    # their spring must exceed the cap, or they press with kp t/2 (the shipped kp gave 20 N on a
+    # 10 mm part gripped with 40 N, and no grip force cured its release).
     grip_force = scene["gripper"]["grip_force"]
     for finger in FINGER_JOINTS:
         act = root.find(f".//actuator/position[@name='{finger}']")
         act.set("forcerange", mjcf_numbers((-grip_force, grip_force)))
         act.set("forcelimited", "true")
+        stiff = JAW_SATURATION * grip_force / (scene["object"]["thickness"] / 2)
+        act.set("kp", repr(max(float(act.get("kp")), stiff)))
     return root
 
 

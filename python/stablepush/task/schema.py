@@ -35,6 +35,7 @@ from stablepush.task.model import (
     make_gripper,
     outline_corners,
 )
+from stablepush.task.release import goal_release_holds, needed_hold_ratio
 from stablepush.units import MM, is_integer, is_real, mm2_to_si, pose_to_si
 
 DEFAULT_PAD_RADIUS_MM = 5.0
@@ -547,8 +548,9 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
 def goal_hold_warnings(task: Task) -> List[str]:
     """What to change when the pads alone cannot hold the object at the goal (Task.goal_hold_ratios):
     a run releases it there and it moves (the verdict's `moved_on_release`). Empty when they hold
-    it whichever pusher pushes last, or when planner.min_hold_ratio >= 1 already makes the plan end
-    where they do."""
+    it whichever pusher pushes last, or when planner.min_hold_ratio already makes the plan end
+    where they hold it through the release. The numbers it gives are the release's (release.py):
+    the weight and the retract's acceleration, anywhere within the goal's tolerance."""
     ratios = task.goal_hold_ratios()
     weak = {name: r for name, r in ratios.items() if r < 1.0}
     if not weak:
@@ -556,20 +558,23 @@ def goal_hold_warnings(task: Task) -> List[str]:
     box = " (at the least favourable corner of the uncertainty box)" if any(task.uncertainty.values()) else ""
     best = max(ratios.values())
     if best < 1.0:
-        # hold_ratio is linear in pad mu x grip force (the friction that balances the weight scales
-        # with it): the force that holds, rounded up to 0.1 N so that it does
-        grip = (f"gripper.grip_force {math.ceil(task.grip_force / best * 10.0) / 10.0:g} N or more" if best > 0.0
+        # The release's hold is linear in pad mu x grip force (the friction that balances the load
+        # scales with it): the force with which every pusher's end holds, rounded up to 0.1 N.
+        least = min(goal_release_holds(task).values())
+        grip = (f"gripper.grip_force {math.ceil(task.grip_force / least * 10.0) / 10.0:g} N or more" if least > 0.0
                 else "no grip force does: the pads hold nothing with gripper.mu 0")
         return [f"goal: the pads alone hold only {best:.2f} times the object's weight at the goal{box}: when the "
                 f"last feature lets go the object moves in the grasp and the run misses (moved_on_release). "
-                f"Grip harder ({grip}), choose a goal where "
-                f"the pads hold it, or end the run on the feature (environment.end_on_feature: true)"]
-    if task.planner.min_hold_ratio >= 1.0:
+                f"Grip harder ({grip}: the weight and the arm's acceleration as it lets go, anywhere within "
+                f"planner.tolerance), choose a goal where the pads hold it, or end the run on the feature "
+                f"(environment.end_on_feature: true)"]
+    need = needed_hold_ratio(task, [n for n in ratios if n not in weak])
+    if task.planner.min_hold_ratio >= need:
         return []
     return [f"goal: the pads alone hold the object at the goal only when the last push is by "
             f"{', '.join(n for n in ratios if n not in weak)}{box}; a plan that ends with "
-            f"{', '.join(weak)} leaves it to move on release (moved_on_release): planner.min_hold_ratio: 1 "
-            f"makes the plan end where they hold it"]
+            f"{', '.join(weak)} leaves it to move on release (moved_on_release): planner.min_hold_ratio: {need:g} "
+            f"makes the plan end where they hold it (the weight and the arm's acceleration as it lets go)"]
 
 
 def _default_name(source: Optional[str]) -> str:
