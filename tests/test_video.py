@@ -130,6 +130,58 @@ def test_execute_video_draws_the_run_and_the_object_moves_in_it(tmp_path, engine
     assert green.sum() > 200  # the plan's ghost outline
 
 
+def _arm_grey(frame):
+    """The pixels of the arm's links (arm.xml's 0.72, 0.74, 0.78, lit): a bluish grey, where the
+    floor is a neutral one."""
+    r, g, b = (frame[..., k].astype(int) for k in range(3))
+    return (b - r >= 6) & (r > 90) & (np.abs(2 * g - r - b) < 16)
+
+
+def _shaded_orange(frame):
+    """The object's orange as the 3-D view's lights shade it (darker on the faces turned away)."""
+    r, g, b = (frame[..., k].astype(int) for k in range(3))
+    return (r > 100) & (r > g + 30) & (g > b + 30)
+
+
+def test_execute_video_draws_the_arm_and_the_part_in_3d(tmp_path):
+    """Issue 68, item 5: `--video-view 3d` draws the run's cell in perspective from the arm's
+    reported joints: frames that are not blank (many colours, the part's orange and the arm's
+    grey each over a good area, the caption's dark text), that change as the arm moves; `both`
+    puts it beside the schematic, the video twice as wide; --video-view without --video is refused,
+    and so is a 3-D view of an arm with no model of its joints."""
+    task, plan = _plan_file(tmp_path)
+    out, both = tmp_path / "run3d.mp4", tmp_path / "both.mp4"
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--video", str(out),
+                                      "--video-view", "3d", "--video-size", "320x240"])
+    assert result.exit_code == 0, result.output
+    assert f"video written to {out}: 70 frames, 320x240 at 25 fps" in result.output
+    frames, fps = _decode(out)
+    assert frames.shape == (70, 240, 320, 3) and fps == 25
+    for frame in (frames[0], frames[35], frames[-1]):
+        assert frame.std() > 20 and len(np.unique(frame.reshape(-1, 3) // 16, axis=0)) > 30  # not blank
+        assert _shaded_orange(frame).sum() > 200 and _arm_grey(frame).sum() > 3000  # the part, and the arm
+        assert (frame[:20].max(axis=2) < 100).sum() > 30  # the caption on the background
+    moved = np.abs(frames[0].astype(int) - frames[-1].astype(int)).max(axis=2) > 40
+    assert moved.sum() > 100  # the hand and the part moved (15 mm, a few pixels at this size)
+
+    result = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--video", str(both),
+                                      "--video-view", "both", "--video-size", "320x240", "--quiet"])
+    assert result.exit_code == 0, result.output
+    three_d = frames
+    frames, _ = _decode(both)
+    assert frames.shape == (70, 240, 640, 3)
+    left, right = frames[35][:, :320].astype(float), frames[35][:, 320:].astype(float)
+    assert np.abs(left - three_d[35]).mean() < 3 < 20 < np.abs(right - three_d[35]).mean()
+    refused = CliRunner().invoke(cli, ["execute", str(plan), "--task", task, "--sim", "--video-view", "3d"])
+    assert refused.exit_code == 2 and "--video-view: only with --video" in refused.output
+    sample = RunSample(0.01, [0.45, 0, 0.3, 1, 0, 0, 0], [0.45, 0, 0.3, 1, 0, 0, 0], [0.45, 0, 0.3, 1, 0, 0, 0],
+                       None, "", "approach", 0, (0.0, 0.0, 0.0))
+    shipped_task = shipped("t-shaped")
+    scene = video.run_scene(shipped_task, check_plan(shipped_task, plan_task(shipped_task, seed=1)))
+    with pytest.raises(OutputError, match="no3d.mp4: the 3-D view draws the arm from its joints"):
+        video.render_run(tmp_path / "no3d.mp4", shipped_task, scene, [sample], view="3d")
+
+
 @pytest.mark.slow
 def test_the_ghost_follows_the_re_planned_steps(tmp_path):
     """With the closed loop, the waypoints after a correction carry the new plan's poses. The new

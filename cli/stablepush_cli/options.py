@@ -116,7 +116,7 @@ def video_options(which: str):
 
 def video_settings_need(option: str) -> None:
     """Exit 2 when --video-fps or --video-size is given without `option` (they would do nothing)."""
-    named = [f"--video-{name}" for name in ("fps", "size") if given(f"video_{name}")]
+    named = [f"--video-{name}" for name in ("fps", "size", "view") if given(f"video_{name}")]
     if named:
         fail(f"{' and '.join(named)}: only with {option}")
 
@@ -160,14 +160,14 @@ class VideoBar:
             self.bar = None
 
 
-def video_output(option: str, path: str, fps: float, size, quiet: bool):
-    """The run's video as an output (stablepush.sim.video.RunVideo), with a VideoBar unless
-    `quiet`; exit 2 naming `option` for one that could not be written. Loads MuJoCo for headless
-    rendering (MUJOCO_GL=osmesa), so call it before the simulated arm starts."""
+def video_output(option: str, path: str, fps: float, size, quiet: bool, view: str = "schematic"):
+    """The run's video in `view` as an output (stablepush.sim.video.RunVideo), with a VideoBar
+    unless `quiet`; exit 2 naming `option` for one that could not be written. Loads MuJoCo for
+    headless rendering (MUJOCO_GL=osmesa), so call it before the simulated arm starts."""
     check_video(option, path, fps, size)
     from stablepush.sim.video import RunVideo
 
-    return RunVideo(path, fps, size, progress=None if quiet else VideoBar(path))
+    return RunVideo(path, fps, size, progress=None if quiet else VideoBar(path), view=view)
 
 
 def parse_host_port(_ctx, _param, value):

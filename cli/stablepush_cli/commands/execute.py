@@ -10,6 +10,7 @@ from stablepush.errors import SettingError
 from stablepush.execution.protocol import DEFAULT_PORT
 from stablepush.execution.tcp_arm import ACK_TIMEOUT_RANGE, DEFAULT_ACK_TIMEOUT
 from stablepush.execution.verdict import CAUSES
+from stablepush.sim import VIDEO_VIEWS
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import with_robot
 from stablepush_cli.common import (
@@ -79,7 +80,8 @@ def _help_with(**values):
 @click.option("--record", "record_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mcap",
               help="Record the run as a ROS 2 bag (one MCAP file): the commanded and measured gripper pose, the "
                    "object in the world and in the grasp, /tf and /tf_static, the pusher in contact, each correction "
-                   "and the verdict (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
+                   "and the verdict; with the arm's model (--sim, --robot or environment.robot) its /joint_states "
+                   "and, for a URDF, /robot_description (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
 @stamp_option("--record", "when the run starts")
 @click.option("--video", "video_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mp4",
               help="Draw the run as a video (H.264 MP4, headless): seen along the gripping axis as the plan figures "
@@ -87,6 +89,11 @@ def _help_with(**values):
                    "at each step as a green ghost (docs/execution.md, 'Video of a run'); needs the object's pose, "
                    "which a simulated arm reports; drawn on a fault too.")
 @video_options("--video")
+@click.option("--video-view", "video_view", type=click.Choice(VIDEO_VIEWS), default="schematic", show_default=True,
+              help="With --video: schematic, along the gripping axis as the plan figures are; 3d, the whole cell in "
+                   "perspective, the arm posed from the joints it reported (its model: --sim, --robot or the task's "
+                   "environment.robot), the part in its jaws and the features; both, the two side by side, the "
+                   "video twice as wide.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("-v", "--verbose", is_flag=True,
               help="A line per correction of the closed loop and per contact (slip, carry, where the guard found "
@@ -119,8 +126,8 @@ def _help_with(**values):
 @_help_with(causes=", ".join(CAUSES))
 def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
             ack_timeout: float, json_path, success_tolerance, record_path, stamp_ns, video_path, video_fps: float,
-            video_size, quiet: bool, verbose: bool, mu_scale: float, tracker_noise, closed_loop: bool, guarded: bool,
-            replan_threshold, final_tolerance, robot_model, flange, tcp, base) -> None:
+            video_size, video_view: str, quiet: bool, verbose: bool, mu_scale: float, tracker_noise, closed_loop: bool,
+            guarded: bool, replan_threshold, final_tolerance, robot_model, flange, tcp, base) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -174,7 +181,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
                ("--sim-mu-scale", mu_scale != 1.0), ("--tracker-noise", any(tracker_noise)))
     _only_with("an arm server (--arm, or no --sim)", not sim, ("--ack-timeout", given("ack_timeout")))
     # The video is made first: the renderer needs MUJOCO_GL=osmesa before the simulated arm loads MuJoCo.
-    video = [video_output("--video", video_path, video_fps, video_size, quiet)] if video_path else []
+    video = [video_output("--video", video_path, video_fps, video_size, quiet, video_view)] if video_path else []
     if not video_path:
         video_settings_need("--video")
     named = ([("--json", JsonReport(json_path))] if json_path else []) + (

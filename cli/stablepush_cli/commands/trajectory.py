@@ -39,8 +39,10 @@ from stablepush_cli.options import (
                    "once every sample is checked: within the joints' limits and reach, each joint under its speed "
                    "limit, every link clear of the features and the floor; a plan the arm cannot follow exits 2 "
                    "naming the first sample, the joint or the link. A "
-                   ".csv or .json holds them instead of G's poses (a column per joint); a .mcap adds /joint_states "
-                   "and a trajectory_msgs/JointTrajectory (/stablepush/joint_trajectory). Needs the [sim] extra.")
+                   ".csv or .json holds them instead of G's poses (a column per joint for the positions, the "
+                   "velocities and the accelerations); a .mcap adds /joint_states, a trajectory_msgs/JointTrajectory "
+                   "(/stablepush/joint_trajectory, in the arm's base link, with velocities and accelerations) and, "
+                   "for a URDF arm, /robot_description. Needs the [sim] extra.")
 @stamp_option("a .mcap", "now")
 @robot_options
 def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str, joints: bool,

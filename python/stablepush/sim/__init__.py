@@ -3,3 +3,7 @@ and Drake (drake_arm.py); what both share (tracking.py: IK on ik.py, the servo r
 deviation.py: a world that departs from the task), the arm behind the arm port in this process
 (local_arm.py) and served over TCP (server.py, `stablepush sim-arm`), the friction-fidelity
 contract both must pass (fidelity.py), and videos of recorded runs (video.py)."""
+
+# How a run's video draws it (video.py): here, so that a command line can offer the choice without
+# loading the renderer's module.
+VIDEO_VIEWS = ("schematic", "3d", "both")

@@ -27,6 +27,15 @@ What a frame shows (poses [x, y, z, qw, qx, qy, qz] in W, m, as recorded):
 Frames are taken from the samples every 1/fps s of the stream's time (100 Hz at `execute`'s default
 rate) and played at fps, so the video runs at the robot's speed.
 
+That is the `schematic` view (the default). The `3d` view draws the run's whole MuJoCo model instead
+(scene.build_mjcf: the arm of the task's robot with its jaws, the object and the features, the
+floor), posed from the recorded states (the arm's reported joints, the object's pose, the jaws at
+the object's faces; nothing simulated), seen by a fixed camera from the front and above that frames
+the arm and the features over the whole run; `both` puts the 3-D view left of the schematic, each
+at the size asked, the video twice as wide. The 3-D view needs the arm's joints in the samples and
+its model: a run whose arm has one (RunRecording.robot: the simulated arm, or an arm checked
+against --robot or environment.robot).
+
 MuJoCo picks its GL back-end when it is first imported (`mujoco.gl_context`, from MUJOCO_GL): this
 module sets MUJOCO_GL=osmesa when it is unset and mujoco is not imported yet. A process that
 imported mujoco first without MUJOCO_GL (the simulated arm does) got GLFW, which needs a display;
@@ -53,8 +62,18 @@ from stablepush.execution.world import place_features, scene_description
 from stablepush.extras import require
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, quat_about_y
 from stablepush.plan.plan import Plan
-from stablepush.sim.scene import add_object_geoms, feature_geom, feature_solid, mjcf_numbers, simulated_outline
-from stablepush.task.model import Task
+from stablepush.sim import VIDEO_VIEWS
+from stablepush.sim.robot import FINGER_JOINTS, arm_model
+from stablepush.sim.scene import (
+    OBJECT_BODY,
+    add_object_geoms,
+    build_mjcf,
+    feature_geom,
+    feature_solid,
+    mjcf_numbers,
+    simulated_outline,
+)
+from stablepush.task.model import Robot, Task
 
 SUFFIX = ".mp4"  # H.264 in MP4: plays in browsers, on GitHub and in every player
 DEFAULT_FPS = 25.0  # frames per second of the stream's time: 2.5 frames per 0.1 s push
@@ -62,6 +81,7 @@ MAX_FPS = 100.0  # the executor's default rate: one frame per sample
 DEFAULT_SIZE = (640, 480)  # width, height in pixels
 SIZE_RANGE = (64, 3840)  # each side, pixels; even, as H.264's 4:2:0 colour needs
 CRF = 20  # x264's constant rate factor: flat shaded scenes stay sharp at about 1 MB a minute
+DEFAULT_VIEW = "schematic"
 
 _CAMERA_DISTANCE = 0.5  # m from G along -y; orthographic, so only the clipping slab depends on it
 _SLAB = 0.03  # m drawn beyond each face of the object along y (the pads, fingers and backdrop)
@@ -74,6 +94,13 @@ _ACTIVE_FEATURE_RGBA = (0.12, 0.42, 0.9, 1.0)
 _PAD_RGBA = (0.15, 0.15, 0.15, 0.55)
 _FINGER_RGBA = (0.5, 0.52, 0.56, 0.12)
 _BACKDROP_RGBA = (0.97, 0.97, 0.97, 1.0)
+_ARM_RGBA = (0.72, 0.74, 0.78, 1.0)  # arm.xml's links
+# The 3-D view's camera: in front of the arm (+x, where it reaches) and to its -y side, above,
+# looking down at the work with the arm behind it.
+_AZIMUTH, _ELEVATION = 150.0, -30.0  # deg (mjvCamera)
+_FRAMING_SAMPLES = 12  # poses of the run the 3-D camera's framing takes in
+_WORK_RADIUS = 0.25  # m: the least the 3-D view shows about the work (the jaws, 90 mm, and the wrist)
+_SKY_RGB = "0.97 0.97 0.97"  # the 3-D view's background, light as the schematic's, for the caption
 
 
 @dataclass(frozen=True)
@@ -122,6 +149,12 @@ def check_size(size: Sequence[int]) -> None:
                          f"(H.264's colour is sampled in 2 x 2 blocks), got {'x'.join(map(str, size))}")
 
 
+def check_view(view: str) -> None:
+    """ValueError unless `view` is one of VIDEO_VIEWS."""
+    if view not in VIDEO_VIEWS:
+        raise ValueError(f"the view must be one of {', '.join(VIDEO_VIEWS)}, got {view!r:.40}")
+
+
 def video_directory(path: Union[str, Path]) -> str:
     """`path` as a directory for videos, made (with its parents) when missing, as an absolute path
     (workers, Ray's among them, need not share the caller's working directory); OutputError when
@@ -142,19 +175,21 @@ def run_scene(task: Task, plan: Plan, closed_loop: bool = False, resume_from: in
 
 
 class RunVideo(RunOutput):
-    """A run drawn into `path` (.mp4) at `fps` and `size` (render_run), in the world its arm was
-    given (run_scene), after a fault too when any waypoint was acknowledged. `progress(frames done,
-    frames)` after each frame. Checked when made (ValueError for fps and size; OutputError,
-    MissingExtra for the path), so a video that could not be written is refused before the run."""
+    """A run drawn into `path` (.mp4) at `fps` and `size` in `view` (render_run), in the world its
+    arm was given (run_scene), after a fault too when any waypoint was acknowledged. `progress(frames
+    done, frames)` after each frame. Checked when made (ValueError for fps, size and view;
+    OutputError, MissingExtra for the path), so a video that could not be written is refused before
+    the run."""
 
     records = True
 
     def __init__(self, path: str, fps: float = DEFAULT_FPS, size: Tuple[int, int] = DEFAULT_SIZE,
-                 progress: Optional[Callable[[int, int], None]] = None):
+                 progress: Optional[Callable[[int, int], None]] = None, view: str = DEFAULT_VIEW):
         check_fps(fps)
         check_size(tuple(size))
+        check_view(view)
         check_video_path(path)
-        self.path, self.fps, self.size, self.progress = path, fps, tuple(size), progress
+        self.path, self.fps, self.size, self.progress, self.view = path, fps, tuple(size), progress, view
         self.info: Optional[VideoInfo] = None
 
     def write(self, run: RunResult) -> Optional[str]:
@@ -162,8 +197,9 @@ class RunVideo(RunOutput):
             return None
         closed_loop = run.options.closed_loop is not None
         scene = run_scene(run.task, run.plan, closed_loop, run.options.resume_from)
+        robot = run.task.environment.robot if run.recording.robot is not None else None  # the arm's joints are its
         info = self.info = render_run(self.path, run.task, scene, run.recording.samples, fps=self.fps,
-                                      size=self.size, progress=self.progress)
+                                      size=self.size, progress=self.progress, view=self.view, robot=robot)
         return (f"video written to {self.path}: {info.frames} frames, {info.width}x{info.height} at {info.fps:g} "
                 f"fps, drawn in {info.render_s:.1f} s ({info.ms_per_frame:.0f} ms a frame)")
 
@@ -339,17 +375,21 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
 
 def render_run(path: Union[str, Path], task: Task, scene: dict, samples: Sequence[RunSample], *,
                fps: float = DEFAULT_FPS, size: Tuple[int, int] = DEFAULT_SIZE,
-               progress: Optional[Callable[[int, int], None]] = None) -> VideoInfo:
+               progress: Optional[Callable[[int, int], None]] = None, view: str = DEFAULT_VIEW,
+               robot: Optional[Robot] = None) -> VideoInfo:
     """Draw the recorded run `samples` (RunRecording.samples) of `task` in the world `scene` (the
-    scene description the run's arm built; the features are drawn where it has them) and write
-    it to `path` (.mp4) atomically. `progress(frames done, frames)` after each frame.
-    OutputError (naming the path) for a bad file name or setting, a run without samples or without
-    the object's pose (a real arm without a tracker), or a missing renderer or encoder."""
+    scene description the run's arm built; the features are drawn where it has them) in `view`
+    (VIDEO_VIEWS; the 3-D view draws the arm of `robot` from the samples' joints) and write it to
+    `path` (.mp4) atomically. `progress(frames done, frames)` after each frame. OutputError (naming
+    the path) for a bad file name or setting, a run without samples or without the object's pose (a
+    real arm without a tracker), a 3-D view without the arm's model or joints, or a missing renderer
+    or encoder."""
     from stablepush.outputs import write_files
 
     try:
         check_fps(fps)
         check_size(tuple(size))
+        check_view(view)
     except ValueError as exc:
         raise OutputError(f"{path}: {exc}") from None
     if not str(path).lower().endswith(SUFFIX):
@@ -359,55 +399,171 @@ def render_run(path: Union[str, Path], task: Task, scene: dict, samples: Sequenc
     if all(object_in_world(s) is None for s in samples):
         raise OutputError(f"{path}: the arm reported no pose of the object (neither object_pose nor a tracker's "
                           f"object_in_grasp), so there is nothing to draw; a simulated arm (--sim) reports it")
+    joints = _arm_joints(path, samples, robot) if view != "schematic" else [None] * len(samples)
     width, height = (int(n) for n in size)
     imageio_ffmpeg = _encoder()
     mujoco = _mujoco()
     _headless_gl(mujoco)
     started = time.perf_counter()
     chosen = frame_samples([s.t for s in samples], fps)
-    model = mujoco.MjModel.from_xml_string(render_model_xml(scene, _frame_box(scene, samples, chosen), (width, height)))
-    data = mujoco.MjData(model)
-    mocap = {name: model.body(name).mocapid[0] for name in ("object", "ghost", "gripper")}
-    features = {f["pusher"]: model.geom(feature_geom(f["pusher"])).id for f in scene["features"]}
+    panels: list = []
     try:
-        renderer = mujoco.Renderer(model, height=height, width=width)
+        if view != "schematic":
+            panels.append(_ArmView(mujoco, path, scene, robot, [samples[i] for i in chosen],
+                                   [joints[i] for i in chosen], (width, height)))
+        if view != "3d":
+            panels.append(_Schematic(mujoco, path, scene, samples, chosen, (width, height)))
+        caption = _Caption(width, height)
+        with tempfile.TemporaryDirectory(prefix="stablepush-video-") as scratch:
+            encoded = Path(scratch) / f"video{SUFFIX}"
+            writer = imageio_ffmpeg.write_frames(str(encoded), (width * len(panels), height), fps=fps,
+                                                 codec="libx264", quality=None, macro_block_size=2,
+                                                 ffmpeg_log_level="error", output_params=["-crf", str(CRF)])
+            writer.send(None)  # starts ffmpeg
+            try:
+                last = next(T for T in map(object_in_world, samples) if T is not None)  # until the arm reports one
+                for n, i in enumerate(chosen):
+                    sample = samples[i]
+                    T_WO = object_in_world(sample)
+                    last = T_WO if T_WO is not None else last  # a tracker may miss a sample: keep the last pose
+                    frame = np.hstack([caption.draw(panel.draw(sample, last, joints[i]), task.name, sample,
+                                                    panel.legend) for panel in panels])
+                    writer.send(np.ascontiguousarray(frame))
+                    if progress is not None:
+                        progress(n + 1, len(chosen))
+            finally:
+                writer.close()
+            write_files({path: encoded.read_bytes()})
+    finally:
+        for panel in panels:
+            panel.close()
+    return VideoInfo(path=str(path), frames=len(chosen), width=width * len(panels), height=height, fps=float(fps),
+                     render_s=time.perf_counter() - started)
+
+
+def _arm_joints(path, samples: Sequence[RunSample], robot: Optional[Robot]) -> List[np.ndarray]:
+    """The arm's joints [rad] at each sample for the 3-D view: as reported, the last reported
+    where a sample has none (or not the model's number); OutputError without a model or joints."""
+    if robot is None:
+        raise OutputError(f"{path}: the 3-D view draws the arm from its joints, and this arm has no model naming "
+                          f"them (run it with --sim, or give --robot or the task's environment.robot)")
+    count = len(arm_model(robot).joints)
+    reported = [None if s.joints is None or len(s.joints) != count else np.asarray(s.joints, float) for s in samples]
+    present = [q for q in reported if q is not None]
+    if not present:
+        raise OutputError(f"{path}: the arm reported none of its {count} joints, so the 3-D view cannot draw it")
+    out, last = [], present[0]
+    for q in reported:
+        last = q if q is not None else last
+        out.append(last)
+    return out
+
+
+def _renderer(mujoco, model, size: Tuple[int, int], path):
+    width, height = size
+    try:
+        return mujoco.Renderer(model, height=height, width=width)
     except Exception as exc:  # noqa: BLE001 - whatever the GL back-end raises, said in one line
         raise OutputError(f"{path}: cannot open MuJoCo's renderer with MUJOCO_GL={os.environ.get('MUJOCO_GL')} "
                           f"({type(exc).__name__}: {' '.join(str(exc).split())[:200]}); headless rendering needs "
                           f"MUJOCO_GL=osmesa and the Debian package libosmesa6") from None
-    caption = _Caption(width, height)
-    with tempfile.TemporaryDirectory(prefix="stablepush-video-") as scratch:
-        encoded = Path(scratch) / f"video{SUFFIX}"
-        writer = imageio_ffmpeg.write_frames(str(encoded), (width, height), fps=fps, codec="libx264", quality=None,
-                                             macro_block_size=2, ffmpeg_log_level="error",
-                                             output_params=["-crf", str(CRF)])
-        writer.send(None)  # starts ffmpeg
-        try:
-            last = next(T for T in map(object_in_world, samples) if T is not None)  # until the arm reports one
-            for n, i in enumerate(chosen):
-                sample = samples[i]
-                T_WG = pose_to_matrix(sample.reported)
-                T_WO = object_in_world(sample)
-                last = T_WO if T_WO is not None else last  # a tracker may miss a sample: keep the last pose
-                _place(data, mocap["gripper"], T_WG)
-                _place(data, mocap["object"], last)
-                if sample.planned is not None:
-                    _place(data, mocap["ghost"], T_WG @ grasp_transform(sample.planned))
-                for pusher, geom in features.items():
-                    model.geom_rgba[geom] = _ACTIVE_FEATURE_RGBA if pusher == sample.pusher else _FEATURE_RGBA
-                mujoco.mj_kinematics(model, data)
-                mujoco.mj_camlight(model, data)  # the camera rides on the gripper's mocap body
-                renderer.update_scene(data, camera="view")
-                frame = caption.draw(renderer.render(), task.name, sample)
-                writer.send(np.ascontiguousarray(frame))
-                if progress is not None:
-                    progress(n + 1, len(chosen))
-        finally:
-            writer.close()
-            renderer.close()
-        write_files({path: encoded.read_bytes()})
-    return VideoInfo(path=str(path), frames=len(chosen), width=width, height=height, fps=float(fps),
-                     render_s=time.perf_counter() - started)
+
+
+class _Schematic:
+    """The view along the gripping axis (render_model_xml), a frame per sample."""
+
+    legend = ((_OBJECT_RGBA, "object"), (_GHOST_EDGE_RGBA, "plan at this step"),
+              (_ACTIVE_FEATURE_RGBA, "pusher in contact"), (_PAD_RGBA, "pads"))
+
+    def __init__(self, mujoco, path, scene: dict, samples: Sequence[RunSample], chosen: Sequence[int],
+                 size: Tuple[int, int]):
+        self.mujoco = mujoco
+        self.model = mujoco.MjModel.from_xml_string(render_model_xml(scene, _frame_box(scene, samples, chosen), size))
+        self.data = mujoco.MjData(self.model)
+        self.mocap = {name: self.model.body(name).mocapid[0] for name in ("object", "ghost", "gripper")}
+        self.features = {f["pusher"]: self.model.geom(feature_geom(f["pusher"])).id for f in scene["features"]}
+        self.renderer = _renderer(mujoco, self.model, size, path)
+
+    def draw(self, sample: RunSample, T_WO: np.ndarray, _joints) -> np.ndarray:
+        model, data = self.model, self.data
+        T_WG = pose_to_matrix(sample.reported)
+        _place(data, self.mocap["gripper"], T_WG)
+        _place(data, self.mocap["object"], T_WO)
+        if sample.planned is not None:
+            _place(data, self.mocap["ghost"], T_WG @ grasp_transform(sample.planned))
+        for pusher, geom in self.features.items():
+            model.geom_rgba[geom] = _ACTIVE_FEATURE_RGBA if pusher == sample.pusher else _FEATURE_RGBA
+        self.mujoco.mj_kinematics(model, data)
+        self.mujoco.mj_camlight(model, data)  # the camera rides on the gripper's mocap body
+        self.renderer.update_scene(data, camera="view")
+        return self.renderer.render()
+
+    def close(self) -> None:
+        self.renderer.close()
+
+
+class _ArmView:
+    """The run's MuJoCo model (scene.build_mjcf with the task's robot) posed from the recorded
+    joints and object pose, the jaws at the object's faces as the simulated arm starts them, seen
+    by a fixed camera that frames the arm and the features at `samples` (the drawn ones)."""
+
+    legend = ((_OBJECT_RGBA, "object"), (_ACTIVE_FEATURE_RGBA, "pusher in contact"), (_ARM_RGBA, "arm"))
+
+    def __init__(self, mujoco, path, scene: dict, robot: Robot, samples: Sequence[RunSample],
+                 joints: Sequence[np.ndarray], size: Tuple[int, int]):
+        self.mujoco = mujoco
+        root = ET.fromstring(build_mjcf(scene, robot=robot))
+        assets = root.find("asset") if root.find("asset") is not None else ET.SubElement(root, "asset")
+        ET.SubElement(assets, "texture", type="skybox", builtin="flat", rgb1=_SKY_RGB, rgb2=_SKY_RGB, width="8",
+                      height="8")
+        model = self.model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+        model.vis.global_.offwidth, model.vis.global_.offheight = size
+        model.vis.headlight.ambient[:], model.vis.headlight.diffuse[:] = (0.4,) * 3, (0.5,) * 3
+        self.data = mujoco.MjData(model)
+        self.arm = [int(model.jnt_qposadr[model.joint(j).id]) for j in arm_model(robot).joints]
+        self.object = int(model.jnt_qposadr[model.joint(OBJECT_BODY).id])
+        for finger in FINGER_JOINTS:
+            self.data.qpos[model.jnt_qposadr[model.joint(finger).id]] = scene["object"]["thickness"] / 2
+        self.features = {f["pusher"]: model.geom(feature_geom(f["pusher"])).id for f in scene["features"]}
+        self.camera = self._framing(samples, joints)
+        self.renderer = _renderer(mujoco, model, size, path)
+
+    def _pose(self, T_WO: np.ndarray, joints: np.ndarray) -> None:
+        self.data.qpos[self.arm] = joints
+        self.data.qpos[self.object:self.object + 7] = matrix_to_pose(T_WO)
+        self.mujoco.mj_kinematics(self.model, self.data)
+
+    def _framing(self, samples: Sequence[RunSample], joints: Sequence[np.ndarray]):
+        """A free camera at _AZIMUTH, _ELEVATION on the work: the features, and the object and G at a
+        few poses spread over the run, with room around them for the jaws and the arm's wrist (the
+        rest of the arm runs out of the picture, where the part would be too small to see)."""
+        model, data = self.model, self.data
+        self.mujoco.mj_kinematics(model, data)
+        points = [data.geom_xpos[g].copy() for g in self.features.values()]
+        for k in np.unique(np.linspace(0, len(samples) - 1, _FRAMING_SAMPLES).astype(int)):
+            T_WO = object_in_world(samples[k])
+            if T_WO is not None:
+                points.append(T_WO[:3, 3])
+            points.append(np.asarray(samples[k].reported[:3], float))
+        points = np.array(points)
+        low, high = points.min(axis=0), points.max(axis=0)
+        camera = self.mujoco.MjvCamera()
+        camera.type = self.mujoco.mjtCamera.mjCAMERA_FREE
+        camera.lookat[:] = (low + high) / 2
+        radius = max(float(np.linalg.norm(high - low)) / 2, _WORK_RADIUS)
+        camera.distance = radius / math.sin(math.radians(model.vis.global_.fovy) / 2)
+        camera.azimuth, camera.elevation = _AZIMUTH, _ELEVATION
+        return camera
+
+    def draw(self, sample: RunSample, T_WO: np.ndarray, joints: np.ndarray) -> np.ndarray:
+        for pusher, geom in self.features.items():
+            self.model.geom_rgba[geom] = _ACTIVE_FEATURE_RGBA if pusher == sample.pusher else _FEATURE_RGBA
+        self._pose(T_WO, joints)
+        self.renderer.update_scene(self.data, camera=self.camera)
+        return self.renderer.render()
+
+    def close(self) -> None:
+        self.renderer.close()
 
 
 def _place(data, mocap_id: int, T: np.ndarray) -> None:
@@ -429,7 +585,7 @@ class _Caption:
         except TypeError:  # Pillow before 10.1: one bitmap size
             self.font = self.small = ImageFont.load_default()
 
-    def draw(self, pixels: np.ndarray, task: str, sample: RunSample) -> np.ndarray:
+    def draw(self, pixels: np.ndarray, task: str, sample: RunSample, legend) -> np.ndarray:
         from PIL import Image, ImageDraw
 
         image = Image.fromarray(pixels)
@@ -439,8 +595,7 @@ class _Caption:
         pen.text((8 * s, 6 * s), f"{task}   t {sample.t:6.2f} s   step {sample.step}   {sample.phase}{contact}",
                  fill=(20, 20, 20), font=self.font)
         x, y = 8 * s, image.height - 20 * s
-        for rgba, label in ((_OBJECT_RGBA, "object"), (_GHOST_EDGE_RGBA, "plan at this step"),
-                            (_ACTIVE_FEATURE_RGBA, "pusher in contact"), (_PAD_RGBA, "pads")):
+        for rgba, label in legend:
             colour = tuple(round(255 * c) for c in rgba[:3])
             pen.rectangle((x, y + 2 * s, x + 11 * s, y + 13 * s), fill=colour)
             pen.text((x + 15 * s, y), label, fill=(40, 40, 40), font=self.small)
