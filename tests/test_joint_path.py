@@ -58,16 +58,18 @@ def test_the_joint_trajectory_reproduces_the_cartesian_one_and_moves_continuousl
 
 
 def test_a_feature_out_of_the_arms_reach_is_refused_before_any_motion():
-    """On the straight move out to a feature 1.5 m away the elbow straightens toward its singularity:
-    the check stops where the first joint would have to turn too fast, before G leaves the reach."""
+    """A feature 1.5 m away, past the shipped arm's 870 mm from its shoulder: the straight move
+    out to it leaves the reach, and the check says by how much before any joint's speed or limit
+    is named (the elbow straightening toward its singularity would have turned j1 too fast first)."""
     from stablepush.sim.joint_path import CellError, joint_path
 
     task = shipped("horizontal-offset-high-mu")
     far = dataclasses.replace(task, environment={**task.environment.as_dict(), "features": {"left": [1500, 0, 300, 0]}})
-    with pytest.raises(CellError, match=r"\(sample \d+, plan step 0, move\) (joint j\d would turn|no joint positions)"):
+    with pytest.raises(CellError, match=r"\(sample \d+, plan step 0, move\) out of reach: the plan's TCP poses lie "
+                                        r"up to \d+ mm beyond the arm's reach of 870 mm from its joint j2 at \[0, 0, 300\] mm"):
         joint_path(far, plan_task(far, seed=1))
     beyond = dataclasses.replace(far, environment={**far.environment.as_dict(), "home": [1400, 0, 300]})
-    with pytest.raises(CellError, match="no joint positions within the arm's limits put G there: it stays"):
+    with pytest.raises(CellError, match=r"\(sample 0, plan step 0, move\) out of reach"):
         joint_path(beyond, plan_task(beyond, seed=1))  # G's start itself lies out of reach
 
 
@@ -191,3 +193,32 @@ def test_the_bags_joint_trajectory_carries_velocities_and_accelerations_of_its_t
     rows = list(csv.DictReader(table.open()))
     assert np.allclose([[float(r[f"j{k}_rad_s"]) for k in range(1, 8)] for r in rows], qd)
     assert np.allclose([[float(r[f"j{k}_rad_s2"]) for k in range(1, 8)] for r in rows], qdd)
+
+
+def test_an_arm_whose_base_stands_too_far_is_out_of_reach_by_how_much_not_at_a_joint_limit(tmp_path):
+    """A lab's six-joint URDF arm (joints within +-2.6 rad) with its base 3 m from the cell: no
+    posture gets G there, and the refusal says so with the numbers, before IK names a joint that
+    stopped at its limit. The reach is the chain's length from its shoulder (joint_2, which joint_1
+    turns in place): the links on to the flange and the TCP's 110 mm, measured on the model."""
+    from stablepush.sim.joint_path import CellError, joint_path
+    from stablepush.task import with_robot
+
+    from generated_arms import link_lengths, urdf_arm
+
+    task = shipped("horizontal-offset-high-mu")
+    plan = plan_task(task, seed=1)
+    arm = urdf_arm(tmp_path / "arm.urdf", 1, ["z", "y", "y", "z", "y", "z"])
+    joint_path(with_robot(task, arm["model"], arm["flange"], arm["tcp"], [0, 0, 0, 0]), plan)  # follows at home
+    far = with_robot(task, arm["model"], arm["flange"], arm["tcp"], [3000, 0, 0, 0])
+    with pytest.raises(CellError) as refused:
+        joint_path(far, plan)
+    reason = str(refused.value).split("approach) ")[1]
+    lengths = link_lengths(1, 6)
+    reach, shoulder = (sum(lengths[1:]) + 0.110) * 1e3, (0.08 + lengths[0]) * 1e3
+    assert reason.startswith("out of reach: the plan's TCP poses lie up to ") and "limit" not in reason, reason
+    assert f"beyond the arm's reach of {reach:.0f} mm from its joint joint_2 at [3000, 0, {shoulder:.0f}] mm" in reason
+    assert "its base at [3000, 0, 0] mm (environment.robot.base, --base)" in reason
+    beyond = float(reason.split("up to ")[1].split(" mm")[0])
+    traj = sp.trajectory(far, plan)
+    farthest = np.linalg.norm(np.asarray(traj.position) - [3.0, 0.0, shoulder / 1e3], axis=1).max() * 1e3
+    assert beyond == pytest.approx(farthest - reach, abs=1.0)

@@ -6,7 +6,8 @@ Every sample of the timed trajectory (execution.trajectory: the executor's strea
 the arm's joint positions (ik.solve_ik, each from the sample before, so the path stays on one
 branch) on the MuJoCo model of the run's scene (scene.build_mjcf: the shipped arm, arm.xml, its
 jaws, the object and the features where the executor places them). The cell check refuses a plan
-(CellError, a PlanError: exit 2) at the first sample where
+(CellError, a PlanError: exit 2) first where a sample lies farther from the arm's first joint
+than the chain's length (out of reach: by how much, from where), then at the first sample where
 - no joint positions within the arm's limits put G within FK_TOLERANCE of the sample's pose
   (out of reach, or a joint at its limit: named, with how far G stays off);
 - a joint would move faster than its speed limit between two samples (a branch flip, or a
@@ -203,12 +204,69 @@ class _Solver:
         self.link_geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] in links]
         self.obstacles = [model.geom(scene_mod.feature_geom(f["pusher"])).id for f in scene["features"]]
         self.obstacles.append(model.geom("floor").id)
+        self.base = robot.base
+        self._arm_reach()
+
+    def _arm_reach(self) -> None:
+        """How far from the arm's shoulder (`shoulder`, in the world [m]) G can be (`reach`) and
+        its last joint's anchor can be (`wrist_reach`), and where that anchor is in G's frame
+        (`wrist`). The distance from each joint's anchor to the next's, and from the last to G, do
+        not change as the joints turn (each pair rides one link), so their sums bound the reach; a
+        sliding joint adds its travel. The last anchor rides the flange with G, so a sample's pose
+        of G (its orientation too) puts it at one place. The shoulder is the first joint's anchor,
+        or the first anchor that the joints before it cannot move."""
+        m, d = self.model, self.kin.data
+        R, p, _ = self.kin(np.clip(np.zeros(len(self.arm.joints)), self.kin.lower, self.kin.upper))
+        ids = [m.joint(j).id for j in self.arm.joints]
+        anchors = [d.xanchor[j].copy() for j in ids]
+        # An anchor on the axes of every joint before it (a shoulder above a turning base) stays put:
+        # the reach is measured from the last such.
+        first = 0
+        def fixed(k: int) -> bool:
+            return all(m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE
+                       and np.linalg.norm(np.cross(anchors[k] - d.xanchor[j], d.xaxis[j])) < 1e-9 for j in ids[:k])
+
+        while first + 1 < len(ids) and fixed(first + 1):
+            first += 1
+        self.first_joint = self.arm.joints[first]
+        ids, anchors = ids[first:], anchors[first:]
+        sliding = [j for j in ids if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE]
+        travel = sum(float(m.jnt_range[j, 1] - m.jnt_range[j, 0]) for j in sliding)
+        self.wrist_reach = sum(float(np.linalg.norm(b - a)) for a, b in zip(anchors, anchors[1:])) + travel
+        self.reach = self.wrist_reach + float(np.linalg.norm(p - anchors[-1]))
+        self.shoulder, self.wrist = anchors[0], R.T @ (anchors[-1] - p)
+
+    def _out_of_reach(self, traj: Trajectory) -> None:
+        """CellError at the first sample where G, or the last joint the sample's pose of G places,
+        lies farther from the arm's shoulder than the chain reaches: no posture gets there, and
+        no joint limit is to blame."""
+        from scipy.spatial.transform import Rotation
+
+        position = np.asarray(traj.position)
+        wxyz = np.asarray(traj.quaternion_wxyz)
+        wrist = position + Rotation.from_quat(wxyz[:, [1, 2, 3, 0]]).apply(self.wrist)
+        for points, reach, what in ((position, self.reach, "the plan's TCP poses lie"),
+                                    (wrist, self.wrist_reach, f"the plan's TCP poses put its last joint "
+                                                              f"({self.arm.joints[-1]})")):
+            beyond = np.linalg.norm(points - self.shoulder, axis=1) - reach
+            if (beyond > 0.0).any():
+                break
+        else:
+            return
+        i = int(np.argmax(beyond > 0.0))
+        shoulder = ", ".join(f"{v * 1e3:.0f}" for v in self.shoulder)
+        base = ", ".join(f"{v:g}" for v in self.base[:3])
+        raise CellError(i, float(traj.t[i]), int(traj.step[i]), traj.phase[i],
+                        f"out of reach: {what} up to {beyond.max() * 1e3:.0f} mm beyond the arm's reach of "
+                        f"{reach * 1e3:.0f} mm from its joint {self.first_joint} at [{shoulder}] mm, its "
+                        f"base at [{base}] mm (environment.robot.base, --base)")
 
     def _solve(self, pose: Sequence[float], q_start: np.ndarray, home: np.ndarray, iterations: int):
         q, _ = ik.solve_ik(self.kin, pose, q_start, home, self.kin.lower, self.kin.upper, iterations)
         return q
 
     def solve(self, traj: Trajectory) -> JointPath:
+        self._out_of_reach(traj)
         q_prev = self.home
         rows, worst = [], (0.0, 0.0)
         peak, least, nearest = 0.0, math.inf, ("", "")
