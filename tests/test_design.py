@@ -280,8 +280,41 @@ def test_the_design_command_says_how_many_layouts_gave_no_plan_and_why_grouped(t
     assert "of the 3 layouts planned, 0 solved and 3 gave no plan:" in result.output
     assert ("  2: the layout's task was refused (left, left + right); e.g. left: environment.features.top: no pusher "
             "named 'top' (the task has left)") in result.output
-    assert "  1: the search ran out of time before the goal, the best partial path " in result.output
+    assert "  1: the search ended before the goal (its check limit or its time ran out), the best partial path " in (
+        result.output)
     groups = yaml.safe_load((tmp_path / "d.json").read_text())["no_plan"]
     assert [(g["outcome"], g["layouts"], g["pushers"]) for g in groups] == [
         ("refused", 2, [["left"], ["left", "right"]]), ("time_limit", 1, [["left", "top"]])]
     assert groups[0]["end_steps"] is None and groups[1]["end_steps"][0] > 0
+
+
+def test_the_design_files_keep_the_design_files_comments_and_mean_the_design_task(tmp_path):
+    from stablepush.design import DesignStudy, design_files
+
+    robot = (ROOT / "data" / "arms" / "six-joint.urdf").read_text()
+    (tmp_path / "arms").mkdir()
+    (tmp_path / "arms" / "six.urdf").write_text(robot)
+    text = DESIGN.read_text().replace("  end_on_feature: true\n", (
+        "  end_on_feature: true\n"
+        "  robot:\n"
+        "    model: arms/six.urdf   # named from the design file's folder\n"
+        "    flange: tool0\n"
+        "    tcp: [0, 0, 110, 0, 180, 0]\n"))
+    assert text != DESIGN.read_text()
+    path = tmp_path / "offset.design.yaml"
+    path.write_text(text)
+    task, candidates = load_design(path)
+    d = Design(("edge0", "edge3"), solved=True, features={"edge0": [1.5, 0.0, 300.0, 0.0], "edge3": [0.0, 150.0, 300.0, 0]})
+    study = DesignStudy(candidates=[c["name"] for c in candidates], designs=[d], pruned_candidates=[],
+                        layouts_searched=1, layouts_pruned=0, rank=DEFAULT_RANK)
+    written = design_files(study, task, candidates, tmp_path / "designs", str(path))[d.task_file]
+    assert yaml.safe_load(written) == design_task(task, candidates, d, str(path))
+    lines = written.splitlines()
+    assert lines[0].startswith("# design-1 of offset.design.yaml (stablepush design): the layout edge0 + edge3")
+    about_candidates = text.split("\ncandidates:")[0].rsplit("step_time: 0.1\n", 1)[1].splitlines()
+    kept = [line for line in text.splitlines() if "#" in line and line not in about_candidates and "model:" not in line]
+    assert len(kept) > 20 and all(line in lines for line in kept), [line for line in kept if line not in lines]
+    assert "  # At the goal the pads alone hold 0.91 times the prism's weight (the grip of the paper's example" in lines
+    assert any(line.startswith(f"    model: {tmp_path / 'arms' / 'six.urdf'} ")  # edited, its comment kept
+               and line.endswith(" # named from the design file's folder") for line in lines)
+    assert about_candidates and not set(about_candidates) & set(lines)  # the candidates' comment goes with them

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
+from stablepush.design.commented import commented_task
 from stablepush.errors import TaskError
 from stablepush.execution.verdict import tolerance_used
 from stablepush.execution.world import place_features
@@ -60,7 +61,7 @@ REACH_TIME_LIMIT = 1.0  # s a cell of that map may plan
 # Why a planned layout gave no plan, by its `outcome` (the plan's PlanOutcome, or the two of the
 # design search's own), in words; an outcome not listed is named as it is.
 NO_PLAN_REASONS: Dict[str, str] = {
-    "time_limit": "the search ran out of time before the goal",
+    "time_limit": "the search ended before the goal (its check limit or its time ran out)",
     "goal_over_switch_limit": "the goal reached only with more switch-overs than planner.max_switches",
     "invalid_start": "the pads do not hold the object at the start",
     "unreachable": "the goal is out of the layout's reach",
@@ -380,11 +381,16 @@ def designs_folder(design_file: str) -> Path:
 
 def design_files(study: DesignStudy, task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], folder: Path,
                  source: Optional[str] = None) -> Dict[str, str]:
-    """Each design as a task file, `folder`/design-<rank>.yaml (its `task_file` set): path -> YAML."""
-    import yaml
-
+    """Each design as a task file, `folder`/design-<rank>.yaml (its `task_file` set): path -> YAML,
+    with the design file `source`'s comments where they apply (commented.commented_task)."""
+    try:
+        text = Path(source).read_text(encoding="utf-8") if source is not None else None
+    except (OSError, UnicodeError):  # read once already (schema.load_design); without it, no comments
+        text = None
     files = {}
     for k, d in enumerate(study.designs, start=1):
         d.task_file = str(Path(folder) / f"design-{k}.yaml")
-        files[d.task_file] = yaml.safe_dump(design_task(task, candidates, d, source), sort_keys=False)
+        header = (f"# design-{k} of {Path(source).name if source else 'a design'} (stablepush design): the layout "
+                  f"{' + '.join(d.pushers)}, each fixture where its plan puts it (environment.features)\n")
+        files[d.task_file] = commented_task(text, design_task(task, candidates, d, source), header)
     return files
