@@ -7,7 +7,7 @@ from stablepush.errors import TaskError
 from stablepush.task import parse_task
 from stablepush_cli.main import cli
 
-from conftest import shipped, task_text
+from conftest import ROOT, TASKS, shipped, task_text
 
 
 def _write(tmp_path, text, name="mine.yaml"):
@@ -207,6 +207,40 @@ def test_lengths_in_metres_are_named_where_accepted_and_where_refused():
     assert error.value.field == "pushers[0]"
     assert error.value.reason.endswith("; written in metres? task files use mm ([[-0.05, -0.0125], [-0.05, 0.0125]] "
                                        "m is [[-50, -12.5], [-50, 12.5]] mm)"), error.value.reason
+
+
+def test_a_robots_tcp_or_base_in_metres_and_radians_is_refused_naming_the_option_or_field(tmp_path):
+    """A user's UR-style TCP, 0.15 m out and pitched -pi/2, written as in their URDF: taken in mm and
+    deg it put G 0.15 mm from the flange, and the cell check refused the plan for a link in the
+    floor. The option, or the task file's field, is named with the unit it takes; the values as
+    the hint reads them pass the check."""
+    from stablepush.task import Robot, robot_with, with_robot
+
+    urdf = str(ROOT / "data" / "arms" / "six-joint.urdf")
+    with pytest.raises(TaskError) as error:
+        robot_with(Robot(), urdf, "tool0", [0, 0, 0.15, 0, -1.5708, 0])
+    assert error.value.field == "--tcp"
+    assert error.value.reason == ("0 0 0.15 0 -1.5708 0: written in metres? (0.15 m is 150 mm); written in radians? "
+                                  "(-1.5708 rad is -90 deg); --tcp takes mm and deg")
+    with pytest.raises(TaskError, match=r"^--base: 0.4 0 0 1.5708: written in metres\? \(0.4 m is 400 mm\); "
+                                        r"written in radians\? \(1.5708 rad is 90 deg\)"):
+        with_robot(shipped("horizontal-offset-low-mu"), base=[0.4, 0, 0, 1.5708])
+    text = task_text("horizontal-offset-low-mu") + (f"  robot: {{model: {urdf}, flange: tool0, "
+                                                    f"tcp: [0, 0, 0.15, 0, -1.5708, 0]}}\n")
+    with pytest.raises(TaskError) as error:
+        parse_task(text)
+    assert error.value.field == "environment.robot.tcp" and "environment.robot.tcp takes mm and deg" in error.value.reason
+    # Whole degrees, mm, the origin, and the shipped arm's TCP are what they say.
+    for tcp in ([0, 0, 110, 0, 180, 0], [0, 0, 0, 0, 0, 0], [0, 0, 150, 0, -90, 0], [0.5, 0, 150, 0, 1.5, 0]):
+        robot_with(Robot(), urdf, "tool0", tcp)
+    # The cure, followed: the plan that the TCP in metres and radians ran into the floor, the arm follows.
+    plan = tmp_path / "p.json"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["plan", str(TASKS / "horizontal-offset-low-mu.yaml"), "-o", str(plan)]).exit_code == 0
+    arm = ["--task", str(TASKS / "horizontal-offset-low-mu.yaml"), "--robot", urdf, "--flange", "tool0", "--tcp"]
+    slipped = runner.invoke(cli, ["check-cell", str(plan), *arm, "0", "0", "0.15", "0", "-1.5708", "0"])
+    assert slipped.exit_code == 2 and "--tcp: 0 0 0.15 0 -1.5708 0: written in metres?" in slipped.output
+    assert runner.invoke(cli, ["check-cell", str(plan), *arm, "0", "0", "150", "0", "-90", "0"]).exit_code == 0
 
 
 def test_a_goal_no_push_from_the_start_moves_the_object_toward_is_named_when_the_search_fails():

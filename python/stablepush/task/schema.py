@@ -674,12 +674,19 @@ def _in_radians(poses, tolerance: float) -> List[str]:
     is planner.tolerance's angle [deg]."""
     out = []
     for label, (_, _, theta) in poses:
-        degrees = math.degrees(theta)
-        round_angle = abs(degrees - 5.0 * round(degrees / 5.0)) <= RADIAN_ROUNDING and abs(degrees) >= 2.5
-        if 0.0 < abs(theta) <= 2.0 * math.pi and theta != round(theta) and (round_angle or abs(theta) <= tolerance):
+        if _reads_as_radians(theta) or (0.0 < abs(theta) <= min(tolerance, 2.0 * math.pi) and theta != round(theta)):
+            degrees = math.degrees(theta)
             out.append(f"{label}[2]: {theta:g} deg; written in radians? ({theta:g} rad is {degrees:.3g} deg; "
                        f"task files use degrees)")
     return out
+
+
+def _reads_as_radians(angle: float) -> bool:
+    """An angle in degrees that reads as written in radians: nonzero, at most 2 pi, not a whole
+    number of degrees, and a round angle in radians (RADIAN_ROUNDING above)."""
+    degrees = math.degrees(angle)
+    round_angle = abs(degrees - 5.0 * round(degrees / 5.0)) <= RADIAN_ROUNDING and abs(degrees) >= 2.5
+    return 0.0 < abs(angle) <= 2.0 * math.pi and angle != round(angle) and round_angle
 
 
 MESH_KEYS = ["file", "scale", "plane_y", "tolerance", "density"]
@@ -848,10 +855,12 @@ def _validate_environment(value: Any, pusher_names: Sequence[str], source: Optio
     return Cell.from_mapping(out)
 
 
-def robot_section(value: Any, source: Optional[str] = None) -> Robot:
+def robot_section(value: Any, source: Optional[str] = None, names: Optional[Dict[str, str]] = None) -> Robot:
     """The environment.robot section as a Robot: `model` a URDF or MJCF file (relative to the task
     file's folder), with the `flange` it mounts the jaws on and the `tcp` (both required with a
-    model: no default fits another arm), `base` and `max_joint_speed` [rad/s] optional."""
+    model: no default fits another arm), `base` and `max_joint_speed` [rad/s] optional. A tcp or
+    base that reads as metres and radians is refused, named as `names` says (a command line's
+    --tcp, --base; default: the task file's field)."""
     robot = _mapping("environment.robot", value, [], ["model", "flange", "tcp", "base", "max_joint_speed"])
     out: Dict[str, Any] = {}
     if "model" in robot:
@@ -870,9 +879,28 @@ def robot_section(value: Any, source: Optional[str] = None) -> Robot:
         base = _vector("environment.robot.base", robot["base"], 4)
         out["base"] = [_number(f"environment.robot.base[{i}]", v, COORDINATE if i < 3 else ANGLE)
                        for i, v in enumerate(base)]
+    for key in ("tcp", "base"):
+        slip = _robot_unit_slip(out[key]) if key in out else ""
+        if slip:
+            name = (names or {}).get(key, f"environment.robot.{key}")
+            raise TaskError(name, f"{' '.join(f'{v:g}' for v in out[key])}: {slip}; {name} takes mm and deg")
     if "max_joint_speed" in robot:
         out["max_joint_speed"] = _number("environment.robot.max_joint_speed", robot["max_joint_speed"], (1e-3, 1e3))
     return Robot.from_mapping(out)
+
+
+def _robot_unit_slip(pose: Sequence[float]) -> str:
+    """Why a tcp or base (x, y, z mm, then angles deg) reads as written in metres and radians, as the
+    task's own lengths and angles do (_sub_millimetre, _in_radians): a position off the origin by
+    under SUB_MM, an angle that is a round one in radians; '' when neither."""
+    position, angles = list(pose[:3]), [a for a in pose[3:] if _reads_as_radians(a)]
+    slips = []
+    if any(position) and max(map(abs, position)) < SUB_MM:
+        slips.append("written in metres? (" + ", ".join(f"{v:g} m is {v * 1e3:g} mm" for v in position if v) + ")")
+    if angles:
+        slips.append("written in radians? (" + ", ".join(f"{a:g} rad is {math.degrees(a):.4g} deg" for a in angles)
+                     + ")")
+    return "; ".join(slips)
 
 
 def with_robot(task: Task, model: Optional[str] = None, flange: Optional[str] = None,
@@ -896,7 +924,7 @@ def robot_with(robot: Robot, model: Optional[str] = None, flange: Optional[str] 
     changes = {"flange": flange, "tcp": None if tcp is None else list(tcp),
                "base": None if base is None else list(base)}
     section.update({k: v for k, v in changes.items() if v is not None})
-    return robot_section(section)
+    return robot_section(section, names={k: f"--{k}" for k in ("tcp", "base") if changes[k] is not None})
 
 
 def robot_model_file(field: str, value: Any, source: Optional[str] = None) -> str:
