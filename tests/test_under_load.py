@@ -8,12 +8,13 @@ import os
 from contextlib import contextmanager
 
 import pytest
-from conftest import shipped
 
 from stablepush.evaluation import Batch, Spreads, evaluate
 from stablepush.plan import check_plan, plan_task
 from stablepush.plan.reach import reach_map
 from stablepush.runners import Runner
+
+from conftest import shipped
 
 
 def _spin(stop) -> None:

@@ -41,8 +41,12 @@ ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine"
                    "the tolerance), switches, pushes (less first), margin, reach (more first), time, and success "
                    "(with --evaluate). Default: arm,fixtures,points,end,switches,margin,pushes,reach,time; with "
                    "--evaluate, success first unless the rule places it.")
-@click.option("--time-limit", default=2.0, show_default=True, type=TIME_LIMIT, metavar="S",
-              help="Each layout's search time (the task's planner.time_limit is not used: there are many layouts).")
+@click.option("--checks", "check_limit", default=2_000_000, show_default=True, type=Whole(min=0, max=10**15),
+              metavar="N", help="Stable-push tests each layout's search may make: a count, so the same design file "
+                                "gives the same designs on any machine under any load (0: --time-limit alone).")
+@click.option("--time-limit", default=30.0, show_default=True, type=TIME_LIMIT, metavar="S",
+              help="Each layout's search time, a guard past --checks (the task's planner.time_limit is not used: "
+                   "there are many layouts).")
 @click.option("--reach-top", default=3, show_default=True, type=Whole(min=0, max=100), metavar="N",
               help="The best N designs get a 3x3 reach map around the goal (2 tolerances either side in x and z), "
                    "and are ranked again with it.")
@@ -74,9 +78,9 @@ ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine"
 @click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
               callback=parse_ray_address, help="Plan the layouts on Ray: a local instance, or the cluster at ADDRESS.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, reach_top: int, trials, evaluate_top: int,
-           vary, feature_error, closed_loop: bool, engine: str, seed: int, out_dir, json_path, png_path, workers,
-           ray_address, quiet: bool) -> None:
+def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, time_limit: float, reach_top: int, trials,
+           evaluate_top: int, vary, feature_error, closed_loop: bool, engine: str, seed: int, out_dir, json_path,
+           png_path, workers, ray_address, quiet: bool) -> None:
     """Find where the fixtures should go: rank layouts of candidate pushers by their plans.
 
     DESIGN.yaml is a task file whose `candidates` stand in for its `pushers`: `candidates: {mu:
@@ -117,7 +121,7 @@ def design(design_file: str, max_fixtures: int, rank_text, time_limit: float, re
     bar = progressbar(quiet, length=None, label="layouts planned", show_pos=True)
     try:
         study = search(task, candidates, source=design_file, max_fixtures=max_fixtures, rank=rank,
-                       reach_top=reach_top, time_limit=time_limit, runner=runner,
+                       reach_top=reach_top, time_limit=time_limit, check_limit=check_limit, runner=runner,
                        progress=(lambda d: bar.update(1)) if bar else None)
     finally:
         if bar is not None:

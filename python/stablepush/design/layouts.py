@@ -43,7 +43,7 @@ from stablepush.plan.verify import plan_margin
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.task.mechanics import stable_directions
 from stablepush.task.model import Robot, Task
-from stablepush.task.schema import parse_task
+from stablepush.task.schema import parse_task, planner_parameter
 
 # What a layout is ranked by, each best first: the key, and +1 where less is better, -1 more.
 # `arm`: 0 where the task's arm follows the plan, 1 where it cannot (no arm named: not a key);
@@ -57,7 +57,11 @@ RANK_KEYS: Dict[str, int] = {"arm": 1, "fixtures": 1, "points": 1, "end": 1, "sw
 DEFAULT_RANK = ("arm", "fixtures", "points", "end", "switches", "margin", "pushes", "reach", "time")
 REACH_CELLS = 3  # per axis (x and z) of the reach map around the goal
 REACH_SPAN = 2.0  # planner.tolerance either side of the goal
-REACH_TIME_LIMIT = 1.0  # s a cell of that map may plan
+# Every search of a design is bounded by stable-push tests, a count, so that the same design file
+# gives the same designs on any machine under any load; the time limits are guards past them.
+LAYOUT_CHECKS = 2_000_000  # a layout's search: about 2 s of a line-pusher task's on 2 cores of 2026
+REACH_CHECKS = 200_000  # a cell of the reach map around the goal
+REACH_TIME_LIMIT = 30.0  # s: the reach cells' guard
 # Why a planned layout gave no plan, by its `outcome` (the plan's PlanOutcome, or the two of the
 # design search's own), in words; an outcome not listed is named as it is.
 NO_PLAN_REASONS: Dict[str, str] = {
@@ -226,6 +230,7 @@ class _Job:
     source: Optional[str]
     layouts: Tuple[Tuple[int, ...], ...]
     time_limit: Optional[float]
+    check_limit: int = LAYOUT_CHECKS
 
 
 def layout_task(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], source: Optional[str] = None) -> Task:
@@ -236,9 +241,10 @@ def layout_task(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], source:
 def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: Optional[str] = None,
            max_fixtures: int = 2, rank: Sequence[str] = DEFAULT_RANK, reach_top: int = 3,
            time_limit: Optional[float] = None, runner: Optional[Runner] = None,
-           progress: Optional[Callable[[Design], None]] = None) -> DesignStudy:
+           progress: Optional[Callable[[Design], None]] = None, check_limit: int = LAYOUT_CHECKS) -> DesignStudy:
     """Search the layouts of at most `max_fixtures` of `candidates` (schema.load_design), each
-    planned within `time_limit` s (None: the task's planner.time_limit), and rank the solved ones
+    planned within `check_limit` stable-push tests (0: no count; then `time_limit` s, None: the
+    task's planner.time_limit, which is otherwise only a guard), and rank the solved ones
     by `rank` (keys of RANK_KEYS); the best `reach_top` get a reach map around the goal.
     `progress(design)` after each layout is planned."""
     if max_fixtures < 1:
@@ -250,7 +256,8 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
     layouts = [combo for size in range(1, max_fixtures + 1)
                for combo in itertools.combinations(range(len(candidates)), size) if set(combo) & set(useful)]
     total = sum(math.comb(len(candidates), k) for k in range(1, max_fixtures + 1))
-    job = _Job(task, tuple(candidates), source, tuple(layouts), time_limit)
+    job = _Job(task, tuple(candidates), source, tuple(layouts), time_limit,
+               planner_parameter("check_limit", "check_limit", check_limit))
     runner = runner or Runner()
     results: List[Design] = []
     for i, result in run_all(_plan_layout, job, range(len(layouts)), runner):
@@ -293,12 +300,14 @@ def _pushers_toward_goal(task: Task) -> set:
 
 
 def _plan_layout(job: _Job, i: int) -> Design:
-    return measure_layout(job.task, [job.candidates[k] for k in job.layouts[i]], job.source, job.time_limit)
+    return measure_layout(job.task, [job.candidates[k] for k in job.layouts[i]], job.source, job.time_limit,
+                          job.check_limit)
 
 
 def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], source: Optional[str] = None,
-                   time_limit: Optional[float] = None) -> Design:
-    """One layout planned (within `time_limit` s; None: the task's) and checked, with what the
+                   time_limit: Optional[float] = None, check_limit: int = LAYOUT_CHECKS) -> Design:
+    """One layout planned (within `check_limit` stable-push tests, 0: none, and `time_limit` s, None:
+    the task's) and checked, with what the
     ranking reads: pushes, switch-overs, planning time, the least margin and the fixtures' places.
     A task's own pushers measured so can be ranked among the designs."""
     d = Design(tuple(p["name"] for p in pushers))
@@ -307,7 +316,7 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
     except TaskError as exc:  # the goal's grasp or the part's checks refuse it with these pushers
         d.reason, d.outcome = str(exc), "refused"
         return d
-    plan = plan_task(d.task, time_limit=time_limit)
+    plan = plan_task(d.task, time_limit=time_limit, check_limit=check_limit or None)
     d.planning_time_s = plan.stats.get("planning_time_s")
     if not plan.solved:
         d.reason = plan.message or "not solved within the time limit"
@@ -348,7 +357,8 @@ def _reach_near_goal(task: Task, runner: Runner) -> float:
     tol = task.planner.tolerance[0] * REACH_SPAN
     gx, gz, gt = task.goal
     cells = reach_map(task, (gx - tol, gx + tol, REACH_CELLS), (gz - tol, gz + tol, REACH_CELLS), (gt, gt, 1),
-                      seed=task.planner.seed, time_limit=REACH_TIME_LIMIT, runner=runner).cells
+                      seed=task.planner.seed, time_limit=REACH_TIME_LIMIT, check_limit=REACH_CHECKS,
+                      runner=runner).cells
     return sum(1 for c in cells if c["solved"]) / len(cells)
 
 

@@ -58,10 +58,10 @@ def plan_task(
     push from the start moves the object (_toward_goal: some 0.05 s; the closed loop's re-plans,
     which read the outcome alone, leave it out).
     A solved plan whose end uses more than planner.end_within of the tolerance in some coordinate
-    (units.tolerance_used) is planned again to that share of the tolerance (`deepen`; _deeper),
-    within DEEPER_CHECKS stable-push tests: a plan that ends at the tolerance's edge leaves an
-    open-loop run no room for a real push's drift. Where that search finds none, the first plan
-    stands and its stats say how deep it got (`end_used`, `deeper`).
+    (units.tolerance_used) is planned again, with finish steps and then to that share of the
+    tolerance (`deepen`; _deeper), within DEEPER_CHECKS stable-push tests: a plan that ends at the
+    tolerance's edge leaves an open-loop run no room for a real push's drift. Where neither finds
+    one, the first plan stands and its stats say how deep it got (`end_used`, `deeper`).
     TaskError (field `goal`) when the start is already within the tolerance of the goal."""
     require_task(task)
     if task.at_goal(task.start):
@@ -93,6 +93,7 @@ def plan_task(
     if deepen and raw.outcome.name == "goal_reached" and settings.end_within < 1.0:
         deep = _deeper(task, models, settings, raw, min_transit_hold, pusher_at_start)
         if deep is not None:
+            deep["first_checks"] = int(raw.stats.feasibility_checks)
             raw = deep.pop("raw") or raw
     names = task.pusher_names
     raw_waypoints = raw.waypoints  # a copy of the core's vector on each access: taken once
@@ -134,7 +135,7 @@ def plan_task(
         stats["end_used"] = tolerance_used(waypoints[-1].pose, task.goal, task.planner.tolerance)
     if deep is not None:
         stats["deeper"] = deep
-        stats["feasibility_checks"] += deep["feasibility_checks"] if not deep["solved"] else deep["first_checks"]
+        stats["feasibility_checks"] = deep.pop("first_checks") + deep["feasibility_checks"]
         stats["planning_time_s"] = time.perf_counter() - began
     if "improve_for" in settings.tuning:
         # the first plan of an anytime search (planner.improve_for), before the improvement; None: no plan
@@ -186,20 +187,31 @@ def _search(task: Task, models, settings: PlannerSettings, tolerance, min_transi
 
 
 def _deeper(task: Task, models, settings: PlannerSettings, first, min_transit_hold: float, start_pusher: int):
-    """When `first` (a solved core plan) ends beyond planner.end_within of the tolerance, the search
-    again to that share of it, within DEEPER_CHECKS tests (or the task's own check_limit, if lower)
-    and the time limit as a guard: a record of it (`solved`, `end_within`, its tests; `raw`, its plan,
-    when solved), or None when the first plan ends deep enough."""
+    """When `first` (a solved core plan) ends beyond planner.end_within of the tolerance: first the
+    same search with finish steps (its last pusher goes on deeper, no switch-over added), then, if
+    that does not end within the share, the search to that share of the tolerance, within
+    DEEPER_CHECKS tests (or the task's own check_limit, if lower), the time limit a guard. A record
+    of it (`solved`, `end_within`, `by`: finish_steps or search, its tests; `raw`, the plan found),
+    or None when the first plan ends deep enough."""
     share = settings.end_within
-    if tolerance_used(pose_from_si(first.waypoints[-1].pose), task.goal, settings.tolerance) <= share + 1e-9:
+    deep_enough = lambda raw: tolerance_used(pose_from_si(raw.waypoints[-1].pose), task.goal,  # noqa: E731
+                                             settings.tolerance) <= share + 1e-9
+    if deep_enough(first):
         return None
     limit = min(DEEPER_CHECKS, int(settings.tuning.get("check_limit", 0)) or DEEPER_CHECKS)
+    spent = 0
+    if not settings.tuning.get("finish_steps"):
+        finishing = _search(task, models, settings.replace(finish_steps=1), settings.tolerance, min_transit_hold,
+                            start_pusher, check_limit=limit)
+        spent = int(finishing.stats.feasibility_checks)
+        if finishing.outcome.name == "goal_reached" and deep_enough(finishing):
+            return {"end_within": share, "solved": True, "by": "finish_steps", "check_limit": limit,
+                    "feasibility_checks": spent, "check_limit_reached": False, "raw": finishing}
     raw = _search(task, models, settings, (settings.tolerance[0] * share, settings.tolerance[1] * share),
                   min_transit_hold, start_pusher, check_limit=limit)
     solved = raw.outcome.name == "goal_reached"
-    return {"end_within": share, "solved": solved, "check_limit": limit,
-            "feasibility_checks": int(raw.stats.feasibility_checks),
-            "first_checks": int(first.stats.feasibility_checks),
+    return {"end_within": share, "solved": solved, "by": "search", "check_limit": limit,
+            "feasibility_checks": spent + int(raw.stats.feasibility_checks),
             "check_limit_reached": bool(raw.stats.check_limit_reached), "raw": raw if solved else None}
 
 

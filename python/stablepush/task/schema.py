@@ -78,6 +78,7 @@ LIMITS: Dict[str, Tuple[float, float]] = {  # kind -> (lowest, highest); both in
     "min_margin": (0.0, 1e6),  # N
     "sampling_margin": (0.0, 1e3),  # unit steps
     "min_hold_ratio": (0.0, 1e3),
+    "end_within": (0.01, 1.0),  # a share of the tolerance; 1: the tolerance's edge will do
 }
 # Where the arm works (stablepush.execution): the environment section's keys but `features`, and
 # their defaults (Cell says what each is).
@@ -965,7 +966,7 @@ def _validate_planner(value: Any) -> PlannerSettings:
     for key in ("step", "tolerance"):
         if key in planner:
             out[key] = list(_vector(f"planner.{key}", planner[key], 2, LIMITS[key]))
-    for key in ("min_margin", "sampling_margin", "min_hold_ratio"):
+    for key in ("min_margin", "sampling_margin", "min_hold_ratio", "end_within"):
         if key in planner:
             out[key] = _number(f"planner.{key}", planner[key], LIMITS[key])
     for key, value in planner.items():
