@@ -188,6 +188,7 @@ def test_finish_steps_walk_a_pin_plan_to_where_it_can_end_at_the_goal_pose():
     from stablepush.plan import check_plan
 
     [(task, _)] = _generator().generated_tasks(seed=2, count=5, goals={"pins-2-4": [-6.167, -1.082, 8.373]})
+    task = dataclasses.replace(task, planner=task.planner.replace(end_within=1.0))  # finish steps alone
     plain = plan_task(task, seed=3)
     assert plain.solved and not plain.ends_at_goal, plain.message
     finishing = dataclasses.replace(task, planner=task.planner.replace(finish_steps=1))
