@@ -184,7 +184,7 @@ def test_a_fixture_out_of_the_arms_reach_is_refused_before_any_motion(arms, tmp_
     robot = ["--robot", arm["model"], "--flange", arm["flange"], "--tcp", *map(str, arm["tcp"])]
     result = runner.invoke(cli, ["execute", str(plan_file), "--task", str(task_file), "--sim", *robot])
     assert result.exit_code == 2, result.output
-    assert re.search(r"the arm cannot follow the plan: .*plan step \d+, move\) (joint q\d would turn|no joint "
+    assert re.search(r"the arm cannot follow the plan: .*plan step \d+, move\) (out of reach|joint q\d would turn|no joint "
                      r"positions)", result.output)
     assert "world built" not in result.output
     checked = runner.invoke(cli, ["check-cell", str(plan_file), "--task", str(task_file), *robot])
