@@ -230,10 +230,10 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
                            min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO, explain=False,
                            deepen=False)
         elapsed += result.stats["planning_time_s"]
-        guarded = guarded or guard_fired(result)
+        guarded = guarded or result.guard_fired
         if not result.solved:
             tried.append(f"{budget} switch-over(s) in {AIM_CHECKS:,} tests: {_ended_by(result)}")
-            ended.append(result.outcome)
+            ended.append(_ended(result))
         elif not _transits_held(task, result.waypoints, result.waypoints[1].pusher):
             tried.append(_unheld_note(result.pusher_sequence, TRANSIT_HOLD_RATIO))
             ended.append("transit")
@@ -266,8 +266,9 @@ def no_way_back(task: Task, pose: Sequence[float], tolerance: Tuple[float, float
 
 # How a failed search ended, as its one-line summary counts it (_summed_up): a Plan.outcome, or the
 # transit rule refusing the plan found.
-_ENDED = {"time_limit": "out of tests", "unreachable": "unreachable", "goal_over_switch_limit": "over the switch-overs",
-          "invalid_start": "no grasp at the start", "transit": "a transit the pads do not hold"}
+_ENDED = {"time_limit": "out of tests", "guard": "stopped by the wall-time guard", "unreachable": "unreachable",
+          "goal_over_switch_limit": "over the switch-overs", "invalid_start": "no grasp at the start",
+          "transit": "a transit the pads do not hold"}
 
 
 def _summed_up(ended: Sequence[str], notes: Sequence[str]) -> str:
@@ -361,10 +362,10 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         transit_hold = (1.0 if task.uncertainty else attempt.transit_hold) if attempt.every_pusher else 0.0
         result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher, explain=False, deepen=False)
         elapsed += result.stats["planning_time_s"]
-        guarded = guarded or guard_fired(result)
+        guarded = guarded or result.guard_fired
         if not result.solved:
             tried.append(f"{attempt.describe(pusher)}: {_ended_by(result)}")
-            ended.append(result.outcome)
+            ended.append(_ended(result))
             continue
         if not _transits_held(task, result.waypoints, pusher, attempt.transit_hold):
             tried.append(f"{attempt.describe(pusher)}: {_unheld_note(result.pusher_sequence, attempt.transit_hold)}")
@@ -384,19 +385,18 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
 def counted(planner, checks: int):
     """`planner` (PlannerSettings) bounded by `checks` stable-push tests (the task's own check_limit,
     when lower), with GUARD_TIME_LIMIT as its wall-time guard."""
-    own = int(planner.tuning.get("check_limit", 0))
-    return planner.replace(check_limit=min(checks, own) if own else checks, time_limit=GUARD_TIME_LIMIT)
+    return planner.with_check_limit(checks).replace(time_limit=GUARD_TIME_LIMIT)
 
 
-def guard_fired(plan) -> bool:
-    """Whether `plan`'s search was stopped by its wall time, not by its count of tests."""
-    return plan.outcome == "time_limit" and not plan.stats.get("check_limit_reached", False)
+def _ended(plan) -> str:
+    """How a search that found no plan ended, as _ENDED names it: its outcome, or `guard` where the
+    wall-time guard stopped it before its count of tests."""
+    return "guard" if plan.guard_fired else plan.outcome
 
 
 def _ended_by(plan) -> str:
     """How a search that found no plan ended, in a few words (an unreachable goal with its reason)."""
     if plan.outcome == "unreachable":
         return plan.message  # the reason, decided at once
-    if plan.outcome == "time_limit":
-        return "out of tests" if plan.stats.get("check_limit_reached") else "stopped by the wall-time guard"
-    return plan.outcome
+    ended = _ended(plan)
+    return _ENDED[ended] if ended in ("time_limit", "guard") else ended

@@ -156,6 +156,13 @@ class Plan:
         return out
 
     @property
+    def guard_fired(self) -> bool:
+        """Whether the search stopped at its time limit, not at its count of stable-push tests
+        (planner.check_limit): where that count bounds it, the time limit is a guard, and a plan it
+        stopped may differ on a less loaded machine."""
+        return self.outcome == "time_limit" and not self.stats.get("check_limit_reached", False)
+
+    @property
     def poses(self) -> np.ndarray:
         """(n, 3): x mm, z mm, theta deg of every waypoint, the start first."""
         return np.array([(w.x, w.z, w.theta) for w in self.waypoints], float)

@@ -151,7 +151,7 @@ def reach_cell(job: ReachJob, i: int) -> dict:
     s = plan.stats
     cell.update(solved=plan.solved, planning_time_s=s["planning_time_s"], switches=s["switches"],
                 pushes=s["pushes"], outcome=plan.outcome,
-                guard_fired=plan.outcome == "time_limit" and not s["check_limit_reached"])
+                guard_fired=plan.guard_fired)
     if plan.solved:
         cell["verdict"] = "reached"
     elif plan.outcome in ("invalid_start", "unreachable"):  # the verdict says it: the reason alone

@@ -89,11 +89,10 @@ def plan_task(
         return _unreachable(task, models, settings, reason, time.perf_counter() - began)
     pusher_at_start = -1 if start_pusher is None else task.pusher_index(start_pusher, "start_pusher")
     raw = _search(task, models, settings, settings.tolerance, min_transit_hold, pusher_at_start)
-    deep = None
+    first_checks, deep = int(raw.stats.feasibility_checks), None
     if deepen and raw.outcome.name == "goal_reached" and settings.end_within < 1.0:
         deep = _deeper(task, models, settings, raw, min_transit_hold, pusher_at_start)
         if deep is not None:
-            deep["first_checks"] = int(raw.stats.feasibility_checks)
             raw = deep.pop("raw") or raw
     names = task.pusher_names
     raw_waypoints = raw.waypoints  # a copy of the core's vector on each access: taken once
@@ -135,7 +134,7 @@ def plan_task(
         stats["end_used"] = tolerance_used(waypoints[-1].pose, task.goal, task.planner.tolerance)
     if deep is not None:
         stats["deeper"] = deep
-        stats["feasibility_checks"] = deep.pop("first_checks") + deep["feasibility_checks"]
+        stats["feasibility_checks"] = first_checks + deep["feasibility_checks"]
         stats["planning_time_s"] = time.perf_counter() - began
     if "improve_for" in settings.tuning:
         # the first plan of an anytime search (planner.improve_for), before the improvement; None: no plan
@@ -170,20 +169,17 @@ MAX_PUSHES = MAX_WAYPOINTS - 1  # the pushes a plan file holds: its waypoints le
 DEEPER_CHECKS = 200_000
 
 
-def _search(task: Task, models, settings: PlannerSettings, tolerance, min_transit_hold: float, start_pusher: int,
-            check_limit: int = 0):
+def _search(task: Task, models, settings: PlannerSettings, tolerance, min_transit_hold: float, start_pusher: int):
     """The core's T-RRT* from the task's start to its goal within `tolerance` (mm, deg)."""
-    parameters = settings.core_parameters()
-    if check_limit:
-        parameters["check_limit"] = str(check_limit)
     # Ctrl-C stops the search at once (KeyboardInterrupt); signals reach the main thread only.
     return _core.plan(models, _core.PlannerSettings(
         start=pose_to_si(task.start), goal=pose_to_si(task.goal),
         step=(settings.step[0] * MM, math.radians(settings.step[1])),
         tolerance=(tolerance[0] * MM, math.radians(tolerance[1])),
         time_limit=settings.time_limit, min_margin=settings.min_margin, sampling_margin=settings.sampling_margin,
-        min_hold_ratio=settings.min_hold_ratio, parameters=parameters, min_transit_hold=float(min_transit_hold),
-        start_pusher=start_pusher), interruptible=threading.current_thread() is threading.main_thread())
+        min_hold_ratio=settings.min_hold_ratio, parameters=settings.core_parameters(),
+        min_transit_hold=float(min_transit_hold), start_pusher=start_pusher),
+        interruptible=threading.current_thread() is threading.main_thread())
 
 
 def _deeper(task: Task, models, settings: PlannerSettings, first, min_transit_hold: float, start_pusher: int):
@@ -198,17 +194,18 @@ def _deeper(task: Task, models, settings: PlannerSettings, first, min_transit_ho
                                              settings.tolerance) <= share + 1e-9
     if deep_enough(first):
         return None
-    limit = min(DEEPER_CHECKS, int(settings.tuning.get("check_limit", 0)) or DEEPER_CHECKS)
+    bounded = settings.with_check_limit(DEEPER_CHECKS)
+    limit = int(bounded.tuning["check_limit"])
     spent = 0
     if not settings.tuning.get("finish_steps"):
-        finishing = _search(task, models, settings.replace(finish_steps=1), settings.tolerance, min_transit_hold,
-                            start_pusher, check_limit=limit)
+        finishing = _search(task, models, bounded.replace(finish_steps=1), settings.tolerance, min_transit_hold,
+                            start_pusher)
         spent = int(finishing.stats.feasibility_checks)
         if finishing.outcome.name == "goal_reached" and deep_enough(finishing):
             return {"end_within": share, "solved": True, "by": "finish_steps", "check_limit": limit,
                     "feasibility_checks": spent, "check_limit_reached": False, "raw": finishing}
-    raw = _search(task, models, settings, (settings.tolerance[0] * share, settings.tolerance[1] * share),
-                  min_transit_hold, start_pusher, check_limit=limit)
+    raw = _search(task, models, bounded, (settings.tolerance[0] * share, settings.tolerance[1] * share),
+                  min_transit_hold, start_pusher)
     solved = raw.outcome.name == "goal_reached"
     return {"end_within": share, "solved": solved, "by": "search", "check_limit": limit,
             "feasibility_checks": spent + int(raw.stats.feasibility_checks),

@@ -123,6 +123,12 @@ class PlannerSettings:
         out["step"], out["tolerance"] = list(self.step), list(self.tolerance)
         return {**out, **self.tuning}
 
+    def with_check_limit(self, checks: int) -> "PlannerSettings":
+        """These settings bounded by at most `checks` stable-push tests (their own check_limit where
+        lower)."""
+        own = int(self.tuning.get("check_limit", 0))
+        return self.replace(check_limit=min(checks, own) if own else checks)
+
     def core_parameters(self) -> Dict[str, str]:
         """T-RRT*'s declared parameters by name, as text: how an OMPL planner's ParamSet takes them."""
         return {"seed": str(self.seed), "max_switches": str(self.max_switches),
