@@ -206,6 +206,14 @@ def test_the_rank_puts_the_arm_first_then_fixtures_point_pushers_and_the_plans_e
     for text in ("success", "margin,margin", "speed"):
         with pytest.raises(TaskError, match="rank"):
             parse_rank(text)
+    # Two layouts tied on every other key rank by their searches' stable-push tests, a count, not by
+    # how long the searches took on a machine that may have been busy.
+    slow_few = Design(("j",), solved=True, pushes=5, switches=0, margin_n=0.1, features={"j": []}, end_used=0.0,
+                      points=0, planning_time_s=0.9, tests=100)
+    fast_many = Design(("k",), solved=True, pushes=5, switches=0, margin_n=0.1, features={"k": []}, end_used=0.0,
+                       points=0, planning_time_s=0.1, tests=5000)
+    assert sorted([fast_many, slow_few], key=lambda d: d.key(DEFAULT_RANK)) == [slow_few, fast_many]
+    assert sorted([slow_few, fast_many], key=lambda d: d.key(parse_rank("time"))) == [fast_many, slow_few]
 
 
 @pytest.mark.parametrize("path", sorted((ROOT / "data" / "designs").glob("*.design.yaml")), ids=lambda p: p.stem)

@@ -38,8 +38,9 @@ ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine"
 @click.option("--rank", "rank_text", default=None, metavar="KEYS",
               help="The ranking rule: keys, most important first, from arm (the task's arm follows the plan "
                    "first), fixtures, points (point pushers used), end (the plan's end's offset from the goal over "
-                   "the tolerance), switches, pushes (less first), margin, reach (more first), time, and success "
-                   "(with --evaluate). Default: arm,fixtures,points,end,switches,margin,pushes,reach,time; with "
+                   "the tolerance), switches, pushes (less first), margin, reach (more first), tests (the search's "
+                   "stable-push tests), time (planning time: depends on the machine's load) and success "
+                   "(with --evaluate). Default: arm,fixtures,points,end,switches,margin,pushes,reach,tests; with "
                    "--evaluate, success first unless the rule places it.")
 @click.option("--checks", "check_limit", default=2_000_000, show_default=True, type=Whole(min=0, max=10**15),
               metavar="N", help="Stable-push tests each layout's search may make: a count, so the same design file "

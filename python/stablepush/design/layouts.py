@@ -53,8 +53,10 @@ from stablepush.task.schema import parse_task, planner_parameter
 # goal, 1 at the tolerance's edge): an open-loop run lands where the plan ends plus its drift;
 # `success`: the rate measured by odds.evaluate_designs (not measured: ranks last).
 RANK_KEYS: Dict[str, int] = {"arm": 1, "fixtures": 1, "points": 1, "end": 1, "switches": 1, "margin": -1,
-                             "pushes": 1, "reach": -1, "time": 1, "success": -1}
-DEFAULT_RANK = ("arm", "fixtures", "points", "end", "switches", "margin", "pushes", "reach", "time")
+                             "pushes": 1, "reach": -1, "tests": 1, "time": 1, "success": -1}
+# Last, the search's effort in stable-push tests, a count: planning `time` would rank two layouts
+# otherwise tied by how busy the machine was (it stays a key a rule may name).
+DEFAULT_RANK = ("arm", "fixtures", "points", "end", "switches", "margin", "pushes", "reach", "tests")
 REACH_CELLS = 3  # per axis (x and z) of the reach map around the goal
 REACH_SPAN = 2.0  # planner.tolerance either side of the goal
 # Every search of a design is bounded by stable-push tests, a count, so that the same design file
@@ -103,6 +105,7 @@ class Design:
     end_used: Optional[float] = None  # the plan's end's largest offset from the goal over the tolerance (1: its edge)
     points: Optional[int] = None  # point pushers the plan uses
     planning_time_s: Optional[float] = None
+    tests: Optional[int] = None  # the stable-push tests its search made
     margin_n: Optional[float] = None
     reach: Optional[float] = None  # share of the goals around the goal it also reaches (None: not measured)
     features: Dict[str, List[float]] = field(default_factory=dict)  # pusher -> [x, y, z mm, theta deg]
@@ -124,7 +127,7 @@ class Design:
     def key(self, rank: Sequence[str]) -> tuple:
         values = {"arm": None if self.arm is None else int(not self.arm["follows"]), "fixtures": self.fixtures,
                   "points": self.points, "end": self.end_used, "switches": self.switches, "margin": self.margin_n,
-                  "pushes": self.pushes, "reach": self.reach, "time": self.planning_time_s,
+                  "pushes": self.pushes, "reach": self.reach, "tests": self.tests, "time": self.planning_time_s,
                   "success": (self.success or {}).get("success_rate")}
         return (not self.solved,) + tuple(math.inf if values[k] is None else RANK_KEYS[k] * values[k] for k in rank)
 
@@ -143,7 +146,7 @@ class Design:
         return {"pushers": list(self.pushers), "fixtures": self.fixtures, "solved": self.solved,
                 "reason": self.reason or None, "outcome": self.outcome, "end_steps": self.end_steps,
                 "pushes": self.pushes, "switches": self.switches, "end_used": self.end_used, "points": self.points,
-                "planning_time_s": self.planning_time_s,
+                "planning_time_s": self.planning_time_s, "tests": self.tests,
                 "margin_n": self.margin_n, "reach": self.reach, "features": self.features, "arm": self.arm,
                 "success": self.success, "task_file": self.task_file}
 
@@ -317,7 +320,7 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
         d.reason, d.outcome = str(exc), "refused"
         return d
     plan = plan_task(d.task, time_limit=time_limit, check_limit=check_limit or None)
-    d.planning_time_s = plan.stats.get("planning_time_s")
+    d.planning_time_s, d.tests = plan.stats.get("planning_time_s"), plan.stats.get("feasibility_checks")
     if not plan.solved:
         d.reason = plan.message or "not solved within the time limit"
         d.outcome = plan.outcome
