@@ -489,3 +489,25 @@ def test_the_evaluation_figure_draws_a_study_of_crashes_and_of_one_world():
     landed = [{**crashed[0], "cause": None, "success": True, "error": None}]
     summary = batch_mod.Evaluation(batch=one, trials=landed, wall_s=1.0, runner="this process", requested=1).summary()
     assert "1/1 landed (100.0%)" in evaluation_figure(summary, landed).axes[0].get_title()
+
+
+def test_an_input_read_after_the_outputs_were_checked_is_refused_when_it_is_one_of_them(tmp_path):
+    """A file a task names is read only as the task loads, after a command checked its outputs:
+    protect_input refuses it then (before any work), and forget_outputs ends the command's claim."""
+    from stablepush.errors import OutputError
+    from stablepush.outputs import check_outputs, forget_outputs, protect_input
+
+    model = tmp_path / "arm.urdf"
+    model.write_text("<robot/>")
+    check_outputs({"--json": str(model)}, {})
+    try:
+        with pytest.raises(OutputError, match="--json .*arm.urdf: is a robot model this process read; refusing"):
+            protect_input(model, "a robot model")
+    finally:
+        forget_outputs()
+    other = tmp_path / "other.urdf"
+    other.write_text("<robot/>")
+    protect_input(other, "a robot model")  # no command claims it
+    with pytest.raises(OutputError, match="refusing to write over it"):
+        check_outputs({"--json": str(other)}, {})
+    forget_outputs()

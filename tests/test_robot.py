@@ -471,3 +471,26 @@ def test_evaluate_runs_its_trials_on_the_arm_it_is_given(arms, tmp_path):
     result = runner.invoke(cli, [*common, "--flange", arm["flange"], "--json", str(tmp_path / "e.json")])
     assert result.exit_code == 0, result.output
     assert "landed 2 of 2" in result.output
+
+
+@pytest.mark.parametrize("command", ["check-cell", "execute"])
+def test_an_output_naming_the_robot_model_is_refused_before_any_work(arms, tmp_path, command):
+    """--json (or -o) naming the arm's URDF, given as --robot or as the task's environment.robot:
+    exit 2 "refusing to write over it" before anything runs, the model as it was."""
+    import shutil
+
+    arm = arms["6-joint URDF"]
+    model = tmp_path / "arm6.urdf"
+    shutil.copy(arm["model"], model)
+    text = model.read_text()
+    task_file = _task_file(tmp_path)
+    plan_file = tmp_path / "t.json"
+    runner = CliRunner()
+    assert runner.invoke(cli, ["plan", str(task_file), "-o", str(plan_file)]).exit_code == 0
+    robot = ["--robot", str(model), "--flange", arm["flange"], "--tcp", *map(str, arm["tcp"])]
+    out = {"check-cell": ["--json"], "execute": ["--sim", "--json"]}[command]
+    result = runner.invoke(cli, [command, str(plan_file), "--task", str(task_file), *robot, *out, str(model)])
+    assert result.exit_code == 2, result.output
+    assert "a robot model this process read; refusing to write over it" in result.output, result.output
+    assert "world built" not in result.output
+    assert model.read_text() == text

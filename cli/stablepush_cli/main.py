@@ -67,6 +67,10 @@ class _Commands(click.Group):
             click.echo(f"internal error: {type(error).__name__}: {text} (a bug; please report it with the input; "
                        f"STABLEPUSH_DEBUG=1 shows the traceback)", err=True)
             ctx.exit(EXIT_INTERNAL)
+        finally:
+            from stablepush.outputs import forget_outputs
+
+            forget_outputs()
 
 
 @click.group(cls=_Commands, context_settings={"help_option_names": ["-h", "--help"]})

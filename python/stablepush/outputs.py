@@ -18,16 +18,29 @@ FIGURE_SUFFIXES = (".png", ".pdf", ".svg")  # what a figure is written as, by th
 # it is. write_files never replaces one, whoever asks (sp.save_plan(plan, "x.json", "t.yaml") wrote
 # a CSV over the task file; the CLI's own check of its inputs was not in the library).
 _INPUTS: Dict[Tuple[int, int], str] = {}
+# The existing files the running command named as its outputs (check_outputs): file identity ->
+# the option. A file a task names (its mesh, its robot model) is read only as the task loads, after
+# the outputs were checked; protect_input refuses it then, before any work.
+_DECLARED: Dict[Tuple[int, int], str] = {}
 
 
 def protect_input(path: Union[str, Path], what: str) -> None:
-    """Remember that `path` (as it is now) is an input, `what` says which ("the task file"), so
-    that no output of this process replaces it."""
+    """Remember that `path` (as it is now) is an input, `what` says which ("a task file"), so
+    that no output of this process replaces it; OutputError when the running command named it as
+    an output (check_outputs)."""
     try:
         info = os.stat(path)
     except OSError:
         return
-    _INPUTS[(info.st_dev, info.st_ino)] = what
+    key = (info.st_dev, info.st_ino)
+    _INPUTS[key] = what
+    if key in _DECLARED:
+        raise OutputError(f"{_DECLARED[key]} {path}: {_read_input(what)}", output=path)
+
+
+def forget_outputs() -> None:
+    """The running command is over: the outputs check_outputs was given are no longer its."""
+    _DECLARED.clear()
 
 
 def default_output(input_file: Union[str, Path], suffix: str) -> str:
@@ -105,7 +118,10 @@ def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
     """Before any work is done: each output (option name -> path; None: not asked for) can be
     written by write_files' rules, and none is one of the inputs (name -> path) or another output.
     A plan written over its task file, or a CSV over its JSON, would lose a file without a word.
-    Streams (/dev/null, a FIFO) may be named more than once. OutputError names the option."""
+    Streams (/dev/null, a FIFO) may be named more than once. OutputError names the option. The
+    outputs are remembered until forget_outputs, so that an input read later is refused too.
+    """
+    forget_outputs()
     seen = {}  # file identity -> what it already is
     for name, path in (inputs or {}).items():
         if path is not None and os.path.exists(path):
@@ -125,6 +141,8 @@ def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
         if key in _INPUTS:
             raise OutputError(f"{name} {path}: {_read_input(_INPUTS[key])}")
         seen[key] = f"also the output of {name}; give each output a file of its own"
+        if os.path.exists(path):
+            _DECLARED[key] = name
 
 
 def _read_input(what: str) -> str:

@@ -940,6 +940,7 @@ def robot_model_file(field: str, value: Any, source: Optional[str] = None) -> st
         raise TaskError(field, f"{value!r:.80} is not a URDF or MJCF file (it ends {', '.join(ROBOT_MODEL_SUFFIXES)})")
     if not path.is_file():
         raise TaskError(field, f"no file {str(path)!r:.120}")
+    protect_input(path, "a robot model")
     return str(path.resolve())
 
 
