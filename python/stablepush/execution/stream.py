@@ -29,9 +29,9 @@ from stablepush.execution.world import GUARD_SPAN, Feature, contacts_of, near_po
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, slerp, translation
 from stablepush.plan.plan import Waypoint
 from stablepush.task.model import Task
+from stablepush.task.release import MOVE_SPEED  # m/s of G between contacts (the release's load depends on it)
 from stablepush.units import MM
 
-MOVE_SPEED = 0.1  # m/s of G between contacts
 TURN_SPEED = math.radians(60)  # rad/s of G between contacts
 SETTLE_TIME = 0.2  # s held still at the end of the last push, before the final retract
 # s held still after the final retract: the pads alone hold the object now, and the verdict judges

@@ -31,14 +31,16 @@ import numpy as np
 from stablepush.task.model import Task
 from stablepush.units import MM, pose_to_si
 
-RETRACT_SPEED = 0.1  # m/s: the executor's speed of G between contacts (execution.stream.MOVE_SPEED)
+# m/s: the executor's speed of G between contacts and on the retract (execution.stream moves at it),
+# defined here, below the executor, since the release's load depends on it
+MOVE_SPEED = 0.1
 DIRECTIONS = 12  # accelerations tried around the circle, 30 deg apart
 
 
 def release_acceleration(task: Task) -> float:
     """The peak acceleration [m/s^2] of G as the run backs off its last feature: 6 v^2 / d of the
     smooth retract over environment.retract (3 m/s^2 for the default 20 mm)."""
-    return 6.0 * RETRACT_SPEED ** 2 / (task.environment.retract * MM)
+    return 6.0 * MOVE_SPEED ** 2 / (task.environment.retract * MM)
 
 
 def release_hold_ratio(task: Task, pose: Sequence[float], pusher: int) -> float:
