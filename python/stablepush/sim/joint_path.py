@@ -104,24 +104,28 @@ class JointPath:
         v[-1] = 0.0
         return v
 
-    def accelerations(self) -> np.ndarray:
+    def accelerations(self, velocities: Optional[np.ndarray] = None) -> np.ndarray:
         """Each joint's acceleration [rad/s^2] at each sample: the finite difference of
-        `velocities` as they do of the positions, from rest at t = 0, zero at the last sample."""
-        a = _derivative(self.t, self.velocities(), np.zeros(len(self.joints)))
+        `velocities` (this path's, when not given) as they do of the positions, from rest at t = 0,
+        zero at the last sample."""
+        velocities = self.velocities() if velocities is None else velocities
+        a = _derivative(self.t, velocities, np.zeros(len(self.joints)))
         a[-1] = 0.0
         return a
 
     def samples(self) -> JointSamples:
         """The joints as a bag writes them (bags.write_bag)."""
-        return JointSamples(self.joints, self.q, self.velocities(), self.accelerations(), self.robot)
+        qd = self.velocities()
+        return JointSamples(self.joints, self.q, qd, self.accelerations(qd), self.robot)
 
     def columns(self) -> List[str]:
         return (["t"] + [f"{name}_rad" for name in self.joints] + [f"{name}_rad_s" for name in self.joints]
                 + [f"{name}_rad_s2" for name in self.joints] + ["phase", "step"])
 
     def rows(self) -> List[list]:
+        velocities = self.velocities()
         return [[float(t), *(float(v) for v in q), *(float(v) for v in qd), *(float(v) for v in qdd), phase, int(step)]
-                for t, q, qd, qdd, phase, step in zip(self.t, self.q, self.velocities(), self.accelerations(),
+                for t, q, qd, qdd, phase, step in zip(self.t, self.q, velocities, self.accelerations(velocities),
                                                       self.phase, self.step)]
 
     def to_csv(self) -> str:
