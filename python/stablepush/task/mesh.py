@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Optional, Tuple
 
@@ -28,6 +29,35 @@ THICKNESS_VARIATION = 0.1
 
 
 @dataclass(frozen=True)
+class PartMesh:
+    """The solid a mesh task's part is, kept beside the section the model plans with: the file,
+    the scale into mm, and where O's y = 0 lies in the scaled mesh (`center_y`, mm: the middle of
+    its extent along y, where the model's slab is centred). `tolerance` (mm) is the section's
+    simplification bound, also the bound within which a pad's face counts as the slab's."""
+
+    file: str  # absolute path
+    scale: float
+    center_y: float  # mm
+    thickness: float  # mm: the solid's extent along y (the model's slab)
+    tolerance: float  # mm
+
+    def solid(self):
+        """The solid in O (a trimesh.Trimesh in mm; y = 0 the slab's centre). Read once per
+        PartMesh (cached): treat it as read-only."""
+        return _solid_in_o(self.file, self.scale, self.center_y)
+
+
+@lru_cache(maxsize=8)
+def _solid_in_o(file: str, scale: float, center_y: float):
+    import trimesh
+
+    mesh = _read_solid(trimesh, Path(file), "object")
+    mesh.apply_scale(scale)
+    mesh.apply_translation([0.0, -center_y, 0.0])
+    return mesh
+
+
+@dataclass(frozen=True)
 class MeshObject:
     """What the task takes from a mesh (mm, g, kg m^2)."""
 
@@ -37,6 +67,7 @@ class MeshObject:
     com: Tuple[float, float]  # mm: the solid's centre of mass (x, z)
     inertia: float  # kg m^2: the solid's moment about y through its centre of mass
     section_vertices: int  # before simplification
+    part: PartMesh
     notes: Tuple[str, ...] = ()  # legal but probably not meant (each names its field)
 
 
@@ -87,8 +118,10 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
         notes.append(f"{field}.file: the solid is {t:.3g} mm thick across the grasp at (x, z) = ({x:.3g}, {z:.3g}) "
                      f"mm but {thickness:.3g} mm overall; the model takes a slab of {thickness:.3g} mm (the pads "
                      f"press on its two faces)")
-    return MeshObject(vertices=vertices, thickness=thickness, mass=float(grams),
-                      com=(float(com[0]), float(com[2])), inertia=inertia, section_vertices=raw, notes=tuple(notes))
+    part = PartMesh(file=str(Path(path).resolve()), scale=float(scale), center_y=float((low + high) / 2),
+                    thickness=thickness, tolerance=float(tolerance))
+    return MeshObject(vertices=vertices, thickness=thickness, mass=float(grams), com=(float(com[0]), float(com[2])),
+                      inertia=inertia, section_vertices=raw, part=part, notes=tuple(notes))
 
 
 def _read_solid(trimesh, path: Path, field: str):

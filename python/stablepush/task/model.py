@@ -15,6 +15,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from stablepush import _core
 from stablepush.errors import TaskError
+from stablepush.task.mesh import PartMesh
 from stablepush.units import MM, G, is_integer, is_real, mm2_to_si, pose_to_si
 
 # How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
@@ -347,6 +348,9 @@ class Task:
     environment: Cell = field(default_factory=Cell)  # a mapping in the file's form is taken as Cell.from_mapping
     source: Optional[str] = None
     pushes: str = PUSHES[0]  # see PUSHES
+    # shape: mesh: the solid the section was cut from (the pads' faces are checked on it, the
+    # simulators run it); None for a box or a polygon, which are the slab itself.
+    mesh: Optional[PartMesh] = None
     uncertainty: Dict[str, float] = field(default_factory=dict)  # key -> +- fraction of nominal (UNCERTAIN)
     # What the file says that is legal but probably not meant (each names the field); the CLI
     # prints them as "warning:" lines.
@@ -401,6 +405,8 @@ class Task:
         _integer("Task.friction_polygon_sides", self.friction_polygon_sides)
         if self.source is not None and not isinstance(self.source, str):
             raise TypeError(f"Task.source must be a string or None, got {type(self.source).__name__}")
+        if self.mesh is not None and not isinstance(self.mesh, PartMesh):
+            raise TypeError(f"Task.mesh must be a PartMesh or None, got {type(self.mesh).__name__}")
         if not isinstance(self.pushes, str) or self.pushes not in PUSHES:
             raise ValueError(f"Task.pushes must be one of {', '.join(PUSHES)}, got {self.pushes!r:.40}")
         object.__setattr__(self, "uncertainty", _string_mapping_of_numbers("Task.uncertainty", self.uncertainty,

@@ -463,7 +463,7 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
                    ["name", "gravity", "dynamics", "planner", "environment", "uncertainty"])
     name = _name("name", top["name"]) if "name" in top else _default_name(source)
     notes: List[str] = []
-    vertices, thickness, mass, com, inertia = _validate_object(top["object"], source, notes)
+    vertices, thickness, mass, com, inertia, mesh = _validate_object(top["object"], source, notes)
 
     section_defect = _core.CrossSection.defect([mm2_to_si(v) for v in vertices])  # numbered as written
     if section_defect:
@@ -538,7 +538,7 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
         name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
         grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
         friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner,
-        environment=environment, source=source, pushes=pushes, uncertainty=uncertainty,
+        environment=environment, source=source, pushes=pushes, uncertainty=uncertainty, mesh=mesh,
         warnings=tuple(notes + _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity)),
     )
     if goal_in_grasp and not environment.end_on_feature:
@@ -730,7 +730,7 @@ def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
     mass = _number("object.mass", obj["mass"], LIMITS["mass"])
     com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else None
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else None
-    return vertices, thickness, mass, com, inertia
+    return vertices, thickness, mass, com, inertia, None
 
 
 def _onto_edge(section: "_core.CrossSection", edge: int, p: Tuple[float, float]) -> Tuple[float, float]:
@@ -779,7 +779,7 @@ def _mesh_object(obj: dict, source: Optional[str], notes: List[str]):
         raise TaskError("object.density", f"gives the solid {mesh.mass:.4g} g, outside {lowest:g} to {highest:g} g"
                                           + hint)
     notes.extend(mesh.notes)
-    return mesh.vertices, mesh.thickness, mesh.mass, com, inertia
+    return mesh.vertices, mesh.thickness, mesh.mass, com, inertia, mesh.part
 
 
 def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str],
