@@ -6,14 +6,15 @@ import math
 import numpy as np
 import pytest
 import trimesh
+import yaml
 from shapely.geometry import Polygon
 
 import stablepush as sp
 from stablepush import _core
-from stablepush.errors import TaskError
+from stablepush.errors import PadFaceError, TaskError
 from stablepush.plan import plan_task
 from stablepush.task import load_task, parse_task
-from stablepush.task.mesh import load_mesh_object
+from stablepush.task.mesh import PartMesh, first_pad_off_faces, load_mesh_object, pad_face_problem
 
 from conftest import ROOT
 
@@ -190,3 +191,120 @@ def test_a_mesh_of_an_implausible_thickness_is_refused(tmp_path, thickness):
     with pytest.raises(TaskError, match="thick along y") as error:
         load_mesh_object(tmp_path / "slab.stl", "object", mass=10.0)
     assert error.value.field == "object.file" and "scale" in error.value.reason
+
+
+# The pads' faces (docs/model.md section 4, "Mesh parts"): the model takes the grasp to be two pads
+# pressing on two parallel planar faces a slab's thickness apart; a mesh part is checked to be that
+# under every pad along the path.
+
+def _revolved(tmp_path, name, profile, axis, sections=64, turn=0.0):
+    """A solid of revolution of `profile` ((r, h) mm, closed on the axis) about `axis` ("x": in the
+    grasp plane, "y": the gripping axis), turned `turn` rad about y."""
+    solid = trimesh.creation.revolve(np.array(profile, float), sections=sections)  # about z
+    to_axis = {"x": trimesh.transformations.rotation_matrix(math.pi / 2, [0, 1, 0]),
+               "y": trimesh.transformations.rotation_matrix(-math.pi / 2, [1, 0, 0])}[axis]
+    solid.apply_transform(to_axis)
+    solid.apply_transform(trimesh.transformations.rotation_matrix(turn, [0, 1, 0]))
+    assert solid.is_watertight
+    solid.export(tmp_path / name)
+    return tmp_path / name
+
+
+def _mesh_task(file, pushers, start, goal, pads=None):
+    gripper = {"grip_force": 20, "mu": 0.5, **({"pads": pads} if pads else {})}
+    return {"object": {"shape": "mesh", "file": file, "density": 1.2}, "gripper": gripper, "pushers": pushers,
+            "start": start, "goal": goal, "gravity": [0, -9.81]}
+
+
+def test_pads_on_a_round_shaft_are_refused_naming_the_pose_the_pad_and_what_they_touch(tmp_path):
+    """The flanged bushing (20 mm shaft along x, 36 mm flange, pads of radius 4 mm on the shaft) was
+    planned and simulated as a 36 mm slab."""
+    _revolved(tmp_path, "bushing.stl", [(0, -20), (10, -20), (10, 20), (18, 20), (18, 25), (0, 25)], "x")
+    pads = [{"center": [0, 0], "radius": 4}, {"center": [0, 0], "radius": 4}]
+    data = _mesh_task("bushing.stl", [{"name": "bottom", "from": [-20, -10], "to": [20, -10], "mu": 0.6}],
+                      [0, 0, 0], [5, 0, 0], pads)
+    with pytest.raises(TaskError) as error:
+        parse_task(data, source=str(tmp_path / "task.yaml"))
+    assert error.value.field == "start"
+    reason = error.value.reason
+    assert reason.startswith("gripper.pads[0] at the start pose [0.0, 0.0, 0.0]"), reason
+    assert "curved faces on both sides" in reason and "to 20 mm thick" in reason and "slab 36 mm thick" in reason
+
+
+def test_pads_over_a_step_in_thickness_are_refused_at_the_goal(tmp_path):
+    """A puck 20 mm thick inside r = 20 mm and 12 mm thick out to r = 35 mm: the goal puts the pads
+    on the thinner ring."""
+    _revolved(tmp_path, "stepped.stl", [(0, -10), (20, -10), (20, -6), (35, -6), (35, 6), (20, 6), (20, 10), (0, 10)],
+              "y", sections=8, turn=math.pi / 8)
+    side = 35 * math.cos(math.pi / 8)  # the octagon's flat side on +x
+    data = _mesh_task("stepped.stl", [{"name": "right", "from": [side, -10], "to": [side, 10], "mu": 0.6}],
+                      [5, 0, 0], [-27, 0, 0])
+    with pytest.raises(TaskError) as error:
+        parse_task(data, source=str(tmp_path / "task.yaml"))
+    assert error.value.field == "goal" and "12 mm thick" in error.value.reason, error.value.reason
+
+
+def _dimpled(tmp_path):
+    """A flat puck 20 mm thick with a dimple 1 mm deep, 3 mm in radius, at the centre of each face."""
+    return _revolved(tmp_path, "dimpled.stl", [(0, -9), (3, -9), (3, -10), (35, -10), (35, 10), (3, 10), (3, 9),
+                                               (0, 9)], "y", sections=8, turn=math.pi / 8)
+
+
+def test_a_path_over_a_dimple_is_refused_though_its_start_and_goal_rest_flat(tmp_path):
+    _dimpled(tmp_path)
+    side = 35 * math.cos(math.pi / 8)
+    data = _mesh_task("dimpled.stl", [{"name": "right", "from": [side, -10], "to": [side, 10], "mu": 0.6}],
+                      [10, 0, 0], [-10, 0, 0])
+    task = parse_task(data, source=str(tmp_path / "task.yaml"))  # the start and goal rest flat
+    with pytest.raises(PadFaceError) as error:
+        plan_task(task, seed=1)
+    assert error.value.field == "gripper.pads[0]"
+    assert "takes the pad off the part's faces just after waypoint" in error.value.reason
+    assert "18 to 20 mm thick" in error.value.reason
+
+
+def test_plan_refuses_a_path_off_the_faces_with_exit_2(tmp_path):
+    from click.testing import CliRunner
+    from stablepush_cli.main import cli
+
+    _dimpled(tmp_path)
+    side = 35 * math.cos(math.pi / 8)
+    data = _mesh_task("dimpled.stl", [{"name": "right", "from": [side, -10], "to": [side, 10], "mu": 0.6}],
+                      [10, 0, 0], [-10, 0, 0])
+    (tmp_path / "task.yaml").write_text(yaml.safe_dump(data))
+    result = CliRunner().invoke(cli, ["plan", str(tmp_path / "task.yaml"), "-o", str(tmp_path / "plan.json")])
+    assert result.exit_code == 2, result.output
+    assert "gripper.pads[0]: the plan's path takes the pad off the part's faces" in result.output
+    assert not (tmp_path / "plan.json").exists()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_pads_anywhere_on_a_box_rest_flat_and_off_its_edges_do_not(tmp_path, seed):
+    """Generated boxes and pads: a disc inside the box's face rests on the slab; one crossing the
+    face's edge hangs over it; the same box sheared along y (its faces tilted) is refused as tilted."""
+    rng = np.random.default_rng(seed)
+    length, thickness, height = rng.uniform(20, 80), rng.uniform(5, 40), rng.uniform(20, 80)
+    radius = rng.uniform(1, min(length, height) / 5)
+    box = trimesh.creation.box([length, thickness, height])
+    box.export(tmp_path / "box.stl")
+    part = PartMesh(str(tmp_path / "box.stl"), 1.0, 0.0, thickness, 0.1)
+    for _ in range(5):
+        inside = (rng.uniform(-1, 1) * (length / 2 - radius * 1.01), rng.uniform(-1, 1) * (height / 2 - radius * 1.01))
+        assert pad_face_problem(part, inside, radius) is None
+    over = (length / 2 - radius / 2, 0.0)
+    assert pad_face_problem(part, over, radius).startswith("hangs over the part's edge")
+    sheared = box.copy()
+    slope = rng.uniform(0.05, 0.3)  # the +y face rises by slope per mm of x: a tilt of atan(slope)
+    sheared.vertices[:, 1] += np.where(sheared.vertices[:, 1] > 0, slope * sheared.vertices[:, 0], 0.0)
+    sheared.export(tmp_path / "sheared.stl")
+    part = PartMesh(str(tmp_path / "sheared.stl"), 1.0, 0.0, float(sheared.extents[1]), 0.1)
+    problem = pad_face_problem(part, (0.0, 0.0), radius)
+    assert problem is not None and "a tilted +y face" in problem, problem
+    assert f"{math.degrees(math.atan(slope)):.2g} deg off" in problem
+
+
+def test_the_shipped_bracket_rests_flat_along_its_plan():
+    task = load_task(BRACKET)
+    plan = plan_task(task, seed=1)
+    assert plan.solved
+    assert first_pad_off_faces(task.mesh, task.pads, [w.pose for w in plan.waypoints]) is None

@@ -29,6 +29,12 @@ class TaskError(_FieldError):
     """A task that cannot be used (task file or API input)."""
 
 
+class PadFaceError(TaskError):
+    """A mesh part's pads that a plan's path would take off the two parallel faces the model takes
+    them to press on (stablepush.task.mesh.first_pad_off_faces): the field is the pad, the message
+    says at which pose and what lies under it."""
+
+
 class PlanError(_FieldError):
     """A plan file that is not a valid plan, or a plan that does not belong to the task."""
 

@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from stablepush.design.commented import commented_task
-from stablepush.errors import TaskError
+from stablepush.errors import PadFaceError, TaskError
 from stablepush.execution.verdict import tolerance_used
 from stablepush.execution.world import place_features
 from stablepush.frames import angle_about_y
@@ -319,7 +319,11 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
     except TaskError as exc:  # the goal's grasp or the part's checks refuse it with these pushers
         d.reason, d.outcome = str(exc), "refused"
         return d
-    plan = plan_task(d.task, time_limit=time_limit, check_limit=check_limit or None)
+    try:
+        plan = plan_task(d.task, time_limit=time_limit, check_limit=check_limit or None)
+    except PadFaceError as exc:  # its path takes a mesh part's pads off the faces the model takes
+        d.reason, d.outcome = str(exc), "refused"
+        return d
     d.planning_time_s, d.tests = plan.stats.get("planning_time_s"), plan.stats.get("feasibility_checks")
     if not plan.solved:
         d.reason = plan.message or "not solved within the time limit"

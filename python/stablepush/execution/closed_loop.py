@@ -53,6 +53,7 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
+from stablepush.errors import PadFaceError
 from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
 from stablepush.task.mechanics import blocked_senses
@@ -226,9 +227,12 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
     elapsed, tried, ended, found, guarded = 0.0, [], [], [], False
     for budget in range(min(switches, task.planner.max_switches), task.planner.max_switches + 1):
         planner = counted(task.planner, AIM_CHECKS).replace(tolerance=list(loop.final_tolerance), max_switches=budget)
-        result = plan_task(dataclasses.replace(task.with_start(start), planner=planner),
-                           min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO, explain=False,
-                           deepen=False)
+        result = _search(dataclasses.replace(task.with_start(start), planner=planner),
+                         min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO)
+        if isinstance(result, PadFaceError):
+            tried.append(f"{budget} switch-over(s): {result.reason}")
+            ended.append("off_faces")
+            continue
         elapsed += result.stats["planning_time_s"]
         guarded = guarded or result.guard_fired
         if not result.solved:
@@ -268,7 +272,17 @@ def no_way_back(task: Task, pose: Sequence[float], tolerance: Tuple[float, float
 # transit rule refusing the plan found.
 _ENDED = {"time_limit": "out of tests", "guard": "stopped by the wall-time guard", "unreachable": "unreachable",
           "goal_over_switch_limit": "over the switch-overs", "invalid_start": "no grasp at the start",
-          "transit": "a transit the pads do not hold"}
+          "transit": "a transit the pads do not hold", "off_faces": "a path off the part's faces"}
+
+
+def _search(task: Task, **kwargs):
+    """A correction's search (plan_task, without its explanation or deeper end), or the
+    PadFaceError of a path that takes a mesh part's pads off its faces: that correction is not
+    taken, and the others are tried."""
+    try:
+        return plan_task(task, explain=False, deepen=False, **kwargs)
+    except PadFaceError as exc:
+        return exc
 
 
 def _summed_up(ended: Sequence[str], notes: Sequence[str]) -> str:
@@ -360,7 +374,11 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         # robust attempts' box too (its pads' mu is 15% lower at two of them: the stricter rule, as
         # measured).
         transit_hold = (1.0 if task.uncertainty else attempt.transit_hold) if attempt.every_pusher else 0.0
-        result = plan_task(candidate, min_transit_hold=transit_hold, start_pusher=pusher, explain=False, deepen=False)
+        result = _search(candidate, min_transit_hold=transit_hold, start_pusher=pusher)
+        if isinstance(result, PadFaceError):
+            tried.append(f"{attempt.describe(pusher)}: {result.reason}")
+            ended.append("off_faces")
+            continue
         elapsed += result.stats["planning_time_s"]
         guarded = guarded or result.guard_fired
         if not result.solved:

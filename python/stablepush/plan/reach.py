@@ -13,12 +13,14 @@ Each cell ends with a verdict:
   not on the object at the start (the planner's `invalid_start`), or the planner's own verdict
   before its search (`stablepush.plan.unreachable`: every pusher excluded by the uncertainty box,
   no stable push out of the start, none that ends within the goal's tolerance, the goal not held
-  well enough anywhere in its tolerance, a pad that would have to leave the object);
+  well enough anywhere in its tolerance, a pad that would have to leave the object), or, for a
+  mesh part, the pads at the goal not on the two faces the model takes (stablepush.task.mesh);
 - `not found`: the search ran out of its stable-push tests (`check_limit`) or its time (`outcome`
   says how: `time_limit`, with `guard_fired` when the time stopped it first, or
   `goal_over_switch_limit` when the goal was reached with more switch-overs than allowed), or the
   goal is within the tolerance of the start where the pads do not hold the object as
-  `planner.min_hold_ratio` asks, and nothing decides it (`outcome` `at_start`; see at_start_verdict).
+  `planner.min_hold_ratio` asks, and nothing decides it (`outcome` `at_start`; see at_start_verdict),
+  or the plan found takes a mesh part's pads off its faces on the way (`reason` says where).
 
 Poses are (x mm, z mm, theta deg), as in task files.
 """
@@ -30,9 +32,10 @@ from typing import List, Optional, Tuple
 
 import numpy as np
 
-from stablepush.errors import TaskError
+from stablepush.errors import PadFaceError, TaskError
 from stablepush.plan.search import plan_task
 from stablepush.plan.unreachable import pads_off_near, why_unreachable
+from stablepush.task.mesh import first_pad_off_faces
 from stablepush.task.model import Task, require_task
 from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_limit, planner_parameter
 from stablepush.units import is_finite_real, pose_to_si
@@ -147,7 +150,11 @@ def reach_cell(job: ReachJob, i: int) -> dict:
                           f"goal: no grasp there"}
     if task.at_goal(task.start):
         return {**cell, **at_start_verdict(task)}
-    plan = plan_task(task, seed=job.seed, time_limit=job.time_limit, check_limit=job.check_limit or None)
+    try:
+        plan = plan_task(task, seed=job.seed, time_limit=job.time_limit, check_limit=job.check_limit or None)
+    except PadFaceError as exc:  # a path that takes a mesh part's pads off its faces: the goal's grasp if there
+        off_at_goal = first_pad_off_faces(task.mesh, task.pads, [goal]) is not None
+        return {**cell, "verdict": "unreachable" if off_at_goal else "not found", "reason": exc.reason}
     s = plan.stats
     cell.update(solved=plan.solved, planning_time_s=s["planning_time_s"], switches=s["switches"],
                 pushes=s["pushes"], outcome=plan.outcome,

@@ -9,15 +9,16 @@ from __future__ import annotations
 import math
 import threading
 import time
-from typing import List, Optional
+from typing import List, Optional, Sequence
 
 from stablepush import _core
-from stablepush.errors import TaskError
+from stablepush.errors import PadFaceError, TaskError
 from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.plan.files import MAX_WAYPOINTS
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.plan.unreachable import why_unreachable
 from stablepush.task.mechanics import blocked_senses
+from stablepush.task.mesh import first_pad_off_faces, slab_text
 from stablepush.task.model import PlannerSettings, Task, require_task
 from stablepush.task.schema import LIMITS, number_field, planner_limit, planner_parameter
 from stablepush.units import MM, pose_from_si, pose_to_si, tolerance_used
@@ -111,6 +112,8 @@ def plan_task(
                                       margin_per_normal=_margin_per_normal(models, raw_waypoints[k - 1].pose, w.pose,
                                                                            w.pusher)))
 
+    if task.mesh is not None:
+        _check_pad_faces(task, waypoints)
     outcome = raw.outcome.name
     s = raw.stats
     stats = {
@@ -210,6 +213,20 @@ def _deeper(task: Task, models, settings: PlannerSettings, first, min_transit_ho
     return {"end_within": share, "solved": solved, "by": "search", "check_limit": limit,
             "feasibility_checks": spent + int(raw.stats.feasibility_checks),
             "check_limit_reached": bool(raw.stats.check_limit_reached), "raw": raw if solved else None}
+
+
+def _check_pad_faces(task: Task, waypoints: Sequence[Waypoint]) -> None:
+    """A mesh part's pads rest on its slab's two faces all along the path (the model's grasp is the
+    slab's; a step, a curve or an edge under a pad is a grasp the model does not describe):
+    PadFaceError naming the pad, the pose and what lies under it."""
+    found = first_pad_off_faces(task.mesh, task.pads, [w.pose for w in waypoints])
+    if found is not None:
+        k, i, (x, z), problem = found
+        pose = [round(v, 3) for v in waypoints[k].pose]
+        raise PadFaceError(f"gripper.pads[{i}]",
+                           f"the plan's path takes the pad off the part's faces just after waypoint {k} (pose {pose}; "
+                           f"its disc at x, z = {x:.3g}, {z:.3g} mm of the part {problem}): {slab_text(task.mesh)}",
+                           task.source)
 
 
 def _step_text(settings: PlannerSettings) -> str:

@@ -8,10 +8,11 @@ times `scale`, must give mm.
 from __future__ import annotations
 
 import io
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Optional, Tuple
+from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -45,6 +46,110 @@ class PartMesh:
         """The solid in O (a trimesh.Trimesh in mm; y = 0 the slab's centre). Read once per
         PartMesh (cached): treat it as read-only."""
         return _solid_in_o(self.file, self.scale, self.center_y)
+
+
+# How a pad's disc is sampled for the face check: the centre and rings of 6i points out to the rim
+# (as the model's pad points, docs/model.md section 2), fine enough that a 1 mm step or hole
+# under a 4 mm pad falls between no two points.
+FACE_RINGS = 3
+RIM = 0.999  # the outer ring just inside the rim: a pad the section holds may touch its edge
+
+
+def pad_faces(part: PartMesh, center: Tuple[float, float], radius: float) -> Tuple[np.ndarray, np.ndarray]:
+    """What a pad's disc, centred at `center` (x, z mm in O) with `radius` mm, rests on at the
+    part's -y and +y sides: per sample point (the centre first), the y (mm) of the first face a ray
+    along the gripping axis meets from outside the solid, and that face's tilt (deg) from the axis,
+    NaN where it meets none. Two arrays (-y side, +y side), each n x 2: (y, tilt)."""
+    points = [(center[0], center[1])]
+    for i in range(1, FACE_RINGS + 1):
+        rho = RIM * radius * i / FACE_RINGS
+        points += [(center[0] + rho * np.cos(a), center[1] + rho * np.sin(a))
+                   for a in np.linspace(0.0, 2 * np.pi, 6 * i, endpoint=False)]
+    solid = part.solid()
+    outside = part.thickness / 2 + 1.0
+    sides = []
+    for sign in (-1.0, 1.0):  # from below the -y face upward, from above the +y face downward
+        origins = np.array([(x, sign * outside, z) for x, z in points])
+        directions = np.tile([0.0, -sign, 0.0], (len(points), 1))
+        where, rays, triangles = solid.ray.intersects_location(origins, directions, multiple_hits=False)
+        found = np.full((len(points), 2), np.nan)
+        if len(rays) == 0:
+            sides.append(found)
+            continue
+        found[rays, 0] = where[:, 1]
+        found[rays, 1] = np.degrees(np.arccos(np.clip(np.abs(solid.face_normals[triangles][:, 1]), 0.0, 1.0)))
+        sides.append(found)
+    return sides[0], sides[1]
+
+
+def pad_face_problem(part: PartMesh, center: Tuple[float, float], radius: float) -> Optional[str]:
+    """Why a pad's disc at `center` (x, z mm in O), `radius` mm, does not rest on the slab the
+    model takes (two parallel planar faces normal to the gripping axis, `part.thickness` apart,
+    each within `part.tolerance` over the disc): what it found, or None when it rests there. A
+    face tilted by a over the disc departs r tan(a) at its rim, so a tilt counts when that exceeds
+    the tolerance."""
+    half, tol = part.thickness / 2, part.tolerance
+    most_tilt = float(np.degrees(np.arctan2(tol, radius)))
+    below, above = pad_faces(part, center, radius)
+    missing = int(np.isnan(below[:, 0]).sum() + np.isnan(above[:, 0]).sum())
+    if missing:
+        return f"hangs over the part's edge ({missing} of its {2 * len(below)} sample rays meet no face)"
+    found, shapes, shifted = [], {}, False
+    for name, face, expected in (("-y", below, -half), ("+y", above, half)):
+        lo, hi = float(face[:, 1].min()), float(face[:, 1].max())
+        if hi > most_tilt:
+            shapes.setdefault("curved" if hi - lo > most_tilt else "tilted", []).append((name, lo, hi))
+        shifted = shifted or float(np.abs(face[:, 0] - expected).max()) > tol
+    for shape, sides in shapes.items():
+        lo, hi = min(s[1] for s in sides), max(s[2] for s in sides)
+        faces = f"{shape} faces on both sides" if len(sides) == 2 else f"a {shape} {sides[0][0]} face"
+        turn = f"{lo:.2g} to {hi:.2g}" if hi - lo > 0.05 else f"{hi:.2g}"
+        found.append(f"{faces} (normals {turn} deg off the gripping axis)")
+    gap = above[:, 0] - below[:, 0]
+    if float(np.abs(gap - part.thickness).max()) > tol:
+        span = f"{gap.min():.3g} to {gap.max():.3g}" if gap.max() - gap.min() > tol else f"{gap[0]:.3g}"
+        found.append(f"{span} mm thick")
+    elif shifted and not shapes:
+        found.append(f"faces at y = {float(below[0, 0]):.3g} and {float(above[0, 0]):.3g} mm, the slab's at "
+                     f"{-half:.3g} and {half:.3g}")
+    return ("rests on " + ", ".join(found)) if found else None
+
+
+def slab_text(part: PartMesh) -> str:
+    """What the model takes a mesh part's grasp to be, for a refusal's end."""
+    return f"the model takes a slab {part.thickness:.3g} mm thick, the pads on its two parallel planar faces"
+
+
+def pad_in_object(pose_mm_deg: Sequence[float], center: Sequence[float]) -> Tuple[float, float]:
+    """A pad's centre (x, z mm in G) seen from O at grasp pose q: p_O = R(theta)^T (p_G - (x, z))
+    (docs/model.md section 1)."""
+    c, s = math.cos(math.radians(pose_mm_deg[2])), math.sin(math.radians(pose_mm_deg[2]))
+    dx, dz = center[0] - pose_mm_deg[0], center[1] - pose_mm_deg[1]
+    return (c * dx - s * dz, s * dx + c * dz)
+
+
+def first_pad_off_faces(part: PartMesh, pads: Sequence[Tuple[Tuple[float, float], float]],
+                        poses: Sequence[Sequence[float]]) -> Optional[Tuple[int, int, Tuple[float, float], str]]:
+    """The first place along a path of grasp poses (x, z mm, theta deg) where a pad ((centre x, z
+    mm in G), radius mm) does not rest on the part's slab faces (pad_face_problem): (the index
+    of the pose before it, the pad's index, its centre in O, what it found), or None. Between two
+    poses the pads are sampled at most half a radius apart, so a path cannot step over a groove."""
+    seen = {}
+    for k, q in enumerate(poses):
+        following = poses[k + 1] if k + 1 < len(poses) else q
+        for i, (center, radius) in enumerate(pads):
+            a, b = pad_in_object(q, center), pad_in_object(following, center)
+            steps = max(1, math.ceil(math.dist(a, b) / (radius / 2)))
+            for j in range(steps if k + 1 < len(poses) else 1):
+                t = j / steps
+                qt = [u + t * (v - u) for u, v in zip(q, following)]
+                p = pad_in_object(qt, center)
+                key = (round(p[0], 3), round(p[1], 3), radius)
+                if key not in seen:
+                    seen[key] = pad_face_problem(part, p, radius)
+                if seen[key] is not None:
+                    return k, i, p, seen[key]
+    return None
 
 
 @lru_cache(maxsize=8)

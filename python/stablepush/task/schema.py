@@ -22,6 +22,7 @@ from stablepush.errors import TaskError
 from stablepush.frames import turn
 from stablepush.inputs import read_capped
 from stablepush.outputs import protect_input
+from stablepush.task.mesh import PartMesh, first_pad_off_faces, load_mesh_object, slab_text
 from stablepush.task.model import (
     ON_BOUNDARY,
     PLANNER_DEFAULTS,
@@ -516,6 +517,8 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
                 where = f"gripper.pads[{i}]" if "pads" in grip else "gripper (default pads)"
                 raise TaskError(label, f"{where} does not lie inside the object at the {label} pose {list(q)}"
                                 + units)
+    if mesh is not None:
+        _check_pad_faces(mesh, pads, "pads" in grip, grasped)
 
     planner = _validate_planner(top.get("planner", {}))
     uncertain = _mapping("uncertainty", top.get("uncertainty", {}), [], list(UNCERTAIN))
@@ -693,6 +696,18 @@ def _reads_as_radians(angle: float) -> bool:
 MESH_KEYS = ["file", "scale", "plane_y", "tolerance", "density"]
 
 
+def _check_pad_faces(mesh: PartMesh, pads, named: bool, grasped) -> None:
+    """A mesh part's pads at the start (and goal) rest on its two slab faces (task.mesh
+    pad_face_problem): TaskError naming the pose, the pad and what it found."""
+    for label, q in grasped:
+        found = first_pad_off_faces(mesh, pads, [q])
+        if found is not None:
+            _, i, (x, z), problem = found
+            where = f"gripper.pads[{i}]" if named else "gripper (default pads)"
+            raise TaskError(label, f"{where} at the {label} pose {list(q)} (its disc at x, z = {x:.3g}, {z:.3g} mm "
+                                   f"of the part) {problem}: {slab_text(mesh)}")
+
+
 def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
     obj = _mapping("object", obj, ["shape"], ["mass", "size", "polygon", "thickness", "com", "inertia"] + MESH_KEYS)
     shape = obj["shape"]
@@ -746,8 +761,6 @@ def _mesh_object(obj: dict, source: Optional[str], notes: List[str]):
     """shape: mesh (stablepush.task.mesh): the file relative to the task file's directory; `mass` g or
     `density` g/cm^3; `scale` to mm; `plane_y` mm (default: the centre of mass's); `tolerance` mm
     of the simplified section (default 0.1). com and inertia come from the solid unless given."""
-    from stablepush.task.mesh import load_mesh_object
-
     for key in ("size", "polygon", "thickness"):
         if key in obj:
             raise TaskError(f"object.{key}", "not for shape: mesh (the mesh gives the section and thickness)")
