@@ -68,7 +68,9 @@ ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine"
               help="With --evaluate: the worlds' seed (every design runs in the same worlds).")
 @click.option("--out", "out_dir", default=None, type=click.Path(file_okay=False), metavar="DIR",
               help="Where each design's task file goes (design-1.yaml is the best). Default: NAME.designs/ beside "
-                   "the design file NAME.design.yaml.")
+                   "the design file NAME.design.yaml. The folder then holds this run's designs only: the designs an "
+                   "earlier run wrote there are replaced or removed; a design-N.yaml this tool did not write is "
+                   "refused before the search; other files are left alone.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the ranked designs (`designs`, best first, each with its `task_file`), the unsolved "
                    "layouts (`unsolved`, and grouped by why: `no_plan`) and the verdict.")
@@ -106,9 +108,17 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
       stablepush plan data/designs/offset-low-mu.designs/design-1.yaml -o best.plan.json
       stablepush design data/designs/offset-low-mu.design.yaml --evaluate 20 --vary pad_mu=0.2
     """
-    from stablepush.design import DEFAULT_RANK, design_files, designs_folder, evaluate_designs, parse_rank
+    from stablepush.design import (
+        DEFAULT_RANK,
+        check_designs_folder,
+        design_files,
+        designs_folder,
+        evaluate_designs,
+        parse_rank,
+        write_designs,
+    )
     from stablepush.design import design as search
-    from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_files
+    from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
     from stablepush.runners import default_workers
     from stablepush.task.schema import load_design
 
@@ -116,6 +126,7 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     out = Path(out_dir) if out_dir is not None else designs_folder(design_file)
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_named_outputs({"--json": json_path, "--plot": png_path}, {"DESIGN.yaml": design_file})
+    check_designs_folder(out, "--out")
     task, candidates = load_design(design_file)
     spreads = _spreads(task, candidates, design_file, trials, vary, feature_error)
     runner = runner_for(workers, ray_address, default=default_workers())
@@ -137,9 +148,7 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     files = design_files(study, task, candidates, out, design_file)
     if json_path is not None:
         files[json_path] = json.dumps(study.as_dict(), indent=1) + "\n"
-    if study.designs:
-        out.mkdir(parents=True, exist_ok=True)
-    write_files(files)
+    write_designs(files, out)
     if png_path is not None and study.designs:
         from stablepush.viz.figures import layouts_figure, save_figure
 

@@ -1,5 +1,7 @@
 """Fixture layouts: from a part and a regrasp to ranked layouts, each a task with a verified plan
-(`stablepush design`; layouts.py), and the best ones' measured odds (odds.py)."""
+(`stablepush design`; layouts.py), the best ones' measured odds (odds.py), and the folder the
+designs are written to (folder.py)."""
+from stablepush.design.folder import check_designs_folder, write_designs
 from stablepush.design.layouts import (
     DEFAULT_RANK,
     RANK_KEYS,
@@ -15,5 +17,6 @@ from stablepush.design.layouts import (
 )
 from stablepush.design.odds import evaluate_designs
 
-__all__ = ["design", "evaluate_designs", "design_files", "designs_folder", "design_task", "layout_task",
-           "measure_layout", "parse_rank", "Design", "DesignStudy", "RANK_KEYS", "DEFAULT_RANK"]
+__all__ = ["design", "evaluate_designs", "design_files", "check_designs_folder", "write_designs", "designs_folder",
+           "design_task", "layout_task", "measure_layout", "parse_rank", "Design", "DesignStudy", "RANK_KEYS",
+           "DEFAULT_RANK"]

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from stablepush.design.commented import commented_task
+from stablepush.design.folder import DESIGN_HEADER, DESIGN_NAME
 from stablepush.errors import PadFaceError, TaskError
 from stablepush.execution.verdict import tolerance_used
 from stablepush.execution.world import place_features
@@ -406,8 +407,8 @@ def design_files(study: DesignStudy, task: Dict[str, Any], candidates: Sequence[
         text = None
     files = {}
     for k, d in enumerate(study.designs, start=1):
-        d.task_file = str(Path(folder) / f"design-{k}.yaml")
-        header = (f"# design-{k} of {Path(source).name if source else 'a design'} (stablepush design): the layout "
-                  f"{' + '.join(d.pushers)}, each fixture where its plan puts it (environment.features)\n")
+        d.task_file = str(Path(folder) / DESIGN_NAME.format(rank=k))
+        header = (DESIGN_HEADER.format(rank=k, source=Path(source).name if source else "a design")
+                  + f"the layout {' + '.join(d.pushers)}, each fixture where its plan puts it (environment.features)\n")
         files[d.task_file] = commented_task(text, design_task(task, candidates, d, source), header)
     return files
