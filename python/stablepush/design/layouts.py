@@ -374,19 +374,19 @@ def design_task(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], d: D
                 source: Optional[str] = None) -> Dict[str, Any]:
     """A design as a complete task in the task file's form: the design file's task with the
     layout's pushers, and environment.features where its plan puts each fixture (what `plan`,
-    `execute` and `evaluate` take unchanged). Files the design file `source` names relative to
-    itself (a mesh, a robot model) are named absolutely, so the task file reads them anywhere."""
+    `execute` and `evaluate` take unchanged). The files the design file `source` names (a mesh, a
+    robot model) are named by the absolute paths its task read them from, so the task file reads
+    the same files anywhere (a model `~/arm.urdf` is the home folder's, as the design file read it)."""
     by_name = {c["name"]: c for c in candidates}
     environment = dict(task.get("environment") or {})
     environment["features"] = {name: [round(v, 6) for v in pose] for name, pose in d.features.items()}
     out = {**task, "pushers": [dict(by_name[name]) for name in d.pushers], "environment": environment}
-    if source is not None:
-        folder = Path(source).resolve().parent
-        if isinstance(out.get("object"), dict) and isinstance(out["object"].get("file"), str):
-            out["object"] = {**out["object"], "file": str(folder / out["object"]["file"])}
-        robot = environment.get("robot")
-        if isinstance(robot, dict) and isinstance(robot.get("model"), str):
-            environment["robot"] = {**robot, "model": str(folder / robot["model"])}
+    read = d.task if d.task is not None else layout_task(task, [by_name[name] for name in d.pushers], source)
+    if read.mesh is not None and isinstance(out.get("object"), dict):
+        out["object"] = {**out["object"], "file": read.mesh.file}
+    robot = environment.get("robot")
+    if isinstance(robot, dict) and read.environment.robot.model is not None:
+        environment["robot"] = {**robot, "model": read.environment.robot.model}
     return out
 
 
