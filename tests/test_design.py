@@ -19,6 +19,7 @@ from stablepush.design import (
     design_task,
     evaluate_designs,
     layout_task,
+    layouts,
     measure_layout,
     parse_rank,
 )
@@ -273,21 +274,27 @@ def test_the_odds_options_are_refused_before_the_search(tmp_path, args, says):
 
 
 
-def test_the_design_command_says_how_many_layouts_gave_no_plan_and_why_grouped(tmp_path):
+def test_the_design_command_says_how_many_layouts_gave_no_plan_and_why_grouped(tmp_path, monkeypatch):
     data = yaml.safe_load(DESIGN.read_text())
     data["candidates"] = [{"name": "left", "from": [-50, -12.5], "to": [-50, 12.5], "mu": 0.2},
                           {"name": "right", "from": [50, 12.5], "to": [50, -12.5], "mu": 0.2},
                           {"name": "top", "from": [50, 12.5], "to": [-50, 12.5], "mu": 0.2}]
-    # a feature for one candidate: every layout without it is refused (a slip a design file can make)
-    data["environment"]["features"] = {"top": [0, 0, 300, 0]}
     path = tmp_path / "three.design.yaml"
     path.write_text(yaml.safe_dump(data))
+    whole = layouts.layout_task
+
+    def refused_without_top(task, pushers, source=None):  # one worker: this process plans every layout
+        if len(pushers) < 3 and "top" not in [p["name"] for p in pushers]:
+            raise TaskError("goal", "refused without top")
+        return whole(task, pushers, source)
+
+    monkeypatch.setattr(layouts, "layout_task", refused_without_top)
     result = CliRunner().invoke(cli, ["design", str(path), "--quiet", "--time-limit", "0.5", "--reach-top", "0",
                                       "--workers", "1", "--json", str(tmp_path / "d.json")])
     assert result.exit_code == 1, result.output
     assert "of the 3 layouts planned, 0 solved and 3 gave no plan:" in result.output
-    assert ("  2: the layout's task was refused (left, left + right); e.g. left: environment.features.top: no pusher "
-            "named 'top' (the task has left)") in result.output
+    assert "  2: the layout's task was refused (left, left + right); e.g. left: goal: refused without top" in (
+        result.output)
     assert "  1: the search ended before the goal (its check limit or its time ran out), the best partial path " in (
         result.output)
     groups = yaml.safe_load((tmp_path / "d.json").read_text())["no_plan"]

@@ -348,7 +348,8 @@ def load_design(path: "str | Path") -> Tuple[Dict[str, Any], List[Dict[str, Any]
     """A design task file (`stablepush design`): a task whose `candidates` stand in for its
     `pushers`. Returns the task's mapping without them and the candidate pushers as pusher entries
     of the task file's form (`candidate_pushers`); every layout of them is then a task of its own
-    (parse_task of the mapping with `pushers` set). TaskError naming the field."""
+    (parse_task of the mapping with `pushers` set). TaskError naming the field; `environment.features`
+    is refused: the design places the fixtures."""
     source = str(path)
     try:
         data = _load_yaml(read_capped(path, MAX_TASK_BYTES).decode("utf-8"))
@@ -367,6 +368,11 @@ def load_design(path: "str | Path") -> Tuple[Dict[str, Any], List[Dict[str, Any]
     if "candidates" not in data:
         raise TaskError("candidates", "missing: {mu: M} (every edge and convex corner of the section), or a list of "
                                       "pusher entries", source)
+    environment = data.get("environment")
+    if isinstance(environment, dict) and "features" in environment:  # else every layout without one is refused
+        raise TaskError("environment.features", "a design places its fixtures itself (each design's "
+                                                "environment.features is where its plan puts them): remove it from "
+                                                "the design file", source)
     task = {k: v for k, v in data.items() if k != "candidates"}
     try:
         return task, candidate_pushers(data["candidates"], task, source)
