@@ -40,6 +40,7 @@ from stablepush.frames import angle_about_y
 from stablepush.plan import check_plan, plan_task
 from stablepush.plan.plan import Plan
 from stablepush.plan.reach import reach_map
+from stablepush.plan.search import require_goal_apart
 from stablepush.plan.verify import plan_margin
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.task.mechanics import stable_directions
@@ -255,6 +256,7 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
         raise TaskError("max_fixtures", f"must be at least 1, got {max_fixtures}")
     max_fixtures = min(max_fixtures, len(candidates))
     everything = layout_task(task, candidates, source)  # every candidate checked once, on the part
+    require_goal_apart(everything)  # else every candidate would be pruned as making no push toward the goal
     toward = _pushers_toward_goal(everything)
     useful = [i for i, c in enumerate(candidates) if c["name"] in toward]
     layouts = [combo for size in range(1, max_fixtures + 1)

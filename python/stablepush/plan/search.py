@@ -32,6 +32,17 @@ def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, 
                          normal=tuple(float(v) for v in normal))
 
 
+def require_goal_apart(task: Task) -> None:
+    """TaskError (field `goal`) when the task's start is already within its tolerance of the goal:
+    there is nothing to plan (`plan`, and `design` before its search, say so in these words)."""
+    require_task(task)
+    if task.at_goal(task.start):
+        tolerance = list(task.planner.tolerance)
+        raise TaskError("goal", f"the start {list(task.start)} is already within planner.tolerance {tolerance} of the "
+                                f"goal {list(task.goal)}: there is nothing to plan (a task written in metres? task "
+                                f"files use mm)", task.source)
+
+
 def plan_task(
     task: Task,
     *,
@@ -64,12 +75,7 @@ def plan_task(
     tolerance's edge leaves an open-loop run no room for a real push's drift. Where neither finds
     one, the first plan stands and its stats say how deep it got (`end_used`, `deeper`).
     TaskError (field `goal`) when the start is already within the tolerance of the goal."""
-    require_task(task)
-    if task.at_goal(task.start):
-        tolerance = list(task.planner.tolerance)
-        raise TaskError("goal", f"the start {list(task.start)} is already within planner.tolerance {tolerance} of the "
-                                f"goal {list(task.goal)}: there is nothing to plan (a task written in metres? task "
-                                f"files use mm)", task.source)
+    require_goal_apart(task)
     settings = task.planner.replace(
         seed=None if seed is None else planner_parameter("seed", "seed", seed),
         max_switches=None if max_switches is None else planner_parameter("max_switches", "max_switches", max_switches),
