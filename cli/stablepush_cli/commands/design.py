@@ -95,12 +95,13 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     them (environment.features), that `plan`, `execute` and `evaluate` take unchanged. With
     --evaluate N, the best designs' plans each run N trials in the same simulated worlds, and the
     designs are ranked by their measured success rate first. Exit 1 when no layout of the
-    candidates can do the regrasp, with the reason.
+    candidates can do the regrasp, with the reason, or when the task's arm (environment.robot) can
+    follow none of the designs (they are written all the same).
 
     \b
-    Exit status: 0 designs found, 1 none, 2 bad input, 4 an evaluation trial crashed (an internal
-    error; everything is written), 130 the evaluation stopped by Ctrl-C (the designs measured so
-    far are ranked and written).
+    Exit status: 0 designs found, 1 none (or none the arm can follow), 2 bad input, 4 an
+    evaluation trial crashed (an internal error; everything is written), 130 the evaluation
+    stopped by Ctrl-C (the designs measured so far are ranked and written).
 
     \b
     Examples:
@@ -170,7 +171,7 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
         say(f"odds: {which}, {e['trials']} trials each in the same worlds ({e['spreads']}; "
             f"seed {e['seed']}, {'closed' if e['closed_loop'] else 'open'} loop on {e['engine']})")
     say(study.verdict)
-    if not study.designs:
+    if not study.usable:
         raise SystemExit(EXIT_NOT_SOLVED)
     crashed = sum(d.success.get("crashed", 0) for d in study.designs if d.success)
     if crashed:

@@ -168,8 +168,19 @@ class DesignStudy:
     interrupted: bool = False  # the odds' trials stopped by Ctrl-C
 
     @property
+    def usable(self) -> List[Design]:
+        """The designs the task's arm can follow (every design where the task names no arm)."""
+        return [d for d in self.designs if d.arm is None or d.arm["follows"]]
+
+    @property
     def verdict(self) -> str:
-        """One line: the best design, or why there is none."""
+        """One line: the best design, or why there is none (none solved; or none the arm can follow,
+        when the ranking's best is one it cannot)."""
+        if self.designs and not self.usable:
+            first = self.designs[0]
+            many = f"any of the {len(self.designs)} designs" if len(self.designs) > 1 else "the one design"
+            return (f"no design is usable by this arm: it cannot follow the plan of {many} (e.g. "
+                    f"{' + '.join(first.pushers)}: {first.arm['reason']})")
         if self.designs:
             best = self.designs[0]
             return (f"best layout: {' + '.join(best.pushers)} ({best.pushes} pushes, {best.switches} switch-overs, "
