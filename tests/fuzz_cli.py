@@ -158,8 +158,18 @@ def _mesh(rng: random.Random):
     import numpy as np
     import trimesh
 
-    kind = rng.choice(["box", "cylinder", "washer", "two", "flat", "huge", "open"])
+    kind = rng.choice(["box", "cylinder", "washer", "two", "flat", "huge", "open", "shaft", "dimpled"])
     turn = trimesh.transformations.rotation_matrix(math.pi / 2, [1, 0, 0])
+    if kind in ("shaft", "dimpled"):  # pads on a round shaft along x; a puck with a dimple under the path
+        radius, half = rng.uniform(5, 30), rng.uniform(3, 20)
+        profile = ([(0, -half), (radius, -half), (radius, half), (0, half)] if kind == "shaft" else
+                   [(0, -half + 0.5), (2, -half + 0.5), (2, -half), (radius, -half), (radius, half), (2, half),
+                    (2, half - 0.5), (0, half - 0.5)])
+        solid = trimesh.creation.revolve(np.array(profile, float), sections=16)
+        axis = [0, 1, 0] if kind == "shaft" else [1, 0, 0]
+        solid.apply_transform(trimesh.transformations.rotation_matrix(math.pi / 2 * (1 if kind == "shaft" else -1),
+                                                                      axis))
+        return kind, solid, float(solid.bounds[0, 0])
     if kind == "cylinder":
         radius = rng.uniform(5, 40)
         solid = trimesh.creation.cylinder(radius=radius, height=rng.uniform(5, 40), sections=32)

@@ -14,7 +14,7 @@ from stablepush import _core
 from stablepush.errors import PadFaceError, TaskError
 from stablepush.plan import plan_task
 from stablepush.task import load_task, parse_task
-from stablepush.task.mesh import PartMesh, first_pad_off_faces, load_mesh_object, pad_face_problem
+from stablepush.task.mesh import PartMesh, _solid_in_o, first_pad_off_faces, load_mesh_object, pad_face_problem
 
 from conftest import ROOT
 
@@ -228,7 +228,7 @@ def test_pads_on_a_round_shaft_are_refused_naming_the_pose_the_pad_and_what_they
     assert error.value.field == "start"
     reason = error.value.reason
     assert reason.startswith("gripper.pads[0] at the start pose [0.0, 0.0, 0.0]"), reason
-    assert "curved faces on both sides" in reason and "to 20 mm thick" in reason and "slab 36 mm thick" in reason
+    assert "curved faces on both sides" in reason and "to 20 mm apart" in reason and "slab 36 mm thick" in reason
 
 
 def test_pads_over_a_step_in_thickness_are_refused_at_the_goal(tmp_path):
@@ -241,7 +241,7 @@ def test_pads_over_a_step_in_thickness_are_refused_at_the_goal(tmp_path):
                       [5, 0, 0], [-27, 0, 0])
     with pytest.raises(TaskError) as error:
         parse_task(data, source=str(tmp_path / "task.yaml"))
-    assert error.value.field == "goal" and "12 mm thick" in error.value.reason, error.value.reason
+    assert error.value.field == "goal" and "faces 12 mm apart" in error.value.reason, error.value.reason
 
 
 def _dimpled(tmp_path):
@@ -260,7 +260,7 @@ def test_a_path_over_a_dimple_is_refused_though_its_start_and_goal_rest_flat(tmp
         plan_task(task, seed=1)
     assert error.value.field == "gripper.pads[0]"
     assert "takes the pad off the part's faces just after waypoint" in error.value.reason
-    assert "18 to 20 mm thick" in error.value.reason
+    assert "18 to 20 mm apart" in error.value.reason
 
 
 def test_plan_refuses_a_path_off_the_faces_with_exit_2(tmp_path):
@@ -308,3 +308,20 @@ def test_the_shipped_bracket_rests_flat_along_its_plan():
     plan = plan_task(task, seed=1)
     assert plan.solved
     assert first_pad_off_faces(task.mesh, task.pads, [w.pose for w in plan.waypoints]) is None
+
+
+def test_a_mesh_file_rewritten_after_the_task_was_read_is_named_not_mistaken(tmp_path):
+    """The pads' faces were checked on a cached solid of the file's earlier content (the fuzz
+    rewrites one file name): the solid is pinned to the bytes the task read."""
+    trimesh.creation.box([60, 20, 40]).export(tmp_path / "part.stl")
+    data = _mesh_task("part.stl", [{"name": "left", "from": [-30, 10], "to": [-30, -10], "mu": 0.6}], [0, 0, 0],
+                      [5, 0, 0])
+    first = parse_task(data, source=str(tmp_path / "task.yaml"))
+    assert first.mesh.solid().extents[1] == pytest.approx(20.0)
+    trimesh.creation.box([60, 30, 40]).export(tmp_path / "part.stl")
+    second = parse_task(data, source=str(tmp_path / "task.yaml"))
+    assert second.mesh.solid().extents[1] == pytest.approx(30.0)  # not the cached 20 mm solid
+    assert first.mesh.solid().extents[1] == pytest.approx(20.0)  # what the first task read, while cached
+    _solid_in_o.cache_clear()
+    with pytest.raises(TaskError, match="changed since the task was read"):
+        first.mesh.solid()

@@ -7,6 +7,7 @@ times `scale`, must give mm.
 """
 from __future__ import annotations
 
+import hashlib
 import io
 import math
 from dataclasses import dataclass
@@ -34,18 +35,22 @@ class PartMesh:
     """The solid a mesh task's part is, kept beside the section the model plans with: the file,
     the scale into mm, and where O's y = 0 lies in the scaled mesh (`center_y`, mm: the middle of
     its extent along y, where the model's slab is centred). `tolerance` (mm) is the section's
-    simplification bound, also the bound within which a pad's face counts as the slab's."""
+    simplification bound, also the bound within which a pad's face counts as the slab's. `digest`
+    (SHA-256 of the file's bytes as the task read them; "" for none) pins the solid to the section
+    the task took from it."""
 
     file: str  # absolute path
     scale: float
     center_y: float  # mm
     thickness: float  # mm: the solid's extent along y (the model's slab)
     tolerance: float  # mm
+    digest: str = ""
 
     def solid(self):
-        """The solid in O (a trimesh.Trimesh in mm; y = 0 the slab's centre). Read once per
-        PartMesh (cached): treat it as read-only."""
-        return _solid_in_o(self.file, self.scale, self.center_y)
+        """The solid in O (a trimesh.Trimesh in mm; y = 0 the slab's centre), read once per file
+        content (cached: treat it as read-only). TaskError (object.file) when the file no longer
+        holds what the task read."""
+        return _solid_in_o(self.file, self.scale, self.center_y, self.digest)
 
 
 # How a pad's disc is sampled for the face check: the centre and rings of 6i points out to the rim
@@ -108,7 +113,7 @@ def pad_face_problem(part: PartMesh, center: Tuple[float, float], radius: float)
     gap = above[:, 0] - below[:, 0]
     if float(np.abs(gap - part.thickness).max()) > tol:
         span = f"{gap.min():.3g} to {gap.max():.3g}" if gap.max() - gap.min() > tol else f"{gap[0]:.3g}"
-        found.append(f"{span} mm thick")
+        found.append(f"{'' if found else 'faces '}{span} mm apart")
     elif shifted and not shapes:
         found.append(f"faces at y = {float(below[0, 0]):.3g} and {float(above[0, 0]):.3g} mm, the slab's at "
                      f"{-half:.3g} and {half:.3g}")
@@ -153,10 +158,12 @@ def first_pad_off_faces(part: PartMesh, pads: Sequence[Tuple[Tuple[float, float]
 
 
 @lru_cache(maxsize=8)
-def _solid_in_o(file: str, scale: float, center_y: float):
+def _solid_in_o(file: str, scale: float, center_y: float, digest: str):
     import trimesh
 
-    mesh = _read_solid(trimesh, Path(file), "object")
+    mesh, now = _read_solid(trimesh, Path(file), "object")
+    if digest and now != digest:
+        raise TaskError("object.file", f"{file} changed since the task was read: load the task again")
     mesh.apply_scale(scale)
     mesh.apply_translation([0.0, -center_y, 0.0])
     return mesh
@@ -189,7 +196,7 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
         from shapely.geometry.polygon import orient
     except ImportError as exc:  # pragma: no cover - both are dependencies
         raise TaskError(field, f"mesh objects need trimesh and shapely ({exc})") from None
-    mesh = _read_solid(trimesh, path, field)
+    mesh, digest = _read_solid(trimesh, path, field)
     mesh.apply_scale(scale)
     thickness = float(mesh.extents[1])
     if not thickness_range[0] <= thickness <= thickness_range[1]:
@@ -224,13 +231,14 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
                      f"mm but {thickness:.3g} mm overall; the model takes a slab of {thickness:.3g} mm (the pads "
                      f"press on its two faces)")
     part = PartMesh(file=str(Path(path).resolve()), scale=float(scale), center_y=float((low + high) / 2),
-                    thickness=thickness, tolerance=float(tolerance))
+                    thickness=thickness, tolerance=float(tolerance), digest=digest)
     return MeshObject(vertices=vertices, thickness=thickness, mass=float(grams), com=(float(com[0]), float(com[2])),
                       inertia=inertia, section_vertices=raw, part=part, notes=tuple(notes))
 
 
 def _read_solid(trimesh, path: Path, field: str):
-    """The mesh in `path` (its own units) once it is one closed body; TaskError naming `field`.file."""
+    """The mesh in `path` (its own units) once it is one closed body, and the SHA-256 of the bytes
+    it was read from; TaskError naming `field`.file."""
     file_type = path.suffix.lstrip(".").lower()
     if file_type not in MESH_FORMATS:
         raise TaskError(f"{field}.file", f"{path.name}: a mesh file is one of {', '.join(MESH_FORMATS)} "
@@ -253,7 +261,7 @@ def _read_solid(trimesh, path: Path, field: str):
     if bodies > 1:
         raise TaskError(f"{field}.file", f"{path} holds {bodies} separate bodies; the grasp holds one "
                                          f"(one body per file)")
-    return mesh
+    return mesh, hashlib.sha256(data).hexdigest()
 
 
 def _section_outline(mesh, y: float, field: str):
