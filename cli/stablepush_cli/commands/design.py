@@ -166,10 +166,7 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
                                         f", the arm cannot follow it ({d.arm['reason']})")
         say(f"{k}. {_figures(d)}{reach}{arm}{d.odds()}, planned in {d.planning_time_s:.3f} s -> {d.task_file}")
     if study.evaluated is not None:
-        e = study.evaluated
-        which = "the best design" if e["top"] == 1 else f"the best {e['top']} designs"
-        say(f"odds: {which}, {e['trials']} trials each in the same worlds ({e['spreads']}; "
-            f"seed {e['seed']}, {'closed' if e['closed_loop'] else 'open'} loop on {e['engine']})")
+        say(study.describe_odds())
     say(study.verdict)
     if not study.usable:
         raise SystemExit(EXIT_NOT_SOLVED)

@@ -228,6 +228,23 @@ class DesignStudy:
             lines.append(f"  {g['layouts']}: {g['why']}{span} ({named}){for_one}")
         return lines
 
+    def describe_odds(self) -> Optional[str]:
+        """How the odds were measured, in a line (None: they were not): the designs, the trials and
+        the worlds; where a design ran fewer trials than asked (the study stopped by Ctrl-C, its
+        arm refused, one world), how many each ran."""
+        e = self.evaluated
+        if e is None:
+            return None
+        which = "the best design" if e["top"] == 1 else f"the best {e['top']} designs"
+        worlds = (f"in the same worlds ({e['spreads']}; seed {e['seed']}, {'closed' if e['closed_loop'] else 'open'} "
+                  f"loop on {e['engine']})")
+        ran = e.get("ran", {})
+        if not self.interrupted and all(n == e["trials"] for n in ran.values()):
+            return f"odds: {which}, {e['trials']} trials each {worlds}"
+        each = ", ".join(f"{layout} ran {n} of {e['trials']}" if n else f"{layout} none" for layout, n in ran.items())
+        return (f"odds: {which}, {e['trials']} trials asked of each {worlds}; "
+                f"{'the study stopped by Ctrl-C: ' if self.interrupted else ''}{each}")
+
     def as_dict(self) -> Dict[str, Any]:
         return {"candidates": self.candidates, "pruned_candidates": self.pruned_candidates,
                 "layouts_searched": self.layouts_searched, "layouts_pruned": self.layouts_pruned,

@@ -10,12 +10,17 @@ then rests on the keys after `success`.
 """
 from __future__ import annotations
 
-from typing import Callable, Optional
+from typing import Any, Callable, Dict, Optional
 
 from stablepush.design.layouts import Design, DesignStudy
+from stablepush.errors import SettingError
 from stablepush.evaluation import Batch, Spreads, evaluate
 from stablepush.runners import Runner
-from stablepush.sim.engines import DEFAULT_ENGINE
+from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.units import is_integer
+
+MAX_TRIALS = 1_000_000  # a design's, as `evaluate --trials` takes
+MAX_SEED = 2**32 - 1
 
 
 def evaluate_designs(study: DesignStudy, trials: int, spreads: Spreads, top: int = 3, seed: int = 1,
@@ -27,10 +32,14 @@ def evaluate_designs(study: DesignStudy, trials: int, spreads: Spreads, top: int
     `success` put first unless the rule places it). A design whose arm cannot follow its plan in
     the cell runs no trial (`success.refused` says why) and ranks below those measured.
     `progress(design, record, done)` after each trial. Ctrl-C stops the study with the designs
-    measured so far (`study.interrupted`)."""
+    measured so far (`study.interrupted`); `study.evaluated["ran"]` says how many trials each of
+    the top designs ran (layout -> trials). SettingError naming an argument out of its range,
+    before any trial."""
+    _check_arguments(study, trials, spreads, top, seed, closed_loop, engine)
     from stablepush.sim.joint_path import CellError  # loads MuJoCo: not before the odds are asked for
 
     runner = runner or Runner()
+    ran: Dict[str, int] = {" + ".join(d.pushers): 0 for d in study.designs[:top]}
     for d in study.designs[:top]:
         try:
             batch = Batch(task=d.task, plan=d.plan, spreads=spreads, seed=seed, closed_loop=closed_loop,
@@ -43,11 +52,32 @@ def evaluate_designs(study: DesignStudy, trials: int, spreads: Spreads, top: int
         s = measured.summary()
         d.success = {key: s[key] for key in ("trials", "judged", "successes", "success_rate", "ci95", "causes",
                                              "crashed", "wall_s")}
+        ran[" + ".join(d.pushers)] = s["trials"]
         if measured.interrupted:
             study.interrupted = True
             break
     study.evaluated = {"trials": trials, "top": min(top, len(study.designs)), "seed": seed,
-                       "spreads": spreads.describe(), "closed_loop": closed_loop, "engine": engine}
+                       "spreads": spreads.describe(), "closed_loop": closed_loop, "engine": engine,
+                       "interrupted": study.interrupted, "ran": ran}
     if "success" not in study.rank:
         study.rank = ("success",) + tuple(study.rank)
     study.designs.sort(key=lambda d: d.key(study.rank))
+
+
+def _check_arguments(study: Any, trials: Any, spreads: Any, top: Any, seed: Any, closed_loop: Any,
+                     engine: Any) -> None:
+    """evaluate_designs' arguments, as `design --evaluate` takes them: SettingError naming the one
+    out of its range (TypeError for a study that is not one)."""
+    if not isinstance(study, DesignStudy):
+        raise TypeError(f"study: expected a DesignStudy (design()'s result), got {type(study).__name__}")
+    for name, value, low, high in (("trials", trials, 1, MAX_TRIALS), ("top", top, 1, None),
+                                   ("seed", seed, 0, MAX_SEED)):  # top past the designs: all of them
+        if isinstance(value, bool) or not is_integer(value) or not low <= value <= (high or value):
+            most = f" to {high:,}" if high else " up"
+            raise SettingError(name, f"must be a whole number from {low}{most}, got {value!r:.40}")
+    if not isinstance(spreads, Spreads):
+        raise SettingError("spreads", f"must be a Spreads (evaluation.Spreads.for_task), got {type(spreads).__name__}")
+    if not isinstance(closed_loop, bool):
+        raise SettingError("closed_loop", f"must be true or false, got {closed_loop!r:.40}")
+    if engine not in ENGINES:
+        raise SettingError("engine", f"must be one of {', '.join(ENGINES)}, got {engine!r:.40}")
