@@ -33,7 +33,7 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from stablepush.design.commented import commented_task
 from stablepush.design.folder import DESIGN_HEADER, DESIGN_NAME
-from stablepush.errors import PadFaceError, TaskError
+from stablepush.errors import PadFaceError, SettingError, TaskError
 from stablepush.execution.verdict import tolerance_used
 from stablepush.execution.world import place_features
 from stablepush.frames import angle_about_y
@@ -45,7 +45,8 @@ from stablepush.plan.verify import plan_margin
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.task.mechanics import stable_directions
 from stablepush.task.model import Robot, Task
-from stablepush.task.schema import parse_task, planner_parameter
+from stablepush.task.schema import parse_task, planner_limit, planner_parameter
+from stablepush.units import is_integer
 
 # What a layout is ranked by, each best first: the key, and +1 where less is better, -1 more.
 # `arm`: 0 where the task's arm follows the plan, 1 where it cannot (no arm named: not a key);
@@ -82,10 +83,14 @@ NO_PLAN_EXAMPLE = ("refused", "unreachable", "worker_lost")  # whose words need 
 def parse_rank(text: str, measured: bool = False) -> Tuple[str, ...]:
     """A ranking rule: keys of RANK_KEYS, comma-separated, most important first, each at most
     once; `success` only where the designs' odds are `measured` (odds.evaluate_designs)."""
-    keys = tuple(k.strip() for k in text.split(",") if k.strip())
-    unknown = [k for k in keys if k not in RANK_KEYS]
+    return _rank_keys(tuple(k.strip() for k in text.split(",") if k.strip()), repr(text), measured)
+
+
+def _rank_keys(keys: Tuple[Any, ...], given: str, measured: bool) -> Tuple[str, ...]:
+    """`keys` as a ranking rule (parse_rank's), TaskError otherwise; `given`: the rule as given."""
+    unknown = [k for k in keys if not isinstance(k, str) or k not in RANK_KEYS]
     if not keys or unknown or len(set(keys)) < len(keys):
-        raise TaskError("rank", f"keys from {', '.join(RANK_KEYS)}, comma-separated, each once, got {text!r:.80}")
+        raise TaskError("rank", f"keys from {', '.join(RANK_KEYS)}, comma-separated, each once, got {given:.80}")
     if "success" in keys and not measured:
         raise TaskError("rank", "`success` is measured by evaluating the designs (--evaluate N); without it "
                                 "no design has a success rate to rank by")
@@ -280,8 +285,7 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
     task's planner.time_limit, which is otherwise only a guard), and rank the solved ones
     by `rank` (keys of RANK_KEYS); the best `reach_top` get a reach map around the goal.
     `progress(design)` after each layout is planned."""
-    if max_fixtures < 1:
-        raise TaskError("max_fixtures", f"must be at least 1, got {max_fixtures}")
+    rank, check_limit = _checked_arguments(max_fixtures, rank, reach_top, time_limit, runner, progress, check_limit)
     max_fixtures = min(max_fixtures, len(candidates))
     everything = layout_task(task, candidates, source)  # every candidate checked once, on the part
     require_goal_apart(everything)  # else every candidate would be pruned as making no push toward the goal
@@ -290,8 +294,7 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
     layouts = [combo for size in range(1, max_fixtures + 1)
                for combo in itertools.combinations(range(len(candidates)), size) if set(combo) & set(useful)]
     total = sum(math.comb(len(candidates), k) for k in range(1, max_fixtures + 1))
-    job = _Job(task, tuple(candidates), source, tuple(layouts), time_limit,
-               planner_parameter("check_limit", "check_limit", check_limit))
+    job = _Job(task, tuple(candidates), source, tuple(layouts), time_limit, check_limit)
     runner = runner or Runner()
     results: List[Design] = []
     for i, result in run_all(_plan_layout, job, range(len(layouts)), runner):
@@ -310,6 +313,28 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
                        pruned_candidates=[c["name"] for i, c in enumerate(candidates) if i not in useful],
                        layouts_searched=len(layouts), layouts_pruned=total - len(layouts), rank=tuple(rank),
                        failed=[d for d in results if not d.solved])
+
+
+def _checked_arguments(max_fixtures: Any, rank: Any, reach_top: Any, time_limit: Any, runner: Any, progress: Any,
+                       check_limit: Any) -> Tuple[Tuple[str, ...], int]:
+    """design()'s arguments checked before any work, as `stablepush design` takes them (TaskError
+    or SettingError naming the one out of its range, TypeError for a runner or progress that is
+    not one): the rank as a tuple of keys (`success` may be among them: evaluate_designs measures
+    it) and the check limit."""
+    if isinstance(max_fixtures, bool) or not is_integer(max_fixtures) or max_fixtures < 1:
+        raise SettingError("max_fixtures", f"must be a whole number from 1 up, got {max_fixtures!r:.40}")
+    if isinstance(reach_top, bool) or not is_integer(reach_top) or reach_top < 0:
+        raise SettingError("reach_top", f"must be a whole number from 0 up, got {reach_top!r:.40}")
+    if time_limit is not None:
+        planner_limit("time_limit", time_limit)
+    if runner is not None and not isinstance(runner, Runner):
+        raise TypeError(f"runner: expected a Runner, got {type(runner).__name__}")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress: expected a function, got {type(progress).__name__}")
+    if isinstance(rank, str) or not isinstance(rank, (tuple, list)):
+        raise TaskError("rank", f"a sequence of keys from {', '.join(RANK_KEYS)}, got {rank!r:.80}")
+    keys = tuple(rank)
+    return _rank_keys(keys, repr(keys), measured=True), planner_parameter("check_limit", "check_limit", check_limit)
 
 
 def _distinct(ranked: List[Design]) -> List[Design]:
