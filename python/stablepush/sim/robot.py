@@ -17,10 +17,13 @@ Lengths in m, angles in rad in the tree; the Robot's fields are mm and deg.
 """
 from __future__ import annotations
 
+import codecs
 import copy
 import functools
 import math
 import os
+import re
+import stat
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -32,6 +35,8 @@ import numpy as np
 from stablepush.errors import TaskError
 from stablepush.execution.arm import RobotDescription
 from stablepush.frames import matrix_to_pose, pose_to_matrix
+from stablepush.inputs import read_capped
+from stablepush.outputs import protect_input
 from stablepush.task.model import Robot
 from stablepush.units import MM
 
@@ -129,13 +134,15 @@ def _built(robot: Robot, _stamp: int) -> ArmModel:
     flange = _flange(root, robot.flange)
     joints = _chain_joints(root, flange)
     if not robot.shipped:
+        _refuse_couplings(root, joints, robot.model)
         _servo(root, joints)
     _mount_jaws(root, flange, robot.tcp)
     names = tuple(j.get("name") for j in joints)
     speeds = np.array([velocity.get(name) or robot.max_joint_speed for name in names])
     mount = root.find(f"worldbody/body[@name='{BASE_BODY}']")
     base = next(body for body in mount if body.tag == "body" and flange in body.iter("body"))
-    urdf = Path(robot.model).read_text() if robot.model and Path(robot.model).suffix.lower() == ".urdf" else None
+    is_urdf = robot.model and Path(robot.model).suffix.lower() == ".urdf"
+    urdf = read_model_text(robot.model) if is_urdf else None
     return ArmModel(root, names, speeds, _home_guesses(joints, robot.shipped), base.get("name"),
                     matrix_to_pose(pose_to_matrix(_body_pose(mount)) @ pose_to_matrix(_body_pose(base))), urdf)
 
@@ -158,44 +165,143 @@ def robot_description(robot: Optional[Robot] = None) -> RobotDescription:
 def _compiled(path: str) -> ET.Element:
     """The model at `path` (URDF or MJCF) compiled by MuJoCo and saved as MJCF: one form for both
     engines, defaults and includes resolved, every angle in radians. A URDF keeps its fixed links
-    (fusestatic off: a flange is often one) and its collision geometry."""
+    (fusestatic off: a flange is often one) and its collision geometry. MuJoCo is handed the text
+    `model_source` makes of the file: the same from any working folder."""
     from stablepush.extras import require
 
     mujoco = require("mujoco", "environment.robot.model (MuJoCo compiles a lab's URDF or MJCF for both engines)")
-    text = Path(path).read_text()
-    folder = str(Path(path).resolve().parent)
+    root = model_source(path)
+    if root.tag == "robot":
+        extension = root.find("mujoco")
+        if extension is None:
+            extension = ET.SubElement(root, "mujoco")
+        compiler = extension.find("compiler")
+        if compiler is None:
+            compiler = ET.SubElement(extension, "compiler")
+        compiler.set("fusestatic", "false")
+        compiler.set("discardvisual", "true")
+        for link in root.iter("link"):  # named, so MuJoCo need not warn of each unnamed one
+            for k, collision in enumerate(link.iter("collision")):
+                collision.set("name", collision.get("name") or f"{link.get('name')}_collision{k}")
     try:
-        if Path(path).suffix.lower() == ".urdf":
-            urdf = ET.fromstring(text)
-            extension = urdf.find("mujoco")
-            if extension is None:
-                extension = ET.SubElement(urdf, "mujoco")
-            compiler = extension.find("compiler")
-            if compiler is None:
-                compiler = ET.SubElement(extension, "compiler")
-            compiler.set("fusestatic", "false")
-            compiler.set("discardvisual", "true")
-            compiler.set("meshdir", compiler.get("meshdir", folder))
-            for link in urdf.iter("link"):  # named, so MuJoCo need not warn of each unnamed one
-                for k, collision in enumerate(link.iter("collision")):
-                    collision.set("name", collision.get("name") or f"{link.get('name')}_collision{k}")
-            model = mujoco.MjModel.from_xml_string(ET.tostring(urdf, encoding="unicode"))
-        else:
-            model = mujoco.MjModel.from_xml_path(path)
-    except (ValueError, ET.ParseError) as exc:
+        model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+    except ValueError as exc:
         raise RobotError("environment.robot.model", f"MuJoCo cannot compile {path!r:.120}: "
                                                     f"{' '.join(str(exc).split())[:300]}") from None
     with tempfile.TemporaryDirectory() as scratch:
         saved = os.path.join(scratch, "robot.xml")
         mujoco.mj_saveLastXML(saved, model)
-        root = ET.parse(saved).getroot()
-    compiler = root.find("compiler")
+        compiled = ET.parse(saved).getroot()
+    compiler = compiled.find("compiler")
     if compiler is None:
-        compiler = ET.SubElement(root, "compiler")
-    for key in ("meshdir", "texturedir"):  # files stay where the model's folder has them
-        compiler.set(key, str(Path(folder, compiler.get(key, ""))))
+        compiler = ET.SubElement(compiled, "compiler")
+    folder = Path(path).resolve().parent
+    for key in ("meshdir", "texturedir"):  # absolute already (model_source); else the model's folder
+        compiler.set(key, str(folder / compiler.get(key, "")))
     compiler.set("angle", "radian")
+    return compiled
+
+
+MAX_MODEL_BYTES = 16_000_000  # a robot model file, and each file it includes
+MAX_INCLUDE_DEPTH = 8
+_ASSET_DIRS = ("meshdir", "texturedir", "assetdir")
+
+
+def read_model_xml(path: "str | Path") -> ET.Element:
+    """The XML of a robot model file (or a file it includes), decoded as it declares (UTF-8,
+    UTF-16, ISO-8859-1), from a regular file of at most MAX_MODEL_BYTES: RobotError naming
+    environment.robot.model otherwise."""
+    try:
+        data = read_capped(path, MAX_MODEL_BYTES)
+    except (OSError, ValueError) as exc:
+        raise RobotError("environment.robot.model", f"cannot read {str(path)!r:.120}: {exc}") from None
+    protect_input(path, "a robot model file")
+    try:
+        return ET.fromstring(data)
+    except (ET.ParseError, LookupError) as exc:  # LookupError: an encoding Python does not know
+        raise RobotError("environment.robot.model", f"{str(path)!r:.120} is not XML "
+                                                    f"({' '.join(str(exc).split())[:200]})") from None
+
+
+def read_model_text(path: "str | Path") -> str:
+    """A robot model file's text as written, decoded as its BOM or XML declaration says (the
+    URDF a recording carries as /robot_description)."""
+    read_model_xml(path)  # refused as the model is, if it is not XML
+    data = read_capped(path, MAX_MODEL_BYTES)
+    for boms, codec in (((codecs.BOM_UTF8,), "utf-8-sig"), ((codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE), "utf-16"),
+                        ((b"<\x00",), "utf-16-le"), ((b"\x00<",), "utf-16-be")):
+        if data.startswith(boms):
+            return data.decode(codec)
+    declared = re.match(rb"<\?xml[^>]*encoding=[\"']([A-Za-z0-9._-]+)", data)
+    return data.decode(declared.group(1).decode() if declared else "utf-8")
+
+
+def model_source(path: "str | Path") -> ET.Element:
+    """A lab's model as MuJoCo should read it from any working folder: its XML decoded
+    (read_model_xml), an MJCF's includes put in place (each a regular file, read and protected as
+    an input; at most MAX_INCLUDE_DEPTH deep), and the folders its meshes and textures are
+    found in made absolute: the model's folder, as MuJoCo takes a file's relative paths."""
+    folder = Path(path).resolve().parent
+    root = read_model_xml(path)
+    if root.tag == "robot":
+        extension = root.find("mujoco")
+        compiler = None if extension is None else extension.find("compiler")
+        if compiler is None:
+            compiler = ET.SubElement(extension if extension is not None else ET.SubElement(root, "mujoco"),
+                                     "compiler")
+        compiler.set("meshdir", str(folder / compiler.get("meshdir", "")))
+        meshes = Path(compiler.get("meshdir"))
+        _regular_files([meshes / Path(m.get("filename", "")).name for m in root.iter("mesh") if m.get("filename")])
+        return root
+    _inline_includes(root, folder, depth=0)
+    compilers = root.findall("compiler") or [ET.SubElement(root, "compiler")]
+    for compiler in compilers:
+        for key in _ASSET_DIRS:
+            if compiler.get(key) is not None:
+                compiler.set(key, str(folder / compiler.get(key)))
+    first = compilers[0]
+    if first.get("assetdir") is None:
+        for key in ("meshdir", "texturedir"):
+            if all(c.get(key) is None for c in compilers):
+                first.set(key, str(folder))
+    found = {key: Path(c.get(key)) for c in compilers for key in _ASSET_DIRS if c.get(key)}
+    meshes, textures = (found.get(key, found.get("assetdir", folder)) for key in ("meshdir", "texturedir"))
+    _regular_files([(textures if e.tag == "texture" else meshes) / e.get("file") for e in root.iter()
+                    if e.tag in ("mesh", "skin", "hfield", "texture") and e.get("file")])
     return root
+
+
+def _regular_files(paths: List[Path]) -> None:
+    """Each file a model names that exists is a regular file: MuJoCo's open of a FIFO would wait
+    for a writer forever. A missing one MuJoCo names itself."""
+    for path in paths:
+        try:
+            mode = os.stat(path).st_mode
+        except OSError:
+            continue
+        if not stat.S_ISREG(mode):
+            raise RobotError("environment.robot.model", f"{str(path)!r:.120} is not a regular file (a device, a "
+                                                        f"FIFO or a directory)")
+
+
+def _inline_includes(element: ET.Element, folder: Path, depth: int) -> None:
+    """Each <include file=...> under `element` replaced by the children of the file's <mujoco>
+    (MuJoCo's include, paths relative to the main model's folder)."""
+    for parent in list(element.iter()):
+        for k, child in reversed(list(enumerate(parent))):
+            if child.tag != "include":
+                continue
+            name = child.get("file")
+            if not name:
+                raise RobotError("environment.robot.model", "an <include> names no file")
+            if depth >= MAX_INCLUDE_DEPTH:
+                raise RobotError("environment.robot.model", f"includes nest more than {MAX_INCLUDE_DEPTH} deep "
+                                                            f"(at {name!r:.80}): a loop?")
+            included = read_model_xml(folder / name)
+            _inline_includes(included, folder, depth + 1)
+            parent.remove(child)
+            for offset, grandchild in enumerate(list(included)):
+                parent.insert(k + offset, grandchild)
 
 
 def _urdf_velocity_limits(path: str) -> Dict[str, float]:
@@ -204,10 +310,17 @@ def _urdf_velocity_limits(path: str) -> Dict[str, float]:
     if Path(path).suffix.lower() != ".urdf":
         return {}
     out = {}
-    for joint in ET.parse(path).getroot().iter("joint"):
+    for joint in read_model_xml(path).iter("joint"):
         limit = joint.find("limit")
-        if limit is not None and limit.get("velocity") and float(limit.get("velocity")) > 0:
-            out[joint.get("name")] = float(limit.get("velocity"))
+        if limit is None or not limit.get("velocity"):
+            continue
+        try:
+            velocity = float(limit.get("velocity"))
+        except ValueError:
+            raise RobotError("environment.robot.model", f"joint {joint.get('name')!r:.60}: limit velocity "
+                                                        f"{limit.get('velocity')!r:.40} is not a number") from None
+        if math.isfinite(velocity) and velocity > 0:
+            out[joint.get("name")] = velocity
     return out
 
 
@@ -230,7 +343,7 @@ def _mount_on_base(root: ET.Element, base: Tuple[float, ...]) -> None:
 
 
 def _flange(root: ET.Element, name: str) -> ET.Element:
-    flange = root.find(f".//body[@name='{name}']") if "'" not in name else None
+    flange = next((body for body in root.iter("body") if body.get("name") == name), None)  # any characters
     if flange is None:
         bodies = [b.get("name") for b in root.iter("body") if b.get("name") and b.get("name") != BASE_BODY]
         raise RobotError("environment.robot.flange", f"the model has no link {name!r:.60} (its links: "
@@ -260,6 +373,30 @@ def _chain_joints(root: ET.Element, flange: ET.Element) -> List[ET.Element]:
     if not joints:
         raise RobotError("environment.robot.flange", f"no joint moves link {flange.get('name')!r}")
     return joints
+
+
+def _refuse_couplings(root: ET.Element, joints: List[ET.Element], path: str) -> None:
+    """RobotError naming any coupling of the arm's joints: a URDF <mimic> (MuJoCo drops it), an
+    MJCF <equality> on a joint, or a limited tendon, of the chain. The IK, the cell check and the
+    joint trajectory move each joint on its own, so a coupled arm would not follow them."""
+    names = {j.get("name") for j in joints}
+    found = []
+    if Path(path).suffix.lower() == ".urdf":
+        found += [f"joint {j.get('name')!r} mimics {j.find('mimic').get('joint')!r} (URDF <mimic>)"
+                  for j in read_model_xml(path).iter("joint")
+                  if j.find("mimic") is not None and ({j.get("name"), j.find("mimic").get("joint")} & names)]
+    for equality in root.findall("equality/*"):
+        coupled = sorted({equality.get(key) for key in ("joint1", "joint2")} & names)
+        if coupled:
+            found.append(f"an <equality> {equality.tag} constraint on joint {coupled[0]!r}")
+    for tendon in root.findall("tendon/*"):
+        coupled = sorted({j.get("joint") for j in tendon.iter("joint")} & names)
+        if coupled and tendon.get("range") is not None and tendon.get("limited", "auto") != "false":
+            found.append(f"tendon {tendon.get('name') or '(unnamed)'!r} limits joint {coupled[0]!r}")
+    if found:
+        raise RobotError("environment.robot.model", f"{'; '.join(found)[:300]}: stablepush moves each joint of the "
+                                                    f"arm on its own (IK, cell check, joint trajectory), so an arm "
+                                                    f"whose joints are coupled is not supported")
 
 
 def _servo(root: ET.Element, joints: List[ET.Element]) -> None:
