@@ -20,6 +20,7 @@ from stablepush.errors import StablepushError
 EXTRAS = {
     "mujoco": ("sim", "mujoco"),
     "pydrake": ("drake", "drake"),
+    "coacd": ("sim", "coacd"),  # a mesh part's convex pieces, on either engine: [drake] brings it too
     "ray": ("ray", "ray"),
     "rosbags": ("ros", "rosbags"),
     "imageio_ffmpeg": ("video", "imageio-ffmpeg"),

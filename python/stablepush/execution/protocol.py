@@ -14,7 +14,9 @@ client -> server
   {"type": "hello", "protocol": "stablepush.arm/2", "rate_hz": 100, "scene": {...}, "continue": false}
       `scene` describes the world (stablepush.execution.world.scene_description); a real arm may ignore
       it. A simulator builds a fresh world from it for each session, or, when `continue` is true
-      and the scene is the one it has, keeps its world (so a run can resume after a fault).
+      and the scene is the one it has, keeps its world (so a run can resume after a fault). Its
+      object may say what solid to simulate: "geometry" (words) and, for a mesh part, "mesh" (its
+      convex pieces' corners in the object's frame, m, its inertia tensor and com along y).
   {"type": "waypoint", "seq": 0, "t": 0.01, "step": 1, "phase": "push", "pose": [...]}
       `seq` counts from 0 on each connection, one up per waypoint; `t` is s since the stream began;
       the server moves G to `pose` over one period (1 / rate_hz) and then acknowledges.
@@ -23,7 +25,8 @@ client -> server
 
 server -> client
   {"type": "ready", "protocol": "stablepush.arm/2", "arm": "...", "state": {...}}
-      optional "engine": the simulator behind the arm ("mujoco"), reported with the run
+      optional "engine": the simulator behind the arm ("mujoco"), and "geometry": the solid it
+      simulates the object as (words), each reported with the run
   {"type": "ack", "seq": 0, "state": {...}}
   {"type": "stopped", "state": {...}}
   {"type": "error", "seq": 3 or null, "message": "..."}   the server has stopped the arm
@@ -54,6 +57,7 @@ import time
 from typing import Any, Dict, Optional
 
 from stablepush import strict_json
+from stablepush.execution.part_geometry import MAX_PIECE_VERTICES, MAX_PIECES
 from stablepush.strict_json import is_finite_number
 from stablepush.task.schema import (
     ANGLE,
@@ -187,6 +191,7 @@ _SCENE_RANGES = {
     "position_mm": COORDINATE,  # mm: the object's x and z in the grasp
 }
 UNIT_NORMAL_TOLERANCE = 1e-3  # a feature's normal is of unit length to this
+MAX_GEOMETRY_CHARS = 200  # scene.object.geometry: words for a run's report
 
 
 def check_scene(scene: dict) -> None:
@@ -197,15 +202,7 @@ def check_scene(scene: dict) -> None:
     built worlds from a gripper mu of -1, a normal [0, 0, 0], a mu of 1e300 or no pads."""
     _fields("scene", scene, ("gravity", "object", "gripper", "features", "gripper_pose", "object_pose"))
     _numbers("scene.gravity", scene["gravity"], 2, "gravity")
-    obj = scene["object"]
-    _fields("scene.object", obj, ("polygon", "thickness", "mass", "com", "inertia"))
-    _count("scene.object.polygon", obj["polygon"], 3, MAX_VERTICES)
-    for i, point in enumerate(obj["polygon"]):
-        _numbers(f"scene.object.polygon[{i}]", point, 2, "position")
-    _number("scene.object.thickness", obj["thickness"], "length")
-    _number("scene.object.mass", obj["mass"], "mass")
-    _numbers("scene.object.com", obj["com"], 2, "position")
-    _number("scene.object.inertia", obj["inertia"], "inertia")
+    _check_object(scene["object"])
     gripper = scene["gripper"]
     _fields("scene.gripper", gripper, ("grip_force", "mu", "pad_rings", "pads"))
     _number("scene.gripper.grip_force", gripper["grip_force"], "force")
@@ -234,6 +231,37 @@ def check_scene(scene: dict) -> None:
         _numbers("scene.object_in_grasp", tracked, 3, "position_mm")
         if not (ANGLE[0] <= tracked[2] <= ANGLE[1]):
             raise ProtocolError(f"hello: scene.object_in_grasp[2] must be from {ANGLE[0]:g} to {ANGLE[1]:g} deg")
+
+
+def _check_object(obj: Any) -> None:
+    """The scene's object: its section, mass properties, and optionally what solid to simulate
+    (`geometry`, words) and a mesh part's convex pieces (`mesh`, part_geometry.scene_object_geometry)."""
+    _fields("scene.object", obj, ("polygon", "thickness", "mass", "com", "inertia"))
+    _count("scene.object.polygon", obj["polygon"], 3, MAX_VERTICES)
+    for i, point in enumerate(obj["polygon"]):
+        _numbers(f"scene.object.polygon[{i}]", point, 2, "position")
+    _number("scene.object.thickness", obj["thickness"], "length")
+    _number("scene.object.mass", obj["mass"], "mass")
+    _numbers("scene.object.com", obj["com"], 2, "position")
+    _number("scene.object.inertia", obj["inertia"], "inertia")
+    geometry = obj.get("geometry", "")
+    if not isinstance(geometry, str) or len(geometry) > MAX_GEOMETRY_CHARS:
+        raise ProtocolError(f"hello: scene.object.geometry must be a string of at most {MAX_GEOMETRY_CHARS} "
+                            f"characters, got {_shown(geometry)}")
+    if "mesh" not in obj:
+        return
+    mesh = obj["mesh"]
+    _fields("scene.object.mesh", mesh, ("pieces", "inertia", "com_y"))
+    _count("scene.object.mesh.pieces", mesh["pieces"], 1, MAX_PIECES)
+    for i, piece in enumerate(mesh["pieces"]):
+        _count(f"scene.object.mesh.pieces[{i}]", piece, 4, MAX_PIECE_VERTICES)  # a solid has 4 corners or more
+        for k, point in enumerate(piece):
+            _numbers(f"scene.object.mesh.pieces[{i}][{k}]", point, 3, "position")
+    _count("scene.object.mesh.inertia", mesh["inertia"], 3, 3)
+    for i, row in enumerate(mesh["inertia"]):
+        _numbers(f"scene.object.mesh.inertia[{i}]", row, 3, None)
+        _number(f"scene.object.mesh.inertia[{i}][{i}]", row[i], "inertia")
+    _number("scene.object.mesh.com_y", mesh["com_y"], "position")
 
 
 def _check_feature(path: str, feature: Any) -> None:

@@ -14,6 +14,7 @@ from typing import Dict, List, Sequence
 import numpy as np
 
 from stablepush import _core
+from stablepush.execution.part_geometry import scene_object_geometry
 from stablepush.frames import grasp_transform, matrix_to_pose, rot_y, translation
 from stablepush.plan.plan import Waypoint
 from stablepush.task.model import Task
@@ -116,12 +117,15 @@ def station_offset(k: int) -> int:
 
 
 def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float],
-                      start_clear: bool = True) -> dict:
+                      start_clear: bool = True, solid: bool = True) -> dict:
     """What a simulated arm needs to build the world (SI units): the object, the gripper, gravity,
     the features, G's pose when the run starts and the object's pose then (`in_grasp`, mm/deg).
     G starts at home, or, with `start_clear`, GUARD_SPAN back from a feature the object would touch
     there, which the run's guarded approach then finds (the executor's world); without it, the
-    object starts on that feature (the friction-fidelity rigs, which load it from the start)."""
+    object starts on that feature (the friction-fidelity rigs, which load it from the start).
+    With `solid`, the object says what solid to simulate (part_geometry.scene_object_geometry: a
+    mesh part's convex pieces, which needs CoACD for a non-convex one); without, a simulator builds
+    the prism of the section (for callers that read only the poses)."""
     body = task.rigid_body()
     start = translation(np.asarray(task.environment.home, float) * MM)
     for feature in features.values() if start_clear else ():
@@ -132,7 +136,8 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequen
         "task": task.name,
         "gravity": list(task.gravity),
         "object": {"polygon": [[x * MM, z * MM] for x, z in task.vertices], "thickness": task.thickness * MM,
-                   "mass": body.mass, "com": list(body.com), "inertia": body.inertia},
+                   "mass": body.mass, "com": list(body.com), "inertia": body.inertia,
+                   **(scene_object_geometry(task) if solid else {})},
         "gripper": {"grip_force": task.grip_force, "mu": task.mu, "pad_rings": task.pad_rings,
                     "pads": [{"center": [c[0] * MM, c[1] * MM], "radius": r * MM} for c, r in task.pads]},
         "features": [f.as_dict() for f in features.values()],
