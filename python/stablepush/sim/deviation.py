@@ -40,6 +40,8 @@ class WorldDeviation:
         obj = scene["object"]
         obj["mass"] *= self.mass_scale
         obj["inertia"] *= self.mass_scale
+        if "mesh" in obj:  # a mesh part's solid's tensor (scene.object_inertia)
+            obj["mesh"]["inertia"] = (np.asarray(obj["mesh"]["inertia"], float) * self.mass_scale).tolist()
         offsets = {name: (dx, dz, dth) for name, dx, dz, dth in self.feature_offsets}
         for feature in scene["features"]:
             feature["mu"] *= self.mu_scale * self.pusher_mu_scale

@@ -6,8 +6,8 @@ The arm is the shipped arm.xml read by Drake's MJCF parser (`scene.arm_tree`); w
 leaves out is added with Drake's own API from the same tree: the position servos' damping `kv`
 (as PD gains), the jaw coupling (a coupler constraint), gravity compensation (`gravcomp`: a
 feed-forward torque) and the site G (a fixed frame). The pads' point spheres, the object's convex
-prisms and the features come from the same scene parts as MuJoCo's (`scene.pad_layout`,
-`scene.object_pieces`, `scene.feature_solid`).
+pieces (a mesh part's own, or the prism of the section) and the features come from the same scene
+parts as MuJoCo's (`scene.pad_layout`, `scene.object_solid`, `scene.feature_solid`).
 
 Contact (chosen by the friction-fidelity contract, `fidelity.py`; docs/engines.md says how):
 - Drake's DRAKE_APPROXIMATION discrete model (a convex approximation solved by SAP; the PD servos,
@@ -17,9 +17,9 @@ Contact (chosen by the friction-fidelity contract, `fidelity.py`; docs/engines.m
 - the pads are point contacts (spheres); each feature is rigid hydroelastic against the object,
   compliant at HYDROELASTIC_MODULUS (a box on a box has one point contact, which chatters; a
   softer patch lets the object roll on the pusher where the rigid model says it sticks);
-- only pads and features touch the object (collision filters); a pad touches a prism piece
-  through a deep copy of it (`_add_pad_faces`: Drake's sphere-vs-convex query misplaces a contact
-  near a thin prism's side face);
+- only pads and features touch the object (collision filters); a pad touches a deep prism of
+  the section under it (`_add_pad_faces`: Drake's sphere-vs-convex query misplaces a contact near
+  a thin prism's side face), or a box piece itself;
 - Drake combines two surfaces' friction as mu = 2 mu1 mu2 / (mu1 + mu2); the object carries
   OBJECT_MU and every pad and feature the partner value that makes the pair's mu the task's
   (`partner_mu`), since each pair in the task has its own mu.
@@ -124,18 +124,18 @@ class DrakeGrasp:
                         for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))]
         arm_geometry += plant.GetCollisionGeometriesForBody(plant.world_body())  # the floor
         self._pads = self._add_pads(scene)
-        pieces = scene_mod.object_pieces(scene["object"])  # (name, outline, whether a box), once
-        self._object_body, self._pieces = self._add_object(scene["object"], pieces)
-        pad_faces = self._add_pad_faces(scene["object"], pieces)
+        solid = scene_mod.object_solid(scene["object"])
+        self._object_body, self._pieces = self._add_object(scene["object"], solid)
+        pad_faces = self._add_pad_faces(scene["object"])
         self._features = self._add_features(scene)
         plant.Finalize()
 
-        # Only pads and features touch the object; a pad touches a box piece, or the deep copy of a
-        # prism piece on its own side (_add_pad_faces).
+        # Only pads and features touch the object; a pad touches a box piece, or the deep prism of a
+        # section piece on its own side (_add_pad_faces).
         sides = [side for _, _, side, _ in scene_mod.pad_layout(scene)]
         pads_on = {s: d.GeometrySet([g for g, side in zip(self._pads, sides) if side == s]) for s in (1.0, -1.0)}
         deep = [g for faces in pad_faces.values() for g in faces]
-        boxes = [g for g, (_, _, rectangle) in zip(self._pieces, pieces) if rectangle]
+        boxes = [g for g, piece in zip(self._pieces, solid) if piece.box]
         everything = d.GeometrySet(arm_geometry + self._pads + self._pieces + deep + list(self._features.values()))
         declaration = (d.CollisionFilterDeclaration().ExcludeWithin(everything)
                        .AllowBetween(d.GeometrySet(list(self._features.values())), d.GeometrySet(self._pieces))
@@ -203,44 +203,48 @@ class DrakeGrasp:
             pads.append(plant.RegisterCollisionGeometry(body, X, d.Sphere(scene_mod.PAD_POINT_RADIUS), name, props))
         return pads
 
-    def _add_object(self, obj: dict, pieces: list):
+    def _add_object(self, obj: dict, solid: list):
+        """The object's body (its solid's mass properties, scene.object_inertia) and the convex
+        `solid` pieces (scene.object_solid) as its geometry: a box piece as a Box, any other as
+        a Convex of its corners."""
         d, plant = self._d, self.plant
         instance = plant.AddModelInstance(scene_mod.OBJECT_BODY)
         J = scene_mod.object_inertia(obj)
-        com = [obj["com"][0], 0.0, obj["com"][1]]
         inertia = d.SpatialInertia.MakeFromCentralInertia(
-            obj["mass"], com, d.RotationalInertia(J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2]))
+            obj["mass"], list(scene_mod.object_com(obj)),
+            d.RotationalInertia(J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2]))
         body = plant.AddRigidBody(scene_mod.OBJECT_BODY, instance, inertia)
         props = self._properties(OBJECT_MU, "compliant")
-        half = obj["thickness"] / 2
         geometries = []
-        for name, piece, rectangle in pieces:
-            if rectangle:
-                xs, zs = [p[0] for p in piece], [p[1] for p in piece]
-                X = d.RigidTransform([(min(xs) + max(xs)) / 2, 0.0, (min(zs) + max(zs)) / 2])
-                shape = d.Box(max(xs) - min(xs), obj["thickness"], max(zs) - min(zs))
+        for piece in solid:
+            if piece.box:
+                center, size = piece.box_center_size()
+                X, shape = d.RigidTransform(center), d.Box(*size)
             else:
                 X = d.RigidTransform()
-                vertices = "".join(f"v {x!r} {sy * half!r} {z!r}\n" for sy in (-1, 1) for x, z in piece)
-                shape = d.Convex(d.InMemoryMesh(mesh_file=d.MemoryFile(vertices, ".obj", name)))
-            geometries.append(plant.RegisterCollisionGeometry(body, X, shape, name, props))
+                vertices = "".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in piece.vertices.tolist())
+                shape = d.Convex(d.InMemoryMesh(mesh_file=d.MemoryFile(vertices, ".obj", piece.name)))
+            geometries.append(plant.RegisterCollisionGeometry(body, X, shape, piece.name, props))
         return body, geometries
 
-    def _add_pad_faces(self, obj: dict, pieces: list) -> Dict[float, list]:
-        """What the pads on each side (+1, -1: the object's +y and -y faces) touch of every piece that
-        is not a box: the piece's outline as a prism from that face PAD_FACE_DEPTH deep into the
-        object, without mass. Drake's sphere-vs-convex query answers a pad point within about 5.5
-        times its penetration of a prism's side face through that side, along the direction from
-        the prism's centre (the wedge's pad point 0.3 mm inside its heel face pushed the wedge out of
-        the grasp with 7.5 N along x; docs/results/engines-cross-engine.md). A deep prism's side faces are far from its
-        centre, so the query answers with the face the pad presses on."""
+    def _add_pad_faces(self, obj: dict) -> Dict[float, list]:
+        """What the pads on each side (+1, -1: the object's +y and -y faces) touch: every piece of the
+        section (scene.object_pieces) that is not built as a box, as a prism from that face
+        PAD_FACE_DEPTH deep into the object, without mass. Drake's sphere-vs-convex query answers a
+        pad point within about 5.5 times its penetration of a prism's side face through that side,
+        along the direction from the prism's centre (the wedge's pad point 0.3 mm inside its heel
+        face pushed the wedge out of the grasp with 7.5 N along x; docs/results/engines-cross-engine.md). A deep prism's
+        side faces are far from its centre, so the query answers with the face the pad presses on.
+        A mesh part gets them for every piece of its section, at +-thickness/2: the planner takes a
+        plan only where the pads rest on the solid's flat faces there (within the part's tolerance),
+        so the prism's faces under the pads are the solid's."""
         d, plant = self._d, self.plant
         props = self._properties(OBJECT_MU)  # point contact, as the pads': no hydroelastic mesh
         half = obj["thickness"] / 2
         faces: Dict[float, list] = {1.0: [], -1.0: []}
-        for name, piece, rectangle in pieces:
-            if rectangle:
-                continue  # the sphere-vs-box query is exact
+        for name, piece, rectangle in scene_mod.object_pieces(obj):
+            if rectangle and "mesh" not in obj:
+                continue  # the pads touch the box piece itself: the sphere-vs-box query is exact
             for side in faces:
                 ys = (side * half, side * (half - PAD_FACE_DEPTH))
                 vertices = "".join(f"v {x!r} {y!r} {z!r}\n" for y in ys for x, z in piece)

@@ -1,6 +1,8 @@
 """The MuJoCo scene of the simulated arm: the shipped arm (arm.xml) plus the held object, the
 multi-point finger pads and the fixed features, built from a scene description (a plain dict,
-SI units, as the executor sends it in its `hello`; see `stablepush.execution.protocol`).
+SI units, as the executor sends it in its `hello`; see `stablepush.execution.protocol`). The object
+is a union of convex pieces (`object_solid`): a mesh part's own, which the scene carries
+(`stablepush.execution.part_geometry`), or for a box or polygon part the prism of its section.
 
 Contact settings that keep friction honest (the simulation's results rest on them, and
 `stablepush.sim.fidelity` measures them):
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
@@ -33,6 +36,7 @@ from stablepush.task.model import Robot
 OBJECT_BODY = "object"
 MAX_SIM_VERTICES = 64  # the simulated object's outline; more are simplified away (simulated_outline)
 PAD_PREFIX = "pad_"  # pad point geoms are named pad_<finger>_<pad>_<point>
+SLAB_PREFIX = "slab_"  # a mesh part's prism of its section, which its pads press on (build_mjcf)
 HAND_JOINTS = ("hand_x", "hand_z", "hand_theta")  # the kinematic hand's slide x, slide z, hinge y
 
 # s: the coarsest step measured to pass the friction-fidelity contract (0.5 ms drops a pad point in
@@ -98,6 +102,27 @@ def convex_pieces(polygon: Sequence[Sequence[float]]) -> List[List[Tuple[float, 
     pts = [tuple(map(float, p)) for p in polygon]
     if _is_convex(pts):
         return [pts]
+    pieces = triangulated(pts)
+    merged = True
+    while merged:
+        merged = False
+        for a in range(len(pieces)):
+            for b in range(a + 1, len(pieces)):
+                union = _merge(pieces[a], pieces[b])
+                if union is not None and _is_convex([pts[i] for i in union]):
+                    pieces[a] = union
+                    pieces.pop(b)
+                    merged = True
+                    break
+            if merged:
+                break
+    return [_drop_collinear([pts[i] for i in piece]) for piece in pieces]
+
+
+def triangulated(polygon: Sequence[Sequence[float]]) -> List[List[int]]:
+    """A simple counterclockwise polygon as counterclockwise triangles of its vertex indices (ear
+    clipping): every vertex is a corner of some triangle."""
+    pts = [tuple(map(float, p)) for p in polygon]
     index = list(range(len(pts)))
     triangles = []
     while len(index) > 3:
@@ -113,21 +138,7 @@ def convex_pieces(polygon: Sequence[Sequence[float]]) -> List[List[Tuple[float, 
         else:
             raise ValueError("polygon could not be triangulated (is it simple and counterclockwise?)")
     triangles.append(index)
-    pieces = [list(t) for t in triangles]
-    merged = True
-    while merged:
-        merged = False
-        for a in range(len(pieces)):
-            for b in range(a + 1, len(pieces)):
-                union = _merge(pieces[a], pieces[b])
-                if union is not None and _is_convex([pts[i] for i in union]):
-                    pieces[a] = union
-                    pieces.pop(b)
-                    merged = True
-                    break
-            if merged:
-                break
-    return [_drop_collinear([pts[i] for i in piece]) for piece in pieces]
+    return triangles
 
 
 def _in_triangle(p, a, b, c) -> bool:
@@ -222,37 +233,83 @@ def pad_layout(scene: dict) -> List[Tuple[str, str, float, Tuple[float, float]]]
 
 
 def object_inertia(obj: dict) -> np.ndarray:
-    """The object's inertia tensor [kg m^2] about its centre of mass, axes of O: a uniform prism of
-    its outline, with the task's own moment about y (docs/model.md section 4)."""
-    inertia = _prism_inertia(obj["polygon"], obj["thickness"], obj["mass"], obj["com"])
+    """The object's inertia tensor [kg m^2] about its centre of mass (object_com), axes of O: a mesh
+    part's solid's, else a uniform prism of its outline; with the task's own moment about y either
+    way (docs/model.md section 4)."""
+    if "mesh" in obj:
+        inertia = np.array(obj["mesh"]["inertia"], float)
+    else:
+        inertia = _prism_inertia(obj["polygon"], obj["thickness"], obj["mass"], obj["com"])
     inertia[1, 1] = obj["inertia"]
     return inertia
 
 
+def object_com(obj: dict) -> Tuple[float, float, float]:
+    """The object's centre of mass in O [m]: the task's x and z, and along y a mesh part's solid's
+    (a prism's lies on its middle plane, y = 0)."""
+    com_y = obj["mesh"]["com_y"] if "mesh" in obj else 0.0
+    return float(obj["com"][0]), float(com_y), float(obj["com"][1])
+
+
 def object_pieces(obj: dict) -> List[Tuple[str, list, bool]]:
-    """The object's collision pieces: (name, convex ccw outline in O's xz [m], whether the piece
-    is an axis-aligned rectangle, built as a box)."""
+    """The section's convex pieces: (name, convex ccw outline in O's xz [m], whether the piece is
+    an axis-aligned rectangle). The prism of these is what a box or polygon part is simulated as
+    (object_solid); Drake's pads touch deep prisms of them on any part (drake_arm._add_pad_faces)."""
     pieces = convex_pieces(simulated_outline(obj["polygon"])[0])
     return [(f"object_piece{i}", piece, _axis_aligned_rectangle(piece)) for i, piece in enumerate(pieces)]
 
 
+@dataclass(frozen=True)
+class SolidPiece:
+    """A convex piece of the simulated object: its corners (n x 3, in O [m]), and whether it is an
+    axis-aligned box in O, which the engines build as a box (their box queries are exact)."""
+
+    name: str
+    vertices: np.ndarray
+    box: bool
+
+    def box_center_size(self) -> Tuple[np.ndarray, np.ndarray]:
+        """A box piece's centre and full extents along O's axes [m]."""
+        low, high = self.vertices.min(axis=0), self.vertices.max(axis=0)
+        return (low + high) / 2, high - low
+
+
+def object_solid(obj: dict, half_y: Optional[float] = None) -> List[SolidPiece]:
+    """The solid the engines build of the scene's object, as convex pieces: a mesh part's own
+    (the object's `mesh`, part_geometry.py), else the prism of each of the section's pieces
+    (object_pieces), `half_y` [m] either side of the xz-plane (default half the thickness; a mesh
+    part's y is scaled to it, as the video's ghost is drawn thinner)."""
+    half = obj["thickness"] / 2
+    half_y = half if half_y is None else half_y
+    if "mesh" in obj:
+        scale = np.array([1.0, half_y / half, 1.0])
+        return [SolidPiece(f"object_piece{i}", np.asarray(piece, float) * scale, False)
+                for i, piece in enumerate(obj["mesh"]["pieces"])]
+    return [SolidPiece(name, np.array([(x, sy * half_y, z) for sy in (-1, 1) for x, z in outline]), rectangle)
+            for name, outline, rectangle in object_pieces(obj)]
+
+
+def simulated_geometry(obj: dict) -> str:
+    """What solid the engines build of the scene's object, in words: a run's report names it."""
+    if "mesh" in obj:
+        return obj.get("geometry") or f"a mesh part, {len(obj['mesh']['pieces'])} convex pieces"
+    return f"prism of the section, {obj['thickness'] * 1e3:g} mm thick"
+
+
 def add_object_geoms(body: ET.Element, assets: ET.Element, obj: dict, half_y: float, rgba: str, prefix: str = "",
                      **attributes: str) -> List[str]:
-    """The object's pieces (object_pieces) as geoms of `body`, `half_y` m either side of the
-    xz-plane: a rectangle as a box, any other piece as a mesh prism in `assets`; `attributes` go on
+    """The object's pieces (object_solid, `half_y` m either side of the xz-plane) as geoms of
+    `body`: a box piece as a box, any other as a mesh in `assets` (m, in O); `attributes` go on
     every geom (e.g. mass), names start with `prefix`. Returns the geoms' names."""
     names = []
-    for name, piece, rectangle in object_pieces(obj):
-        name = prefix + name
-        if rectangle:
-            xs = [p[0] for p in piece]
-            zs = [p[1] for p in piece]
-            ET.SubElement(body, "geom", name=name, type="box", **attributes,
-                          pos=mjcf_numbers(((min(xs) + max(xs)) / 2, 0.0, (min(zs) + max(zs)) / 2)),
-                          size=mjcf_numbers(((max(xs) - min(xs)) / 2, half_y, (max(zs) - min(zs)) / 2)), rgba=rgba)
+    for piece in object_solid(obj, half_y):
+        name = prefix + piece.name
+        if piece.box:
+            center, size = piece.box_center_size()
+            ET.SubElement(body, "geom", name=name, type="box", **attributes, pos=mjcf_numbers(center),
+                          size=mjcf_numbers(size / 2), rgba=rgba)
         else:
-            vertices = [(px, sy * half_y, pz) for sy in (-1, 1) for px, pz in piece]
-            ET.SubElement(assets, "mesh", name=name, vertex=mjcf_numbers(np.ravel(vertices)))
+            ET.SubElement(assets, "mesh", name=name, vertex=mjcf_numbers(np.ravel(piece.vertices)))
             ET.SubElement(body, "geom", name=name, type="mesh", mesh=name, **attributes, rgba=rgba)
         names.append(name)
     return names
@@ -315,19 +372,28 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
                       pos=mjcf_numbers((px, side * PAD_POINT_RADIUS, pz)), mass="0.0001", rgba="0.2 0.2 0.2 1")
         pad_names.append(name)
 
-    # The held object: a free body of convex prisms in O.
+    # The held object: a free body of convex pieces in O (object_solid).
     x, y, z, w, qx, qy, qz = scene["object_pose"]
     body = ET.SubElement(worldbody, "body", name=OBJECT_BODY, pos=mjcf_numbers((x, y, z)),
                          quat=mjcf_numbers((w, qx, qy, qz)))
     ET.SubElement(body, "freejoint", name=OBJECT_BODY)
-    com = obj["com"]
     inertia = object_inertia(obj)
-    ET.SubElement(body, "inertial", pos=mjcf_numbers((com[0], 0.0, com[1])), mass=repr(obj["mass"]),
-                  fullinertia=mjcf_numbers((inertia[0, 0], inertia[1, 1], inertia[2, 2], 0.0, inertia[0, 2], 0.0)))
+    ET.SubElement(body, "inertial", pos=mjcf_numbers(object_com(obj)), mass=repr(obj["mass"]),
+                  fullinertia=mjcf_numbers((inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2],
+                                            inertia[1, 2])))
     assets = root.find("asset")
     if assets is None:
         assets = ET.SubElement(root, "asset")
     piece_names = add_object_geoms(body, assets, obj, half_thickness, "0.85 0.55 0.25 1", mass="0")
+    pad_faces = piece_names
+    if "mesh" in obj:
+        # A mesh part's pads press on the prism of its section, massless and unseen, not on its
+        # pieces: MuJoCo's sphere-vs-convex-mesh contact (libccd) turned the pivoting box, built as
+        # one mesh, 0.11 deg in the world where its box primitive turns 0.01 deg (the contract's
+        # limit is 0.1). The planner takes a plan only where the pads rest on the solid's flat faces
+        # at +-thickness/2, so the prism's faces under the pads are the solid's.
+        section = {key: value for key, value in obj.items() if key != "mesh"}
+        pad_faces = add_object_geoms(body, assets, section, half_thickness, "0 0 0 0", prefix=SLAB_PREFIX, mass="0")
 
     # The features: fixed solids whose contact face is the pusher's segment.
     contact = ET.SubElement(root, "contact")
@@ -345,7 +411,7 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
         for piece in piece_names:
             _pair(contact, name, piece, feature["mu"])
     for pad in pad_names:
-        for piece in piece_names:
+        for piece in pad_faces:
             _pair(contact, pad, piece, gripper["mu"])
     return ET.tostring(root, encoding="unicode")
 
