@@ -148,6 +148,7 @@ def run_trial(batch: Batch, trial: int) -> dict:
                           cause=report.verdict.cause if report.verdict else None,
                           verdict=report.verdict.detail if report.verdict else None,
                           sim_time_s=report.waypoints / RATE_HZ, error=None,
+                          simulated_geometry=report.simulated_geometry,
                           # corrections whose search the wall-time guard stopped: this trial may differ elsewhere
                           wall_guard=sum(1 for r in report.replans if r.guard_fired))
     except Exception as exc:  # noqa: BLE001 - a crashed trial is a result, not the end of the batch
@@ -321,6 +322,8 @@ class Evaluation:
             "tolerance": list(self.batch.judged_with), "one_world": self.batch.spreads.one_world,
             "closed_loop": self.batch.closed_loop, "guarded": self.batch.guarded,
             "engine": self.batch.engine, "seed": self.batch.seed,
+            "simulated_geometry": next((t["simulated_geometry"] for t in self.trials if t.get("simulated_geometry")),
+                                       None),
             "plan_uncertainty": dict(self.batch.task.uncertainty),
             "vary": dict(self.batch.spreads.vary), "feature_error": list(self.batch.spreads.feature_error),
             "tracker_noise": list(self.batch.spreads.tracker_noise),
@@ -354,6 +357,8 @@ class Evaluation:
             lines = [f"{s['task']}: landed {s['successes']} of {s['judged']} trials {within}: {s['success_rate']:.1%} "
                      f"(95% CI {low:.1%}-{high:.1%})" + (f"; interrupted after {s['trials']} of {s['requested']}"
                                                          if s["interrupted"] else "")]
+        if s["simulated_geometry"]:
+            lines.append(f"simulated as: {s['simulated_geometry']}")
         if s["goal_error_mm"]:
             mm, deg = s["goal_error_mm"], s["goal_error_deg"]
             lines.append(f"goal error: median {mm['p50']:.3f} mm / {deg['p50']:.3f} deg, "

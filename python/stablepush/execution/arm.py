@@ -34,12 +34,14 @@ class ArmError(Exception):
 
 @dataclass(frozen=True)
 class ArmReady:
-    """The arm's answer to hello: its `state` where it stands, what it calls itself (`arm`), and
-    the simulator behind it (`engine`, e.g. "mujoco"; None for a real arm)."""
+    """The arm's answer to hello: its `state` where it stands, what it calls itself (`arm`), the
+    simulator behind it (`engine`, e.g. "mujoco"; None for a real arm) and the solid that simulator
+    built of the object (`geometry`, words, e.g. "l-bracket.stl: CoACD, 2 convex pieces ...")."""
 
     state: dict
     arm: str = ""
     engine: Optional[str] = None
+    geometry: Optional[str] = None
 
 
 @dataclass(frozen=True)

@@ -250,6 +250,7 @@ class _Run:
             features=[f.as_dict() for f in self.features.values()], wall_time_s=time.perf_counter() - self.started,
             sim_steps_per_s=state.get("steps_per_s"), closed_loop=self.loop_status, guard=self.watch.status,
             replans=self.replans, warnings=execution_warnings(task), engine=self.ready.engine,
+            simulated_geometry=self.ready.geometry,
             ends_on_feature=task.environment.end_on_feature,
         )
         loop = self.options.closed_loop

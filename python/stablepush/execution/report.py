@@ -67,6 +67,7 @@ class ExecutionReport:
     replans: List[Replan] = field(default_factory=list)
     warnings: List[str] = field(default_factory=list)  # execution_warnings(task)
     engine: Optional[str] = None  # the simulator that ran it, as the arm says ("mujoco"); None for a real arm
+    simulated_geometry: Optional[str] = None  # the solid the simulator made of the object, as it says
     verdict: Optional[Verdict] = None  # whether it landed, and why not (stablepush.execution.verdict)
     ends_on_feature: bool = False  # the task's environment.end_on_feature: no release at the end
 
@@ -118,6 +119,8 @@ class ExecutionReport:
         lines = [f"{self.task}: steps {self.resumed_from + 1}-{self.last_confirmed_step} of {self.total_steps} "
                  f"confirmed, {self.waypoints} waypoints in {self.wall_time_s:.1f} s"
                  + (f" ({self.sim_steps_per_s:.0f} simulation steps/s)" if self.sim_steps_per_s else "")]
+        if self.simulated_geometry:
+            lines.append(f"simulated as: {self.simulated_geometry}")
         if self.final_error is None:
             return lines + ["the arm does not report the object, so the final pose in the grasp is not measured"]
         lines += self._landing_lines()
@@ -176,6 +179,7 @@ class ExecutionReport:
         return {
             "task": self.task, "success": verdict.get("success"), "tolerance": verdict.get("tolerance"),
             "cause": verdict.get("cause"), "verdict": verdict.get("detail"), "engine": self.engine,
+            "simulated_geometry": self.simulated_geometry,
             "resumed_from": self.resumed_from, "last_confirmed_step": self.last_confirmed_step,
             "total_steps": self.total_steps, "waypoints": self.waypoints, "planned_final": list(self.planned_final),
             "goal": list(self.goal), "final_in_grasp": self.final_in_grasp, "final_error": self.final_error,

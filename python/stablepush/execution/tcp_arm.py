@@ -9,7 +9,7 @@ from typing import Optional
 
 from stablepush.errors import SettingError
 from stablepush.execution.arm import Arm, ArmError, ArmReady
-from stablepush.execution.protocol import PROTOCOL, LineReader, ProtocolError, decode, encode
+from stablepush.execution.protocol import MAX_GEOMETRY_CHARS, PROTOCOL, LineReader, ProtocolError, decode, encode
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.units import is_finite_real
 
@@ -46,7 +46,9 @@ class TcpArm(Arm):
         self.reader = LineReader(self.sock, self.where)
         ready = self._exchange({"type": "hello", "protocol": PROTOCOL, "rate_hz": rate_hz, "scene": scene,
                                 "continue": resume}, "ready")
-        return ArmReady(state=ready["state"], arm=str(ready.get("arm", "")), engine=ready.get("engine"))
+        geometry = ready.get("geometry")
+        return ArmReady(state=ready["state"], arm=str(ready.get("arm", "")), engine=ready.get("engine"),
+                        geometry=geometry[:MAX_GEOMETRY_CHARS] if isinstance(geometry, str) else None)
 
     def move(self, waypoint: ArmWaypoint) -> dict:
         reply = self._exchange({"type": "waypoint", "seq": waypoint.seq, "t": waypoint.t, "step": waypoint.step,

@@ -13,7 +13,7 @@ from stablepush.plan.plan import Plan
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
 from stablepush.sim.robot import arm_model, robot_description
-from stablepush.sim.scene import simulated_outline
+from stablepush.sim.scene import simulated_geometry, simulated_outline
 from stablepush.task.model import Robot, Task
 
 # The scene keys that say where a run starts, not what the world is: a resume starts elsewhere.
@@ -78,7 +78,8 @@ class SimulatedArm(Arm):
             simplified = f"; outline simplified within {tolerance * 1e3:g} mm" if tolerance else ""
             self.log(f"world built for {scene.get('task', 'a task')} ({sim.describe()}{simplified})")
         self.connected = True
-        return ArmReady(state=self.sim.state(), arm=self.name, engine=self.engine)
+        return ArmReady(state=self.sim.state(), arm=self.name, engine=self.engine,
+                        geometry=simulated_geometry(self._scene["object"]))
 
     def move(self, waypoint: ArmWaypoint) -> dict:
         """Track G to the waypoint over one period. The wrist's force is read during approaches,

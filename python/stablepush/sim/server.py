@@ -116,7 +116,7 @@ class SimArmServer:
                     greeted = True
                     expected_seq = 0
                     reply = {"type": "ready", "protocol": message["protocol"], "arm": ready.arm,
-                             "engine": ready.engine, "state": ready.state}
+                             "engine": ready.engine, "geometry": ready.geometry, "state": ready.state}
                 elif kind == "waypoint":
                     if message["seq"] != expected_seq:
                         raise ProtocolError(f"out-of-order waypoint: expected seq {expected_seq}, got {message['seq']}")
