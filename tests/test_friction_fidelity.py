@@ -95,3 +95,39 @@ def test_each_drake_contact_pair_has_the_tasks_mu():
         assert 2 * a * b / (a + b) == pytest.approx(mu, rel=1e-12, abs=1e-15)
     with pytest.raises(ValueError, match="mu"):
         drake_arm.partner_mu(2 * drake_arm.OBJECT_MU)
+
+
+# A mesh part is simulated as its convex pieces (execution/part_geometry.py): the contract holds on
+# them too, on a box given as a mesh (its own hull) and on the pivot's bar with a notch (CoACD's
+# pieces, a seam under the pads).
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_wall_holds_a_mesh_box_while_the_pads_slide_over_it(engine, tmp_path):
+    result = fidelity.wall_creep(0.9, 0.005, engine=engine, mesh_dir=tmp_path)
+    assert result.wall_cone_use == pytest.approx(0.9, abs=0.06)
+    assert result.creep_um_per_mm <= fidelity.CREEP_LIMIT_UM_PER_MM[0.9], result
+    assert result.pad_friction_ratio == pytest.approx(1.0, abs=fidelity.PAD_FRICTION_TOLERANCE), result
+    assert result.pad_dropout_steps == 0, result
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_pivot_of_a_non_convex_mesh_part_holds_where_the_model_says_it_does(engine, tmp_path):
+    task = fidelity.notched_pivoting(shipped("pivoting"), tmp_path)
+    verdict = check_push(task, (0, 0, 0), (0, 0, 1), "left")["left"]
+    assert verdict["feasible"] and verdict["case"] == "sticking"
+    result = fidelity.pivot(task, "left", turn_deg=30, engine=engine)
+    assert result.moved_mm <= fidelity.PIVOT_LIMIT_MM, result
+    assert abs(result.rotated_deg) <= fidelity.PIVOT_LIMIT_DEG, result
+    assert abs(result.grasp_error_deg) <= fidelity.PIVOT_LIMIT_DEG, result
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_pivot_of_a_non_convex_mesh_part_by_the_arm_follows_its_plan(engine, tmp_path):
+    result = fidelity.pivot_on_arm(fidelity.notched_pivoting(shipped("pivoting"), tmp_path), engine=engine)
+    assert result.pushes == fidelity.ARM_PIVOT_PUSHES
+    assert result.error_mm <= fidelity.ARM_PIVOT_LIMIT_MM, result
+    assert abs(result.error_deg) <= fidelity.ARM_PIVOT_LIMIT_DEG, result

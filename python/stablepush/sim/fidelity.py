@@ -21,6 +21,10 @@ friction, not the arm's tracking:
   sliding ring points' friction must still leave the pad centre stuck (1.3 deg was lost
   in 90 when the sliding friction was off its slip by a few degrees).
 
+A mesh part is simulated as its convex pieces (`stablepush.execution.part_geometry`): `as_mesh_part`
+makes any of these rigs' objects one, and `notched_pivoting` is the pivot's bar with a notch, a
+non-convex part whose decomposition has a seam under the pads.
+
 Units: SI inside; results in mm, um, deg and N as their names say.
 """
 from __future__ import annotations
@@ -28,6 +32,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Optional, Sequence
 
 import numpy as np
@@ -39,6 +44,8 @@ from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
 from stablepush.plan.verify import check_plan
 from stablepush.sim.engines import DEFAULT_ENGINE, make_grasp
+from stablepush.sim.scene import triangulated
+from stablepush.task.mesh import load_mesh_object
 from stablepush.task.model import Task
 from stablepush.task.schema import parse_task
 
@@ -75,6 +82,45 @@ def _box_task(wall_load: Optional[float], grip_force: float = 10.0, mu: float = 
         "goal": [0, 0, 0],
     }
     return parse_task(yaml.safe_dump(data), source="friction-fidelity scene")
+
+
+# The pivoting task's bar (x, z mm, counterclockwise) with a 10 x 10 mm notch in its top face.
+NOTCHED_BAR = ((-50, -12.5), (50, -12.5), (50, 12.5), (40, 12.5), (40, 2.5), (30, 2.5), (30, 12.5), (-50, 12.5))
+
+
+def write_extrusion(outline: Sequence[Sequence[float]], thickness: float, path: Path) -> Path:
+    """An STL at `path` of the solid `outline` (x, z mm, counterclockwise) makes along y, from
+    -thickness/2 to +thickness/2 mm: a mesh part's file."""
+    import trimesh
+
+    points = [tuple(map(float, p)) for p in outline]
+    cap = [tuple(t) for t in triangulated(points)]
+    n, half = len(points), thickness / 2
+    vertices = [(x, -half, z) for x, z in points] + [(x, half, z) for x, z in points]
+    faces = cap + [(a + n, c + n, b + n) for a, b, c in cap]
+    faces += [f for i in range(n) for f in ((i, (i + 1) % n + n, (i + 1) % n), (i, i + n, (i + 1) % n + n))]
+    solid = trimesh.Trimesh(vertices, faces)
+    solid.fix_normals()
+    solid.export(path)
+    return path
+
+
+def as_mesh_part(task: Task, directory: Path, outline: Optional[Sequence[Sequence[float]]] = None) -> Task:
+    """`task` with its object a mesh part (an STL written into `directory`): `outline` (x, z mm;
+    default the task's section) extruded to the task's thickness, of the task's mass. Its pushers
+    and poses are the task's, so `outline` must keep them on its boundary."""
+    name = f"{task.name}-mesh"
+    path = write_extrusion(outline if outline is not None else task.vertices, task.thickness,
+                           Path(directory) / f"{name}.stl")
+    part = load_mesh_object(path, "object", mass=task.mass)
+    return dataclasses.replace(task, name=name, vertices=part.vertices, thickness=part.thickness, com=part.com,
+                               inertia=part.inertia, mesh=part.part)
+
+
+def notched_pivoting(task: Task, directory: Path) -> Task:
+    """The pivoting task (`task`) with its bar notched (NOTCHED_BAR) as a mesh part: non-convex, so
+    CoACD's pieces, one of whose seams runs under the pads."""
+    return as_mesh_part(task, directory, NOTCHED_BAR)
 
 
 def with_pusher_mu(task: Task, pusher: str, mu: float) -> Task:
@@ -135,9 +181,11 @@ class CreepResult:
 
 
 def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None,
-               engine: str = DEFAULT_ENGINE) -> CreepResult:
-    """Slide the pads at `pad_speed` m/s over a box that a wall holds at `load` of its cone."""
+               engine: str = DEFAULT_ENGINE, mesh_dir: Optional[Path] = None) -> CreepResult:
+    """Slide the pads at `pad_speed` m/s over a box that a wall holds at `load` of its cone; with
+    `mesh_dir`, a box given as a mesh part (as_mesh_part: its STL written there)."""
     task = _box_task(load)
+    task = task if mesh_dir is None else as_mesh_part(task, mesh_dir)
     rig = KinematicGrasp(task, ["wall"], engine)
     travel = travel if travel is not None else min(0.004, pad_speed * 0.5)
     rig.hold(SETTLE_TIME)
