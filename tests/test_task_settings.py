@@ -32,7 +32,7 @@ def test_replace_changes_what_it_names_tuning_keys_too_and_none_leaves_a_key_as_
     ({"seed": 1.5}, "planner.seed must be an integer"),
     ({"max_switches": True}, "planner.max_switches must be an integer"),
     ({"step": (1.0,)}, "planner.step must be 2 numbers"),
-    ({"tolerance": (1.0, float("nan"))}, "planner.tolerance must be finite"),
+    ({"tolerance": (1.0, float("nan"))}, "planner.tolerance: must be finite"),
     ({"time_limit": "10"}, "planner.time_limit must be a number"),
     ({"goal_biass": 0.1}, "planner.goal_biass: not a planner setting"),
 ])
@@ -62,7 +62,7 @@ def test_the_environment_section_is_a_typed_cell_that_round_trips():
 
 @pytest.mark.parametrize("changes, says", [
     ({"home": [0, 0]}, "environment.home must be 3 numbers"),
-    ({"retract": float("inf")}, "environment.retract must be finite"),
+    ({"retract": float("inf")}, "environment.retract: must be finite"),
     ({"end_on_feature": "yes"}, "environment.end_on_feature must be true or false"),
     ({"features": {"left": [0, 0, 0]}}, "environment.features.left must be 4 numbers"),
 ])

@@ -16,8 +16,7 @@ from typing import Dict, Optional, Sequence, Tuple
 import numpy as np
 
 from stablepush.errors import SettingError
-from stablepush.task.model import UNCERTAIN, Task
-from stablepush.task.schema import MAX_ANGLE, MAX_COORDINATE
+from stablepush.task.model import MAX_ANGLE, MAX_COORDINATE, UNCERTAIN, Task
 
 VARY_KEYS = tuple(UNCERTAIN)  # pad_mu, pusher_mu, grip_force, mass: the keys of a task's uncertainty box
 MAX_FRACTION = 0.9  # a spread of +-90% at most: every multiplier stays positive (the box's own limit)

@@ -11,12 +11,26 @@ import math
 import os
 import weakref
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.task.mesh import PartMesh
 from stablepush.units import MM, G, is_integer, is_real, mm2_to_si, pose_to_si
+
+# Plausible-physics bounds on world numbers, in file units: the task file's (schema.py) and the
+# cell's and robot's values made in code alike. Past them the model's arithmetic (doubles and the
+# exact re-check) is no longer meaningful. Far wider than any real cell.
+MAX_COORDINATE = 1e4  # mm: vertices, com, pusher ends, pad centres, poses, world positions
+MAX_ANGLE = 3600.0  # deg: poses and feature orientations
+COORDINATE = (-MAX_COORDINATE, MAX_COORDINATE)
+ANGLE = (-MAX_ANGLE, MAX_ANGLE)
+LENGTH = (1e-2, MAX_COORDINATE)  # mm: sizes, radii, distances
+JOINT_SPEED = (1e-3, 1e3)  # rad/s or m/s: environment.robot.max_joint_speed
+# A robot model file is named by one of these endings (MuJoCo compiles both; Drake parses both).
+ROBOT_MODEL_SUFFIXES = (".urdf", ".xml", ".mjcf")
+MAX_NAME = 100  # characters of a name (a pusher's, the flange's)
 
 # How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
 # (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
@@ -32,7 +46,40 @@ def _finite(field: str, value) -> None:
     except OverflowError:
         ok = False
     if not ok:
-        raise ValueError(f"{field} must be finite, got {value!r:.40}")
+        raise TaskError(field, f"must be finite, got {value!r:.40}")
+
+
+def _within(field: str, value, within: Tuple[float, float]) -> None:
+    """A finite number (TypeError, ValueError as _finite) from within[0] to within[1]: TaskError
+    naming `field`, as the task file's own check words it."""
+    _finite(field, value)
+    if not within[0] <= float(value) <= within[1]:
+        raise TaskError(field, f"must be between {within[0]:g} and {within[1]:g}, got {float(value):g}")
+
+
+def _world_pose(field: str, value, size: int) -> None:
+    """x, y, z mm (COORDINATE) then angles deg (ANGLE), each named field[i]."""
+    _finite_vector(field, value, size)
+    for i, v in enumerate(value):
+        _within(f"{field}[{i}]", v, COORDINATE if i < 3 else ANGLE)
+
+
+def _robot_model(value: str) -> str:
+    """A robot model's file, `~` expanded: an existing URDF or MJCF file (TaskError otherwise)."""
+    try:
+        path = Path(value).expanduser()
+    except RuntimeError:  # ~user of no such user: named as given, and found nowhere
+        path = Path(value)
+    if path.suffix.lower() not in ROBOT_MODEL_SUFFIXES:
+        raise TaskError("environment.robot.model",
+                        f"{value!r:.80} is not a URDF or MJCF file (it ends {', '.join(ROBOT_MODEL_SUFFIXES)})")
+    try:
+        found = path.is_file()
+    except OSError:  # a name longer than the system allows, say
+        found = False
+    if not found:
+        raise TaskError("environment.robot.model", f"no file {str(path)!r:.120}")
+    return str(path)
 
 
 def _integer(field: str, value) -> None:
@@ -194,7 +241,9 @@ class Robot:
     and the fixed-axis roll, pitch, yaw deg of a URDF `rpy`), `base`, the arm's base in the world
     (x, y, z mm and yaw deg about the world's z), and `max_joint_speed` [rad/s, or m/s for a
     sliding joint], the limit of a joint whose model gives none (URDF `limit velocity` is read).
-    Made with a field of the wrong shape it raises TypeError or ValueError naming it."""
+    Made with a field of the wrong type it raises TypeError naming it; with one the task file
+    would refuse (a model that is no URDF or MJCF file, a number out of its range), TaskError
+    naming the field, before anything reads the model."""
 
     model: Optional[str] = None
     flange: str = "hand"
@@ -207,11 +256,14 @@ class Robot:
             raise TypeError(f"environment.robot.model must be a file name, got {self.model!r:.60}")
         if not isinstance(self.flange, str) or not self.flange:
             raise TypeError(f"environment.robot.flange must be a link name, got {self.flange!r:.60}")
-        _finite_vector("environment.robot.tcp", self.tcp, 6)
-        _finite_vector("environment.robot.base", self.base, 4)
-        _finite("environment.robot.max_joint_speed", self.max_joint_speed)
-        if not self.max_joint_speed > 0:
-            raise ValueError(f"environment.robot.max_joint_speed must be positive, got {self.max_joint_speed!r:.40}")
+        if not self.flange.strip() or len(self.flange) > MAX_NAME or not self.flange.isprintable():
+            raise TaskError("environment.robot.flange", f"must be at most {MAX_NAME} printable characters, not all "
+                                                        f"spaces, got {self.flange!r:.60}")
+        _world_pose("environment.robot.tcp", self.tcp, 6)
+        _world_pose("environment.robot.base", self.base, 4)
+        _within("environment.robot.max_joint_speed", self.max_joint_speed, JOINT_SPEED)
+        if self.model is not None:
+            object.__setattr__(self, "model", _robot_model(self.model))
         object.__setattr__(self, "tcp", tuple(float(v) for v in self.tcp))
         object.__setattr__(self, "base", tuple(float(v) for v in self.base))
         object.__setattr__(self, "max_joint_speed", float(self.max_joint_speed))
@@ -228,8 +280,8 @@ class Robot:
         named = {f.name for f in dataclasses.fields(cls)}
         unknown = [key for key in values if key not in named]
         if unknown:
-            raise ValueError(f"environment.robot.{unknown[0]!s:.40}: not a setting of the robot "
-                             f"({', '.join(sorted(named))})")
+            raise TaskError(f"environment.robot.{unknown[0]!s:.40}", f"not a setting of the robot "
+                                                                     f"({', '.join(sorted(named))})")
         return cls(**values)
 
     def replace(self, **changes: Any) -> "Robot":
@@ -252,8 +304,8 @@ class Cell:
     z, theta about world y]; the others are placed by stablepush.execution.world), whether a
     run ends with the object on its last feature (`end_on_feature`), and the arm (`robot`, a
     Robot; the shipped arm when the task names none). Made with a field of the wrong
-    shape it raises TypeError or ValueError naming it; the file's ranges are checked where the file
-    is read (schema.py)."""
+    shape it raises TypeError or ValueError naming it, with a number out of the task file's range
+    TaskError naming the field (which features name the task's pushers is the task's check)."""
 
     home: Tuple[float, float, float] = (450.0, 0.0, 300.0)
     retract: float = 20.0
@@ -264,21 +316,21 @@ class Cell:
     robot: Robot = field(default_factory=Robot)
 
     def __post_init__(self) -> None:
-        _finite_vector("environment.home", self.home, 3)
+        _world_pose("environment.home", self.home, 3)
         if isinstance(self.robot, dict):
             object.__setattr__(self, "robot", Robot.from_mapping(self.robot))
         if not isinstance(self.robot, Robot):
             raise TypeError(f"environment.robot must be a Robot or a mapping, got {type(self.robot).__name__}")
         object.__setattr__(self, "home", tuple(float(v) for v in self.home))
         for name in ("retract", "station_spacing", "lane_offset"):
-            _finite(f"environment.{name}", getattr(self, name))
+            _within(f"environment.{name}", getattr(self, name), LENGTH)
             object.__setattr__(self, name, float(getattr(self, name)))
         if not isinstance(self.end_on_feature, bool):
             raise TypeError(f"environment.end_on_feature must be true or false, got {self.end_on_feature!r:.40}")
         if not isinstance(self.features, dict):
             raise TypeError("environment.features must map pusher names to [x, y, z, theta] (mm, deg)")
         for name, pose in self.features.items():
-            _finite_vector(f"environment.features.{name}", pose, 4)
+            _world_pose(f"environment.features.{name}", pose, 4)
         object.__setattr__(self, "features", {name: tuple(float(v) for v in pose)
                                               for name, pose in self.features.items()})
 
@@ -288,7 +340,8 @@ class Cell:
         named = {f.name for f in dataclasses.fields(cls)}
         unknown = [key for key in values if key not in named]
         if unknown:
-            raise ValueError(f"environment.{unknown[0]!s:.40}: not a setting of the cell ({', '.join(sorted(named))})")
+            raise TaskError(f"environment.{unknown[0]!s:.40}",
+                            f"not a setting of the cell ({', '.join(sorted(named))})")
         return cls(**values)
 
     def as_dict(self) -> Dict[str, Any]:

@@ -24,9 +24,14 @@ from stablepush.inputs import read_capped
 from stablepush.outputs import protect_input
 from stablepush.task.mesh import PartMesh, first_pad_off_faces, load_mesh_object, slab_text
 from stablepush.task.model import (
+    ANGLE,
+    COORDINATE,
+    JOINT_SPEED,
+    LENGTH,
     ON_BOUNDARY,
     PLANNER_DEFAULTS,
     PUSHES,
+    ROBOT_MODEL_SUFFIXES,
     UNCERTAIN,
     Cell,
     PlannerSettings,
@@ -61,12 +66,10 @@ MAX_PUSHER_POINTS = 20
 MAX_POLYGON_SIDES = 64
 MAX_YAML_ALIASES = 1000  # aliases (*name) a task file may use (PyYAML writes one per shared value)
 MAX_YAML_NODES = 100_000  # values in the file, aliases expanded
-# Plausible-physics bounds on each number, in file units; past them the model's arithmetic
-# (doubles and the exact re-check) is no longer meaningful. Far wider than any real cell.
-MAX_COORDINATE = 1e4  # mm: vertices, com, pusher ends, pad centres, poses, world positions
-MAX_ANGLE = 3600.0  # deg: poses and feature orientations
+# Plausible-physics bounds on each number, in file units (the world's, COORDINATE, ANGLE and
+# LENGTH, are model.py's: the cell and robot values check them too).
 LIMITS: Dict[str, Tuple[float, float]] = {  # kind -> (lowest, highest); both inclusive
-    "length": (1e-2, MAX_COORDINATE),  # mm: sizes, radii, distances
+    "length": LENGTH,  # mm: sizes, radii, distances
     "mass": (1e-3, 1e7),  # g
     "inertia": (1e-15, 1e6),  # kg m^2
     "force": (1e-6, 1e5),  # N
@@ -84,8 +87,6 @@ LIMITS: Dict[str, Tuple[float, float]] = {  # kind -> (lowest, highest); both in
 # Where the arm works (stablepush.execution): the environment section's keys but `features`, and
 # their defaults (Cell says what each is).
 ENVIRONMENT_DEFAULTS: Dict[str, Any] = {k: v for k, v in Cell().as_dict().items() if k not in ("features", "robot")}
-# The file names a robot model by one of these endings (MuJoCo compiles both; Drake parses both).
-ROBOT_MODEL_SUFFIXES = (".urdf", ".xml", ".mjcf")
 
 # TRRTstar's declared parameters and their ranges live in the C++ planner (declared once there;
 # its setters refuse values outside them): key -> (kind, lowest, highest). seed and max_switches
@@ -268,10 +269,6 @@ def _vector(path: str, value: Any, n: int, within: Optional[Tuple[float, float]]
     if not isinstance(value, (list, tuple)) or len(value) != n:
         raise TaskError(path, f"must be a list of {n} numbers, got {_shown(value)}")
     return tuple(_number(f"{path}[{i}]", v, within) for i, v in enumerate(value))
-
-
-COORDINATE = (-MAX_COORDINATE, MAX_COORDINATE)
-ANGLE = (-MAX_ANGLE, MAX_ANGLE)
 
 
 def number_field(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> float:
@@ -905,7 +902,7 @@ def robot_section(value: Any, source: Optional[str] = None, names: Optional[Dict
             name = (names or {}).get(key, f"environment.robot.{key}")
             raise TaskError(name, f"{' '.join(f'{v:g}' for v in out[key])}: {slip}; {name} takes mm and deg")
     if "max_joint_speed" in robot:
-        out["max_joint_speed"] = _number("environment.robot.max_joint_speed", robot["max_joint_speed"], (1e-3, 1e3))
+        out["max_joint_speed"] = _number("environment.robot.max_joint_speed", robot["max_joint_speed"], JOINT_SPEED)
     return Robot.from_mapping(out)
 
 
