@@ -22,6 +22,7 @@ EXTRAS = {
     "pydrake": ("drake", "drake"),
     "coacd": ("sim", "coacd"),  # a mesh part's convex pieces, on either engine: [drake] brings it too
     "ray": ("ray", "ray"),
+    "h2": ("ray", "h2"),  # --ray HOST:PORT: the check that a Ray head answers there
     "rosbags": ("ros", "rosbags"),
     "imageio_ffmpeg": ("video", "imageio-ffmpeg"),
 }

@@ -183,19 +183,83 @@ def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterat
             ray.shutdown()
 
 
+# The call that tells a Ray head from anything else that accepts a connection: the method every
+# Ray client asks a head's GCS first (its cluster id), made over gRPC (HTTP/2, by h2).
+RAY_HEAD_METHOD = "/ray.rpc.NodeInfoGcsService/GetClusterId"
+# A Ray Client server (ray://) is asked a method no server has: a gRPC server answers it with
+# status 12, UNIMPLEMENTED, which is enough to tell it from a proxy or another kind of server.
+GRPC_PROBE_METHOD = "/stablepush.Probe/NoSuchMethod"
+GRPC_OK, GRPC_UNIMPLEMENTED = 0, 12
+
+
 def probe_ray_head(address: Optional[str]) -> None:
-    """RunnerError unless something answers at a HOST:PORT address within RAY_CONNECT_TIMEOUT_S
-    (None, "auto" and "local" are left to ray.init)."""
+    """RunnerError unless a Ray head answers at a HOST:PORT address within RAY_CONNECT_TIMEOUT_S:
+    its GCS returns the cluster id over gRPC (for ray://HOST:PORT, a gRPC server answers at all).
+    ray.init waits minutes on anything else that accepts the connection (a proxy, another server).
+    None, "auto" and "local" are left to ray.init."""
     if address in (None, "auto", "local"):
         return
-    import socket
-
     host, port = _host_port(check_ray_address(address))
+    advice = "start one there (`ray start --head`), or run on a local instance"
+    client = address.startswith("ray://")
     try:
-        socket.create_connection((host, int(port)), timeout=RAY_CONNECT_TIMEOUT_S).close()
+        status = grpc_status(host, int(port), GRPC_PROBE_METHOD if client else RAY_HEAD_METHOD,
+                             RAY_CONNECT_TIMEOUT_S)
+    except socket.timeout:
+        raise RunnerError(f"{address} accepts a connection but answers nothing within {RAY_CONNECT_TIMEOUT_S:g} s: "
+                          f"not a Ray head (its GCS answers gRPC at once): {advice}") from None
     except OSError as exc:
-        raise RunnerError(f"no Ray head answers at {address} ({exc.strerror or type(exc).__name__}): start one "
-                          f"there (`ray start --head`), or run on a local instance") from None
+        raise RunnerError(f"no Ray head answers at {address} ({exc.strerror or type(exc).__name__}): "
+                          f"{advice}") from None
+    expected = (GRPC_OK, GRPC_UNIMPLEMENTED) if client else (GRPC_OK,)
+    if status not in expected:
+        what = "no gRPC server" if status is None else f"a gRPC server without Ray's GCS (status {status})"
+        raise RunnerError(f"{address} answers, but as {what}, not a Ray head: {advice}")
+
+
+def grpc_status(host: str, port: int, method: str, timeout: float) -> Optional[int]:
+    """The grpc-status a server at host:port returns for an empty unary call of `method`, or None
+    when it does not answer as a gRPC server (HTTP status not 200, not application/grpc, no
+    status). socket.timeout when it answers nothing within `timeout` s; OSError when it cannot
+    be reached."""
+    require("h2", "--ray HOST:PORT (checking that a Ray head answers there)")
+    from h2 import events as h2_events
+    from h2.connection import H2Connection
+    from h2.exceptions import ProtocolError
+
+    with socket.create_connection((host, port), timeout=timeout) as sock:
+        sock.settimeout(timeout)
+        conn = H2Connection()
+        conn.initiate_connection()
+        stream = conn.get_next_available_stream_id()
+        conn.send_headers(stream, [(":method", "POST"), (":scheme", "http"), (":path", method),
+                                   (":authority", f"{host}:{port}"), ("content-type", "application/grpc"),
+                                   ("te", "trailers")])
+        conn.send_data(stream, bytes(5), end_stream=True)  # one message: uncompressed, 0 bytes (an empty request)
+        sock.sendall(conn.data_to_send())
+        headers: dict = {}
+        while True:
+            data = sock.recv(65536)
+            if not data:
+                return _grpc_code(headers)
+            try:
+                events = conn.receive_data(data)
+            except ProtocolError:
+                return None
+            for event in events:
+                if isinstance(event, (h2_events.ResponseReceived, h2_events.TrailersReceived)):
+                    headers.update((bytes(k).decode(errors="replace"), bytes(v).decode(errors="replace"))
+                                   for k, v in event.headers)
+                if isinstance(event, (h2_events.StreamEnded, h2_events.StreamReset, h2_events.ConnectionTerminated)):
+                    return _grpc_code(headers)
+            sock.sendall(conn.data_to_send())
+
+
+def _grpc_code(headers: dict) -> Optional[int]:
+    if headers.get(":status") != "200" or not headers.get("content-type", "").startswith("application/grpc"):
+        return None
+    code = headers.get("grpc-status")
+    return int(code) if code is not None and code.isdigit() else None
 
 
 def _join_ray(ray, address: Optional[str]) -> None:

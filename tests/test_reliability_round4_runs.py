@@ -1,0 +1,85 @@
+"""Reliability, round four (issue 69), the classes of runs and outputs: G (a --ray address where
+something accepts TCP but is not a Ray head) and the rule that no output names an input. Each
+test fails on the code before its fix."""
+import socket
+import socketserver
+import threading
+import time
+
+import pytest
+from click.testing import CliRunner
+
+from stablepush.errors import RunnerError
+from stablepush.runners import probe_ray_head
+from stablepush_cli.main import cli
+
+from conftest import TASKS
+
+
+class _Silent(socketserver.BaseRequestHandler):
+    def handle(self):
+        time.sleep(8)  # accepts, reads nothing, says nothing
+
+
+class _Http1(socketserver.BaseRequestHandler):
+    def handle(self):
+        self.request.recv(1024)
+        self.request.sendall(b"HTTP/1.1 400 Bad Request\r\ncontent-length: 0\r\n\r\n")
+
+
+class _Http2NotGrpc(socketserver.BaseRequestHandler):
+    """An HTTP/2 endpoint that is not a gRPC server: its SETTINGS, then a 404 to any request (h2)."""
+
+    def handle(self):
+        from h2.config import H2Configuration
+        from h2.connection import H2Connection
+        from h2.events import RequestReceived
+
+        conn = H2Connection(H2Configuration(client_side=False))
+        conn.initiate_connection()
+        self.request.sendall(conn.data_to_send())
+        while True:
+            data = self.request.recv(65536)
+            if not data:
+                return
+            for event in conn.receive_data(data):
+                if isinstance(event, RequestReceived):
+                    conn.send_headers(event.stream_id, [(":status", "404")], end_stream=True)
+            self.request.sendall(conn.data_to_send())
+
+
+@pytest.fixture(params=[_Silent, _Http1, _Http2NotGrpc], ids=["silent", "http1", "http2-not-grpc"])
+def not_a_head(request):
+    server = socketserver.ThreadingTCPServer(("127.0.0.1", 0), request.param)
+    server.daemon_threads = True
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    yield f"127.0.0.1:{server.server_address[1]}"
+    server.shutdown()
+    server.server_close()
+
+
+def test_g_a_server_that_is_not_a_ray_head_is_refused_within_seconds(not_a_head):
+    """Something that accepts TCP but is not a Ray head: ray.init waited (killed after 150 s)."""
+    started = time.perf_counter()
+    with pytest.raises(RunnerError, match=f"{not_a_head} (answers, but as|accepts a connection but)"):
+        probe_ray_head(not_a_head)
+    assert time.perf_counter() - started < 15
+    with pytest.raises(RunnerError):
+        probe_ray_head(f"ray://{not_a_head}")
+
+
+def test_g_evaluate_names_the_address_and_exits_2_before_any_work(not_a_head, tmp_path):
+    task = str(TASKS / "t-shaped.yaml")
+    result = CliRunner().invoke(cli, ["evaluate", task, "--trials", "2", "--ray", not_a_head,
+                                      "--json", str(tmp_path / "out.json")])
+    assert result.exit_code == 2, result.output
+    assert not_a_head in result.output and "not a Ray head" in result.output
+    assert not (tmp_path / "out.json").exists()
+
+
+def test_g_nothing_listening_is_still_named_at_once():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with pytest.raises(RunnerError, match=f"no Ray head answers at 127.0.0.1:{port}"):
+        probe_ray_head(f"127.0.0.1:{port}")
