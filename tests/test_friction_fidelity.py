@@ -113,6 +113,14 @@ def test_a_wall_holds_a_mesh_box_while_the_pads_slide_over_it(engine, tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="MuJoCo's wall against a convex mesh (libccd) creeps 19.6 um/mm at 90% and "
+                                       "1 mm/s, past the contract's 5 (docs/execution.md, 'Friction fidelity')")
+def test_a_wall_holds_a_mesh_box_under_slow_sliding_pads_on_mujoco(tmp_path):
+    result = fidelity.wall_creep(0.9, 0.001, engine="mujoco", mesh_dir=tmp_path)
+    assert result.creep_um_per_mm <= fidelity.CREEP_LIMIT_UM_PER_MM[0.9], result
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("engine", ENGINES)
 def test_a_pivot_of_a_non_convex_mesh_part_holds_where_the_model_says_it_does(engine, tmp_path):
     task = fidelity.notched_pivoting(shipped("pivoting"), tmp_path)
