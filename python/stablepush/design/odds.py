@@ -15,11 +15,11 @@ from typing import Any, Callable, Dict, Optional
 from stablepush.design.layouts import Design, DesignStudy
 from stablepush.errors import SettingError
 from stablepush.evaluation import Batch, Spreads, evaluate
+from stablepush.evaluation.batch import MAX_TRIALS
 from stablepush.runners import Runner
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.units import is_integer
 
-MAX_TRIALS = 1_000_000  # a design's, as `evaluate --trials` takes
 MAX_SEED = 2**32 - 1
 
 

@@ -21,6 +21,7 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from stablepush.errors import SettingError
 from stablepush.evaluation.sequential import SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.bags import RunRecording
@@ -35,12 +36,13 @@ from stablepush.runners import Runner, WorkerLost, run_all, this_node
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.local_arm import SimulatedArm
 from stablepush.task.model import Task
-from stablepush.units import angle_difference_deg
+from stablepush.units import angle_difference_deg, is_integer
 
 RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
 PERCENTILES = (50, 90, 95, 99)
 EDGE = 0.9  # of the success tolerance: an open-loop plan ending this far out is warned of
 DEFAULT_TRIALS = 100  # a study's trials when none are named and no sequential test sets the cap
+MAX_TRIALS = 1_000_000  # a study's, as `evaluate --trials` takes
 
 
 @dataclass(frozen=True)
@@ -197,7 +199,10 @@ def _crashed(batch: Batch, trial: int, why: str) -> dict:
 def study_trials(spreads: Spreads, trials: Optional[int] = None, test: Optional[SequentialTest] = None) -> int:
     """The trials a study runs (at most, with a `test`): `trials` when given, else the test's
     default cap (SequentialTest.default_cap: one it decides within), else DEFAULT_TRIALS; one where
-    every world is the model's own (Spreads.trials_to_run)."""
+    every world is the model's own (Spreads.trials_to_run). SettingError for `trials` that is not a
+    whole number from 1 to MAX_TRIALS: a study of none would rate nothing."""
+    if trials is not None and (isinstance(trials, bool) or not is_integer(trials) or not 1 <= trials <= MAX_TRIALS):
+        raise SettingError("trials", f"must be a whole number from 1 to {MAX_TRIALS:,}, got {trials!r:.40}")
     if trials is None:
         trials = test.default_cap() if test is not None else DEFAULT_TRIALS
     return spreads.trials_to_run(trials)
