@@ -83,3 +83,18 @@ def test_g_nothing_listening_is_still_named_at_once():
         port = s.getsockname()[1]
     with pytest.raises(RunnerError, match=f"no Ray head answers at 127.0.0.1:{port}"):
         probe_ray_head(f"127.0.0.1:{port}")
+
+
+def test_r_a_batch_on_ray_that_finishes_nothing_for_a_while_says_what_ray_waits_for(monkeypatch):
+    """A starved machine: no trial finished in 15 minutes on a local Ray and nothing was printed."""
+    pytest.importorskip("ray")
+    from stablepush import runners
+    from stablepush.runners import Runner, run_all
+
+    monkeypatch.setattr(runners, "RAY_QUIET_S", 0.5)
+    said = []
+    slow = lambda _shared, i: time.sleep(1.5) or i  # noqa: E731 - by value: Ray's workers cannot import tests
+    results = dict(run_all(slow, None, [0, 1], Runner(ray=True, on_wait=said.append)))
+    assert results == {0: 0, 1: 1}
+    assert said, "nothing said while Ray finished nothing"
+    assert said[0].startswith("Ray: 0 of 2 jobs finished after ") and "CPUs" in said[0], said[0]

@@ -145,7 +145,8 @@ def runner_for(workers, ray_address, default: int):
 
     if ray_address is not None and workers is not None:
         fail("--workers and --ray: choose one")
-    runner = Runner(workers=workers or default, ray=ray_address is not None, ray_address=ray_address or None)
+    runner = Runner(workers=workers or default, ray=ray_address is not None, ray_address=ray_address or None,
+                    on_wait=lambda line: click.echo(f"\n{line}", err=True))
     if runner.ray:
         from stablepush.runners import probe_ray_head
 

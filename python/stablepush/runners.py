@@ -14,8 +14,9 @@ from __future__ import annotations
 import contextlib
 import os
 import socket
+import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Iterator, Optional, Tuple
 
 from stablepush.errors import RunnerError
@@ -24,6 +25,8 @@ from stablepush.extras import require
 Job = Callable[[Any, int], Any]
 # How long joining a Ray cluster may wait for its head to answer: Ray itself retries for minutes.
 RAY_CONNECT_TIMEOUT_S = 5.0
+# After this long with no job finished, and again after each as long, Runner.on_wait is told why.
+RAY_QUIET_S = 30.0
 # Local worker processes per CPU at most: each job keeps a CPU busy (a simulation, a search), so
 # more only share the CPUs (and each costs a process's memory); `--workers 1000` started 1,000.
 WORKERS_PER_CPU = 2
@@ -61,11 +64,16 @@ class Runner:
     workers: int = 1
     ray: bool = False
     ray_address: Optional[str] = None
+    # Told what Ray is waiting for when no job has finished for RAY_QUIET_S (a line of text): a
+    # study on a starved machine otherwise says nothing for minutes. Not part of the value.
+    on_wait: Optional[Callable[[str], None]] = field(default=None, compare=False, repr=False)
 
     def __post_init__(self):
         if isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1:
             raise ValueError(f"workers must be a whole number from 1, got {self.workers!r:.40}")
         check_ray_address(self.ray_address)
+        if self.on_wait is not None and not callable(self.on_wait):
+            raise TypeError(f"on_wait must be callable, got {type(self.on_wait).__name__}")
 
     def processes(self, jobs: int) -> int:
         """How many local processes a batch of `jobs` runs on: `workers`, but no more than the jobs
@@ -117,7 +125,7 @@ def run_all(job: Job, shared: Any, indices: Iterable[int], runner: Runner) -> It
     Closing the iterator (or Ctrl-C in the caller) cancels the jobs not yet started."""
     indices = list(indices)
     if runner.ray:
-        return _ray(job, shared, indices, runner.ray_address)
+        return _ray(job, shared, indices, runner.ray_address, runner.on_wait)
     workers = runner.processes(len(indices))
     if workers > 1:
         return _processes(job, shared, indices, workers)
@@ -152,7 +160,8 @@ def _processes(job: Job, shared: Any, indices: list, workers: int) -> Iterator[T
                 raise
 
 
-def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterator[Tuple[int, Any]]:
+def _ray(job: Job, shared: Any, indices: list, address: Optional[str],
+         on_wait: Optional[Callable[[str], None]] = None) -> Iterator[Tuple[int, Any]]:
     ray = require("ray", "--ray")
 
     started_here = not ray.is_initialized()
@@ -164,9 +173,16 @@ def _ray(job: Job, shared: Any, indices: list, address: Optional[str]) -> Iterat
         shared_ref = ray.put(shared)
         name = getattr(job, "__name__", "job")
         refs = {remote.options(name=f"{name}[{i}]").remote(job, shared_ref, i): i for i in indices}
+        began = quiet_since = time.monotonic()
         try:
             while refs:
-                done, _ = ray.wait(list(refs), num_returns=1)
+                done, _ = ray.wait(list(refs), num_returns=1, timeout=RAY_QUIET_S if on_wait else None)
+                if not done:
+                    if on_wait is not None and time.monotonic() - quiet_since >= RAY_QUIET_S:
+                        on_wait(ray_waiting(ray, len(indices) - len(refs), len(indices), time.monotonic() - began))
+                        quiet_since = time.monotonic()
+                    continue
+                quiet_since = time.monotonic()
                 for ref in done:
                     i = refs.pop(ref)
                     try:
@@ -190,6 +206,23 @@ RAY_HEAD_METHOD = "/ray.rpc.NodeInfoGcsService/GetClusterId"
 # status 12, UNIMPLEMENTED, which is enough to tell it from a proxy or another kind of server.
 GRPC_PROBE_METHOD = "/stablepush.Probe/NoSuchMethod"
 GRPC_OK, GRPC_UNIMPLEMENTED = 0, 12
+
+
+def ray_waiting(ray, finished: int, total: int, elapsed_s: float) -> str:
+    """What a batch on Ray is waiting for, in a line: how many jobs finished, and whether Ray's
+    CPUs are all taken (the jobs are running, slowly) or some are free (Ray is still starting the
+    worker processes that would take them: slow on a loaded machine)."""
+    try:
+        cpus, free = ray.cluster_resources().get("CPU", 0.0), ray.available_resources().get("CPU", 0.0)
+    except Exception:  # noqa: BLE001 - a report must not end the batch; Ray raises many kinds
+        return f"Ray: {finished} of {total} jobs finished after {elapsed_s:.0f} s (its resources cannot be read)"
+    if free > 0:
+        why = (f"{free:g} of its {cpus:g} CPUs are free, so it is still starting the worker processes that take "
+               f"the jobs (a loaded machine starts them slowly; --workers runs without Ray)")
+    else:
+        why = f"all {cpus:g} of its CPUs are running jobs"
+    return (f"Ray: {finished} of {total} jobs finished after {elapsed_s:.0f} s, none in the last {RAY_QUIET_S:g} s: "
+            f"{why}")
 
 
 def probe_ray_head(address: Optional[str]) -> None:
