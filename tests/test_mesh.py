@@ -265,6 +265,7 @@ def test_a_path_over_a_dimple_is_refused_though_its_start_and_goal_rest_flat(tmp
 
 def test_plan_refuses_a_path_off_the_faces_with_exit_2(tmp_path):
     from click.testing import CliRunner
+
     from stablepush_cli.main import cli
 
     _dimpled(tmp_path)
