@@ -124,3 +124,68 @@ def test_q_a_flange_whose_name_holds_a_quote_is_found(tmp_path):
     path, arm = _urdf(tmp_path)
     path.write_text(path.read_text().replace('"tool0"', '"fl\'ange"'))
     assert len(arm_model(_robot(path, arm, flange="fl'ange")).joints) == 6
+
+
+def _scene_model(robot):
+    """The MuJoCo model of a shipped task's scene on `robot` (compiled: a repeated name fails here)."""
+    from conftest import shipped
+    from stablepush.execution.world import place_features, scene_description
+    from stablepush.plan import plan_task
+    from stablepush.sim.scene import build_mjcf
+
+    task = shipped("horizontal-offset-low-mu")
+    plan = plan_task(task, seed=1)
+    features = place_features(task, list(plan.waypoints))
+    xml = build_mjcf(scene_description(task, features, task.start), robot=robot)
+    return mujoco.MjModel.from_xml_string(xml)
+
+
+def test_c_the_shipped_arm_given_as_a_labs_model_keeps_its_names_apart_from_the_jaws(tmp_path):
+    """arm.xml as --robot: exit 4 "repeated name" (its own finger_pos, finger_neg, G, floor)."""
+    from stablepush.sim.robot import ARM_XML
+
+    robot = Robot(model=str(ARM_XML), flange="hand", tcp=(0.0, 0.0, 110.0, 0.0, 180.0, 0.0))
+    model = _scene_model(robot)
+    assert model.joint("finger_pos").id != model.joint("robot/finger_pos").id
+    assert arm_model(robot).joints == tuple(f"j{i}" for i in range(1, 8))
+
+
+def test_c_a_labs_links_and_geoms_named_as_the_projects_are_renamed_not_taken_for_them(tmp_path):
+    """Links named object and feature_left, and a geom named floor 0.3 m up: the cell check took
+    the lab's floor for the floor."""
+    path, arm = _urdf(tmp_path)
+    text = path.read_text().replace('"link3"', '"object"').replace('"link4"', '"feature_left"')
+    text = text.replace('<link name="base">', '<link name="base"><collision name="floor"><origin xyz="0 0 0.3"/>'
+                                              '<geometry><box size="0.05 0.05 0.01"/></geometry></collision>')
+    path.write_text(text)
+    model = _scene_model(_robot(path, arm))
+    assert model.body("robot/object").id != model.body("object").id
+    assert model.geom("floor").type == mujoco.mjtGeom.mjGEOM_PLANE and model.geom("floor").pos[2] == 0.0
+    assert model.geom("robot/floor").type == mujoco.mjtGeom.mjGEOM_BOX
+    assert robot_description(_robot(path, arm)).base_link == "base"
+
+
+def test_c_an_arm_joint_named_as_the_jaws_is_refused_by_name(tmp_path):
+    path, arm = _urdf(tmp_path)
+    path.write_text(path.read_text().replace('"joint_2"', '"finger_pos"'))
+    with pytest.raises(RobotError, match="the arm's joint 'finger_pos' has a name stablepush gives its own jaws"):
+        arm_model(_robot(path, arm))
+
+
+def test_c_every_name_a_scene_adds_is_one_a_labs_model_is_kept_apart_from():
+    """PROJECT_NAMES and PROJECT_PREFIXES cover every name scene.py and the jaws add (so a lab's
+    model is renamed wherever it could clash)."""
+    from stablepush.sim.robot import ARM_XML, is_project_name
+
+    model = _scene_model(None)
+    arm = mujoco.MjModel.from_xml_path(str(ARM_XML))
+    shipped_arm = {mujoco.mj_id2name(arm, kind, i) for kind, count in ((mujoco.mjtObj.mjOBJ_BODY, arm.nbody),
+                                                                         (mujoco.mjtObj.mjOBJ_GEOM, arm.ngeom),
+                                                                         (mujoco.mjtObj.mjOBJ_JOINT, arm.njnt))
+                   for i in range(count)}
+    added = {mujoco.mj_id2name(model, kind, i) for kind, count in ((mujoco.mjtObj.mjOBJ_BODY, model.nbody),
+                                                                     (mujoco.mjtObj.mjOBJ_GEOM, model.ngeom),
+                                                                     (mujoco.mjtObj.mjOBJ_JOINT, model.njnt),
+                                                                     (mujoco.mjtObj.mjOBJ_SITE, model.nsite))
+             for i in range(count)} - shipped_arm - {None, "world"}
+    assert added and all(is_project_name(name) for name in added), sorted(added)

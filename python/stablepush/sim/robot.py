@@ -55,6 +55,18 @@ JOINT_ARMATURE = 0.2  # kg m^2
 HOME_STARTS = 24  # seeded joint vectors IK starts from to find a lab's arm's home posture
 # What of a lab's model the run has no use for, or replaces by its own.
 _DROPPED = ("actuator", "sensor", "keyframe", "contact", "option")
+# The names the project gives what it adds to a scene (here, scene.py and video.py: the base, G,
+# the jaws and their servos, the floor, the kinematic hand, the object, the features, the pads, a
+# mesh part's slabs). A lab's model that uses one has it renamed LAB_PREFIX + name, with every
+# reference to it, so that neither is taken for the other (test_robot_models checks the list).
+PROJECT_NAMES = frozenset({BASE_BODY, GRIPPER_SITE, *FINGER_JOINTS, "floor", "hand", "hand_x", "hand_z",
+                           "hand_theta", "object", "ghost", "gripper", "backdrop", "view"})
+PROJECT_PREFIXES = ("feature_", "pad_", "slab_", "object_", "ghost_")
+LAB_PREFIX = "robot/"
+# The MJCF attributes that name another element (MuJoCo 3's schema, those a saved model can hold).
+_REFERENCES = ("body", "body1", "body2", "joint", "joint1", "joint2", "geom", "geom1", "geom2", "site", "site1",
+               "site2", "tendon", "tendon1", "tendon2", "actuator", "mesh", "material", "texture", "hfield", "skin",
+               "target", "objname", "slidersite", "cranksite", "jointinparent", "refsite", "camera", "light")
 
 
 class RobotError(TaskError):
@@ -124,16 +136,19 @@ def _built(robot: Robot, _stamp: int) -> ArmModel:
         for child in [c for c in hand if c.tag in ("site", "body")]:
             hand.remove(child)  # its G and jaws: remounted at the robot's TCP
         velocity: Dict[str, float] = {}
+        renamed: set = set()
     else:
         root = _compiled(robot.model)
         velocity = _urdf_velocity_limits(robot.model)
         for tag in _DROPPED:
             for element in root.findall(tag):
                 root.remove(element)
+        renamed = _keep_apart(root)
     _mount_on_base(root, robot.base)
-    flange = _flange(root, robot.flange)
+    flange = _flange(root, robot.flange if robot.shipped or robot.flange not in renamed else LAB_PREFIX + robot.flange)
     joints = _chain_joints(root, flange)
     if not robot.shipped:
+        _refuse_project_joint_names(joints)
         _refuse_couplings(root, joints, robot.model)
         _servo(root, joints)
     _mount_jaws(root, flange, robot.tcp)
@@ -143,8 +158,43 @@ def _built(robot: Robot, _stamp: int) -> ArmModel:
     base = next(body for body in mount if body.tag == "body" and flange in body.iter("body"))
     is_urdf = robot.model and Path(robot.model).suffix.lower() == ".urdf"
     urdf = read_model_text(robot.model) if is_urdf else None
-    return ArmModel(root, names, speeds, _home_guesses(joints, robot.shipped), base.get("name"),
+    return ArmModel(root, names, speeds, _home_guesses(joints, robot.shipped), _lab_name(base.get("name")),
                     matrix_to_pose(pose_to_matrix(_body_pose(mount)) @ pose_to_matrix(_body_pose(base))), urdf)
+
+
+def is_project_name(name: str) -> bool:
+    """Whether `name` is one the project gives what it adds to a scene (PROJECT_NAMES, PROJECT_PREFIXES)."""
+    return name in PROJECT_NAMES or name.startswith(PROJECT_PREFIXES)
+
+
+def _keep_apart(root: ET.Element) -> set:
+    """Every element of a lab's compiled model named as the project names its own (is_project_name)
+    renamed LAB_PREFIX + name, with every reference to it: MuJoCo refuses a repeated name, and a
+    lab's geom named floor was taken for the floor. Returns the names renamed."""
+    renamed = {e.get("name") for e in root.iter() if e.get("name") and is_project_name(e.get("name"))}
+    for element in root.iter():
+        if element.get("name") in renamed:
+            element.set("name", LAB_PREFIX + element.get("name"))
+        for key in _REFERENCES:
+            if element.get(key) in renamed:
+                element.set(key, LAB_PREFIX + element.get(key))
+    return renamed
+
+
+def _lab_name(name: str) -> str:
+    """A name of the lab's model as the lab's file writes it (without LAB_PREFIX)."""
+    return name[len(LAB_PREFIX):] if name.startswith(LAB_PREFIX) else name
+
+
+def _refuse_project_joint_names(joints: List[ET.Element]) -> None:
+    """A joint of the arm renamed by _keep_apart would reach the lab's controller under a name it
+    does not know: RobotError naming it."""
+    clashing = [_lab_name(j.get("name")) for j in joints if j.get("name").startswith(LAB_PREFIX)]
+    if clashing:
+        raise RobotError("environment.robot.model", f"the arm's joint {clashing[0]!r} has a name stablepush gives "
+                                                    f"its own jaws or scene ({', '.join(sorted(PROJECT_NAMES))[:200]}, "
+                                                    f"or starting {', '.join(PROJECT_PREFIXES)}): rename it in the "
+                                                    f"model")
 
 
 def _body_pose(body: ET.Element) -> List[float]:
