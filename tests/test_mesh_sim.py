@@ -21,7 +21,7 @@ from stablepush.execution.world import place_features, scene_description
 from stablepush.extras import MissingExtra
 from stablepush.plan import Waypoint, check_plan, plan_task
 from stablepush.sim import fidelity
-from stablepush.sim.scene import build_mjcf
+from stablepush.sim.scene import FEATURE_TILES, build_mjcf
 from stablepush.task import load_task
 
 from conftest import ROOT, shipped
@@ -126,9 +126,12 @@ def test_the_mjcf_of_a_mesh_task_holds_its_pieces_as_mesh_geoms(tmp_path):
     # The solid, not the 36 mm slab: its shaft is 20 mm across.
     ys = np.vstack([_mesh_vertices(root, g.get("mesh")) for g in geoms])[:, 1]
     assert np.isclose(ys, 0.010).any() and np.isclose(ys, -0.010).any()
-    # Features touch the pieces; pads the prism of the section under them (slab_*).
+    # Features touch the pieces by their tiles, each tile every piece; pads the prism of the section
+    # under them (slab_*).
     pairs = [(p.get("geom1"), p.get("geom2")) for p in root.iter("pair")]
-    assert {b for a, b in pairs if a == "feature_left"} == {g.get("name") for g in geoms}
+    tiles = {a for a, _ in pairs if a.startswith("feature_left_tile")}
+    assert len(tiles) == math.prod(FEATURE_TILES) and not any(a == "feature_left" for a, _ in pairs)
+    assert {(a, b) for a, b in pairs if a in tiles} == {(t, g.get("name")) for t in tiles for g in geoms}
     assert {b for a, b in pairs if a.startswith("pad_")} == {g.get("name") for g in body.findall("geom")
                                                             if g.get("name").startswith("slab_")}
 

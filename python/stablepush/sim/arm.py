@@ -103,16 +103,16 @@ class SimulatedGrasp:
 
     def contact_force_on_object(self, pusher: str) -> np.ndarray:
         """Total force [N, world frame] that pusher `pusher`'s feature exerts on the object now."""
-        geom = self.model.geom(scene_mod.feature_geom(pusher)).id
+        geoms = set(scene_mod.feature_geoms(self.model, pusher))
         total = np.zeros(3)
         f6 = np.zeros(6)
         for i in range(self.data.ncon):
             c = self.data.contact[i]
-            if geom not in (c.geom1, c.geom2):
+            if c.geom1 not in geoms and c.geom2 not in geoms:
                 continue
             mujoco.mj_contactForce(self.model, self.data, i, f6)
             f = c.frame.reshape(3, 3).T @ f6[:3]  # rows of frame: normal, tangents; the force acts on geom2
-            total += f if c.geom1 == geom else -f
+            total += f if c.geom1 in geoms else -f
         return total
 
     @property

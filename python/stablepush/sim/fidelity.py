@@ -181,11 +181,13 @@ class CreepResult:
 
 
 def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None,
-               engine: str = DEFAULT_ENGINE, mesh_dir: Optional[Path] = None) -> CreepResult:
+               engine: str = DEFAULT_ENGINE, mesh_dir: Optional[Path] = None,
+               outline: Optional[Sequence[Sequence[float]]] = None) -> CreepResult:
     """Slide the pads at `pad_speed` m/s over a box that a wall holds at `load` of its cone; with
-    `mesh_dir`, a box given as a mesh part (as_mesh_part: its STL written there)."""
+    `mesh_dir`, the box given as a mesh part (as_mesh_part: its STL written there), or the part of
+    section `outline` (x, z mm, ccw; its left face the box's, x = -25 from z = -25 to 25)."""
     task = _box_task(load)
-    task = task if mesh_dir is None else as_mesh_part(task, mesh_dir)
+    task = task if mesh_dir is None else as_mesh_part(task, mesh_dir, outline)
     rig = KinematicGrasp(task, ["wall"], engine)
     travel = travel if travel is not None else min(0.004, pad_speed * 0.5)
     rig.hold(SETTLE_TIME)

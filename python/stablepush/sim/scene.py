@@ -15,7 +15,8 @@ Contact settings that keep friction honest (the simulation's results rest on the
 - each pad is a disc of point contacts laid out as the task's `pad_rings` says, so the simulated
   pad's force acts where the model's does (docs/planner.md, "The mechanics");
 - multi-point convex collisions by libccd (`multiccd`, native CCD off), so a face on a face
-  touches at several points;
+  touches at several points; a mesh piece touches a line feature's tiles (FEATURE_TILES), so that
+  the contact bears a moment by its stiffness;
 - only the object touches pads and features (explicit contact pairs with the task's friction);
   the fingers are driven by force-capped joint servos, not as mocap bodies, so the pads press
   with exactly the task's grip force and friction can drag the object.
@@ -51,6 +52,12 @@ PAD_POINT_RADIUS = 0.0005  # m, radius of each pad contact sphere
 FEATURE_DEPTH = 0.01  # m, how far a feature extends behind its contact face
 FEATURE_CLEARANCE = 0.002  # m, a feature is this much narrower than the object along y on each side
 FEATURE_ROD_RADIUS = 0.001  # m, the rod of a point pusher's feature
+# A line feature's tiles (along its segment, along y) that the object's mesh pieces touch instead
+# of its one box (build_mjcf): MuJoCo's convex collision (multiccd) gives every contact point of a
+# pair the pair's one depth, so a single pair bears no moment by its stiffness; tiles have depths of
+# their own. 2 x 2 bears a moment about either axis of the face.
+FEATURE_TILES = (2, 2)
+TILE_INFIX = "_tile"  # a feature's tile geoms are named <feature geom>_tile<k>
 # m a line feature's solid stops short of an end of its segment in a reflex corner of the object
 # (at most a quarter of the segment): a solid reaching the corner, placed off by any amount toward
 # the adjacent face, lies in that face's path on the approach (the T's web feature over its
@@ -357,7 +364,9 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
                   impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS),
                   noslip_tolerance=repr(NOSLIP_TOLERANCE), integrator="implicitfast")
     # libccd, not MuJoCo's native CCD: with native CCD the wedge's convex mesh slid 0.6 mm along
-    # its heel stop in 12 pushes that the model, Drake and libccd all hold (docs/results/engines-cross-engine.md).
+    # its heel stop in 12 pushes that the model, Drake and libccd all hold (docs/results/engines-cross-engine.md),
+    # and with the feature tiles the notched pivot's bar still turned 0.15 deg in the world where
+    # libccd turns it 0.03 (its pads on the section's non-rectangular pieces).
     root.find("option").append(ET.Element("flag", multiccd="enable", nativeccd="disable"))
     worldbody = root.find("worldbody")
     obj = scene["object"]
@@ -395,8 +404,11 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
         section = {key: value for key, value in obj.items() if key != "mesh"}
         pad_faces = add_object_geoms(body, assets, section, half_thickness, "0 0 0 0", prefix=SLAB_PREFIX, mass="0")
 
-    # The features: fixed solids whose contact face is the pusher's segment.
+    # The features: fixed solids whose contact face is the pusher's segment. A mesh piece touches a
+    # line feature's tiles (FEATURE_TILES), a box piece its box (box-box contacts have their own depths).
     contact = ET.SubElement(root, "contact")
+    mesh_pieces = [n for n in piece_names if body.find(f"geom[@name='{n}']").get("type") == "mesh"]
+    box_pieces = [n for n in piece_names if n not in mesh_pieces]
     for feature in scene["features"]:
         name = feature_geom(feature["pusher"])
         solid = feature_solid(feature, obj)
@@ -408,8 +420,12 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
             c, h = solid["center"], solid["half_length"]
             ET.SubElement(worldbody, "geom", name=name, type="capsule", size=repr(solid["radius"]),
                           fromto=mjcf_numbers((*(c - [0, h, 0]), *(c + [0, h, 0]))), rgba="0.3 0.5 0.8 1")
-        for piece in piece_names:
+        for piece in box_pieces:
             _pair(contact, name, piece, feature["mu"])
+        tiles = _add_feature_tiles(worldbody, name, solid) if solid["kind"] == "box" and mesh_pieces else [name]
+        for tile in tiles:
+            for piece in mesh_pieces:
+                _pair(contact, tile, piece, feature["mu"])
     for pad in pad_names:
         for piece in pad_faces:
             _pair(contact, pad, piece, gripper["mu"])
@@ -419,6 +435,36 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
 def feature_geom(pusher: str) -> str:
     """The name of the geom of pusher `pusher`'s feature in a model built by `build_mjcf`."""
     return f"feature_{pusher}"
+
+
+def feature_geoms(model, pusher: str) -> List[int]:
+    """The ids of the geoms of pusher `pusher`'s feature in a model built by `build_mjcf`: its solid
+    and the tiles that a mesh piece touches (FEATURE_TILES)."""
+    name = feature_geom(pusher)
+    return [g for g in range(model.ngeom) if model.geom(g).name == name
+            or model.geom(g).name.startswith(name + TILE_INFIX)]
+
+
+def feature_tiles(solid: dict) -> List[Tuple[np.ndarray, Tuple[float, float, float]]]:
+    """A box feature's solid (feature_solid) cut into FEATURE_TILES boxes, each (centre in W [m],
+    half sizes along the solid's axes): their union is the solid."""
+    (n_along, n_y), (hx, hy, hz) = FEATURE_TILES, solid["half_size"]
+    c, s = math.cos(solid["angle"]), math.sin(solid["angle"])
+    along = np.array([c, 0.0, -s])  # the solid's x axis in W: rotated by `angle` about y
+    half = (hx / n_along, hy / n_y, hz)
+    return [(np.asarray(solid["center"], float) + along * (-hx + half[0] * (2 * i + 1))
+             + np.array([0.0, -hy + half[1] * (2 * j + 1), 0.0]), half)
+            for i in range(n_along) for j in range(n_y)]
+
+
+def _add_feature_tiles(worldbody: ET.Element, name: str, solid: dict) -> List[str]:
+    """The tiles of box feature `name` (feature_tiles) as unseen geoms of `worldbody`; their names."""
+    names = []
+    for k, (center, half) in enumerate(feature_tiles(solid)):
+        names.append(f"{name}{TILE_INFIX}{k}")
+        ET.SubElement(worldbody, "geom", name=names[-1], type="box", pos=mjcf_numbers(center),
+                      quat=mjcf_numbers(quat_about_y(solid["angle"])), size=mjcf_numbers(half), rgba="0 0 0 0")
+    return names
 
 
 def pad_geoms(model) -> List[int]:
