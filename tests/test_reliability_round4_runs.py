@@ -98,3 +98,40 @@ def test_r_a_batch_on_ray_that_finishes_nothing_for_a_while_says_what_ray_waits_
     assert results == {0: 0, 1: 1}
     assert said, "nothing said while Ray finished nothing"
     assert said[0].startswith("Ray: 0 of 2 jobs finished after ") and "CPUs" in said[0], said[0]
+
+
+def test_a_plan_file_read_is_not_written_over_by_the_api(tmp_path):
+    """Inputs are never outputs, in the library: sp.save_plan wrote over the plan file it had read."""
+    import stablepush as sp
+    from stablepush.errors import OutputError
+
+    from conftest import shipped
+
+    task = shipped("t-shaped")
+    path = tmp_path / "t.json"
+    sp.save_plan(sp.plan_task(task, seed=1), str(path))
+    plan = sp.load_plan(str(path))
+    before = path.read_bytes()
+    with pytest.raises(OutputError, match="a plan file this process read; refusing to write over it"):
+        sp.save_plan(plan, str(path))
+    assert path.read_bytes() == before
+
+
+def test_a_file_the_robot_model_includes_is_refused_as_an_output_before_any_work(tmp_path):
+    """check-cell --json naming a file the MJCF arm includes: the model's include was written over."""
+    from generated_arms import mjcf_arm
+
+    arm = mjcf_arm(tmp_path / "arm.xml", 5, ("z", "x", "z", "-x", "z", "x", "z"))
+    model = tmp_path / "arm.xml"
+    extra = tmp_path / "extra.xml"
+    extra.write_text('<mujoco><default><geom rgba="1 0 0 1"/></default></mujoco>')
+    model.write_text(model.read_text().replace("<worldbody>", '<include file="extra.xml"/><worldbody>'))
+    runner = CliRunner()
+    task = str(TASKS / "horizontal-offset-low-mu.yaml")
+    plan = str(tmp_path / "p.json")
+    assert runner.invoke(cli, ["plan", task, "-o", plan]).exit_code == 0
+    result = runner.invoke(cli, ["check-cell", plan, "--task", task, "--robot", str(model), "--flange",
+                                 arm["flange"], "--tcp", *map(str, arm["tcp"]), "--json", str(extra)])
+    assert result.exit_code == 2, result.output
+    assert f"--json {extra}: is a file the robot model includes this process read" in result.output, result.output
+    assert extra.read_text().startswith("<mujoco><default>")

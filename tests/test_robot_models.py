@@ -128,10 +128,11 @@ def test_q_a_flange_whose_name_holds_a_quote_is_found(tmp_path):
 
 def _scene_model(robot):
     """The MuJoCo model of a shipped task's scene on `robot` (compiled: a repeated name fails here)."""
-    from conftest import shipped
     from stablepush.execution.world import place_features, scene_description
     from stablepush.plan import plan_task
     from stablepush.sim.scene import build_mjcf
+
+    from conftest import shipped
 
     task = shipped("horizontal-offset-low-mu")
     plan = plan_task(task, seed=1)

@@ -40,7 +40,7 @@ def _error_text(ctx: click.Context, error: StablepushError) -> str:
     """The error's message, an output's prefixed with the option that named it (check_named_outputs)."""
     if isinstance(error, OutputError) and error.output is not None:
         for name, path in ctx.meta.get(OUTPUTS, {}).items():
-            if Path(path) == Path(error.output):
+            if Path(path) == Path(error.output) and not str(error).startswith(f"{name} "):
                 return f"{name} {error}"
     return str(error)
 

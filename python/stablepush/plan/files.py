@@ -13,7 +13,7 @@ from typing import Optional, Union
 from stablepush import strict_json
 from stablepush.errors import OutputError, PlanError
 from stablepush.inputs import read_capped
-from stablepush.outputs import is_stream, same_file, write_files
+from stablepush.outputs import is_stream, protect_input, same_file, write_files
 from stablepush.plan.plan import (
     FieldFault,
     Plan,
@@ -175,6 +175,7 @@ def read_plan(path: Union[str, Path]) -> dict:
         raise PlanError("", f"{exc}; not a plan this tool wrote", source) from None
     except OSError as exc:
         raise PlanError("", f"cannot read the plan file ({exc.strerror or exc})", source) from None
+    protect_input(path, "a plan file")
     try:
         data = strict_json.loads(raw.decode("utf-8"))
     except (UnicodeDecodeError, ValueError) as exc:

@@ -17,6 +17,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 from stablepush import _core
 from stablepush.errors import TaskError
 from stablepush.task.mesh import PartMesh
+from stablepush.task.robot_files import model_source
 from stablepush.units import MM, G, is_integer, is_real, mm2_to_si, pose_to_si
 
 # Plausible-physics bounds on world numbers, in file units: the task file's (schema.py) and the
@@ -79,6 +80,7 @@ def _robot_model(value: str) -> str:
         found = False
     if not found:
         raise TaskError("environment.robot.model", f"no file {str(path)!r:.120}")
+    model_source(path)  # read now, every file it names protected as an input (RobotError, a TaskError)
     return str(path)
 
 

@@ -42,6 +42,7 @@ from stablepush.task.model import (
     outline_corners,
 )
 from stablepush.task.release import goal_release_holds, needed_hold_ratio
+from stablepush.task.robot_files import model_source
 from stablepush.units import MM, is_integer, is_real, mm2_to_si, pose_to_si
 
 DEFAULT_PAD_RADIUS_MM = 5.0
@@ -350,7 +351,7 @@ def load_design(path: "str | Path") -> Tuple[Dict[str, Any], List[Dict[str, Any]
     source = str(path)
     try:
         data = _load_yaml(read_capped(path, MAX_TASK_BYTES).decode("utf-8"))
-        protect_input(path, "a task file")
+        protect_input(path, "a design file")
     except ValueError as exc:
         raise TaskError("", f"cannot read the design file: {exc}", source) from None
     except OSError as exc:
@@ -956,7 +957,7 @@ def robot_model_file(field: str, value: Any, source: Optional[str] = None) -> st
         raise TaskError(field, f"{value!r:.80} is not a URDF or MJCF file (it ends {', '.join(ROBOT_MODEL_SUFFIXES)})")
     if not path.is_file():
         raise TaskError(field, f"no file {str(path)!r:.120}")
-    protect_input(path, "a robot model")
+    model_source(path)  # read now, every file it names protected as an input: refused before any work
     return str(path.resolve())
 
 
