@@ -17,6 +17,7 @@ import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator, Optional
 
+from stablepush.errors import SettingError
 from stablepush.execution.arm import ArmError
 from stablepush.execution.protocol import LineReader, ProtocolError, decode, encode
 from stablepush.execution.stream import ArmWaypoint
@@ -44,7 +45,12 @@ class SimArmServer:
         self.engine = self.arm.engine
         self._waypoints = 0
         self._session = threading.Lock()
-        self._socket = socket.create_server((host, port))
+        try:
+            self._socket = socket.create_server((host, port))
+        except (OSError, OverflowError, UnicodeError) as exc:  # no such host, a port taken or not ours to bind
+            self.arm.close()
+            raise SettingError("host", f"cannot listen on {host!r:.80} port {port}: "
+                                       f"{' '.join(str(exc).split())[:200]}") from None
         self.host, self.port = self._socket.getsockname()[:2]
         self._closed = threading.Event()
 
