@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "stablepush/internal/checker_validator.hpp"
 #include "stablepush/internal/grasp_space.hpp"
 #include "stablepush/internal/trrt_star.hpp"
 
@@ -363,42 +364,51 @@ Plan plan_stable_pushes(const ModelSet& models, const PlannerSettings& settings)
   return plan;
 }
 
-namespace {
+CheckerMotionValidator::CheckerMotionValidator(const ob::SpaceInformationPtr& si, std::shared_ptr<PushChecker> checker)
+    : ob::MotionValidator(si), checker_(std::move(checker)) {}
 
-/// The motion validator of a search with a PushChecker written elsewhere: OMPL's question (is
-/// a -> b valid?) and the search's (which pushers?) both go to it.
-class CheckerMotionValidator : public ob::MotionValidator, public PushChecker {
- public:
-  CheckerMotionValidator(const ob::SpaceInformationPtr& si, std::shared_ptr<PushChecker> checker)
-      : ob::MotionValidator(si), checker_(std::move(checker)) {}
-  bool checkMotion(const ob::State* a, const ob::State* b) const override {
-    return stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_pushers()) != 0;
-  }
-  bool checkMotion(const ob::State* a, const ob::State* b, std::pair<ob::State*, double>& last_valid) const override {
-    const bool ok = checkMotion(a, b);
-    if (!ok) last_valid.second = 0.0;
-    return ok;
-  }
-  PusherSet all_pushers() const override { return checker_->all_pushers(); }
-  PusherSet stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const override {
-    return checker_->stable_pushers(a, b, candidates);
-  }
-  double push_margin(const Pose& a, const Pose& b, int pusher) const override {
-    return checker_->push_margin(a, b, pusher);
-  }
-  PusherSet wedge_pushers() const override { return checker_->wedge_pushers(); }
-  std::optional<Pose> onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction, double length,
-                                         int pusher) const override {
-    return checker_->onto_wedge_surface(a, direction, length, pusher);
-  }
-  std::uint64_t feasibility_checks() const override { return checker_->feasibility_checks(); }
-  void reset_feasibility_checks() override { checker_->reset_feasibility_checks(); }
+bool CheckerMotionValidator::checkMotion(const ob::State* a, const ob::State* b) const {
+  return stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_pushers()) != 0;
+}
 
- private:
-  std::shared_ptr<PushChecker> checker_;
-};
+bool CheckerMotionValidator::checkMotion(const ob::State* a, const ob::State* b,
+                                         std::pair<ob::State*, double>& last_valid) const {
+  const bool ok = checkMotion(a, b);
+  if (!ok) last_valid.second = 0.0;
+  return ok;
+}
 
-}  // namespace
+PusherSet CheckerMotionValidator::all_pushers() const { return checker_->all_pushers(); }
+
+PusherSet CheckerMotionValidator::stable_pushers(const Pose& a, const Pose& b, PusherSet candidates) const {
+  return checker_->stable_pushers(a, b, candidates);
+}
+
+PusherSet CheckerMotionValidator::stable_pushers_preferring(const Pose& a, const Pose& b, PusherSet candidates,
+                                                            PusherSet preferred) const {
+  return checker_->stable_pushers_preferring(a, b, candidates, preferred);
+}
+
+double CheckerMotionValidator::push_margin(const Pose& a, const Pose& b, int pusher) const {
+  return checker_->push_margin(a, b, pusher);
+}
+
+PusherSet CheckerMotionValidator::wedge_pushers() const { return checker_->wedge_pushers(); }
+
+std::optional<Pose> CheckerMotionValidator::onto_wedge_surface(const Pose& a, const Eigen::Vector3d& direction,
+                                                               double length, int pusher) const {
+  return checker_->onto_wedge_surface(a, direction, length, pusher);
+}
+
+std::vector<double> CheckerMotionValidator::wedge_translation_headings(const Pose& a, int pusher) const {
+  return checker_->wedge_translation_headings(a, pusher);
+}
+
+std::vector<Vec2> CheckerMotionValidator::pivot_points() const { return checker_->pivot_points(); }
+
+std::uint64_t CheckerMotionValidator::feasibility_checks() const { return checker_->feasibility_checks(); }
+
+void CheckerMotionValidator::reset_feasibility_checks() { checker_->reset_feasibility_checks(); }
 
 CheckedPlan plan_with_checker(std::shared_ptr<PushChecker> checker, const PlannerSettings& settings) {
   check_settings(settings);

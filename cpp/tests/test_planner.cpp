@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "stablepush/internal/checker_validator.hpp"
 #include "stablepush/internal/grasp_space.hpp"
 #include "stablepush/internal/trrt_star.hpp"
 #include "stablepush/planning.hpp"
@@ -48,24 +49,11 @@ class ConeChecker : public PushChecker {
   mutable std::uint64_t checks_ = 0;
 };
 
-/// OMPL's motion validator asking a toy checker, as plan_with_checker sets it up.
-template <class Checker>
-class ToyValidator : public ob::MotionValidator, public Checker {
- public:
-  template <class... Args>
-  explicit ToyValidator(const ob::SpaceInformationPtr& si, Args&&... args)
-      : ob::MotionValidator(si), Checker(std::forward<Args>(args)...) {}
-  using Checker::all_pushers;
-  using Checker::stable_pushers;
-  bool checkMotion(const ob::State* a, const ob::State* b) const override {
-    return stable_pushers(GraspPoseSpace::pose(a), GraspPoseSpace::pose(b), all_pushers()) != 0;
-  }
-  bool checkMotion(const ob::State* a, const ob::State* b, std::pair<ob::State*, double>& last) const override {
-    const bool ok = checkMotion(a, b);
-    if (!ok) last.second = 0.0;
-    return ok;
-  }
-};
+/// OMPL's motion validator asking a toy checker: plan_with_checker's own adapter.
+template <class Checker, class... Args>
+std::shared_ptr<CheckerMotionValidator> validator_of(const ob::SpaceInformationPtr& si, Args&&... args) {
+  return std::make_shared<CheckerMotionValidator>(si, std::make_shared<Checker>(std::forward<Args>(args)...));
+}
 
 PlannerSettings settings_to(const Pose& goal) {
   PlannerSettings s;
@@ -92,7 +80,7 @@ struct ToyProblem {
     auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
     si = std::make_shared<ob::SpaceInformation>(space);
     si->setStateValidityChecker([valid](const ob::State* s) { return valid(GraspPoseSpace::pose(s)); });
-    si->setMotionValidator(std::make_shared<ToyValidator<ConeChecker>>(si));
+    si->setMotionValidator(validator_of<ConeChecker>(si));
     si->setup();
     pdef = std::make_shared<ob::ProblemDefinition>(si);
     ob::ScopedState<GraspPoseSpace> start(space);
@@ -257,7 +245,7 @@ ob::PlannerStatus solve_pivot(long long pivot_steps, std::vector<PathNode>* path
   auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
   auto si = std::make_shared<ob::SpaceInformation>(space);
   si->setStateValidityChecker([](const ob::State*) { return true; });
-  si->setMotionValidator(std::make_shared<ToyValidator<PivotChecker>>(si));
+  si->setMotionValidator(validator_of<PivotChecker>(si));
   si->setup();
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
   ob::ScopedState<GraspPoseSpace> start(space);
@@ -337,7 +325,7 @@ std::uint64_t descents_to(const std::vector<Eigen::Vector3d>& normals, const Pos
   auto space = std::make_shared<GraspPoseSpace>(kStep, bounds);
   auto si = std::make_shared<ob::SpaceInformation>(space);
   si->setStateValidityChecker([](const ob::State*) { return true; });
-  si->setMotionValidator(std::make_shared<ToyValidator<PlaneChecker>>(si, normals));
+  si->setMotionValidator(validator_of<PlaneChecker>(si, normals));
   si->setup();
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
   ob::ScopedState<GraspPoseSpace> start(space);
