@@ -4,11 +4,13 @@
 
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+#include <pybind11/typing.h>
 
 #include <atomic>
 #include <csignal>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "bindings.hpp"
@@ -117,7 +119,10 @@ void expose_planning(py::module_& m) {
       .def_readwrite("min_transit_hold", &PlannerSettings::min_transit_hold,
                      "switch pushers only where the pads hold this many times the weight (0: anywhere)")
       .def_readwrite("start_pusher", &PlannerSettings::start_pusher, "the pusher in contact at the start, or -1")
-      .def_readwrite("stop", &PlannerSettings::stop, "a StopFlag that ends the search early when set, or None")
+      .def_property(
+          "stop", [](const PlannerSettings& s) -> py::typing::Optional<StopFlag> { return py::cast(s.stop); },
+          [](PlannerSettings& s, std::optional<std::shared_ptr<StopFlag>> stop) { s.stop = stop.value_or(nullptr); },
+          "a StopFlag that ends the search early when set, or None")
       .def_readwrite("parameters", &PlannerSettings::parameters, "TRRTstar's declared parameters by name, as text");
 
   py::class_<Waypoint>(m, "Waypoint", "The pose after a unit push, its pusher (-1 at the start) and the verdict.")

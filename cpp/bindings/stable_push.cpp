@@ -55,7 +55,8 @@ void expose_stable_push(py::module_& m) {
                     std::vector<double>>(),
            py::kw_only(), py::arg("section"), py::arg("body"), py::arg("gripper"), py::arg("pushers"),
            py::arg("gravity"), py::arg("step_time"), py::arg("friction_polygon_sides") = 16,
-           py::arg("gravity_frame") = GravityFrame::Gripper, py::arg("feature_angles") = std::vector<double>{},
+           py::arg_v("gravity_frame", GravityFrame::Gripper, "GravityFrame.gripper"),
+           py::arg("feature_angles") = std::vector<double>{},
            "gravity: in G's plane when G's axes are the world's [m/s^2]; gravity_frame, feature_angles (the\n"
            "object's world orientation on each pusher's feature [rad]): how gravity turns during a push.")
       .def_property_readonly("gravity_frame", &StablePushModel::gravity_frame)

@@ -4,6 +4,7 @@
 
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+#include <pybind11/typing.h>
 
 #include <array>
 #include <sstream>
@@ -37,13 +38,13 @@ void bind_triple(py::module_& m, const char* name, const char* doc, const char* 
       .def_readwrite(c, pc)
       .def("__len__", [](const T&) { return 3; })
       .def("__getitem__",
-           [as_tuple](const T& v, py::ssize_t i) -> py::object {
+           [as_tuple](const T& v, py::ssize_t i) -> py::float_ {
              if (i < 0) i += 3;
              if (i < 0 || i >= 3) throw py::index_error("index out of range (3 coordinates)");
              const py::tuple values = as_tuple(v);
-             return values[static_cast<std::size_t>(i)];
+             return values[static_cast<std::size_t>(i)].cast<py::float_>();
            })
-      .def("__iter__", [as_tuple](const T& v) { return py::iter(as_tuple(v)); })
+      .def("__iter__", [as_tuple](const T& v) -> py::typing::Iterator<py::float_> { return py::iter(as_tuple(v)); })
       .def("__eq__",
            [as_tuple](const T& v, const py::object& other) {
              if (py::isinstance<T>(other)) return as_tuple(v).equal(as_tuple(other.cast<const T&>()));
@@ -78,7 +79,9 @@ void expose_types(py::module_& m) {
            py::arg("values"))
       .def_readwrite("length", &StepSize::length)
       .def_readwrite("angle", &StepSize::angle)
-      .def("__iter__", [](const StepSize& s) { return py::iter(py::make_tuple(s.length, s.angle)); });
+      .def("__iter__", [](const StepSize& s) -> py::typing::Iterator<py::float_> {
+        return py::iter(py::make_tuple(s.length, s.angle));
+      });
   py::implicitly_convertible<py::tuple, StepSize>();
   py::implicitly_convertible<py::list, StepSize>();
 }
