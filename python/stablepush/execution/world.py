@@ -13,7 +13,7 @@ from typing import Dict, List, Sequence
 
 import numpy as np
 
-from stablepush import _core
+from stablepush.compiled import _core
 from stablepush.execution.part_geometry import scene_object_geometry
 from stablepush.frames import grasp_transform, matrix_to_pose, rot_y, translation
 from stablepush.plan.plan import Waypoint

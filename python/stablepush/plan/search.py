@@ -11,7 +11,7 @@ import threading
 import time
 from typing import List, Optional, Sequence
 
-from stablepush import _core
+from stablepush.compiled import _core
 from stablepush.errors import PadFaceError, TaskError
 from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.plan.files import MAX_WAYPOINTS

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from typing import List, Optional
 
-from stablepush import _core
+from stablepush.compiled import _core
 from stablepush.errors import PlanError
 from stablepush.plan.plan import FieldFault, Plan, Waypoint, require_plan
 from stablepush.task.model import Task, require_task

@@ -6,7 +6,7 @@ from typing import Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
-from stablepush import _core
+from stablepush.compiled import _core
 from stablepush.errors import TaskError
 from stablepush.task.model import Task, require_task
 from stablepush.task.schema import number_field, pose_field

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-from stablepush import _core
+from stablepush.compiled import _core
 from stablepush.errors import TaskError
 from stablepush.task.mesh import PartMesh
 from stablepush.task.robot_files import model_source

@@ -17,7 +17,7 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 import yaml
 
-from stablepush import _core
+from stablepush.compiled import _core
 from stablepush.errors import TaskError
 from stablepush.frames import turn
 from stablepush.inputs import read_capped
