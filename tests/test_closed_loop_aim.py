@@ -10,7 +10,8 @@ from conftest import shipped
 
 
 def _within(pose, goal, tolerance):
-    return max(abs(pose[0] - goal[0]), abs(pose[1] - goal[1])) <= tolerance[0] and abs(pose[2] - goal[2]) <= tolerance[1]
+    position, angle = tolerance
+    return max(abs(pose[0] - goal[0]), abs(pose[1] - goal[1])) <= position and abs(pose[2] - goal[2]) <= angle
 
 
 def test_a_plan_that_ends_short_of_the_final_tolerance_is_planned_again_to_it():

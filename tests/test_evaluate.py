@@ -122,9 +122,9 @@ def test_a_study_is_judged_by_the_tasks_tolerance_as_a_run_is_unless_told():
     """One tolerance: `execute` judges a run by the task's planner.tolerance, and so does a study
     (the user study's screwdriver plan landed by execute and 0 of 10 by evaluate's own 0.5 mm)."""
     batch = _batch("t-shaped")
-    assert batch.tolerance is None and batch.judged_with == (1.0, 1.0) == tuple(batch.task.planner.tolerance)
+    assert batch.tolerance is None and tuple(batch.success_tolerance) == (1.0, 1.0) == tuple(batch.task.planner.tolerance)
     assert Evaluation(batch=batch, trials=[], wall_s=1.0, runner="", requested=0).summary()["tolerance"] == [1.0, 1.0]
-    assert dataclasses.replace(batch, tolerance=(0.5, 0.5)).judged_with == (0.5, 0.5)
+    assert tuple(dataclasses.replace(batch, tolerance=(0.5, 0.5)).success_tolerance) == (0.5, 0.5)
 
 
 def test_a_study_that_names_no_spread_varies_the_tasks_box_or_a_labs_defaults():

@@ -433,13 +433,12 @@ def test_shipped_plans_end_within_half_their_tolerance(name):
     0.79 of it, the large manipulation's at 0.98) leaves an open-loop run no room for drift. The
     share is in the plan's stats, and the plan is a checked plan of its task."""
     from stablepush.plan import check_plan
-    from stablepush.units import tolerance_used
 
     task = load_task(TASKS / f"{name}.yaml")
     for seed in (1, 2, 3):
         plan = plan_task(task, seed=seed)
         assert plan.solved, (name, seed, plan.message)
-        used = tolerance_used(plan.waypoints[-1].pose, task.goal, task.planner.tolerance)
+        used = task.tolerance.used(plan.waypoints[-1].pose, task.goal)
         assert used <= 0.5 + 1e-9, (name, seed, used)
         assert plan.stats["end_used"] == pytest.approx(used)
         assert plan.ends_at_goal or f"using {used:.2f} of its tolerance" in plan.message

@@ -6,7 +6,8 @@ import pytest
 
 from stablepush.execution.closed_loop import Replan
 from stablepush.execution.report import ContactRecord, ExecutionReport
-from stablepush.execution.verdict import CAUSES, Verdict, judge, success_tolerance, within
+from stablepush.execution.verdict import CAUSES, Verdict, judge, success_tolerance
+from stablepush.pose import Tolerance
 
 from conftest import shipped
 
@@ -27,11 +28,11 @@ def _replan(solved, failure=None):
 
 
 def test_the_goal_tolerance_is_the_tasks_per_coordinate_unless_given():
-    assert TASK.goal == (20.0, 0.0, 0.0) and success_tolerance(TASK) == (0.5, 0.5)
-    assert success_tolerance(TASK, [0.2, 0.3]) == (0.2, 0.3)
+    assert TASK.goal == (20.0, 0.0, 0.0) and success_tolerance(TASK) == Tolerance(0.5, 0.5)
+    assert success_tolerance(TASK, [0.2, 0.3]) == Tolerance(0.2, 0.3)
     # Per coordinate, as Task.at_goal: 0.45 mm in x and 0.45 mm in z is 0.64 mm away, and within.
-    assert within({"x": 20.45, "z": 0.45, "theta": -0.45}, TASK.goal, (0.5, 0.5))
-    assert not within({"x": 20.0, "z": 0.0, "theta": 0.51}, TASK.goal, (0.5, 0.5))
+    assert Tolerance(0.5, 0.5).within({"x": 20.45, "z": 0.45, "theta": -0.45}, TASK.goal)
+    assert not Tolerance(0.5, 0.5).within({"x": 20.0, "z": 0.0, "theta": 0.51}, TASK.goal)
 
 
 @pytest.mark.parametrize("tolerance", [(float("nan"), 0.5), (0.5, float("inf")), (0.0, 0.5), (0.5, -1.0)])
@@ -77,7 +78,7 @@ def test_a_run_that_ends_on_its_feature_is_judged_there():
 def test_a_tighter_tolerance_turns_the_same_run_into_a_miss():
     report = _report((20.3, -0.2, 0.4))
     v = judge(TASK, report, (0.2, 0.2))
-    assert v.success is False and v.tolerance == (0.2, 0.2) and v.cause == "drift"
+    assert v.success is False and v.tolerance == Tolerance(0.2, 0.2) and v.cause == "drift"
 
 
 def test_a_slipping_pusher_is_the_cause_and_named():
@@ -162,7 +163,7 @@ def test_angles_are_compared_within_one_turn():
     v = judge(turned, report)
     assert v.success is True and "theta -0.20 deg" in v.detail
     assert report.final_error["theta"] == pytest.approx(-0.2) and report.goal_error["theta"] == pytest.approx(-0.2)
-    assert within({"x": 20.0, "z": 0.0, "theta": 179.9}, (20.0, 0.0, -179.9), (0.5, 0.5))
+    assert Tolerance(0.5, 0.5).within({"x": 20.0, "z": 0.0, "theta": 179.9}, (20.0, 0.0, -179.9))
 
 
 def test_execute_help_lists_every_cause_a_report_can_give():

@@ -58,10 +58,3 @@ def angle_difference_deg(a: float, b: float) -> float:
     """a - b [deg], wrapped into [-180, 180): a tracker reports theta in one turn, while a plan's
     theta may lie beyond it (a task at 360 deg is at 0 deg in the world)."""
     return (a - b + 180.0) % 360.0 - 180.0
-
-
-def tolerance_used(pose: Sequence[float], goal: Sequence[float], tolerance: Sequence[float]) -> float:
-    """The largest of `pose`'s offsets from `goal` (x, z mm; theta deg, wrapped) in each coordinate,
-    over its tolerance (mm, deg): 0 at the goal, 1 at the tolerance's edge."""
-    return max(abs(pose[0] - goal[0]) / tolerance[0], abs(pose[1] - goal[1]) / tolerance[0],
-               abs(angle_difference_deg(pose[2], goal[2])) / tolerance[1])

@@ -34,7 +34,6 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 from stablepush.design.commented import commented_task
 from stablepush.design.folder import DESIGN_HEADER, DESIGN_NAME
 from stablepush.errors import PadFaceError, SettingError, TaskError
-from stablepush.execution.verdict import tolerance_used
 from stablepush.execution.world import place_features
 from stablepush.frames import angle_about_y
 from stablepush.plan import check_plan, plan_task
@@ -393,7 +392,7 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
     d.switches = max(0, len(plan.pusher_sequence) - 1)
     d.margin_n = plan_margin(d.task, plan)
     end = plan.waypoints[-1].pose
-    d.end_used = tolerance_used({"x": end[0], "z": end[1], "theta": end[2]}, d.task.goal, d.task.planner.tolerance)
+    d.end_used = d.task.tolerance.used(end, d.task.goal)
     for name, feature in place_features(d.task, list(plan.waypoints)).items():
         T = feature.object_pose
         d.features[name] = [float(T[0, 3] * 1e3), float(T[1, 3] * 1e3), float(T[2, 3] * 1e3),

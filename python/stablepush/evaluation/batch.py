@@ -29,14 +29,15 @@ from stablepush.execution.closed_loop import ClosedLoop
 from stablepush.execution.executor import RunOptions, execution_warnings
 from stablepush.execution.guard import GuardedApproach
 from stablepush.execution.run import run_plan
-from stablepush.execution.verdict import success_tolerance, tolerance_used, within
+from stablepush.execution.verdict import success_tolerance
 from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
+from stablepush.pose import Pose, Tolerance
 from stablepush.runners import Runner, WorkerLost, run_all, this_node
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.local_arm import SimulatedArm
 from stablepush.task.model import Task
-from stablepush.units import angle_difference_deg, is_integer
+from stablepush.units import is_integer
 
 RATE_HZ = 100.0  # waypoints per second of robot time, as `execute`'s default
 PERCENTILES = (50, 90, 95, 99)
@@ -75,8 +76,8 @@ class Batch:
         SimulatedArm(self.engine, robot=self.task.environment.robot).check_cell(self.task, self.plan, RATE_HZ)
 
     @property
-    def judged_with(self) -> Tuple[float, float]:
-        """The tolerance (mm, deg) a trial is judged with: the batch's, else the task's."""
+    def success_tolerance(self) -> Tolerance:
+        """The Tolerance a trial is judged with: the batch's, else the task's."""
         return success_tolerance(self.task, self.tolerance)
 
     def warnings(self) -> List[str]:
@@ -86,22 +87,23 @@ class Batch:
         lands only where the world's own error happens to make up the difference, or within it but
         at its edge (EDGE of it or more in some coordinate), where any drift of a real push misses."""
         out = execution_warnings(self.task)
-        tol = self.judged_with
+        tol = self.success_tolerance
         end, goal = self.plan.waypoints[-1].pose, self.task.goal
-        mm, deg = max(abs(end[0] - goal[0]), abs(end[1] - goal[1])), abs(angle_difference_deg(end[2], goal[2]))
-        at = {"x": end[0], "z": end[1], "theta": end[2]}
+        dx, dz, dtheta = Pose.of(end).minus(goal)
+        mm, deg = max(abs(dx), abs(dz)), abs(dtheta)
         others = "let the last pusher go on toward the goal pose (planner.finish_steps: 1) or run the closed loop"
-        if not self.closed_loop and not within(at, goal, tol):
+        tol0, tol1 = tol
+        if not self.closed_loop and not tol.within(end, goal):
             out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), "
-                       f"outside the success tolerance {tol[0]:g} mm / {tol[1]:g} deg: an "
+                       f"outside the success tolerance {tol0:g} mm / {tol1:g} deg: an "
                        f"open-loop trial lands only where its world's error happens to make up the difference. "
-                       f"To land, plan to the tolerance (planner.tolerance: [{tol[0]:g}, "
-                       f"{tol[1]:g}]), {others}")
-        elif not self.closed_loop and tolerance_used(at, goal, tol) >= EDGE:
+                       f"To land, plan to the tolerance (planner.tolerance: [{tol0:g}, "
+                       f"{tol1:g}]), {others}")
+        elif not self.closed_loop and tol.used(end, goal) >= EDGE:
             out.append(f"the plan ends {mm:.2f} mm / {deg:.2f} deg from the goal (the larger of x and z; theta), at "
-                       f"the edge of the success tolerance {tol[0]:g} mm / {tol[1]:g} deg: an "
+                       f"the edge of the success tolerance {tol0:g} mm / {tol1:g} deg: an "
                        f"open-loop trial that drifts outward at all misses. To leave it room, plan to less "
-                       f"(planner.tolerance: [{tol[0] / 2:g}, {tol[1] / 2:g}]), {others}")
+                       f"(planner.tolerance: [{tol0 / 2:g}, {tol1 / 2:g}]), {others}")
         return out
 
     def world(self, trial: int) -> TrialWorld:
@@ -324,7 +326,7 @@ class Evaluation:
             "judged": judged, "successes": successes, "success_rate": successes / judged if judged else None,
             # one world: every trial would be this one, so a rate over them says nothing more
             "ci95": None if not judged or self.batch.spreads.one_world else list(wilson_interval(successes, judged)),
-            "tolerance": list(self.batch.judged_with), "one_world": self.batch.spreads.one_world,
+            "tolerance": self.batch.success_tolerance.as_list(), "one_world": self.batch.spreads.one_world,
             "closed_loop": self.batch.closed_loop, "guarded": self.batch.guarded,
             "engine": self.batch.engine, "seed": self.batch.seed,
             "simulated_geometry": next((t["simulated_geometry"] for t in self.trials if t.get("simulated_geometry")),

@@ -51,15 +51,16 @@ from __future__ import annotations
 import dataclasses
 from collections import OrderedDict
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 from stablepush.errors import PadFaceError
 from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
+from stablepush.pose import Pose, PoseLike, Tolerance
 from stablepush.task.mechanics import blocked_senses
 from stablepush.task.model import Task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
-from stablepush.units import angle_difference_deg, pose_to_si
+from stablepush.units import pose_to_si
 
 THRESHOLD_FRACTION = 0.5  # default threshold: this fraction of the task's goal tolerance
 FINAL_FRACTION = 0.2  # default final tolerance: this fraction of the task's goal tolerance
@@ -96,33 +97,33 @@ CORRECTION_MU_SPREAD = 0.15
 @dataclass(frozen=True)
 class ClosedLoop:
     """When to re-plan: after a push, when the measured pose is off the planned one by more than
-    `threshold` (mm, deg) in x, z or theta; after the last push, when it is off the goal by more
-    than `final_tolerance` (mm, deg)."""
+    `threshold` in x, z or theta; after the last push, when it is off the goal by more than
+    `final_tolerance` (Tolerances; a (mm, deg) pair is taken as one)."""
 
-    threshold: Tuple[float, float]
-    final_tolerance: Tuple[float, float]
+    threshold: Tolerance
+    final_tolerance: Tolerance
     max_replans: int = MAX_REPLANS
     max_failed_replans: int = MAX_FAILED_REPLANS
 
+    def __post_init__(self):
+        for name in ("threshold", "final_tolerance"):
+            object.__setattr__(self, name, Tolerance.of(getattr(self, name)))
+
     @classmethod
-    def for_task(cls, task: Task, threshold: Optional[Sequence[float]] = None,
-                 final_tolerance: Optional[Sequence[float]] = None) -> "ClosedLoop":
-        tol = task.planner.tolerance
-        return cls(
-            threshold=tuple(threshold) if threshold else (THRESHOLD_FRACTION * tol[0], THRESHOLD_FRACTION * tol[1]),
-            final_tolerance=tuple(final_tolerance)
-            if final_tolerance
-            else (FINAL_FRACTION * tol[0], FINAL_FRACTION * tol[1]),
-        )
+    def for_task(cls, task: Task, threshold: "Tolerance | Sequence[float] | None" = None,
+                 final_tolerance: "Tolerance | Sequence[float] | None" = None) -> "ClosedLoop":
+        return cls(threshold=threshold if threshold else task.tolerance.scaled(THRESHOLD_FRACTION),
+                   final_tolerance=final_tolerance if final_tolerance else task.tolerance.scaled(FINAL_FRACTION))
 
     def may_replan(self, replans: Sequence["Replan"]) -> bool:
         """Whether the run may still re-plan, given the re-plans it made."""
         failed = sum(1 for r in replans if not r.solved and r.trigger != "plan_short")  # aim's: not a correction
         return len(replans) < self.max_replans and failed < self.max_failed_replans
 
-    def off_by(self, measured: Dict[str, float], pose: Sequence[float], limit: Tuple[float, float]) -> bool:
-        dx, dz, dth = deviation(measured, pose)
-        return max(abs(dx), abs(dz)) > limit[0] or abs(dth) > limit[1]
+    @staticmethod
+    def off_by(measured: PoseLike, pose: PoseLike, limit: Tolerance) -> bool:
+        """Whether `measured` lies beyond `limit` of `pose` in some coordinate."""
+        return not limit.within(measured, pose)
 
 
 @dataclass(frozen=True)
@@ -220,13 +221,14 @@ def aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tup
 
 def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tuple[Replan, List[Waypoint]]]:
     start, end = steps[0].pose, steps[-1].pose
-    at = lambda pose: not loop.off_by(dict(zip(("x", "z", "theta"), pose)), task.goal, loop.final_tolerance)  # noqa: E731
+    at = lambda pose: loop.final_tolerance.within(pose, task.goal)  # noqa: E731
     if at(end) or at(start):
         return None
     switches = sum(1 for a, b in zip(steps[1:], steps[2:]) if a.pusher != b.pusher)
     elapsed, tried, ended, found, guarded = 0.0, [], [], [], False
     for budget in range(min(switches, task.planner.max_switches), task.planner.max_switches + 1):
-        planner = counted(task.planner, AIM_CHECKS).replace(tolerance=list(loop.final_tolerance), max_switches=budget)
+        planner = counted(task.planner, AIM_CHECKS).replace(tolerance=loop.final_tolerance.as_list(),
+                                                            max_switches=budget)
         result = _search(dataclasses.replace(task.with_start(start), planner=planner),
                          min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO)
         if isinstance(result, PadFaceError):
@@ -253,18 +255,13 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
     return record, found
 
 
-def deviation(measured: Dict[str, float], pose: Sequence[float]) -> Tuple[float, float, float]:
-    """The measured pose minus `pose`: x mm, z mm, theta deg."""
-    return measured["x"] - pose[0], measured["z"] - pose[1], angle_difference_deg(measured["theta"], pose[2])
-
-
-def no_way_back(task: Task, pose: Sequence[float], tolerance: Tuple[float, float]) -> Optional[str]:
+def no_way_back(task: Task, pose: Sequence[float], tolerance: "Tolerance | Sequence[float]") -> Optional[str]:
     """When the goal lies, from `pose` (x mm, z mm, theta deg, in the task's world), beyond
-    `tolerance` (mm, deg) in a sense of x, z or theta in which no stable unit push of the task's
+    `tolerance` in a sense of x, z or theta in which no stable unit push of the task's
     pushers moves the object by more than mechanics.NO_WAY_BACK of a unit step (`blocked_senses`,
     headings every 10 deg): those senses, each with the largest such push ("-x (at most 0.05 of a
     unit step)"), else None. Why a correction cannot exist from there."""
-    gap = (task.goal[0] - pose[0], task.goal[1] - pose[1], angle_difference_deg(task.goal[2], pose[2]))
+    gap = Pose.of(task.goal).minus(pose)
     return blocked_senses(task.with_start(pose), pose, gap, tolerance)
 
 
@@ -299,7 +296,7 @@ def _unheld_note(pushers: Sequence[str], ratio: float) -> str:
             f"{ratio:g} times its weight")
 
 
-def _way_back_note(task: Task, pose: Sequence[float], tolerance: Tuple[float, float], where: str) -> List[str]:
+def _way_back_note(task: Task, pose: Sequence[float], tolerance: Tolerance, where: str) -> List[str]:
     """A failed search's last line, when `no_way_back` finds senses blocked from `pose`."""
     blocked = no_way_back(task, pose, tolerance)
     return [f"{where} no stable push moves the object toward the goal along {blocked}"] if blocked else []
@@ -344,8 +341,8 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
     the run, ended here, would miss its success tolerance) and taking
     the first plan whose transits are held. Returns the record and the new plan's steps (empty when
     none was found); the first step is the measured pose."""
-    tolerance = list(loop.final_tolerance)
-    base = dataclasses.replace(task.with_start(measured), planner=task.planner.replace(tolerance=tolerance))
+    base = dataclasses.replace(task.with_start(measured), planner=task.planner.replace(
+        tolerance=loop.final_tolerance.as_list()))
     if base.at_goal(base.start):  # off the plan but at the goal already: nothing to correct
         return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []

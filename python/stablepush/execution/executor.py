@@ -24,12 +24,12 @@ from stablepush.execution.guard import GuardedApproach, GuardWatch, measured_pos
 from stablepush.execution.protocol import DEFAULT_RATE_HZ, ProtocolError, check_state
 from stablepush.execution.report import ContactRecord, ExecutionReport
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from, contact_first, renumbered
-from stablepush.execution.verdict import judge, within
-from stablepush.execution.verdict import success_tolerance as judged_with
+from stablepush.execution.verdict import judge, success_tolerance
 from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.plan.plan import Plan, Waypoint
 from stablepush.plan.verify import check_plan
+from stablepush.pose import Tolerance
 from stablepush.task.model import Task
 from stablepush.units import MM
 
@@ -234,7 +234,7 @@ class _Run:
         if not loop.may_replan(self.replans):
             return
         spliced = _correct(self.task, self.steps, self.features, loop, w, self.state, self.options.rate_hz,
-                           self.replans, judged_with(self.task, self.options.success_tolerance), touched)
+                           self.replans, success_tolerance(self.task, self.options.success_tolerance), touched)
         if spliced is not None:
             self.steps, new_points = spliced
             self.pending = renumbered(w, self.options.rate_hz, new_points)
@@ -259,12 +259,12 @@ class _Run:
 
 
 def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
-             state: dict, rate_hz: float, replans: List[Replan], success_tolerance: Sequence[float],
+             state: dict, rate_hz: float, replans: List[Replan], judged_within: Tolerance,
              touched: bool = False):
     """After plan step w.step: when the tracked pose is off the plan (or, at rest after the last
     push, off the goal) by more than the loop allows, re-plan from it and return the spliced steps and the
     waypoints that carry them out from where G is now (seq and t counted from this waypoint);
-    else None. At rest off the goal by more than `success_tolerance` (mm, deg) the verdict is at
+    else None. At rest off the goal by more than `judged_within` (the verdict's tolerance) the verdict is at
     stake, and the re-plan may take its last, riskier attempt (closed_loop.replan). `touched`: the
     object has just come onto the feature of the next push (w ends an approach); a feature met off
     its place has pushed it already, and every push of the contact would carry that error on. In
@@ -288,7 +288,7 @@ def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], lo
     measured = measured_pose(steps[k].pose, tracked)
     trigger = "off_goal" if last else "on_touch" if touched else "last_switch" if last_switch else "off_plan"
     record, new_steps = replan(task, measured, pusher, loop, k, steps[k].pose, trigger=trigger,
-                               verdict_at_stake=last and not within(tracked, task.goal, success_tolerance))
+                               verdict_at_stake=last and not judged_within.within(tracked, task.goal))
     replans.append(record)
     if not record.solved or record.pushes == 0:
         return None

@@ -10,10 +10,9 @@ from typing import Dict, List, Optional, Sequence
 
 from stablepush.errors import ArmFault
 from stablepush.execution.closed_loop import Replan
-from stablepush.execution.verdict import Verdict
-from stablepush.execution.verdict import success_tolerance as judged_with
+from stablepush.execution.verdict import Verdict, success_tolerance
+from stablepush.pose import Pose, Tolerance
 from stablepush.task.model import Task
-from stablepush.units import angle_difference_deg
 
 # Past this change in the grasp when the last feature lets go (mm, deg), the grasp alone does not
 # hold the final pose against gravity: ExecutionReport.release_moved.
@@ -102,8 +101,8 @@ class ExecutionReport:
         when the grasp alone cannot hold the final pose against gravity."""
         if self.final_in_grasp is None or self.released_in_grasp is None or self.ends_on_feature:
             return None
-        change = {k: self.released_in_grasp[k] - self.final_in_grasp[k] for k in ("x", "z")}
-        return {**change, "theta": angle_difference_deg(self.released_in_grasp["theta"], self.final_in_grasp["theta"])}
+        dx, dz, dtheta = Pose.of(self.released_in_grasp).minus(self.final_in_grasp)
+        return {"x": dx, "z": dz, "theta": dtheta}
 
     @property
     def release_moved(self) -> bool:
@@ -227,14 +226,14 @@ def _error(actual: Optional[Dict[str, float]], pose: Sequence[float]) -> Optiona
     """`actual` minus `pose` (x, z mm, theta deg), and the distance mm; None when not measured."""
     if actual is None:
         return None
-    dx, dz = actual["x"] - pose[0], actual["z"] - pose[1]
-    return {"x": dx, "z": dz, "theta": angle_difference_deg(actual["theta"], pose[2]), "distance": math.hypot(dx, dz)}
+    dx, dz, dtheta = Pose.of(actual).minus(pose)
+    return {"x": dx, "z": dz, "theta": dtheta, "distance": math.hypot(dx, dz)}
 
 
-def fault_report(task: Task, fault: ArmFault, success_tolerance: Optional[Sequence[float]] = None) -> dict:
+def fault_report(task: Task, fault: ArmFault, tolerance: "Tolerance | Sequence[float] | None" = None) -> dict:
     """The report of a run that ended in an arm fault, in the fields of ExecutionReport.as_dict that
     a script reads first: the verdict (cause "arm_fault"), the reason and where to resume."""
-    verdict = Verdict.for_fault(judged_with(task, success_tolerance), fault.reason)
-    return {"task": task.name, "success": verdict.success, "tolerance": list(verdict.tolerance),
+    verdict = Verdict.for_fault(success_tolerance(task, tolerance), fault.reason)
+    return {"task": task.name, "success": verdict.success, "tolerance": verdict.tolerance.as_list(),
             "cause": verdict.cause, "verdict": verdict.detail, "last_confirmed_step": fault.last_confirmed_step,
             "arm_stopped": fault.arm_stopped, "connected": fault.connected, "replanned": fault.replanned}

@@ -32,11 +32,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Dict, Optional, Sequence, Tuple
+from typing import Optional, Sequence
 
-from stablepush import units
+from stablepush.pose import Pose, PoseLike, Tolerance
 from stablepush.task.model import Task
-from stablepush.units import angle_difference_deg, pose_to_si
 
 CAUSES = ("moved_on_release", "grasp_lost", "correction_not_found", "corrections_exhausted", "feature_off",
           "pusher_slipped", "plan_short", "drift", "arm_fault", "not_measured")
@@ -47,38 +46,37 @@ SLIP_FRACTION = 0.5
 @dataclass(frozen=True)
 class Verdict:
     """success: the run landed (None: the arm does not report the object, so it is not known);
-    tolerance: (mm, deg) it was judged with; cause: one of CAUSES for a miss, else None; detail:
+    tolerance: the Tolerance it was judged with; cause: one of CAUSES for a miss, else None; detail:
     one sentence for a person."""
 
     success: Optional[bool]
-    tolerance: Tuple[float, float]
+    tolerance: Tolerance
     cause: Optional[str]
     detail: str
 
+    def __post_init__(self):
+        object.__setattr__(self, "tolerance", _success_tolerance(self.tolerance))
+
     @classmethod
-    def for_fault(cls, tolerance: Sequence[float], reason: str) -> "Verdict":
-        return cls(False, _pair(tolerance), "arm_fault", f"the run ended in an arm fault: {reason}")
+    def for_fault(cls, tolerance: "Tolerance | Sequence[float]", reason: str) -> "Verdict":
+        return cls(False, tolerance, "arm_fault", f"the run ended in an arm fault: {reason}")
 
     def as_dict(self) -> dict:
-        return {"success": self.success, "tolerance": list(self.tolerance), "cause": self.cause,
+        return {"success": self.success, "tolerance": self.tolerance.as_list(), "cause": self.cause,
                 "detail": self.detail}
 
 
-def success_tolerance(task: Task, tolerance: Optional[Sequence[float]] = None) -> Tuple[float, float]:
-    """The tolerance (mm, deg) a run of `task` is judged with: `tolerance`, else the task's own."""
-    return _pair(tolerance if tolerance is not None else task.planner.tolerance)
+def success_tolerance(task: Task, tolerance: "Tolerance | Sequence[float] | None" = None) -> Tolerance:
+    """The Tolerance a run of `task` is judged with: `tolerance` (a Tolerance or mm, deg), else the
+    task's own. ValueError for one that is not two finite numbers above 0."""
+    return task.tolerance if tolerance is None else _success_tolerance(tolerance)
 
 
-def within(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[float]) -> bool:
-    """Whether `pose` (x, z mm, theta deg) is within `tolerance` of `goal` in each coordinate."""
-    return (abs(pose["x"] - goal[0]) <= tolerance[0] and abs(pose["z"] - goal[1]) <= tolerance[0]
-            and abs(angle_difference_deg(pose["theta"], goal[2])) <= tolerance[1])
-
-
-def tolerance_used(pose: Dict[str, float], goal: Sequence[float], tolerance: Sequence[float]) -> float:
-    """The largest of `pose`'s offsets from `goal` in x, z (mm) and theta (deg), each over its
-    `tolerance`: at most 1 within it (`within`), 0 at the goal."""
-    return units.tolerance_used((pose["x"], pose["z"], pose["theta"]), goal, tolerance)
+def _success_tolerance(value: "Tolerance | Sequence[float]") -> Tolerance:
+    try:
+        return Tolerance.of(value)
+    except ValueError as exc:
+        raise ValueError(f"success {exc}") from None
 
 
 def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
@@ -90,20 +88,20 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
     if final is None or landed is None:
         return Verdict(None, tol, "not_measured", "the arm does not report the object in the grasp, so whether "
                                                   "it landed is not known")
-    off = f"{_offsets(landed, task.goal)} (tolerance {tol[0]:g} mm, {tol[0]:g} mm, {tol[1]:g} deg)"
-    if within(landed, task.goal, tol):
+    off = f"{_offsets(landed, task.goal)} (tolerance {tol.describe()})"
+    if tol.within(landed, task.goal):
         return Verdict(True, tol, None, f"landed: {off}")
 
     def miss(cause: str, why: str) -> Verdict:
         return Verdict(False, tol, cause, f"missed: {off}: {why}")
 
-    if within(final, task.goal, tol):  # on the feature it was within: the release moved it out
+    if tol.within(final, task.goal):  # on the feature it was within: the release moved it out
         change = report.release_change
         moved = f"{math.hypot(change['x'], change['z']):.2f} mm, {change['theta']:+.2f} deg"
         return miss("moved_on_release", f"on its last feature it was within the tolerance "
                                         f"({_offsets(final, task.goal)}); when the feature let go it moved in the "
                                         f"grasp by {moved}: the pads alone do not hold it there against gravity")
-    if not task.build_model().grasp_maintained(pose_to_si((landed["x"], landed["z"], landed["theta"]))):
+    if not task.build_model().grasp_maintained(Pose.of(landed).si()):
         return miss("grasp_lost", "a pad is no longer on the object where it came to rest")
     failed = [r for r in report.replans if not r.solved and r.trigger != "plan_short"]
     if failed:
@@ -111,7 +109,7 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
         return miss("correction_not_found", f"no correction found after step {last.after_step} ({last.failure})")
     if report.closed_loop == "on" and max_replans is not None and len(report.replans) >= max_replans:
         return miss("corrections_exhausted", f"the closed loop made its {max_replans} corrections and is still off")
-    late = [c for c in report.contacts if c.carried_mm is not None and c.carried_mm > SLIP_FRACTION * tol[0]]
+    late = [c for c in report.contacts if c.carried_mm is not None and c.carried_mm > SLIP_FRACTION * tol.position]
     if late:
         worst = max(late, key=lambda c: c.carried_mm)
         if worst.feature_met is False:
@@ -124,29 +122,20 @@ def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
                                    f"{worst.carried_mm:.2f} mm into step {worst.first_step} before it stopped it "
                                    f"({where})")
     slipped = [c for c in report.contacts if c.slip_mm is not None
-               and (c.slip_mm > SLIP_FRACTION * tol[0] or c.slip_deg > SLIP_FRACTION * tol[1])]
+               and (c.slip_mm > SLIP_FRACTION * tol.position or c.slip_deg > SLIP_FRACTION * tol.angle)]
     if slipped:
-        worst = max(slipped, key=lambda c: c.slip_mm / tol[0] + c.slip_deg / tol[1])
+        worst = max(slipped, key=lambda c: c.slip_mm / tol.position + c.slip_deg / tol.angle)
         return miss("pusher_slipped", f"{worst.pusher} slipped {worst.slip_mm:.2f} mm, {worst.slip_deg:.2f} deg on its "
                                       f"feature over steps {worst.first_step}-{worst.last_step}")
-    planned = dict(zip(("x", "z", "theta"), report.planned_final))
-    if not within(planned, task.goal, tol):
+    planned = Pose.of(report.planned_final)
+    if not tol.within(planned, task.goal):
         aimed = [r for r in report.replans if r.trigger == "plan_short"]
         why = f" and no plan to the goal was found before the first push ({aimed[0].failure})" if aimed else ""
         return miss("plan_short", f"the plan itself ends at {_offsets(planned, task.goal)} from the goal{why}")
     return miss("drift", "no pusher slipped past half the tolerance; the error built up over the run")
 
 
-def _offsets(pose: Dict[str, float], goal: Sequence[float]) -> str:
+def _offsets(pose: PoseLike, goal: PoseLike) -> str:
     """`pose` minus `goal`, each coordinate named: the tolerance is per coordinate, so is the line."""
-    return (f"x {pose['x'] - goal[0]:+.2f} mm, z {pose['z'] - goal[1]:+.2f} mm, "
-            f"theta {angle_difference_deg(pose['theta'], goal[2]):+.2f} deg")
-
-
-def _pair(values: Sequence[float]) -> Tuple[float, float]:
-    # A nan tolerance would call every run a miss, and a negative one every run too: refuse both here,
-    # where the library takes it, as the CLI's options do.
-    mm, deg = (float(v) for v in values)
-    if not (math.isfinite(mm) and math.isfinite(deg) and mm > 0 and deg > 0):
-        raise ValueError(f"success tolerance must be two finite numbers above 0 (mm, deg), got {tuple(values)}")
-    return mm, deg
+    dx, dz, dtheta = Pose.of(pose).minus(goal)
+    return f"x {dx:+.2f} mm, z {dz:+.2f} mm, theta {dtheta:+.2f} deg"

@@ -17,11 +17,12 @@ from stablepush.frames import direction_in_gripper, point_in_gripper
 from stablepush.plan.files import MAX_WAYPOINTS
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.plan.unreachable import why_unreachable
+from stablepush.pose import Tolerance
 from stablepush.task.mechanics import blocked_senses
 from stablepush.task.mesh import first_pad_off_faces, slab_text
 from stablepush.task.model import PlannerSettings, Task, require_task
 from stablepush.task.schema import LIMITS, number_field, planner_limit, planner_parameter
-from stablepush.units import MM, pose_from_si, pose_to_si, tolerance_used
+from stablepush.units import MM, pose_from_si, pose_to_si
 
 
 def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, pose_mm_deg) -> PusherContact:
@@ -70,7 +71,7 @@ def plan_task(
     push from the start moves the object (_toward_goal: some 0.05 s; the closed loop's re-plans,
     which read the outcome alone, leave it out).
     A solved plan whose end uses more than planner.end_within of the tolerance in some coordinate
-    (units.tolerance_used) is planned again, with finish steps and then to that share of the
+    (Tolerance.used) is planned again, with finish steps and then to that share of the
     tolerance (`deepen`; _deeper), within DEEPER_CHECKS stable-push tests: a plan that ends at the
     tolerance's edge leaves an open-loop run no room for a real push's drift. Where neither finds
     one, the first plan stands and its stats say how deep it got (`end_used`, `deeper`).
@@ -95,7 +96,7 @@ def plan_task(
     if reason is not None:
         return _unreachable(task, models, settings, reason, time.perf_counter() - began)
     pusher_at_start = -1 if start_pusher is None else task.pusher_index(start_pusher, "start_pusher")
-    raw = _search(task, models, settings, settings.tolerance, min_transit_hold, pusher_at_start)
+    raw = _search(task, models, settings, Tolerance.of(settings.tolerance), min_transit_hold, pusher_at_start)
     first_checks, deep = int(raw.stats.feasibility_checks), None
     if deepen and raw.outcome.name == "goal_reached" and settings.end_within < 1.0:
         deep = _deeper(task, models, settings, raw, min_transit_hold, pusher_at_start)
@@ -140,7 +141,7 @@ def plan_task(
         "check_limit_reached": bool(s.check_limit_reached),
     }
     if outcome == "goal_reached":
-        stats["end_used"] = tolerance_used(waypoints[-1].pose, task.goal, task.planner.tolerance)
+        stats["end_used"] = task.tolerance.used(waypoints[-1].pose, task.goal)
     if deep is not None:
         stats["deeper"] = deep
         stats["feasibility_checks"] = first_checks + deep["feasibility_checks"]
@@ -178,13 +179,14 @@ MAX_PUSHES = MAX_WAYPOINTS - 1  # the pushes a plan file holds: its waypoints le
 DEEPER_CHECKS = 200_000
 
 
-def _search(task: Task, models, settings: PlannerSettings, tolerance, min_transit_hold: float, start_pusher: int):
-    """The core's T-RRT* from the task's start to its goal within `tolerance` (mm, deg)."""
+def _search(task: Task, models, settings: PlannerSettings, tolerance: Tolerance, min_transit_hold: float,
+            start_pusher: int):
+    """The core's T-RRT* from the task's start to its goal within `tolerance`."""
     # Ctrl-C stops the search at once (KeyboardInterrupt); signals reach the main thread only.
     return _core.plan(models, _core.PlannerSettings(
         start=pose_to_si(task.start), goal=pose_to_si(task.goal),
         step=(settings.step[0] * MM, math.radians(settings.step[1])),
-        tolerance=(tolerance[0] * MM, math.radians(tolerance[1])),
+        tolerance=tolerance.si(),
         time_limit=settings.time_limit, min_margin=settings.min_margin, sampling_margin=settings.sampling_margin,
         min_hold_ratio=settings.min_hold_ratio, parameters=settings.core_parameters(),
         min_transit_hold=float(min_transit_hold), start_pusher=start_pusher),
@@ -198,23 +200,20 @@ def _deeper(task: Task, models, settings: PlannerSettings, first, min_transit_ho
     DEEPER_CHECKS tests (or the task's own check_limit, if lower), the time limit a guard. A record
     of it (`solved`, `end_within`, `by`: finish_steps or search, its tests; `raw`, the plan found),
     or None when the first plan ends deep enough."""
-    share = settings.end_within
-    deep_enough = lambda raw: tolerance_used(pose_from_si(raw.waypoints[-1].pose), task.goal,  # noqa: E731
-                                             settings.tolerance) <= share + 1e-9
+    share, tolerance = settings.end_within, Tolerance.of(settings.tolerance)
+    deep_enough = lambda raw: tolerance.used(pose_from_si(raw.waypoints[-1].pose), task.goal) <= share + 1e-9  # noqa: E731
     if deep_enough(first):
         return None
     bounded = settings.with_check_limit(DEEPER_CHECKS)
     limit = int(bounded.tuning["check_limit"])
     spent = 0
     if not settings.tuning.get("finish_steps"):
-        finishing = _search(task, models, bounded.replace(finish_steps=1), settings.tolerance, min_transit_hold,
-                            start_pusher)
+        finishing = _search(task, models, bounded.replace(finish_steps=1), tolerance, min_transit_hold, start_pusher)
         spent = int(finishing.stats.feasibility_checks)
         if finishing.outcome.name == "goal_reached" and deep_enough(finishing):
             return {"end_within": share, "solved": True, "by": "finish_steps", "check_limit": limit,
                     "feasibility_checks": spent, "check_limit_reached": False, "raw": finishing}
-    raw = _search(task, models, bounded, (settings.tolerance[0] * share, settings.tolerance[1] * share),
-                  min_transit_hold, start_pusher)
+    raw = _search(task, models, bounded, tolerance.scaled(share), min_transit_hold, start_pusher)
     solved = raw.outcome.name == "goal_reached"
     return {"end_within": share, "solved": solved, "by": "search", "check_limit": limit,
             "feasibility_checks": spent + int(raw.stats.feasibility_checks),
@@ -278,9 +277,8 @@ def _toward_goal(task: Task) -> str:
     tolerance, in which no stable push from the start moves the object (mechanics.blocked_senses),
     with where the goal lies; "" when there is none. Not a proof that the goal is out of reach (a
     plan may go around, through poses where other pushes are stable): why the search found little."""
-    tol = task.planner.tolerance
     gap = tuple(g - s for g, s in zip(task.goal, task.start))  # theta unwrapped, as the planner turns
-    blocked = blocked_senses(task, task.start, gap, (tol[0], tol[1]))
+    blocked = blocked_senses(task, task.start, gap, task.tolerance)
     if blocked is None:
         return ""
     return (f"; the goal lies at dx {gap[0]:g} mm, dz {gap[1]:g} mm, dtheta {gap[2]:g} deg from the start, and no "

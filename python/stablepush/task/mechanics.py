@@ -2,12 +2,13 @@
 from __future__ import annotations
 
 import math
-from typing import Dict, Optional, Sequence, Tuple
+from typing import Dict, Optional, Sequence
 
 import numpy as np
 
 from stablepush.compiled import _core
 from stablepush.errors import TaskError
+from stablepush.pose import Tolerance
 from stablepush.task.model import Task, require_task
 from stablepush.task.schema import number_field, pose_field
 from stablepush.units import pose_to_si
@@ -154,9 +155,9 @@ NO_WAY_BACK = 0.1
 
 
 def blocked_senses(task: Task, pose: Sequence[float], gap: Sequence[float],
-                   tolerance: Tuple[float, float]) -> Optional[str]:
+                   tolerance: "Tolerance | Sequence[float]") -> Optional[str]:
     """The senses of x, z and theta in which `gap` (dx mm, dz mm, dtheta deg: where the goal lies
-    from `pose`) is beyond `tolerance` (mm, deg) and no stable unit push from `pose` (x mm, z mm,
+    from `pose`) is beyond `tolerance` and no stable unit push from `pose` (x mm, z mm,
     theta deg) moves the object by more than NO_WAY_BACK of a unit step (stable_directions,
     headings every 10 deg), each with the largest such push: "-x (none)" (no push moves the object
     that way), "-x (at most 0.05 of a unit step)"; else None, and None where the pads do not hold
@@ -167,7 +168,9 @@ def blocked_senses(task: Task, pose: Sequence[float], gap: Sequence[float],
     except TaskError:  # no grasp at the pose: the planner's own refusal says so
         return None
     blocked = []
-    for axis, (name, limit) in enumerate(zip(("x", "z", "theta"), (tolerance[0], tolerance[0], tolerance[1]))):
+    tolerance = Tolerance.of(tolerance)
+    limits = (tolerance.position, tolerance.position, tolerance.angle)
+    for axis, (name, limit) in enumerate(zip(("x", "z", "theta"), limits)):
         sense = ("+" if gap[axis] > 0 else "-") + name
         if abs(gap[axis]) > limit and (largest[sense] is None or largest[sense] < NO_WAY_BACK):
             most = ("none" if largest[sense] is None or largest[sense] <= 1e-9  # 1e-9: cos(90 deg)'s rounding

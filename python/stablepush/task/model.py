@@ -16,6 +16,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from stablepush.compiled import _core
 from stablepush.errors import TaskError
+from stablepush.pose import Tolerance
 from stablepush.task.mesh import PartMesh
 from stablepush.task.robot_files import model_source
 from stablepush.units import MM, G, is_integer, is_real, mm2_to_si, pose_to_si
@@ -508,11 +509,15 @@ class Task:
             "features": {name: self.feature_angle(name) for name in self.pusher_names},
         })
 
+    @property
+    def tolerance(self) -> Tolerance:
+        """planner.tolerance, the goal's: how near the goal a plan must end."""
+        return Tolerance.of(self.planner.tolerance)
+
     def at_goal(self, pose) -> bool:
         """Whether `pose` (x mm, z mm, theta deg) lies within planner.tolerance of the goal, in each
-        coordinate."""
-        tol = self.planner.tolerance
-        return all(abs(a - b) <= t for a, b, t in zip(pose, self.goal, (tol[0], tol[0], tol[1])))
+        coordinate (theta wrapped: Tolerance.within)."""
+        return self.tolerance.within(pose, self.goal)
 
     @property
     def pusher_names(self) -> List[str]:
