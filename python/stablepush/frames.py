@@ -8,14 +8,14 @@ Poses as vectors are [x, y, z, qw, qx, qy, qz] (m; the arm protocol's and MuJoCo
 from __future__ import annotations
 
 import math
-from typing import List, Sequence, Tuple
+from typing import List, Sequence, Tuple, Union
 
 import numpy as np
 
 from stablepush.units import MM
 
 
-def point_in_gripper(pose_mm_deg: Sequence[float], p: Sequence[float]) -> Tuple[float, float]:
+def point_in_gripper(pose_mm_deg: Sequence[float], p: Union[Sequence[float], np.ndarray]) -> Tuple[float, float]:
     """A point of O (mm) seen from G at q (x mm, z mm, theta deg): p_G = (x, z) + R(theta) p_O.
     Plain floats: a plan asks this for every waypoint, where numpy's per-call cost would dominate."""
     c, s = math.cos(math.radians(pose_mm_deg[2])), math.sin(math.radians(pose_mm_deg[2]))

@@ -114,7 +114,7 @@ def _not_a_file_name(path: Union[str, Path]) -> Optional[str]:
 
 
 def check_outputs(outputs: Mapping[str, Optional[Union[str, Path]]],
-                  inputs: Mapping[str, Optional[Union[str, Path]]] = None) -> None:
+                  inputs: Optional[Mapping[str, Optional[Union[str, Path]]]] = None) -> None:
     """Before any work is done: each output (option name -> path; None: not asked for) can be
     written by write_files' rules, and none is one of the inputs (name -> path) or another output.
     A plan written over its task file, or a CSV over its JSON, would lose a file without a word.
@@ -236,8 +236,8 @@ def _signals_deferred():
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-        for sig in dict.fromkeys(pending):
-            signal.raise_signal(sig)
+        for signum in dict.fromkeys(pending):
+            signal.raise_signal(signum)
 
 
 _DEFERRED = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)

@@ -81,7 +81,7 @@ def _sections(text: str) -> Optional[Tuple[List[str], List[Tuple[Any, List[str],
     starts = [i for i, line in enumerate(lines) if _SECTION.match(line)]
     if not starts:
         return None
-    sections = []
+    sections: List[Tuple[List[str], List[str], int, int]] = []
     for n, start in enumerate(starts):
         end = starts[n + 1] if n + 1 < len(starts) else len(lines)
         if n + 1 < len(starts):  # the next section's comments above it are its own

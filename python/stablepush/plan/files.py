@@ -35,7 +35,7 @@ CSV_COLUMNS = ["step", "x", "z", "theta", "pusher", "margin", "margin_per_normal
 
 
 def _waypoint_dict(w: Waypoint) -> dict:
-    out = {"x": w.x, "z": w.z, "theta": w.theta, "pusher": w.pusher, "margin": w.margin,
+    out: dict = {"x": w.x, "z": w.z, "theta": w.theta, "pusher": w.pusher, "margin": w.margin,
            "margin_per_normal": w.margin_per_normal, "case": w.case, "pusher_in_gripper": None}
     if w.contact is not None:
         out["pusher_in_gripper"] = {"from": list(w.contact.start), "to": list(w.contact.end),

@@ -107,7 +107,7 @@ def value_kind(v: Any) -> str:
         return "null"
     if isinstance(v, bool):
         return "a boolean"
-    kinds = {str: "a string", dict: "a mapping", list: "a list"}
+    kinds: Dict[type, str] = {str: "a string", dict: "a mapping", list: "a list"}
     return kinds.get(type(v), "a number" if is_real(v) else type(v).__name__)
 
 
@@ -151,6 +151,8 @@ class Plan:
         """The pushers in the order they are used, one entry per contact."""
         out: List[str] = []
         for w in self.waypoints[1:]:
+            if w.pusher is None:  # the start only (require_plan)
+                continue
             if not out or out[-1] != w.pusher:
                 out.append(w.pusher)
         return out

@@ -39,7 +39,7 @@ same algorithm in numpy, which the compiled one is checked against.
 """
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -80,7 +80,7 @@ class CoulombPadFriction:
     are read when it is made.
     """
 
-    def __init__(self, model: mujoco.MjModel, pad_geoms: Sequence[int]):
+    def __init__(self, model: Any, pad_geoms: Sequence[int]):  # model: a mujoco.MjModel
         self.model = model  # the compiled friction keeps the model's address: this keeps the model alive
         parameters = _pad_friction.PadFrictionParameters(
             slide_speed=SLIDE_SPEED, stick_speed=STICK_SPEED, slide_steps=SLIDE_STEPS, on_cone=ON_CONE,
@@ -88,10 +88,10 @@ class CoulombPadFriction:
             frictionless_mu=FRICTIONLESS_MU)
         self._compiled = _pad_friction.CoulombPadFriction(model._address, [int(g) for g in pad_geoms], parameters)
 
-    def step(self, data: mujoco.MjData) -> None:
+    def step(self, data: Any) -> None:  # data: a mujoco.MjData
         self._compiled.step(data._address)
 
-    def update(self, data: mujoco.MjData) -> None:
+    def update(self, data: Any) -> None:  # data: a mujoco.MjData
         """The friction of the next step only (`step` without its step): `mujoco.mj_step` after it
         takes the same step as `step`."""
         self._compiled.update(data._address)

@@ -252,7 +252,7 @@ def _cone_ring(gens: np.ndarray) -> List[np.ndarray]:
            for i, g in enumerate(gens)]
     pts.sort()
     def half(points):
-        out = []
+        out: list = []
         for p in points:
             while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
                                      - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 1e-12:
