@@ -139,6 +139,7 @@ def _built(robot: Robot, _stamp: int) -> ArmModel:
     joints = _chain_joints(root, flange)
     if not robot.shipped:
         _refuse_project_joint_names(joints)
+        _refuse_empty_ranges(joints)
         _refuse_couplings(root, joints, robot.model)
         _servo(root, joints)
     _mount_jaws(root, flange, robot.tcp)
@@ -386,10 +387,25 @@ def _home_guesses(joints: List[ET.Element], shipped: bool) -> Tuple[np.ndarray, 
     if shipped:
         return (SHIPPED_HOME_GUESS,)
     lower, upper = joint_ranges(joints)
-    lo, hi = np.maximum(lower, -math.pi), np.minimum(upper, math.pi)
+    # Draws within the turn about zero, clipped to each range; a range wholly past a half turn either
+    # way (4 to 5 rad, say) is drawn within itself, a turn of it at most.
+    lo, hi = np.clip(-math.pi, lower, upper), np.clip(math.pi, lower, upper)
+    beyond = (lo == hi) & (lower < upper)
+    lo, hi = (np.where(beyond, np.maximum(lower, hi - 2 * math.pi), lo),
+              np.where(beyond, np.minimum(upper, lo + 2 * math.pi), hi))
     rng = np.random.default_rng(0)
     return (np.clip((lo + hi) / 2, lower, upper), np.clip(np.zeros(len(joints)), lower, upper),
             *(rng.uniform(lo, hi) for _ in range(HOME_STARTS)))
+
+
+def _refuse_empty_ranges(joints: List[ET.Element]) -> None:
+    """RobotError naming an arm's joint whose range is no interval: its lower end above its upper
+    (MuJoCo compiles `range="2.6 -2.6"`, and the IK's draws within it failed as an internal error)."""
+    for joint, lower, upper in zip(joints, *joint_ranges(joints)):
+        if not lower <= upper:
+            raise RobotError("environment.robot.model", f"joint {_lab_name(joint.get('name'))!r:.60}: its range "
+                                                        f"{lower:g} to {upper:g} is empty (the lower end above the "
+                                                        f"upper)")
 
 
 def joint_ranges(joints: List[ET.Element]) -> Tuple[np.ndarray, np.ndarray]:
