@@ -18,13 +18,18 @@ one JSON line on stdout: cases, exit statuses, the slowest case.
 from __future__ import annotations
 
 import collections
+import contextlib
 import copy
 import json
 import math
+import os
 import random
+import re
+import signal
 import sys
 import time
 from pathlib import Path
+from typing import List, Optional
 
 import yaml
 from click.testing import CliRunner
@@ -318,10 +323,707 @@ def run_api(count: int, seed: int, scratch: Path) -> None:
                       "failure_count": len(failures), "slowest_s": round(slowest[0], 3), "slowest": slowest[1]}))
 
 
+# -- shared by the generated kinds: a bound on each case, a tally, the judge of a CLI result -------
+
+CASE_LIMIT_S = 60.0  # a case past this is a hang (SIGALRM); one stuck in C past HARD_LIMIT_S ends the worker
+
+
+class CaseTimeout(BaseException):
+    """A case that ran past CASE_LIMIT_S (raised in the main thread by SIGALRM: no `except
+    Exception` of the library or the CLI catches it)."""
+
+
+def _on_alarm(_signum, _frame):
+    raise CaseTimeout()
+
+
+class Tally:
+    """Counts per exit status, failures, the slowest case; a watchdog thread that, should a case
+    be stuck where SIGALRM cannot reach it (a blocking call in C), prints the summary with that
+    case as a hang and ends the worker (exit 3)."""
+
+    HARD_LIMIT_S = CASE_LIMIT_S + 60.0
+
+    def __init__(self, scratch: Path):
+        import threading
+
+        self.scratch, self.statuses, self.failures, self.slowest = scratch, collections.Counter(), [], (0.0, "")
+        self.label, self.started = None, None
+        signal.signal(signal.SIGALRM, _on_alarm)
+        threading.Thread(target=self._watch, daemon=True).start()
+
+    def _watch(self):
+        while True:
+            time.sleep(1.0)
+            started, label = self.started, self.label
+            if started is not None and time.perf_counter() - started > self.HARD_LIMIT_S:
+                self.failures.append({"case": label, "problem": f"hang: still running after {self.HARD_LIMIT_S:.0f} s "
+                                                                 f"(not interruptible; the worker stopped here)"})
+                print(json.dumps(self.summary()), flush=True)
+                os._exit(3)
+
+    @contextlib.contextmanager
+    def case(self, label: str, detail: str = ""):
+        (self.scratch / "current").write_text(f"{label}\n{detail[:20000]}", errors="replace")
+        self.label, self.started = label, time.perf_counter()
+        signal.setitimer(signal.ITIMER_REAL, CASE_LIMIT_S)
+        try:
+            yield
+        except CaseTimeout:
+            self.count("hang")
+            self.fail(label, f"hang: still running after {CASE_LIMIT_S:.0f} s", detail)
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            self.slowest = max(self.slowest, (time.perf_counter() - self.started, label))
+            self.started = None
+
+    def count(self, status) -> None:
+        self.statuses[str(status)] += 1
+
+    def fail(self, label: str, problem: str, detail: str = "") -> None:
+        self.failures.append({"case": label, "problem": problem, "input": detail[:600]})
+
+    def summary(self) -> dict:
+        return {"cases": sum(self.statuses.values()), "exit_statuses": dict(self.statuses),
+                "failures": self.failures[:20], "failure_count": len(self.failures),
+                "slowest_s": round(self.slowest[0], 3), "slowest": self.slowest[1]}
+
+
+def judge(result, allowed=(0, 1, 2)) -> Optional[str]:
+    """What is wrong with a CLI result, if anything: an exit status outside `allowed`, a
+    traceback, an internal error, or a refusal (2) that is neither one `error:` line nor click's
+    own usage error ("Usage: ..." and one "Error: ..." line)."""
+    text = result.output + result.stderr
+    stderr = [line for line in result.stderr.splitlines() if line.strip() and not line.startswith("warning: ")]
+    if result.exit_code not in allowed:
+        return f"exit {result.exit_code}: {result.stderr.strip()[-300:] or result.exception!r}"
+    if "Traceback" in text or "internal error" in text:
+        return "a traceback or an internal error"
+    if result.exception is not None and not isinstance(result.exception, SystemExit):
+        return f"an exception escaped: {type(result.exception).__name__}: {str(result.exception)[:200]}"
+    if result.exit_code == 2:
+        usage = any(line.startswith("Usage: ") for line in stderr) and sum(
+            line.startswith("Error: ") for line in stderr) == 1
+        if not usage and (len(stderr) != 1 or not stderr[0].startswith("error: ")):
+            return f"a refusal not in one 'error:' line: {stderr[:3]}"
+    return None
+
+
+def _digest(paths) -> dict:
+    import hashlib
+
+    return {str(p): hashlib.sha256(Path(p).read_bytes()).hexdigest() for p in paths if Path(p).is_file()}
+
+
+# -- options: every command's options generated from its click parameters --------------------------
+
+LOW_MU = ROOT / "data" / "tasks" / "horizontal-offset-low-mu.yaml"
+OUTPUT_PARAMS = {"json_path", "csv_path", "png_path", "gif_path", "out_path", "out_dir", "record_path", "video_path",
+                 "video_dir"}
+LEGAL = 0.8  # the chance that an option's value is drawn from the legal ones (so that most cases get past parsing)
+REAL = 0.25  # the chance that evaluate, design --evaluate and execute --sim simulate (else stand-ins, below)
+
+# Legal values kept cheap: (command or "*", parameter) -> values. Hostile ones come from the type.
+CHEAP = {
+    ("plan", "time_limit"): ["0.05", "1e-6", "0.01"], ("bench", "time_limit"): ["0.02", "1e-6"],
+    ("bench", "trials"): ["1", "2"], ("bench", "count"): ["1", "50", "2000"], ("bench", "improve_for"): ["0", "0.02"],
+    ("design", "time_limit"): ["0.05", "1e-6"], ("design", "check_limit"): ["0", "1", "100000"],
+    ("design", "reach_top"): ["0", "1"], ("design", "trials"): ["1", "2"], ("design", "evaluate_top"): ["1", "2"],
+    ("reach", "time_limit"): ["0.01", "1e-6"], ("reach", "check_limit"): ["0", "1", "10000"],
+    ("evaluate", "trials"): ["1", "2"], ("*", "workers"): ["1", "2"], ("execute", "resume_from"): ["0", "1", "21", "22"],
+    ("execute", "ack_timeout"): ["0.01", "5", "3600"], ("sim-arm", "idle_timeout"): ["0.1", "2"],
+    ("sim-arm", "port"): ["0"], ("sim-arm", "exit_after"): ["1", "5"], ("*", "video_fps"): ["1", "5", "25"],
+    ("*", "seed"): ["0", "1", "4294967295"], ("plan", "max_switches"): ["0", "1", "100"],
+}
+
+
+class Scene:
+    """The files a case may name: good inputs (a task, its plan, a design file, two arms), hostile
+    paths (a folder, a FIFO nobody writes, /dev/null, a missing file, an empty and a binary file),
+    outputs (fresh names, a FIFO drained by a thread, an input's own name), and a TCP port that
+    accepts but is no Ray head nor arm."""
+
+    def __init__(self, scratch: Path):
+        import socket
+        import threading
+
+        import stablepush as sp
+
+        from generated_arms import mjcf_arm, urdf_arm
+
+        self.scratch = scratch
+        folder = scratch / "in"
+        folder.mkdir(exist_ok=True)
+        self.task = folder / "task.yaml"
+        self.task.write_text(LOW_MU.read_text())
+        self.plan = folder / "task.plan.json"
+        sp.save_plan(sp.plan_task(sp.load_task(self.task)), str(self.plan))
+        design = yaml.safe_load(LOW_MU.read_text())
+        design["candidates"] = design.pop("pushers")
+        self.design = folder / "two.design.yaml"
+        self.design.write_text(yaml.safe_dump(design))
+        self.urdf = urdf_arm(folder / "arm.urdf", 3, ("z", "y", "y", "z", "y", "z"))
+        self.mjcf = mjcf_arm(folder / "arm.xml", 5, ("z", "x", "z", "-x", "z", "x", "z"))
+        self.empty = folder / "empty.yaml"
+        self.empty.write_text("")
+        self.binary = folder / "binary.json"
+        self.binary.write_bytes(bytes(range(256)) * 4)
+        self.folder = scratch / "a-folder"
+        self.folder.mkdir(exist_ok=True)
+        self.fifo_in, self.fifo_out = scratch / "fifo-in", scratch / "fifo-out"
+        for fifo in (self.fifo_in, self.fifo_out):
+            if not fifo.exists():
+                os.mkfifo(fifo)
+        threading.Thread(target=self._drain, daemon=True).start()
+        self.listener = socket.socket()
+        self.listener.bind(("127.0.0.1", 0))
+        self.listener.listen(16)
+        self.silent_port = self.listener.getsockname()[1]  # accepts, answers nothing
+        threading.Thread(target=self._accept, daemon=True).start()
+        self.inputs = [self.task, self.plan, self.design, Path(self.urdf["model"]), Path(self.mjcf["model"]), self.empty,
+                       self.binary]
+        self.pristine = {str(p): p.read_bytes() for p in self.inputs}
+        self.digests = _digest(self.inputs)
+
+    def _drain(self):
+        while True:
+            with open(self.fifo_out, "rb") as fifo:
+                while fifo.read(65536):
+                    pass
+
+    def _accept(self):
+        held = []
+        while True:
+            connection, _ = self.listener.accept()
+            held = (held + [connection])[-16:]
+
+    def input_path(self, rng, good: Path) -> str:
+        if rng.random() < 0.85:
+            return str(good)
+        return str(rng.choice([self.folder, self.fifo_in, "/dev/null", self.scratch / "missing.yaml", self.empty,
+                               self.binary, self.task, self.plan, self.design, self.urdf["model"], "", "/proc/self/mem"]))
+
+    def output_path(self, rng, suffixes) -> str:
+        if rng.random() < 0.7:
+            return str(self.scratch / "out" / f"o{rng.randrange(100)}{rng.choice(suffixes)}")
+        return str(rng.choice([self.folder, self.fifo_out, "/dev/null", "/dev/full", self.scratch / "no" / "dir" / "x",
+                               "", str(self.scratch / "out") + "/", ".", "..", self.task, self.plan, self.design,
+                               self.urdf["model"], self.mjcf["model"], "/proc/self", self.scratch / "out" / "x.unknown"]))
+
+    def changed_inputs(self) -> List[str]:
+        """Inputs a case wrote over (each put back)."""
+        now = _digest(self.inputs)
+        changed = [p for p in self.digests if now.get(p) != self.digests[p]]
+        for path in changed:
+            Path(path).write_bytes(self.pristine[path])
+        return changed
+
+
+def _finite_text(t, rng, legal: bool) -> str:
+    lo, hi = t.min, t.max
+    if legal:
+        edges = ([lo] if lo is not None and not t.min_open else []) + ([hi] if hi is not None and not t.max_open else [])
+        a = lo if lo is not None else -1e3
+        b = hi if hi is not None else a + 1e3
+        inside = a + (b - a) * rng.choice([0.5, 0.25, 1e-9, 0.999])
+        return repr(float(rng.choice(edges + [inside, inside])))
+    out = ["nan", "inf", "-inf", "1e400", "-1e400", "abc", "", " ", "٣", "３", "0x10", "1,5", "-0"]
+    if lo is not None:
+        out += [repr(lo - 1), repr(lo - 1e-12) if lo else "-1e-300", repr(lo) if t.min_open else "-1"]
+    if hi is not None:
+        out += [repr(hi * 2 + 1), repr(hi) if t.max_open else "1e308"]
+    return rng.choice(out)
+
+
+def _whole_text(t, rng, legal: bool) -> str:
+    lo = t.min if t.min is not None else -(2 ** 31)
+    hi = t.max if t.max is not None else 2 ** 31
+    if legal:
+        return str(rng.choice([lo, min(hi, lo + 1), min(hi, lo + 2), hi if hi < 10 ** 6 else lo + 3]))
+    return rng.choice([str(lo - 1), str(hi + 1), "1.5", "1e3", "٢", "", "x", str(2 ** 64), "-0", " 1", "0b1"])
+
+
+def _real_text(rng, legal: bool) -> str:
+    if legal:
+        return rng.choice(["0", "1", "-1", "110", "180", "0.5", "5", "-40", "-0", "1e-3"])
+    return rng.choice(["nan", "inf", "-inf", "1e308", "-1e308", "1e-300", "x", "٣", "", "1e400", "1e9"])
+
+
+STRINGS = {
+    "ray_address": lambda r, s: r.choice(["127.0.0.1:1", "notanaddress", ":::", f"127.0.0.1:{s.silent_port}",
+                                          "host:0", "[::1]:x", "127.0.0.1:٦٣٧٩", ""]),
+    "rank_text": lambda r, s: r.choice(["margin", "arm,fixtures", "margin,margin", "speed", "", ",", "success",
+                                        "time,reach,pushes", "fixtures,points,end,switches,margin,pushes,reach,tests"]),
+    "vary": lambda r, s: f"{r.choice(['pad_mu', 'pusher_mu', 'grip_force', 'mass', '', 'heat', 'pad_mu=1'])}="
+                         f"{r.choice(['0.1', '0', '-0', '0.9', '1', 'nan', '-1', '1e308', ''])}",
+    "pusher": lambda r, s: r.choice(["left", "right", "bottom", "", "nobody", "left,right", "'", "Left"]),
+    "flange": lambda r, s: r.choice(["tool0", "flange", "hand", "", "fl'ange", "link1", "object", "nope", " ", "G"]),
+    "stamp_ns": lambda r, s: r.choice(["0", "-1", "1764600000.5", "2026-12-01T15:00:00Z", "2026-12-01T15:00:00",
+                                       "1e30", "nan", "٣", "", "99999999999999999999999"]),
+    "video_size": lambda r, s: r.choice(["640x480", "64x48", "0x0", "1x1", "99999x99999", "x", "-1x5", "", "640"]),
+    "x_axis": lambda r, s: r.choice(["-1:1:2", "0:0:1", "0:1:0", "nan:1:2", "0:inf:2", "0:1", "a:b:c", "0:1:٢", "",
+                                     "-1e5:1:2", "0:1:100000", "::", "0:1:2:3", "-0:-0:1"]),
+    "host": lambda r, s: r.choice(["127.0.0.1", "", "999.1.1.1", "localhost", "::1", "not a host", "127.0.0.1 "]),
+    "arm": lambda r, s: r.choice(["127.0.0.1:1", "x:٣", "", "host", f"127.0.0.1:{s.silent_port}", "127.0.0.1:99999"]),
+}
+STRINGS["z_axis"] = STRINGS["theta_axis"] = STRINGS["x_axis"]
+SUFFIXES = {"json_path": [".json"], "csv_path": [".csv"], "png_path": [".png", ".svg", ".jpg", ".pdf", ".txt"],
+            "gif_path": [".gif", ".png"], "out_path": [".csv", ".json", ".mcap", ".txt"], "out_dir": ["", "/"],
+            "record_path": [".mcap", ".json"], "video_path": [".mp4", ".gif", ".avi"], "video_dir": ["", "/"]}
+
+
+def _option_value(command: str, param, rng, scene: Scene) -> List[str]:
+    """One option's words on the command line: drawn from its type (legal three times in ten...
+    LEGAL), cheap legal values for the costly ones (CHEAP)."""
+    import click
+
+    name, t = param.name, param.type
+    if param.is_flag if isinstance(param, click.Option) else False:
+        return [rng.choice([param.opts[0]] + list(param.secondary_opts))]
+    words = []
+    hostile = -1 if rng.random() < LEGAL else rng.randrange(param.nargs)  # the one word drawn hostile, if any
+    for k in range(param.nargs):
+        legal = k != hostile
+        cheap = CHEAP.get((command, name)) or CHEAP.get(("*", name))
+        if name in OUTPUT_PARAMS:
+            words.append(scene.output_path(rng, SUFFIXES[name]))
+        elif name == "robot_model":
+            words.append(scene.input_path(rng, Path(rng.choice([scene.urdf, scene.mjcf])["model"])))
+        elif name == "task_file":
+            words.append(scene.input_path(rng, scene.task))
+        elif name == "plan_file":
+            words.append(scene.input_path(rng, scene.plan))
+        elif cheap and legal:
+            words.append(rng.choice(cheap))
+        elif isinstance(t, click.Choice):
+            words.append(rng.choice(list(t.choices)) if legal else rng.choice(["", "bogus", t.choices[0].upper()]))
+        elif isinstance(t, click.IntRange):
+            words.append(_whole_text(t, rng, legal))
+        elif isinstance(t, click.FloatRange):
+            words.append(_finite_text(t, rng, legal))
+        elif isinstance(t, click.types.FloatParamType):
+            words.append(_real_text(rng, legal))
+        elif name in STRINGS:
+            words.append(STRINGS[name](rng, scene))
+        else:
+            words.append(rng.choice(["", "x", "-1", "nan", "\u202e", "y" * 500]))
+    return [param.opts[0], *words] if isinstance(param, click.Option) else words
+
+
+# What a command is given whatever else is drawn, unless drawn itself: the cheap bounds.
+DEFAULTS = {
+    "plan": {"time_limit": ["--time-limit", "0.05"], "quiet": ["--quiet"]},
+    "bench": {"trials": ["--trials", "1"], "time_limit": ["--time-limit", "0.02"], "count": ["-n", "50"]},
+    "design": {"time_limit": ["--time-limit", "0.05"], "workers": ["--workers", "1"], "reach_top": ["--reach-top", "0"],
+               "quiet": ["--quiet"]},
+    "reach": {"time_limit": ["--time-limit", "0.01"], "workers": ["--workers", "1"], "x_axis": ["--x", "-1:1:2"],
+              "z_axis": ["--z", "0:0:1"], "theta_axis": ["--theta", "0:0:1"], "quiet": ["--quiet"]},
+    "evaluate": {"trials": ["--trials", "1"], "workers": ["--workers", "1"], "quiet": ["--quiet"]},
+    "execute": {"pace": ["--no-pace"], "quiet": ["--quiet"]},
+    "sim-arm": {"port": ["--port", "0"], "idle_timeout": ["--idle-timeout", "2"]},
+}
+
+
+def options_case(command: str, rng, scene: Scene) -> List[str]:
+    """A command line for `command`: its arguments, its required options, 0-5 of its other
+    options (the robot's four together now and then), each drawn from its click parameter."""
+    import click
+
+    from stablepush_cli.main import cli
+
+    params = cli.commands[command].params
+    args = [command]
+    for param in params:
+        if isinstance(param, click.Argument):
+            if param.nargs == -1:  # bench: one or two task files
+                args += [scene.input_path(rng, scene.task) for _ in range(rng.choice([1, 1, 2]))]
+            elif param.name == "design_file":
+                args.append(scene.input_path(rng, scene.design))
+            else:
+                args += _option_value(command, param, rng, scene)
+    required = [p for p in params if isinstance(p, click.Option) and p.required]
+    optional = [p for p in params if isinstance(p, click.Option) and not p.required]
+    drawn = required + rng.sample(optional, rng.randint(0, min(5, len(optional))))
+    names = {p.name for p in drawn}
+    if {"robot_model", "flange", "tcp"} <= {p.name for p in params} and rng.random() < 0.3:
+        arm = rng.choice([scene.urdf, scene.mjcf])
+        args += ["--robot", arm["model"], "--flange", arm["flange"], "--tcp", *map(str, arm["tcp"])]
+        names |= {"robot_model", "flange", "tcp"}
+        drawn = [p for p in drawn if p.name not in ("robot_model", "flange", "tcp")]
+    if command == "check" and not names & {"move", "directions"}:
+        args += ["--move", *rng.choice([["1", "0", "0"], ["0", "1", "0"], ["0", "0", "1"], ["-1", "0", "0.5"]])]
+    if command == "execute" and not names & {"arm", "sim"}:
+        args.append(rng.choice(["--sim", "--sim", "--sim", "--arm"]))
+        if args[-1] == "--arm":
+            args.append(STRINGS["arm"](rng, scene))
+    for param in drawn:
+        args += _option_value(command, param, rng, scene)
+    for name, words in DEFAULTS.get(command, {}).items():
+        if name not in names:
+            args += words
+    return args
+
+
+class _NoWorld:
+    """execute's simulated arm, refusing to build its world: the run faults at its hello (exit 3)
+    once every option has been taken, without a simulation."""
+
+    name = "fuzz arm"
+
+    def __init__(self, engine="mujoco", deviation=None, log=None, robot=None):
+        self.engine, self.deviation, self.connected, self.robot = engine, deviation, False, robot
+
+    def check_cell(self, task, plan, rate_hz):
+        return None
+
+    def robot_description(self):
+        from stablepush.sim.robot import robot_description
+
+        return robot_description(self.robot)
+
+    def hello(self, scene, rate_hz, resume):
+        from stablepush.execution.arm import ArmError
+
+        raise ArmError("fuzz: no world is built here")
+
+    move = hello
+
+    def stop(self):
+        return None
+
+    close = stop
+
+
+def _landed(batch, trial):
+    """A trial that draws its world as run_trial does, and lands, without a simulation."""
+    return {"trial": trial, "world": batch.world(trial).as_dict(), "goal_error": None, "final_error": None,
+            "replans": 0, "sim_time_s": 1.0, "wall_s": 0.0, "verdict": None, "error": None, "success": True,
+            "cause": None}
+
+
+def _sim_arm(args: List[str]):
+    """sim-arm in a child process (it serves until interrupted): refused at once (exit 2, one
+    line), or listening: sent a line that is no message, then Ctrl-C, after which it must exit 0.
+    Returns its exit status ("hang" if it would not end) and what is wrong, if anything."""
+    import socket
+    import subprocess
+
+    child = subprocess.Popen([sys.executable, "-c", "from stablepush_cli.main import cli; cli(prog_name='stablepush')",
+                              *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line, lines = "", []
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            line = child.stderr.readline()
+            lines.append(line)
+            if "listening on" in line or not line:
+                break
+        if "listening on" in line:
+            port = int(line.split("listening on ")[1].split(" ")[0].rsplit(":", 1)[1])
+            host = "::1" if "listening on ::1" in line else "127.0.0.1"
+            with socket.create_connection((host, port), timeout=10) as connection:
+                connection.sendall(b"not a message\n")
+                connection.recv(4096)
+            child.send_signal(signal.SIGINT)
+        _, err = child.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        child.kill()
+        child.communicate()
+        return "hang", "hang: sim-arm did not exit"
+    err, code = "".join(lines) + err, child.returncode
+    lines = [x for x in err.splitlines() if x.strip() and not x.startswith(("warning: ", "sim-arm: "))]
+    if code not in (0, 2) or "Traceback" in err or "internal error" in err:
+        return code, f"exit {code}: {err.strip()[-300:]}"
+    if code == 2 and not (any(x.startswith("Error: ") for x in lines) or
+                          (len(lines) == 1 and lines[0].startswith("error: "))):
+        return code, f"a refusal not in one 'error:' line: {lines[:3]}"
+    return code, None
+
+
+def run_options(count: int, seed: int, scratch: Path) -> None:
+    """`count` command lines per command that `stablepush --help` lists, generated from each
+    command's click parameters; prints the summary (statuses keyed "command:status")."""
+    import shlex
+
+    import stablepush.sim.local_arm as local_arm
+    from stablepush.evaluation import batch as batch_mod
+    from stablepush_cli.main import cli
+
+    rng = random.Random(seed)
+    scene = Scene(scratch)
+    (scratch / "out").mkdir(exist_ok=True)
+    os.chdir(scratch / "out")  # where the default outputs (named after the task) go
+    tally = Tally(scratch)
+    real_trial, real_arm = batch_mod.run_trial, local_arm.SimulatedArm
+    runner = CliRunner()
+    for case in range(count):
+        for command in sorted(cli.commands):
+            args = options_case(command, rng, scene)
+            label = f"options {case} {command}"
+            detail = shlex.join(args)
+            if command == "sim-arm":
+                with tally.case(label, detail):
+                    code, problem = _sim_arm(args)
+                    tally.count(code)
+                    tally.count(f"{command}:{code}")
+                    if problem:
+                        tally.fail(label, problem, detail)
+                continue
+            real = rng.random() < REAL
+            batch_mod.run_trial = real_trial if real else _landed
+            local_arm.SimulatedArm = real_arm if real else _NoWorld
+            with tally.case(label + (" (simulated)" if real else ""), detail):
+                result = runner.invoke(cli, args, catch_exceptions=True)
+                tally.count(result.exit_code)
+                tally.count(f"{command}:{result.exit_code}")
+                problem = judge(result, (0, 1, 2, 3, 5) if command == "execute" else (0, 1, 2, 3))
+                changed = scene.changed_inputs()
+                if changed:
+                    problem = f"an input was written over: {changed}"
+                if problem:
+                    tally.fail(label, problem, detail)
+    batch_mod.run_trial, local_arm.SimulatedArm = real_trial, real_arm
+    summary = tally.summary()
+    summary["cases"] = sum(v for k, v in tally.statuses.items() if ":" not in k)
+    print(json.dumps(summary))
+
+
+# -- robots: generated URDF and MJCF arms, mutated, given to check-cell and to arm_model ------------
+
+PROJECT_NAMES = ["finger_pos", "finger_neg", "arm_base", "object", "feature_left", "floor", "G", "hand", "pad_left"]
+ODD_NAMES = ["fl'ange", "a&quot;b", "關節", "link one", "", "x" * 300, "robot/x", "~", "..", "a<b".replace("<", "&lt;")]
+
+
+def _rename(text: str, old: str, new: str) -> str:
+    """Every attribute value `old` (a name and the references to it) made `new` (XML-escaped already)."""
+    return text.replace(f'"{old}"', f'"{new}"')
+
+
+def _mutate_encoding(urdf, text, folder, rng, flange, links, joints):
+    how = rng.choice(["ISO-8859-1", "UTF-16", "BOM", "invalid bytes", "latin-1 undeclared", "UTF-16 undeclared"])
+    renamed = _rename(text, links[0], "lïnk_é")
+    if how == "ISO-8859-1":
+        body = renamed.replace('<?xml version="1.0"?>', "")
+        return f'<?xml version="1.0" encoding="ISO-8859-1"?>{body}'.encode("latin-1"), flange, how
+    if how == "UTF-16":
+        body = renamed.replace('<?xml version="1.0"?>', "")
+        return f'<?xml version="1.0" encoding="UTF-16"?>{body}'.encode("utf-16"), flange, how
+    if how == "UTF-16 undeclared":
+        return renamed.replace('<?xml version="1.0"?>', "").encode("utf-16"), flange, how
+    if how == "BOM":
+        return b"\xef\xbb\xbf" + renamed.encode(), flange, how
+    if how == "latin-1 undeclared":
+        return renamed.encode("latin-1"), flange, how
+    data = text.encode()
+    at = data.index(f'"{links[1]}"'.encode()) + 2
+    return data[:at] + rng.choice([b"\xff\xfe", b"\xc3", b"\x00", b"\xed\xa0\x80"]) + data[at:], flange, how
+
+
+def _mutate_names(urdf, text, folder, rng, flange, links, joints):
+    new = rng.choice(PROJECT_NAMES + ODD_NAMES + links + joints)
+    old = rng.choice(links + joints + [flange] * 3)
+    note = f"{old} renamed {new!r}"
+    if rng.random() < 0.2 and not urdf:
+        return text.replace('<geom type="cylinder"', '<geom name="floor" type="cylinder"', 1), flange, \
+            "a geom named floor"
+    text = _rename(text, old, new)
+    if old == flange:
+        flange = new.replace("&quot;", '"').replace("&lt;", "<")
+    return text, flange, note
+
+
+def _mutate_couplings(urdf, text, folder, rng, flange, links, joints):
+    a, b = rng.sample(joints[:4], 2)
+    if urdf:
+        at = text.index(f'<joint name="{b}"')
+        end = text.index("</joint>", at)
+        on = rng.choice([a, "no_such_joint", b])
+        return text[:end] + f'<mimic joint="{on}" multiplier="{rng.choice([1, -1, 0, "nan"])}"/>' + text[end:], \
+            flange, f"{b} mimics {on}"
+    how = rng.choice(["equality", "tendon limited", "tendon unlimited", "equality on nothing"])
+    block = {"equality": f'<equality><joint joint1="{a}" joint2="{b}"/></equality>',
+             "equality on nothing": '<equality><weld body1="pedestal"/></equality>',
+             "tendon limited": f'<tendon><fixed name="t" limited="true" range="-1 1"><joint joint="{a}" coef="1"/>'
+                               f'<joint joint="{b}" coef="1"/></fixed></tendon>',
+             "tendon unlimited": f'<tendon><fixed name="t"><joint joint="{a}" coef="1"/></fixed></tendon>'}[how]
+    return text.replace("</mujoco>", block + "</mujoco>"), flange, how
+
+
+def _mutate_includes(urdf, text, folder, rng, flange, links, joints):
+    how = rng.choice(["missing", "a folder", "a FIFO", "a loop", "nested", "/dev/null", "absolute", "not XML"])
+    (folder / "sub").mkdir(exist_ok=True)
+    (folder / "b.xml").write_text('<mujoco><option timestep="0.002"/></mujoco>')
+    target = {"missing": "missing.xml", "a folder": "sub", "a FIFO": "fifo.xml", "a loop": "a.xml",
+              "nested": "a.xml", "/dev/null": "/dev/null", "absolute": str(folder / "b.xml"),
+              "not XML": "junk.xml"}[how]
+    if how == "a FIFO":
+        os.mkfifo(folder / "fifo.xml")
+    (folder / "junk.xml").write_bytes(b"\x00\xffnot xml")
+    (folder / "a.xml").write_text('<mujoco><include file="a.xml"/></mujoco>' if how == "a loop" else
+                                  '<mujoco><include file="b.xml"/></mujoco>')
+    include = f'<include file="{target}"/>'
+    if urdf:  # MuJoCo's extension of a URDF
+        return text.replace("</robot>", f"<mujoco>{include}</mujoco></robot>"), flange, f"include {how}"
+    return text.replace("<worldbody>", include + "<worldbody>", 1), flange, f"include {how}"
+
+
+def _mutate_meshes(urdf, text, folder, rng, flange, links, joints):
+    import trimesh
+
+    how = rng.choice(["relative meshdir", "missing", "a FIFO", "a folder", "garbage", "absolute", "no meshdir"])
+    (folder / "meshes").mkdir(exist_ok=True)
+    mesh = folder / "meshes" / "part.stl"
+    if how == "a FIFO":
+        os.mkfifo(mesh)
+    elif how == "a folder":
+        mesh.mkdir()
+    elif how == "garbage":
+        mesh.write_bytes(b"solid x\n" + bytes(rng.randrange(256) for _ in range(300)))
+    elif how != "missing":
+        mesh.write_bytes(trimesh.creation.box([0.05, 0.05, 0.05]).export(file_type="stl"))
+    name = str(mesh) if how == "absolute" else "meshes/part.stl" if how == "no meshdir" else "part.stl"
+    meshdir = "" if how in ("absolute", "no meshdir") else ' meshdir="meshes"'
+    if urdf:
+        geometry = f'<collision><geometry><mesh filename="{name}"/></geometry></collision>'
+        text = text.replace('<link name="link1">', '<link name="link1">' + geometry, 1)
+        return text.replace("</robot>", f"<mujoco><compiler{meshdir}/></mujoco></robot>"), flange, f"mesh {how}"
+    text = text.replace('<compiler angle="radian"', f'<compiler{meshdir} angle="radian"', 1)
+    text = text.replace("<worldbody>", f'<asset><mesh name="part" file="{name}"/></asset><worldbody>', 1)
+    return text.replace('<body name="pedestal">', '<body name="pedestal"><geom type="mesh" mesh="part"/>', 1), \
+        flange, f"mesh {how}"
+
+
+def _mutate_limits(urdf, text, folder, rng, flange, links, joints):
+    bad = rng.choice(["abc", "inf", "-1", "nan", "", "0", "1e308", "-inf", "2 3"])
+    if urdf:
+        how = rng.choice(["velocity", "lower>upper", "no limit", "effort", "lower"])
+        if how == "velocity":
+            return re.sub(r'velocity="[^"]*"', f'velocity="{bad}"', text, count=rng.randint(1, 6)), flange, \
+                f"velocity {bad!r}"
+        if how == "lower>upper":
+            return text.replace('lower="-2.6" upper="2.6"', 'lower="2.6" upper="-2.6"'), flange, how
+        if how == "no limit":
+            return re.sub(r"<limit [^>]*/>", "", text, count=1), flange, how
+        return re.sub(f'{how}="[^"]*"', f'{how}="{bad}"', text, count=1), flange, f"{how} {bad!r}"
+    return re.sub(r'range="[^"]*"', rng.choice(['range="2.6 -2.6"', f'range="{bad} 1"', 'range=""', 'range="1"']),
+                  text, count=rng.randint(1, 3)), flange, "a joint range"
+
+
+def _mutate_truncated(urdf, text, folder, rng, flange, links, joints):
+    data = text.encode()
+    return data[:rng.randrange(len(data))], flange, "truncated"
+
+
+def _mutate_joint_types(urdf, text, folder, rng, flange, links, joints):
+    if urdf:
+        new = rng.choice(["continuous", "floating", "planar", "prismatic", "bogus", ""])
+        return text.replace('type="revolute"', f'type="{new}"', rng.randint(1, 2)), flange, f"joint type {new!r}"
+    new = rng.choice(['<freejoint/>', '<joint type="ball"/>', '<joint type="slide" name="s"/>', '<joint/>'])
+    return text.replace('<body name="l2" pos="0 0 0.', f'<body name="l2">{new}<body name="l2b" pos="0 0 0.', 1
+                        ).replace("</worldbody>", "</body></worldbody>", 1), flange, f"a joint {new}"
+
+
+def _mutate_numbers(urdf, text, folder, rng, flange, links, joints):
+    numbers = re.findall(r"-?\d+\.\d+", text)
+    old = rng.choice(numbers)
+    new = rng.choice(["nan", "inf", "-inf", "1e308", "-0", "x", "1e9", "0"])
+    return text.replace(old, new, 1), flange, f"number {old} made {new}"
+
+
+ROBOT_MUTATIONS = {"encoding": _mutate_encoding, "names": _mutate_names, "couplings": _mutate_couplings, "includes": _mutate_includes, "meshes": _mutate_meshes, "limits": _mutate_limits, "truncated": _mutate_truncated, "joint types": _mutate_joint_types, "numbers": _mutate_numbers}
+
+
+def _robot_mutation(kind: str, text: str, folder: Path, rng: random.Random, flange: str):
+    """One edit of a generated arm's file: returns (text or bytes, flange, what was done). Files it
+    names (included models, meshes, FIFOs, folders) are made in `folder`."""
+    urdf = kind == "urdf"
+    links = [f"link{i}" for i in range(1, 7)] + ["tool0"] if urdf else [f"l{i}" for i in range(1, 8)] + ["flange"]
+    joints = [f"joint_{i}" for i in range(1, 7)] if urdf else [f"q{i}" for i in range(1, 8)]
+    what = rng.choice(["encoding", "names", "names", "couplings", "includes", "meshes", "limits", "truncated",
+                       "joint types", "numbers"])
+    return ROBOT_MUTATIONS[what](urdf, text, folder, rng, flange, links, joints)
+
+
+def run_robots(count: int, seed: int, scratch: Path) -> None:
+    """`count` generated arms (tests/generated_arms.py: URDF or MJCF, 6 or 7 joints), each with
+    one to two mutations (_robot_mutation), given to `check-cell` (now and then with `--json`
+    naming the model itself) or to stablepush.sim.robot.arm_model. check-cell must end 0, 1 or
+    2 in one `error:` line; arm_model must return or raise a StablepushError; no case may hang or
+    write over the model."""
+    import shlex
+    import shutil
+
+    import stablepush as sp
+    from stablepush.errors import StablepushError
+    from stablepush.sim.robot import arm_model
+    from stablepush_cli.main import cli
+
+    from generated_arms import TCP, mjcf_arm, urdf_arm
+
+    rng = random.Random(seed)
+    task = scratch / "task.yaml"
+    task.write_text(LOW_MU.read_text())
+    plan = scratch / "task.plan.json"
+    sp.save_plan(sp.plan_task(sp.load_task(task)), str(plan))
+    (scratch / "elsewhere").mkdir(exist_ok=True)
+    os.chdir(scratch / "elsewhere")  # not the model's folder: a relative meshdir must not depend on it
+    tally, runner = Tally(scratch), CliRunner()
+    for case in range(count):
+        folder = scratch / f"arm{case % 2}"
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir()
+        kind = rng.choice(["urdf", "mjcf"])
+        axes = rng.choice([("z", "y", "y", "z", "y", "z")] if kind == "urdf" else
+                          [("z", "x", "z", "-x", "z", "x", "z")])
+        path = folder / ("arm.urdf" if kind == "urdf" else rng.choice(["arm.xml", "arm.mjcf"]))
+        arm = (urdf_arm if kind == "urdf" else mjcf_arm)(path, rng.randrange(100), axes)
+        content, flange, notes = path.read_text(), arm["flange"], []
+        for _ in range(rng.choice([1, 1, 2])):
+            text = content if isinstance(content, str) else content.decode("utf-8", "replace")
+            content, flange, note = _robot_mutation(kind, text, folder, rng, flange)
+            notes.append(note)
+        if isinstance(content, str):
+            path.write_text(content, encoding="utf-8")
+        else:
+            path.write_bytes(content)
+        if rng.random() < 0.05:
+            path.unlink()
+            os.mkfifo(path)
+            notes.append("the model a FIFO")
+        before = _digest([path])
+        label = f"robot {case} {kind}: {'; '.join(notes)}"
+        if rng.random() < 0.25:
+            with tally.case(label, str(path)):
+                try:
+                    arm_model(sp.Robot(model=str(path), flange=flange, tcp=TCP))
+                    tally.count("returned")
+                except StablepushError:
+                    tally.count("refused")
+                except Exception as exc:  # noqa: BLE001 - what escapes is the finding
+                    tally.count("escaped")
+                    tally.fail(label, f"{type(exc).__name__}: {str(exc)[:200]}", str(path))
+            continue
+        args = ["check-cell", str(plan), "--task", str(task), "--robot", str(path), "--flange", flange, "--tcp",
+                *map(str, TCP)]
+        if rng.random() < 0.15:
+            args += ["--json", str(path)]
+        with tally.case(label, shlex.join(args)):
+            result = runner.invoke(cli, args, catch_exceptions=True)
+            tally.count(result.exit_code)
+            problem = judge(result, (0, 1, 2))
+            if "--json" in args and result.exit_code != 2:
+                problem = problem or "--json naming the model was not refused"
+            if _digest([path]) != before:
+                problem = "the model was written over"
+            if problem:
+                tally.fail(label, problem, shlex.join(args))
+    print(json.dumps(tally.summary()))
+
+
 def main() -> None:
     kind, count, seed, scratch = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), Path(sys.argv[4])
-    if kind == "api":
-        run_api(count, seed, scratch)
+    if kind in ("api", "options", "robots"):
+        {"api": run_api, "options": run_options, "robots": run_robots}[kind](count, seed, scratch)
         return
     cases = {"tasks": run_tasks, "plans": run_plans, "meshes": run_meshes, "semantics": run_semantics}[kind](
         count, seed, scratch)
