@@ -264,21 +264,264 @@ def run_semantics(count: int, seed: int, scratch: Path):
                ["trajectory", str(plan_file), "--task", str(path), "-o", str(scratch / "out.csv")], text[:2000])
 
 
-API_ERRORS = ("StablepushError", "TypeError", "ValueError", "KeyboardInterrupt")
+# -- api, every public function and value type: generated wrong types and values --------------------
+
+NAN, INF = float("nan"), float("inf")
+BAD, MAYBE = "bad", "maybe"  # a value the task file would refuse; one that may be taken (a default, a quirk)
+
+
+def _pool(kind: str, ctx: dict):
+    """(good values, bad values) of an argument kind: the good ones are what the task file or the
+    command line takes, the bad ones what either would refuse."""
+    pools = {
+        "count": ([1, 2], [0, -1, 1.5, NAN, "2", 10 ** 30, [1]]),
+        "whole0": ([0, 1], [-1, 1.5, "1", NAN, 2 ** 70]),
+        "seed": ([0, 1, 2 ** 32 - 1], [-1, 2 ** 32, 1.5, "1", NAN, 2 ** 64]),
+        "time": ([0.01, 0.02], [0, -1.0, NAN, INF, "0.1", 1e300]),
+        "rate": ([100.0, 50], [0, -1, NAN, INF, "100", 1e9, None]),
+        "vary": ([{"pad_mu": 0.1}, {"mass": 0.05}], [{"pad_mu": -0.1}, {"pad_mu": 5}, {"heat": 0.1}, {"pad_mu": NAN},
+                                                      "pad_mu", [("pad_mu", 0.1)], {"pad_mu": "0.1"}]),
+        "pair": ([(0.0, 0.0), (0.1, 0.1)], [(-1, 0), (NAN, 0), (0,), "0 0", (1e308, 0), (0, INF), None]),
+        "prob": ([0.5, 0.9], [0, 1, -0.1, NAN, "0.9", 1.5, None]),
+        "confidence": ([0.9, 0.95], [0.5, 1, NAN, "0.95", 2]),
+        "engine": (["mujoco"], ["bullet", "", 3, None, "MUJOCO"]),
+        "bool": ([True, False], ["yes", "false", NAN]),
+        "flag": ([True, False, 1, 0], []),  # an argument of the API alone, truthy as Python's
+        "path_in": ([ctx["task_path"]], [ctx["folder"], ctx["fifo"], "/dev/null", ctx["missing"], 3, b"\xff", "",
+                                         ctx["binary"]]),
+        "plan_path": ([ctx["plan_path"]], [ctx["folder"], ctx["fifo"], "/dev/null", ctx["missing"], 3, "",
+                                           ctx["binary"], ctx["task_path"]]),
+        "path_out": ([ctx["out"] + ".json"], [ctx["folder"], "", ctx["task_path"], "/proc/self", 3, ctx["out"] + "/",
+                                              ctx["mesh"], ctx["model"]]),
+        "csv_out": ([None, ctx["out"] + ".csv"], [ctx["folder"], ctx["task_path"], 3, ctx["plan_path"]]),
+        "pusher": (["left", None], ["", 3, "nobody", ["left"]]),
+        "pose": ([(0, 0, 0), (1.0, 0.0, 0.0)], [(NAN, 0, 0), (0, 0), "000", (1e308, 0, 0), None, (0, 0, INF)]),
+        "model": ([None, ctx["model"]], [ctx["folder"], ctx["fifo"], ctx["missing"], ctx["task_path"], 3, "",
+                                         "/dev/null"]),
+        "flange": (["hand"], ["", " ", 3, None]),
+        "tcp": ([(0, 0, 110, 0, 180, 0)], [(NAN, 0, 110, 0, 180, 0), (0, 0, 110), (1e300, 0, 0, 0, 0, 0), "0 0 110",
+                                           None]),
+        "base": ([(0, 0, 0, 0)], [(0, 0, 0), (0, -1e5, 0, 0), (NAN, 0, 0, 0), "0"]),
+        "speed": ([2.5, 1.0], [0, -1, 1e9, NAN, "2.5"]),
+        "length": ([20.0, 150.0], [-50, 0, NAN, INF, 1e9, "20"]),
+        "home": ([(450.0, 0.0, 300.0)], [(1e9, 0, 0), (NAN, 0, 0), (0, 0), "450 0 300"]),
+        "features": ([{}, {"left": (0, 0, 0, 0)}], [{"left": (0, 0, 1e9, 0)}, {"left": (NAN, 0, 0, 0)}, {"left": (0,)},
+                                                   ["left"], {3: (0, 0, 0, 0)}]),
+        "rank": ([("fixtures", "margin"), ("margin",)], [("bogus",), ("fixtures", "fixtures"), (["arm"],), "fixtures",
+                                                        (), 3]),
+        "axis": ([(-1.0, 1.0, 2), (0.0, 0.0, 1)], [(NAN, 1, 2), (0, 1, 0), (0, 1, 10 ** 6), "0:1:2", (0, 1),
+                                                   (0, INF, 2), (0, 1, 1.5)]),
+        "task": ([ctx["task"]], [None, ctx["task_path"], {"name": "x"}, ctx["plan"], 3]),
+        "plan": ([ctx["plan"]], [None, ctx["plan_path"], ctx["task"], {"waypoints": []}, 3]),
+        "runner": ([None], ["ray", 3, "local", ctx["task"]]),
+        "spreads": ([ctx["spreads"]], [{"pad_mu": 0.1}, 3, "pad_mu=0.1"]),
+        "study": ([ctx["study"]], [None, 3, ctx["task"], "study"]),
+        "batch": ([ctx["batch"]], [None, 3, ctx["task"], "batch"]),
+        "test": ([None, ctx["test"]], [3, "sprt", 0.9]),
+        "workers": ([1, 2], [0, -2, 1.5, "2", 10 ** 6]),
+        "ray_address": ([None], [3, ":::", "host:0", "127.0.0.1:٦٣٧٩"]),
+        "robot": ([None, ctx["robot"]], ["arm.urdf", {"model": ctx["model"]}, 3]),
+        "title": ([None, "a title", 3], []),  # matplotlib's to print
+        "design_task": ([ctx["design_task"]], [None, "task.yaml", 3, ctx["task"]]),
+        "candidates": ([ctx["candidates"]], [None, [], "left", [{"name": "left"}], 3]),
+        "text": ([ctx["task_text"]], [None, 3, "", "name: [", {"name": 1}, b"\xff"]),
+        "source": ([None, "mine.yaml"], [3, ["x"]]),
+        "label": ([None, "mine.yaml", 3], []),  # a name in messages: any value will do
+        "mu": ([0.5], [-1, NAN, INF, "0.5", 1e300]),
+        "size": ([(640, 480)], [(0, 0), (-1, 5), (99999, 99999), "640x480", (640.5, 480)]),
+        "deviation": ([ctx["deviation"]], [3, "none", {"mu_scale": 2}]),
+    }
+    return pools[kind]
+
+
+def _api_table(sp, ctx):
+    """function -> (callable, {parameter: kind}): every name of stablepush.__all__ that is a function
+    or a value type, and the documented functions of the subpackages (design, evaluation, runners,
+    reach, the simulated arm, the run's options)."""
+    from stablepush.design import design, evaluate_designs
+    from stablepush.evaluation import Batch, SequentialTest, Spreads, evaluate
+    from stablepush.execution.executor import RunOptions
+    from stablepush.plan.reach import reach_map
+    from stablepush.runners import Runner
+    from stablepush.sim.deviation import WorldDeviation
+    from stablepush.sim.local_arm import SimulatedArm
+
+    return {
+        "load_task": (sp.load_task, {"path": "path_in"}),
+        "parse_task": (sp.parse_task, {"text": "text", "source": "source"}),
+        "load_plan": (sp.load_plan, {"path": "plan_path"}),
+        "save_plan": (sp.save_plan, {"plan": "plan", "json_path": "path_out", "csv_path": "csv_out"}),
+        "plan_task": (sp.plan_task, {"task": "task", "seed": "seed", "time_limit": "time", "max_switches": "whole0",
+                                     "improve_for": "time", "check_limit": "whole0", "start_pusher": "pusher"}),
+        "check": (sp.check, {"task": "task", "at": "pose", "move": "pose", "pusher": "pusher"}),
+        "check_plan": (sp.check_plan, {"task": "task", "plan": "plan", "source": "label",
+                                       "require_solved": "flag"}),
+        "trajectory": (sp.trajectory, {"task": "task", "plan": "plan", "rate_hz": "rate"}),
+        "joint_path": (sp.joint_path, {"task": "task", "plan": "plan", "rate_hz": "rate", "robot": "robot"}),
+        "plan_figure": (sp.plan_figure, {"task": "task", "plan": "plan", "title": "title"}),
+        "Robot": (sp.Robot, {"model": "model", "flange": "flange", "tcp": "tcp", "base": "base",
+                             "max_joint_speed": "speed"}),
+        "Cell": (sp.Cell, {"home": "home", "retract": "length", "station_spacing": "length", "lane_offset": "length",
+                           "features": "features", "end_on_feature": "bool", "robot": "robot"}),
+        "PlannerSettings": (sp.PlannerSettings, {"time_limit": "time", "seed": "seed", "max_switches": "whole0"}),
+        "PusherSpec": (sp.PusherSpec, {"name": "pusher", "a": "pair", "b": "pair", "mu": "mu", "points": "count"}),
+        "Spreads": (Spreads, {"vary": "vary", "feature_error": "pair", "tracker_noise": "pair"}),
+        "SequentialTest": (SequentialTest, {"target": "prob", "confidence": "confidence"}),
+        "Runner": (Runner, {"workers": "workers", "ray": "bool", "ray_address": "ray_address"}),
+        "Batch": (Batch, {"task": "task", "plan": "plan", "spreads": "spreads", "seed": "seed", "closed_loop": "bool",
+                          "guarded": "bool", "engine": "engine", "tolerance": "pair", "video_fps": "rate",
+                          "video_size": "size"}),
+        "evaluate": (evaluate, {"batch": "batch", "trials": "count", "runner": "runner", "test": "test"}),
+        "design": (design, {"task": "design_task", "candidates": "candidates", "source": "source",
+                            "max_fixtures": "count", "rank": "rank", "reach_top": "whole0", "time_limit": "time",
+                            "runner": "runner", "check_limit": "whole0"}),
+        "evaluate_designs": (evaluate_designs, {"study": "study", "trials": "count", "spreads": "spreads",
+                                                "top": "count", "seed": "seed", "closed_loop": "bool",
+                                                "engine": "engine", "runner": "runner"}),
+        "reach_map": (reach_map, {"task": "task", "x": "axis", "z": "axis", "theta": "axis", "seed": "seed",
+                                  "time_limit": "time", "check_limit": "whole0"}),
+        "SimulatedArm": (SimulatedArm, {"engine": "engine", "deviation": "deviation", "robot": "robot"}),
+        "WorldDeviation": (WorldDeviation, {"mu_scale": "mu", "tracker_noise_mm": "length", "seed": "seed"}),
+        "RunOptions": (RunOptions, {"rate_hz": "rate", "resume_from": "whole0", "pace": "bool",
+                                    "success_tolerance": "pair"}),
+    }
+
+
+# Arguments the table must keep cheap when good: the fixed ones each call gets unless drawn.
+API_FIXED = {"plan_task": {"time_limit": 0.02}, "design": {"time_limit": 0.05, "reach_top": 0},
+             "reach_map": {"time_limit": 0.01, "x": (-1.0, 1.0, 2), "z": (0.0, 0.0, 1), "theta": (0.0, 0.0, 1)},
+             "evaluate": {"trials": 1}, "evaluate_designs": {"trials": 1, "top": 1}, "WorldDeviation": {},
+             "Runner": {"workers": 1}}
+# Good values that the kind's pool would not give for this function.
+API_GOOD = {("Cell", "retract"): [20.0], ("Cell", "lane_offset"): [75.0], ("WorldDeviation", "tracker_noise_mm"): [0.0],
+            ("SimulatedArm", "robot"): [None], ("Runner", "workers"): [1], ("evaluate", "trials"): [1],
+            ("evaluate_designs", "trials"): [1], ("evaluate_designs", "top"): [1], ("design", "reach_top"): [0],
+            ("plan_task", "improve_for"): [None], ("plan_task", "check_limit"): [None, 100000],
+            ("design", "check_limit"): [100000], ("reach_map", "check_limit"): [100000],
+            ("design", "max_fixtures"): [1, 2], ("PusherSpec", "points"): [2], ("Batch", "tolerance"): [None, (0.5, 0.5)]}
+
+
+def _api_context(sp, scratch: Path) -> dict:
+    from stablepush.design import design
+    from stablepush.evaluation import Batch, SequentialTest, Spreads
+    from stablepush.sim.deviation import WorldDeviation
+    from stablepush.task.schema import load_design
+
+    from generated_arms import urdf_arm
+
+    folder = scratch / "in"
+    folder.mkdir(exist_ok=True)
+    task_path = folder / "task.yaml"
+    task_path.write_text(LOW_MU.read_text())
+    task = sp.load_task(task_path)
+    plan = sp.plan_task(task, seed=1)
+    plan_path = folder / "task.plan.json"
+    sp.save_plan(plan, str(plan_path))
+    data = yaml.safe_load(LOW_MU.read_text())
+    data["candidates"] = [p for p in data.pop("pushers") if p["name"] in ("left", "bottom")]
+    design_path = folder / "two.design.yaml"
+    design_path.write_text(yaml.safe_dump(data))
+    design_task, candidates = load_design(design_path)
+    arm = urdf_arm(folder / "arm.urdf", 3, ("z", "y", "y", "z", "y", "z"))
+    fifo = scratch / "fifo"
+    if not fifo.exists():
+        os.mkfifo(fifo)
+    (scratch / "a-folder").mkdir(exist_ok=True)
+    (folder / "binary.bin").write_bytes(bytes(range(256)))
+    spreads = Spreads(vary={"pad_mu": 0.1})
+    study = design(design_task, candidates, source=str(design_path), time_limit=0.05, reach_top=0)
+    return {"task": task, "plan": plan, "task_path": str(task_path), "plan_path": str(plan_path),
+            "task_text": LOW_MU.read_text(), "folder": str(scratch / "a-folder"), "fifo": str(fifo),
+            "missing": str(scratch / "missing.yaml"), "binary": str(folder / "binary.bin"),
+            "out": str(scratch / "out" / "api"), "mesh": str(ROOT / "data" / "tasks" / "meshes"),
+            "model": arm["model"], "robot": sp.Robot(model=arm["model"], flange="tool0", tcp=arm["tcp"]),
+            "spreads": spreads, "study": study, "batch": Batch(task=task, plan=plan, spreads=spreads),
+            "test": SequentialTest(target=0.5), "design_task": design_task, "candidates": candidates,
+            "deviation": WorldDeviation()}
+
+
+class _Work:
+    """Probes on the work a call may start (the planner's search, a batch's trials, a design's or
+    a reach map's jobs): which one started, if any; a batch's trials land without a simulation."""
+
+    def __init__(self):
+        from stablepush import _core, runners
+        from stablepush.design import layouts
+        from stablepush.evaluation import batch
+
+        self.started = None
+        for module, name in ((_core, "plan"), (runners, "run_all"), (layouts, "run_all"), (batch, "run_all")):
+            setattr(module, name, self._probe(f"{module.__name__}.{name}", getattr(module, name)))
+        batch.run_trial = _landed
+
+    def _probe(self, label, original):
+        def probe(*args, **kwargs):
+            self.started = self.started or label
+            return original(*args, **kwargs)
+
+        return probe
+
+
+def run_api_surface(rng: random.Random, count: int, scratch: Path, tally: "Tally") -> None:
+    """`count` calls of the public functions and value types (_api_table), each with one or two
+    arguments drawn: a bad one (what the task file or the CLI refuses) three times in four, the
+    rest good. A call may only return or raise a StablepushError, or a TypeError for a wrong type;
+    a bad argument must be refused, and before any work (_Work) starts."""
+    import stablepush as sp
+    from stablepush.errors import StablepushError
+
+    (scratch / "out").mkdir(exist_ok=True)
+    ctx = _api_context(sp, scratch)
+    work = _Work()
+    table = _api_table(sp, ctx)
+    for case in range(count):
+        name = rng.choice(sorted(table))
+        function, params = table[name]
+        kwargs = dict(API_FIXED.get(name, {}))
+        for param, kind in params.items():
+            if param not in kwargs:
+                good = API_GOOD.get((name, param)) or _pool(kind, ctx)[0]
+                kwargs[param] = rng.choice(good)
+        drawn = {}
+        for param in rng.sample(sorted(params), min(len(params), rng.choice([1, 1, 2]))):
+            good, bad = _pool(params[param], ctx)
+            good = API_GOOD.get((name, param)) or good
+            is_bad = bool(bad) and rng.random() < 0.75
+            value = copy.copy(rng.choice(bad if is_bad else good))
+            kwargs[param], drawn[param] = value, is_bad
+        label = f"api {case} {name}({', '.join(f'{k}={kwargs[k]!r:.60}' for k in drawn)})"
+        work.started = None
+        with tally.case(label):
+            try:
+                function(**kwargs)
+                tally.count("returned")
+                if any(drawn.values()):
+                    tally.fail(label, f"a bad value was taken: {[k for k, b in drawn.items() if b]}")
+            except (StablepushError, TypeError) as exc:
+                tally.count("refused")
+                if any(drawn.values()) and work.started:
+                    tally.fail(label, f"{work.started} started before the refusal: {type(exc).__name__}: "
+                                      f"{str(exc)[:150]}")
+            except Exception as exc:  # noqa: BLE001 - what escapes is the finding
+                tally.count("escaped")
+                tally.fail(label, f"{type(exc).__name__}: {str(exc)[:200]}")
 
 
 def run_api(count: int, seed: int, scratch: Path) -> None:
-    """The Python API misused: sp.plan_task, sp.check, sp.check_plan, sp.trajectory and sp.save_plan with
-    hostile arguments. Each call returns or raises a StablepushError, TypeError or ValueError;
-    anything else (or a crash by signal, which kills this process) is a failure. Prints the summary."""
+    """The Python API misused, 2 x `count` calls: `count` of sp.plan_task, sp.check, sp.check_plan,
+    sp.trajectory and sp.save_plan with hostile arguments, then `count` of every public function
+    and value type with generated wrong types and values (run_api_surface). Each call returns or
+    raises a StablepushError, or a TypeError for a wrong type; anything else (or a crash by
+    signal, which kills this process) is a failure. Prints the summary."""
     import dataclasses
 
     import stablepush as sp
+    from stablepush.errors import StablepushError
 
     rng = random.Random(seed)
     tasks = [sp.load_task(path) for path in TASKS[:5]]
     plans = [sp.plan_task(task, seed=1) for task in tasks]
-    outcomes, failures, slowest = collections.Counter(), [], (0.0, "")
+    tally = Tally(scratch)
 
     def hostile():
         return rng.choice(HOSTILE + [(1, 2), (float("nan"),) * 3, (0, 0, 0), (1e308, 0, 0), "left", -5, 3.5])
@@ -307,20 +550,17 @@ def run_api(count: int, seed: int, scratch: Path) -> None:
         else:
             call = lambda: sp.save_plan(dataclasses.replace(plan, stats=hostile()), str(scratch / "api.plan.json"))  # noqa: E731
         label = f"api {case} {what} on {task.name}"
-        (scratch / "current").write_text(label)
-        started = time.perf_counter()
-        try:
-            call()
-            outcomes["returned"] += 1
-        except BaseException as exc:  # noqa: BLE001 - sorting what escaped is the point
-            kinds = [c.__name__ for c in type(exc).__mro__]
-            if any(kind in API_ERRORS for kind in kinds):
-                outcomes["refused"] += 1
-            else:
-                failures.append({"case": label, "problem": f"{type(exc).__name__}: {str(exc)[:200]}"})
-        slowest = max(slowest, (time.perf_counter() - started, label))
-    print(json.dumps({"cases": count, "exit_statuses": dict(outcomes), "failures": failures[:20],
-                      "failure_count": len(failures), "slowest_s": round(slowest[0], 3), "slowest": slowest[1]}))
+        with tally.case(label):
+            try:
+                call()
+                tally.count("returned")
+            except (StablepushError, TypeError):
+                tally.count("refused")
+            except Exception as exc:  # noqa: BLE001 - what escapes is the finding
+                tally.count("escaped")
+                tally.fail(label, f"{type(exc).__name__}: {str(exc)[:200]}")
+    run_api_surface(rng, count, scratch, tally)
+    print(json.dumps(tally.summary()))
 
 
 # -- shared by the generated kinds: a bound on each case, a tally, the judge of a CLI result -------
@@ -381,11 +621,17 @@ class Tally:
         self.statuses[str(status)] += 1
 
     def fail(self, label: str, problem: str, detail: str = "") -> None:
+        """A failure, kept (the summary shows 20) and appended to SCRATCH/failures.jsonl (all)."""
         self.failures.append({"case": label, "problem": problem, "input": detail[:600]})
+        with open(self.scratch / "failures.jsonl", "a") as out:
+            out.write(json.dumps(self.failures[-1]) + "\n")
 
     def summary(self) -> dict:
+        kinds = collections.Counter(re.sub(r"[0-9]+|'[^']*'|\([^)]*\)", "#", f"{f['case'].split(' ')[2]}: {f['problem']}")[:120]
+                                    for f in self.failures)
         return {"cases": sum(self.statuses.values()), "exit_statuses": dict(self.statuses),
                 "failures": self.failures[:20], "failure_count": len(self.failures),
+                "failure_kinds": dict(kinds.most_common(30)),
                 "slowest_s": round(self.slowest[0], 3), "slowest": self.slowest[1]}
 
 

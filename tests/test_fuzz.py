@@ -53,13 +53,72 @@ def test_generated_meshes_and_plans_that_do_not_fit_their_task_get_one_line(tmp_
 
 
 def test_the_python_api_misused_refuses_with_its_own_errors(tmp_path):
-    """The API surface (issue 24): sp.plan_task, sp.check, sp.check_plan, sp.trajectory and sp.save_plan
-    with hostile arguments, a Task edited past its loader, another task's models. Each call returns
-    or raises a StablepushError, TypeError or ValueError: no AttributeError, ZeroDivisionError or
-    OverflowError from inside (the first run found 55 of 300), and no crash by signal."""
-    worker = subprocess.run([sys.executable, str(FUZZ), "api", "300", "2026", str(tmp_path)], capture_output=True,
-                            text=True, preexec_fn=_cap_memory, timeout=900)
-    assert worker.returncode == 0, f"api worker died ({worker.returncode}): {worker.stderr[-2000:]}"
-    summary = json.loads(worker.stdout.strip().splitlines()[-1])
+    """The API surface (issues 24 and 69): sp.plan_task, sp.check, sp.check_plan, sp.trajectory and
+    sp.save_plan with hostile arguments, a Task edited past its loader, another task's models; then
+    every public function and value type (stablepush.__all__, design, evaluate_designs, evaluate,
+    Batch, Spreads, SequentialTest, Runner, reach_map, SimulatedArm, RunOptions) with generated
+    wrong types and values. Each call returns or raises a StablepushError or a TypeError, a bad
+    value is refused before any work starts, and no crash by signal; the gaps still open are
+    KNOWN_API_GAPS."""
+    import re
+
+    summary = _fuzz("api", 300, tmp_path)
+    failures = [json.loads(line) for line in (tmp_path / "failures.jsonl").read_text().splitlines()] if (
+        tmp_path / "failures.jsonl").exists() else []
+    new = [f for f in failures if not any(re.search(gap, f"{f['case']} {f['problem']}") for gap in KNOWN_API_GAPS)]
+    assert not new, new[:10]
+    assert summary["cases"] == 600 and summary["exit_statuses"].get("refused", 0) > 200
+
+def _fuzz(kind: str, count: int, scratch, timeout: float = 900) -> dict:
+    worker = subprocess.run([sys.executable, str(FUZZ), kind, str(count), "2026", str(scratch)], capture_output=True,
+                            text=True, preexec_fn=_cap_memory, timeout=timeout)
+    current = (scratch / "current").read_text()[:2000] if (scratch / "current").exists() else ""
+    assert worker.returncode == 0, f"{kind} worker died ({worker.returncode}) on:\n{current}\n{worker.stderr[-2000:]}"
+    return json.loads(worker.stdout.strip().splitlines()[-1])
+
+
+def test_generated_options_of_every_command_never_end_in_an_internal_error(tmp_path):
+    """Issue 69: every command `stablepush --help` lists (plan, check, show, cone, bench, design,
+    check-cell, sim-arm, reach, trajectory, execute, evaluate), its options generated from its
+    click parameters (legal, edge and hostile values; folders, FIFOs, /dev/null, missing files and
+    inputs as outputs), a quarter of evaluate's and execute's runs simulated; sim-arm in a child
+    process. Exit 0-3 (5: execute's miss), no traceback, one `error:` line, no input written over."""
+    from stablepush_cli.main import cli
+
+    summary = _fuzz("options", 5, tmp_path)
     assert summary["failure_count"] == 0, summary["failures"]
-    assert summary["cases"] == 300 and summary["exit_statuses"].get("refused", 0) > 100
+    statuses = summary["exit_statuses"]
+    assert {key.split(":")[0] for key in statuses if ":" in key} == set(cli.commands)
+    assert "4" not in statuses and "hang" not in statuses and statuses.get("0", 0) > 0
+    assert summary["slowest_s"] < 60, summary
+
+
+def test_generated_robot_models_get_exit_0_1_or_2_with_one_line(tmp_path):
+    """Issue 69: generated URDF and MJCF arms, mutated (encodings, names the project uses,
+    couplings, includes of a FIFO or a loop, mesh paths, limits, truncation, joint types), given
+    to check-cell and arm_model: exit 0, 1 or 2 in one line (or a StablepushError), no hang, the
+    model never written over."""
+    summary = _fuzz("robots", 40, tmp_path)
+    assert summary["failure_count"] == 0, summary["failures"]
+    assert summary["cases"] == 40 and set(summary["exit_statuses"]) <= {"0", "1", "2", "returned", "refused"}
+    assert summary["exit_statuses"].get("2", 0) > 0 and summary["exit_statuses"].get("0", 0) > 0
+
+
+# The API's open gaps (issue 69, "The API fuzz"): a plain ValueError or an AttributeError where a
+# StablepushError or a TypeError is the rule, and value types that take what the task file refuses.
+# Each is in a module other work has open; listed so that the fuzz fails on any new class.
+KNOWN_API_GAPS = [
+    r"^api \d+ trajectory[ (].*ValueError: rate_hz must be",
+    r"^api \d+ joint_path\(.*(ValueError: rate_hz must be|AttributeError)",
+    r"^api \d+ save_plan .*ValueError: dictionary update sequence",
+    r"^api \d+ design\(.*ValueError: dictionary update sequence",
+    r"^api \d+ plan-models .*ValueError: models\[",
+    r"^api \d+ plan-edited .*ValueError: \w+ must be",
+    r"^api \d+ (Batch|SimulatedArm)\(.*ValueError: engine must be one of",
+    r"^api \d+ Batch\(.*ValueError: success tolerance must be",
+    r"^api \d+ Runner\(.*ValueError: (expected HOST:PORT|workers must be)",
+    r"^api \d+ Spreads\(.*ValueError: vary:",
+    r"^api \d+ (Batch|Runner|SimulatedArm|evaluate|evaluate_designs|joint_path)\(.*AttributeError",
+    r"^api \d+ (Batch|PlannerSettings|PusherSpec|RunOptions|Runner|SimulatedArm|Spreads|WorldDeviation)\(.*"
+    r"a bad value was taken",
+]
