@@ -12,24 +12,33 @@ from stablepush.execution.tcp_arm import ACK_TIMEOUT_RANGE, DEFAULT_ACK_TIMEOUT
 from stablepush.execution.verdict import CAUSES
 from stablepush.sim import VIDEO_VIEWS
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
-from stablepush.task import with_robot
 from stablepush_cli.common import (
     EXIT_ARM_FAULT,
     EXIT_MISSED,
     check_named_outputs,
     fail,
     given,
-    load_plan_and_task,
     progressbar,
     say_beside,
+)
+from stablepush_cli.groups import (
+    ArmChoice,
+    LoopChoice,
+    PlanFiles,
+    RobotChoice,
+    SimWorld,
+    StreamChoice,
+    VideoRequest,
+    option_group,
+    plan_and_task,
+    robot_choice,
+    video_request,
 )
 from stablepush_cli.options import (
     Finite,
     Whole,
     parse_host_port,
-    robot_options,
     stamp_option,
-    video_options,
     video_output,
     video_settings_need,
 )
@@ -45,31 +54,35 @@ def _help_with(**values):
 
 
 @click.command()
-@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
-@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
-              help="The task the plan was made for (checked against the plan before anything moves).")
-@click.option("--arm", "arm", default=None, metavar="HOST:PORT", callback=parse_host_port,
-              help=f"The arm server (stablepush.arm/2 protocol, see docs/execution.md). Default: with --sim a "
-                   f"simulated arm started in this process, else 127.0.0.1:{DEFAULT_PORT}.")
-@click.option("--sim", is_flag=True, help="Start a simulated arm here and run the plan on it (see --engine).")
-@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
-              help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with stablepush's own "
-                   "Coulomb friction; drake: Drake's contact solver alone decides stick and slip.")
-@click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
-              metavar="HZ", help="Waypoints per second of motion. Each push takes the fewest whole periods that "
-                                 "last the task's dynamics.step_time (slower than the model when HZ does not divide "
-                                 "it); the last push of each contact eases to rest, up to 4/3 of the planned "
-                                 "speed on the way (docs/execution.md).")
-@click.option("--resume-from", "resume_from", default=0, type=Whole(min=0), metavar="STEP",
-              help="Continue after plan step STEP (the last confirmed step a fault reported). A `stablepush sim-arm` "
-                   "server then keeps the world it has; --sim starts a fresh one, the object where step STEP "
-                   "leaves it.")
-@click.option("--pace/--no-pace", default=None,
-              help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off with --sim).")
-@click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True, type=Finite(*ACK_TIMEOUT_RANGE),
-              metavar="S",
-              help="Give up when the arm server does not reply within S seconds (not with --sim: the simulated "
-                   "arm runs in this process, and a waypoint takes as long as it takes).")
+@plan_and_task("The task the plan was made for (checked against the plan before anything moves).")
+@option_group("connection", ArmChoice,
+              click.option("--arm", "arm", default=None, metavar="HOST:PORT", callback=parse_host_port,
+                           help=f"The arm server (stablepush.arm/2 protocol, see docs/execution.md). Default: with "
+                                f"--sim a simulated arm started in this process, else 127.0.0.1:{DEFAULT_PORT}."),
+              click.option("--sim", is_flag=True,
+                           help="Start a simulated arm here and run the plan on it (see --engine)."),
+              click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+                           help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with "
+                                "stablepush's own Coulomb friction; drake: Drake's contact solver alone decides "
+                                "stick and slip."),
+              click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True,
+                           type=Finite(*ACK_TIMEOUT_RANGE), metavar="S",
+                           help="Give up when the arm server does not reply within S seconds (not with --sim: the "
+                                "simulated arm runs in this process, and a waypoint takes as long as it takes)."))
+@option_group("stream", StreamChoice,
+              click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
+                           metavar="HZ", help="Waypoints per second of motion. Each push takes the fewest whole "
+                                              "periods that last the task's dynamics.step_time (slower than the "
+                                              "model when HZ does not divide it); the last push of each contact "
+                                              "eases to rest, up to 4/3 of the planned speed on the way "
+                                              "(docs/execution.md)."),
+              click.option("--resume-from", "resume_from", default=0, type=Whole(min=0), metavar="STEP",
+                           help="Continue after plan step STEP (the last confirmed step a fault reported). A "
+                                "`stablepush sim-arm` server then keeps the world it has; --sim starts a fresh one, "
+                                "the object where step STEP leaves it."),
+              click.option("--pace/--no-pace", default=None,
+                           help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off "
+                                "with --sim)."))
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the run's report as JSON: success, tolerance, cause of a miss, engine, final pose in the "
                    "grasp, slip per contact, corrections, features (on an arm fault: the verdict and where to resume).")
@@ -83,51 +96,58 @@ def _help_with(**values):
                    "and the verdict; with the arm's model (--sim, --robot or environment.robot) its /joint_states "
                    "and, for a URDF, /robot_description (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
 @stamp_option("--record", "when the run starts")
-@click.option("--video", "video_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mp4",
-              help="Draw the run as a video (H.264 MP4, headless): seen along the gripping axis as the plan figures "
-                   "are, the object, the pads, the features (the pusher in contact highlighted) and the plan's pose "
-                   "at each step as a green ghost (docs/execution.md, 'Video of a run'); needs the object's pose, "
-                   "which a simulated arm reports; drawn on a fault too.")
-@video_options("--video")
-@click.option("--video-view", "video_view", type=click.Choice(VIDEO_VIEWS), default="schematic", show_default=True,
-              help="With --video: schematic, along the gripping axis as the plan figures are; 3d, the whole cell in "
-                   "perspective, the arm posed from the joints it reported (its model: --sim, --robot or the task's "
-                   "environment.robot), the part in its jaws and the features; both, the two side by side, the "
-                   "video twice as wide.")
+@video_request(
+    "--video",
+    click.option("--video", "video_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mp4",
+                 help="Draw the run as a video (H.264 MP4, headless): seen along the gripping axis as the plan "
+                      "figures are, the object, the pads, the features (the pusher in contact highlighted) and the "
+                      "plan's pose at each step as a green ghost (docs/execution.md, 'Video of a run'); needs the "
+                      "object's pose, which a simulated arm reports; drawn on a fault too."),
+    click.option("--video-view", "video_view", type=click.Choice(VIDEO_VIEWS), default="schematic",
+                 show_default=True,
+                 help="With --video: schematic, along the gripping axis as the plan figures are; 3d, the whole cell "
+                      "in perspective, the arm posed from the joints it reported (its model: --sim, --robot or the "
+                      "task's environment.robot), the part in its jaws and the features; both, the two side by "
+                      "side, the video twice as wide."))
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @click.option("-v", "--verbose", is_flag=True,
               help="A line per correction of the closed loop and per contact (slip, carry, where the guard found "
                    "its feature); without, one line sums each up.")
-@click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=Finite(min=0.1, max=10),
-              metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
-                                "the plan against a world whose friction differs from its model.")
-@click.option("--tracker-noise", "tracker_noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0),
-              metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise on the "
-                                     "object's pose in the grasp (x and z in mm, theta in deg).")
-@click.option("--closed-loop", "closed_loop", is_flag=True,
-              help="As the object comes onto each feature and after each push compare the arm's tracked "
-                   "pose in the grasp with the plan's; past --replan-threshold (on the last contact's "
-                   "feature, --final-tolerance) re-plan from the measured pose and continue with the new plan. "
-                   "An arm that reports no tracked pose runs open loop (and says so).")
-@click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
-              help="End each approach slowly and find the feature by touch (the arm's contact force, else its "
-                   "tracked pose in the grasp), then push from where it was found: a feature off its place is "
-                   "found, not pushed into or missed. After a contact's first push, a feature the object rests "
-                   "on turned (past 0.15 deg) is taken as turned for the contact's other pushes. An arm that "
-                   "reports no tracked pose approaches as planned (and says so).")
-@click.option("--replan-threshold", nargs=2, type=Finite(min=0, min_open=True), default=None,
-              metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a re-plan "
-                                     "(default: half the task's goal tolerance).")
-@click.option("--final-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None,
-              metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object is "
-                                     "this close to the goal, and re-plan on the last contact's feature past it "
-                                     "(default: a fifth of the task's goal tolerance).")
-@robot_options
+@option_group("world", SimWorld,
+              click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True,
+                           type=Finite(min=0.1, max=10), metavar="S",
+                           help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
+                                "the plan against a world whose friction differs from its model."),
+              click.option("--tracker-noise", "tracker_noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0),
+                           metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise "
+                                                  "on the object's pose in the grasp (x and z in mm, theta in deg)."))
+@option_group("loop", LoopChoice,
+              click.option("--closed-loop", "closed_loop", is_flag=True,
+                           help="As the object comes onto each feature and after each push compare the arm's "
+                                "tracked pose in the grasp with the plan's; past --replan-threshold (on the last "
+                                "contact's feature, --final-tolerance) re-plan from the measured pose and continue "
+                                "with the new plan. An arm that reports no tracked pose runs open loop (and says "
+                                "so)."),
+              click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
+                           help="End each approach slowly and find the feature by touch (the arm's contact force, "
+                                "else its tracked pose in the grasp), then push from where it was found: a feature "
+                                "off its place is found, not pushed into or missed. After a contact's first push, a "
+                                "feature the object rests on turned (past 0.15 deg) is taken as turned for the "
+                                "contact's other pushes. An arm that reports no tracked pose approaches as planned "
+                                "(and says so)."),
+              click.option("--replan-threshold", nargs=2, type=Finite(min=0, min_open=True), default=None,
+                           metavar="MM DEG", help="With --closed-loop: deviation from the plan that triggers a "
+                                                  "re-plan (default: half the task's goal tolerance)."),
+              click.option("--final-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None,
+                           metavar="MM DEG", help="With --closed-loop: after the last push, correct until the object "
+                                                  "is this close to the goal, and re-plan on the last contact's "
+                                                  "feature past it (default: a fifth of the task's goal "
+                                                  "tolerance)."))
+@robot_choice
 @_help_with(causes=", ".join(CAUSES))
-def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz: float, resume_from: int, pace,
-            ack_timeout: float, json_path, success_tolerance, record_path, stamp_ns, video_path, video_fps: float,
-            video_size, video_view: str, quiet: bool, verbose: bool, mu_scale: float, tracker_noise, closed_loop: bool,
-            guarded: bool, replan_threshold, final_tolerance, robot_model, flange, tcp, base) -> None:
+def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, json_path, success_tolerance, record_path,
+            stamp_ns, video: VideoRequest, quiet: bool, verbose: bool, world: SimWorld, loop: LoopChoice,
+            robot: RobotChoice) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -158,7 +178,7 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
       stablepush sim-arm --port 47100 &     # or your robot's bridge
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
     """
-    from stablepush.execution import ClosedLoop, GuardedApproach, RunOptions, execution_warnings
+    from stablepush.execution import GuardedApproach, RunOptions, execution_warnings
     from stablepush.execution.run import BagRecording, JsonReport, recording_for, run_plan
     from stablepush.execution.stream import check_resume_from
     from stablepush.outputs import require_suffix
@@ -166,56 +186,54 @@ def execute(plan_file: str, task_file: str, arm, sim: bool, engine: str, rate_hz
     require_suffix("--record", record_path, (".mcap",))
     if stamp_ns is not None and not record_path:
         fail("--stamp: only with --record (it is the recording's start time)")
-    check_named_outputs({"--json": json_path, "--record": record_path, "--video": video_path},
-                  {"PLAN.json": plan_file, "--task": task_file})
-    task, plan = load_plan_and_task(plan_file, task_file)
-    task = with_robot(task, robot_model, flange, tcp, base)
+    check_named_outputs({"--json": json_path, "--record": record_path, "--video": video.path}, files.inputs())
+    task, plan = files.load()
+    task = robot.on(task)
     for warning in execution_warnings(task):
         click.echo(f"warning: {warning}", err=True)
-    check_resume_from(plan.waypoints, resume_from, field="--resume-from")
-    _only_with("--closed-loop", closed_loop, ("--replan-threshold", replan_threshold),
-               ("--final-tolerance", final_tolerance))
-    if sim and arm is not None:
+    check_resume_from(plan.waypoints, stream.resume_from, field="--resume-from")
+    _only_with("--closed-loop", loop.closed_loop, ("--replan-threshold", loop.replan_threshold),
+               ("--final-tolerance", loop.final_tolerance))
+    if connection.sim and connection.arm is not None:
         fail("--sim and --arm: choose one (a simulated arm started here, or the arm server at HOST:PORT)")
-    _only_with("--sim (a simulated arm started here)", sim, ("--engine", engine != DEFAULT_ENGINE),
-               ("--sim-mu-scale", mu_scale != 1.0), ("--tracker-noise", any(tracker_noise)))
-    _only_with("an arm server (--arm, or no --sim)", not sim, ("--ack-timeout", given("ack_timeout")))
+    _only_with("--sim (a simulated arm started here)", connection.sim,
+               ("--engine", connection.engine != DEFAULT_ENGINE), ("--sim-mu-scale", world.mu_scale != 1.0),
+               ("--tracker-noise", any(world.tracker_noise)))
+    _only_with("an arm server (--arm, or no --sim)", not connection.sim, ("--ack-timeout", given("ack_timeout")))
     # The video is made first: the renderer needs MUJOCO_GL=osmesa before the simulated arm loads MuJoCo.
-    video = [video_output("--video", video_path, video_fps, video_size, quiet, video_view)] if video_path else []
-    if not video_path:
+    videos = ([video_output("--video", video.path, video.fps, video.size, quiet, video.view)] if video.path
+              else [])
+    if not video.path:
         video_settings_need("--video")
     named = ([("--json", JsonReport(json_path))] if json_path else []) + (
-        [("--record", BagRecording(record_path, stamp_ns))] if record_path else []) + [("--video", v) for v in video]
+        [("--record", BagRecording(record_path, stamp_ns))] if record_path else []) + [("--video", v) for v in videos]
     outputs = [output for _, output in named]
     try:
-        guard = GuardedApproach.for_tracker_noise(*tracker_noise) if guarded else None
+        guard = GuardedApproach.for_tracker_noise(*world.tracker_noise) if loop.guarded else None
     except SettingError as exc:  # a noise the guard cannot tell a touch from
         fail(f"--tracker-noise: {exc.reason}")
-    options = RunOptions(rate_hz=rate_hz, resume_from=resume_from, pace=pace,
-                         closed_loop=ClosedLoop.for_task(task, replan_threshold, final_tolerance) if closed_loop
-                         else None,
-                         guard=guard, success_tolerance=success_tolerance)
-    target = _arm_for(arm, sim, engine, mu_scale, tracker_noise, ack_timeout, quiet, task.environment.robot)
-    with _run_progress(task, plan, resume_from, quiet) as progress:
+    options = RunOptions(rate_hz=stream.rate_hz, resume_from=stream.resume_from, pace=stream.pace,
+                         closed_loop=loop.loop_for(task), guard=guard, success_tolerance=success_tolerance)
+    target = _arm_for(connection, world, quiet, task.environment.robot)
+    with _run_progress(task, plan, stream.resume_from, quiet) as progress:
         run = run_plan(task, plan, target, options, progress=progress,
                        recording=recording_for(task, plan, options, outputs))
     try:  # after the run's bar has ended: the video draws its own
         run.write(outputs)
     finally:
-        for output in video:
+        for output in videos:
             if output.progress is not None:
                 output.progress.close()
-    say = say_beside(json_path, record_path, video_path)
+    say = say_beside(json_path, record_path, video.path)
     lines = run.written if run.fault is not None else run.report.describe(verbose) + run.written
     for line in lines:
         say(line)
     for output, error in run.failed:  # as each would have been refused before the run, named by its option
         fail(f"{next(name for name, o in named if o is output)} {error}")
     if run.fault is not None:
-        _report_fault(run.fault, plan_file, len(plan.waypoints) - 1, sim)
+        _report_fault(run.fault, files.plan_file, len(plan.waypoints) - 1, connection.sim)
     if run.report.success is False:
         sys.exit(EXIT_MISSED)
-
 
 
 def _only_with(option: str, given: bool, *others) -> None:
@@ -225,23 +243,19 @@ def _only_with(option: str, given: bool, *others) -> None:
         fail(f"{' and '.join(named)}: only with {option}")
 
 
-def _arm_for(arm, sim: bool, engine: str, mu_scale: float, tracker_noise, ack_timeout: float, quiet: bool, robot):
+def _arm_for(connection: ArmChoice, world: SimWorld, quiet: bool, robot):
     """The arm a run goes to: a simulated `robot` in this process (--sim), else the arm server at
     --arm (or the default port here), checked against `robot` when one is named."""
-    if sim and arm is None:
-        from stablepush.sim.deviation import WorldDeviation
+    if connection.sim and connection.arm is None:
         from stablepush.sim.local_arm import SimulatedArm
 
-        deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0],
-                                   tracker_noise_deg=tracker_noise[1])
-        return SimulatedArm(engine, deviation, log=None if quiet else lambda text: click.echo(f"sim-arm: {text}",
-                                                                                             err=True), robot=robot)
+        log = None if quiet else lambda text: click.echo(f"sim-arm: {text}", err=True)
+        return SimulatedArm(connection.engine, world.deviation(), log=log, robot=robot)
     from stablepush.execution import TcpArm
-
-    host, port = arm or ("127.0.0.1", DEFAULT_PORT)
     from stablepush.sim.joint_path import modelled
 
-    return modelled(TcpArm(host, port, ack_timeout), robot)
+    host, port = connection.arm or ("127.0.0.1", DEFAULT_PORT)
+    return modelled(TcpArm(host, port, connection.ack_timeout), robot)
 
 
 @contextlib.contextmanager

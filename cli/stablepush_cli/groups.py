@@ -1,0 +1,153 @@
+"""Options that reach a command as one value: the plan and its task, the arm a run moves, the
+world a simulated run departs into, the closed loop, a video. Each group is declared once here and
+taken by every command that has it, so a command's function takes a few values, not every option.
+
+`option_group(target, build, *decorators)` adds the options of `decorators` to a command and hands
+it `target` = build(**their values). The options keep their names in click's context (`ctx.params`),
+where `--help`, `given()` and a resume command read them.
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Any, Callable, Dict, Optional, Tuple
+
+import click
+
+from stablepush_cli.options import robot_options as _robot_options
+
+
+def option_group(target: str, build: Callable[..., Any], *decorators: Callable) -> Callable:
+    """A decorator: the options `decorators` add, handed to the command as `target` = build(**values)."""
+    probe = click.command()(functools.reduce(lambda f, d: d(f), reversed(decorators), lambda **_: None))
+    names = [param.name for param in probe.params]
+
+    def decorate(command: Callable) -> Callable:
+        @functools.wraps(command)
+        def grouped(*args, **kwargs):
+            kwargs[target] = build(**{name: kwargs.pop(name) for name in names})
+            return command(*args, **kwargs)
+
+        for decorator in reversed(decorators):
+            grouped = decorator(grouped)
+        return grouped
+
+    return decorate
+
+
+@dataclass(frozen=True)
+class PlanFiles:
+    """PLAN.json and --task: a plan and the task it was made for, as paths until `load`."""
+
+    plan_file: str
+    task_file: str
+
+    def inputs(self) -> Dict[str, str]:
+        """The files as check_named_outputs names its inputs."""
+        return {"PLAN.json": self.plan_file, "--task": self.task_file}
+
+    def load(self, require_solved: bool = True):
+        """(task, plan), once the plan is shown to belong to the task (exit 2 if not)."""
+        from stablepush_cli.common import load_plan_and_task
+
+        return load_plan_and_task(self.plan_file, self.task_file, require_solved)
+
+
+def plan_and_task(task_help: str = "The task the plan was made for (checked against the plan).") -> Callable:
+    """PLAN.json and --task TASK.yaml, as `files` (PlanFiles)."""
+    return option_group(
+        "files", PlanFiles,
+        click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False)),
+        click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
+                     help=task_help))
+
+
+@dataclass(frozen=True)
+class RobotChoice:
+    """--robot, --flange, --tcp, --base: the arm over the task's environment.robot (None: the task's)."""
+
+    robot_model: Optional[str] = None
+    flange: Optional[str] = None
+    tcp: Optional[Tuple[float, ...]] = None
+    base: Optional[Tuple[float, ...]] = None
+
+    def on(self, task):
+        """`task` on this arm (stablepush.task.with_robot checks the fields)."""
+        from stablepush.task import with_robot
+
+        return with_robot(task, self.robot_model, self.flange, self.tcp, self.base)
+
+
+robot_choice = option_group("robot", RobotChoice, _robot_options)
+
+
+@dataclass(frozen=True)
+class ArmChoice:
+    """--arm, --sim, --engine, --ack-timeout: where a run goes, a simulated arm started here or an
+    arm server at HOST:PORT."""
+
+    arm: Optional[Tuple[str, int]]
+    sim: bool
+    engine: str
+    ack_timeout: float
+
+
+@dataclass(frozen=True)
+class SimWorld:
+    """--sim-mu-scale, --tracker-noise: how a simulated world departs from the task."""
+
+    mu_scale: float
+    tracker_noise: Tuple[float, float]
+
+    def deviation(self):
+        from stablepush.sim.deviation import WorldDeviation
+
+        return WorldDeviation(mu_scale=self.mu_scale, tracker_noise_mm=self.tracker_noise[0],
+                              tracker_noise_deg=self.tracker_noise[1])
+
+
+@dataclass(frozen=True)
+class LoopChoice:
+    """--closed-loop, --guard, --replan-threshold, --final-tolerance: how a run corrects itself."""
+
+    closed_loop: bool
+    guarded: bool
+    replan_threshold: Optional[Tuple[float, float]]
+    final_tolerance: Optional[Tuple[float, float]]
+
+    def loop_for(self, task):
+        """The task's ClosedLoop with these thresholds, or None open loop."""
+        from stablepush.execution import ClosedLoop
+
+        return ClosedLoop.for_task(task, self.replan_threshold, self.final_tolerance) if self.closed_loop else None
+
+
+@dataclass(frozen=True)
+class StreamChoice:
+    """--rate, --resume-from, --pace: how the waypoints go out."""
+
+    rate_hz: float
+    resume_from: int
+    pace: Optional[bool]
+
+
+@dataclass(frozen=True)
+class VideoRequest:
+    """--video and its settings (fps, WxH, view); `path` None: no video."""
+
+    path: Optional[str]
+    fps: float
+    size: Tuple[int, int]
+    view: str = "schematic"
+
+
+def video_request(option: str, path_option: Callable, view_option: Optional[Callable] = None) -> Callable:
+    """`option` (a path, declared by `path_option`), its --video-fps and --video-size, and, when
+    given, its view (`view_option`), as `video` (VideoRequest)."""
+    from stablepush_cli.options import video_options
+
+    def build(video_path, video_fps, video_size, video_view="schematic"):
+        return VideoRequest(video_path, video_fps, video_size, video_view)
+
+    decorators = [path_option, video_options(option)] + ([view_option] if view_option else [])
+    return option_group("video", build, *decorators)
