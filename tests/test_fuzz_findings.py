@@ -68,3 +68,14 @@ def test_a_joint_whose_range_lies_past_a_half_turn_is_drawn_within_it(tmp_path):
     for guess in model.home_guesses:
         assert 4 <= guess[1] <= 5 and -5 <= guess[0] <= -4, guess
     assert len({tuple(np.round(g, 6)) for g in model.home_guesses}) > 2
+
+
+def test_show_of_a_plan_path_that_names_no_file_is_refused_in_one_line(tmp_path):
+    """`show '' --task T --gif x.png` exited 4 (ValueError: PosixPath('.') has an empty name) making
+    the default PNG's name beside the plan file."""
+    from conftest import TASKS
+
+    result = CliRunner().invoke(cli, ["show", "", "--task", str(TASKS / "t-shaped.yaml"), "--gif",
+                                      str(tmp_path / "x.gif")])
+    assert result.exit_code == 2, result.output
+    assert result.stderr.startswith("error: ") and len(result.stderr.splitlines()) == 1, result.stderr

@@ -164,8 +164,11 @@ def load_plan_and_task(plan_file: str, task_file: str, require_solved: bool = Tr
 
 
 def beside(path: str, endings, suffix: str) -> str:
-    """`path` with each of `endings` it ends in taken off, in turn, and `suffix` put on."""
+    """`path` with each of `endings` it ends in taken off, in turn, and `suffix` put on. A path
+    that names no file (empty, `.`, `/`) has nothing to put an output beside: exit 2."""
     name = Path(path).name
+    if not name:
+        fail(f"{path!r:.80} names no file (an output is named after it)")
     for ending in endings:
         if name.lower().endswith(ending) and len(name) > len(ending):
             name = name[: -len(ending)]
