@@ -1117,8 +1117,14 @@ def _mutate_meshes(urdf, text, folder, rng, flange, links, joints):
     import trimesh
 
     how = rng.choice(["relative meshdir", "missing", "a FIFO", "a folder", "garbage", "absolute", "no meshdir"])
+    import shutil
+
     (folder / "meshes").mkdir(exist_ok=True)
     mesh = folder / "meshes" / "part.stl"
+    if mesh.is_dir():  # a second mutation of the same model
+        shutil.rmtree(mesh)
+    elif mesh.exists() or mesh.is_symlink():
+        mesh.unlink()
     if how == "a FIFO":
         os.mkfifo(mesh)
     elif how == "a folder":
