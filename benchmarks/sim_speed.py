@@ -60,7 +60,7 @@ def main() -> None:
             setattr(arm.model.opt, name, type(getattr(arm.model.opt, name))(value))
         timed = {k: _timer(arm.data, k) for k in ("STEP", "CONSTRAINT")}
         load = []
-        points = arm_trajectory(task, steps, features, args.rate, scene["gripper_pose"])[:args.waypoints]
+        points = arm_trajectory(task, steps, features, args.rate, scene.gripper_pose)[:args.waypoints]
         period = 1.0 / args.rate
         friction = arm.pad_friction
         steps_before = round(float(arm.data.time) / arm.timestep)

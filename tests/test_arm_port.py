@@ -36,7 +36,7 @@ class ScriptedArm(Arm):
 
     def hello(self, scene, rate_hz, resume):
         self.connected = True
-        self.pose = list(scene["gripper_pose"])
+        self.pose = list(scene.gripper_pose)
         return ArmReady(state={"ee_pose": self.pose, "joints": []}, arm="scripted")
 
     def move(self, waypoint):

@@ -103,19 +103,20 @@ def test_a_world_deviation_changes_the_scene_as_asked():
     deviation = WorldDeviation(mu_scale=1.1, pad_mu_scale=0.9, pusher_mu_scale=1.2, grip_scale=0.8, mass_scale=1.05,
                                feature_offsets=(("left", 1.0, 2.0, 90.0),))
     world = deviation.apply(scene)
-    assert world["gripper"]["mu"] == pytest.approx(scene["gripper"]["mu"] * 1.1 * 0.9)
-    assert world["gripper"]["grip_force"] == pytest.approx(scene["gripper"]["grip_force"] * 0.8)
-    assert world["object"]["mass"] == pytest.approx(scene["object"]["mass"] * 1.05)
-    assert world["object"]["inertia"] == pytest.approx(scene["object"]["inertia"] * 1.05)
-    (before,), (after,) = scene["features"], world["features"]
-    assert after["mu"] == pytest.approx(before["mu"] * 1.1 * 1.2)
-    mid = [(a + b) / 2 for a, b in zip(before["from"], before["to"])]
-    rel = [a - m for a, m in zip(before["from"], mid)]
+    assert world.gripper.mu == pytest.approx(scene.gripper.mu * 1.1 * 0.9)
+    assert world.gripper.grip_force == pytest.approx(scene.gripper.grip_force * 0.8)
+    assert world.object.mass == pytest.approx(scene.object.mass * 1.05)
+    assert world.object.inertia == pytest.approx(scene.object.inertia * 1.05)
+    (before,), (after,) = scene.features, world.features
+    assert after.mu == pytest.approx(before.mu * 1.1 * 1.2)
+    mid = [(a + b) / 2 for a, b in zip(before.start, before.end)]
+    rel = [a - m for a, m in zip(before.start, mid)]
     # rot_y(90 deg): x' = z, z' = -x
     expected = [mid[0] + rel[2] + 1e-3, mid[1] + rel[1], mid[2] - rel[0] + 2e-3]
-    assert after["from"] == pytest.approx(expected, abs=1e-12)
-    assert after["normal"] == pytest.approx([before["normal"][2], before["normal"][1], -before["normal"][0]], abs=1e-12)
-    assert scene["features"][0] is before and before["mu"] == task.pushers[0].mu  # the scene itself unchanged
+    assert after.start == pytest.approx(expected, abs=1e-12)
+    assert after.normal == pytest.approx([before.normal[2], before.normal[1], -before.normal[0]], abs=1e-12)
+    assert scene.features[0] is before and before.mu == task.pushers[0].mu  # the scene itself unchanged
+    assert world.object_pose == scene.object_pose and world.gripper.pads == scene.gripper.pads  # the rest kept
 
 
 def test_a_study_is_judged_by_the_tasks_tolerance_as_a_run_is_unless_told():

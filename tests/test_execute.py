@@ -340,7 +340,7 @@ def test_the_sim_arm_refuses_malformed_and_out_of_order_waypoints_and_stops():
     plan = check_plan(task, plan_task(task, seed=1))
     from stablepush.execution.world import place_features, scene_description
 
-    scene = scene_description(task, place_features(task, plan.waypoints), task.start)
+    scene = scene_description(task, place_features(task, plan.waypoints), task.start).as_dict()
     with running_sim_arm(log=lambda text: None) as server:
         for bad, says in ((b"{not json\n", "not a JSON line"),
                           (encode({"type": "waypoint", "seq": 5, "t": 0.0, "step": 0, "phase": "push",
@@ -503,7 +503,7 @@ def test_protocol_versions_arm_2_and_arm_1_are_both_served_and_others_refused():
     plan = check_plan(task, plan_task(task, seed=1))
     from stablepush.execution.world import place_features, scene_description
 
-    scene = scene_description(task, place_features(task, plan.waypoints), task.start)
+    scene = scene_description(task, place_features(task, plan.waypoints), task.start).as_dict()
     with running_sim_arm(log=lambda text: None) as server:
         for version in ("stablepush.arm/1", PROTOCOL):
             with socket.create_connection((server.host, server.port), timeout=30) as conn:

@@ -17,6 +17,7 @@ from stablepush.execution import RunOptions
 from stablepush.execution.part_geometry import part_pieces
 from stablepush.execution.protocol import ProtocolError, check_scene
 from stablepush.execution.run import run_plan
+from stablepush.execution.scene import Scene
 from stablepush.execution.world import place_features, scene_description
 from stablepush.extras import MissingExtra
 from stablepush.plan import Waypoint, check_plan, plan_task
@@ -58,7 +59,7 @@ def _mesh_vertices(root, name):
 def test_the_scene_of_a_mesh_task_carries_its_convex_pieces():
     task = load_task(BRACKET)
     scene = _scene(task)
-    obj = json.loads(json.dumps(scene))["object"]  # as sent over the wire
+    obj = json.loads(json.dumps(scene.as_dict()))["object"]  # as sent over the wire
     assert obj["geometry"].startswith("l-bracket.stl: CoACD, 2 convex pieces")
     pieces = [np.array(p) for p in obj["mesh"]["pieces"]]
     assert len(pieces) == 2
@@ -71,12 +72,14 @@ def test_the_scene_of_a_mesh_task_carries_its_convex_pieces():
     inertia = np.array(obj["mesh"]["inertia"])
     assert inertia[1, 1] == pytest.approx(obj["inertia"], rel=1e-9) and np.allclose(inertia, inertia.T)
     assert obj["mesh"]["com_y"] == pytest.approx(0.0, abs=1e-9)
-    check_scene(scene)
+    check_scene(scene.as_dict())
+    assert Scene.from_dict(json.loads(json.dumps(scene.as_dict()))) == scene  # read back as sent
 
 
 def test_a_box_or_polygon_part_is_the_prism_of_its_section():
-    obj = _scene(shipped("t-shaped"))["object"]
-    assert "mesh" not in obj and obj["geometry"] == "prism of the section, 25 mm thick"
+    obj = _scene(shipped("t-shaped")).object
+    assert obj.mesh is None and obj.geometry == "prism of the section, 25 mm thick"
+    assert "mesh" not in obj.as_dict()
 
 
 def test_a_convex_mesh_part_is_its_own_hull_without_coacd(tmp_path, monkeypatch):
@@ -120,8 +123,8 @@ def test_the_mjcf_of_a_mesh_task_holds_its_pieces_as_mesh_geoms(tmp_path):
     root = ET.fromstring(build_mjcf(scene))
     body = root.find(".//body[@name='object']")
     geoms = [g for g in body.findall("geom") if not g.get("name").startswith("slab_")]
-    assert [g.get("type") for g in geoms] == ["mesh"] * len(scene["object"]["mesh"]["pieces"])
-    for geom, piece in zip(geoms, scene["object"]["mesh"]["pieces"]):
+    assert [g.get("type") for g in geoms] == ["mesh"] * len(scene.object.mesh.pieces)
+    for geom, piece in zip(geoms, scene.object.mesh.pieces):
         assert np.allclose(_mesh_vertices(root, geom.get("mesh")), piece)
     # The solid, not the 36 mm slab: its shaft is 20 mm across.
     ys = np.vstack([_mesh_vertices(root, g.get("mesh")) for g in geoms])[:, 1]
@@ -144,7 +147,7 @@ def test_the_drake_world_of_a_mesh_task_holds_its_pieces_as_convex_shapes(tmp_pa
     scene = _scene(task)
     grasp = DrakeGrasp(scene, kinematic_hand=True)
     inspector = grasp.plant.EvalSceneGraphInspector(grasp.plant_context)
-    pieces = scene["object"]["mesh"]["pieces"]
+    pieces = scene.object.mesh.pieces
     assert len(grasp._pieces) == len(pieces)
     for geometry, piece in zip(grasp._pieces, pieces):
         shape = inspector.GetShape(geometry)
@@ -162,7 +165,7 @@ def test_a_malformed_mesh_in_a_scene_is_refused():
                        (lambda m: m["pieces"][1][0].__setitem__(1, float("nan")), r"pieces\[1\]\[0\]\[1\]"),
                        (lambda m: m.pop("inertia"), "has no 'inertia'"),
                        (lambda m: m["inertia"][2].__setitem__(2, -1.0), r"inertia\[2\]\[2\]")):
-        broken = json.loads(json.dumps(scene))
+        broken = json.loads(json.dumps(scene.as_dict()))
         edit(broken["object"]["mesh"])
         with pytest.raises(ProtocolError, match=says):
             check_scene(broken)
@@ -186,4 +189,4 @@ def test_the_shipped_mesh_part_is_planned_run_and_lands_as_its_mesh(engine, tmp_
     assert f"simulated as: {report.simulated_geometry}" in report.describe()
     written = json.loads((tmp_path / "run.json").read_text())
     assert written["simulated_geometry"] == report.simulated_geometry and written["engine"] == engine
-    assert "mesh" in arm._scene["object"]  # the world it built was the mesh's
+    assert arm._scene.object.mesh is not None  # the world it built was the mesh's

@@ -36,7 +36,7 @@ def _object_path(friction_class):
     arm.pad_friction = friction_class(arm.model, scene_mod.pad_geoms(arm.model))
     q = arm._object_qpos
     path = []
-    for point in arm_trajectory(task, steps, features, 100.0, scene["gripper_pose"])[:WAYPOINTS]:
+    for point in arm_trajectory(task, steps, features, 100.0, scene.gripper_pose)[:WAYPOINTS]:
         arm.move_to(point.pose, 0.01)
         path.append(arm.data.qpos[q:q + 7].copy())
     return np.array(path), arm

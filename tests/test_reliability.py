@@ -500,7 +500,7 @@ def high_mu_run():
 
     task = shipped("horizontal-offset-high-mu")
     plan = check_plan(task, plan_task(task, seed=1))
-    return task, plan, scene_description(task, place_features(task, plan.waypoints), task.start)
+    return task, plan, scene_description(task, place_features(task, plan.waypoints), task.start).as_dict()
 
 
 def test_the_sim_arm_survives_hostile_clients_and_then_serves_a_good_one(high_mu_run):

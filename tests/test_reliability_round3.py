@@ -290,7 +290,7 @@ def _scene(name="horizontal-offset-high-mu"):
 
     task = shipped(name) if "/" not in name else sp.load_task(TASKS / name)
     plan = sp.plan_task(task, time_limit=0.5)
-    return scene_description(task, place_features(task, plan.waypoints), task.start)
+    return scene_description(task, place_features(task, plan.waypoints), task.start).as_dict()  # as on the wire
 
 
 def _hello_line(scene):

@@ -97,7 +97,7 @@ def test_during_a_push_the_object_stays_on_its_feature():
     plan = plan_task(task, seed=2)
     steps = plan.waypoints
     features = place_features(task, steps)
-    home = scene_description(task, features, task.start)["gripper_pose"]
+    home = scene_description(task, features, task.start).gripper_pose
     waypoints = arm_trajectory(task, steps, features, 100.0, home)
     pushes = [w for w in waypoints if w.phase == "push"]
     assert sum(w.completes for w in pushes) == len(steps) - 1
@@ -126,14 +126,14 @@ def test_every_approach_ends_slowly_toward_where_the_plan_puts_its_feature():
     scene = scene_description(task, features, task.start)
     first = features[steps[1].pusher]
     touching = first.object_pose @ np.linalg.inv(grasp_transform(task.start))
-    np.testing.assert_allclose(np.array(scene["gripper_pose"][:3]) - touching[:3, 3], first.normal * GUARD_SPAN,
+    np.testing.assert_allclose(np.array(scene.gripper_pose[:3]) - touching[:3, 3], first.normal * GUARD_SPAN,
                                atol=1e-12)
-    points = arm_trajectory(task, steps, features, 100.0, scene["gripper_pose"])
+    points = arm_trajectory(task, steps, features, 100.0, scene.gripper_pose)
     starts = [i for i, w in enumerate(points) if w.phase == "push" and points[i - 1].phase != "push"]
     assert len(starts) == sum(1 for a, b in zip(steps[1:], steps[2:]) if a.pusher != b.pusher) + 1
     for i in starts:
         n = len(list(itertools.takewhile(lambda w: w.guarded, reversed(points[:i]))))
-        before = points[i - n - 1].pose if i > n else scene["gripper_pose"]  # where the slow end begins
+        before = points[i - n - 1].pose if i > n else scene.gripper_pose  # where the slow end begins
         path = np.array([before[:3]] + [w.pose[:3] for w in points[i - n:i]])
         feature = features[steps[points[i].step].pusher]
         touch = feature.object_pose @ np.linalg.inv(grasp_transform(steps[points[i].step - 1].pose))
@@ -203,20 +203,20 @@ def test_a_feature_stops_short_of_a_reflex_corner_of_the_object_wherever_it_is_p
     task = shipped("t-shaped")
     scene = scene_description(task, place_features(task, [Waypoint(*task.start)], every_pusher=True), task.start)
     world = WorldDeviation(feature_offsets=tuple((name, *offset) for name in task.pusher_names)).apply(scene)
-    for feature in world["features"]:
-        solid = feature_solid(feature, world["object"])
-        a, b = np.asarray(feature["from"]), np.asarray(feature["to"])
+    for feature in world.features:
+        solid = feature_solid(feature, world.object)
+        a, b = np.asarray(feature.start), np.asarray(feature.end)
         length = np.linalg.norm(b - a)
-        if feature["pusher"] != "web":
-            assert 2 * solid["half_size"][0] == pytest.approx(length, abs=1e-12), feature["pusher"]
+        if feature.pusher != "web":
+            assert 2 * solid["half_size"][0] == pytest.approx(length, abs=1e-12), feature.pusher
             continue
         assert 2 * solid["half_size"][0] == pytest.approx(length - FEATURE_CORNER_GAP, abs=1e-12)
         # The end that stops short is the one at the corner (10, -10) mm in O, the web's foot.
-        T_WO = pose_to_matrix(feature["object_pose"])
+        T_WO = pose_to_matrix(feature.object_pose)
         corner = (T_WO @ np.array([0.010, 0.0, -0.010, 1.0]))[:3]
         near = a if np.linalg.norm(a - corner) < np.linalg.norm(b - corner) else b
         u = (b - a) / length
-        centre = np.asarray(solid["center"]) + np.asarray(feature["normal"]) * FEATURE_DEPTH / 2  # on the contact face
+        centre = np.asarray(solid["center"]) + np.asarray(feature.normal) * FEATURE_DEPTH / 2  # on the contact face
         assert np.linalg.norm(centre + np.sign(u @ (near - centre)) * u * solid["half_size"][0] - near) == \
             pytest.approx(FEATURE_CORNER_GAP, abs=1e-9)
 
@@ -228,7 +228,7 @@ def test_a_deviated_world_scales_every_pad_and_feature_mu():
     steps = [Waypoint(*task.start), Waypoint(*task.start, pusher="left")]
     scene = scene_description(task, place_features(task, steps), task.start)
     nominal, scaled = SimArm(scene), SimArm(scene, WorldDeviation(mu_scale=0.85))
-    assert scene["gripper"]["mu"] == task.mu  # the scene itself is left as the executor sent it
+    assert scene.gripper.mu == task.mu  # the scene itself is left as the executor sent it
     np.testing.assert_allclose(scaled.model.pair_friction, 0.85 * nominal.model.pair_friction)
     assert sorted(set(np.round(nominal.model.pair_friction[:, 0], 9))) == sorted({task.mu, 0.2})
 

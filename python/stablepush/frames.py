@@ -53,7 +53,7 @@ def grasp_transform(pose_mm_deg: Sequence[float]) -> np.ndarray:
     return T
 
 
-def translation(p: Sequence[float]) -> np.ndarray:
+def translation(p: "Sequence[float] | np.ndarray") -> np.ndarray:
     T = np.eye(4)
     T[:3, 3] = p
     return T

@@ -13,11 +13,12 @@ the world [m]; joints in rad (m for a sliding joint).
 from __future__ import annotations
 
 import abc
-from typing import Optional, Sequence
+from typing import Any, Dict, Optional, Sequence
 
 import numpy as np
 
 from stablepush.execution.arm import Arm, ArmError, ArmReady, RobotDescription
+from stablepush.execution.scene import Scene
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.frames import matrix_to_pose
 from stablepush.plan.plan import Plan
@@ -89,7 +90,7 @@ class JointTrajectoryArm(Arm):
     def robot_description(self) -> RobotDescription:
         return robot_description(self.robot)
 
-    def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
+    def hello(self, scene: Scene, rate_hz: float, resume: bool) -> ArmReady:
         """The arm's kinematics in the scene's world (its base where the robot says) and the arm's
         state where it stands (the executor's stream starts from there); the posture IK's null
         space pulls toward is the one at the scene's start pose nearest the measured joints."""
@@ -98,7 +99,7 @@ class JointTrajectoryArm(Arm):
         self._period = 1.0 / float(rate_hz)
         q = self._read()
         self._command = q
-        self._home, _ = ik.find_home(self._kinematics, scene["gripper_pose"], (q, *self.arm.home_guesses),
+        self._home, _ = ik.find_home(self._kinematics, scene.gripper_pose, (q, *self.arm.home_guesses),
                                      self._kinematics.lower, self._kinematics.upper)
         self.connected = True
         return ArmReady(state=self._state(q, False), arm=f"joint trajectory bridge ({len(self.arm.joints)} joints)")
@@ -106,12 +107,14 @@ class JointTrajectoryArm(Arm):
     def move(self, waypoint: ArmWaypoint) -> dict:
         """IK from the last command to the waypoint's pose, checked against the limits and speeds
         of the model, sent as one trajectory point over the period; the state read back."""
-        kin = self._kinematics
-        q, error = ik.follow(kin, waypoint.pose, self._command, self._home, kin.lower, kin.upper)
+        kin, command, home = self._kinematics, self._command, self._home
+        if kin is None or command is None or home is None:
+            raise ArmError("a waypoint before hello")
+        q, error = ik.follow(kin, waypoint.pose, command, home, kin.lower, kin.upper)
         if error > ik.IK_REACH:
             raise ArmError(f"the arm cannot reach the pose of plan step {waypoint.step} ({waypoint.phase}): IK "
                            f"stays {error * 1e3:.3f} mm off")
-        fast = self.arm.too_fast(self._command, q, self._period)
+        fast = self.arm.too_fast(command, q, self._period)
         if fast is not None:
             raise ArmError(f"{fast} (plan step {waypoint.step}, {waypoint.phase})")
         self._call("send", [float(v) for v in q], self._period)
@@ -135,10 +138,12 @@ class JointTrajectoryArm(Arm):
         return q
 
     def _state(self, q: np.ndarray, contact_force: bool) -> dict:
+        if self._kinematics is None:
+            raise ArmError("the arm's state before hello")
         R, p, _ = self._kinematics(q)
         T = np.eye(4)
         T[:3, :3], T[:3, 3] = R, p
-        state = {"ee_pose": matrix_to_pose(T), "joints": [float(v) for v in q]}
+        state: Dict[str, Any] = {"ee_pose": matrix_to_pose(T), "joints": [float(v) for v in q]}
         tracked = self._call("object_in_grasp")
         if tracked is not None:
             state["object_in_grasp"] = {k: float(tracked[k]) for k in ("x", "z", "theta")}

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Optional, Tuple
 from stablepush.execution.stream import ArmWaypoint
 
 if TYPE_CHECKING:
+    from stablepush.execution.scene import Scene
     from stablepush.plan.plan import Plan
     from stablepush.task.model import Task
 
@@ -81,8 +82,8 @@ class Arm(abc.ABC):
         return None
 
     @abc.abstractmethod
-    def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
-        """Start a session for a run of `scene` (stablepush.execution.world.scene_description) at
+    def hello(self, scene: "Scene", rate_hz: float, resume: bool) -> ArmReady:
+        """Start a session for a run of `scene` (execution.scene.Scene, world.scene_description) at
         `rate_hz` waypoints per second. `resume`: the run continues one that ended in a fault, and
         a simulator keeps its world when the scene is the one it has."""
 

@@ -22,7 +22,7 @@ data lies in its time. Topics, one message per trajectory sample unless said:
 - `/stablepush/arm_scene` (std_msgs/msg/String), once at the start: the world as the arm protocol's
   hello describes it (JSON in the protocol's conventions, not ROS's: SI but for `object_in_grasp`,
   the plan's x mm, z mm, theta deg; poses [x, y, z, qw, qx, qy, qz];
-  `stablepush.execution.world.scene_description`), so that a bridge can replay the bag to an arm
+  `stablepush.execution.scene.Scene.as_dict`), so that a bridge can replay the bag to an arm
   server (examples/bag_to_arm.py).
 Units in the ROS messages: m, s, rad; quaternions x, y, z, w.
 """
@@ -171,7 +171,7 @@ def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajec
         write("/stablepush/scene", start_ns, T["visualization_msgs/msg/MarkerArray"](
             markers=_scene_markers(T, start, task, features.values())))
         scene = scene_description(task, features, steps[0].pose)
-        write("/stablepush/arm_scene", start_ns, T["std_msgs/msg/String"](data=json.dumps(scene)))
+        write("/stablepush/arm_scene", start_ns, T["std_msgs/msg/String"](data=json.dumps(scene.as_dict())))
         held_poses = _continuous([matrix_to_pose(m) for m in T_GO])
         for i in range(len(trajectory)):
             ns = start_ns + int(round(float(trajectory.t[i]) * 1e9))

@@ -1,11 +1,11 @@
 """The solid a simulator builds for a mesh part: convex pieces of the part itself (CoACD's convex
 decomposition of a non-convex part, the hull of a convex one) and the solid's inertia, for the
-scene description (world.py) that both engines build their worlds from.
+scene (scene.py, made by world.py) that both engines build their worlds from.
 
 Both engines collide convex solids only, so a non-convex part is simulated as the union of convex
 pieces. Planning never needs any of this: the model plans with the section at the grasp plane.
 
-Here, not in `stablepush.sim`: the executor's scene description carries the pieces to a simulator
+Here, not in `stablepush.sim`: the executor's scene carries the pieces to a simulator
 that may run in another process or on another machine, without the mesh file.
 """
 from __future__ import annotations
@@ -13,10 +13,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Tuple
+from typing import Optional, Tuple
 
 import numpy as np
 
+from stablepush.execution.scene import MeshSolid
 from stablepush.task.mesh import PartMesh
 from stablepush.task.model import Task
 
@@ -108,16 +109,14 @@ def solid_inertia(part: PartMesh, mass_g: float) -> Tuple[np.ndarray, np.ndarray
     return per_density * (mass_g / float(solid.volume)) * MM3_G_TO_KG_M2, np.asarray(solid.center_mass, float)
 
 
-def scene_object_geometry(task: Task) -> dict:
-    """What a scene description's object adds to the section for a simulator (SI units): `geometry`,
-    what the simulated solid is, in words; for a mesh part also `mesh`: its convex `pieces`
-    (vertices in O, m), the solid's `inertia` tensor about its centre of mass (kg m^2, O's axes;
-    the simulator takes I_yy from the task's `inertia`, which a task file may give) and that
-    centre's `com_y` (m; the task gives x and z)."""
+def scene_object_geometry(task: Task) -> Tuple[str, Optional[MeshSolid]]:
+    """What a scene's object adds to the section for a simulator: what the simulated solid is, in
+    words, and for a mesh part its convex pieces, the solid's inertia tensor and the y of its
+    centre of mass (scene.MeshSolid, SI units)."""
     if task.mesh is None:
-        return {"geometry": f"prism of the section, {task.thickness:g} mm thick"}
+        return f"prism of the section, {task.thickness:g} mm thick", None
     built = part_pieces(task.mesh)
     inertia, com = solid_inertia(task.mesh, task.mass)
-    return {"geometry": built.description,
-            "mesh": {"pieces": [(piece * 1e-3).tolist() for piece in built.pieces], "inertia": inertia.tolist(),
-                     "com_y": float(com[1]) * 1e-3}}
+    return built.description, MeshSolid(
+        pieces=tuple(tuple((x, y, z) for x, y, z in (piece * 1e-3).tolist()) for piece in built.pieces),
+        inertia=tuple((a, b, c) for a, b, c in inertia.tolist()), com_y=float(com[1]) * 1e-3)

@@ -12,8 +12,8 @@ the next is sent.
 
 client -> server
   {"type": "hello", "protocol": "stablepush.arm/2", "rate_hz": 100, "scene": {...}, "continue": false}
-      `scene` describes the world (stablepush.execution.world.scene_description); a real arm may ignore
-      it. A simulator builds a fresh world from it for each session, or, when `continue` is true
+      `scene` describes the world (stablepush.execution.scene.Scene.as_dict, below); a real arm may
+      ignore it. A simulator builds a fresh world from it for each session, or, when `continue` is true
       and the scene is the one it has, keeps its world (so a run can resume after a fault). Its
       object may say what solid to simulate: "geometry" (words) and, for a mesh part, "mesh" (its
       convex pieces' corners in the object's frame, m, its inertia tensor and com along y).
@@ -58,6 +58,7 @@ from typing import Any, Dict, Optional
 
 from stablepush import strict_json
 from stablepush.execution.part_geometry import MAX_PIECE_VERTICES, MAX_PIECES
+from stablepush.execution.scene import Scene
 from stablepush.strict_json import is_finite_number
 from stablepush.task.schema import (
     ANGLE,
@@ -79,13 +80,13 @@ DEFAULT_RATE_HZ = 100.0
 RATE_HZ = (1.0, 1000.0)  # waypoints per second a hello may ask for
 MAX_LINE_BYTES = 4_000_000  # a hello carries the scene (a 1,000-vertex object is about 40 kB)
 
-_CLIENT_FIELDS = {
+_CLIENT_FIELDS: Dict[str, Dict[str, Any]] = {
     "hello": {"protocol": str, "rate_hz": (int, float), "scene": dict},
     "waypoint": {"seq": int, "t": (int, float), "step": int, "phase": str, "pose": list},
     "stop": {},
     "bye": {},
 }
-_SERVER_FIELDS = {
+_SERVER_FIELDS: Dict[str, Dict[str, Any]] = {
     "ready": {"protocol": str, "state": dict},
     "ack": {"seq": int, "state": dict},
     "stopped": {"state": dict},
@@ -119,7 +120,7 @@ def decode(line: bytes, sender: str) -> Dict[str, Any]:
     if not isinstance(message, dict):
         raise ProtocolError(f"not a JSON object: {_clip(line)}")
     kind = message.get("type")
-    if kind not in fields:
+    if not isinstance(kind, str) or kind not in fields:
         raise ProtocolError(f"unknown message type {kind!r} (expected one of {', '.join(fields)})")
     for name, types in fields[kind].items():
         value = message.get(name)
@@ -178,7 +179,7 @@ def _check_placed(pose: list, what: str) -> None:
         raise ProtocolError(f"{what}: the quaternion is not of unit length")
 
 
-# A hello's scene (world.scene_description, SI units) within the task file's own ranges (schema.LIMITS,
+# A hello's scene (scene.Scene.as_dict, SI units) within the task file's own ranges (schema.LIMITS,
 # in mm, g and N there): kind -> (lowest, highest), converted once.
 _SCENE_RANGES = {
     "position": (COORDINATE[0] * MM, COORDINATE[1] * MM),  # m: polygon, com, pad centres, feature ends
@@ -194,8 +195,14 @@ UNIT_NORMAL_TOLERANCE = 1e-3  # a feature's normal is of unit length to this
 MAX_GEOMETRY_CHARS = 200  # scene.object.geometry: words for a run's report
 
 
-def check_scene(scene: dict) -> None:
-    """A hello's `scene` (world.scene_description) as a world can be built from: every number finite
+def read_scene(scene: Any) -> Scene:
+    """The Scene of a hello's `scene`, checked (check_scene: ProtocolError naming the field)."""
+    check_scene(scene)
+    return Scene.from_dict(scene)
+
+
+def check_scene(scene: Any) -> None:
+    """A hello's `scene` (scene.Scene.as_dict) as a world can be built from: every number finite
     and within the task file's own range for it (schema.LIMITS, in SI), the counts within the task
     file's caps (vertices, pads, pad rings and their points, features), each feature's normal a
     unit vector and its object pose a pose; ProtocolError naming the field otherwise. A simulator

@@ -10,6 +10,7 @@ from typing import Optional
 from stablepush.errors import SettingError
 from stablepush.execution.arm import Arm, ArmError, ArmReady
 from stablepush.execution.protocol import MAX_GEOMETRY_CHARS, PROTOCOL, LineReader, ProtocolError, decode, encode
+from stablepush.execution.scene import Scene
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.units import is_finite_real
 
@@ -37,14 +38,14 @@ class TcpArm(Arm):
         self.sock: Optional[socket.socket] = None
         self.connected = False
 
-    def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
+    def hello(self, scene: Scene, rate_hz: float, resume: bool) -> ArmReady:
         try:
             self.sock = socket.create_connection((self.host, self.port), timeout=self.timeout)
         except OSError as exc:
             raise ArmError(f"cannot reach {self.where} ({exc.strerror or exc})") from None
         self.connected = True
         self.reader = LineReader(self.sock, self.where)
-        ready = self._exchange({"type": "hello", "protocol": PROTOCOL, "rate_hz": rate_hz, "scene": scene,
+        ready = self._exchange({"type": "hello", "protocol": PROTOCOL, "rate_hz": rate_hz, "scene": scene.as_dict(),
                                 "continue": resume}, "ready")
         geometry = ready.get("geometry")
         return ArmReady(state=ready["state"], arm=str(ready.get("arm", "")), engine=ready.get("engine"),
@@ -84,6 +85,8 @@ class TcpArm(Arm):
                 pass
 
     def _send(self, message: dict) -> None:
+        if self.sock is None:
+            raise ConnectionError(f"not connected to {self.where} (no hello)")
         self.sock.settimeout(self.timeout)
         self.sock.sendall(encode(message))
 

@@ -96,7 +96,7 @@ def timed_trajectory(task: Task, plan: Plan, rate_hz: float = 100.0) -> Trajecto
     rate_hz = rate_hz if isinstance(rate_hz, (int, float)) else float(rate_hz)  # numpy's, as the arm's JSON takes
     steps = list(plan.waypoints)
     features = place_features(task, steps)
-    start = scene_description(task, features, steps[0].pose, solid=False)["gripper_pose"]
+    start = scene_description(task, features, steps[0].pose, solid=False).gripper_pose
     points = arm_trajectory(task, steps, features, rate_hz, start)
     poses = np.array([start] + [p.pose for p in points], float)  # [x, y, z, qw, qx, qy, qz]
     dt = 1.0 / rate_hz

@@ -15,8 +15,10 @@ import numpy as np
 
 from stablepush.compiled import _core
 from stablepush.execution.part_geometry import scene_object_geometry
+from stablepush.execution.scene import Pad, Scene, SceneFeature, SceneGripper, SceneObject
 from stablepush.frames import grasp_transform, matrix_to_pose, rot_y, translation
 from stablepush.plan.plan import Waypoint
+from stablepush.pose import Pose, PoseLike
 from stablepush.task.model import Task
 from stablepush.units import MM, mm2_to_si
 
@@ -39,9 +41,14 @@ class Feature:
     normal: np.ndarray
     mu: float
 
+    def in_scene(self) -> SceneFeature:
+        """This feature as a scene carries it (W, m; the object's pose as a 7-vector)."""
+        (ax, ay, az), (bx, by, bz), (nx, ny, nz) = self.start.tolist(), self.end.tolist(), self.normal.tolist()
+        return SceneFeature(pusher=self.pusher, start=(ax, ay, az), end=(bx, by, bz), normal=(nx, ny, nz), mu=self.mu,
+                            object_pose=tuple(matrix_to_pose(self.object_pose)))
+
     def as_dict(self) -> dict:
-        return {"pusher": self.pusher, "from": self.start.tolist(), "to": self.end.tolist(),
-                "normal": self.normal.tolist(), "mu": self.mu, "object_pose": matrix_to_pose(self.object_pose)}
+        return self.in_scene().as_dict()
 
 
 @dataclass(frozen=True)
@@ -60,10 +67,13 @@ def contacts_of(steps: Sequence[Waypoint]) -> List[Contact]:
     """The plan's pushes grouped into contacts: runs of consecutive pushes by one pusher."""
     out: List[Contact] = []
     for i, step in enumerate(steps[1:], start=1):
-        if out and out[-1].pusher == step.pusher and out[-1].last == i - 1:
-            out[-1] = Contact(step.pusher, out[-1].first, i)
+        pusher = step.pusher
+        if pusher is None:  # a plan's pushes each name their pusher (plan.verify)
+            raise ValueError(f"plan step {i} is a push by no pusher")
+        if out and out[-1].pusher == pusher and out[-1].last == i - 1:
+            out[-1] = Contact(pusher, out[-1].first, i)
         else:
-            out.append(Contact(step.pusher, i - 1, i))
+            out.append(Contact(pusher, i - 1, i))
     return out
 
 
@@ -116,35 +126,40 @@ def station_offset(k: int) -> int:
     return (k + 1) // 2 if k % 2 else -(k // 2)
 
 
-def scene_description(task: Task, features: Dict[str, Feature], in_grasp: Sequence[float],
-                      start_clear: bool = True, solid: bool = True) -> dict:
-    """What a simulated arm needs to build the world (SI units): the object, the gripper, gravity,
-    the features, G's pose when the run starts and the object's pose then (`in_grasp`, mm/deg).
-    G starts at home, or, with `start_clear`, GUARD_SPAN back from a feature the object would touch
-    there, which the run's guarded approach then finds (the executor's world); without it, the
-    object starts on that feature (the friction-fidelity rigs, which load it from the start).
-    With `solid`, the object says what solid to simulate (part_geometry.scene_object_geometry: a
-    mesh part's convex pieces, which needs CoACD for a non-convex one); without, a simulator builds
-    the prism of the section (for callers that read only the poses)."""
+def scene_description(task: Task, features: Dict[str, Feature], in_grasp: PoseLike,
+                      start_clear: bool = True, solid: bool = True) -> Scene:
+    """What a simulated arm needs to build the world (scene.Scene, SI units): the object, the
+    gripper, gravity, the features, G's pose when the run starts and the object's pose then
+    (`in_grasp`, mm/deg). G starts at home, or, with `start_clear`, GUARD_SPAN back from a feature
+    the object would touch there, which the run's guarded approach then finds (the executor's
+    world); without it, the object starts on that feature (the friction-fidelity rigs, which load
+    it from the start). With `solid`, the object says what solid to simulate
+    (part_geometry.scene_object_geometry: a mesh part's convex pieces, which needs CoACD for a
+    non-convex one); without, a simulator builds the prism of the section (for callers that read
+    only the poses)."""
     body = task.rigid_body()
+    q = Pose.of(in_grasp)
+    T_GO = grasp_transform(tuple(q))
     start = translation(np.asarray(task.environment.home, float) * MM)
     for feature in features.values() if start_clear else ():
-        if near_pose(start, feature.object_pose @ np.linalg.inv(grasp_transform(in_grasp))):
+        if near_pose(start, feature.object_pose @ np.linalg.inv(T_GO)):
             start = translation(feature.normal * GUARD_SPAN) @ start
             break
-    return {
-        "task": task.name,
-        "gravity": list(task.gravity),
-        "object": {"polygon": [[x * MM, z * MM] for x, z in task.vertices], "thickness": task.thickness * MM,
-                   "mass": body.mass, "com": list(body.com), "inertia": body.inertia,
-                   **(scene_object_geometry(task) if solid else {})},
-        "gripper": {"grip_force": task.grip_force, "mu": task.mu, "pad_rings": task.pad_rings,
-                    "pads": [{"center": [c[0] * MM, c[1] * MM], "radius": r * MM} for c, r in task.pads]},
-        "features": [f.as_dict() for f in features.values()],
-        "gripper_pose": matrix_to_pose(start),
-        "object_pose": matrix_to_pose(start @ grasp_transform(in_grasp)),
-        "object_in_grasp": list(in_grasp),
-    }
+    geometry, mesh = scene_object_geometry(task) if solid else (None, None)
+    com_x, com_z = body.com
+    gravity_x, gravity_z = task.gravity
+    return Scene(
+        task=task.name,
+        gravity=(gravity_x, gravity_z),
+        object=SceneObject(polygon=tuple((x * MM, z * MM) for x, z in task.vertices), thickness=task.thickness * MM,
+                           mass=body.mass, com=(com_x, com_z), inertia=body.inertia, geometry=geometry, mesh=mesh),
+        gripper=SceneGripper(grip_force=task.grip_force, mu=task.mu, pad_rings=task.pad_rings,
+                             pads=tuple(Pad(center=(c[0] * MM, c[1] * MM), radius=r * MM) for c, r in task.pads)),
+        features=tuple(f.in_scene() for f in features.values()),
+        gripper_pose=tuple(matrix_to_pose(start)),
+        object_pose=tuple(matrix_to_pose(start @ T_GO)),
+        object_in_grasp=q,
+    )
 
 
 RESTING_DISTANCE = 1e-3  # m: G this near the pose that holds the object on a feature rests it there (near_pose)

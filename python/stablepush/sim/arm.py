@@ -12,6 +12,7 @@ from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
 
+from stablepush.execution.scene import Scene
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.friction import CoulombPadFriction, mujoco
@@ -26,7 +27,7 @@ class SimulatedGrasp:
     grip force, the pad friction (friction.py) stepped with the physics, and the read-outs of the
     grasp."""
 
-    def __init__(self, scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None):
+    def __init__(self, scene: Scene, kinematic_hand: bool = False, robot: Optional[Robot] = None):
         self.arm = arm_model(robot)
         self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, kinematic_hand, robot))
         self.data = mujoco.MjData(self.model)
@@ -38,8 +39,8 @@ class SimulatedGrasp:
         self.steps = 0
         self.step_wall_time = 0.0
         fingers = [m.jnt_qposadr[m.joint(j).id] for j in FINGER_JOINTS]
-        self.data.qpos[fingers] = scene["object"]["thickness"] / 2
-        self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene["object_pose"]
+        self.data.qpos[fingers] = scene.object.thickness / 2
+        self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene.object_pose
         # close: the servos saturate at the grip force
         self.data.ctrl[[m.actuator(j).id for j in FINGER_JOINTS]] = 0.0
         self._pad_geoms = set(scene_mod.pad_geoms(m))
@@ -150,10 +151,10 @@ class ArmKinematics:
 
 
 class SimArm(TrackingArm, SimulatedGrasp):
-    """The arm of `robot` (the shipped arm when None), the grasp and the world of one scene
-    description (as `deviation` alters it)."""
+    """The arm of `robot` (the shipped arm when None), the grasp and the world of one scene (as
+    `deviation` alters it)."""
 
-    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation(), robot: Optional[Robot] = None):
+    def __init__(self, scene: Scene, deviation: WorldDeviation = WorldDeviation(), robot: Optional[Robot] = None):
         super().__init__(scene, deviation, robot)
         m = self.model
         self._kinematics = ArmKinematics(m, self.arm.joints)

@@ -1,14 +1,15 @@
-"""How a simulated world departs from the task it is given: the same on every engine, applied
-to the scene description before an engine builds its world (SI units, poses as in `scene.py`)."""
+"""How a simulated world departs from the task it is given: the same on every engine, a new scene
+made from the one an engine is given, before it builds its world (SI units, poses as in `scene.py`)."""
 from __future__ import annotations
 
-import copy
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Tuple
 
 import numpy as np
 
+from stablepush.execution.scene import Scene, SceneFeature
 from stablepush.frames import matrix_to_pose, pose_to_matrix, rot_y
 
 
@@ -32,33 +33,36 @@ class WorldDeviation:
     mass_scale: float = 1.0
     feature_offsets: Tuple[Tuple[str, float, float, float], ...] = ()
 
-    def apply(self, scene: dict) -> dict:
-        """`scene` (a scene description, SI units) as this world has it; the scene itself unchanged."""
-        scene = copy.deepcopy(scene)
-        scene["gripper"]["mu"] *= self.mu_scale * self.pad_mu_scale
-        scene["gripper"]["grip_force"] *= self.grip_scale
-        obj = scene["object"]
-        obj["mass"] *= self.mass_scale
-        obj["inertia"] *= self.mass_scale
-        if "mesh" in obj:  # a mesh part's solid's tensor (scene.object_inertia)
-            obj["mesh"]["inertia"] = (np.asarray(obj["mesh"]["inertia"], float) * self.mass_scale).tolist()
+    def apply(self, scene: Scene) -> Scene:
+        """`scene` as this world has it: a new Scene."""
+        gripper = dataclasses.replace(scene.gripper, mu=scene.gripper.mu * (self.mu_scale * self.pad_mu_scale),
+                                      grip_force=scene.gripper.grip_force * self.grip_scale)
+        obj = scene.object
+        mesh = obj.mesh
+        if mesh is not None:  # a mesh part's solid's tensor (scene.object_inertia)
+            scaled = (np.asarray(mesh.inertia, float) * self.mass_scale).tolist()
+            mesh = dataclasses.replace(mesh, inertia=tuple((a, b, c) for a, b, c in scaled))
+        obj = dataclasses.replace(obj, mass=obj.mass * self.mass_scale, inertia=obj.inertia * self.mass_scale,
+                                  mesh=mesh)
         offsets = {name: (dx, dz, dth) for name, dx, dz, dth in self.feature_offsets}
-        for feature in scene["features"]:
-            feature["mu"] *= self.mu_scale * self.pusher_mu_scale
-            if feature["pusher"] in offsets:
-                _move_feature(feature, *offsets[feature["pusher"]])
-        return scene
+        features = []
+        for feature in scene.features:
+            feature = dataclasses.replace(feature, mu=feature.mu * (self.mu_scale * self.pusher_mu_scale))
+            if feature.pusher in offsets:
+                feature = _moved(feature, *offsets[feature.pusher])
+            features.append(feature)
+        return dataclasses.replace(scene, gripper=gripper, object=obj, features=tuple(features))
 
 
-def _move_feature(feature: dict, dx_mm: float, dz_mm: float, dtheta_deg: float) -> None:
-    """Turn a feature by dtheta about the world's y through the middle of its segment, then shift it,
-    with the object's pose on it (its segment stays where it was on the object)."""
-    a, b = np.asarray(feature["from"], float), np.asarray(feature["to"], float)
+def _moved(feature: SceneFeature, dx_mm: float, dz_mm: float, dtheta_deg: float) -> SceneFeature:
+    """The feature turned by dtheta about the world's y through the middle of its segment, then
+    shifted, with the object's pose on it (its segment stays where it was on the object)."""
+    a, b = np.asarray(feature.start, float), np.asarray(feature.end, float)
     middle = (a + b) / 2
     move = np.eye(4)  # the turn about the middle, then the shift, as one rigid motion in W
     move[:3, :3] = rot_y(math.radians(dtheta_deg))
     move[:3, 3] = middle + np.array([dx_mm * 1e-3, 0.0, dz_mm * 1e-3]) - move[:3, :3] @ middle
-    feature["from"] = (move @ np.append(a, 1.0))[:3].tolist()
-    feature["to"] = (move @ np.append(b, 1.0))[:3].tolist()
-    feature["normal"] = (move[:3, :3] @ np.asarray(feature["normal"], float)).tolist()
-    feature["object_pose"] = matrix_to_pose(move @ pose_to_matrix(feature["object_pose"]))
+    (ax, ay, az), (bx, by, bz) = (move @ np.append(a, 1.0))[:3].tolist(), (move @ np.append(b, 1.0))[:3].tolist()
+    nx, ny, nz = (move[:3, :3] @ np.asarray(feature.normal, float)).tolist()
+    return dataclasses.replace(feature, start=(ax, ay, az), end=(bx, by, bz), normal=(nx, ny, nz),
+                               object_pose=tuple(matrix_to_pose(move @ pose_to_matrix(feature.object_pose))))

@@ -35,6 +35,7 @@ from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
 
+from stablepush.execution.scene import Scene, SceneObject
 from stablepush.extras import require
 from stablepush.frames import pose_to_matrix
 from stablepush.sim import scene as scene_mod
@@ -80,7 +81,7 @@ class DrakeGrasp:
 
     engine = "drake"
 
-    def __init__(self, scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None):
+    def __init__(self, scene: Scene, kinematic_hand: bool = False, robot: Optional[Robot] = None):
         d = _drake()
         self._d = d
         self.timestep = time_step = DRAKE_TIMESTEP
@@ -90,7 +91,7 @@ class DrakeGrasp:
         if kinematic_hand:
             # Drake keeps a joint's armature only on an actuated joint: a heavy hand stands in for
             # the hand joints' (the pads' forces must not move it within a step).
-            tree.find(f".//body[@name='{KINEMATIC_HAND_BODY}']/geom").set("mass", repr(KINEMATIC_HAND_MASS))
+            scene_mod.found(tree, f".//body[@name='{KINEMATIC_HAND_BODY}']/geom").set("mass", repr(KINEMATIC_HAND_MASS))
         builder = d.DiagramBuilder()
         plant, scene_graph = d.AddMultibodyPlantSceneGraph(builder, time_step=time_step)
         plant.set_discrete_contact_approximation(getattr(d.DiscreteContactApproximation, "k" + approximation.title()))
@@ -99,22 +100,22 @@ class DrakeGrasp:
         parser = d.Parser(plant)
         parser.SetAutoRenaming(False)
         (self._arm,) = _quietly(lambda: parser.AddModelsFromString(ET.tostring(tree, encoding="unicode"), "xml"))
-        gx, gz = scene["gravity"]
+        gx, gz = scene.gravity
         plant.mutable_gravity_field().set_gravity_vector([gx, 0.0, gz])
         if kinematic_hand:  # the hand's motion is prescribed, its fingers carried (gravcomp)
             plant.set_gravity_enabled(self._arm, False)
         self.plant = plant
 
         # What the MJCF parser leaves out, from the same tree.
-        for position in tree.find("actuator"):
+        for position in scene_mod.found(tree, "actuator"):
             actuator = plant.GetJointActuatorByName(position.get("name"), self._arm)
-            actuator.set_controller_gains(d.PdControllerGains(p=float(position.get("kp")),
+            actuator.set_controller_gains(d.PdControllerGains(p=float(position.attrib["kp"]),
                                                               d=float(position.get("kv", "0"))))
         pos_joint, neg_joint = (plant.GetJointByName(j, self._arm) for j in FINGER_JOINTS)
         plant.AddCouplerConstraint(joint0=neg_joint, joint1=pos_joint, gear_ratio=1.0)
         self._gravcomp_bodies = [plant.GetBodyByName(b.get("name"), self._arm).index()
                                  for b in tree.iter("body") if b.get("gravcomp") == "1"]
-        site = tree.find(f".//site[@name='{GRIPPER_SITE}']")
+        site = scene_mod.found(tree, f".//site[@name='{GRIPPER_SITE}']")
         parent = next(b for b in tree.iter("body") if site in list(b))
         X_BG = d.RigidTransform(d.Quaternion(_vector(site.get("quat", "1 0 0 0"))), _vector(site.get("pos", "0 0 0")))
         hand = plant.GetBodyByName(parent.get("name"), self._arm)
@@ -124,9 +125,9 @@ class DrakeGrasp:
                         for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))]
         arm_geometry += plant.GetCollisionGeometriesForBody(plant.world_body())  # the floor
         self._pads = self._add_pads(scene)
-        solid = scene_mod.object_solid(scene["object"])
-        self._object_body, self._pieces = self._add_object(scene["object"], solid)
-        pad_faces = self._add_pad_faces(scene["object"])
+        solid = scene_mod.object_solid(scene.object)
+        self._object_body, self._pieces = self._add_object(scene.object, solid)
+        pad_faces = self._add_pad_faces(scene.object)
         self._features = self._add_features(scene)
         plant.Finalize()
 
@@ -157,10 +158,10 @@ class DrakeGrasp:
         self.step_wall_time = 0.0
 
         # The object where the scene puts it, the jaws at its faces; the subclass sets its drives.
-        X_WO = d.RigidTransform(pose_to_matrix(scene["object_pose"]))
+        X_WO = d.RigidTransform(pose_to_matrix(scene.object_pose))
         plant.SetFreeBodyPose(self.plant_context, self._object_body, X_WO)
         for joint in (pos_joint, neg_joint):
-            joint.set_translation(self.plant_context, scene["object"]["thickness"] / 2)
+            joint.set_translation(self.plant_context, scene.object.thickness / 2)
         self._finger_servos = [self._servo_index(j) for j in FINGER_JOINTS]
         if kinematic_hand:
             self._hand = [plant.GetJointByName(j, self._arm) for j in scene_mod.HAND_JOINTS]
@@ -193,9 +194,9 @@ class DrakeGrasp:
             d.AddRigidHydroelasticProperties(HYDRO_RESOLUTION, props)
         return props
 
-    def _add_pads(self, scene: dict) -> list:
+    def _add_pads(self, scene: Scene) -> list:
         d, plant = self._d, self.plant
-        props = self._properties(partner_mu(scene["gripper"]["mu"]))
+        props = self._properties(partner_mu(scene.gripper.mu))
         pads = []
         for name, finger, side, (px, pz) in scene_mod.pad_layout(scene):
             body = plant.GetBodyByName(finger, self._arm)
@@ -203,7 +204,7 @@ class DrakeGrasp:
             pads.append(plant.RegisterCollisionGeometry(body, X, d.Sphere(scene_mod.PAD_POINT_RADIUS), name, props))
         return pads
 
-    def _add_object(self, obj: dict, solid: list):
+    def _add_object(self, obj: SceneObject, solid: list):
         """The object's body (its solid's mass properties, scene.object_inertia) and the convex
         `solid` pieces (scene.object_solid) as its geometry: a box piece as a Box, any other as
         a Convex of its corners."""
@@ -211,7 +212,7 @@ class DrakeGrasp:
         instance = plant.AddModelInstance(scene_mod.OBJECT_BODY)
         J = scene_mod.object_inertia(obj)
         inertia = d.SpatialInertia.MakeFromCentralInertia(
-            obj["mass"], list(scene_mod.object_com(obj)),
+            obj.mass, list(scene_mod.object_com(obj)),
             d.RotationalInertia(J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2]))
         body = plant.AddRigidBody(scene_mod.OBJECT_BODY, instance, inertia)
         props = self._properties(OBJECT_MU, "compliant")
@@ -227,7 +228,7 @@ class DrakeGrasp:
             geometries.append(plant.RegisterCollisionGeometry(body, X, shape, piece.name, props))
         return body, geometries
 
-    def _add_pad_faces(self, obj: dict) -> Dict[float, list]:
+    def _add_pad_faces(self, obj: SceneObject) -> Dict[float, list]:
         """What the pads on each side (+1, -1: the object's +y and -y faces) touch: every piece of the
         section (scene.object_pieces) that is not built as a box, as a prism from that face
         PAD_FACE_DEPTH deep into the object, without mass. Drake's sphere-vs-convex query answers a
@@ -240,10 +241,10 @@ class DrakeGrasp:
         so the prism's faces under the pads are the solid's."""
         d, plant = self._d, self.plant
         props = self._properties(OBJECT_MU)  # point contact, as the pads': no hydroelastic mesh
-        half = obj["thickness"] / 2
+        half = obj.thickness / 2
         faces: Dict[float, list] = {1.0: [], -1.0: []}
         for name, piece, rectangle in scene_mod.object_pieces(obj):
-            if rectangle and "mesh" not in obj:
+            if rectangle and obj.mesh is None:
                 continue  # the pads touch the box piece itself: the sphere-vs-box query is exact
             for side in faces:
                 ys = (side * half, side * (half - PAD_FACE_DEPTH))
@@ -253,21 +254,21 @@ class DrakeGrasp:
                                                                    f"{name}_pad_face{side:+g}", props))
         return faces
 
-    def _add_features(self, scene: dict) -> Dict[str, int]:
+    def _add_features(self, scene: Scene) -> Dict[str, int]:
         d, plant = self._d, self.plant
         out = {}
-        for feature in scene["features"]:
-            solid = scene_mod.feature_solid(feature, scene["object"])
+        for feature in scene.features:
+            solid = scene_mod.feature_solid(feature, scene.object)
             if solid["kind"] == "box":
                 R = d.RotationMatrix.MakeYRotation(solid["angle"])
                 shape = d.Box(*(2 * np.asarray(solid["half_size"])))
             else:  # a rod along y
                 R = d.RotationMatrix.MakeXRotation(math.pi / 2)
                 shape = d.Capsule(solid["radius"], 2 * solid["half_length"])
-            name = scene_mod.feature_geom(feature["pusher"])
-            out[feature["pusher"]] = plant.RegisterCollisionGeometry(
+            name = scene_mod.feature_geom(feature.pusher)
+            out[feature.pusher] = plant.RegisterCollisionGeometry(
                 plant.world_body(), d.RigidTransform(R, solid["center"]), shape, name,
-                self._properties(partner_mu(feature["mu"]), "rigid"))
+                self._properties(partner_mu(feature.mu), "rigid"))
         return out
 
     def _servo_index(self, joint_name: str) -> int:
@@ -361,10 +362,10 @@ class DrakeGrasp:
 
 
 class DrakeArm(TrackingArm, DrakeGrasp):
-    """The arm, the grasp and the world of one scene description (as `deviation` alters it), in
+    """The arm, the grasp and the world of one scene (as `deviation` alters it), in
     Drake; the same interface as `arm.SimArm` (move_to, advance, stop, state, solve_ik)."""
 
-    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation(), robot: Optional[Robot] = None):
+    def __init__(self, scene: Scene, deviation: WorldDeviation = WorldDeviation(), robot: Optional[Robot] = None):
         super().__init__(scene, deviation, robot)
         plant = self.plant
         joints = [plant.GetJointByName(j, self._arm) for j in self.arm.joints]

@@ -1,10 +1,15 @@
 """The physics engines a simulated arm can run on, by name: MuJoCo (`arm.py`, whose sliding pad
 friction is stablepush's own Coulomb law, `friction.py`) and Drake (`drake_arm.py`, whose contact
 solver alone decides stick and slip). Both build the same arm, grasp and world from a scene
-description and answer to the same calls, so the in-process arm (local_arm.py), the executor and the fidelity contract
-never ask which one they have. Importing this module loads neither engine.
+(execution.scene.Scene) and answer to the same calls, so the in-process arm (local_arm.py), the
+executor and the fidelity contract never ask which one they have. Importing this module loads neither engine.
 """
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from stablepush.execution.scene import Scene
 
 ENGINES = ("mujoco", "drake")
 DEFAULT_ENGINE = "mujoco"
@@ -28,7 +33,7 @@ def load_engine(engine: str) -> str:
     return engine
 
 
-def make_arm(engine: str, scene: dict, deviation=None, robot=None):
+def make_arm(engine: str, scene: Scene, deviation=None, robot=None):
     """The simulated arm of `scene` on `engine` (SimArm or DrakeArm), in the world `deviation`
     (a `deviation.WorldDeviation`; None: the task's own), the arm of `robot` (a
     task.model.Robot; None: the shipped arm)."""
@@ -43,7 +48,7 @@ def make_arm(engine: str, scene: dict, deviation=None, robot=None):
     return SimArm(scene, deviation, robot)
 
 
-def make_grasp(engine: str, scene: dict):
+def make_grasp(engine: str, scene: Scene):
     """The grasp of `scene` on a kinematic hand (no arm), on `engine`: the friction rig's world."""
     if check_engine(engine) == "drake":
         from stablepush.sim.drake_arm import DrakeGrasp

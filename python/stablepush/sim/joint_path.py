@@ -31,6 +31,7 @@ import numpy as np
 from stablepush.errors import PlanError
 from stablepush.execution.arm import Arm, ArmReady, RobotDescription
 from stablepush.execution.bags import JointSamples
+from stablepush.execution.scene import Scene
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.execution.trajectory import Trajectory, timed_trajectory
 from stablepush.execution.world import place_features, scene_description
@@ -195,18 +196,18 @@ def checked_path(task: Task, plan: Plan, rate_hz: float, robot: Robot) -> JointP
 class _Solver:
     """IK, limits, speed and clearance along one trajectory, on the MuJoCo model of its scene."""
 
-    def __init__(self, scene: dict, robot: Robot):
+    def __init__(self, scene: Scene, robot: Robot):
         self.arm = arm_model(robot)
         self.robot = robot_description(robot)
         model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, robot=robot))
         self.kin = ArmKinematics(model, self.arm.joints)
         self.model, self.data = model, self.kin.data
         # out of reach, the first sample says so (CellError) from the nearest posture found
-        self.home, _ = ik.find_home(self.kin, scene["gripper_pose"], self.arm.home_guesses, self.kin.lower,
+        self.home, _ = ik.find_home(self.kin, scene.gripper_pose, self.arm.home_guesses, self.kin.lower,
                                     self.kin.upper)
         links = _link_bodies(model, self.arm.joints)
         self.link_geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] in links]
-        self.obstacles = [model.geom(scene_mod.feature_geom(f["pusher"])).id for f in scene["features"]]
+        self.obstacles = [model.geom(scene_mod.feature_geom(f.pusher)).id for f in scene.features]
         self.obstacles.append(model.geom("floor").id)
         self.base = robot.base
         self._arm_reach()
@@ -373,7 +374,7 @@ class ModelledArm(Arm):
     def robot_description(self) -> RobotDescription:
         return robot_description(self.robot)
 
-    def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
+    def hello(self, scene: Scene, rate_hz: float, resume: bool) -> ArmReady:
         return self.arm.hello(scene, rate_hz, resume)
 
     def move(self, waypoint: ArmWaypoint) -> dict:

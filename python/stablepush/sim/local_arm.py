@@ -4,9 +4,10 @@ drives it with calls, no socket; `stablepush sim-arm` (server.py) serves one ove
 """
 from __future__ import annotations
 
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 from stablepush.execution.arm import Arm, ArmError, ArmReady, RobotDescription
+from stablepush.execution.scene import Scene
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.extras import MissingExtra, require
 from stablepush.plan.plan import Plan
@@ -15,13 +16,6 @@ from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
 from stablepush.sim.robot import arm_model, robot_description
 from stablepush.sim.scene import simulated_geometry, simulated_outline
 from stablepush.task.model import Robot, Task
-
-# The scene keys that say where a run starts, not what the world is: a resume starts elsewhere.
-_START_KEYS = ("object_pose", "object_in_grasp", "gripper_pose")
-
-
-def _world(scene: Optional[dict]) -> Optional[dict]:
-    return None if scene is None else {k: v for k, v in scene.items() if k not in _START_KEYS}
 
 
 class SimulatedArm(Arm):
@@ -36,8 +30,8 @@ class SimulatedArm(Arm):
         arm_model(self.robot)  # a model that cannot carry the jaws is the caller's error now (RobotError)
         self.deviation = deviation
         self.log = log or (lambda text: None)
-        self.sim = None  # the engine's arm (arm.SimArm or drake_arm.DrakeArm) of the current world
-        self._scene: Optional[dict] = None
+        self.sim: Any = None  # the engine's arm (arm.SimArm or drake_arm.DrakeArm) of the current world
+        self._scene: Optional[Scene] = None
         self._period = 0.01
 
     @property
@@ -61,11 +55,11 @@ class SimulatedArm(Arm):
         path = checked_path(task, plan, rate_hz, self.robot)
         self.log(f"cell checked: {path.describe()}")
 
-    def hello(self, scene: dict, rate_hz: float, resume: bool) -> ArmReady:
+    def hello(self, scene: Scene, rate_hz: float, resume: bool) -> ArmReady:
         """A fresh world built from `scene`, or, with `resume` and the scene the one it has, the
         world as the last session left it. ArmError when no world can be built from it."""
         self._period = 1.0 / float(rate_hz)
-        if self.sim is not None and resume and _world(scene) == _world(self._scene):
+        if self.sim is not None and resume and scene.same_world(self._scene):
             self.log("world kept from the previous session (continue)")
         else:
             try:
@@ -74,12 +68,12 @@ class SimulatedArm(Arm):
                 raise ArmError(f"hello: cannot build a world from this scene ({type(exc).__name__}: "
                                f"{' '.join(str(exc).split())[:200]})") from None
             self.sim, self._scene = sim, scene
-            _, tolerance = simulated_outline(scene["object"]["polygon"])
+            _, tolerance = simulated_outline(scene.object.polygon)
             simplified = f"; outline simplified within {tolerance * 1e3:g} mm" if tolerance else ""
-            self.log(f"world built for {scene.get('task', 'a task')} ({sim.describe()}{simplified})")
+            self.log(f"world built for {'a task' if scene.task is None else scene.task} ({sim.describe()}{simplified})")
         self.connected = True
         return ArmReady(state=self.sim.state(), arm=self.name, engine=self.engine,
-                        geometry=simulated_geometry(self._scene["object"]))
+                        geometry=simulated_geometry(scene.object))
 
     def move(self, waypoint: ArmWaypoint) -> dict:
         """Track G to the waypoint over one period. The wrist's force is read during approaches,

@@ -1,8 +1,8 @@
 """The MuJoCo scene of the simulated arm: the shipped arm (arm.xml) plus the held object, the
-multi-point finger pads and the fixed features, built from a scene description (a plain dict,
-SI units, as the executor sends it in its `hello`; see `stablepush.execution.protocol`). The object
-is a union of convex pieces (`object_solid`): a mesh part's own, which the scene carries
-(`stablepush.execution.part_geometry`), or for a box or polygon part the prism of its section.
+multi-point finger pads and the fixed features, built from a scene (`stablepush.execution.scene.Scene`,
+SI units: what the executor sends in its `hello`). The object is a union of convex pieces
+(`object_solid`): a mesh part's own, which the scene carries (`stablepush.execution.part_geometry`),
+or for a box or polygon part the prism of its section.
 
 Contact settings that keep friction honest (the simulation's results rest on them, and
 `stablepush.sim.fidelity` measures them):
@@ -23,6 +23,7 @@ Contact settings that keep friction honest (the simulation's results rest on the
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -30,6 +31,7 @@ from typing import List, Optional, Sequence, Tuple
 
 import numpy as np
 
+from stablepush.execution.scene import Scene, SceneFeature, SceneObject
 from stablepush.frames import pose_to_matrix, quat_about_y, turn
 from stablepush.sim.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.task.model import Robot
@@ -88,7 +90,7 @@ def simulated_outline(polygon: Sequence[Sequence[float]]) -> Tuple[List[Tuple[fl
     used (m; 0 when unchanged). The planner always uses the full polygon; only the simulated
     world is simplified, so that it builds in bounded time (the convex decomposition is cubic in
     the vertices)."""
-    pts = [tuple(map(float, p)) for p in polygon]
+    pts = [_point(p) for p in polygon]
     if len(pts) <= MAX_SIM_VERTICES:
         return pts, 0.0
     from shapely.geometry import Polygon
@@ -99,14 +101,19 @@ def simulated_outline(polygon: Sequence[Sequence[float]]) -> Tuple[List[Tuple[fl
         simple = orient(shape.simplify(tolerance, preserve_topology=True), 1.0)
         outline = list(simple.exterior.coords)[:-1]
         if len(outline) <= MAX_SIM_VERTICES:
-            return [tuple(map(float, p)) for p in outline], tolerance
+            return [_point(p) for p in outline], tolerance
         tolerance *= 2.0
+
+
+def _point(p: Sequence[float]) -> Tuple[float, float]:
+    x, z = p
+    return float(x), float(z)
 
 
 def convex_pieces(polygon: Sequence[Sequence[float]]) -> List[List[Tuple[float, float]]]:
     """A simple counterclockwise polygon as convex counterclockwise pieces: ear-clipping
     triangulation, then adjacent pieces merged while their union stays convex (Hertel-Mehlhorn)."""
-    pts = [tuple(map(float, p)) for p in polygon]
+    pts = [_point(p) for p in polygon]
     if _is_convex(pts):
         return [pts]
     pieces = triangulated(pts)
@@ -197,12 +204,21 @@ def _prism_inertia(polygon, thickness: float, mass: float, com) -> np.ndarray:
     return np.array([[my + mz, 0.0, -mxz], [0.0, mx + mz, 0.0], [-mxz, 0.0, mx + my]])
 
 
+def found(element: ET.Element, path: str) -> ET.Element:
+    """The first element at `path` under `element`; ValueError when there is none (a model the
+    arm's MJCF does not describe)."""
+    hit = element.find(path)
+    if hit is None:
+        raise ValueError(f"the arm's MJCF has no {path}")
+    return hit
+
+
 def mjcf_numbers(values) -> str:
     """Numbers as an MJCF attribute: space-separated, each exact (repr)."""
     return " ".join(repr(float(v)) for v in values)
 
 
-def arm_tree(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None) -> ET.Element:
+def arm_tree(scene: Scene, kinematic_hand: bool = False, robot: Optional[Robot] = None) -> ET.Element:
     """The arm of `robot` (robot.arm_model: the shipped arm when None) as an MJCF element tree, its
     finger servos capped at the scene's grip force; with `kinematic_hand` the shipped arm is
     replaced by a hand at the scene's gripper pose that moves in G's plane through three joints
@@ -211,58 +227,61 @@ def arm_tree(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] =
     (MuJoCo whole, Drake through its MJCF parser)."""
     root = arm_model(None if kinematic_hand else robot).arm_tree()
     if kinematic_hand:
-        _replace_arm_by_kinematic_hand(root, scene["gripper_pose"])
+        _replace_arm_by_kinematic_hand(root, scene.gripper_pose)
     # The finger servos close toward y = 0 and press with at most the grip force. They press with
     # exactly that only while saturated: at the object's faces, half its thickness from y = 0,
     # their spring must exceed the cap, or they press with kp t/2 (the shipped kp gave 20 N on a
     # 10 mm part gripped with 40 N, and no grip force cured its release).
-    grip_force = scene["gripper"]["grip_force"]
+    grip_force = scene.gripper.grip_force
     for finger in FINGER_JOINTS:
-        act = root.find(f".//actuator/position[@name='{finger}']")
+        act = found(root, f".//actuator/position[@name='{finger}']")
         act.set("forcerange", mjcf_numbers((-grip_force, grip_force)))
         act.set("forcelimited", "true")
-        stiff = JAW_SATURATION * grip_force / (scene["object"]["thickness"] / 2)
-        act.set("kp", repr(max(float(act.get("kp")), stiff)))
+        stiff = JAW_SATURATION * grip_force / (scene.object.thickness / 2)
+        kp = act.get("kp")
+        if kp is None:
+            raise ValueError(f"the arm's MJCF gives the servo of {finger} no kp")
+        act.set("kp", repr(max(float(kp), stiff)))
     return root
 
 
-def pad_layout(scene: dict) -> List[Tuple[str, str, float, Tuple[float, float]]]:
+def pad_layout(scene: Scene) -> List[Tuple[str, str, float, Tuple[float, float]]]:
     """Every pad contact point as (name, finger body, side, (x, z) in G [m]): pad i sits on finger
     i mod 2 (the task lists the opposed pads in pairs), `side` is the finger's inner face (+1 on
     finger_pos, -1 on finger_neg), the points as `pad_points` lays them out."""
-    gripper = scene["gripper"]
+    gripper = scene.gripper
     out = []
     for f, (finger, side) in enumerate(zip(FINGER_JOINTS, (1.0, -1.0))):
-        for p, pad in list(enumerate(gripper["pads"]))[f::2]:
-            for k, point in enumerate(pad_points(pad["center"], pad["radius"], gripper["pad_rings"])):
+        for p, pad in list(enumerate(gripper.pads))[f::2]:
+            for k, point in enumerate(pad_points(pad.center, pad.radius, gripper.pad_rings)):
                 out.append((f"{PAD_PREFIX}{finger}_{p}_{k}", finger, side, point))
     return out
 
 
-def object_inertia(obj: dict) -> np.ndarray:
+def object_inertia(obj: SceneObject) -> np.ndarray:
     """The object's inertia tensor [kg m^2] about its centre of mass (object_com), axes of O: a mesh
     part's solid's, else a uniform prism of its outline; with the task's own moment about y either
     way (docs/model.md section 4)."""
-    if "mesh" in obj:
-        inertia = np.array(obj["mesh"]["inertia"], float)
+    if obj.mesh is not None:
+        inertia = np.array(obj.mesh.inertia, float)
     else:
-        inertia = _prism_inertia(obj["polygon"], obj["thickness"], obj["mass"], obj["com"])
-    inertia[1, 1] = obj["inertia"]
+        inertia = _prism_inertia(obj.polygon, obj.thickness, obj.mass, obj.com)
+    inertia[1, 1] = obj.inertia
     return inertia
 
 
-def object_com(obj: dict) -> Tuple[float, float, float]:
+def object_com(obj: SceneObject) -> Tuple[float, float, float]:
     """The object's centre of mass in O [m]: the task's x and z, and along y a mesh part's solid's
     (a prism's lies on its middle plane, y = 0)."""
-    com_y = obj["mesh"]["com_y"] if "mesh" in obj else 0.0
-    return float(obj["com"][0]), float(com_y), float(obj["com"][1])
+    com_y = obj.mesh.com_y if obj.mesh is not None else 0.0
+    return float(obj.com[0]), float(com_y), float(obj.com[1])
 
 
-def object_pieces(obj: dict) -> List[Tuple[str, list, bool]]:
+def object_pieces(obj: SceneObject) -> List[Tuple[str, list, bool]]:
     """The section's convex pieces: (name, convex ccw outline in O's xz [m], whether the piece is
     an axis-aligned rectangle). The prism of these is what a box or polygon part is simulated as
     (object_solid); Drake's pads touch deep prisms of them on any part (drake_arm._add_pad_faces)."""
-    pieces = convex_pieces(simulated_outline(obj["polygon"])[0])
+    pieces = convex_pieces(simulated_outline(obj.polygon)[0])
     return [(f"object_piece{i}", piece, _axis_aligned_rectangle(piece)) for i, piece in enumerate(pieces)]
 
 
@@ -281,29 +300,29 @@ class SolidPiece:
         return (low + high) / 2, high - low
 
 
-def object_solid(obj: dict, half_y: Optional[float] = None) -> List[SolidPiece]:
+def object_solid(obj: SceneObject, half_y: Optional[float] = None) -> List[SolidPiece]:
     """The solid the engines build of the scene's object, as convex pieces: a mesh part's own
     (the object's `mesh`, part_geometry.py), else the prism of each of the section's pieces
     (object_pieces), `half_y` [m] either side of the xz-plane (default half the thickness; a mesh
     part's y is scaled to it, as the video's ghost is drawn thinner)."""
-    half = obj["thickness"] / 2
+    half = obj.thickness / 2
     half_y = half if half_y is None else half_y
-    if "mesh" in obj:
+    if obj.mesh is not None:
         scale = np.array([1.0, half_y / half, 1.0])
         return [SolidPiece(f"object_piece{i}", np.asarray(piece, float) * scale, False)
-                for i, piece in enumerate(obj["mesh"]["pieces"])]
+                for i, piece in enumerate(obj.mesh.pieces)]
     return [SolidPiece(name, np.array([(x, sy * half_y, z) for sy in (-1, 1) for x, z in outline]), rectangle)
             for name, outline, rectangle in object_pieces(obj)]
 
 
-def simulated_geometry(obj: dict) -> str:
+def simulated_geometry(obj: SceneObject) -> str:
     """What solid the engines build of the scene's object, in words: a run's report names it."""
-    if "mesh" in obj:
-        return obj.get("geometry") or f"a mesh part, {len(obj['mesh']['pieces'])} convex pieces"
-    return f"prism of the section, {obj['thickness'] * 1e3:g} mm thick"
+    if obj.mesh is not None:
+        return obj.geometry or f"a mesh part, {len(obj.mesh.pieces)} convex pieces"
+    return f"prism of the section, {obj.thickness * 1e3:g} mm thick"
 
 
-def add_object_geoms(body: ET.Element, assets: ET.Element, obj: dict, half_y: float, rgba: str, prefix: str = "",
+def add_object_geoms(body: ET.Element, assets: ET.Element, obj: SceneObject, half_y: float, rgba: str, prefix: str = "",
                      **attributes: str) -> List[str]:
     """The object's pieces (object_solid, `half_y` m either side of the xz-plane) as geoms of
     `body`: a box piece as a box, any other as a mesh in `assets` (m, in O); `attributes` go on
@@ -313,30 +332,30 @@ def add_object_geoms(body: ET.Element, assets: ET.Element, obj: dict, half_y: fl
         name = prefix + piece.name
         if piece.box:
             center, size = piece.box_center_size()
-            ET.SubElement(body, "geom", name=name, type="box", **attributes, pos=mjcf_numbers(center),
-                          size=mjcf_numbers(size / 2), rgba=rgba)
+            ET.SubElement(body, "geom", {"name": name, "type": "box", **attributes, "pos": mjcf_numbers(center),
+                                         "size": mjcf_numbers(size / 2), "rgba": rgba})
         else:
             ET.SubElement(assets, "mesh", name=name, vertex=mjcf_numbers(np.ravel(piece.vertices)))
-            ET.SubElement(body, "geom", name=name, type="mesh", mesh=name, **attributes, rgba=rgba)
+            ET.SubElement(body, "geom", {"name": name, "type": "mesh", "mesh": name, **attributes, "rgba": rgba})
         names.append(name)
     return names
 
 
-def feature_solid(feature: dict, obj: dict) -> dict:
+def feature_solid(feature: SceneFeature, obj: SceneObject) -> dict:
     """A feature's fixed solid in W: a box whose contact face is the pusher's segment (less
     FEATURE_CORNER_GAP, or a quarter of it, at an end in a reflex corner of the object's polygon),
     extending FEATURE_DEPTH behind it (`center`, `angle` about y, `half_size`), or for a point
     pusher a rod along y (`center`, `radius`, `half_length`). It is FEATURE_CLEARANCE narrower than
     the object `obj` (the scene's, m) on each side along y, so that it touches the object's face and
     never a pad."""
-    a = np.asarray(feature["from"], float)
-    b = np.asarray(feature["to"], float)
-    n = np.asarray(feature["normal"], float)
-    half_y = max(obj["thickness"] / 2 - FEATURE_CLEARANCE, 0.001)
+    a = np.asarray(feature.start, float)
+    b = np.asarray(feature.end, float)
+    n = np.asarray(feature.normal, float)
+    half_y = max(obj.thickness / 2 - FEATURE_CLEARANCE, 0.001)
     length = float(np.linalg.norm(b - a))
     if length > 0:
         t = (b - a) / length
-        corners = _reflex_corners_in_world(obj["polygon"], feature["object_pose"])
+        corners = _reflex_corners_in_world(obj.polygon, feature.object_pose)
         in_corner = lambda p: any(np.linalg.norm(p - c) < 1e-6 for c in corners)  # noqa: E731
         gap = min(FEATURE_CORNER_GAP, length / 4)
         a, b = (a + t * gap if in_corner(a) else a), (b - t * gap if in_corner(b) else b)
@@ -354,12 +373,12 @@ def _reflex_corners_in_world(polygon: Sequence[Sequence[float]], object_pose: Se
             if turn(polygon[k - 1], v, polygon[(k + 1) % n]) < -1e-15]  # a right turn, as _is_convex counts one
 
 
-def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot] = None) -> str:
-    """The complete MJCF of a scene description (see `stablepush.execution.protocol`): `arm_tree`
+def build_mjcf(scene: Scene, kinematic_hand: bool = False, robot: Optional[Robot] = None) -> str:
+    """The complete MJCF of a scene (`stablepush.execution.scene.Scene`): `arm_tree`
     of `robot` plus the solver options, the pad points, the held object, the features and the
     contact pairs."""
     root = arm_tree(scene, kinematic_hand, robot)
-    gx, gz = scene["gravity"]
+    gx, gz = scene.gravity
     ET.SubElement(root, "option", timestep=repr(TIMESTEP), gravity=mjcf_numbers((gx, 0.0, gz)), cone="elliptic",
                   impratio=repr(IMPRATIO), noslip_iterations=str(NOSLIP_ITERATIONS),
                   noslip_tolerance=repr(NOSLIP_TOLERANCE), integrator="implicitfast")
@@ -367,27 +386,26 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
     # its heel stop in 12 pushes that the model, Drake and libccd all hold (docs/results/engines-cross-engine.md),
     # and with the feature tiles the notched pivot's bar still turned 0.15 deg in the world where
     # libccd turns it 0.03 (its pads on the section's non-rectangular pieces).
-    root.find("option").append(ET.Element("flag", multiccd="enable", nativeccd="disable"))
-    worldbody = root.find("worldbody")
-    obj = scene["object"]
-    gripper = scene["gripper"]
-    half_thickness = obj["thickness"] / 2
+    found(root, "option").append(ET.Element("flag", multiccd="enable", nativeccd="disable"))
+    worldbody = found(root, "worldbody")
+    obj = scene.object
+    half_thickness = obj.thickness / 2
 
     # The pads: point spheres on the inner side of each finger, in G's xz-plane.
     pad_names = []
     for name, finger, side, (px, pz) in pad_layout(scene):
-        body = root.find(f".//body[@name='{finger}']")
+        body = found(root, f".//body[@name='{finger}']")
         ET.SubElement(body, "geom", name=name, type="sphere", size=repr(PAD_POINT_RADIUS),
                       pos=mjcf_numbers((px, side * PAD_POINT_RADIUS, pz)), mass="0.0001", rgba="0.2 0.2 0.2 1")
         pad_names.append(name)
 
     # The held object: a free body of convex pieces in O (object_solid).
-    x, y, z, w, qx, qy, qz = scene["object_pose"]
+    x, y, z, w, qx, qy, qz = scene.object_pose
     body = ET.SubElement(worldbody, "body", name=OBJECT_BODY, pos=mjcf_numbers((x, y, z)),
                          quat=mjcf_numbers((w, qx, qy, qz)))
     ET.SubElement(body, "freejoint", name=OBJECT_BODY)
     inertia = object_inertia(obj)
-    ET.SubElement(body, "inertial", pos=mjcf_numbers(object_com(obj)), mass=repr(obj["mass"]),
+    ET.SubElement(body, "inertial", pos=mjcf_numbers(object_com(obj)), mass=repr(obj.mass),
                   fullinertia=mjcf_numbers((inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2],
                                             inertia[1, 2])))
     assets = root.find("asset")
@@ -395,22 +413,22 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
         assets = ET.SubElement(root, "asset")
     piece_names = add_object_geoms(body, assets, obj, half_thickness, "0.85 0.55 0.25 1", mass="0")
     pad_faces = piece_names
-    if "mesh" in obj:
+    if obj.mesh is not None:
         # A mesh part's pads press on the prism of its section, massless and unseen, not on its
         # pieces: MuJoCo's sphere-vs-convex-mesh contact (libccd) turned the pivoting box, built as
         # one mesh, 0.11 deg in the world where its box primitive turns 0.01 deg (the contract's
         # limit is 0.1). The planner takes a plan only where the pads rest on the solid's flat faces
         # at +-thickness/2, so the prism's faces under the pads are the solid's.
-        section = {key: value for key, value in obj.items() if key != "mesh"}
+        section = dataclasses.replace(obj, mesh=None)
         pad_faces = add_object_geoms(body, assets, section, half_thickness, "0 0 0 0", prefix=SLAB_PREFIX, mass="0")
 
     # The features: fixed solids whose contact face is the pusher's segment. A mesh piece touches a
     # line feature's tiles (FEATURE_TILES), a box piece its box (box-box contacts have their own depths).
     contact = ET.SubElement(root, "contact")
-    mesh_pieces = [n for n in piece_names if body.find(f"geom[@name='{n}']").get("type") == "mesh"]
+    mesh_pieces = [n for n in piece_names if found(body, f"geom[@name='{n}']").get("type") == "mesh"]
     box_pieces = [n for n in piece_names if n not in mesh_pieces]
-    for feature in scene["features"]:
-        name = feature_geom(feature["pusher"])
+    for feature in scene.features:
+        name = feature_geom(feature.pusher)
         solid = feature_solid(feature, obj)
         if solid["kind"] == "box":
             ET.SubElement(worldbody, "geom", name=name, type="box", pos=mjcf_numbers(solid["center"]),
@@ -421,14 +439,14 @@ def build_mjcf(scene: dict, kinematic_hand: bool = False, robot: Optional[Robot]
             ET.SubElement(worldbody, "geom", name=name, type="capsule", size=repr(solid["radius"]),
                           fromto=mjcf_numbers((*(c - [0, h, 0]), *(c + [0, h, 0]))), rgba="0.3 0.5 0.8 1")
         for piece in box_pieces:
-            _pair(contact, name, piece, feature["mu"])
+            _pair(contact, name, piece, feature.mu)
         tiles = _add_feature_tiles(worldbody, name, solid) if solid["kind"] == "box" and mesh_pieces else [name]
         for tile in tiles:
             for piece in mesh_pieces:
-                _pair(contact, tile, piece, feature["mu"])
+                _pair(contact, tile, piece, feature.mu)
     for pad in pad_names:
         for piece in pad_faces:
-            _pair(contact, pad, piece, gripper["mu"])
+            _pair(contact, pad, piece, scene.gripper.mu)
     return ET.tostring(root, encoding="unicode")
 
 
@@ -475,9 +493,9 @@ def pad_geoms(model) -> List[int]:
 def _replace_arm_by_kinematic_hand(root: ET.Element, gripper_pose: Sequence[float]) -> None:
     """Swap the arm for a body at G's pose with HAND_JOINTS and the arm's own fingers, finger
     servos and jaw coupling (so the grasp is the arm's, without the arm's dynamics)."""
-    worldbody = root.find("worldbody")
-    arm_base = worldbody.find("body")
-    fingers = [root.find(f".//body[@name='{f}']") for f in FINGER_JOINTS]
+    worldbody = found(root, "worldbody")
+    arm_base = found(worldbody, "body")
+    fingers = [found(root, f".//body[@name='{f}']") for f in FINGER_JOINTS]
     worldbody.remove(arm_base)
     x, y, z, w, qx, qy, qz = gripper_pose
     hand = ET.SubElement(worldbody, "body", name="hand", pos=mjcf_numbers((x, y, z)),
@@ -490,7 +508,7 @@ def _replace_arm_by_kinematic_hand(root: ET.Element, gripper_pose: Sequence[floa
         finger.set("pos", "0 0 0")
         finger.set("quat", "1 0 0 0")
         hand.append(finger)
-    actuators = root.find("actuator")
+    actuators = found(root, "actuator")
     for act in list(actuators):
         if act.get("name") not in FINGER_JOINTS:
             actuators.remove(act)

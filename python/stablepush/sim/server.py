@@ -20,6 +20,7 @@ from typing import Callable, Iterator, Optional
 from stablepush.errors import SettingError
 from stablepush.execution.arm import ArmError
 from stablepush.execution.protocol import LineReader, ProtocolError, decode, encode
+from stablepush.execution.scene import Scene
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE
@@ -33,7 +34,7 @@ class SimArmServer:
     """Serves the simulated arm of `robot` (a task.model.Robot; None: the shipped arm) on
     host:port (port 0 picks a free one; see `.port`)."""
 
-    def __init__(self, host: str = "127.0.0.1", port: int = 0, log: Callable[[str], None] = None,
+    def __init__(self, host: str = "127.0.0.1", port: int = 0, log: Optional[Callable[[str], None]] = None,
                  exit_after: Optional[int] = None, deviation: WorldDeviation = WorldDeviation(),
                  idle_timeout: float = DEFAULT_IDLE_TIMEOUT, engine: str = DEFAULT_ENGINE, robot=None):
         self.log = log or (lambda text: print(f"sim-arm: {text}", file=sys.stderr, flush=True))
@@ -118,7 +119,9 @@ class SimArmServer:
                 if not greeted and kind != "hello":
                     raise ProtocolError(f"expected hello first, got {kind!r}")
                 if kind == "hello":
-                    ready = self.arm.hello(message["scene"], message["rate_hz"], message.get("continue") is True)
+                    # decode checked the scene (protocol.check_scene)
+                    ready = self.arm.hello(Scene.from_dict(message["scene"]), message["rate_hz"],
+                                           message.get("continue") is True)
                     greeted = True
                     expected_seq = 0
                     reply = {"type": "ready", "protocol": message["protocol"], "arm": ready.arm,

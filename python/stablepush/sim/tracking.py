@@ -8,13 +8,17 @@ midway between the pads.
 from __future__ import annotations
 
 import math
-from typing import Dict, Optional, Sequence
+from typing import TYPE_CHECKING, Callable, Dict, Optional, Sequence
 
 import numpy as np
 
+from stablepush.execution.scene import Scene
 from stablepush.frames import angle_about_y, matrix_to_pose
 from stablepush.sim import ik
 from stablepush.sim.deviation import WorldDeviation
+
+if TYPE_CHECKING:
+    from stablepush.sim.robot import ArmModel
 
 SETTLE_TIME = 0.3  # s of simulation after the grasp closes, before the first waypoint
 
@@ -36,8 +40,22 @@ class TrackingArm:
     next's over the waypoint period (`_set_servos`, `_run`), and the report with the tracker's
     noise. Mixed in before the engine's grasp class, whose constructor takes the altered scene."""
 
-    def __init__(self, scene: dict, deviation: WorldDeviation = WorldDeviation(), robot=None):
-        super().__init__(deviation.apply(scene), robot=robot)
+    if TYPE_CHECKING:  # what the engine's grasp and arm class give (arm.SimArm, drake_arm.DrakeArm)
+        arm: ArmModel
+        timestep: float
+        steps_per_second: float
+        _kinematics: ik.Kinematics
+        _lower: np.ndarray
+        _upper: np.ndarray
+
+        def _set_servos(self, q_arm: np.ndarray) -> None: ...
+        def _run(self, n: int, before_step: Callable[[int], None]) -> None: ...
+        def gripper_matrix(self) -> np.ndarray: ...
+        def object_matrix(self) -> np.ndarray: ...
+        def contact_force_on_object(self, pusher: str) -> np.ndarray: ...
+
+    def __init__(self, scene: Scene, deviation: WorldDeviation = WorldDeviation(), robot=None):
+        super().__init__(deviation.apply(scene), robot=robot)  # type: ignore[call-arg]  # the engine's grasp
         self.scene = scene
         self.deviation = deviation
         self._tracker_rng = np.random.default_rng(deviation.seed)
@@ -46,10 +64,10 @@ class TrackingArm:
         """The joint angles [rad] that put G at the scene's gripper pose: the posture IK's
         null space pulls toward, and the servos' first target (ik.find_home from the arm's
         guesses)."""
-        self.home_posture, error = ik.find_home(self._kinematics, self.scene["gripper_pose"], self.arm.home_guesses,
+        self.home_posture, error = ik.find_home(self._kinematics, self.scene.gripper_pose, self.arm.home_guesses,
                                                 self._lower, self._upper)
         if error > ik.HOME_TOLERANCE:
-            raise ik.unreachable(self.scene["gripper_pose"], error)
+            raise ik.unreachable(self.scene.gripper_pose, error)
         self.target = self.home_posture.copy()
         return self.home_posture
 
@@ -98,6 +116,6 @@ class TrackingArm:
             "steps_per_s": round(self.steps_per_second, 1),
         }
         if contact_force:
-            report["contact_force"] = [float(v) for v in sum((self.contact_force_on_object(f["pusher"])
-                                                              for f in self.scene["features"]), np.zeros(3))]
+            report["contact_force"] = [float(v) for v in sum((self.contact_force_on_object(f.pusher)
+                                                              for f in self.scene.features), np.zeros(3))]
         return report

@@ -3,8 +3,8 @@ recorded by the executor (`stablepush.execution.bags.RunRecording`, one sample p
 waypoint) drawn after the run by MuJoCo's renderer, headless (OSMesa), and encoded as H.264 MP4 by
 the ffmpeg that the imageio-ffmpeg wheel ships.
 
-The drawing is a render-only MuJoCo model built from the run's scene description (the one the
-executor sends in its hello, `stablepush.execution.world.scene_description`): the features, the
+The drawing is a render-only MuJoCo model built from the run's scene (the one the executor sends
+in its hello, `stablepush.execution.world.scene_description`): the features, the
 object, the pads and the plan's ghost are mocap bodies or fixed geoms whose poses are set from
 the recorded states frame by frame, and nothing is simulated. So a run on Drake, or on an arm that
 reports the object, is drawn the same way as one on MuJoCo.
@@ -58,6 +58,7 @@ import numpy as np
 from stablepush.errors import OutputError
 from stablepush.execution.bags import RunSample
 from stablepush.execution.run import RunOutput, RunResult
+from stablepush.execution.scene import Scene
 from stablepush.execution.world import place_features, scene_description
 from stablepush.extras import require
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, quat_about_y
@@ -166,8 +167,8 @@ def video_directory(path: Union[str, Path]) -> str:
     return os.path.abspath(path)
 
 
-def run_scene(task: Task, plan: Plan, closed_loop: bool = False, resume_from: int = 0) -> dict:
-    """The scene description `execute_plan` sends for this run (the features it places: every
+def run_scene(task: Task, plan: Plan, closed_loop: bool = False, resume_from: int = 0) -> Scene:
+    """The scene `execute_plan` sends for this run (the features it places: every
     pusher's with a closed loop), in the task's own world; a simulated world that departs from it
     is `WorldDeviation.apply` of this."""
     steps = list(plan.waypoints)
@@ -189,16 +190,20 @@ class RunVideo(RunOutput):
         check_size(tuple(size))
         check_view(view)
         check_video_path(path)
-        self.path, self.fps, self.size, self.progress, self.view = path, fps, tuple(size), progress, view
+        width, height = size
+        self.path, self.fps, self.size, self.progress, self.view = path, fps, (width, height), progress, view
         self.info: Optional[VideoInfo] = None
 
     def write(self, run: RunResult) -> Optional[str]:
-        if run.fault is not None and not run.recording.samples:
+        recording = run.recording
+        if recording is None:  # `records`: run_plan keeps a recording for this output
+            raise ValueError("a video needs the run's recording")
+        if run.fault is not None and not recording.samples:
             return None
         closed_loop = run.options.closed_loop is not None
         scene = run_scene(run.task, run.plan, closed_loop, run.options.resume_from)
-        robot = run.task.environment.robot if run.recording.robot is not None else None  # the arm's joints are its
-        info = self.info = render_run(self.path, run.task, scene, run.recording.samples, fps=self.fps,
+        robot = run.task.environment.robot if recording.robot is not None else None  # the arm's joints are its
+        info = self.info = render_run(self.path, run.task, scene, recording.samples, fps=self.fps,
                                       size=self.size, progress=self.progress, view=self.view, robot=robot)
         return (f"video written to {self.path}: {info.frames} frames, {info.width}x{info.height} at {info.fps:g} "
                 f"fps, drawn in {info.render_s:.1f} s ({info.ms_per_frame:.0f} ms a frame)")
@@ -273,13 +278,13 @@ def object_in_world(sample: RunSample) -> Optional[np.ndarray]:
 # -- the render-only model ------------------------------------------------------------------------
 
 
-def _frame_box(scene: dict, samples: Sequence[RunSample], chosen: Sequence[int]) -> Tuple[float, float, float, float]:
+def _frame_box(scene: Scene, samples: Sequence[RunSample], chosen: Sequence[int]) -> Tuple[float, float, float, float]:
     """The region of G's xz-plane the camera shows (x0, z0, x1, z1, m): the plan's outline at
     every drawn step, the object at the start and the pads, with a margin for the features. An
     object dropped from the grasp leaves the picture rather than shrinking it."""
-    outline = np.asarray(simulated_outline(scene["object"]["polygon"])[0])
+    outline = np.asarray(simulated_outline(scene.object.polygon)[0])
     points = []
-    poses = {samples[i].planned for i in chosen if samples[i].planned is not None}
+    poses = {q for q in (samples[i].planned for i in chosen) if q is not None}
     for q in poses:
         T = grasp_transform(q)
         points.append(outline @ T[[0, 2]][:, [0, 2]].T + T[[0, 2], 3])
@@ -287,8 +292,8 @@ def _frame_box(scene: dict, samples: Sequence[RunSample], chosen: Sequence[int])
     if first is not None:
         T = np.linalg.inv(pose_to_matrix(samples[chosen[0]].reported)) @ first
         points.append(outline @ T[[0, 2]][:, [0, 2]].T + T[[0, 2], 3])
-    for pad in scene["gripper"]["pads"]:
-        (cx, cz), r = pad["center"], pad["radius"]
+    for pad in scene.gripper.pads:
+        (cx, cz), r = pad.center, pad.radius
         points.append(np.array([[cx - r, cz - r], [cx + r, cz + r]]))
     allp = np.vstack(points)
     low, high = allp.min(axis=0), allp.max(axis=0)
@@ -296,13 +301,13 @@ def _frame_box(scene: dict, samples: Sequence[RunSample], chosen: Sequence[int])
     return low[0] - margin, low[1] - margin, high[0] + margin, high[1] + margin
 
 
-def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: Tuple[int, int]) -> str:
-    """The render-only MJCF of a scene description (SI units): the features as fixed geoms named as
+def render_model_xml(scene: Scene, box: Tuple[float, float, float, float], size: Tuple[int, int]) -> str:
+    """The render-only MJCF of a scene (SI units): the features as fixed geoms named as
     the simulated arm names them (`scene.feature_geom`), the object, the plan's ghost and the
     gripper (pads, fingers, backdrop and the camera `view`) as mocap bodies; no joints, no contacts.
     The camera frames `box` (G's xz-plane, m) at the aspect of `size` (width, height)."""
-    obj, gripper = scene["object"], scene["gripper"]
-    half = obj["thickness"] / 2
+    obj = scene.object
+    half = obj.thickness / 2
     width, height = size
     x0, z0, x1, z1 = box
     # 6% of the height above and below for the caption and the legend
@@ -322,9 +327,9 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
     assets = ET.SubElement(root, "asset")
     world = ET.SubElement(root, "worldbody")
 
-    for feature in scene["features"]:
+    for feature in scene.features:
         solid = feature_solid(feature, obj)
-        name = feature_geom(feature["pusher"])
+        name = feature_geom(feature.pusher)
         if solid["kind"] == "box":
             ET.SubElement(world, "geom", name=name, type="box", pos=mjcf_numbers(solid["center"]),
                           quat=mjcf_numbers(quat_about_y(solid["angle"])), size=mjcf_numbers(solid["half_size"]),
@@ -342,7 +347,7 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
     # of the object's face and of the pads, so it is always seen, 3 pixels wide.
     ghost = ET.SubElement(world, "body", name="ghost", mocap="true")
     add_object_geoms(ghost, assets, obj, max(half - 0.001, half / 2), mjcf_numbers(_GHOST_RGBA), prefix="ghost_")
-    outline = simulated_outline(obj["polygon"])[0]
+    outline = simulated_outline(obj.polygon)[0]
     front = -(half + 0.0015)
     for k, (a, b) in enumerate(zip(outline, outline[1:] + outline[:1])):
         ET.SubElement(ghost, "geom", name=f"ghost_edge{k}", type="capsule",
@@ -350,9 +355,9 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
                       fromto=mjcf_numbers((a[0], front, a[1], b[0], front, b[1])), rgba=mjcf_numbers(_GHOST_EDGE_RGBA))
 
     hand = ET.SubElement(world, "body", name="gripper", mocap="true")
-    for k, pad in enumerate(gripper["pads"]):  # pad k on the finger at +y when k is even (scene.pad_layout)
+    for k, pad in enumerate(scene.gripper.pads):  # pad k on the finger at +y when k is even (scene.pad_layout)
         side = 1.0 if k % 2 == 0 else -1.0
-        (cx, cz), r = pad["center"], pad["radius"]
+        (cx, cz), r = pad.center, pad.radius
         ET.SubElement(hand, "geom", name=f"pad{k}", type="cylinder", size=mjcf_numbers((r, 0.0005)),
                       pos=mjcf_numbers((cx, side * (half + 0.0006), cz)),
                       quat=mjcf_numbers((math.sqrt(0.5), math.sqrt(0.5), 0, 0)),
@@ -373,12 +378,12 @@ def render_model_xml(scene: dict, box: Tuple[float, float, float, float], size: 
 # -- drawing and encoding ------------------------------------------------------------------------
 
 
-def render_run(path: Union[str, Path], task: Task, scene: dict, samples: Sequence[RunSample], *,
+def render_run(path: Union[str, Path], task: Task, scene: Scene, samples: Sequence[RunSample], *,
                fps: float = DEFAULT_FPS, size: Tuple[int, int] = DEFAULT_SIZE,
                progress: Optional[Callable[[int, int], None]] = None, view: str = DEFAULT_VIEW,
                robot: Optional[Robot] = None) -> VideoInfo:
     """Draw the recorded run `samples` (RunRecording.samples) of `task` in the world `scene` (the
-    scene description the run's arm built; the features are drawn where it has them) in `view`
+    scene the run's arm built; the features are drawn where it has them) in `view`
     (VIDEO_VIEWS; the 3-D view draws the arm of `robot` from the samples' joints) and write it to
     `path` (.mp4) atomically. `progress(frames done, frames)` after each frame. OutputError (naming
     the path) for a bad file name or setting, a run without samples or without the object's pose (a
@@ -399,7 +404,8 @@ def render_run(path: Union[str, Path], task: Task, scene: dict, samples: Sequenc
     if all(object_in_world(s) is None for s in samples):
         raise OutputError(f"{path}: the arm reported no pose of the object (neither object_pose nor a tracker's "
                           f"object_in_grasp), so there is nothing to draw; a simulated arm (--sim) reports it")
-    joints = _arm_joints(path, samples, robot) if view != "schematic" else [None] * len(samples)
+    joints: Sequence[Optional[np.ndarray]] = (_arm_joints(path, samples, robot) if view != "schematic"
+                                              else [None] * len(samples))
     width, height = (int(n) for n in size)
     imageio_ffmpeg = _encoder()
     mujoco = _mujoco()
@@ -475,13 +481,13 @@ class _Schematic:
     legend = ((_OBJECT_RGBA, "object"), (_GHOST_EDGE_RGBA, "plan at this step"),
               (_ACTIVE_FEATURE_RGBA, "pusher in contact"), (_PAD_RGBA, "pads"))
 
-    def __init__(self, mujoco, path, scene: dict, samples: Sequence[RunSample], chosen: Sequence[int],
+    def __init__(self, mujoco, path, scene: Scene, samples: Sequence[RunSample], chosen: Sequence[int],
                  size: Tuple[int, int]):
         self.mujoco = mujoco
         self.model = mujoco.MjModel.from_xml_string(render_model_xml(scene, _frame_box(scene, samples, chosen), size))
         self.data = mujoco.MjData(self.model)
         self.mocap = {name: self.model.body(name).mocapid[0] for name in ("object", "ghost", "gripper")}
-        self.features = {f["pusher"]: self.model.geom(feature_geom(f["pusher"])).id for f in scene["features"]}
+        self.features = {f.pusher: self.model.geom(feature_geom(f.pusher)).id for f in scene.features}
         self.renderer = _renderer(mujoco, self.model, size, path)
 
     def draw(self, sample: RunSample, T_WO: np.ndarray, _joints) -> np.ndarray:
@@ -509,11 +515,13 @@ class _ArmView:
 
     legend = ((_OBJECT_RGBA, "object"), (_ACTIVE_FEATURE_RGBA, "pusher in contact"), (_ARM_RGBA, "arm"))
 
-    def __init__(self, mujoco, path, scene: dict, robot: Robot, samples: Sequence[RunSample],
-                 joints: Sequence[np.ndarray], size: Tuple[int, int]):
+    def __init__(self, mujoco, path, scene: Scene, robot: Optional[Robot], samples: Sequence[RunSample],
+                 joints: Sequence[Optional[np.ndarray]], size: Tuple[int, int]):
         self.mujoco = mujoco
         root = ET.fromstring(build_mjcf(scene, robot=robot))
-        assets = root.find("asset") if root.find("asset") is not None else ET.SubElement(root, "asset")
+        assets = root.find("asset")
+        if assets is None:
+            assets = ET.SubElement(root, "asset")
         ET.SubElement(assets, "texture", type="skybox", builtin="flat", rgb1=_SKY_RGB, rgb2=_SKY_RGB, width="8",
                       height="8")
         model = self.model = mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
@@ -523,8 +531,8 @@ class _ArmView:
         self.arm = [int(model.jnt_qposadr[model.joint(j).id]) for j in arm_model(robot).joints]
         self.object = int(model.jnt_qposadr[model.joint(OBJECT_BODY).id])
         for finger in FINGER_JOINTS:
-            self.data.qpos[model.jnt_qposadr[model.joint(finger).id]] = scene["object"]["thickness"] / 2
-        self.features = {f["pusher"]: model.geom(feature_geom(f["pusher"])).id for f in scene["features"]}
+            self.data.qpos[model.jnt_qposadr[model.joint(finger).id]] = scene.object.thickness / 2
+        self.features = {f.pusher: model.geom(feature_geom(f.pusher)).id for f in scene.features}
         self.camera = self._framing(samples, joints)
         self.renderer = _renderer(mujoco, model, size, path)
 
@@ -533,7 +541,7 @@ class _ArmView:
         self.data.qpos[self.object:self.object + 7] = matrix_to_pose(T_WO)
         self.mujoco.mj_kinematics(self.model, self.data)
 
-    def _framing(self, samples: Sequence[RunSample], joints: Sequence[np.ndarray]):
+    def _framing(self, samples: Sequence[RunSample], joints: Sequence[Optional[np.ndarray]]):
         """A free camera at _AZIMUTH, _ELEVATION on the work: the features, and the object and G at a
         few poses spread over the run, with room around them for the jaws and the arm's wrist (the
         rest of the arm runs out of the picture, where the part would be too small to see)."""
@@ -545,8 +553,8 @@ class _ArmView:
             if T_WO is not None:
                 points.append(T_WO[:3, 3])
             points.append(np.asarray(samples[k].reported[:3], float))
-        points = np.array(points)
-        low, high = points.min(axis=0), points.max(axis=0)
+        corners = np.array(points)
+        low, high = corners.min(axis=0), corners.max(axis=0)
         camera = self.mujoco.MjvCamera()
         camera.type = self.mujoco.mjtCamera.mjCAMERA_FREE
         camera.lookat[:] = (low + high) / 2
