@@ -151,3 +151,63 @@ def video_request(option: str, path_option: Callable, view_option: Optional[Call
 
     decorators = [path_option, video_options(option)] + ([view_option] if view_option else [])
     return option_group("video", build, *decorators)
+
+
+@dataclass(frozen=True)
+class RunnerChoice:
+    """--workers K | --ray [ADDRESS]: where a batch runs (stablepush.runners.Runner)."""
+
+    workers: Optional[int]
+    ray_address: Optional[str]
+
+    def runner(self, default: int):
+        """The Runner (`default` workers when neither is given; both at once exit 2), a Ray head
+        checked before any work."""
+        from stablepush_cli.common import runner_for
+
+        return runner_for(self.workers, self.ray_address, default)
+
+
+def runner_choice(what: str, default: str = "the number of CPUs", where_help: str = "") -> Callable:
+    """--workers and --ray for the jobs `what` names ("the trials"), as `where` (RunnerChoice);
+    `default` says where they run without either."""
+    from stablepush_cli.options import Whole, parse_ray_address
+
+    return option_group(
+        "where", RunnerChoice,
+        click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
+                     help=f"Run {what} on K local processes (default: {default}).{where_help}"),
+        click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+                     callback=parse_ray_address,
+                     help=f"Run {what} on Ray: a local instance, or the cluster at ADDRESS (e.g. 10.0.0.5:6379; see "
+                          f"docs/evaluate.md, 'Where the trials run')."))
+
+
+@dataclass(frozen=True)
+class StudyOutputs:
+    """--json, --csv, --plot: where a study's records and figure go."""
+
+    json_path: Optional[str]
+    csv_path: Optional[str]
+    png_path: Optional[str]
+
+    def named(self) -> Dict[str, Optional[str]]:
+        return {"--json": self.json_path, "--csv": self.csv_path, "--plot": self.png_path}
+
+    def given(self) -> list:
+        return [path for path in (self.json_path, self.csv_path, self.png_path) if path]
+
+
+@dataclass(frozen=True)
+class WorldSpreads:
+    """--vary, --feature-error, --tracker-noise: how a study's worlds differ from the task."""
+
+    vary: Optional[Dict[str, float]]
+    feature_error: Optional[Tuple[float, float]]
+    tracker_noise: Tuple[float, float] = (0.0, 0.0)
+
+    def spreads(self, task):
+        """The study's Spreads for `task` (exit 2 naming the option for one out of range)."""
+        from stablepush_cli.common import study_spreads
+
+        return study_spreads(task, self.vary, self.feature_error, self.tracker_noise)

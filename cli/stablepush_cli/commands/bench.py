@@ -8,15 +8,14 @@ import click
 from stablepush_cli.common import (
     check_named_outputs,
     load_task_file,
-    runner_for,
     say_beside,
 )
+from stablepush_cli.groups import RunnerChoice, runner_choice
 from stablepush_cli.options import (
     SEED,
     TIME_LIMIT,
     Finite,
     Whole,
-    parse_ray_address,
 )
 
 
@@ -42,14 +41,10 @@ from stablepush_cli.options import (
 @click.option("--improve-for", type=Finite(min=0), default=None, metavar="S",
               help="Anytime planning: keep improving S seconds after the first plan (planner.improve_for), "
                    "and report the first and the improved plans.")
-@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
-              help="Run the planning trials on K local processes (default: one after the other, here). "
-                   "Times are each search's own, so they compare across runners; parallel runs share the CPUs.")
-@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
-              callback=parse_ray_address,
-              help="Run the planning trials on Ray: a local instance, or the cluster at ADDRESS.")
+@runner_choice("the planning trials", "one after the other, here",
+               " Times are each search's own, so they compare across runners; parallel runs share the CPUs.")
 def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out_path, count: int,
-          improve_for, workers, ray_address) -> None:
+          improve_for, where: RunnerChoice) -> None:
     """Benchmark planning over seeds, in the shape of the paper's Table II.
 
     For each task: success rate, median / p95 / min / max planning time, median switch-overs and path
@@ -82,7 +77,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     check_named_outputs({"--out": out_path}, {f"TASK.yaml {path}": path for path in task_files})
     say = say_beside(out_path)
 
-    runner = None if workers is None and ray_address is None else runner_for(workers, ray_address, default=1)
+    runner = None if where.workers is None and where.ray_address is None else where.runner(default=1)
     every, rows = [], []
     with click.progressbar(length=trials * len(tasks), label="planning", file=sys.stderr) as bar:
         for task in tasks:

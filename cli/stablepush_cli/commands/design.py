@@ -16,15 +16,14 @@ from stablepush_cli.common import (
     given,
     landings_bar,
     progressbar,
-    runner_for,
     say_beside,
     study_spreads,
 )
+from stablepush_cli.groups import RunnerChoice, runner_choice
 from stablepush_cli.options import (
     TIME_LIMIT,
     Finite,
     Whole,
-    parse_ray_address,
     parse_vary,
 )
 
@@ -76,14 +75,11 @@ ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine"
                    "layouts (`unsolved`, and grouped by why: `no_plan`) and the verdict.")
 @click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
               help="Draw the best three layouts side by side (PNG, PDF or SVG).")
-@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
-              help="Plan the layouts on K local processes (default: the number of CPUs).")
-@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
-              callback=parse_ray_address, help="Plan the layouts on Ray: a local instance, or the cluster at ADDRESS.")
+@runner_choice("the layouts' plans")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, time_limit: float, reach_top: int, trials,
            evaluate_top: int, vary, feature_error, closed_loop: bool, engine: str, seed: int, out_dir, json_path,
-           png_path, workers, ray_address, quiet: bool) -> None:
+           png_path, where: RunnerChoice, quiet: bool) -> None:
     """Find where the fixtures should go: rank layouts of candidate pushers by their plans.
 
     DESIGN.yaml is a task file whose `candidates` stand in for its `pushers`: `candidates: {mu:
@@ -130,7 +126,7 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     check_designs_folder(out, "--out")
     task, candidates = load_design(design_file)
     spreads = _spreads(task, candidates, design_file, trials, vary, feature_error)
-    runner = runner_for(workers, ray_address, default=default_workers())
+    runner = where.runner(default=default_workers())
     bar = progressbar(quiet, length=None, label="layouts planned", show_pos=True)
     try:
         study = search(task, candidates, source=design_file, max_fixtures=max_fixtures, rank=rank,

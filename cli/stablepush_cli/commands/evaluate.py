@@ -8,7 +8,6 @@ import click
 
 from stablepush.errors import OutputError, SettingError
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
-from stablepush.task import with_robot
 from stablepush_cli.common import (
     EXIT_INTERNAL,
     EXIT_NOT_SOLVED,
@@ -18,18 +17,24 @@ from stablepush_cli.common import (
     landings_bar,
     load_plan_and_task,
     load_task_file,
-    runner_for,
     say_beside,
-    study_spreads,
+)
+from stablepush_cli.groups import (
+    RobotChoice,
+    RunnerChoice,
+    StudyOutputs,
+    VideoRequest,
+    WorldSpreads,
+    option_group,
+    robot_choice,
+    runner_choice,
+    video_request,
 )
 from stablepush_cli.options import (
     Finite,
     Whole,
     check_video,
-    parse_ray_address,
     parse_vary,
-    robot_options,
-    video_options,
     video_settings_need,
 )
 
@@ -58,16 +63,18 @@ from stablepush_cli.options import (
 @click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
               help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and outcomes, "
                    "serially, on workers or on Ray.")
-@click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
+@option_group(
+    "worlds", WorldSpreads,
+    click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
               help="Multiply the task's KEY (pad_mu, pusher_mu, grip_force or mass) in each world by a factor drawn "
                    "uniformly within 1 +- FRACTION. Repeatable; `--vary none` varies nothing. Default: the task's "
                    "uncertainty box, else pad_mu and pusher_mu 0.1, grip_force 0.05, mass 0.02, with "
-                   "--feature-error 0.2 0.2 (docs/evaluate.md, 'The worlds').")
-@click.option("--feature-error", nargs=2, type=Finite(min=0), default=None, metavar="MM DEG",
-              help="Place each feature off by up to MM in x and z and DEG about y (uniform). Default: 0.2 0.2 "
-                   "without --vary, else 0 0.")
-@click.option("--tracker-noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0), metavar="MM DEG",
-              help="Standard deviations of the tracker's noise on the pose in the grasp.")
+                   "--feature-error 0.2 0.2 (docs/evaluate.md, 'The worlds')."),
+    click.option("--feature-error", nargs=2, type=Finite(min=0), default=None, metavar="MM DEG",
+                 help="Place each feature off by up to MM in x and z and DEG about y (uniform). Default: 0.2 0.2 "
+                      "without --vary, else 0 0."),
+    click.option("--tracker-noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0), metavar="MM DEG",
+                 help="Standard deviations of the tracker's noise on the pose in the grasp."))
 @click.option("--closed-loop", is_flag=True, help="Run each trial closed loop (re-plan from the tracked pose).")
 @click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
               help="Find each feature by touch at the end of its approach (as `execute --guard`).")
@@ -76,28 +83,26 @@ from stablepush_cli.options import (
 @click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None, metavar="MM DEG",
               help="A trial lands when the object comes to rest within MM (x and z) and DEG of the goal in the "
                    "grasp, as `execute` judges a run (default: the task's planner.tolerance).")
-@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
-              help="Run the trials on K local processes (default: the number of CPUs).")
-@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
-              callback=parse_ray_address,
-              help="Run the trials on Ray: a local instance, or the cluster at ADDRESS (e.g. 10.0.0.5:6379; see "
-                   "docs/evaluate.md, 'Where the trials run').")
-@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
-              help="Write the summary and every trial as JSON.")
-@click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row.")
-@click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
-              help="Draw the goal error's CDF against the tolerance, and success over the varied parameters (PNG, "
-                   "PDF or SVG, as the name ends).")
-@click.option("--video-failed", "video_dir", type=click.Path(file_okay=False), default=None, metavar="DIR",
-              help="Draw each failed trial's run as a video, DIR/trial-<i>.mp4 (made if missing; as `execute "
-                   "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv).")
-@video_options("--video-failed")
+@runner_choice("the trials")
+@option_group(
+    "outputs", StudyOutputs,
+    click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+                 help="Write the summary and every trial as JSON."),
+    click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row."),
+    click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
+                 help="Draw the goal error's CDF against the tolerance, and success over the varied parameters "
+                      "(PNG, PDF or SVG, as the name ends)."))
+@video_request(
+    "--video-failed",
+    click.option("--video-failed", "video_path", type=click.Path(file_okay=False), default=None, metavar="DIR",
+                 help="Draw each failed trial's run as a video, DIR/trial-<i>.mp4 (made if missing; as `execute "
+                      "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv)."))
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-@robot_options
-def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confidence: float, seed: int, vary,
-             feature_error, tracker_noise, closed_loop: bool, guarded: bool, engine: str, success_tolerance, workers,
-             ray_address, json_path, csv_path, png_path, video_dir, video_fps: float, video_size,
-             quiet: bool, robot_model, flange, tcp, base) -> None:
+@robot_choice
+def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confidence: float, seed: int,
+             worlds: WorldSpreads, closed_loop: bool, guarded: bool, engine: str, success_tolerance,
+             where: RunnerChoice, outputs: StudyOutputs, video: VideoRequest, quiet: bool,
+             robot: RobotChoice) -> None:
     """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
 
     Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
@@ -126,8 +131,9 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
       stablepush evaluate data/tasks/t-shaped.yaml --trials 20 --vary pad_mu=0.3 --video-failed t-failed
     """
     test = _test(target, confidence)
+    video_dir = video.path
     if video_dir:  # before the trials load MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
-        check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video_fps, video_size)
+        check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video.fps, video.size)
     else:
         video_settings_need("--video-failed")
     from stablepush.evaluation import Batch, decision_state, study_trials, write_evaluation
@@ -135,21 +141,20 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
     from stablepush.runners import default_workers
 
-    require_suffix("--plot", png_path, FIGURE_SUFFIXES)
-    check_named_outputs({"--json": json_path, "--csv": csv_path, "--plot": png_path},
-                  {"TASK.yaml": task_file, "--plan": plan_file})
-    say = say_beside(json_path, csv_path, png_path)
+    require_suffix("--plot", outputs.png_path, FIGURE_SUFFIXES)
+    check_named_outputs(outputs.named(), {"TASK.yaml": task_file, "--plan": plan_file})
+    say = say_beside(*outputs.given())
 
-    runner = runner_for(workers, ray_address, default=default_workers())
+    runner = where.runner(default=default_workers())
     if guarded:  # before a plan is searched for; Batch refuses it as well
         from stablepush.execution import GuardedApproach
 
         try:
-            GuardedApproach.for_tracker_noise(*tracker_noise)
+            GuardedApproach.for_tracker_noise(*worlds.tracker_noise)
         except SettingError as exc:
             fail(f"--tracker-noise: {exc.reason}")
-    task, plan, spreads = _study(task_file, plan_file, robust, vary, feature_error, tracker_noise)
-    task = with_robot(task, robot_model, flange, tcp, base)
+    task, plan, spreads = _study(task_file, plan_file, robust, worlds)
+    task = robot.on(task)
     if video_dir:
         from stablepush.sim.video import video_directory
 
@@ -159,8 +164,8 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
             fail(f"--video-failed {exc}")
     try:
         batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
-                      engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video_fps,
-                      video_size=tuple(video_size))
+                      engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video.fps,
+                      video_size=tuple(video.size))
     except SettingError as exc:  # the tracker's noise, past what the guard can tell a touch from
         fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
     for warning in batch.warnings():
@@ -177,12 +182,12 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     with landings_bar(quiet, trials) as landed:
         result = run_evaluation(batch, trials, runner, (lambda record, done: landed(
             done, suffix=f"; {decision_state(test, done)}" if test else "")) if landed else None, test=test)
-    write_evaluation(result, json_path, csv_path, png_path)
+    write_evaluation(result, outputs.json_path, outputs.csv_path, outputs.png_path)
     s = result.summary()
     if not s["trials"]:
         click.echo("interrupted before any trial finished" if s["interrupted"] else "no trial finished", err=True)
         sys.exit(130 if s["interrupted"] else EXIT_NOT_SOLVED)
-    for line in result.describe(written=[p for p in (json_path, csv_path, png_path) if p]):
+    for line in result.describe(written=outputs.given()):
         say(line)
     if s["crashed"]:  # internal errors: no rate stands for the trials asked for
         click.echo(f"error: {s['crashed']} of {s['trials']} trials crashed (internal errors, a bug; each trial's "
@@ -192,7 +197,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         sys.exit(130)
 
 
-def _study(task_file: str, plan_file, robust: bool, vary, feature_error, tracker_noise):
+def _study(task_file: str, plan_file, robust: bool, worlds: WorldSpreads):
     """The task, the plan to evaluate (the one given, else planned here) and the worlds' spreads."""
     if robust and plan_file:
         fail("--robust plans from the task; a plan given with --plan is evaluated as it is")
@@ -200,7 +205,7 @@ def _study(task_file: str, plan_file, robust: bool, vary, feature_error, tracker
         task, plan = load_plan_and_task(plan_file, task_file)
     else:
         task = load_task_file(task_file)
-    spreads = study_spreads(task, vary, feature_error, tracker_noise)
+    spreads = worlds.spreads(task)
     if not plan_file:
         task, plan = _plan_for(task, spreads, robust)
     return task, plan, spreads

@@ -9,15 +9,14 @@ from stablepush_cli.common import (
     check_named_outputs,
     load_task_file,
     progressbar,
-    runner_for,
     say_beside,
 )
+from stablepush_cli.groups import RunnerChoice, runner_choice
 from stablepush_cli.options import (
     SEED,
     TIME_LIMIT,
     Whole,
     parse_axis,
-    parse_ray_address,
 )
 
 
@@ -35,11 +34,7 @@ from stablepush_cli.options import (
               metavar="S", help="Each cell's search time, a guard past --checks: a cell it stops is counted in the "
                                 "summary (its verdict may differ on a less loaded machine).")
 @click.option("--seed", default=None, type=SEED, help="Planner seed (default: the task's).")
-@click.option("--workers", type=Whole(min=1, max=1024), default=None, metavar="K",
-              help="Plan the cells on K local processes (default: the number of CPUs).")
-@click.option("--ray", "ray_address", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
-              callback=parse_ray_address,
-              help="Plan the cells on Ray: a local instance, or the cluster at ADDRESS.")
+@runner_choice("the cells' plans")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the map: its cells (goal, verdict, reason, solved, seed, planning time, switch-overs).")
 @click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
@@ -47,8 +42,8 @@ from stablepush_cli.options import (
                    "ends); at most six slices, evenly chosen, the one nearest the start's theta among them (the "
                    "title says how many of how many).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_limit: float, seed, workers, ray_address,
-          json_path, png_path, quiet: bool) -> None:
+def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_limit: float, seed,
+          where: RunnerChoice, json_path, png_path, quiet: bool) -> None:
     """Map where the pushers can take the object: plan from the task's start to every goal of a grid.
 
     Each cell is the task with its goal replaced, planned on its own. Its verdict: `reached`,
@@ -71,7 +66,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_lim
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_named_outputs({"--json": json_path, "--plot": png_path}, {"TASK.yaml": task_file})
     say = say_beside(json_path, png_path)
-    runner = runner_for(workers, ray_address, default=default_workers())
+    runner = where.runner(default=default_workers())
     # The grid replaces the goal; its cells say where there is no grasp.
     task = load_task_file(task_file, goal_in_grasp=False)
     gx, gz, gth = task.goal
