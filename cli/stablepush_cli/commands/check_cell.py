@@ -7,26 +7,23 @@ import click
 
 from stablepush_cli.common import (
     check_named_outputs,
-    load_plan_and_task,
 )
+from stablepush_cli.groups import PlanFiles, RobotChoice, plan_and_task, robot_choice
 from stablepush_cli.options import (
     Finite,
-    robot_options,
 )
 
 
 @click.command("check-cell")
-@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
-@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
-              help="The task the plan was made for (checked against the plan); its environment places the "
-                   "features and names the arm (environment.robot).")
+@plan_and_task("The task the plan was made for (checked against the plan); its environment places the features "
+               "and names the arm (environment.robot).")
 @click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000), metavar="HZ",
               help="Samples per second of the timed trajectory checked (execute's --rate).")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the verdict as JSON: follows true with the figures printed, or follows false with the "
                    "sample, t, plan step, phase and reason.")
-@robot_options
-def check_cell(plan_file: str, task_file: str, rate_hz: float, json_path, robot_model, flange, tcp, base) -> None:
+@robot_choice
+def check_cell(files: PlanFiles, rate_hz: float, json_path, robot: RobotChoice) -> None:
     """Say whether the arm can follow a plan in its cell, before any motion.
 
     Every sample of the timed trajectory (as `trajectory` writes it and `execute` streams it) is
@@ -45,14 +42,13 @@ def check_cell(plan_file: str, task_file: str, rate_hz: float, json_path, robot_
     """
     from stablepush.extras import require
     from stablepush.outputs import write_atomically
-    from stablepush.task import with_robot
 
     require("mujoco", "check-cell (the arm's kinematics)")
     from stablepush.sim.joint_path import CellError, joint_path
 
-    check_named_outputs({"--json": json_path}, {"PLAN.json": plan_file, "--task": task_file})
-    task, plan = load_plan_and_task(plan_file, task_file)
-    task = with_robot(task, robot_model, flange, tcp, base)
+    check_named_outputs({"--json": json_path}, files.inputs())
+    task, plan = files.load()
+    task = robot.on(task)
     arm = task.environment.robot.model or "the shipped arm"
     try:
         path = joint_path(task, plan, rate_hz)

@@ -6,19 +6,17 @@ import click
 from stablepush_cli.common import (
     beside,
     check_named_outputs,
-    load_plan_and_task,
 )
+from stablepush_cli.groups import PlanFiles, plan_and_task
 
 
 @click.command()
-@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
-@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
-              help="The task the plan was made for (checked against the plan).")
+@plan_and_task()
 @click.option("-o", "--output", "png_path", type=click.Path(dir_okay=False), default=None,
               help="Figure to write: PNG, PDF or SVG, as the name ends. Default: PLAN.png beside the plan file "
                    "(t.plan.json: t.png; run.2.json: run.2.png).")
 @click.option("--gif", "gif_path", type=click.Path(dir_okay=False), default=None, help="Also write an animated GIF.")
-def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
+def show(files: PlanFiles, png_path, gif_path) -> None:
     """Draw a plan: snapshots of the object in the grasp and x, z, theta against step.
 
     The snapshots (as in the paper's fig. 1) show the object's outline in the gripper frame G with
@@ -36,11 +34,11 @@ def show(plan_file: str, task_file: str, png_path, gif_path) -> None:
     from stablepush.viz import figures
 
     png_label = "-o" if png_path is not None else "the default -o"
-    png_path = png_path if png_path is not None else beside(plan_file, (".json", ".plan"), ".png")
+    png_path = png_path if png_path is not None else beside(files.plan_file, (".json", ".plan"), ".png")
     require_suffix(png_label, png_path, FIGURE_SUFFIXES)
     require_suffix("--gif", gif_path, (".gif",))
-    check_named_outputs({png_label: png_path, "--gif": gif_path}, {"PLAN.json": plan_file, "--task": task_file})
-    task, plan = load_plan_and_task(plan_file, task_file, require_solved=False)
+    check_named_outputs({png_label: png_path, "--gif": gif_path}, files.inputs())
+    task, plan = files.load(require_solved=False)
     figures.save_figure(figures.plan_figure(task, plan), png_path)
     click.echo(f"figure written to {png_path}")
     if gif_path:

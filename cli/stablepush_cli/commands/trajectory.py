@@ -3,23 +3,19 @@ from __future__ import annotations
 
 import click
 
-from stablepush.task import with_robot
 from stablepush_cli.common import (
     check_named_outputs,
     fail,
-    load_plan_and_task,
 )
+from stablepush_cli.groups import PlanFiles, RobotChoice, plan_and_task, robot_choice
 from stablepush_cli.options import (
     Finite,
-    robot_options,
     stamp_option,
 )
 
 
 @click.command()
-@click.argument("plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False))
-@click.option("--task", "task_file", required=True, metavar="TASK.yaml", type=click.Path(dir_okay=False),
-              help="The task the plan was made for (checked against the plan).")
+@plan_and_task()
 @click.option("-o", "--output", "out_path", required=True, type=click.Path(dir_okay=False),
               metavar="TRAJ.csv|.json|.mcap",
               help="Where to write the trajectory: CSV (a header, one row per sample), JSON (columns and rows), or a "
@@ -44,9 +40,9 @@ from stablepush_cli.options import (
                    "(/stablepush/joint_trajectory, in the arm's base link, with velocities and accelerations) and, "
                    "for a URDF arm, /robot_description. Needs the [sim] extra.")
 @stamp_option("a .mcap", "now")
-@robot_options
-def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, quat: str, joints: bool,
-               stamp_ns, robot_model, flange, tcp, base) -> None:
+@robot_choice
+def trajectory(files: PlanFiles, out_path: str, rate_hz: float, quat: str, joints: bool, stamp_ns,
+               robot: RobotChoice) -> None:
     """Write the gripper's timed trajectory for a plan: what the executor streams, for your robot.
 
     One sample per 1/HZ s: time (s), G's position in the world (m) and orientation (a unit
@@ -71,14 +67,14 @@ def trajectory(plan_file: str, task_file: str, out_path: str, rate_hz: float, qu
               f".csv and .json")
     if stamp_ns is not None and not out_path.lower().endswith(".mcap"):
         fail("--stamp: only with a .mcap (a ROS 2 bag; a .csv or .json counts t from 0)")
-    if not joints and any(v is not None for v in (robot_model, flange, tcp, base)):
+    if not joints and robot != RobotChoice():
         fail("--robot, --flange, --tcp and --base: only with --joints (G's poses are the same for every arm)")
     if joints and quat is not None:
         fail("--joints: joint positions have no quaternions; --quat is for the gripper's poses")
     quat = quat or "xyzw"
-    check_named_outputs({"-o": out_path}, {"PLAN.json": plan_file, "--task": task_file})
-    task, plan = load_plan_and_task(plan_file, task_file)
-    task = with_robot(task, robot_model, flange, tcp, base)
+    check_named_outputs({"-o": out_path}, files.inputs())
+    task, plan = files.load()
+    task = robot.on(task)
     for warning in execution_warnings(task):  # the stream is the executor's, so is its cell
         click.echo(f"warning: {warning}", err=True)
     traj = timed_trajectory(task, plan, rate_hz)
