@@ -100,7 +100,7 @@ class SimWorld:
     tracker_noise: Tuple[float, float]
 
     def deviation(self):
-        from stablepush.sim.deviation import WorldDeviation
+        from stablepush.sim import WorldDeviation
 
         return WorldDeviation(mu_scale=self.mu_scale, tracker_noise_mm=self.tracker_noise[0],
                               tracker_noise_deg=self.tracker_noise[1])

@@ -10,7 +10,7 @@ import click
 
 from stablepush.errors import OutputError, TaskError
 from stablepush.extras import MissingExtra
-from stablepush.task.schema import LIMITS, PLANNER_PARAMETER_RANGES
+from stablepush.task import LIMITS, PLANNER_PARAMETER_RANGES
 from stablepush_cli.common import (
     fail,
     given,
@@ -76,7 +76,7 @@ def parse_stamp(_ctx, _param, value):
     """--stamp as Unix ns (None: the bag's default), by the library's rule (bags.parse_stamp)."""
     if value is None:
         return None
-    from stablepush.execution.bags import parse_stamp
+    from stablepush.execution import parse_stamp
 
     try:
         return parse_stamp(value)
@@ -125,7 +125,7 @@ def check_video(option: str, path: str, fps: float, size) -> None:
     """Refuse, before anything runs, a video that could not be written (exit 2 naming the option).
     Loads MuJoCo for headless rendering (MUJOCO_GL=osmesa), so call it before the simulated arm
     starts."""
-    from stablepush.sim.video import check_fps, check_size, check_video_path
+    from stablepush.sim import check_fps, check_size, check_video_path
 
     for name, check, value in (("--video-fps", check_fps, fps), ("--video-size", check_size, size)):
         try:
@@ -165,7 +165,7 @@ def video_output(option: str, path: str, fps: float, size, quiet: bool, view: st
     unless `quiet`; exit 2 naming `option` for one that could not be written. Loads MuJoCo for
     headless rendering (MUJOCO_GL=osmesa), so call it before the simulated arm starts."""
     check_video(option, path, fps, size)
-    from stablepush.sim.video import RunVideo
+    from stablepush.sim import RunVideo
 
     return RunVideo(path, fps, size, progress=None if quiet else VideoBar(path), view=view)
 
@@ -205,8 +205,8 @@ def parse_axis(_ctx, param, value):
     """A grid axis A:B:N (N values from A to B; A:A:1 for A alone), within the task file's pose bounds;
     the library's own check (grid_axis) refuses a count of 1 with B other than A, and equal ends
     with a larger count, named as the option."""
-    from stablepush.plan.reach import MAX_AXIS, grid_axis
-    from stablepush.task.schema import ANGLE, COORDINATE
+    from stablepush.plan import MAX_AXIS, grid_axis
+    from stablepush.task import ANGLE, COORDINATE
 
     if value is None:
         return None

@@ -65,7 +65,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
       stablepush bench data/tasks/*.yaml --trials 10 --out results.csv
       stablepush bench --checks data/tasks/horizontal-offset-low-mu.yaml
     """
-    from stablepush.plan import benchmark
+    from stablepush.plan import bench_planning, summarize_planning, write_planning_trials
 
     tasks = [load_task_file(path) for path in task_files]
     if checks_only:
@@ -81,10 +81,10 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
     every, rows = [], []
     with click.progressbar(length=trials * len(tasks), label="planning", file=sys.stderr) as bar:
         for task in tasks:
-            runs = benchmark.bench_planning(task, trials, seed=seed, time_limit=time_limit, progress=bar.update,
+            runs = bench_planning(task, trials, seed=seed, time_limit=time_limit, progress=bar.update,
                                             improve_for=improve_for, runner=runner)
             every.extend(runs)
-            rows.append(benchmark.summarize_planning(runs))
+            rows.append(summarize_planning(runs))
 
     def num(v, fmt):
         return "-" if v is None else format(v, fmt)
@@ -110,12 +110,12 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
                 f"{r['first_median_path_length_steps']:>6.1f} -> {r['improved_median_path_length_steps']:<6.1f} "
                 f"{r['first_median_min_margin']:>7.3f} -> {r['improved_median_min_margin']:<7.3f}")
     if out_path:
-        benchmark.write_planning_trials(out_path, every, rows)
+        write_planning_trials(out_path, every, rows)
         say(f"written: {out_path}")
 
 
 def _bench_checks(tasks, count: int, seed: int) -> None:
-    from stablepush.plan.benchmark import bench_checks
+    from stablepush.plan import bench_checks
 
     click.echo(f"{'task':<28} {'case':<12} {'median us':>10} {'min us':>8} {'checks':>8} {'feasible':>9} {'exact':>7}")
     for task in tasks:

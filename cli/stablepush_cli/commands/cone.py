@@ -27,7 +27,7 @@ def cone(task_file: str, pusher: str, png_path) -> None:
       stablepush cone data/tasks/pivoting.yaml --pusher left -o left-cone.png
     """
     from stablepush.outputs import FIGURE_SUFFIXES, default_output, require_suffix
-    from stablepush.viz import figures
+    from stablepush.viz import cone_figure, save_figure
 
     task = load_task_file(task_file)
     task.pusher_index(pusher)
@@ -35,5 +35,5 @@ def cone(task_file: str, pusher: str, png_path) -> None:
     png_path = png_path if png_path is not None else default_output(task_file, f".{pusher}.cone.png")
     require_suffix(png_label, png_path, FIGURE_SUFFIXES)
     check_named_outputs({png_label: png_path}, {"TASK.yaml": task_file})
-    figures.save_figure(figures.cone_figure(task, pusher), png_path)
+    save_figure(cone_figure(task, pusher), png_path)
     click.echo(f"figure written to {png_path}")

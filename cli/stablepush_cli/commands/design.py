@@ -7,7 +7,7 @@ from pathlib import Path
 
 import click
 
-from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.sim import DEFAULT_ENGINE, ENGINES
 from stablepush_cli.common import (
     EXIT_INTERNAL,
     EXIT_NOT_SOLVED,
@@ -117,7 +117,7 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     from stablepush.design import design as search
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
     from stablepush.runners import default_workers
-    from stablepush.task.schema import load_design
+    from stablepush.task import load_design
 
     rank = parse_rank(rank_text, measured=trials is not None) if rank_text is not None else DEFAULT_RANK
     out = Path(out_dir) if out_dir is not None else designs_folder(design_file)
@@ -147,7 +147,7 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
         files[json_path] = json.dumps(study.as_dict(), indent=1) + "\n"
     write_designs(files, out)
     if png_path is not None and study.designs:
-        from stablepush.viz.figures import layouts_figure, save_figure
+        from stablepush.viz import layouts_figure, save_figure
 
         top = [{"task": d.task, "rank": k, "label": _figures(d)} for k, d in enumerate(study.designs[:3], start=1)]
         save_figure(layouts_figure(top, f"{study.designs[0].task.name}: the best layouts"), png_path)

@@ -7,7 +7,7 @@ import sys
 import click
 
 from stablepush.errors import OutputError, SettingError
-from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.sim import DEFAULT_ENGINE, ENGINES
 from stablepush_cli.common import (
     EXIT_INTERNAL,
     EXIT_NOT_SOLVED,
@@ -156,7 +156,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     task, plan, spreads = _study(task_file, plan_file, robust, worlds)
     task = robot.on(task)
     if video_dir:
-        from stablepush.sim.video import video_directory
+        from stablepush.sim import video_directory
 
         try:
             video_dir = video_directory(video_dir)

@@ -7,11 +7,8 @@ import sys
 import click
 
 from stablepush.errors import SettingError
-from stablepush.execution.protocol import DEFAULT_PORT
-from stablepush.execution.tcp_arm import ACK_TIMEOUT_RANGE, DEFAULT_ACK_TIMEOUT
-from stablepush.execution.verdict import CAUSES
-from stablepush.sim import VIDEO_VIEWS
-from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.execution import ACK_TIMEOUT_RANGE, CAUSES, DEFAULT_ACK_TIMEOUT, DEFAULT_PORT
+from stablepush.sim import DEFAULT_ENGINE, ENGINES, VIDEO_VIEWS
 from stablepush_cli.common import (
     EXIT_ARM_FAULT,
     EXIT_MISSED,
@@ -178,9 +175,16 @@ def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, json_
       stablepush sim-arm --port 47100 &     # or your robot's bridge
       stablepush execute low-mu.plan.json --task data/tasks/horizontal-offset-low-mu.yaml --arm 127.0.0.1:47100
     """
-    from stablepush.execution import GuardedApproach, RunOptions, execution_warnings
-    from stablepush.execution.run import BagRecording, JsonReport, recording_for, run_plan
-    from stablepush.execution.stream import check_resume_from
+    from stablepush.execution import (
+        BagRecording,
+        GuardedApproach,
+        JsonReport,
+        RunOptions,
+        check_resume_from,
+        execution_warnings,
+        recording_for,
+        run_plan,
+    )
     from stablepush.outputs import require_suffix
 
     require_suffix("--record", record_path, (".mcap",))
@@ -247,12 +251,12 @@ def _arm_for(connection: ArmChoice, world: SimWorld, quiet: bool, robot):
     """The arm a run goes to: a simulated `robot` in this process (--sim), else the arm server at
     --arm (or the default port here), checked against `robot` when one is named."""
     if connection.sim and connection.arm is None:
-        from stablepush.sim.local_arm import SimulatedArm
+        from stablepush.sim import SimulatedArm
 
         log = None if quiet else lambda text: click.echo(f"sim-arm: {text}", err=True)
         return SimulatedArm(connection.engine, world.deviation(), log=log, robot=robot)
     from stablepush.execution import TcpArm
-    from stablepush.sim.joint_path import modelled
+    from stablepush.sim import modelled
 
     host, port = connection.arm or ("127.0.0.1", DEFAULT_PORT)
     return modelled(TcpArm(host, port, connection.ack_timeout), robot)

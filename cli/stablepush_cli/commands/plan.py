@@ -63,8 +63,7 @@ def plan(task_file: str, json_path, csv_path, seed, time_limit, max_switches, qu
       stablepush plan data/tasks/horizontal-offset-low-mu.yaml -o low-mu.plan.json --csv low-mu.csv
     """
     from stablepush.outputs import default_output
-    from stablepush.plan import end_text, plan_task, write_plan
-    from stablepush.plan.verify import release_note
+    from stablepush.plan import end_text, plan_task, release_note, write_plan
 
     json_label = "-o" if json_path is not None else "the default -o"
     json_path = json_path if json_path is not None else default_output(task_file, ".plan.json")

@@ -60,7 +60,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_lim
           --json t.reach.json --plot t.reach.png
     """
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix, write_atomically
-    from stablepush.plan.reach import reach_map
+    from stablepush.plan import reach_map
     from stablepush.runners import default_workers
 
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
@@ -84,7 +84,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_lim
     if json_path is not None:
         write_atomically(json_path, json.dumps(data, indent=1) + "\n")
     if png_path is not None:
-        from stablepush.viz.figures import reach_figure, save_figure
+        from stablepush.viz import reach_figure, save_figure
 
         save_figure(reach_figure(task, data), png_path)
     c = data["counts"]

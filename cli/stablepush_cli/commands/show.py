@@ -31,7 +31,7 @@ def show(files: PlanFiles, png_path, gif_path) -> None:
       stablepush show t.plan.json --task data/tasks/t-shaped.yaml -o t.png --gif t.gif
     """
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
-    from stablepush.viz import figures
+    from stablepush.viz import plan_figure, save_figure, save_plan_gif
 
     png_label = "-o" if png_path is not None else "the default -o"
     png_path = png_path if png_path is not None else beside(files.plan_file, (".json", ".plan"), ".png")
@@ -39,8 +39,8 @@ def show(files: PlanFiles, png_path, gif_path) -> None:
     require_suffix("--gif", gif_path, (".gif",))
     check_named_outputs({png_label: png_path, "--gif": gif_path}, files.inputs())
     task, plan = files.load(require_solved=False)
-    figures.save_figure(figures.plan_figure(task, plan), png_path)
+    save_figure(plan_figure(task, plan), png_path)
     click.echo(f"figure written to {png_path}")
     if gif_path:
-        figures.save_plan_gif(task, plan, gif_path)
+        save_plan_gif(task, plan, gif_path)
         click.echo(f"animation written to {gif_path}")

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import click
 
-from stablepush.execution.protocol import DEFAULT_PORT
-from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.execution import DEFAULT_PORT
+from stablepush.sim import DEFAULT_ENGINE, ENGINES
 from stablepush.task import Robot, robot_with
 from stablepush_cli.options import (
     Finite,
@@ -52,8 +52,7 @@ def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, se
     (one waypoint period per waypoint), headless, and reports its steps/s. Each acknowledgement carries
     the object's pose in the grasp as a tracker would (`object_in_grasp`), with --tracker-noise.
     """
-    from stablepush.sim.deviation import WorldDeviation
-    from stablepush.sim.server import SimArmServer
+    from stablepush.sim import SimArmServer, WorldDeviation
 
     deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1],
                                seed=seed)

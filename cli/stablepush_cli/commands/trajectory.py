@@ -88,7 +88,7 @@ def trajectory(files: PlanFiles, out_path: str, rate_hz: float, quat: str, joint
             click.echo(f"{task.name}: {path.describe()}; written to {out_path}")
             return
     if out_path.lower().endswith(".mcap"):
-        from stablepush.execution.bags import write_bag
+        from stablepush.execution import write_bag
 
         write_bag(out_path, task, plan, traj, start_ns=stamp_ns,
                   joints=None if path is None else path.samples())

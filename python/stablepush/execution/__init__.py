@@ -6,13 +6,16 @@ and the run with its outputs (run.py). Builds on
 The names below are loaded when first used, so that importing one module of the package (the
 arm protocol, say) does not load the executor.
 """
-import importlib
+from stablepush.lazy import lazy_exports
 
 _EXPORTS = {
     "Arm": "stablepush.execution.arm",
     "ArmError": "stablepush.execution.arm",
     "ArmReady": "stablepush.execution.arm",
     "TcpArm": "stablepush.execution.tcp_arm",
+    "ACK_TIMEOUT_RANGE": "stablepush.execution.tcp_arm",
+    "DEFAULT_ACK_TIMEOUT": "stablepush.execution.tcp_arm",
+    "DEFAULT_PORT": "stablepush.execution.protocol",
     "ClosedLoop": "stablepush.execution.closed_loop",
     "GuardedApproach": "stablepush.execution.guard",
     "ExecutionReport": "stablepush.execution.report",
@@ -20,18 +23,18 @@ _EXPORTS = {
     "RunOptions": "stablepush.execution.executor",
     "RunResult": "stablepush.execution.run",
     "run_plan": "stablepush.execution.run",
+    "recording_for": "stablepush.execution.run",
     "JsonReport": "stablepush.execution.run",
     "BagRecording": "stablepush.execution.run",
     "execute_plan": "stablepush.execution.executor",
     "execution_warnings": "stablepush.execution.executor",
+    "check_resume_from": "stablepush.execution.stream",
     "Verdict": "stablepush.execution.verdict",
+    "CAUSES": "stablepush.execution.verdict",
     "Trajectory": "stablepush.execution.trajectory",
     "timed_trajectory": "stablepush.execution.trajectory",
+    "parse_stamp": "stablepush.execution.bags",
+    "write_bag": "stablepush.execution.bags",
 }
 __all__ = list(_EXPORTS)
-
-
-def __getattr__(name: str):
-    if name not in _EXPORTS:
-        raise AttributeError(f"module 'stablepush.execution' has no attribute {name!r}")
-    return getattr(importlib.import_module(_EXPORTS[name]), name)
+__getattr__ = lazy_exports(__name__, _EXPORTS)

@@ -7,3 +7,22 @@ contract both must pass (fidelity.py), and videos of recorded runs (video.py).""
 # How a run's video draws it (video.py): here, so that a command line can offer the choice without
 # loading the renderer's module.
 VIDEO_VIEWS = ("schematic", "3d", "both")
+
+from stablepush.lazy import lazy_exports  # noqa: E402 - after the constant the command line reads
+
+_EXPORTS = {
+    "DEFAULT_ENGINE": "stablepush.sim.engines",
+    "ENGINES": "stablepush.sim.engines",
+    "WorldDeviation": "stablepush.sim.deviation",
+    "SimulatedArm": "stablepush.sim.local_arm",
+    "SimArmServer": "stablepush.sim.server",
+    "CellError": "stablepush.sim.joint_path",
+    "modelled": "stablepush.sim.joint_path",
+    "RunVideo": "stablepush.sim.video",
+    "check_fps": "stablepush.sim.video",
+    "check_size": "stablepush.sim.video",
+    "check_video_path": "stablepush.sim.video",
+    "video_directory": "stablepush.sim.video",
+}
+__all__ = ["VIDEO_VIEWS", *_EXPORTS]
+__getattr__ = lazy_exports(__name__, _EXPORTS)
