@@ -33,8 +33,8 @@ from point_pusher_tasks import random_task
 
 from stablepush.errors import TaskError
 from stablepush.evaluation import Batch, evaluate, robust_task, wilson_interval
-from stablepush.execution.verdict import tolerance_used
 from stablepush.plan import check_plan, plan_task
+from stablepush.pose import Tolerance
 from stablepush.task import parse_task
 
 GOAL_SPAN = (20.0, 15.0, 20.0)  # mm, mm, deg either side of the start
@@ -87,7 +87,7 @@ def goal_for(data: dict, seed: int, index: int, tries: int = 8):
 def ends_at(task, plan) -> float:
     """The plan's end's largest offset from the goal, each coordinate over TOLERANCE (1: its edge)."""
     end = plan.waypoints[-1]
-    return tolerance_used({"x": end.x, "z": end.z, "theta": end.theta}, task.goal, TOLERANCE)
+    return Tolerance.of(TOLERANCE).used(end.pose, task.goal)
 
 
 def _row(task, data: dict, loop: str, plan, s: dict) -> str:

@@ -28,7 +28,6 @@ from shipped import shipped_tasks
 
 from stablepush.plan import plan_task
 from stablepush.task import load_task
-from stablepush.units import tolerance_used
 
 HERE = Path(__file__).resolve().parent
 
@@ -52,7 +51,7 @@ def _row(kind: str, task, seed: int) -> dict:
         began = time.perf_counter()
         plan = plan_task(t, seed=seed)
         out[label] = {"solved": plan.solved, "ms": (time.perf_counter() - began) * 1e3,
-                      "used": tolerance_used(plan.waypoints[-1].pose, task.goal, task.planner.tolerance)
+                      "used": task.tolerance.used(plan.waypoints[-1].pose, task.goal)
                       if plan.solved else None,
                       "pushes": plan.stats["pushes"], "checks": plan.stats["feasibility_checks"],
                       "deeper_found": (plan.stats.get("deeper") or {}).get("solved")}

@@ -292,7 +292,8 @@ def _pool(kind: str, ctx: dict):
         "plan_path": ([ctx["plan_path"]], [ctx["folder"], ctx["fifo"], "/dev/null", ctx["missing"], 3, "",
                                            ctx["binary"], ctx["task_path"]]),
         "path_out": ([ctx["out"] + ".json"], [ctx["folder"], "", ctx["task_path"], "/proc/self", 3, ctx["out"] + "/"]),
-        "csv_out": ([None, ctx["out"] + ".csv"], [ctx["folder"], ctx["task_path"], 3, ctx["plan_path"]]),
+        # the plan file is not among them: this call reads no plan file (a plan read earlier is refused: protect_input)
+        "csv_out": ([None, ctx["out"] + ".csv"], [ctx["folder"], ctx["task_path"], 3]),
         "pusher": (["left", None], ["", 3, "nobody", ["left"]]),
         "pose": ([(0, 0, 0), (1.0, 0.0, 0.0)], [(NAN, 0, 0), (0, 0), "000", (1e308, 0, 0), None, (0, 0, INF)]),
         "model": ([None, ctx["model"]], [ctx["folder"], ctx["fifo"], ctx["missing"], ctx["task_path"], 3, "",
@@ -303,6 +304,11 @@ def _pool(kind: str, ctx: dict):
         "base": ([(0, 0, 0, 0)], [(0, 0, 0), (0, -1e5, 0, 0), (NAN, 0, 0, 0), "0"]),
         "speed": ([2.5, 1.0], [0, -1, 1e9, NAN, "2.5"]),
         "length": ([20.0, 150.0], [-50, 0, NAN, INF, 1e9, "20"]),
+        "noise": ([0.0, 0.1], [-0.1, NAN, INF, 1e9, "0.1"]),  # a standard deviation: 0 is no noise
+        "point": ([(0.0, 0.0), (-20.0, 5.0)], [(NAN, 0), (0,), "0 0", (1e308, 0), (0, INF), None]),  # mm in O
+        "seconds0": ([None, 0, 0.01], [-1.0, NAN, INF, "0.1", 1e300]),  # a duration where 0 is none
+        "name": (["left", "a pusher"], ["", " ", 3, "x" * 500, None]),  # a new pusher's name: any but empty
+        "tolerance": ([None, (0.5, 0.5)], [(-1, 0), (NAN, 0), (0,), "0 0", (0, INF), (0.0, 0.5)]),
         "home": ([(450.0, 0.0, 300.0)], [(1e9, 0, 0), (NAN, 0, 0), (0, 0), "450 0 300"]),
         "features": ([{}, {"left": (0, 0, 0, 0)}], [{"left": (0, 0, 1e9, 0)}, {"left": (NAN, 0, 0, 0)}, {"left": (0,)},
                                                    ["left"], {3: (0, 0, 0, 0)}]),
@@ -351,7 +357,7 @@ def _api_table(sp, ctx):
         "load_plan": (sp.load_plan, {"path": "plan_path"}),
         "save_plan": (sp.save_plan, {"plan": "plan", "json_path": "path_out", "csv_path": "csv_out"}),
         "plan_task": (sp.plan_task, {"task": "task", "seed": "seed", "time_limit": "time", "max_switches": "whole0",
-                                     "improve_for": "time", "check_limit": "whole0", "start_pusher": "pusher"}),
+                                     "improve_for": "seconds0", "check_limit": "whole0", "start_pusher": "pusher"}),
         "check": (sp.check, {"task": "task", "at": "pose", "move": "pose", "pusher": "pusher"}),
         "check_plan": (sp.check_plan, {"task": "task", "plan": "plan", "source": "label",
                                        "require_solved": "flag"}),
@@ -363,7 +369,7 @@ def _api_table(sp, ctx):
         "Cell": (sp.Cell, {"home": "home", "retract": "length", "station_spacing": "length", "lane_offset": "length",
                            "features": "features", "end_on_feature": "bool", "robot": "robot"}),
         "PlannerSettings": (sp.PlannerSettings, {"time_limit": "time", "seed": "seed", "max_switches": "whole0"}),
-        "PusherSpec": (sp.PusherSpec, {"name": "pusher", "a": "pair", "b": "pair", "mu": "mu", "points": "count"}),
+        "PusherSpec": (sp.PusherSpec, {"name": "name", "a": "point", "b": "point", "mu": "mu", "points": "count"}),
         "Spreads": (Spreads, {"vary": "vary", "feature_error": "pair", "tracker_noise": "pair"}),
         "SequentialTest": (SequentialTest, {"target": "prob", "confidence": "confidence"}),
         "Runner": (Runner, {"workers": "workers", "ray": "bool", "ray_address": "ray_address"}),
@@ -380,9 +386,9 @@ def _api_table(sp, ctx):
         "reach_map": (reach_map, {"task": "task", "x": "axis", "z": "axis", "theta": "axis", "seed": "seed",
                                   "time_limit": "time", "check_limit": "whole0"}),
         "SimulatedArm": (SimulatedArm, {"engine": "engine", "deviation": "deviation", "robot": "robot"}),
-        "WorldDeviation": (WorldDeviation, {"mu_scale": "mu", "tracker_noise_mm": "length", "seed": "seed"}),
+        "WorldDeviation": (WorldDeviation, {"mu_scale": "mu", "tracker_noise_mm": "noise", "seed": "seed"}),
         "RunOptions": (RunOptions, {"rate_hz": "rate", "resume_from": "whole0", "pace": "bool",
-                                    "success_tolerance": "pair"}),
+                                    "success_tolerance": "tolerance"}),
     }
 
 

@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 
+from stablepush.errors import SettingError
 from stablepush.pose import Pose, Tolerance
 
 
@@ -34,7 +35,7 @@ def test_a_pose_is_read_from_a_tuple_a_mapping_or_a_pose_and_goes_to_si():
 
 @pytest.mark.parametrize("value", [(float("nan"), 0.5), (0.5, float("inf")), (0.0, 0.5), (0.5, -1.0), (1.0,), "ab"])
 def test_a_tolerance_that_is_not_two_finite_numbers_above_0_is_refused(value):
-    with pytest.raises(ValueError, match="tolerance must be two finite numbers above 0"):
+    with pytest.raises(SettingError, match="tolerance: must be two finite numbers above 0"):
         Tolerance.of(value)
 
 

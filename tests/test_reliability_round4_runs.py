@@ -135,3 +135,13 @@ def test_a_file_the_robot_model_includes_is_refused_as_an_output_before_any_work
     assert result.exit_code == 2, result.output
     assert f"--json {extra}: is a file the robot model includes this process read" in result.output, result.output
     assert extra.read_text().startswith("<mujoco><default>")
+
+
+def test_the_design_commands_bounds_are_the_librarys():
+    """--evaluate-top and --reach-top are bounded by the numbers design() and evaluate_designs()
+    refuse past (one bound, two places: the command line keeps from loading the design package)."""
+    from stablepush.design.layouts import MAX_REACH_TOP
+    from stablepush.design.odds import MAX_TOP
+
+    params = {p.name: p for p in cli.commands["design"].params}
+    assert params["evaluate_top"].type.max == MAX_TOP and params["reach_top"].type.max == MAX_REACH_TOP

@@ -37,9 +37,9 @@ def test_the_goal_tolerance_is_the_tasks_per_coordinate_unless_given():
 
 @pytest.mark.parametrize("tolerance", [(float("nan"), 0.5), (0.5, float("inf")), (0.0, 0.5), (0.5, -1.0)])
 def test_a_tolerance_that_is_not_finite_and_positive_is_refused_naming_it(tolerance):
-    with pytest.raises(ValueError, match="success tolerance"):
+    with pytest.raises(ValueError, match="success_tolerance: must be two finite numbers above 0"):
         success_tolerance(TASK, tolerance)
-    with pytest.raises(ValueError, match="success tolerance"):
+    with pytest.raises(ValueError, match="success_tolerance: must be two finite numbers above 0"):
         Verdict.for_fault(tolerance, "stopped")
 
 

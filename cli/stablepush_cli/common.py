@@ -86,10 +86,8 @@ def study_spreads(task, vary, feature_error, tracker_noise=(0.0, 0.0)):
 
     try:
         return Spreads.for_task(task, vary, feature_error, tracker_noise)
-    except SettingError as exc:  # --feature-error or --tracker-noise past its bound
+    except SettingError as exc:  # --vary, --feature-error or --tracker-noise past its bound
         fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
-    except ValueError as exc:  # --vary, which Spreads names `vary`
-        fail(f"--{exc}")
 
 
 @contextlib.contextmanager

@@ -8,7 +8,7 @@ import sys
 
 import click
 
-from stablepush.errors import OutputError, TaskError
+from stablepush.errors import OutputError, SettingError, TaskError
 from stablepush.extras import MissingExtra
 from stablepush.task import LIMITS, PLANNER_PARAMETER_RANGES
 from stablepush_cli.common import (
@@ -68,8 +68,8 @@ def parse_ray_address(_ctx, _param, value):
 
     try:
         return check_ray_address(value) if value else value
-    except ValueError as exc:
-        raise click.BadParameter(str(exc)) from None
+    except SettingError as exc:
+        raise click.BadParameter(exc.reason) from None
 
 
 def parse_stamp(_ctx, _param, value):
@@ -80,8 +80,8 @@ def parse_stamp(_ctx, _param, value):
 
     try:
         return parse_stamp(value)
-    except ValueError as exc:
-        raise click.BadParameter(str(exc)) from None
+    except SettingError as exc:
+        raise click.BadParameter(exc.reason) from None
 
 
 def stamp_option(which: str, default: str):
@@ -130,8 +130,8 @@ def check_video(option: str, path: str, fps: float, size) -> None:
     for name, check, value in (("--video-fps", check_fps, fps), ("--video-size", check_size, size)):
         try:
             check(value)
-        except ValueError as exc:
-            fail(f"{name}: {exc}")
+        except SettingError as exc:
+            fail(f"{name}: {exc.reason}")
     try:
         check_video_path(path)
     except OutputError as exc:

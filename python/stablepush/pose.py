@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass
 from typing import Iterator, List, Mapping, Sequence, Tuple, Union
 
+from stablepush.errors import SettingError
 from stablepush.units import MM, angle_difference_deg
 
 PoseLike = Union["Pose", Sequence[float], Mapping[str, float]]
@@ -63,8 +64,8 @@ class Tolerance:
     def __post_init__(self):
         # A nan tolerance would call every pose a miss, a negative one too: refused where it is made.
         if not all(isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in (self.position, self.angle)):
-            raise ValueError(f"tolerance must be two finite numbers above 0 (mm, deg), got "
-                             f"({self.position!r:.20}, {self.angle!r:.20})")
+            raise SettingError("tolerance", f"must be two finite numbers above 0 (mm, deg), got "
+                                            f"({self.position!r:.20}, {self.angle!r:.20})")
 
     @classmethod
     def of(cls, value: "Tolerance | Sequence[float]") -> "Tolerance":
@@ -74,7 +75,8 @@ class Tolerance:
         try:
             position, angle = (float(v) for v in value)
         except (TypeError, ValueError):
-            raise ValueError(f"tolerance must be two finite numbers above 0 (mm, deg), got {value!r:.60}") from None
+            raise SettingError("tolerance", f"must be two finite numbers above 0 (mm, deg), "
+                                            f"got {value!r:.60}") from None
         return cls(position, angle)
 
     def __iter__(self) -> Iterator[float]:

@@ -19,10 +19,13 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Iterator, Optional, Tuple
 
-from stablepush.errors import RunnerError
+from stablepush.errors import RunnerError, SettingError
 from stablepush.extras import require
 
 Job = Callable[[Any, int], Any]
+# The most local workers a Runner may name (the CLI's --workers bound): a batch still starts no more
+# than max_workers() processes.
+MAX_RUNNER_WORKERS = 1024
 # How long joining a Ray cluster may wait for its head to answer: Ray itself retries for minutes.
 RAY_CONNECT_TIMEOUT_S = 5.0
 # After this long with no job finished, and again after each as long, Runner.on_wait is told why.
@@ -45,8 +48,8 @@ def check_ray_address(address: Optional[str]) -> Optional[str]:
         return address
     host, port = _host_port(address)
     if not host or not (port.isascii() and port.isdigit()) or not 0 < int(port) < 65536:  # "٦٣٧٩" is no port
-        raise ValueError(f"expected HOST:PORT of a running Ray head (e.g. 10.0.0.5:6379, or ray://HOST:10001), "
-                         f"'auto' or 'local'; got {address!r}")
+        raise SettingError("ray_address", f"expected HOST:PORT of a running Ray head (e.g. 10.0.0.5:6379, or "
+                                          f"ray://HOST:10001), 'auto' or 'local'; got {address!r}")
     return address
 
 
@@ -70,7 +73,13 @@ class Runner:
 
     def __post_init__(self):
         if isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1:
-            raise ValueError(f"workers must be a whole number from 1, got {self.workers!r:.40}")
+            raise SettingError("workers", f"must be a whole number from 1, got {self.workers!r:.40}")
+        if self.workers > MAX_RUNNER_WORKERS:
+            raise SettingError("workers", f"must be at most {MAX_RUNNER_WORKERS}, got {self.workers}")
+        if not isinstance(self.ray, bool):
+            raise TypeError(f"ray must be True or False, got {self.ray!r:.40}")
+        if self.ray_address is not None and not isinstance(self.ray_address, str):
+            raise TypeError(f"ray_address must be a string or None, got {type(self.ray_address).__name__}")
         check_ray_address(self.ray_address)
         if self.on_wait is not None and not callable(self.on_wait):
             raise TypeError(f"on_wait must be callable, got {type(self.on_wait).__name__}")

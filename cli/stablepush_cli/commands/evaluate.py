@@ -220,8 +220,8 @@ def _plan_for(task, spreads, robust: bool):
     if robust:
         try:
             task = robust_task(task, spreads)
-        except ValueError as exc:
-            fail(f"--robust: {exc}")
+        except SettingError as exc:
+            fail(f"--robust: {exc.reason}")
     plan = plan_task(task)
     if not plan.solved:
         click.echo(f"{task.name}{' (robust)' if robust else ''}: {plan.message}", err=True)

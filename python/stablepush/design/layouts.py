@@ -60,6 +60,7 @@ RANK_KEYS: Dict[str, int] = {"arm": 1, "fixtures": 1, "points": 1, "end": 1, "sw
 # otherwise tied by how busy the machine was (it stays a key a rule may name).
 DEFAULT_RANK = ("arm", "fixtures", "points", "end", "switches", "margin", "pushes", "reach", "tests")
 REACH_CELLS = 3  # per axis (x and z) of the reach map around the goal
+MAX_REACH_TOP = 100  # the best designs given a reach map (design --reach-top)
 REACH_SPAN = 2.0  # planner.tolerance either side of the goal
 # Every search of a design is bounded by stable-push tests, a count, so that the same design file
 # gives the same designs on any machine under any load; the time limits are guards past them.
@@ -285,6 +286,10 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
     by `rank` (keys of RANK_KEYS); the best `reach_top` get a reach map around the goal.
     `progress(design)` after each layout is planned."""
     rank, check_limit = _checked_arguments(max_fixtures, rank, reach_top, time_limit, runner, progress, check_limit)
+    if not isinstance(task, dict):
+        raise TypeError(f"task must be a design file's task mapping (schema.load_design), got {type(task).__name__}")
+    if not isinstance(candidates, (list, tuple)) or not all(isinstance(c, dict) for c in candidates):
+        raise TypeError(f"candidates must be a list of pusher entries (schema.load_design), got {candidates!r:.60}")
     max_fixtures = min(max_fixtures, len(candidates))
     everything = layout_task(task, candidates, source)  # every candidate checked once, on the part
     require_goal_apart(everything)  # else every candidate would be pruned as making no push toward the goal
@@ -322,8 +327,8 @@ def _checked_arguments(max_fixtures: Any, rank: Any, reach_top: Any, time_limit:
     it) and the check limit."""
     if isinstance(max_fixtures, bool) or not is_integer(max_fixtures) or max_fixtures < 1:
         raise SettingError("max_fixtures", f"must be a whole number from 1 up, got {max_fixtures!r:.40}")
-    if isinstance(reach_top, bool) or not is_integer(reach_top) or reach_top < 0:
-        raise SettingError("reach_top", f"must be a whole number from 0 up, got {reach_top!r:.40}")
+    if isinstance(reach_top, bool) or not is_integer(reach_top) or not 0 <= reach_top <= MAX_REACH_TOP:
+        raise SettingError("reach_top", f"must be a whole number from 0 to {MAX_REACH_TOP}, got {reach_top!r:.40}")
     if time_limit is not None:
         planner_limit("time_limit", time_limit)
     if runner is not None and not isinstance(runner, Runner):

@@ -17,10 +17,11 @@ from stablepush.errors import SettingError
 from stablepush.evaluation import Batch, Spreads, evaluate
 from stablepush.evaluation.batch import MAX_TRIALS
 from stablepush.runners import Runner
+from stablepush.sim.deviation import MAX_SEED
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.units import is_integer
 
-MAX_SEED = 2**32 - 1
+MAX_TOP = 100  # designs whose odds one study measures (design --evaluate-top)
 
 
 def evaluate_designs(study: DesignStudy, trials: int, spreads: Spreads, top: int = 3, seed: int = 1,
@@ -70,11 +71,10 @@ def _check_arguments(study: Any, trials: Any, spreads: Any, top: Any, seed: Any,
     out of its range (TypeError for a study that is not one)."""
     if not isinstance(study, DesignStudy):
         raise TypeError(f"study: expected a DesignStudy (design()'s result), got {type(study).__name__}")
-    for name, value, low, high in (("trials", trials, 1, MAX_TRIALS), ("top", top, 1, None),
+    for name, value, low, high in (("trials", trials, 1, MAX_TRIALS), ("top", top, 1, MAX_TOP),
                                    ("seed", seed, 0, MAX_SEED)):  # top past the designs: all of them
-        if isinstance(value, bool) or not is_integer(value) or not low <= value <= (high or value):
-            most = f" to {high:,}" if high else " up"
-            raise SettingError(name, f"must be a whole number from {low}{most}, got {value!r:.40}")
+        if isinstance(value, bool) or not is_integer(value) or not low <= value <= high:
+            raise SettingError(name, f"must be a whole number from {low} to {high:,}, got {value!r:.40}")
     if not isinstance(spreads, Spreads):
         raise SettingError("spreads", f"must be a Spreads (evaluation.Spreads.for_task), got {type(spreads).__name__}")
     if not isinstance(closed_loop, bool):

@@ -34,8 +34,9 @@ from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
 from stablepush.pose import Pose, Tolerance
 from stablepush.runners import Runner, WorkerLost, run_all, this_node
-from stablepush.sim.deviation import WorldDeviation
+from stablepush.sim.deviation import MAX_SEED, WorldDeviation
 from stablepush.sim.local_arm import SimulatedArm
+from stablepush.sim.video import check_fps, check_size
 from stablepush.task.model import Task
 from stablepush.units import is_integer
 
@@ -70,6 +71,16 @@ class Batch:
         # Refused here, before any trial runs, rather than once per trial as a crash: a plan not of
         # the task, a tolerance out of range, a robot that cannot carry the jaws (RobotError) or a
         # plan it cannot follow in its cell (CellError).
+        for name, kind in (("task", Task), ("plan", Plan), ("spreads", Spreads)):
+            if not isinstance(getattr(self, name), kind):
+                raise TypeError(f"Batch.{name} must be a {kind.__name__}, got {type(getattr(self, name)).__name__}")
+        if isinstance(self.seed, bool) or not is_integer(self.seed) or not 0 <= self.seed <= MAX_SEED:
+            raise SettingError("seed", f"must be a whole number from 0 to {MAX_SEED}, got {self.seed!r:.40}")
+        for name in ("closed_loop", "guarded"):
+            if not isinstance(getattr(self, name), bool):
+                raise TypeError(f"Batch.{name} must be True or False, got {getattr(self, name)!r:.40}")
+        check_fps(self.video_fps)
+        check_size(self.video_size)
         check_plan(self.task, self.plan)
         success_tolerance(self.task, self.tolerance)
         guard_of(self)  # a tracker noise the guard cannot tell a touch from: SettingError (tracker_noise)
@@ -221,6 +232,12 @@ def evaluate(batch: Batch, trials: Optional[int] = None, runner: Runner = Runner
     each trial in the order of the trials' numbers (a trial that finishes early on another worker
     waits for those before it), since a test asked in the order trials happen to finish could be
     swayed by how long each kind takes; decision_state(test, done) is where it stands."""
+    if not isinstance(batch, Batch):
+        raise TypeError(f"batch must be a Batch, got {type(batch).__name__}")
+    if not isinstance(runner, Runner):
+        raise TypeError(f"runner must be a Runner (stablepush.runners.Runner), got {type(runner).__name__}")
+    if test is not None and not isinstance(test, SequentialTest):
+        raise TypeError(f"test must be a SequentialTest or None, got {type(test).__name__}")
     trials = study_trials(batch.spreads, trials, test)
     source = run_all(run_trial, batch, range(trials), runner)
     started = time.perf_counter()

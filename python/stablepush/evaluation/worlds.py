@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Dict, Optional, Sequence, Tuple
+from typing import Dict, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -43,14 +43,17 @@ class Spreads:
     def __post_init__(self):
         # -0.0 passes the range checks but makes numpy's uniform(0, -0) refuse "high - low < 0": every
         # spread is taken as the non-negative number it is (x + 0.0 is 0.0 for -0.0, x for any other).
+        if not isinstance(self.vary, Mapping):
+            raise TypeError(f"vary must be a mapping of {', '.join(VARY_KEYS)} to fractions, got "
+                            f"{type(self.vary).__name__}")
         object.__setattr__(self, "vary", {key: fraction + 0.0 for key, fraction in dict(self.vary).items()})
         for name in ("feature_error", "tracker_noise"):
             object.__setattr__(self, name, tuple(v + 0.0 for v in getattr(self, name)))
         for key, fraction in self.vary.items():
             if key not in VARY_KEYS:
-                raise ValueError(f"vary: unknown key {key!r} (one of {', '.join(VARY_KEYS)})")
+                raise SettingError("vary", f"unknown key {key!r} (one of {', '.join(VARY_KEYS)})")
             if not 0.0 <= fraction <= MAX_FRACTION:
-                raise ValueError(f"vary: {key} must be a fraction from 0 to {MAX_FRACTION:g}, got {fraction:g}")
+                raise SettingError("vary", f"{key} must be a fraction from 0 to {MAX_FRACTION:g}, got {fraction:g}")
         for name, pair in (("feature_error", self.feature_error), ("tracker_noise", self.tracker_noise)):
             if len(pair) != 2 or not all(0.0 <= v <= most for v, most in zip(pair, SPREAD_LIMITS)):  # nan fails too
                 raise SettingError(name, f"must be 2 numbers, not negative, at most {SPREAD_LIMITS[0]:g} mm and "
@@ -124,9 +127,10 @@ def robust_task(task: Task, spreads: Spreads) -> Task:
     """The task whose `uncertainty` box holds every multiplier the spreads draw: each key the
     larger of the task's fraction and the spread's. A plan of it has every push stable at the box's
     corners, and so in every world of the batch up to the features' offsets and the tracker's noise,
-    which the box does not describe (docs/model.md section 7). ValueError when the spreads vary
+    which the box does not describe (docs/model.md section 7). SettingError when the spreads vary
     nothing: there is no box to widen the task's to."""
     if not any(spreads.vary.values()):
-        raise ValueError("a robust plan needs spreads to widen the box to (vary, or the defaults it takes without)")
+        raise SettingError("vary", "a robust plan needs spreads to widen the box to (vary, or the defaults it takes "
+                                   "without)")
     box = {key: max(task.uncertainty.get(key, 0.0), spreads.vary.get(key, 0.0)) for key in VARY_KEYS}
     return dataclasses.replace(task, uncertainty={key: value for key, value in box.items() if value > 0.0})

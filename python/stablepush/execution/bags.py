@@ -41,7 +41,7 @@ from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, 
 
 import numpy as np
 
-from stablepush.errors import OutputError
+from stablepush.errors import OutputError, SettingError
 from stablepush.execution.arm import RobotDescription
 from stablepush.execution.trajectory import Trajectory, continuous_quaternions
 from stablepush.execution.world import Feature, place_features, scene_description
@@ -75,7 +75,7 @@ _UNIX_SECONDS = re.compile(r"\d+(\.\d+)?")
 def parse_stamp(value: str) -> int:
     """A bag's start time (`--stamp`) as Unix ns, from Unix seconds (`1764600000.5`, rounded to
     the ns) or an ISO-8601 time with its zone (`2026-12-01T15:00:00Z`, `2026-12-01T16:00:00+01:00`).
-    ValueError saying why not."""
+    SettingError saying why not."""
     text = value.strip()
     if _UNIX_SECONDS.fullmatch(text):
         ns = int((Decimal(text) * 1_000_000_000).to_integral_value())
@@ -83,14 +83,15 @@ def parse_stamp(value: str) -> int:
         try:  # Python before 3.11 reads no Z
             when = datetime.datetime.fromisoformat(text[:-1] + "+00:00" if text.endswith(("Z", "z")) else text)
         except ValueError:
-            raise ValueError(f"expected Unix seconds (e.g. 1764600000.5) or an ISO-8601 time with its zone "
-                             f"(e.g. 2026-12-01T15:00:00Z), got {value!r}") from None
+            raise SettingError("stamp", f"expected Unix seconds (e.g. 1764600000.5) or an ISO-8601 time with its "
+                                        f"zone (e.g. 2026-12-01T15:00:00Z), got {value!r:.60}") from None
         if when.tzinfo is None:
-            raise ValueError(f"{value!r} has no zone: add one (Z for UTC, or an offset such as +01:00)")
+            raise SettingError("stamp", f"{value!r:.60} has no zone: add one (Z for UTC, or an offset such as +01:00)")
         since = when - datetime.datetime(1970, 1, 1, tzinfo=datetime.timezone.utc)
         ns = (since.days * 86_400 + since.seconds) * 1_000_000_000 + since.microseconds * 1_000
     if not 0 <= ns <= STAMP_MAX_S * 1_000_000_000:
-        raise ValueError(f"{value!r} is outside 1970-01-01 to 2038-01-18 (ROS 2 stamps hold int32 seconds)")
+        raise SettingError("stamp", f"{value!r:.60} is outside 1970-01-01 to 2038-01-18 (ROS 2 stamps hold int32 "
+                                    f"seconds)")
     return ns
 
 

@@ -17,21 +17,22 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
-from stablepush.errors import ArmFault
+from stablepush.errors import ArmFault, SettingError
 from stablepush.execution.arm import Arm, ArmError, ArmReady
 from stablepush.execution.closed_loop import ClosedLoop, Replan, aim, replan, switch_held
 from stablepush.execution.guard import GuardedApproach, GuardWatch, measured_pose
-from stablepush.execution.protocol import DEFAULT_RATE_HZ, ProtocolError, check_state
+from stablepush.execution.protocol import DEFAULT_RATE_HZ, RATE_HZ, ProtocolError, check_state
 from stablepush.execution.report import ContactRecord, ExecutionReport
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from, contact_first, renumbered
-from stablepush.execution.verdict import judge, success_tolerance
+from stablepush.execution.verdict import judge, success_tolerance, success_tolerance_of
 from stablepush.execution.world import Feature, place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
+from stablepush.plan.files import MAX_WAYPOINTS
 from stablepush.plan.plan import Plan, Waypoint
 from stablepush.plan.verify import check_plan
 from stablepush.pose import Tolerance
 from stablepush.task.model import Task
-from stablepush.units import MM
+from stablepush.units import MM, is_integer, is_real
 
 # An arm whose reported pose stays this far from the commanded one (m, rad) for this many acks in
 # a row is not following the stream (a real arm lags by a fraction of a mm): the run ends in a fault.
@@ -86,7 +87,24 @@ class RunOptions:
     pace: Optional[bool] = None
     closed_loop: Optional[ClosedLoop] = None
     guard: Optional[GuardedApproach] = GuardedApproach()
-    success_tolerance: Optional[Tuple[float, float]] = None
+    success_tolerance: "Optional[Tolerance | Tuple[float, float]]" = None
+
+    def __post_init__(self):
+        """Each option's type (TypeError) and range (SettingError naming it), as `execute` checks them."""
+        rate = self.rate_hz
+        if isinstance(rate, bool) or not is_real(rate) or not RATE_HZ[0] <= rate <= RATE_HZ[1]:
+            raise SettingError("rate_hz", f"must be a number from {RATE_HZ[0]:g} to {RATE_HZ[1]:g}, "
+                                          f"got {self.rate_hz!r:.40}")
+        if (isinstance(self.resume_from, bool) or not is_integer(self.resume_from)
+                or not 0 <= self.resume_from < MAX_WAYPOINTS):  # a plan file's steps at most
+            raise SettingError("resume_from", f"must be a whole number from 0 to {MAX_WAYPOINTS - 1:,}, "
+                                              f"got {self.resume_from!r:.40}")
+        for name, kind in (("pace", bool), ("closed_loop", ClosedLoop), ("guard", GuardedApproach)):
+            value = getattr(self, name)
+            if value is not None and not isinstance(value, kind):
+                raise TypeError(f"{name} must be a {kind.__name__} or None, got {type(value).__name__}")
+        if self.success_tolerance is not None:
+            success_tolerance_of(self.success_tolerance)
 
 
 Progress = Callable[[ArmWaypoint, int, int], None]

@@ -20,6 +20,7 @@ from typing import List
 
 import numpy as np
 
+from stablepush.errors import SettingError
 from stablepush.execution.protocol import RATE_HZ
 from stablepush.execution.stream import arm_trajectory
 from stablepush.execution.world import place_features, scene_description
@@ -57,7 +58,7 @@ class Trajectory:
     def columns(self, quat: str = "xyzw") -> List[str]:
         """The column names of rows(), the quaternion in `quat` order (xyzw or wxyz)."""
         if quat not in QUATERNION_ORDERS:
-            raise ValueError(f"quat must be one of {', '.join(QUATERNION_ORDERS)}, got {quat!r}")
+            raise SettingError("quat", f"must be one of {', '.join(QUATERNION_ORDERS)}, got {quat!r:.40}")
         q = ["qx", "qy", "qz", "qw"] if quat == "xyzw" else ["qw", "qx", "qy", "qz"]
         return ["t", "x", "y", "z", *q, "vx", "vy", "vz", "wx", "wy", "wz", "phase", "step"]
 
@@ -92,7 +93,7 @@ def timed_trajectory(task: Task, plan: Plan, rate_hz: float = 100.0) -> Trajecto
     from G where the executor's world starts it (world.scene_description). ValueError unless `rate_hz`
     lies in the arm protocol's RATE_HZ."""
     if not is_real(rate_hz) or not RATE_HZ[0] <= rate_hz <= RATE_HZ[1]:
-        raise ValueError(f"rate_hz must be a number from {RATE_HZ[0]:g} to {RATE_HZ[1]:g}, got {rate_hz!r:.40}")
+        raise SettingError("rate_hz", f"must be a number from {RATE_HZ[0]:g} to {RATE_HZ[1]:g}, got {rate_hz!r:.40}")
     rate_hz = rate_hz if isinstance(rate_hz, (int, float)) else float(rate_hz)  # numpy's, as the arm's JSON takes
     steps = list(plan.waypoints)
     features = place_features(task, steps)

@@ -34,6 +34,7 @@ import math
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
+from stablepush.errors import SettingError
 from stablepush.pose import Pose, PoseLike, Tolerance
 from stablepush.task.model import Task
 
@@ -55,7 +56,7 @@ class Verdict:
     detail: str
 
     def __post_init__(self):
-        object.__setattr__(self, "tolerance", _success_tolerance(self.tolerance))
+        object.__setattr__(self, "tolerance", success_tolerance_of(self.tolerance))
 
     @classmethod
     def for_fault(cls, tolerance: "Tolerance | Sequence[float]", reason: str) -> "Verdict":
@@ -69,14 +70,15 @@ class Verdict:
 def success_tolerance(task: Task, tolerance: "Tolerance | Sequence[float] | None" = None) -> Tolerance:
     """The Tolerance a run of `task` is judged with: `tolerance` (a Tolerance or mm, deg), else the
     task's own. ValueError for one that is not two finite numbers above 0."""
-    return task.tolerance if tolerance is None else _success_tolerance(tolerance)
+    return task.tolerance if tolerance is None else success_tolerance_of(tolerance)
 
 
-def _success_tolerance(value: "Tolerance | Sequence[float]") -> Tolerance:
+def success_tolerance_of(value: "Tolerance | Sequence[float]") -> Tolerance:
+    """`value` (a Tolerance or mm, deg) as the success tolerance: SettingError naming it otherwise."""
     try:
         return Tolerance.of(value)
-    except ValueError as exc:
-        raise ValueError(f"success {exc}") from None
+    except SettingError as exc:
+        raise SettingError("success_tolerance", exc.reason) from None
 
 
 def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,

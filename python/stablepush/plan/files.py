@@ -107,6 +107,9 @@ def write_plan(plan: Plan, json_path: Union[str, Path], csv_path: Optional[Union
     OutputError when both paths name one file."""
     require_plan(plan)
     source = f"the plan to write to {json_path}"
+    for key in ("stats", "uncertainty"):  # mappings, as load_plan reads them (a Plan edited in code)
+        if not isinstance(getattr(plan, key), dict):
+            raise PlanError(key, f"must be a mapping, got {type(getattr(plan, key)).__name__}", source)
     data = plan_to_dict(plan)
     text = json.dumps(data, indent=1, default=_json_number) + "\n"
     check_plan_dict(json.loads(text), source)  # names a waypoint's field

@@ -9,8 +9,21 @@ from typing import Tuple
 
 import numpy as np
 
+from stablepush.errors import SettingError
 from stablepush.execution.scene import Scene, SceneFeature
 from stablepush.frames import matrix_to_pose, pose_to_matrix, rot_y
+from stablepush.task.model import MAX_ANGLE, MAX_COORDINATE
+from stablepush.units import is_finite_real, is_integer
+
+SCALE_RANGE = (1e-3, 1e3)  # a world's multiplier of a task's mu, grip force or mass
+MAX_SEED = 2**32 - 1  # the tracker's noise seed (numpy's legacy bound, as a study's seed)
+
+
+def _number(name: str, value, bounds) -> None:
+    if isinstance(value, bool) or not is_finite_real(value) or not bounds[0] <= float(value) <= bounds[1]:
+        if not is_finite_real(value) and not isinstance(value, (int, float)):
+            raise TypeError(f"{name} must be a number, got {type(value).__name__}")
+        raise SettingError(name, f"must be a finite number from {bounds[0]:g} to {bounds[1]:g}, got {value!r:.40}")
 
 
 @dataclass(frozen=True)
@@ -32,6 +45,26 @@ class WorldDeviation:
     grip_scale: float = 1.0
     mass_scale: float = 1.0
     feature_offsets: Tuple[Tuple[str, float, float, float], ...] = ()
+
+    def __post_init__(self):
+        """Each field within what a world can be (SettingError naming it; TypeError for a wrong
+        type): a scale a positive multiplier up to SCALE_RANGE, a noise not negative, a seed a
+        whole number from 0, an offset within the task file's bounds on coordinates and angles."""
+        for name in ("mu_scale", "pad_mu_scale", "pusher_mu_scale", "grip_scale", "mass_scale"):
+            _number(name, getattr(self, name), SCALE_RANGE)
+        _number("tracker_noise_mm", self.tracker_noise_mm, (0.0, MAX_COORDINATE))
+        _number("tracker_noise_deg", self.tracker_noise_deg, (0.0, MAX_ANGLE))
+        if isinstance(self.seed, bool) or not is_integer(self.seed) or not 0 <= self.seed <= MAX_SEED:
+            raise SettingError("seed", f"must be a whole number from 0 to {MAX_SEED}, got {self.seed!r:.40}")
+        if not isinstance(self.feature_offsets, (tuple, list)):
+            raise TypeError(f"feature_offsets must be a sequence of (pusher, dx, dz, dtheta), got "
+                            f"{type(self.feature_offsets).__name__}")
+        for k, offset in enumerate(self.feature_offsets):
+            if not isinstance(offset, (tuple, list)) or len(offset) != 4 or not isinstance(offset[0], str):
+                raise TypeError(f"feature_offsets[{k}] must be (pusher, dx mm, dz mm, dtheta deg), got {offset!r:.60}")
+            for name, value, bound in zip(("dx", "dz", "dtheta"), offset[1:], (MAX_COORDINATE, MAX_COORDINATE,
+                                                                                MAX_ANGLE)):
+                _number(f"feature_offsets[{k}].{name}", value, (-bound, bound))
 
     def apply(self, scene: Scene) -> Scene:
         """`scene` as this world has it: a new Scene."""

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from stablepush.errors import SettingError
+
 if TYPE_CHECKING:
     from stablepush.execution.scene import Scene
 
@@ -17,7 +19,7 @@ DEFAULT_ENGINE = "mujoco"
 
 def check_engine(engine: str) -> str:
     if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {', '.join(ENGINES)}, got {engine!r}")
+        raise SettingError("engine", f"must be one of {', '.join(ENGINES)}, got {engine!r:.40}")
     return engine
 
 

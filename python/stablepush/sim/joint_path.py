@@ -170,6 +170,8 @@ def joint_path(task: Task, plan: Plan, rate_hz: float = 100.0, trajectory: Optio
     """The joints of `robot` (the task's environment.robot when None) along the plan's timed
     trajectory at `rate_hz` (`trajectory`, when the caller has it already), once the plan is shown
     to belong to the task (check_plan) and the arm can follow it in its cell (CellError otherwise)."""
+    if robot is not None and not isinstance(robot, Robot):
+        raise TypeError(f"robot must be a Robot (stablepush.task.Robot) or None, got {type(robot).__name__}")
     plan = check_plan(task, plan)
     steps = list(plan.waypoints)
     scene = scene_description(task, place_features(task, steps), steps[0].pose)

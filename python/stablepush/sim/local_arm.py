@@ -25,6 +25,10 @@ class SimulatedArm(Arm):
 
     def __init__(self, engine: str = DEFAULT_ENGINE, deviation: WorldDeviation = WorldDeviation(),
                  log: Optional[Callable[[str], None]] = None, robot: Optional[Robot] = None):
+        if robot is not None and not isinstance(robot, Robot):
+            raise TypeError(f"robot must be a Robot (stablepush.task.Robot), got {type(robot).__name__}")
+        if not isinstance(deviation, WorldDeviation):
+            raise TypeError(f"deviation must be a WorldDeviation, got {type(deviation).__name__}")
         self.engine = load_engine(engine)
         self.robot = robot if robot is not None else Robot()
         arm_model(self.robot)  # a model that cannot carry the jaws is the caller's error now (RobotError)

@@ -55,7 +55,7 @@ from typing import Callable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from stablepush.errors import OutputError
+from stablepush.errors import OutputError, SettingError
 from stablepush.execution.bags import RunSample
 from stablepush.execution.run import RunOutput, RunResult
 from stablepush.execution.scene import Scene
@@ -136,24 +136,25 @@ def check_video_path(path: Union[str, Path]) -> None:
 
 
 def check_fps(fps: float) -> None:
-    """ValueError unless 0 < fps <= MAX_FPS."""
+    """SettingError unless 0 < fps <= MAX_FPS."""
     if not (isinstance(fps, (int, float)) and 0 < fps <= MAX_FPS):
-        raise ValueError(f"frames per second must be above 0 and at most {MAX_FPS:g} (one frame per waypoint at "
-                         f"100 Hz), got {fps}")
+        raise SettingError("video_fps", f"frames per second must be above 0 and at most {MAX_FPS:g} (one frame per "
+                                        f"waypoint at 100 Hz), got {fps!r:.40}")
 
 
 def check_size(size: Sequence[int]) -> None:
-    """ValueError unless `size` is (width, height), both even and within SIZE_RANGE pixels."""
+    """SettingError unless `size` is (width, height), both even and within SIZE_RANGE pixels."""
     low, high = SIZE_RANGE
-    if len(size) != 2 or not all(isinstance(n, int) and low <= n <= high and n % 2 == 0 for n in size):
-        raise ValueError(f"width and height must be even numbers of pixels from {low} to {high} "
-                         f"(H.264's colour is sampled in 2 x 2 blocks), got {'x'.join(map(str, size))}")
+    if (not isinstance(size, (tuple, list)) or len(size) != 2
+            or not all(isinstance(n, int) and low <= n <= high and n % 2 == 0 for n in size)):
+        raise SettingError("video_size", f"width and height must be even numbers of pixels from {low} to {high} "
+                                         f"(H.264's colour is sampled in 2 x 2 blocks), got {size!r:.40}")
 
 
 def check_view(view: str) -> None:
-    """ValueError unless `view` is one of VIDEO_VIEWS."""
+    """SettingError unless `view` is one of VIDEO_VIEWS."""
     if view not in VIDEO_VIEWS:
-        raise ValueError(f"the view must be one of {', '.join(VIDEO_VIEWS)}, got {view!r:.40}")
+        raise SettingError("video_view", f"must be one of {', '.join(VIDEO_VIEWS)}, got {view!r:.40}")
 
 
 def video_directory(path: Union[str, Path]) -> str:
@@ -178,7 +179,7 @@ def run_scene(task: Task, plan: Plan, closed_loop: bool = False, resume_from: in
 class RunVideo(RunOutput):
     """A run drawn into `path` (.mp4) at `fps` and `size` in `view` (render_run), in the world its
     arm was given (run_scene), after a fault too when any waypoint was acknowledged. `progress(frames
-    done, frames)` after each frame. Checked when made (ValueError for fps, size and view;
+    done, frames)` after each frame. Checked when made (SettingError for fps, size and view;
     OutputError, MissingExtra for the path), so a video that could not be written is refused before
     the run."""
 
@@ -395,8 +396,8 @@ def render_run(path: Union[str, Path], task: Task, scene: Scene, samples: Sequen
         check_fps(fps)
         check_size(tuple(size))
         check_view(view)
-    except ValueError as exc:
-        raise OutputError(f"{path}: {exc}") from None
+    except SettingError as exc:
+        raise OutputError(f"{path}: {exc.reason}") from None
     if not str(path).lower().endswith(SUFFIX):
         raise OutputError(f"{path}: a video's file name must end in {SUFFIX} (H.264 in MP4)")
     if not samples:

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from stablepush.compiled import _core
-from stablepush.errors import TaskError
+from stablepush.errors import SettingError, TaskError
 from stablepush.pose import Tolerance
 from stablepush.task.mesh import PartMesh
 from stablepush.task.robot_files import model_source
@@ -33,6 +33,28 @@ JOINT_SPEED = (1e-3, 1e3)  # rad/s or m/s: environment.robot.max_joint_speed
 # A robot model file is named by one of these endings (MuJoCo compiles both; Drake parses both).
 ROBOT_MODEL_SUFFIXES = (".urdf", ".xml", ".mjcf")
 MAX_NAME = 100  # characters of a name (a pusher's, the flange's)
+MU = (0.0, 100.0)  # a friction coefficient
+# The part's, the gripper's and the world's numbers (file units), checked by Task whoever makes
+# one: the task file (schema.py) and code alike.
+PHYSICS_LIMITS: Dict[str, Tuple[float, float]] = {
+    "mass": (1e-3, 1e7),  # g
+    "inertia": (1e-15, 1e6),  # kg m^2
+    "force": (1e-6, 1e5),  # N
+    "gravity": (-1e3, 1e3),  # m/s^2 per component
+    "step_time": (1e-4, 1e3),  # s
+}
+MAX_PUSHER_POINTS = 20  # a line pusher's contact points
+# The planner section's numbers (file units), checked by PlannerSettings whoever makes one: the
+# task file (schema.py) and code alike.
+PLANNER_LIMITS: Dict[str, Tuple[float, float]] = {
+    "step": (1e-3, 1e3),  # mm or deg per unit step
+    "tolerance": (1e-4, 1e4),  # mm or deg
+    "time_limit": (1e-6, _core.MAX_TIME_LIMIT),  # s
+    "min_margin": (0.0, 1e6),  # N
+    "sampling_margin": (0.0, 1e3),  # unit steps
+    "min_hold_ratio": (0.0, 1e3),
+    "end_within": (0.01, 1.0),  # a share of the tolerance; 1: the tolerance's edge will do
+}
 
 # How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
 # (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
@@ -57,6 +79,14 @@ def _within(field: str, value, within: Tuple[float, float]) -> None:
     _finite(field, value)
     if not within[0] <= float(value) <= within[1]:
         raise TaskError(field, f"must be between {within[0]:g} and {within[1]:g}, got {float(value):g}")
+
+
+def _within_each(field: str, value, size: int, bounds: Sequence[Tuple[float, float]]) -> None:
+    """`size` finite numbers (TypeError otherwise), the i-th within bounds[i] (the last bound for
+    the rest): TaskError naming field[i]."""
+    _finite_vector(field, value, size)
+    for i, v in enumerate(value):
+        _within(f"{field}[{i}]", v, bounds[min(i, len(bounds) - 1)])
 
 
 def _world_pose(field: str, value, size: int) -> None:
@@ -99,7 +129,7 @@ def _string_mapping_of_numbers(field: str, value, keys=None) -> Dict[str, float]
     for key, v in value.items():
         if not isinstance(key, str) or (keys is not None and key not in keys):
             allowed = f" (one of {', '.join(keys)})" if keys is not None else ""
-            raise ValueError(f"{field}: {key!r:.40} is not a name it takes{allowed}")
+            raise TaskError(field, f"{key!r:.40} is not a name it takes{allowed}")
         _finite(f"{field}.{key}", v)
         out[key] = float(v)
     return out
@@ -136,23 +166,28 @@ class PlannerSettings:
     tuning: Dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        """Each field's type (TypeError) and range (TaskError naming planner.KEY), as the task
+        file's planner section is checked: PLANNER_LIMITS and the core's declared parameters."""
         for name in ("time_limit", "min_margin", "sampling_margin", "min_hold_ratio", "end_within"):
-            _finite(f"planner.{name}", getattr(self, name))
+            _within(f"planner.{name}", getattr(self, name), PLANNER_LIMITS[name])
             object.__setattr__(self, name, float(getattr(self, name)))
         for name in ("seed", "max_switches"):
             if isinstance(getattr(self, name), bool) or not is_integer(getattr(self, name)):
                 raise TypeError(f"planner.{name} must be an integer, got {getattr(self, name)!r:.40}")
+            _within(f"planner.{name}", getattr(self, name), _core.TRRT_STAR_PARAMETER_RANGES[name][1:])
             object.__setattr__(self, name, int(getattr(self, name)))
         for name in ("step", "tolerance"):
             _finite_vector(f"planner.{name}", getattr(self, name), 2)
+            for i, v in enumerate(getattr(self, name)):
+                _within(f"planner.{name}[{i}]", v, PLANNER_LIMITS[name])
             object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
         if not isinstance(self.tuning, dict):
             raise TypeError(f"planner.tuning must be a mapping, got {type(self.tuning).__name__}")
         object.__setattr__(self, "tuning", dict(self.tuning))  # its own: the caller's mapping may change
         for key, value in self.tuning.items():
             if key not in _core.TRRT_STAR_PARAMETER_RANGES or key in ("seed", "max_switches"):
-                raise ValueError(f"planner.{key!s:.40}: not a planner setting")
-            _finite(f"planner.{key}", value)
+                raise TaskError(f"planner.{key!s:.40}", "not a planner setting")
+            _within(f"planner.{key}", value, _core.TRRT_STAR_PARAMETER_RANGES[key][1:])
 
     @classmethod
     def from_mapping(cls, values: Dict[str, Any]) -> "PlannerSettings":
@@ -257,7 +292,7 @@ class Robot:
     def __post_init__(self) -> None:
         if self.model is not None and (not isinstance(self.model, str) or not self.model):
             raise TypeError(f"environment.robot.model must be a file name, got {self.model!r:.60}")
-        if not isinstance(self.flange, str) or not self.flange:
+        if not isinstance(self.flange, str):
             raise TypeError(f"environment.robot.flange must be a link name, got {self.flange!r:.60}")
         if not self.flange.strip() or len(self.flange) > MAX_NAME or not self.flange.isprintable():
             raise TaskError("environment.robot.flange", f"must be at most {MAX_NAME} printable characters, not all "
@@ -285,6 +320,10 @@ class Robot:
         if unknown:
             raise TaskError(f"environment.robot.{unknown[0]!s:.40}", f"not a setting of the robot "
                                                                      f"({', '.join(sorted(named))})")
+        if values.get("model") is not None:  # a lab's model: where its jaws go is its own, no default
+            for key in ("flange", "tcp"):
+                if key not in values:
+                    raise TaskError(f"environment.robot.{key}", "missing: a robot model needs its flange and tcp")
         return cls(**values)
 
     def replace(self, **changes: Any) -> "Robot":
@@ -333,6 +372,8 @@ class Cell:
         if not isinstance(self.features, dict):
             raise TypeError("environment.features must map pusher names to [x, y, z, theta] (mm, deg)")
         for name, pose in self.features.items():
+            if not isinstance(name, str):
+                raise TypeError(f"environment.features: its keys are pusher names, got {name!r:.40}")
             _world_pose(f"environment.features.{name}", pose, 4)
         object.__setattr__(self, "features", {name: tuple(float(v) for v in pose)
                                               for name, pose in self.features.items()})
@@ -368,11 +409,14 @@ class PusherSpec:
         """The shape of the fields (TypeError or ValueError naming the field), as Task's."""
         if not isinstance(self.name, str):
             raise TypeError(f"PusherSpec.name must be a string, got {type(self.name).__name__}")
+        if not self.name.strip() or len(self.name) > MAX_NAME:
+            raise TaskError("pushers[].name", f"must be a name of 1 to {MAX_NAME} characters, got {self.name!r:.40}")
         for end in ("a", "b"):
-            _finite_vector(f"pushers.{self.name:.40}.{end}", getattr(self, end), 2)
+            _within_each(f"pushers.{self.name:.40}.{end}", getattr(self, end), 2, [COORDINATE])
             object.__setattr__(self, end, tuple(float(v) for v in getattr(self, end)))
-        _finite(f"pushers.{self.name:.40}.mu", self.mu)
+        _within(f"pushers.{self.name:.40}.mu", self.mu, MU)
         _integer(f"pushers.{self.name:.40}.points", self.points)
+        _within(f"pushers.{self.name:.40}.points", self.points, (1, MAX_PUSHER_POINTS))
 
     @property
     def is_point(self) -> bool:
@@ -429,21 +473,24 @@ class Task:
             object.__setattr__(self, "environment", Cell.from_mapping(self.environment))
         if not isinstance(self.environment, Cell):
             raise TypeError(f"Task.environment must be a Cell or a mapping, got {type(self.environment).__name__}")
-        for name in ("thickness", "mass", "grip_force", "mu", "step_time"):
-            _finite(f"Task.{name}", getattr(self, name))
-        for name, size in (("gravity", 2), ("start", 3), ("goal", 3)):
-            _finite_vector(f"Task.{name}", getattr(self, name), size)
+        for name, bounds in (("thickness", LENGTH), ("mass", PHYSICS_LIMITS["mass"]),
+                             ("grip_force", PHYSICS_LIMITS["force"]), ("mu", MU),
+                             ("step_time", PHYSICS_LIMITS["step_time"])):
+            _within(f"Task.{name}", getattr(self, name), bounds)
+        _within_each("Task.gravity", self.gravity, 2, [PHYSICS_LIMITS["gravity"]])
+        _within_each("Task.start", self.start, 3, [COORDINATE, COORDINATE, ANGLE])
+        _within_each("Task.goal", self.goal, 3, [COORDINATE, COORDINATE, ANGLE])
         if not isinstance(self.vertices, (tuple, list)) or len(self.vertices) < 3:
             raise TypeError("Task.vertices must be a sequence of at least 3 (x, z) pairs")
         for i, v in enumerate(self.vertices):
-            _finite_vector(f"Task.vertices[{i}]", v, 2)
+            _within_each(f"Task.vertices[{i}]", v, 2, [COORDINATE])
         if not isinstance(self.pads, (tuple, list)) or not self.pads:
             raise TypeError("Task.pads must be a sequence of ((x, z), radius)")
         for i, pad in enumerate(self.pads):
             if not isinstance(pad, (tuple, list)) or len(pad) != 2:
                 raise TypeError(f"Task.pads[{i}] must be ((x, z), radius)")
-            _finite_vector(f"Task.pads[{i}] centre", pad[0], 2)
-            _finite(f"Task.pads[{i}] radius", pad[1])
+            _within_each(f"Task.pads[{i}].center", pad[0], 2, [COORDINATE])
+            _within(f"Task.pads[{i}] radius", pad[1], LENGTH)
         if not isinstance(self.pushers, (tuple, list)) or not all(isinstance(p, PusherSpec) for p in self.pushers):
             raise TypeError("Task.pushers must be a sequence of PusherSpec")
         self._check_the_other_fields()
@@ -456,7 +503,7 @@ class Task:
             _finite_vector("Task.com", com, 2)
             object.__setattr__(self, "com", tuple(float(v) for v in com))
         if self.inertia is not None:
-            _finite("Task.inertia", self.inertia)
+            _within("Task.inertia", self.inertia, PHYSICS_LIMITS["inertia"])
         _integer("Task.pad_rings", self.pad_rings)
         _integer("Task.friction_polygon_sides", self.friction_polygon_sides)
         if self.source is not None and not isinstance(self.source, str):
@@ -464,7 +511,7 @@ class Task:
         if self.mesh is not None and not isinstance(self.mesh, PartMesh):
             raise TypeError(f"Task.mesh must be a PartMesh or None, got {type(self.mesh).__name__}")
         if not isinstance(self.pushes, str) or self.pushes not in PUSHES:
-            raise ValueError(f"Task.pushes must be one of {', '.join(PUSHES)}, got {self.pushes!r:.40}")
+            raise TaskError("dynamics.pushes", f"must be one of {', '.join(PUSHES)}, got {self.pushes!r:.40}")
         object.__setattr__(self, "uncertainty", _string_mapping_of_numbers("Task.uncertainty", self.uncertainty,
                                                                            tuple(UNCERTAIN)))
         object.__setattr__(self, "feature_orientations",
@@ -594,11 +641,11 @@ class Task:
             made_from = _MODEL_INPUTS.get(model)
             if made_from not in expected:
                 box = " (the task has an uncertainty box: its corner models)" if any(self.uncertainty.values()) else ""
-                raise ValueError(f"{name}: not one of the corner_models() of task {self.name!r}{box}: a model of "
-                                 f"another task, or not made by Task.build_model")
+                raise SettingError(name, f"not one of the corner_models() of task {self.name!r}{box}: a model of "
+                                         f"another task, or not made by Task.build_model")
             found.add(made_from)
         if found != expected:
-            raise ValueError(f"{field}: {len(models)} model(s), not the {len(expected)} of task.corner_models()")
+            raise SettingError(field, f"{len(models)} model(s), not the {len(expected)} of task.corner_models()")
 
     def model_inputs(self) -> str:
         """What build_model builds from, as canonical JSON (numbers as floats, so 62 and 62.0 are

@@ -28,8 +28,12 @@ from stablepush.task.model import (
     COORDINATE,
     JOINT_SPEED,
     LENGTH,
+    MAX_PUSHER_POINTS,
+    MU,
     ON_BOUNDARY,
+    PHYSICS_LIMITS,
     PLANNER_DEFAULTS,
+    PLANNER_LIMITS,
     PUSHES,
     ROBOT_MODEL_SUFFIXES,
     UNCERTAIN,
@@ -63,7 +67,6 @@ MAX_PAD_RINGS = 6  # 1 + 3 r (r + 1) points per pad: 127 at the cap
 MAX_PAD_POINTS = 128  # over all pads: the hold ratio's LP grows with the cube of the points (about 2 s at the cap)
 MAX_PADS = 8
 # A segment's cone is its end points' anyway, and building it grows fast with more (0.1 s a pusher at 50).
-MAX_PUSHER_POINTS = 20
 MAX_POLYGON_SIDES = 64
 MAX_YAML_ALIASES = 1000  # aliases (*name) a task file may use (PyYAML writes one per shared value)
 MAX_YAML_NODES = 100_000  # values in the file, aliases expanded
@@ -71,19 +74,9 @@ MAX_YAML_NODES = 100_000  # values in the file, aliases expanded
 # LENGTH, are model.py's: the cell and robot values check them too).
 LIMITS: Dict[str, Tuple[float, float]] = {  # kind -> (lowest, highest); both inclusive
     "length": LENGTH,  # mm: sizes, radii, distances
-    "mass": (1e-3, 1e7),  # g
-    "inertia": (1e-15, 1e6),  # kg m^2
-    "force": (1e-6, 1e5),  # N
-    "mu": (0.0, 100.0),
-    "gravity": (-1e3, 1e3),  # m/s^2 per component
-    "step_time": (1e-4, 1e3),  # s
-    "step": (1e-3, 1e3),  # mm or deg per unit step
-    "tolerance": (1e-4, 1e4),  # mm or deg
-    "time_limit": (1e-6, _core.MAX_TIME_LIMIT),  # s
-    "min_margin": (0.0, 1e6),  # N
-    "sampling_margin": (0.0, 1e3),  # unit steps
-    "min_hold_ratio": (0.0, 1e3),
-    "end_within": (0.01, 1.0),  # a share of the tolerance; 1: the tolerance's edge will do
+    "mu": MU,
+    **PHYSICS_LIMITS,
+    **PLANNER_LIMITS,
 }
 # Where the arm works (stablepush.execution): the environment section's keys but `features`, and
 # their defaults (Cell says what each is).
