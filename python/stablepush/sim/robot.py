@@ -25,7 +25,7 @@ import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -78,7 +78,7 @@ class ArmModel:
     max_speed: np.ndarray
     home_guesses: Tuple[np.ndarray, ...]
     base_link: str = ""
-    base_pose: Tuple[float, ...] = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+    base_pose: Sequence[float] = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
     urdf: Optional[str] = None
 
     def too_fast(self, q_from: np.ndarray, q_to: np.ndarray, dt: float) -> Optional[str]:
@@ -114,22 +114,23 @@ def model_stamp(robot: Robot) -> int:
 def _shipped() -> ArmModel:
     tree = ET.parse(ARM_XML).getroot()
     speeds = np.full(len(SHIPPED_JOINTS), Robot().max_joint_speed)
-    base = tree.find("worldbody/body")
-    return ArmModel(tree, SHIPPED_JOINTS, speeds, (SHIPPED_HOME_GUESS,), base.get("name"), _body_pose(base))
+    base = _find(tree, "worldbody/body")
+    return ArmModel(tree, SHIPPED_JOINTS, speeds, (SHIPPED_HOME_GUESS,), _name(base), _body_pose(base))
 
 
 @functools.lru_cache(maxsize=8)
 def _built(robot: Robot, _stamp: int) -> ArmModel:
-    if robot.shipped:  # the shipped arm on another flange, TCP or base
+    model = robot.model  # None: the shipped arm (robot.shipped)
+    if model is None:  # the shipped arm on another flange, TCP or base
         root = ET.parse(ARM_XML).getroot()
-        hand = root.find(".//body[@name='hand']")
+        hand = _find(root, ".//body[@name='hand']")
         for child in [c for c in hand if c.tag in ("site", "body")]:
             hand.remove(child)  # its G and jaws: remounted at the robot's TCP
         velocity: Dict[str, float] = {}
         renamed: set = set()
     else:
-        root = _compiled(robot.model)
-        velocity = _urdf_velocity_limits(robot.model)
+        root = _compiled(model)
+        velocity = _urdf_velocity_limits(model)
         for tag in _DROPPED:
             for element in root.findall(tag):
                 root.remove(element)
@@ -137,19 +138,18 @@ def _built(robot: Robot, _stamp: int) -> ArmModel:
     _mount_on_base(root, robot.base)
     flange = _flange(root, robot.flange if robot.shipped or robot.flange not in renamed else LAB_PREFIX + robot.flange)
     joints = _chain_joints(root, flange)
-    if not robot.shipped:
+    if model is not None:
         _refuse_project_joint_names(joints)
         _refuse_empty_ranges(joints)
-        _refuse_couplings(root, joints, robot.model)
+        _refuse_couplings(root, joints, model)
         _servo(root, joints)
     _mount_jaws(root, flange, robot.tcp)
-    names = tuple(j.get("name") for j in joints)
+    names = tuple(_name(j) for j in joints)
     speeds = np.array([velocity.get(name) or robot.max_joint_speed for name in names])
-    mount = root.find(f"worldbody/body[@name='{BASE_BODY}']")
+    mount = _find(root, f"worldbody/body[@name='{BASE_BODY}']")
     base = next(body for body in mount if body.tag == "body" and flange in body.iter("body"))
-    is_urdf = robot.model and Path(robot.model).suffix.lower() == ".urdf"
-    urdf = read_model_text(robot.model) if is_urdf else None
-    return ArmModel(root, names, speeds, _home_guesses(joints, robot.shipped), _lab_name(base.get("name")),
+    urdf = read_model_text(model) if model and Path(model).suffix.lower() == ".urdf" else None
+    return ArmModel(root, names, speeds, _home_guesses(joints, robot.shipped), _lab_name(_name(base)),
                     matrix_to_pose(pose_to_matrix(_body_pose(mount)) @ pose_to_matrix(_body_pose(base))), urdf)
 
 
@@ -158,17 +158,34 @@ def is_project_name(name: str) -> bool:
     return name in PROJECT_NAMES or name.startswith(PROJECT_PREFIXES)
 
 
+def _find(parent: ET.Element, path: str) -> ET.Element:
+    """`parent.find(path)`, an element the model is known to hold (arm.xml's hand and jaws, the
+    world body MuJoCo saves, the body _mount_on_base adds): RobotError naming the path if not."""
+    found = parent.find(path)
+    if found is None:
+        raise RobotError("environment.robot.model", f"the model has no {path!r:.120}")
+    return found
+
+
+def _name(element: ET.Element) -> str:
+    """The name of an element the model names (an arm's joint, checked by _chain_joints; a body
+    the chain starts from): RobotError naming its tag if it has none."""
+    name = element.get("name")
+    if name is None:
+        raise RobotError("environment.robot.model", f"a <{element.tag}> of the arm has no name")
+    return name
+
+
 def _keep_apart(root: ET.Element) -> set:
     """Every element of a lab's compiled model named as the project names its own (is_project_name)
     renamed LAB_PREFIX + name, with every reference to it: MuJoCo refuses a repeated name, and a
     lab's geom named floor was taken for the floor. Returns the names renamed."""
-    renamed = {e.get("name") for e in root.iter() if e.get("name") and is_project_name(e.get("name"))}
+    renamed = {name for e in root.iter() if (name := e.get("name")) and is_project_name(name)}
     for element in root.iter():
-        if element.get("name") in renamed:
-            element.set("name", LAB_PREFIX + element.get("name"))
-        for key in _REFERENCES:
-            if element.get(key) in renamed:
-                element.set(key, LAB_PREFIX + element.get(key))
+        for key in ("name", *_REFERENCES):
+            value = element.get(key)
+            if value is not None and value in renamed:
+                element.set(key, LAB_PREFIX + value)
     return renamed
 
 
@@ -180,7 +197,7 @@ def _lab_name(name: str) -> str:
 def _refuse_project_joint_names(joints: List[ET.Element]) -> None:
     """A joint of the arm renamed by _keep_apart would reach the lab's controller under a name it
     does not know: RobotError naming it."""
-    clashing = [_lab_name(j.get("name")) for j in joints if j.get("name").startswith(LAB_PREFIX)]
+    clashing = [_lab_name(_name(j)) for j in joints if _name(j).startswith(LAB_PREFIX)]
     if clashing:
         raise RobotError("environment.robot.model", f"the arm's joint {clashing[0]!r} has a name stablepush gives "
                                                     f"its own jaws or scene ({', '.join(sorted(PROJECT_NAMES))[:200]}, "
@@ -251,21 +268,23 @@ def _urdf_velocity_limits(path: str) -> Dict[str, float]:
     out = {}
     for joint in read_model_xml(path).iter("joint"):
         limit = joint.find("limit")
-        if limit is None or not limit.get("velocity"):
+        text = None if limit is None else limit.get("velocity")
+        if not text:
             continue
         try:
-            velocity = float(limit.get("velocity"))
+            velocity = float(text)
         except ValueError:
             raise RobotError("environment.robot.model", f"joint {joint.get('name')!r:.60}: limit velocity "
-                                                        f"{limit.get('velocity')!r:.40} is not a number") from None
-        if math.isfinite(velocity) and velocity > 0:
-            out[joint.get("name")] = velocity
+                                                        f"{text!r:.40} is not a number") from None
+        name = joint.get("name")
+        if name is not None and math.isfinite(velocity) and velocity > 0:  # an unnamed one: no arm joint
+            out[name] = velocity
     return out
 
 
 def _mount_on_base(root: ET.Element, base: Tuple[float, ...]) -> None:
     """Everything in the model's world body moves into BASE_BODY at `base` (x, y, z mm, yaw deg)."""
-    worldbody = root.find("worldbody")
+    worldbody = _find(root, "worldbody")
     x, y, z, yaw = base
     half = math.radians(yaw) / 2
     mount = ET.Element("body", name=BASE_BODY, pos=_numbers((x * MM, y * MM, z * MM)),
@@ -284,7 +303,7 @@ def _mount_on_base(root: ET.Element, base: Tuple[float, ...]) -> None:
 def _flange(root: ET.Element, name: str) -> ET.Element:
     flange = next((body for body in root.iter("body") if body.get("name") == name), None)  # any characters
     if flange is None:
-        bodies = [b.get("name") for b in root.iter("body") if b.get("name") and b.get("name") != BASE_BODY]
+        bodies = [n for b in root.iter("body") if (n := b.get("name")) and n != BASE_BODY]
         raise RobotError("environment.robot.flange", f"the model has no link {name!r:.60} (its links: "
                                                      f"{', '.join(bodies)[:300]})")
     return flange
@@ -293,7 +312,8 @@ def _flange(root: ET.Element, name: str) -> ET.Element:
 def _chain_joints(root: ET.Element, flange: ET.Element) -> List[ET.Element]:
     """The hinge and slide joints on the way from the world to `flange`, base first."""
     parent = {child: body for body in root.iter() for child in body}
-    chain, body = [], flange
+    chain: List[ET.Element] = []
+    body: Optional[ET.Element] = flange
     while body is not None and body.tag == "body":
         chain.append(body)
         body = parent.get(body)
@@ -318,18 +338,18 @@ def _refuse_couplings(root: ET.Element, joints: List[ET.Element], path: str) -> 
     """RobotError naming any coupling of the arm's joints: a URDF <mimic> (MuJoCo drops it), an
     MJCF <equality> on a joint, or a limited tendon, of the chain. The IK, the cell check and the
     joint trajectory move each joint on its own, so a coupled arm would not follow them."""
-    names = {j.get("name") for j in joints}
+    names = {_name(j) for j in joints}
     found = []
     if Path(path).suffix.lower() == ".urdf":
-        found += [f"joint {j.get('name')!r} mimics {j.find('mimic').get('joint')!r} (URDF <mimic>)"
+        found += [f"joint {j.get('name')!r} mimics {mimic.get('joint')!r} (URDF <mimic>)"
                   for j in read_model_xml(path).iter("joint")
-                  if j.find("mimic") is not None and ({j.get("name"), j.find("mimic").get("joint")} & names)]
+                  if (mimic := j.find("mimic")) is not None and (names & {j.get("name"), mimic.get("joint")})]
     for equality in root.findall("equality/*"):
-        coupled = sorted({equality.get(key) for key in ("joint1", "joint2")} & names)
+        coupled = sorted(names & {equality.get(key) for key in ("joint1", "joint2")})
         if coupled:
             found.append(f"an <equality> {equality.tag} constraint on joint {coupled[0]!r}")
     for tendon in root.findall("tendon/*"):
-        coupled = sorted({j.get("joint") for j in tendon.iter("joint")} & names)
+        coupled = sorted(names & {j.get("joint") for j in tendon.iter("joint")})
         if coupled and tendon.get("range") is not None and tendon.get("limited", "auto") != "false":
             found.append(f"tendon {tendon.get('name') or '(unnamed)'!r} limits joint {coupled[0]!r}")
     if found:
@@ -345,7 +365,7 @@ def _servo(root: ET.Element, joints: List[ET.Element]) -> None:
         joint.set("armature", repr(max(float(joint.get("armature", "0")), JOINT_ARMATURE)))
     actuators = ET.SubElement(root, "actuator")
     for joint in joints:
-        ET.SubElement(actuators, "position", name=joint.get("name"), joint=joint.get("name"), kp=repr(SERVO_KP),
+        ET.SubElement(actuators, "position", name=_name(joint), joint=_name(joint), kp=repr(SERVO_KP),
                       kv=repr(SERVO_KV))
     for body in root.iter("body"):
         body.set("gravcomp", "1")
@@ -359,7 +379,7 @@ def _mount_jaws(root: ET.Element, flange: ET.Element, tcp: Tuple[float, ...]) ->
     from scipy.spatial.transform import Rotation
 
     shipped = ET.parse(ARM_XML).getroot()
-    hand = shipped.find(".//body[@name='hand']")
+    hand = _find(shipped, ".//body[@name='hand']")
     X_FG = np.eye(4)
     X_FG[:3, :3] = Rotation.from_euler("xyz", tcp[3:], degrees=True).as_matrix()
     X_FG[:3, 3] = np.asarray(tcp[:3]) * MM
@@ -374,11 +394,11 @@ def _mount_jaws(root: ET.Element, flange: ET.Element, tcp: Tuple[float, ...]) ->
         actuators = ET.SubElement(root, "actuator")
     for finger in FINGER_JOINTS:  # the shipped arm has them already
         if actuators.find(f"position[@name='{finger}']") is None:
-            actuators.append(shipped.find(f".//actuator/position[@name='{finger}']"))
+            actuators.append(_find(shipped, f".//actuator/position[@name='{finger}']"))
     if root.find("equality") is None:
         ET.SubElement(root, "equality")
     if root.find("equality/joint[@joint1='finger_neg']") is None:
-        root.find("equality").append(shipped.find("equality/joint"))
+        _find(root, "equality").append(_find(shipped, "equality/joint"))
 
 
 def _home_guesses(joints: List[ET.Element], shipped: bool) -> Tuple[np.ndarray, ...]:
@@ -403,7 +423,7 @@ def _refuse_empty_ranges(joints: List[ET.Element]) -> None:
     (MuJoCo compiles `range="2.6 -2.6"`, and the IK's draws within it failed as an internal error)."""
     for joint, lower, upper in zip(joints, *joint_ranges(joints)):
         if not lower <= upper:
-            raise RobotError("environment.robot.model", f"joint {_lab_name(joint.get('name'))!r:.60}: its range "
+            raise RobotError("environment.robot.model", f"joint {_lab_name(_name(joint))!r:.60}: its range "
                                                         f"{lower:g} to {upper:g} is empty (the lower end above the "
                                                         f"upper)")
 
@@ -412,8 +432,11 @@ def joint_ranges(joints: List[ET.Element]) -> Tuple[np.ndarray, np.ndarray]:
     """Each joint's [lower, upper] from its MJCF `range` (unlimited: -inf, inf)."""
     lower, upper = [], []
     for joint in joints:
-        limited = joint.get("range") is not None and joint.get("limited", "auto") != "false"
-        a, b = (float(v) for v in joint.get("range").split()) if limited else (-math.inf, math.inf)
+        text = joint.get("range")
+        if text is not None and joint.get("limited", "auto") != "false":
+            a, b = (float(v) for v in text.split())
+        else:
+            a, b = -math.inf, math.inf
         lower.append(a)
         upper.append(b)
     return np.array(lower), np.array(upper)
