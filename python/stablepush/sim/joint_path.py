@@ -35,15 +35,17 @@ from stablepush.execution.scene import Scene
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.execution.trajectory import Trajectory, timed_trajectory
 from stablepush.execution.world import place_features, scene_description
+from stablepush.extras import require
 from stablepush.frames import pose_to_matrix
 from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
 from stablepush.sim import ik
 from stablepush.sim import scene as scene_mod
 from stablepush.sim.arm import ArmKinematics
-from stablepush.sim.friction import mujoco
 from stablepush.sim.robot import arm_model, model_stamp, robot_description
 from stablepush.task.model import Robot, Task
+
+mujoco = require("mujoco", "the arm's kinematics and the cell check")  # a kinematics library here, not a simulator
 
 # G through the joints' forward kinematics stays this close to each sample (m, rad): the joint
 # trajectory reproduces the Cartesian one within 0.01 mm and 0.01 deg.
