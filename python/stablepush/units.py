@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Any, Sequence, Tuple
+from typing import Any, Iterable, Sequence, Tuple, TypeVar, cast
 
 MM = 1e-3  # m per mm
 G = 1e-3  # kg per g
+
+T = TypeVar("T")
 
 
 def pose_to_si(q: Sequence[float]) -> Tuple[float, float, float]:
@@ -25,6 +27,19 @@ def pose_from_si(q: Sequence[float]) -> Tuple[float, float, float]:
 def mm2_to_si(p: Sequence[float]) -> Tuple[float, float]:
     """A point (mm, mm) -> (m, m)."""
     return (p[0] * MM, p[1] * MM)
+
+
+def as_pair(values: Iterable[T]) -> Tuple[T, T]:
+    """tuple(values), typed as the two it holds (an (x, z) point, a (mm, deg) spread, a video's
+    size): for values known to be two, or handed to a value type that checks their count itself."""
+    return cast(Tuple[T, T], tuple(values))  # the count is the caller's to know; the type checker cannot
+
+
+def as_triple(values: Iterable[T]) -> Tuple[T, T, T]:
+    """tuple(values), typed as the three it holds (a pose x, z, theta): for values known to be
+    three (a plan's or a tracker's pose), or handed to a value type that checks their count itself
+    (Task)."""
+    return cast(Tuple[T, T, T], tuple(values))  # as as_pair
 
 
 def is_real(value: Any) -> bool:

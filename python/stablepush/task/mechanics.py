@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import math
-from typing import Dict, Optional, Sequence
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -114,7 +114,7 @@ def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = N
         for heading in headings:
             h = math.radians(heading)
             if not rows:  # a 3-D cone: every elevation of the grid, each its own candidate
-                candidates = [(b,) for b in elevations]
+                candidates: List[Tuple[float, ...]] = [(b,) for b in elevations]  # an elevation, or a root's two sides
             else:
                 e = np.asarray(rows[0])
 

@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -99,7 +99,9 @@ def pad_face_problem(part: PartMesh, center: Tuple[float, float], radius: float)
     missing = int(np.isnan(below[:, 0]).sum() + np.isnan(above[:, 0]).sum())
     if missing:
         return f"hangs over the part's edge ({missing} of its {2 * len(below)} sample rays meet no face)"
-    found, shapes, shifted = [], {}, False
+    found: List[str] = []
+    shapes: Dict[str, List[Tuple[str, float, float]]] = {}
+    shifted = False
     for name, face, expected in (("-y", below, -half), ("+y", above, half)):
         lo, hi = float(face[:, 1].min()), float(face[:, 1].max())
         if hi > most_tilt:
@@ -152,8 +154,9 @@ def first_pad_off_faces(part: PartMesh, pads: Sequence[Tuple[Tuple[float, float]
                 key = (round(p[0], 3), round(p[1], 3), radius)
                 if key not in seen:
                     seen[key] = pad_face_problem(part, p, radius)
-                if seen[key] is not None:
-                    return k, i, p, seen[key]
+                problem = seen[key]
+                if problem is not None:
+                    return k, i, p, problem
     return None
 
 
@@ -208,7 +211,11 @@ def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Opt
         raise TaskError(f"{field}.file", f"{path} encloses no volume (inside out?)")
     if (mass is None) == (density is None):
         raise TaskError(field, "give exactly one of mass (g) and density (g/cm^3)")
-    grams = mass if mass is not None else density * G_PER_CM3 * volume
+    if mass is not None:
+        grams = mass
+    else:
+        assert density is not None, "exactly one of mass and density is given (checked above)"
+        grams = density * G_PER_CM3 * volume
     com = mesh.center_mass
     y = float(com[1]) if plane_y is None else plane_y
     low, high = mesh.bounds[:, 1]

@@ -19,7 +19,7 @@ from stablepush.errors import SettingError, TaskError
 from stablepush.pose import Tolerance
 from stablepush.task.mesh import PartMesh
 from stablepush.task.robot_files import model_source
-from stablepush.units import MM, G, is_integer, is_real, mm2_to_si, pose_to_si
+from stablepush.units import MM, G, as_triple, is_integer, is_real, mm2_to_si, pose_to_si
 
 # Plausible-physics bounds on world numbers, in file units: the task file's (schema.py) and the
 # cell's and robot's values made in code alike. Past them the model's arithmetic (doubles and the
@@ -499,7 +499,8 @@ class Task:
         """The fields __post_init__ has not checked: each one's type, named (an edited Task with
         uncertainty=None, say, escaped from sp.check and sp.plan_task as an AttributeError)."""
         if self.com is not None:  # a numpy array too, taken as the pair it holds
-            com = self.com.tolist() if getattr(self.com, "ndim", None) == 1 else self.com
+            com: Any = self.com  # typed a pair; an array is taken too
+            com = com.tolist() if getattr(com, "ndim", None) == 1 else com
             _finite_vector("Task.com", com, 2)
             object.__setattr__(self, "com", tuple(float(v) for v in com))
         if self.inertia is not None:
@@ -533,7 +534,7 @@ class Task:
         """The same task from another start (x mm, z mm, theta deg) in the same world: each feature
         keeps the object's world orientation it had, not the new start's (a re-plan from a measured
         pose, where gravity in O on a feature must stay the one the world has)."""
-        return dataclasses.replace(self, start=tuple(float(v) for v in start),
+        return dataclasses.replace(self, start=as_triple(float(v) for v in start),
                                    feature_orientations={p: self.feature_angle(p) for p in self.pusher_names})
 
     def identity(self) -> Dict[str, Any]:

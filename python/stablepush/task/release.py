@@ -29,7 +29,7 @@ from typing import Dict, List, Sequence, Tuple
 import numpy as np
 
 from stablepush.task.model import Task
-from stablepush.units import MM, pose_to_si
+from stablepush.units import MM, as_triple, pose_to_si
 
 # m/s: the executor's speed of G between contacts and on the retract (execution.stream moves at it),
 # defined here, below the executor, since the release's load depends on it
@@ -67,7 +67,7 @@ def release_hold_ratio(task: Task, pose: Sequence[float], pusher: int) -> float:
 def goal_poses(task: Task) -> List[Tuple[float, float, float]]:
     """The goal and the corners of its tolerance box (x, z mm, theta deg): a plan ends anywhere in it."""
     (x, z, theta), (mm, deg) = task.goal, task.planner.tolerance
-    return [tuple(task.goal)] + [(x + sx * mm, z + sz * mm, theta + st * deg)
+    return [as_triple(task.goal)] + [(x + sx * mm, z + sz * mm, theta + st * deg)
                                  for sx, sz, st in itertools.product((-1.0, 1.0), repeat=3)]
 
 

@@ -70,25 +70,27 @@ def model_source(path: "str | Path") -> ET.Element:
         if compiler is None:
             compiler = ET.SubElement(extension if extension is not None else ET.SubElement(root, "mujoco"),
                                      "compiler")
-        compiler.set("meshdir", str(folder / compiler.get("meshdir", "")))
-        meshes = Path(compiler.get("meshdir"))
+        meshdir = str(folder / compiler.get("meshdir", ""))
+        compiler.set("meshdir", meshdir)
+        meshes = Path(meshdir)
         _regular_files([meshes / Path(m.get("filename", "")).name for m in root.iter("mesh") if m.get("filename")])
         return root
     _inline_includes(root, folder, depth=0)
     compilers = root.findall("compiler") or [ET.SubElement(root, "compiler")]
     for compiler in compilers:
         for key in _ASSET_DIRS:
-            if compiler.get(key) is not None:
-                compiler.set(key, str(folder / compiler.get(key)))
+            value = compiler.get(key)
+            if value is not None:
+                compiler.set(key, str(folder / value))
     first = compilers[0]
     if first.get("assetdir") is None:
         for key in ("meshdir", "texturedir"):
             if all(c.get(key) is None for c in compilers):
                 first.set(key, str(folder))
-    found = {key: Path(c.get(key)) for c in compilers for key in _ASSET_DIRS if c.get(key)}
+    found = {key: Path(value) for c in compilers for key in _ASSET_DIRS if (value := c.get(key))}
     meshes, textures = (found.get(key, found.get("assetdir", folder)) for key in ("meshdir", "texturedir"))
-    _regular_files([(textures if e.tag == "texture" else meshes) / e.get("file") for e in root.iter()
-                    if e.tag in ("mesh", "skin", "hfield", "texture") and e.get("file")])
+    _regular_files([(textures if e.tag == "texture" else meshes) / file for e in root.iter()
+                    if e.tag in ("mesh", "skin", "hfield", "texture") and (file := e.get("file"))])
     return root
 
 

@@ -265,6 +265,12 @@ def _vector(path: str, value: Any, n: int, within: Optional[Tuple[float, float]]
     return tuple(_number(f"{path}[{i}]", v, within) for i, v in enumerate(value))
 
 
+def _pair(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> Tuple[float, float]:
+    """_vector of two numbers, typed as the pair it is (an (x, z) point, gravity)."""
+    x, z = _vector(path, value, 2, within)
+    return x, z
+
+
 def number_field(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> float:
     """An argument that must be a finite number (within `within`, inclusive): TaskError naming `path`."""
     return _number(path, value, within)
@@ -297,7 +303,8 @@ def _yaml_kind(value: Any) -> str:
         return "a boolean"
     if isinstance(value, (int, float)):
         return "a number"
-    return {str: "a string", list: "a list", dict: "a mapping"}.get(type(value), f"a {type(value).__name__}")
+    kinds: Dict[type, str] = {str: "a string", list: "a list", dict: "a mapping"}
+    return kinds.get(type(value), f"a {type(value).__name__}")
 
 
 def _shown(value: Any, limit: int = 60) -> str:
@@ -477,13 +484,13 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
     if "pads" in grip:
         if not isinstance(grip["pads"], list) or not 1 <= len(grip["pads"]) <= MAX_PADS:
             raise TaskError("gripper.pads", f"must be a list of 1 to {MAX_PADS} {{center: [x, z], radius: r}}")
-        pads = []
+        listed = []
         for i, pad in enumerate(grip["pads"]):
             path = f"gripper.pads[{i}]"
             pad = _mapping(path, pad, ["center", "radius"], [])
-            pads.append((_vector(f"{path}.center", pad["center"], 2, COORDINATE),
+            listed.append((_pair(f"{path}.center", pad["center"], COORDINATE),
                          _number(f"{path}.radius", pad["radius"], LIMITS["length"])))
-        pads = tuple(pads)
+        pads = tuple(listed)
     else:
         pads = (((0.0, 0.0), DEFAULT_PAD_RADIUS_MM), ((0.0, 0.0), DEFAULT_PAD_RADIUS_MM))
     points = len(pads) * (1 + 3 * pad_rings * (pad_rings + 1))
@@ -491,7 +498,7 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
         raise TaskError("gripper.pad_rings", f"{len(pads)} pads of {pad_rings} rings make {points} pad points; "
                                              f"at most {MAX_PAD_POINTS} (fewer rings or pads)")
 
-    gravity = _vector("gravity", top.get("gravity", list(DEFAULT_GRAVITY)), 2, LIMITS["gravity"])
+    gravity = _pair("gravity", top.get("gravity", list(DEFAULT_GRAVITY)), LIMITS["gravity"])
     dyn = _mapping("dynamics", top.get("dynamics", {}), [], ["step_time", "friction_polygon_sides", "pushes"])
     pushes = dyn.get("pushes", PUSHES[0])
     if pushes not in PUSHES:
@@ -643,7 +650,7 @@ def _com_outside(vertices, com) -> List[str]:
             f"section along y (com is in mm, in O)"]
 
 
-def _sub_millimetre(pads, environment: Dict[str, Any]) -> List[str]:
+def _sub_millimetre(pads, environment: Cell) -> List[str]:
     """Warnings for lengths in range but under SUB_MM where a cell's are millimetres to metres (a
     pad's radius, the retract and spacings, world positions near 0 in every coordinate): each
     reads as written in metres."""
@@ -725,7 +732,7 @@ def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
             raise TaskError("object.size", "missing (a box needs [L along x, B along y, H along z] in mm)")
         length, thickness, height = _vector("object.size", obj["size"], 3, LIMITS["length"])
         x, z = length / 2, height / 2
-        vertices = ((-x, -z), (x, -z), (x, z), (-x, z))
+        vertices: Tuple[Tuple[float, float], ...] = ((-x, -z), (x, -z), (x, z), (-x, z))
     elif shape == "polygon":
         if "size" in obj:
             raise TaskError("object.size", "only for shape: box (a polygon takes polygon and thickness)")
@@ -735,12 +742,12 @@ def _validate_object(obj: Any, source: Optional[str], notes: List[str]):
         if not isinstance(poly, list) or not 3 <= len(poly) <= MAX_VERTICES:
             raise TaskError("object.polygon", f"must be a list of 3 to {MAX_VERTICES} [x, z] vertices"
                                               + (f", got {len(poly)}" if isinstance(poly, list) else ""))
-        vertices = tuple(_vector(f"object.polygon[{i}]", v, 2, COORDINATE) for i, v in enumerate(poly))
+        vertices = tuple(_pair(f"object.polygon[{i}]", v, COORDINATE) for i, v in enumerate(poly))
         thickness = _number("object.thickness", obj.get("thickness", 25.0), LIMITS["length"])
     else:
         raise TaskError("object.shape", f"must be box, polygon or mesh, got {_shown(shape)}")
     mass = _number("object.mass", obj["mass"], LIMITS["mass"])
-    com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else None
+    com = _pair("object.com", obj["com"], COORDINATE) if "com" in obj else None
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else None
     return vertices, thickness, mass, com, inertia, None
 
@@ -751,7 +758,8 @@ def _onto_edge(section: "_core.CrossSection", edge: int, p: Tuple[float, float])
     u = np.array(vertices[edge]) / MM
     v = np.array(vertices[(edge + 1) % len(vertices)]) / MM
     t = float(np.clip(np.dot(np.array(p) - u, v - u) / np.dot(v - u, v - u), 0.0, 1.0))
-    return tuple(float(c) for c in u + t * (v - u))
+    x, z = (float(c) for c in u + t * (v - u))
+    return x, z
 
 
 def _mesh_object(obj: dict, source: Optional[str], notes: List[str]):
@@ -781,7 +789,7 @@ def _mesh_object(obj: dict, source: Optional[str], notes: List[str]):
         mass=_number("object.mass", obj["mass"], LIMITS["mass"]) if "mass" in obj else None,
         density=_number("object.density", obj["density"], (1e-3, 100.0)) if "density" in obj else None,
         max_vertices=MAX_VERTICES, thickness_range=LIMITS["length"])
-    com = _vector("object.com", obj["com"], 2, COORDINATE) if "com" in obj else mesh.com
+    com = _pair("object.com", obj["com"], COORDINATE) if "com" in obj else mesh.com
     inertia = _number("object.inertia", obj["inertia"], LIMITS["inertia"]) if "inertia" in obj else mesh.inertia
     lowest, highest = LIMITS["mass"]
     if not lowest <= mesh.mass <= highest:  # only a density can give it: a mass given was checked above
@@ -807,12 +815,12 @@ def _validate_pushers(value: Any, section: "_core.CrossSection", notes: List[str
             raw = _mapping(path, raw, ["name", "at", "mu"], [])
             if "from" in raw or "to" in raw:
                 raise TaskError(path, "give either at (a point pusher) or from/to (a segment), not both")
-            a = b = _vector(f"{path}.at", raw["at"], 2, COORDINATE)
+            a = b = _pair(f"{path}.at", raw["at"], COORDINATE)
             points = 1
         else:
             raw = _mapping(path, raw, ["name", "from", "to", "mu"], ["points"])
-            a = _vector(f"{path}.from", raw["from"], 2, COORDINATE)
-            b = _vector(f"{path}.to", raw["to"], 2, COORDINATE)
+            a = _pair(f"{path}.from", raw["from"], COORDINATE)
+            b = _pair(f"{path}.to", raw["to"], COORDINATE)
             if a == b:
                 raise TaskError(f"{path}.to", "equals from; a point pusher is written at: [x, z]")
             points = _integer(f"{path}.points", raw.get("points", DEFAULT_PUSHER_POINTS), 2, MAX_PUSHER_POINTS)
@@ -976,7 +984,7 @@ def _validate_planner(value: Any) -> PlannerSettings:
         out["time_limit"] = planner_limit("planner.time_limit", planner["time_limit"])
     for key in ("step", "tolerance"):
         if key in planner:
-            out[key] = list(_vector(f"planner.{key}", planner[key], 2, LIMITS[key]))
+            out[key] = list(_pair(f"planner.{key}", planner[key], LIMITS[key]))
     for key in ("min_margin", "sampling_margin", "min_hold_ratio", "end_within"):
         if key in planner:
             out[key] = _number(f"planner.{key}", planner[key], LIMITS[key])
