@@ -27,7 +27,7 @@ def in_gripper(pose_mm_deg: Sequence[float], points) -> np.ndarray:
     return np.array([point_in_gripper(pose_mm_deg, p) for p in np.asarray(points, float).reshape(-1, 2)]).reshape(-1, 2)
 
 
-def direction_in_gripper(theta_deg: float, v: Sequence[float]) -> Tuple[float, float]:
+def direction_in_gripper(theta_deg: float, v: Union[Sequence[float], np.ndarray]) -> Tuple[float, float]:
     """A direction of O seen from G: R(theta) v."""
     c, s = math.cos(math.radians(theta_deg)), math.sin(math.radians(theta_deg))
     return (c * v[0] + s * v[1], -s * v[0] + c * v[1])

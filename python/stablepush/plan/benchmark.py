@@ -77,7 +77,8 @@ def bench_checks(
     batches = -(-checks // batch)
     sizes = [checks // batches + (k < checks % batches) for k in range(batches)]
     for case, sticking in (("all_sliding", False), ("sticking", True)):
-        per_check, feasible, exact, done = [], 0, 0, 0
+        per_check: List[float] = []
+        feasible, exact, done = 0, 0, 0
         for size in sizes:
             q, dq = _queries(task, rng, size, sticking)
             pusher = len(per_check) % len(task.pushers)
@@ -133,7 +134,7 @@ def planning_trial(task: Task, seed: int, time_limit: Optional[float] = None, im
         planning_time_s=s["planning_time_s"], switches=s["switches"], pushes=s["pushes"],
         path_length_steps=s["path_length_steps"], feasibility_checks=s["feasibility_checks"], nodes=s["nodes"],
         pusher_sequence=list(plan.pusher_sequence),
-        min_margin=min((w.margin for w in plan.waypoints[1:]), default=None),
+        min_margin=min((w.margin for w in plan.waypoints[1:] if w.margin is not None), default=None),  # each push's
         first_time_s=first.get("planning_time_s"), first_switches=first.get("switches"),
         first_path_length_steps=first.get("path_length_steps"), first_min_margin=first.get("min_margin"),
     )

@@ -66,6 +66,14 @@ class Waypoint:
         """(x mm, z mm, theta deg)."""
         return (self.x, self.z, self.theta)
 
+    @property
+    def pushed_by(self) -> str:
+        """The pusher of this push: every waypoint after the start has one (check_plan); PlanError
+        for one without (the start, which is no push)."""
+        if self.pusher is None:
+            raise PlanError("waypoint.pusher", "missing: every waypoint after the start is a push by a pusher")
+        return self.pusher
+
 
 def waypoint_fault(fields: Mapping[str, Any]) -> FieldFault:
     """What is wrong with a waypoint's fields, by Waypoint's names (a Waypoint's own, or a plan
@@ -135,7 +143,7 @@ class Plan:
     outcome: str  # goal_reached | goal_over_switch_limit | time_limit | invalid_start | unreachable
     message: str
     waypoints: List[Waypoint]
-    stats: Dict[str, float] = field(default_factory=dict)
+    stats: Dict[str, Any] = field(default_factory=dict)  # numbers, flags, and "first" (the anytime search's first plan)
     # The largest multiple of the weight the pads alone hold at the last waypoint, gravity as during
     # the last push (>= 1: released there, the object stays; inf without gravity). hold_ratio.
     final_hold_ratio: float = math.inf

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import List, Optional, Tuple
+from typing import Dict, List, Tuple
 
 import numpy as np
 
@@ -37,8 +37,8 @@ from stablepush.plan.search import plan_task
 from stablepush.plan.unreachable import pads_off_near, why_unreachable
 from stablepush.task.mesh import first_pad_off_faces
 from stablepush.task.model import Task, require_task
-from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_limit, planner_parameter
-from stablepush.units import is_finite_real, pose_to_si
+from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_integer, planner_limit
+from stablepush.units import as_triple, is_finite_real, pose_to_si
 
 Axis = Tuple[float, float, int]  # from, to, count (count 1: `from` alone)
 MAX_AXIS, MAX_CELLS = 1000, 100_000  # values an axis, cells a map
@@ -88,9 +88,9 @@ class ReachJob:
         if x[2] * z[2] * theta[2] > MAX_CELLS:
             raise TaskError("x, z, theta", f"{x[2] * z[2] * theta[2]} cells; at most {MAX_CELLS}")
         goals = tuple((gx, gz, gth) for gth in axis_values(theta) for gz in axis_values(z) for gx in axis_values(x))
-        return cls(task=task, goals=goals, seed=planner_parameter("seed", "seed", seed),
+        return cls(task=task, goals=goals, seed=planner_integer("seed", "seed", seed),
                    time_limit=planner_limit("time_limit", time_limit), axes=(x, z, theta),
-                   check_limit=planner_parameter("check_limit", "check_limit", check_limit))
+                   check_limit=planner_integer("check_limit", "check_limit", check_limit))
 
 
 def grid_axis(name: str, axis, bound: Tuple[float, float]) -> Axis:
@@ -142,7 +142,7 @@ def reach_cell(job: ReachJob, i: int) -> dict:
     cell = {"goal": list(goal), "seed": job.seed, "solved": False, "planning_time_s": 0.0, "switches": None,
             "pushes": None, "outcome": None, "verdict": None, "reason": None, "node": this_node(),
             "guard_fired": False}
-    task = dataclasses.replace(job.task, goal=tuple(goal))
+    task = dataclasses.replace(job.task, goal=as_triple(goal))
     off = pads_off_near(task, goal)
     if off:
         return {**cell, "verdict": "unreachable",
@@ -153,6 +153,7 @@ def reach_cell(job: ReachJob, i: int) -> dict:
     try:
         plan = plan_task(task, seed=job.seed, time_limit=job.time_limit, check_limit=job.check_limit or None)
     except PadFaceError as exc:  # a path that takes a mesh part's pads off its faces: the goal's grasp if there
+        assert task.mesh is not None, "PadFaceError is a mesh part's"
         off_at_goal = first_pad_off_faces(task.mesh, task.pads, [goal]) is not None
         return {**cell, "verdict": "unreachable" if off_at_goal else "not found", "reason": exc.reason}
     s = plan.stats
@@ -217,7 +218,7 @@ def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_lim
     job = ReachJob.grid(task, x, z, theta, seed, time_limit, check_limit)
     runner = runner or Runner()
     started = time.perf_counter()
-    cells: List[Optional[dict]] = [None] * len(job.goals)
+    cells: Dict[int, dict] = {}  # by index: run_all yields each once, as it finishes
     for i, cell in run_all(reach_cell, job, range(len(job.goals)), runner):
         if isinstance(cell, WorkerLost):
             cell = {"goal": list(job.goals[i]), "seed": job.seed, "solved": False, "planning_time_s": 0.0,
@@ -226,6 +227,8 @@ def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_lim
         cells[i] = cell
         if progress is not None:
             progress(cell)
-    return ReachMap(task=task.name, start=tuple(task.start), axes=dict(zip(("x", "z", "theta"), map(list, job.axes))),
-                    seed=job.seed, time_limit=job.time_limit, cells=cells, wall_s=time.perf_counter() - started,
+    return ReachMap(task=task.name, start=as_triple(task.start),
+                    axes=dict(zip(("x", "z", "theta"), map(list, job.axes))), seed=job.seed,
+                    time_limit=job.time_limit, cells=[cells[i] for i in range(len(job.goals))],
+                    wall_s=time.perf_counter() - started,
                     runner=runner.describe(len(cells)), check_limit=job.check_limit)

@@ -30,7 +30,7 @@ def contact_in_gripper(task: Task, model: "_core.StablePushModel", pusher: int, 
     spec = task.pushers[pusher]
     normal = direction_in_gripper(pose_mm_deg[2], model.pushers[pusher].inward_normal)
     return PusherContact(start=point_in_gripper(pose_mm_deg, spec.a), end=point_in_gripper(pose_mm_deg, spec.b),
-                         normal=tuple(float(v) for v in normal))
+                         normal=(float(normal[0]), float(normal[1])))
 
 
 def require_goal_apart(task: Task) -> None:
@@ -110,7 +110,8 @@ def plan_task(
                                         f"larger step", task.source)
     waypoints: List[Waypoint] = []
     for k, w in enumerate(raw_waypoints):
-        pose = tuple(float(v) for v in pose_from_si(w.pose))
+        x, z, theta = pose_from_si(w.pose)
+        pose = (float(x), float(z), float(theta))
         if w.pusher < 0:
             waypoints.append(Waypoint(*pose))
         else:
@@ -224,13 +225,15 @@ def _check_pad_faces(task: Task, waypoints: Sequence[Waypoint]) -> None:
     """A mesh part's pads rest on its slab's two faces all along the path (the model's grasp is the
     slab's; a step, a curve or an edge under a pad is a grasp the model does not describe):
     PadFaceError naming the pad, the pose and what lies under it."""
-    found = first_pad_off_faces(task.mesh, task.pads, [w.pose for w in waypoints])
+    mesh = task.mesh
+    assert mesh is not None, "only a mesh part's pads are checked against its faces"
+    found = first_pad_off_faces(mesh, task.pads, [w.pose for w in waypoints])
     if found is not None:
         k, i, (x, z), problem = found
         pose = [round(v, 3) for v in waypoints[k].pose]
         raise PadFaceError(f"gripper.pads[{i}]",
                            f"the plan's path takes the pad off the part's faces just after waypoint {k} (pose {pose}; "
-                           f"its disc at x, z = {x:.3g}, {z:.3g} mm of the part {problem}): {slab_text(task.mesh)}",
+                           f"its disc at x, z = {x:.3g}, {z:.3g} mm of the part {problem}): {slab_text(mesh)}",
                            task.source)
 
 

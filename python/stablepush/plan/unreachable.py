@@ -242,7 +242,7 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int, box=(0.0, 0.0)
     arm = float(np.linalg.norm(r_cm))
     force = body.mass * (math.sqrt(2.0) * L + A * arm) / dt2
     momentum = np.array([force, force, arm * force + body.inertia * A / dt2])
-    slack = _box_slack(model, limits, np.linalg.norm(weight), arm, *box)
+    slack = _box_slack(model, limits, float(np.linalg.norm(weight)), arm, *box)
     n_g, n_p = len(gens), len(positions)
     # Columns: l (n_g), f (2 n_p), e (3), t.
     n = n_g + 2 * n_p + 3 + 1

@@ -122,8 +122,8 @@ def _pushes_fault(task: Task, waypoints: List[Waypoint], model, corners: Optiona
         q0, q1 = pose_to_si(waypoints[i - 1].pose), pose_to_si(waypoints[i].pose)
         fault = _step_fault(task, q0, q1, unit)
         if fault is None:
-            fault = _stability_fault(waypoints[i].pusher, task.pusher_index(waypoints[i].pusher), q0, q1, model,
-                                     corners, min_margin)
+            pusher = waypoints[i].pushed_by  # after the start (_waypoints_fault)
+            fault = _stability_fault(pusher, task.pusher_index(pusher), q0, q1, model, corners, min_margin)
         if fault is None and not model.grasp_maintained(q1):
             fault = "the pads leave the object at this pose"
         if fault is not None:
@@ -166,7 +166,7 @@ def plan_margin(task: Task, plan: Plan) -> float:
     for w0, w1 in zip(plan.waypoints, plan.waypoints[1:]):
         q0, q1 = pose_to_si(w0.pose), pose_to_si(w1.pose)
         dq = tuple(b - a for a, b in zip(q0, q1))
-        index = task.pusher_index(w1.pusher)
+        index = task.pusher_index(w1.pushed_by)
         verdict = _core.worst_case(corners, q0, dq, index) if corners else model.check(q0, dq, index)
         least = min(least, verdict.margin)
     return least
@@ -177,7 +177,7 @@ def _hold_fault(task: Task, waypoints: List[Waypoint], models: list, require_sol
     min_hold = task.planner.min_hold_ratio
     if not (require_solved and min_hold > 0 and len(waypoints) > 1):
         return None
-    q, last = pose_to_si(waypoints[-1].pose), task.pusher_index(waypoints[-1].pusher)
+    q, last = pose_to_si(waypoints[-1].pose), task.pusher_index(waypoints[-1].pushed_by)  # a push: len > 1
     held = min(m.hold_ratio(q, last) for m in models)
     if held < min_hold - MARGIN_SLACK:
         return (f"waypoints[{len(waypoints) - 1}]",

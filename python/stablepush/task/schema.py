@@ -967,8 +967,15 @@ def planner_parameter(path: str, key: str, value: Any) -> "int | float":
     (the CLI's --seed and --max-switches go through here too)."""
     kind, lowest, highest = PLANNER_PARAMETER_RANGES[key]
     if kind == "integer":
-        return _integer(path, value, int(lowest), int(highest))
+        return planner_integer(path, key, value)
     return _number(path, value, (lowest, highest))
+
+
+def planner_integer(path: str, key: str, value: Any) -> int:
+    """planner_parameter of an integer parameter (seed, max_switches, check_limit), typed int."""
+    kind, lowest, highest = PLANNER_PARAMETER_RANGES[key]
+    assert kind == "integer", f"the planner's {key} is a {kind} parameter"
+    return _integer(path, value, int(lowest), int(highest))
 
 
 def planner_limit(path: str, value: Any) -> float:
