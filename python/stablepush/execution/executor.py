@@ -25,7 +25,7 @@ from stablepush.execution.protocol import DEFAULT_RATE_HZ, RATE_HZ, ProtocolErro
 from stablepush.execution.report import ContactRecord, ExecutionReport
 from stablepush.execution.stream import ArmWaypoint, arm_trajectory, check_resume_from, contact_first, renumbered
 from stablepush.execution.verdict import judge, success_tolerance, success_tolerance_of
-from stablepush.execution.world import Feature, place_features, scene_description
+from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.plan.files import MAX_WAYPOINTS
 from stablepush.plan.plan import Plan, Waypoint
@@ -251,12 +251,52 @@ class _Run:
         loop = self.options.closed_loop
         if not loop.may_replan(self.replans):
             return
-        spliced = _correct(self.task, self.steps, self.features, loop, w, self.state, self.options.rate_hz,
-                           self.replans, success_tolerance(self.task, self.options.success_tolerance), touched)
+        spliced = self._correction(w, loop, touched)
         if spliced is not None:
             self.steps, new_points = spliced
             self.pending = renumbered(w, self.options.rate_hz, new_points)
             self.replanned_from = w.step if self.replanned_from is None else min(self.replanned_from, w.step)
+
+    def _correction(self, w: ArmWaypoint, loop: ClosedLoop, touched: bool = False):
+        """After plan step w.step: when the tracked pose is off the plan (or, at rest after the last
+        push, off the goal) by more than the loop allows, re-plan from it and return the spliced
+        steps and the waypoints that carry them out from where G is now (seq and t counted from this
+        waypoint); else None. At rest off the goal by more than the verdict's tolerance the verdict is
+        at stake, and the re-plan may take its last, riskier attempt (closed_loop.replan). `touched`:
+        the object has just come onto the feature of the next push (w ends an approach); a feature
+        met off its place has pushed it already, and every push of the contact would carry that error
+        on. In the plan's last contact it is corrected past the loop's final tolerance: the contact
+        ends at the goal, where an error along the push is one the pusher cannot push back (the
+        hexagon's closed-loop misses, docs/results/evaluate-1000-trials.md). So it is after the last
+        push of a contact from whose end a correction may still switch to another feature
+        (closed_loop.switch_held): past it, the pusher in contact is the only one left. The feature
+        in contact is updated: the object's pose on it becomes the measured one (G's pose times the
+        tracked pose in the grasp), so the rest of this contact pushes from where the object really is."""
+        task, steps, features, state = self.task, self.steps, self.features, self.state
+        k = w.step
+        tracked = state["object_in_grasp"]
+        last = k == len(steps) - 1 and not touched
+        pusher = steps[k + 1].pusher if touched else steps[k].pusher  # the one the object rests on
+        final_contact = touched and all(s.pusher == pusher for s in steps[k + 1:])
+        last_switch = not (last or touched) and steps[k + 1].pusher == pusher and switch_held(
+            task, steps[k].pose, pusher) and not switch_held(task, steps[k + 1].pose, pusher)
+        limit = loop.final_tolerance if last or final_contact or last_switch else loop.threshold
+        if not loop.off_by(tracked, task.goal if last else steps[k].pose, limit):
+            return None
+        measured = measured_pose(steps[k].pose, tracked)
+        trigger = "off_goal" if last else "on_touch" if touched else "last_switch" if last_switch else "off_plan"
+        judged_within = success_tolerance(task, self.options.success_tolerance)
+        record, new_steps = replan(task, measured, pusher, loop, k, steps[k].pose, trigger=trigger,
+                                   verdict_at_stake=last and not judged_within.within(tracked, task.goal))
+        self.replans.append(record)
+        if not record.solved or record.pushes == 0:
+            return None
+        on_feature = pose_to_matrix(state["ee_pose"]) @ grasp_transform(measured)
+        features[pusher] = dataclasses.replace(features[pusher], object_pose=on_feature)
+        spliced = steps[:k] + [Waypoint(*measured, pusher=steps[k].pusher)] + new_steps[1:]
+        points = arm_trajectory(task, spliced, features, self.options.rate_hz, state["ee_pose"], resume_from=k,
+                                resting_on=pusher)
+        return spliced, points
 
     def report(self) -> ExecutionReport:
         task, steps, state = self.task, self.steps, self.state
@@ -274,47 +314,6 @@ class _Run:
         loop = self.options.closed_loop
         report.verdict = judge(task, report, self.options.success_tolerance, loop.max_replans if loop else None)
         return report
-
-
-def _correct(task: Task, steps: List[Waypoint], features: Dict[str, Feature], loop: ClosedLoop, w: ArmWaypoint,
-             state: dict, rate_hz: float, replans: List[Replan], judged_within: Tolerance,
-             touched: bool = False):
-    """After plan step w.step: when the tracked pose is off the plan (or, at rest after the last
-    push, off the goal) by more than the loop allows, re-plan from it and return the spliced steps and the
-    waypoints that carry them out from where G is now (seq and t counted from this waypoint);
-    else None. At rest off the goal by more than `judged_within` (the verdict's tolerance) the verdict is at
-    stake, and the re-plan may take its last, riskier attempt (closed_loop.replan). `touched`: the
-    object has just come onto the feature of the next push (w ends an approach); a feature met off
-    its place has pushed it already, and every push of the contact would carry that error on. In
-    the plan's last contact it is corrected past the loop's final tolerance: the contact ends at the
-    goal, where an error along the push is one the pusher cannot push back (the hexagon's closed-loop
-    misses, docs/results/evaluate-1000-trials.md). So it is after the last push of a contact from whose end a correction
-    may still switch to another feature (closed_loop.switch_held): past it, the pusher in contact is
-    the only one left. `features` is updated in place: the object's pose on the
-    feature in contact becomes the measured one (G's pose times the tracked pose in the grasp), so
-    the rest of this contact pushes from where the object really is."""
-    k = w.step
-    tracked = state["object_in_grasp"]
-    last = k == len(steps) - 1 and not touched
-    pusher = steps[k + 1].pusher if touched else steps[k].pusher  # the one the object rests on
-    final_contact = touched and all(s.pusher == pusher for s in steps[k + 1:])
-    last_switch = not (last or touched) and steps[k + 1].pusher == pusher and switch_held(
-        task, steps[k].pose, pusher) and not switch_held(task, steps[k + 1].pose, pusher)
-    limit = loop.final_tolerance if last or final_contact or last_switch else loop.threshold
-    if not loop.off_by(tracked, task.goal if last else steps[k].pose, limit):
-        return None
-    measured = measured_pose(steps[k].pose, tracked)
-    trigger = "off_goal" if last else "on_touch" if touched else "last_switch" if last_switch else "off_plan"
-    record, new_steps = replan(task, measured, pusher, loop, k, steps[k].pose, trigger=trigger,
-                               verdict_at_stake=last and not judged_within.within(tracked, task.goal))
-    replans.append(record)
-    if not record.solved or record.pushes == 0:
-        return None
-    on_feature = pose_to_matrix(state["ee_pose"]) @ grasp_transform(measured)
-    features[pusher] = dataclasses.replace(features[pusher], object_pose=on_feature)
-    spliced = steps[:k] + [Waypoint(*measured, pusher=steps[k].pusher)] + new_steps[1:]
-    points = arm_trajectory(task, spliced, features, rate_hz, state["ee_pose"], resume_from=k, resting_on=pusher)
-    return spliced, points
 
 
 def _pusher_point(task: Task, pusher: str) -> np.ndarray:
