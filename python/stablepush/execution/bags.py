@@ -123,7 +123,7 @@ def object_in_gripper(task: Task, plan: Plan, trajectory: Trajectory) -> np.ndar
         step = int(trajectory.step[i])
         if trajectory.phase[i] == "push":
             T_WG = pose_to_matrix([*trajectory.position[i], *trajectory.quaternion_wxyz[i]])
-            out[i] = np.linalg.inv(T_WG) @ features[steps[step].pusher].object_pose
+            out[i] = np.linalg.inv(T_WG) @ features[steps[step].pushed_by].object_pose
         else:
             out[i] = grasp_transform(steps[step].pose)
     return out
@@ -167,7 +167,7 @@ def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajec
         start = _time(T, start_ns)
         if joints is not None:
             write("/stablepush/joint_trajectory", start_ns, _joint_trajectory(T, start, trajectory, joints))
-            _write_robot(T, write, start_ns, robot)
+            _write_robot(T, write, start_ns, joints.robot)
         write(TF_STATIC, start_ns, _static_transforms(T, start, features.values(), robot))
         write("/stablepush/scene", start_ns, T["visualization_msgs/msg/MarkerArray"](
             markers=_scene_markers(T, start, task, features.values())))
@@ -179,6 +179,7 @@ def write_bag(path: Union[str, Path], task: Task, plan: Plan, trajectory: Trajec
             stamp = _time(T, ns)
             pose = _pose(T, trajectory.position[i], trajectory.quaternion_wxyz[i])
             held = held_poses[i]
+            assert held is not None, "every sample of a plan's trajectory holds the object"
             write("/tf", ns, T["tf2_msgs/msg/TFMessage"](transforms=[
                 _transform(T, stamp, WORLD, GRIPPER, trajectory.position[i], trajectory.quaternion_wxyz[i]),
                 _transform(T, stamp, GRIPPER, OBJECT, held[:3], held[3:])]))
@@ -230,12 +231,12 @@ def _continuous(poses: Sequence[Optional[Sequence[float]]]) -> List[Optional[Lis
     """Poses [x, y, z, qw, qx, qy, qz] (None where a sample has none) with their quaternions made
     continuous over the ones present (trajectory.continuous_quaternions): a topic's quaternion
     does not jump to the other sign between two samples."""
-    present = [i for i, p in enumerate(poses) if p is not None]
+    present = [(i, p) for i, p in enumerate(poses) if p is not None]
     out: List[Optional[List[float]]] = [None] * len(poses)
     if present:
-        quats = continuous_quaternions(np.array([poses[i][3:] for i in present], float))
-        for i, q in zip(present, quats):
-            out[i] = [*map(float, poses[i][:3]), *map(float, q)]
+        quats = continuous_quaternions(np.array([p[3:] for _, p in present], float))
+        for (i, p), q in zip(present, quats):
+            out[i] = [*map(float, p[:3]), *map(float, q)]
     return out
 
 
@@ -309,7 +310,7 @@ def _quaternion(T, q_wxyz: Sequence[float]):
                                              w=float(q_wxyz[0]))
 
 
-def _pose(T, p: Sequence[float], q_wxyz: Sequence[float]):
+def _pose(T, p: Union[Sequence[float], np.ndarray], q_wxyz: Sequence[float]):
     return T["geometry_msgs/msg/Pose"](position=T["geometry_msgs/msg/Point"](x=float(p[0]), y=float(p[1]),
                                                                              z=float(p[2])),
                                        orientation=_quaternion(T, q_wxyz))
@@ -476,6 +477,7 @@ class RunRecording:
             for k, (t, _, _, _, _, pusher, phase, step, _, joints) in enumerate(samples):
                 commanded, reported, in_world, held = (commanded_poses[k], reported_poses[k], world_poses[k],
                                                        grasp_poses[k])
+                assert commanded is not None and reported is not None, "every sample has both (__call__)"
                 ns = last_ns = start_ns + int(round(t * 1e9))
                 end_of_step[step] = ns
                 stamp = _time(T, ns)
@@ -496,6 +498,7 @@ class RunRecording:
                 write("/stablepush/phase", ns, T["std_msgs/msg/String"](data=phase))
                 write("/stablepush/step", ns, T["std_msgs/msg/Int32"](data=int(step)))
                 if k in with_joints:
+                    assert self.robot is not None, "joint samples are the arm model's (joint_samples)"
                     write("/joint_states", ns, _joint_state(T, stamp, self.robot.joints, joints))
             for correction in report.get("replans") or []:
                 ns = end_of_step.get(correction["after_step"], last_ns)

@@ -60,7 +60,7 @@ from stablepush.pose import Pose, PoseLike, Tolerance
 from stablepush.task.mechanics import blocked_senses
 from stablepush.task.model import Task
 from stablepush.task.schema import PLANNER_PARAMETER_RANGES
-from stablepush.units import pose_to_si
+from stablepush.units import as_triple, pose_to_si
 
 THRESHOLD_FRACTION = 0.5  # default threshold: this fraction of the task's goal tolerance
 FINAL_FRACTION = 0.2  # default final tolerance: this fraction of the task's goal tolerance
@@ -112,8 +112,9 @@ class ClosedLoop:
     @classmethod
     def for_task(cls, task: Task, threshold: "Tolerance | Sequence[float] | None" = None,
                  final_tolerance: "Tolerance | Sequence[float] | None" = None) -> "ClosedLoop":
-        return cls(threshold=threshold if threshold else task.tolerance.scaled(THRESHOLD_FRACTION),
-                   final_tolerance=final_tolerance if final_tolerance else task.tolerance.scaled(FINAL_FRACTION))
+        return cls(threshold=Tolerance.of(threshold) if threshold else task.tolerance.scaled(THRESHOLD_FRACTION),
+                   final_tolerance=(Tolerance.of(final_tolerance) if final_tolerance
+                                    else task.tolerance.scaled(FINAL_FRACTION)))
 
     def may_replan(self, replans: Sequence["Replan"]) -> bool:
         """Whether the run may still re-plan, given the re-plans it made."""
@@ -167,7 +168,7 @@ def _transits_held(task: Task, steps: Sequence[Waypoint], pusher: str, ratio: fl
             q, index = pose_to_si(before.pose), task.pusher_index(previous)
             if nominal.hold_ratio(q, index) < ratio or any(m.hold_ratio(q, index) < 1.0 for m in corners):
                 return False
-        previous = step.pusher
+        previous = step.pushed_by  # a push: every step after steps[0]
     return True
 
 
@@ -247,7 +248,7 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
             found = list(result.waypoints)
             break
     notes = [] if found else _way_back_note(task, end, loop.final_tolerance, "from the plan's end")  # run as it is
-    record = Replan(after_step=0, measured=tuple(start), planned=tuple(end), solved=bool(found),
+    record = Replan(after_step=0, measured=as_triple(start), planned=as_triple(end), solved=bool(found),
                     pushers=result.pusher_sequence if found else [], pushes=max(len(found) - 1, 0),
                     kept_pusher=False, planning_ms=elapsed * 1e3, trigger="plan_short",
                     failure=None if found else _summed_up(ended, notes), tried=[] if found else tried + notes,
@@ -344,7 +345,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
     base = dataclasses.replace(task.with_start(measured), planner=task.planner.replace(
         tolerance=loop.final_tolerance.as_list()))
     if base.at_goal(base.start):  # off the plan but at the goal already: nothing to correct
-        return Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=True,
+        return Replan(after_step=after_step, measured=as_triple(measured), planned=as_triple(planned), solved=True,
                       pushers=[], pushes=0, kept_pusher=False, planning_ms=0.0, trigger=trigger), []
     spec = task.pushers[task.pusher_index(pusher)]
     elapsed, tried, ended, steps, found_by, guarded = 0.0, [], [], [], None, False
@@ -389,7 +390,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         steps, found_by = list(result.waypoints), attempt.describe(pusher)
         break
     notes = [] if steps else _way_back_note(task, measured, loop.final_tolerance, "from here")
-    record = Replan(after_step=after_step, measured=tuple(measured), planned=tuple(planned), solved=bool(steps),
+    record = Replan(after_step=after_step, measured=as_triple(measured), planned=as_triple(planned), solved=bool(steps),
                     pushers=result.pusher_sequence if steps else [], pushes=max(len(steps) - 1, 0),
                     kept_pusher=bool(steps[1:]) and steps[1].pusher == pusher, planning_ms=elapsed * 1e3,
                     trigger=trigger, failure=None if steps else _summed_up(ended, notes), attempt=found_by,

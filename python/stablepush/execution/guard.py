@@ -165,7 +165,8 @@ def from_touch(steps: Sequence[Waypoint], k: int, measured: Sequence[float]) -> 
     while last + 1 < len(steps) and steps[last + 1].pusher == steps[k + 1].pusher:
         last += 1
     d = [measured[0] - steps[k].pose[0], measured[1] - steps[k].pose[1], measured[2] - steps[k].pose[2]]
-    out = list(steps[:k]) + [Waypoint(*measured, pusher=steps[k].pusher)]
+    x, z, theta = measured
+    out = list(steps[:k]) + [Waypoint(x, z, theta, pusher=steps[k].pusher)]
     for i in range(k + 1, last):
         share = (last - i) / (last - k)
         out.append(replace(steps[i], x=steps[i].x + share * d[0], z=steps[i].z + share * d[1],
@@ -228,7 +229,8 @@ class GuardWatch:
             return self._seated(task, steps, features, w, state, rate_hz)
         if not w.guarded or self.since is None:
             return None
-        k, pusher = w.step, steps[w.step + 1].pusher
+        assert self.guard is not None, "since is set only while the watch is on, which it is with a guard"
+        k, pusher = w.step, steps[w.step + 1].pushed_by  # the push the approach leads to
         slow_end_left = bool(pending) and pending[0].guarded
         if self.holding:
             if slow_end_left:
@@ -255,8 +257,9 @@ class GuardWatch:
                 rate_hz: float):
         """After push w.step: when it is its contact's first and more follow, the pushes left re-based
         on the feature where the object rests (guard.seated_feature), else None."""
+        assert self.guard is not None, "called while the watch is on, which it is with a guard"
         k = w.step
-        pusher = steps[k].pusher
+        pusher = steps[k].pushed_by  # w is a push's
         if contact_first(steps, k) != k or k + 1 >= len(steps) or steps[k + 1].pusher != pusher \
                 or "object_in_grasp" not in state:
             return None

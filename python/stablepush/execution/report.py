@@ -141,6 +141,7 @@ class ExecutionReport:
     def _landing_lines(self) -> List[str]:
         """Where the object was on its last feature, and where it came to rest after the release."""
         err, f = self.final_error, self.final_in_grasp
+        assert err is not None and f is not None, "describe asks it of a run whose object was measured"
         x, z, th = self.planned_final
         lines = [f"on the last feature, in the grasp: x {f['x']:.3f} z {f['z']:.3f} mm, theta {f['theta']:.3f} deg "
                  f"(plan {x:.3f}, {z:.3f}, {th:.3f}); error {err['distance']:.3f} mm, {err['theta']:+.3f} deg"]
@@ -150,6 +151,7 @@ class ExecutionReport:
                          "judged there")
         elif change is not None:
             r = self.released_in_grasp
+            assert r is not None, "a release change is measured from it"
             lines.append(f"at rest after the release: x {r['x']:.3f} z {r['z']:.3f} mm, theta {r['theta']:.3f} deg; "
                          f"it moved {math.hypot(change['x'], change['z']):.3f} mm, {change['theta']:+.3f} deg when "
                          f"the feature let go")
@@ -166,7 +168,7 @@ class ExecutionReport:
                          f"taken, {len(failed)} with none found{last} (each with -v)")
         measured = [c for c in self.contacts if c.slip_mm is not None]
         if measured:
-            worst = max(measured, key=lambda c: c.slip_mm)
+            worst = max(measured, key=lambda c: c.slip_mm or 0.0)  # each measured: slip_mm set
             carried = max(c.carried_mm or 0.0 for c in measured)
             lines.append(f"{len(measured)} contact(s): the most slip at a pusher {worst.slip_mm:.3f} mm, "
                          f"{worst.slip_deg:.3f} deg ({worst.pusher}, steps {worst.first_step}-{worst.last_step}); "

@@ -39,19 +39,23 @@ class RunResult:
     @property
     def success(self) -> Optional[bool]:
         """Landed (True), missed or faulted (False), or not judged (None: the arm reports no object)."""
-        return False if self.fault is not None else self.report.success
+        return False if self.fault is not None else self._report().success
 
     def report_or_fault(self) -> ExecutionReport:
         """The run's report; its ArmFault raised when it ended in one."""
         if self.fault is not None:
             raise self.fault
+        return self._report()
+
+    def _report(self) -> ExecutionReport:
+        assert self.report is not None, "a run that ended in no fault has its report (run_plan)"
         return self.report
 
     def as_dict(self) -> dict:
         """The run's JSON report: ExecutionReport.as_dict, or after a fault `fault_report`."""
         if self.fault is not None:
             return fault_report(self.task, self.fault, self.options.success_tolerance)
-        return self.report.as_dict()
+        return self._report().as_dict()
 
     def write(self, outputs: Sequence["RunOutput"]) -> None:
         """Write each of `outputs`: a line each in `written`, or, for one that cannot be written
@@ -101,6 +105,7 @@ class BagRecording(RunOutput):
         self.start_ns = start_ns
 
     def write(self, run: RunResult) -> str:
+        assert run.recording is not None, "a run with an output that records is recorded (run_plan)"
         run.recording.write(self.path, run.as_dict(), start_ns=self.start_ns)
         return f"run recorded to {self.path}"
 

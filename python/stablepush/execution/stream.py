@@ -30,7 +30,7 @@ from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, s
 from stablepush.plan.plan import Waypoint
 from stablepush.task.model import Task
 from stablepush.task.release import MOVE_SPEED  # m/s of G between contacts (the release's load depends on it)
-from stablepush.units import MM
+from stablepush.units import MM, as_triple
 
 TURN_SPEED = math.radians(60)  # rad/s of G between contacts
 SETTLE_TIME = 0.2  # s held still at the end of the last push, before the final retract
@@ -72,7 +72,7 @@ class _Stream:
         self.points: List[ArmWaypoint] = []
         self.pose = start_pose
         self.step = step
-        self.planned = [tuple(float(v) for v in pose) for pose in planned]  # each plan step's pose in the grasp
+        self.planned = [as_triple(float(v) for v in pose) for pose in planned]  # each plan step's pose in the grasp
 
     def _emit(self, T: np.ndarray, phase: str, step: int, completes: bool = False, guarded: bool = False) -> None:
         if len(self.points) >= MAX_TRAJECTORY_SAMPLES:

@@ -60,7 +60,7 @@ class Verdict:
 
     @classmethod
     def for_fault(cls, tolerance: "Tolerance | Sequence[float]", reason: str) -> "Verdict":
-        return cls(False, tolerance, "arm_fault", f"the run ended in an arm fault: {reason}")
+        return cls(False, success_tolerance_of(tolerance), "arm_fault", f"the run ended in an arm fault: {reason}")
 
     def as_dict(self) -> dict:
         return {"success": self.success, "tolerance": self.tolerance.as_list(), "cause": self.cause,
@@ -81,7 +81,7 @@ def success_tolerance_of(value: "Tolerance | Sequence[float]") -> Tolerance:
         raise SettingError("success_tolerance", exc.reason) from None
 
 
-def judge(task: Task, report, tolerance: Optional[Sequence[float]] = None,
+def judge(task: Task, report, tolerance: "Tolerance | Sequence[float] | None" = None,
           max_replans: Optional[int] = None) -> Verdict:
     """The verdict on a completed run (`ExecutionReport`), judged with `tolerance` (mm, deg; default:
     the task's). `max_replans`: the closed loop's budget, when it ran."""
