@@ -226,7 +226,7 @@ class _Run:
         """During a push, note where the feature stopped the object riding with the hand."""
         if w.phase != "push" or self.touch_state is None or self.met_state is not None:
             return
-        riding = _rode_with_hand(self.task, self.steps[w.step].pusher, previous, self.state)
+        riding = _rode_with_hand(self.task, self.steps[w.step].pushed_by, previous, self.state)
         if riding is False:  # met during this waypoint: after a ride, its motion is still carried
             self.met_state = self.state if self.rode else previous
         self.rode = self.rode or bool(riding)
@@ -249,6 +249,7 @@ class _Run:
             self.loop_status = "no tracker"  # the cell reports no pose in the grasp: open loop
             return
         loop = self.options.closed_loop
+        assert loop is not None, "the loop is on (loop_status) only with a closed loop"
         if not loop.may_replan(self.replans):
             return
         spliced = self._correction(w, loop, touched)
@@ -276,7 +277,7 @@ class _Run:
         k = w.step
         tracked = state["object_in_grasp"]
         last = k == len(steps) - 1 and not touched
-        pusher = steps[k + 1].pusher if touched else steps[k].pusher  # the one the object rests on
+        pusher = (steps[k + 1] if touched else steps[k]).pushed_by  # the one the object rests on (a push's)
         final_contact = touched and all(s.pusher == pusher for s in steps[k + 1:])
         last_switch = not (last or touched) and steps[k + 1].pusher == pusher and switch_held(
             task, steps[k].pose, pusher) and not switch_held(task, steps[k + 1].pose, pusher)
@@ -300,6 +301,7 @@ class _Run:
 
     def report(self) -> ExecutionReport:
         task, steps, state = self.task, self.steps, self.state
+        assert self.ready is not None, "a run reports after stream, whose hello made it ready"
         report = ExecutionReport(
             task=task.name, resumed_from=self.options.resume_from, last_confirmed_step=self.last_confirmed,
             total_steps=len(steps) - 1, waypoints=self.sent, planned_final=steps[-1].pose, goal=task.goal,
@@ -343,7 +345,7 @@ def _record(contacts: Dict[int, ContactRecord], task: Task, steps: Sequence[Wayp
     the world since it came onto the feature by the plan (`touch_state`): up to where the feature
     stopped it (`met_state`; None: not yet) it was carried, after that it slipped (when the arm
     reports the object); with what the guarded approach found of its feature (`watch`)."""
-    pusher = steps[step].pusher
+    pusher = steps[step].pushed_by  # a push's step: it completes
     first = contact_first(steps, step)
     record = contacts.setdefault(first, ContactRecord(pusher, first, step))
     record.last_step = step

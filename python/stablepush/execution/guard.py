@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, replace
-from typing import Dict, List, Mapping, Optional, Sequence
+from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -181,7 +181,7 @@ def offset_along_approach_mm(planned: Feature, found: Feature) -> float:
     return float(-np.dot(planned.normal, shift)) / MM
 
 
-def measured_pose(planned: Sequence[float], tracked: dict) -> tuple:
+def measured_pose(planned: Sequence[float], tracked: dict) -> Tuple[float, float, float]:
     """The tracker's pose in the grasp (x mm, z mm, theta deg) with theta on the planned pose's turn (a
     plan may run past +-180 deg; a tracker reports one turn)."""
     theta = planned[2] + angle_difference_deg(float(tracked["theta"]), planned[2])
