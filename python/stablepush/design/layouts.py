@@ -29,7 +29,7 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 from stablepush.design.commented import commented_task
 from stablepush.design.folder import DESIGN_HEADER, DESIGN_NAME
@@ -44,7 +44,7 @@ from stablepush.plan.verify import plan_margin
 from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.task.mechanics import stable_directions
 from stablepush.task.model import Robot, Task
-from stablepush.task.schema import parse_task, planner_limit, planner_parameter
+from stablepush.task.schema import parse_task, planner_integer, planner_limit
 from stablepush.units import is_integer
 
 # What a layout is ranked by, each best first: the key, and +1 where less is better, -1 more.
@@ -136,7 +136,8 @@ class Design:
                   "points": self.points, "end": self.end_used, "switches": self.switches, "margin": self.margin_n,
                   "pushes": self.pushes, "reach": self.reach, "tests": self.tests, "time": self.planning_time_s,
                   "success": (self.success or {}).get("success_rate")}
-        return (not self.solved,) + tuple(math.inf if values[k] is None else RANK_KEYS[k] * values[k] for k in rank)
+        ranked = tuple(math.inf if (value := values[k]) is None else RANK_KEYS[k] * value for k in rank)
+        return (not self.solved, *ranked)
 
     def odds(self) -> str:
         """The measured odds in words (", landed 19 of 20 trials (76%-99%)"), or why none were
@@ -183,6 +184,7 @@ class DesignStudy:
         when the ranking's best is one it cannot)."""
         if self.designs and not self.usable:
             first = self.designs[0]
+            assert first.arm is not None, "a design the arm cannot follow was checked against it"
             many = f"any of the {len(self.designs)} designs" if len(self.designs) > 1 else "the one design"
             return (f"no design is usable by this arm: it cannot follow the plan of {many} (e.g. "
                     f"{' + '.join(first.pushers)}: {first.arm['reason']})")
@@ -311,6 +313,7 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
     results.sort(key=lambda d: d.pushers)  # in the layouts' order, whichever worker finished first
     solved = _distinct(sorted((d for d in results if d.solved), key=lambda d: d.key(rank)))
     for d in solved[:reach_top]:
+        assert d.task is not None, "a solved design has its task"
         d.reach = _reach_near_goal(d.task, runner)
     solved.sort(key=lambda d: d.key(rank))
     return DesignStudy(candidates=[c["name"] for c in candidates], designs=solved,
@@ -338,7 +341,7 @@ def _checked_arguments(max_fixtures: Any, rank: Any, reach_top: Any, time_limit:
     if isinstance(rank, str) or not isinstance(rank, (tuple, list)):
         raise TaskError("rank", f"a sequence of keys from {', '.join(RANK_KEYS)}, got {rank!r:.80}")
     keys = tuple(rank)
-    return _rank_keys(keys, repr(keys), measured=True), planner_parameter("check_limit", "check_limit", check_limit)
+    return _rank_keys(keys, repr(keys), measured=True), planner_integer("check_limit", "check_limit", check_limit)
 
 
 def _distinct(ranked: List[Design]) -> List[Design]:
@@ -457,14 +460,14 @@ def designs_folder(design_file: str) -> Path:
 
 
 def design_files(study: DesignStudy, task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], folder: Path,
-                 source: Optional[str] = None) -> Dict[str, str]:
+                 source: Optional[str] = None) -> Dict[Union[str, Path], str]:
     """Each design as a task file, `folder`/design-<rank>.yaml (its `task_file` set): path -> YAML,
     with the design file `source`'s comments where they apply (commented.commented_task)."""
     try:
         text = Path(source).read_text(encoding="utf-8") if source is not None else None
     except (OSError, UnicodeError):  # read once already (schema.load_design); without it, no comments
         text = None
-    files = {}
+    files: Dict[Union[str, Path], str] = {}  # as write_designs takes them (each key a str)
     for k, d in enumerate(study.designs, start=1):
         d.task_file = str(Path(folder) / DESIGN_NAME.format(rank=k))
         header = (DESIGN_HEADER.format(rank=k, source=Path(source).name if source else "a design")

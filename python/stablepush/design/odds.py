@@ -10,6 +10,7 @@ then rests on the keys after `success`.
 """
 from __future__ import annotations
 
+import functools
 from typing import Any, Callable, Dict, Optional
 
 from stablepush.design.layouts import Design, DesignStudy
@@ -42,6 +43,7 @@ def evaluate_designs(study: DesignStudy, trials: int, spreads: Spreads, top: int
     runner = runner or Runner()
     ran: Dict[str, int] = {" + ".join(d.pushers): 0 for d in study.designs[:top]}
     for d in study.designs[:top]:
+        assert d.task is not None and d.plan is not None, "the study's designs are solved, each with its plan"
         try:
             batch = Batch(task=d.task, plan=d.plan, spreads=spreads, seed=seed, closed_loop=closed_loop,
                           engine=engine)
@@ -49,7 +51,7 @@ def evaluate_designs(study: DesignStudy, trials: int, spreads: Spreads, top: int
             d.success = {"refused": str(refusal)}
             continue
         measured = evaluate(batch, trials, runner,
-                            progress=(lambda record, done, d=d: progress(d, record, done)) if progress else None)
+                            progress=functools.partial(progress, d) if progress else None)  # progress(d, record, done)
         s = measured.summary()
         d.success = {key: s[key] for key in ("trials", "judged", "successes", "success_rate", "ci95", "causes",
                                              "crashed", "wall_s")}

@@ -17,7 +17,7 @@ import os
 import time
 import traceback
 from dataclasses import dataclass
-from typing import Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -145,7 +145,7 @@ def run_trial(batch: Batch, trial: int) -> dict:
     for a trial that landed, or when it could not be drawn, `video_error` then says why)."""
     world = batch.world(trial)
     started = time.perf_counter()
-    record = {"trial": trial, "world": world.as_dict()}
+    record: Dict[str, Any] = {"trial": trial, "world": world.as_dict()}
     # Made before the run, so that a trial that crashes part-way still has what it ran to draw.
     recording = RunRecording() if batch.video_dir else None
     try:
@@ -157,7 +157,7 @@ def run_trial(batch: Batch, trial: int) -> dict:
         if run.fault is not None:  # the simulated arm failed (a simulator blow-up, an unreachable pose): stopped
             record.update(_not_run("arm_fault", str(run.fault)))
         else:
-            report = run.report
+            report = run.report_or_fault()  # no fault: its report
             record.update(final_error=report.final_error, goal_error=report.goal_error,
                           replans=sum(1 for r in report.replans if r.solved), success=bool(report.success),
                           cause=report.verdict.cause if report.verdict else None,
@@ -173,6 +173,7 @@ def run_trial(batch: Batch, trial: int) -> dict:
     record["wall_s"] = time.perf_counter() - started
     record["node"] = this_node()
     if batch.video_dir:
+        assert recording is not None, "made above for a batch with a video_dir"
         record["video"] = None if record["success"] else _failed_trial_video(batch, trial, world, recording, record)
     return record
 
@@ -183,6 +184,7 @@ def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: 
     it cannot be drawn (no waypoint was acknowledged, say). Never raises: the trial's record stands."""
     from stablepush.sim.video import render_run, run_scene
 
+    assert batch.video_dir is not None, "asked only of a batch with a video_dir"
     path = os.path.join(batch.video_dir, f"trial-{trial}.mp4")
     try:
         scene = deviation_of(batch, world).apply(run_scene(batch.task, batch.plan, batch.closed_loop))
@@ -280,7 +282,7 @@ class _Decision:
 
     def __init__(self, test: Optional[SequentialTest]):
         self.test = test
-        self.waiting: Dict[int, bool] = {}
+        self.waiting: Dict[int, Optional[bool]] = {}  # None: a crashed trial, passed over
         self.next = self.successes = self.judged = 0
         self.verdict: Optional[str] = None
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from stablepush.errors import SettingError
 from stablepush.task.model import MAX_ANGLE, MAX_COORDINATE, UNCERTAIN, Task
+from stablepush.units import as_pair
 
 VARY_KEYS = tuple(UNCERTAIN)  # pad_mu, pusher_mu, grip_force, mass: the keys of a task's uncertainty box
 MAX_FRACTION = 0.9  # a spread of +-90% at most: every multiplier stays positive (the box's own limit)
@@ -71,8 +72,8 @@ class Spreads:
         if vary is None:
             vary = {k: v for k, v in task.uncertainty.items() if v > 0.0} or dict(DEFAULT_VARY)
             feature_error = DEFAULT_FEATURE_ERROR if feature_error is None else feature_error
-        return cls(vary=dict(vary), feature_error=tuple(feature_error or (0.0, 0.0)),
-                   tracker_noise=tuple(tracker_noise))
+        return cls(vary=dict(vary), feature_error=as_pair(feature_error or (0.0, 0.0)),
+                   tracker_noise=as_pair(tracker_noise))  # Spreads checks each is two
 
     @property
     def one_world(self) -> bool:

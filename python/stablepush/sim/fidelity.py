@@ -282,9 +282,11 @@ def pivot_on_arm(task: Task, pushes: int = ARM_PIVOT_PUSHES, seed: int = 1,
     full = check_plan(task, plan_task(task, seed=seed))
     # The first pushes are a plan of the task whose goal is where they end: the executor runs only
     # a plan of the task it is given (check_plan).
-    first = dataclasses.replace(task, goal=tuple(full.waypoints[pushes].pose))
+    first = dataclasses.replace(task, goal=full.waypoints[pushes].pose)
     plan = dataclasses.replace(full, waypoints=full.waypoints[:pushes + 1], task_identity=first.identity())
     arm = SimulatedArm(engine, robot=task.environment.robot)
     report = run_plan(first, plan, arm, RunOptions(rate_hz=100.0)).report_or_fault()
-    return ArmPivotResult(pushes=len(plan.waypoints) - 1, error_mm=report.final_error["distance"],
-                          error_deg=report.final_error["theta"], steps_per_s=report.sim_steps_per_s)
+    error, rate = report.final_error, report.sim_steps_per_s
+    assert error is not None and rate is not None, "the simulated arm reports the object and its rate"
+    return ArmPivotResult(pushes=len(plan.waypoints) - 1, error_mm=error["distance"], error_deg=error["theta"],
+                          steps_per_s=rate)
