@@ -121,9 +121,10 @@ def searching(label: str, seconds: float, quiet: bool):
         started = time.monotonic()
         if done.wait(1.0):
             return
-        with click.progressbar(length=max(1, round(seconds * 10)), label=label, file=sys.stderr) as bar:
+        length = max(1, round(seconds * 10))
+        with click.progressbar(length=length, label=label, file=sys.stderr) as bar:
             while not done.wait(0.1):
-                bar.update(min(round((time.monotonic() - started) * 10), bar.length) - bar.pos)
+                bar.update(min(round((time.monotonic() - started) * 10), length) - bar.pos)
 
     watcher = None if quiet or not sys.stderr.isatty() else threading.Thread(target=show, daemon=True)
     if watcher is not None:

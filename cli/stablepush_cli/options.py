@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import sys
+from typing import TYPE_CHECKING, Optional
 
 import click
 
@@ -15,6 +16,9 @@ from stablepush_cli.common import (
     fail,
     given,
 )
+
+if TYPE_CHECKING:
+    from click._termui_impl import ProgressBar  # what click.progressbar returns
 
 
 def ascii_number(text: str) -> bool:
@@ -146,7 +150,7 @@ class VideoBar:
 
     def __init__(self, path: str):
         self.path = path
-        self.bar = None
+        self.bar: Optional[ProgressBar[int]] = None
 
     def __call__(self, done: int, frames: int) -> None:
         if self.bar is None:

@@ -150,7 +150,9 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
         from stablepush.viz import layouts_figure, save_figure
 
         top = [{"task": d.task, "rank": k, "label": _figures(d)} for k, d in enumerate(study.designs[:3], start=1)]
-        save_figure(layouts_figure(top, f"{study.designs[0].task.name}: the best layouts"), png_path)
+        best = study.designs[0].task
+        assert best is not None, "a solved design has its task"
+        save_figure(layouts_figure(top, f"{best.name}: the best layouts"), png_path)
     say = say_beside(json_path, png_path)
     say(f"{len(candidates)} candidates, {study.layouts_searched} layouts planned, {study.layouts_pruned} pruned "
         f"(no stable push toward the goal from the start: {', '.join(study.pruned_candidates) or 'none'})")

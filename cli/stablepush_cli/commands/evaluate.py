@@ -165,7 +165,7 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     try:
         batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
                       engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video.fps,
-                      video_size=tuple(video.size))
+                      video_size=video.size)
     except SettingError as exc:  # the tracker's noise, past what the guard can tell a touch from
         fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
     for warning in batch.warnings():

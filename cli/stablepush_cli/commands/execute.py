@@ -324,9 +324,9 @@ def _resume_command(ctx: click.Context, step: int) -> str:
             continue
         if param.name == "arm":
             words += ["--arm", f"{value[0]}:{value[1]}"]
-        elif param.is_flag and param.secondary_opts:  # --x/--no-x
+        elif isinstance(param, click.Option) and param.is_flag and param.secondary_opts:  # --x/--no-x
             words.append(param.opts[0] if value else param.secondary_opts[0])
-        elif param.is_flag:
+        elif isinstance(param, click.Option) and param.is_flag:
             words.append(param.opts[0])
         else:
             words += [param.opts[0], *(f"{v:g}" if isinstance(v, float) else str(v)
