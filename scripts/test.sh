@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The tests, as CI runs them (.ci/run): set up (system packages, a virtual environment, the
-# package with its test extras), then lint, the import layers, the C++ unit tests and the Python
-# suite. Extra arguments go to pytest (e.g. -m "not slow" for the fast set); they come after the
-# defaults, so `-n 0` runs the suite in one process and `-n 4` on four workers.
+# package with its test extras), then lint, the import layers, the types (mypy), the C++ unit tests
+# and the Python suite. Extra arguments go to pytest (e.g. -m "not slow" for the fast set); they come
+# after the defaults, so `-n 0` runs the suite in one process and `-n 4` on four workers.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh --test
@@ -14,6 +14,8 @@ echo "test: ruff" >&2
 ruff check .
 echo "test: import layers (lint-imports)" >&2
 lint-imports
+echo "test: types (mypy)" >&2
+mypy  # python/ and cli/, as pyproject.toml's [tool.mypy] says
 if [ -f cpp/tests/CMakeLists.txt ]; then
   echo "test: clang-format" >&2
   find cpp -name '*.hpp' -o -name '*.cpp' | xargs clang-format --dry-run --Werror
