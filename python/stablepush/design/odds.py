@@ -43,10 +43,10 @@ def evaluate_designs(study: DesignStudy, trials: int, spreads: Spreads, top: int
     runner = runner or Runner()
     ran: Dict[str, int] = {" + ".join(d.pushers): 0 for d in study.designs[:top]}
     for d in study.designs[:top]:
-        assert d.task is not None and d.plan is not None, "the study's designs are solved, each with its plan"
         try:
-            batch = Batch(task=d.task, plan=d.plan, spreads=spreads, seed=seed, closed_loop=closed_loop,
-                          engine=engine)
+            # A design without its task or plan (design() makes none) is Batch's to refuse, naming the field.
+            batch = Batch(task=d.task, plan=d.plan,  # type: ignore[arg-type]  # Batch checks both at run time
+                          spreads=spreads, seed=seed, closed_loop=closed_loop, engine=engine)
         except CellError as refusal:
             d.success = {"refused": str(refusal)}
             continue
