@@ -67,7 +67,7 @@ def test_bad_spreads_are_refused_naming_the_key():
 def test_a_batch_with_a_bad_success_tolerance_is_refused_before_any_trial():
     good = _batch()
     for bad in ((float("nan"), 0.5), (0.5, 0.0)):
-        with pytest.raises(ValueError, match="success tolerance"):
+        with pytest.raises(ValueError, match="success_tolerance: must be two finite numbers above 0"):
             dataclasses.replace(good, tolerance=bad)
 
 
