@@ -245,9 +245,9 @@ def probe_ray_head(address: Optional[str]) -> None:
     its GCS returns the cluster id over gRPC (for ray://HOST:PORT, a gRPC server answers at all).
     ray.init waits minutes on anything else that accepts the connection (a proxy, another server).
     None, "auto" and "local" are left to ray.init."""
-    if address in (None, "auto", "local"):
+    if address is None or address in ("auto", "local"):
         return
-    host, port = _host_port(check_ray_address(address))
+    host, port = _host_port(check_ray_address(address) or address)
     advice = "start one there (`ray start --head`), or run on a local instance"
     client = address.startswith("ray://")
     try:
