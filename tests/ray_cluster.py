@@ -32,13 +32,15 @@ def free_port() -> int:
 
 def node_env() -> Dict[str, str]:
     """The environment a node runs in: this checkout's stablepush first on the path, then the tests
-    (for the jobs below), no token."""
+    (for the jobs below), no token, and workers at the tests' own priority (RAY_worker_niceness=0,
+    as stablepush's local instance), so that the suite's other tests on the same cores do not
+    starve them (Ray's nice 15 leaves a worker a few percent of a loaded CPU)."""
     import stablepush
     import stablepush_cli
 
     paths = [str(Path(m.__file__).resolve().parent.parent) for m in (stablepush, stablepush_cli)]
     paths.append(str(Path(__file__).resolve().parent))
-    env = dict(os.environ, RAY_AUTH_MODE="disabled", RAY_USAGE_STATS_ENABLED="0")
+    env = dict(os.environ, RAY_AUTH_MODE="disabled", RAY_USAGE_STATS_ENABLED="0", RAY_worker_niceness="0")
     env["PYTHONPATH"] = os.pathsep.join(dict.fromkeys(paths + [p for p in env.get("PYTHONPATH", "").split(os.pathsep)
                                                                 if p]))
     return env
