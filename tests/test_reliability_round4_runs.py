@@ -1,7 +1,7 @@
 """Reliability, round four (issue 69), the classes of runs and outputs: G (a --ray address where
 something accepts TCP but is not a Ray head) and the rule that no output names an input. Each
 test fails on the code before its fix."""
-import os
+import json
 import socket
 import socketserver
 import threading
@@ -86,17 +86,31 @@ def test_g_nothing_listening_is_still_named_at_once():
         probe_ray_head(f"127.0.0.1:{port}")
 
 
-def test_r_a_batch_on_ray_that_finishes_nothing_for_a_while_says_what_ray_waits_for(monkeypatch):
+# A local Ray started in the test process would leave it unable to join the test cluster later
+# (tests/test_ray_cluster.py: OwnerDiedError once a local session has run in the same process):
+# the local instances below run in a child process of their own.
+def _in_a_child(code: str) -> str:
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    return done.stdout
+
+
+def test_r_a_batch_on_ray_that_finishes_nothing_for_a_while_says_what_ray_waits_for():
     """A starved machine: no trial finished in 15 minutes on a local Ray and nothing was printed."""
     pytest.importorskip("ray")
-    from stablepush import runners
-    from stablepush.runners import Runner, run_all
-
-    monkeypatch.setattr(runners, "RAY_QUIET_S", 0.5)
-    said = []
-    slow = lambda _shared, i: time.sleep(1.5) or i  # noqa: E731 - by value: Ray's workers cannot import tests
-    results = dict(run_all(slow, None, [0, 1], Runner(ray=True, on_wait=said.append)))
-    assert results == {0: 0, 1: 1}
+    out = _in_a_child(
+        "import json, time\n"
+        "from stablepush import runners\n"
+        "from stablepush.runners import Runner, run_all\n"
+        "runners.RAY_QUIET_S = 0.5\n"
+        "said = []\n"
+        "slow = lambda _shared, i: time.sleep(1.5) or i\n"
+        "print(json.dumps([dict(run_all(slow, None, [0, 1], Runner(ray=True, on_wait=said.append))), said]))\n")
+    results, said = json.loads(out.strip().splitlines()[-1])
+    assert results == {"0": 0, "1": 1}
     assert said, "nothing said while Ray finished nothing"
     assert said[0].startswith("Ray: 0 of 2 jobs finished after ") and "CPUs" in said[0], said[0]
 
@@ -105,11 +119,15 @@ def test_r_a_local_rays_jobs_run_at_this_processs_priority():
     """Ray ran its workers at nice 15: on 2 cores with 10 busy loops each got 0.7% of a CPU and 4
     trials finished none in 400 s, where at nice 0 they took 114 s."""
     pytest.importorskip("ray")
-    from stablepush.runners import RAY_LOCAL_CONFIG, Runner, run_all
-
-    niceness = lambda _shared, i: os.nice(0)  # noqa: E731 - by value: Ray's workers cannot import tests
-    assert dict(run_all(niceness, None, [0, 1], Runner(ray=True))) == {0: os.nice(0), 1: os.nice(0)}
-    assert RAY_LOCAL_CONFIG == {"worker_niceness": 0}, "one session's settings kept for the next"
+    out = _in_a_child(
+        "import json, os\n"
+        "from stablepush.runners import RAY_LOCAL_CONFIG, Runner, run_all\n"
+        "niceness = lambda _shared, i: os.nice(0)\n"
+        "jobs = dict(run_all(niceness, None, [0, 1], Runner(ray=True)))\n"
+        "print(json.dumps([jobs, os.nice(0), RAY_LOCAL_CONFIG]))\n")
+    jobs, driver, config = json.loads(out.strip().splitlines()[-1])
+    assert jobs == {"0": driver, "1": driver}
+    assert config == {"worker_niceness": 0}, "one session's settings kept for the next"
 
 
 @pytest.mark.parametrize("address", [None, "local", "auto", "10.0.0.5:6379"])
