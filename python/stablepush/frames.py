@@ -22,6 +22,13 @@ def point_in_gripper(pose_mm_deg: Sequence[float], p: Union[Sequence[float], np.
     return (pose_mm_deg[0] + c * p[0] + s * p[1], pose_mm_deg[1] - s * p[0] + c * p[1])
 
 
+def point_in_object(pose_mm_deg: Sequence[float], p: Sequence[float]) -> Tuple[float, float]:
+    """A point of G (mm) seen from O at q: point_in_gripper's inverse, p_O = R(theta)^T (p_G - (x, z))."""
+    c, s = math.cos(math.radians(pose_mm_deg[2])), math.sin(math.radians(pose_mm_deg[2]))
+    dx, dz = p[0] - pose_mm_deg[0], p[1] - pose_mm_deg[1]
+    return (c * dx - s * dz, s * dx + c * dz)
+
+
 def in_gripper(pose_mm_deg: Sequence[float], points) -> np.ndarray:
     """Points of O (n x 2, mm) seen from G at q, as an n x 2 array (point_in_gripper for each)."""
     return np.array([point_in_gripper(pose_mm_deg, p) for p in np.asarray(points, float).reshape(-1, 2)]).reshape(-1, 2)

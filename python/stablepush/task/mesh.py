@@ -18,6 +18,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from stablepush.errors import TaskError
+from stablepush.frames import point_in_object
 from stablepush.inputs import read_capped
 from stablepush.outputs import protect_input
 
@@ -127,14 +128,6 @@ def slab_text(part: PartMesh) -> str:
     return f"the model takes a slab {part.thickness:.3g} mm thick, the pads on its two parallel planar faces"
 
 
-def pad_in_object(pose_mm_deg: Sequence[float], center: Sequence[float]) -> Tuple[float, float]:
-    """A pad's centre (x, z mm in G) seen from O at grasp pose q: p_O = R(theta)^T (p_G - (x, z))
-    (docs/model.md section 1)."""
-    c, s = math.cos(math.radians(pose_mm_deg[2])), math.sin(math.radians(pose_mm_deg[2]))
-    dx, dz = center[0] - pose_mm_deg[0], center[1] - pose_mm_deg[1]
-    return (c * dx - s * dz, s * dx + c * dz)
-
-
 def first_pad_off_faces(part: PartMesh, pads: Sequence[Tuple[Tuple[float, float], float]],
                         poses: Sequence[Sequence[float]]) -> Optional[Tuple[int, int, Tuple[float, float], str]]:
     """The first place along a path of grasp poses (x, z mm, theta deg) where a pad ((centre x, z
@@ -145,12 +138,12 @@ def first_pad_off_faces(part: PartMesh, pads: Sequence[Tuple[Tuple[float, float]
     for k, q in enumerate(poses):
         following = poses[k + 1] if k + 1 < len(poses) else q
         for i, (center, radius) in enumerate(pads):
-            a, b = pad_in_object(q, center), pad_in_object(following, center)
+            a, b = point_in_object(q, center), point_in_object(following, center)
             steps = max(1, math.ceil(math.dist(a, b) / (radius / 2)))
             for j in range(steps if k + 1 < len(poses) else 1):
                 t = j / steps
                 qt = [u + t * (v - u) for u, v in zip(q, following)]
-                p = pad_in_object(qt, center)
+                p = point_in_object(qt, center)
                 key = (round(p[0], 3), round(p[1], 3), radius)
                 if key not in seen:
                     seen[key] = pad_face_problem(part, p, radius)
