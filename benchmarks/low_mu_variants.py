@@ -48,8 +48,7 @@ def main() -> None:
         edit(data)
         data["planner"]["time_limit"] = 3
         task = parse_task(yaml.safe_dump(data), f"{TASK.name} ({name})")
-        models = task.corner_models()
-        plans = [plan_task(task, seed=s, models=models) for s in range(1, args.seeds + 1)]
+        plans = [plan_task(task, seed=s) for s in range(1, args.seeds + 1)]
         ms = np.array([p.stats["planning_time_s"] * 1e3 for p in plans])
         tests = np.array([p.stats["feasibility_checks"] for p in plans])
         print(f"| {name} | {sum(p.solved for p in plans)}/{args.seeds} | {np.median(ms):.2f} | "

@@ -27,9 +27,8 @@ def main() -> None:
     out = {}
     for path in tasks:
         task = load_task(path)
-        models = task.corner_models()
         for seed in range(1, args.seeds + 1):
-            plan = plan_task(task, seed=seed, models=models)
+            plan = plan_task(task, seed=seed)
             out[f"{task.name}:{seed}"] = {
                 "outcome": plan.outcome, "checks": plan.stats["feasibility_checks"],
                 "waypoints": [[repr(w.x), repr(w.z), repr(w.theta), w.pusher, repr(w.margin)] for w in plan.waypoints],

@@ -26,14 +26,13 @@ def main() -> None:
     print("|---|---:|---:|---:|---:|---:|---:|---:|")
     for path in paths:
         task = load_task(path)
-        models = task.corner_models()
         times = np.full((2, args.seeds), np.inf)
         tests = np.zeros(args.seeds)
         switches = np.zeros(args.seeds)
         solved = 0
         for attempt in range(2):
             for k in range(args.seeds):
-                plan = plan_task(task, seed=k + 1, models=models)
+                plan = plan_task(task, seed=k + 1)
                 times[attempt, k] = plan.stats["planning_time_s"] * 1e3
                 tests[k] = plan.stats["feasibility_checks"]
                 switches[k] = plan.stats["switches"]

@@ -83,10 +83,10 @@ def main() -> None:
     task = load_task(args.task)
     plan = plan_task(task, seed=args.seed)
     pusher = args.pusher or (plan.waypoints[-1].pusher if len(plan.waypoints) > 1 else task.pusher_names[0])
-    pad_g = np.mean([centre for centre, _ in task.pads], axis=0)
+    pad_g = np.mean([centre for centre, _ in task.gripper.pads], axis=0)
     print(f"{task.name}: {plan.message}")
 
-    if not task.build_model().pusher_cones[task.pusher_index(pusher)].equality_rows:
+    if not task.model.pusher_cones[task.pusher_index(pusher)].equality_rows:
         parser.error(f"{pusher} is not a point pusher (its cone is 3-D): name one with --pusher")
     p_start = pad_centre_in_object(task.start, pad_g)
     print(f"1. {pusher}: the pads' centre moves in O, under its push that does not turn the object, toward")

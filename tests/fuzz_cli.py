@@ -255,7 +255,7 @@ def run_semantics(count: int, seed: int, scratch: Path):
             edited = plan_task(dataclasses.replace(task, goal=(task.goal[0] - 3, task.goal[1], task.goal[2])), seed=1)
             steps = list(edited.waypoints)
         if how == "other-model":
-            edited = plan_task(dataclasses.replace(task, mu=task.mu * 2), seed=1)
+            edited = plan_task(task.with_values({"gripper.mu": task.gripper.mu * 2}), seed=1)
             steps = list(edited.waypoints)
         text = json.dumps(plan_to_dict(dataclasses.replace(edited, waypoints=steps)))
         plan_file = scratch / "case.plan.json"
@@ -534,16 +534,14 @@ def run_api(count: int, seed: int, scratch: Path) -> None:
     for case in range(count):
         k = rng.randrange(len(tasks))
         task, plan = tasks[k], plans[k]
-        what = rng.choice(["plan", "check", "check_plan", "trajectory", "save_plan", "plan-models", "plan-edited"])
+        what = rng.choice(["plan", "check", "check_plan", "trajectory", "save_plan", "plan-edited"])
         if what == "plan":
             key = rng.choice(["seed", "time_limit", "max_switches", "improve_for", "min_transit_hold", "start_pusher"])
             call = lambda: sp.plan_task(task, **{key: hostile()}, **({} if key == "time_limit" else {"time_limit": 0.02}))  # noqa: E731
-        elif what == "plan-models":
-            call = lambda: sp.plan_task(task, models=rng.choice([[None], [], "x", [task], tasks[k - 1].corner_models()]),  # noqa: E731
-                                   time_limit=0.02)
-        elif what == "plan-edited":  # a Task edited past its loader's checks
-            field = rng.choice(["mu", "grip_force", "mass", "start", "goal", "pads", "pushers", "gravity"])
-            call = lambda: sp.plan_task(dataclasses.replace(task, **{field: hostile()}), time_limit=0.02)  # noqa: E731
+        elif what == "plan-edited":  # a Task edited past its loader's checks: a quantity by its path, or a field
+            field = rng.choice(["gripper.mu", "gripper.grip_force", "object.mass", "pushers.left.mu", "start", "goal",
+                                "gripper.pads", "object", "pushers", "gravity"])
+            call = lambda: sp.plan_task(_edited(task, field, hostile()), time_limit=0.02)  # noqa: E731
         elif what == "check":
             call = lambda: sp.check(task, at=hostile(), move=hostile(), pusher=rng.choice([None, "left", hostile()]))  # noqa: E731
         elif what == "check_plan":
@@ -566,6 +564,18 @@ def run_api(count: int, seed: int, scratch: Path) -> None:
                 tally.fail(label, f"{type(exc).__name__}: {str(exc)[:200]}")
     run_api_surface(rng, count, scratch, tally)
     print(json.dumps(tally.summary()))
+
+
+def _edited(task, field: str, value):
+    """`task` with `field` set to `value`: gripper.pads in its group, another dotted path through
+    Task.with_values, else a field of the Task."""
+    import dataclasses
+
+    if field == "gripper.pads":
+        return dataclasses.replace(task, gripper=dataclasses.replace(task.gripper, pads=value))
+    if "." in field:
+        return task.with_values({field: value})
+    return dataclasses.replace(task, **{field: value})
 
 
 # -- shared by the generated kinds: a bound on each case, a tally, the judge of a CLI result -------

@@ -45,33 +45,33 @@ def polygon_props(vertices_m):
 
 class IndependentModel:
     def __init__(self, task):
-        self.vertices = np.array(task.vertices, float) * MM
+        self.vertices = np.array(task.object.vertices, float) * MM
         area, centroid, jc = polygon_props(self.vertices)
-        self.mass = task.mass * G
-        self.com = np.array(task.com, float) * MM if task.com is not None else centroid
-        if task.inertia is not None:
-            self.inertia = task.inertia
+        self.mass = task.object.mass * G
+        self.com = np.array(task.object.com, float) * MM if task.object.com is not None else centroid
+        if task.object.inertia is not None:
+            self.inertia = task.object.inertia
         else:
             d = centroid - self.com
             self.inertia = self.mass * (jc / area + d @ d)
         self.gravity = np.array(task.gravity, float)  # in G while G's axes are the world's
         # Against fixed features the object keeps its world orientation phi_p on pusher p's feature,
         # so gravity is fixed in O and turns in G: g_G = R(theta - phi_p) g (docs/model.md section 7).
-        self.fixed_features = task.pushes == "against_fixed_features"
+        self.fixed_features = task.dynamics.pushes == "against_fixed_features"
         self.feature_angles = [math.radians(task.feature_angle(p.name)) for p in task.pushers]
-        self.dt = task.step_time
-        self.sides = task.friction_polygon_sides
-        k = 1 + sum(6 * i for i in range(1, task.pad_rings + 1))
+        self.dt = task.dynamics.step_time
+        self.sides = task.dynamics.friction_polygon_sides
+        k = 1 + sum(6 * i for i in range(1, task.gripper.pad_rings + 1))
         self.pad_points = []  # (position in G, friction limit, pad radius)
-        for center, radius in task.pads:
+        for center, radius in task.gripper.pads:
             c = np.array(center, float) * MM
             r = radius * MM
-            self.pad_points.append((c, task.mu * task.grip_force / k, r))
-            for ring in range(1, task.pad_rings + 1):
+            self.pad_points.append((c, task.gripper.mu * task.gripper.grip_force / k, r))
+            for ring in range(1, task.gripper.pad_rings + 1):
                 for j in range(6 * ring):
                     a = 2 * math.pi * j / (6 * ring)
-                    p = c + ring * r / task.pad_rings * np.array([math.cos(a), math.sin(a)])
-                    self.pad_points.append((p, task.mu * task.grip_force / k, r))
+                    p = c + ring * r / task.gripper.pad_rings * np.array([math.cos(a), math.sin(a)])
+                    self.pad_points.append((p, task.gripper.mu * task.gripper.grip_force / k, r))
         self.cones = [self._generators(p) for p in task.pushers]
 
     def _generators(self, spec):

@@ -1,8 +1,10 @@
 """The Python API (`import stablepush as sp`) and timed trajectories."""
+import copy
 import dataclasses
 import json
 import math
 import os
+import pickle
 import re
 import subprocess
 from collections import Counter
@@ -75,9 +77,9 @@ def test_each_push_lasts_the_models_step_time_or_the_next_whole_period_never_les
     task = sp.load_task(TASKS / "horizontal-offset-low-mu.yaml")
     traj = sp.trajectory(task, sp.plan_task(task, seed=1), rate_hz=rate_hz)
     samples = Counter(int(step) for phase, step in zip(traj.phase, traj.step) if phase == "push")
-    expected = math.ceil(task.step_time * rate_hz - 1e-9)
+    expected = math.ceil(task.dynamics.step_time * rate_hz - 1e-9)
     assert set(samples.values()) == {expected}
-    assert expected / rate_hz >= task.step_time - 1e-12 and (expected - 1) / rate_hz < task.step_time
+    assert expected / rate_hz >= task.dynamics.step_time - 1e-12 and (expected - 1) / rate_hz < task.dynamics.step_time
 
 
 def test_the_trajectory_puts_the_object_where_the_plan_says_at_every_push():
@@ -99,7 +101,7 @@ def test_the_trajectory_puts_the_object_where_the_plan_says_at_every_push():
         assert np.allclose(T_GO, grasp_transform((w.x, w.z, w.theta)), atol=1e-9)
     # One unit push lasts dynamics.step_time.
     pushes = [int(s) for s, p in zip(traj.step, traj.phase) if p == "push"]
-    assert all(pushes.count(k) == round(task.step_time * 100) for k in done)
+    assert all(pushes.count(k) == round(task.dynamics.step_time * 100) for k in done)
 
 
 def test_velocities_match_the_motion():
@@ -141,17 +143,6 @@ def test_trajectory_command_writes_csv_and_json_in_either_quaternion_order(tmp_p
     assert bad.exit_code == 2 and "--quat wxyz" in bad.stderr and not (tmp_path / "t.mcap").exists()
 
 
-def test_plan_refuses_models_that_are_not_the_tasks():
-    import stablepush as sp
-
-    task, other = sp.load_task(TASKS / "t-shaped.yaml"), sp.load_task(TASKS / "pivoting.yaml")
-    with pytest.raises(TypeError, match=r"models\[0\]: expected a StablePushModel"):
-        sp.plan_task(task, models=[None])  # was a segmentation fault
-    with pytest.raises(ValueError, match="not one of the corner_models.. of task 't-shaped'"):
-        sp.plan_task(task, models=other.corner_models())
-    assert sp.plan_task(task, models=task.corner_models()).solved
-
-
 def test_the_planning_subpackage_keeps_its_dotted_path():
     """`sp.plan_task` plans; `stablepush.plan` stays the subpackage the docs name
     (stablepush.plan.reach.reach_map, stablepush.plan.load_plan)."""
@@ -162,36 +153,86 @@ def test_the_planning_subpackage_keeps_its_dotted_path():
     assert sp.plan_task is planning.plan_task
 
 
-def test_check_answers_for_the_task_given_and_plan_takes_only_its_own_corner_models():
-    """check() builds the task's own models (robust with an uncertainty box); plan_task's `models`
-    must be the task's corner models: another task's friction, or the nominal model of a task
-    with a box, would answer for another task."""
-    high, low = sp.load_task(TASKS / "horizontal-offset-high-mu.yaml"), sp.load_task(TASKS / "horizontal-offset-low-mu.yaml")
-    with pytest.raises(TypeError):
-        sp.check(high, at=(0, 0, 0), move=(1, 0, 0), model=low.build_model())
-    with pytest.raises(ValueError, match=r"models\[0\]: not one of the corner_models.. of task 'horizontal-offset-high"):
-        sp.plan_task(high, models=low.corner_models(), time_limit=0.3)
-    robust = sp.load_task(TASKS / "more" / "large-manipulation-robust.yaml")
-    with pytest.raises(ValueError, match="uncertainty box"):
-        sp.plan_task(robust, models=[robust.build_model()], time_limit=0.3)
-    with pytest.raises(ValueError, match="1 model"):
-        sp.plan_task(robust, models=robust.corner_models()[:1], time_limit=0.3)
-    assert sp.plan_task(robust, models=robust.corner_models()[::-1]).solved  # any order
+def test_a_task_builds_its_models_once_and_a_task_made_from_it_builds_its_own():
+    """Task.model and Task.corner_models are built on first use and kept; a Task made from it
+    (with_values, dataclasses.replace of a group) has its own, built from its own values; check
+    and plan_task answer in the task's own models and take none from elsewhere."""
     base = sp.load_task(TASKS / "large-manipulation.yaml")
-    edits = {"com": dict(com=(30.0, -5.0)), "step_time": dict(step_time=0.5), "pushes": dict(pushes="by_moving_pusher"),
-             "pad_rings": dict(pad_rings=3), "pads": dict(pads=(((5.0, 0.0), 5.0), ((5.0, 0.0), 5.0)))}
-    for name, edit in edits.items():
-        with pytest.raises(ValueError, match="not one of the corner_models"):
-            sp.plan_task(base, models=dataclasses.replace(base, **edit).corner_models(), time_limit=0.3)
-    frictionless = dataclasses.replace(base, mu=0.0, uncertainty={"pad_mu": 0.2})
-    frictionless.check_models(frictionless.corner_models())
-    elsewhere = dataclasses.replace(base, goal=(5.0, 0.0, 0.0))  # a model does not depend on the goal
-    elsewhere.check_models(base.corner_models())
-    dataclasses.replace(base, mass=round(base.mass)).check_models(base.corner_models())  # 130 is 130.0
-    moving = dataclasses.replace(base, pushes="by_moving_pusher")  # no feature, so no start's turn in it
-    dataclasses.replace(moving, start=(0.0, 0.0, 10.0)).check_models(moving.corner_models())
-    arrays = dataclasses.replace(base, com=np.array([0.0, -5.0]))
-    arrays.check_models(arrays.corner_models())
+    assert base.model is base.model and base.corner_models is base.corner_models
+    assert base.corner_models == (base.model,)  # no box: the nominal model alone
+    robust = sp.load_task(TASKS / "more" / "large-manipulation-robust.yaml")
+    assert len(robust.corner_models) == 4 and robust.model not in robust.corner_models
+    assert all(m is t.model for m, t in zip(robust.corner_models, robust.corner_tasks))
+    heavy = base.with_values({"object.mass": 2 * base.object.mass})
+    assert heavy.model is not base.model
+    assert heavy.model.body.mass == pytest.approx(2 * base.model.body.mass) and base.object.mass == 130.0
+    edits = {"object": (dict(com=(30.0, -5.0)), lambda m: tuple(m.body.com) == pytest.approx((0.030, -0.005))),
+             "gripper": (dict(pad_rings=3), lambda m: len(m.gripper.point_positions) == 2 * 37),
+             "dynamics": (dict(pushes="by_moving_pusher"), lambda m: m.gravity_frame.name == "gripper")}
+    for group, (change, holds) in edits.items():
+        edited = dataclasses.replace(base, **{group: dataclasses.replace(getattr(base, group), **change)})
+        assert holds(edited.model) and not holds(base.model), group
+    high, low = sp.load_task(TASKS / "horizontal-offset-high-mu.yaml"), sp.load_task(TASKS / "horizontal-offset-low-mu.yaml")
+    assert sp.check(high, at=(0, 0, 0), move=(1, 0, 0), pusher="left")["left"]["feasible"]
+    assert not sp.check(low, at=(0, 0, 0), move=(1, 0, 0), pusher="left")["left"]["feasible"]
+    with pytest.raises(TypeError):
+        sp.plan_task(high, models=low.corner_models)  # a task plans in its own models, and no others
+
+
+@pytest.mark.parametrize("copy_of", [lambda t: pickle.loads(pickle.dumps(t)), copy.deepcopy, copy.copy],
+                         ids=["pickle", "deepcopy", "copy"])
+def test_a_pickled_or_copied_task_leaves_its_models_behind_and_builds_equal_ones(copy_of):
+    """Ray sends Tasks to its workers pickled: the models (which do not pickle) stay behind, and
+    the copy builds its own from the same values."""
+    task = sp.load_task(TASKS / "more" / "large-manipulation-robust.yaml")
+    task.model, task.corner_models  # built, so that there is something to leave behind
+    again = copy_of(task)
+    assert again == task and not {"model", "corner_models", "corner_tasks"} & set(vars(again))
+    q, dq = (0.0, 0.0, 0.0), (1e-3, 0.0, 0.0)
+    for mine, theirs in zip((again.model, *again.corner_models), (task.model, *task.corner_models)):
+        assert mine is not theirs and mine.body.mass == theirs.body.mass
+        assert mine.check(q, dq, 0).margin == theirs.check(q, dq, 0).margin
+
+
+@pytest.mark.parametrize("path, value", [("gripper.mu", 0.3), ("gripper.grip_force", 12.5), ("object.mass", 90.0),
+                                         ("pushers.under-web.mu", 0.35)])
+def test_each_value_path_reads_and_writes_its_quantity(path, value):
+    task = sp.load_task(TASKS / "t-shaped.yaml")
+    group, _, name = path.partition(".")
+    held = task.pushers[task.pusher_index("under-web")].mu if group == "pushers" else getattr(getattr(task, group), name)
+    assert task.value(path) == held != value
+    changed = task.with_values({path: value})
+    assert changed.value(path) == value and task.value(path) == held  # a new Task; the first one is as it was
+    assert [changed.value(p) for p in ("gripper.mu", "gripper.grip_force", "object.mass") if p != path] == \
+        [task.value(p) for p in ("gripper.mu", "gripper.grip_force", "object.mass") if p != path]
+
+
+def test_a_new_mass_scales_a_given_inertia_with_it():
+    mesh = sp.load_task(TASKS / "more" / "l-bracket-mesh.yaml")  # a mesh part: its inertia is given
+    heavier = mesh.with_values({"object.mass": 3 * mesh.object.mass})
+    assert heavier.object.inertia == pytest.approx(3 * mesh.object.inertia, rel=1e-15)
+    plain = sp.load_task(TASKS / "t-shaped.yaml")
+    assert plain.with_values({"object.mass": 90.0}).object.inertia is None  # the uniform prism's, from the mass
+
+
+@pytest.mark.parametrize("values, error, says", [
+    ({"gripper.pads": 0.1}, sp.TaskError, "gripper.pads: not a value of a task (gripper.mu, "),
+    ({"mu": 0.1}, sp.TaskError, "mu: not a value of a task"),
+    ({"pushers.nobody.mu": 0.1}, sp.TaskError, "pushers.nobody.mu: no pusher named 'nobody' (the task has left, "),
+    ({"gripper.mu": -0.1}, sp.TaskError, "gripper.mu: must be between 0 and 100, got -0.1"),
+    ({"gripper.grip_force": 0.0}, sp.TaskError, "gripper.grip_force: must be between 1e-06 and 100000, got 0"),
+    ({"object.mass": 1e9}, sp.TaskError, "object.mass: must be between 0.001 and 1e+07, got 1e+09"),
+    ({"pushers.left.mu": math.inf}, sp.TaskError, "pushers.left.mu: must be finite"),
+    ({"gripper.mu": "0.3"}, TypeError, "gripper.mu must be a number"),
+    ([("gripper.mu", 0.3)], TypeError, "takes a mapping"),
+])
+def test_an_unknown_path_or_a_value_out_of_range_is_refused_by_name(values, error, says):
+    task = sp.load_task(TASKS / "t-shaped.yaml")
+    with pytest.raises(error, match=re.escape(says)):
+        task.with_values(values)
+    if "not a value" in says or "no pusher" in says:
+        with pytest.raises(error, match=re.escape(says)):
+            task.value(next(iter(values)))
 
 
 def test_a_task_written_in_code_plans_like_the_file():

@@ -87,7 +87,7 @@ def test_every_topic_is_there_with_its_type_and_a_message_per_sample(t_bag):
     frames = {m.header.frame_id for m in markers}
     task = shipped("t-shaped")
     assert frames == {"object", "gripper", "world"}
-    assert len(markers) == 1 + len(task.pads) + 2  # the outline, each pad, the features of left and under-web
+    assert len(markers) == 1 + len(task.gripper.pads) + 2  # the outline, each pad, the features of left and under-web
 
 
 def test_the_gripper_pose_is_the_csv_row(t_bag):

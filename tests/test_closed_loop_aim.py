@@ -79,7 +79,7 @@ def test_aimed_plans_switch_over_only_where_corrections_may_and_no_more_than_nee
     record, steps = aim(task, plan.waypoints, ClosedLoop.for_task(task))
     assert plan.pusher_sequence == ["heel-stop"] and task.planner.max_switches == 2
     assert record.solved and record.pushers == ["heel-stop", "floor-block"], record
-    model = task.build_model()
+    model = task.model
     holds = [model.hold_ratio(pose_to_si(before.pose), task.pusher_index(before.pusher))
              for before, after in zip(steps[1:], steps[2:]) if after.pusher != before.pusher]
     assert len(holds) == 1 and holds[0] >= TRANSIT_HOLD_RATIO, holds

@@ -39,7 +39,7 @@ BAND_N = 1e-6  # N: pushes this close to their cone's boundary are not compared 
 
 def _agrees_with_the_independent_lp(task, plan) -> None:
     reference = IndependentModel(task)
-    model = task.build_model()
+    model = task.model
     for w0, w1 in zip(plan.waypoints, plan.waypoints[1:]):
         q0, q1 = pose_to_si(w0.pose), pose_to_si(w1.pose)
         dq = tuple(b - a for a, b in zip(q0, q1))

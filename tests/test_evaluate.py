@@ -89,7 +89,7 @@ def test_an_open_loop_batch_of_a_plan_that_ends_outside_the_success_tolerance_is
     assert "at the edge of the success tolerance 0.85 mm / 0.85 deg" in edge and "[0.425, 0.425]" in edge
     assert dataclasses.replace(open_loop, closed_loop=True).warnings() == []
     assert dataclasses.replace(open_loop, tolerance=(1.0, 1.0)).warnings() == []
-    moving = dataclasses.replace(task, pushes="by_moving_pusher")
+    moving = dataclasses.replace(task, dynamics=dataclasses.replace(task.dynamics, pushes="by_moving_pusher"))
     moved = Batch(task=moving, plan=check_plan(moving, plan_task(moving, seed=1)), spreads=Spreads(), closed_loop=True)
     assert any("another cell" in w for w in moved.warnings())
 
@@ -236,9 +236,9 @@ def _pushes_of(plan):
 def _in_world(task, world):
     """The task with its friction, grip and mass multiplied as in one trial's world (no box)."""
     m = world.multipliers
-    pushers = tuple(dataclasses.replace(p, mu=p.mu * m["pusher_mu"]) for p in task.pushers)
-    return dataclasses.replace(task, mu=task.mu * m["pad_mu"], grip_force=task.grip_force * m["grip_force"],
-                               mass=task.mass * m["mass"], pushers=pushers, uncertainty={})
+    return dataclasses.replace(task, uncertainty={}).with_values({
+        "gripper.mu": task.gripper.mu * m["pad_mu"], "gripper.grip_force": task.gripper.grip_force * m["grip_force"],
+        "object.mass": task.object.mass * m["mass"], **{f"pushers.{p.name}.mu": p.mu * m["pusher_mu"] for p in task.pushers}})
 
 
 def test_a_robust_plan_is_stable_in_every_world_its_spreads_draw():

@@ -24,13 +24,13 @@ BRACKET = ROOT / "data" / "tasks" / "more" / "l-bracket-mesh.yaml"
 def test_the_shipped_bracket_gives_its_outline_and_a_prisms_mass_properties():
     task = load_task(BRACKET)
     outline = [(-30, -25), (30, -25), (30, -5), (-10, -5), (-10, 25), (-30, 25)]
-    assert sorted(task.vertices) == sorted(map(lambda p: (float(p[0]), float(p[1])), outline))
-    assert task.thickness == pytest.approx(25.0) and task.mass == pytest.approx(1.41e-3 * 45_000)
+    assert sorted(task.object.vertices) == sorted(map(lambda p: (float(p[0]), float(p[1])), outline))
+    assert task.object.thickness == pytest.approx(25.0) and task.object.mass == pytest.approx(1.41e-3 * 45_000)
     # For an extrusion the solid's com and moment about y are the uniform prism's (core, independently).
     section = _core.CrossSection([(x * 1e-3, z * 1e-3) for x, z in outline])
-    prism = _core.RigidBody.uniform(section, task.mass * 1e-3)
-    assert np.allclose(np.array(task.com) * 1e-3, prism.com, atol=1e-12)
-    assert task.inertia == pytest.approx(prism.inertia, rel=1e-9)
+    prism = _core.RigidBody.uniform(section, task.object.mass * 1e-3)
+    assert np.allclose(np.array(task.object.com) * 1e-3, prism.com, atol=1e-12)
+    assert task.object.inertia == pytest.approx(prism.inertia, rel=1e-9)
 
 
 def test_a_mesh_task_is_planned_end_to_end():
@@ -308,7 +308,7 @@ def test_the_shipped_bracket_rests_flat_along_its_plan():
     task = load_task(BRACKET)
     plan = plan_task(task, seed=1)
     assert plan.solved
-    assert first_pad_off_faces(task.mesh, task.pads, [w.pose for w in plan.waypoints]) is None
+    assert first_pad_off_faces(task.object.mesh, task.gripper.pads, [w.pose for w in plan.waypoints]) is None
 
 
 def test_a_mesh_file_rewritten_after_the_task_was_read_is_named_not_mistaken(tmp_path):
@@ -318,11 +318,11 @@ def test_a_mesh_file_rewritten_after_the_task_was_read_is_named_not_mistaken(tmp
     data = _mesh_task("part.stl", [{"name": "left", "from": [-30, 10], "to": [-30, -10], "mu": 0.6}], [0, 0, 0],
                       [5, 0, 0])
     first = parse_task(data, source=str(tmp_path / "task.yaml"))
-    assert first.mesh.solid().extents[1] == pytest.approx(20.0)
+    assert first.object.mesh.solid().extents[1] == pytest.approx(20.0)
     trimesh.creation.box([60, 30, 40]).export(tmp_path / "part.stl")
     second = parse_task(data, source=str(tmp_path / "task.yaml"))
-    assert second.mesh.solid().extents[1] == pytest.approx(30.0)  # not the cached 20 mm solid
-    assert first.mesh.solid().extents[1] == pytest.approx(20.0)  # what the first task read, while cached
+    assert second.object.mesh.solid().extents[1] == pytest.approx(30.0)  # not the cached 20 mm solid
+    assert first.object.mesh.solid().extents[1] == pytest.approx(20.0)  # what the first task read, while cached
     _solid_in_o.cache_clear()
     with pytest.raises(TaskError, match="changed since the task was read"):
-        first.mesh.solid()
+        first.object.mesh.solid()

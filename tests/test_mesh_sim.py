@@ -89,7 +89,7 @@ def test_a_convex_mesh_part_is_its_own_hull_without_coacd(tmp_path, monkeypatch)
     (tmp_path / "block.yaml").write_text(text)
     monkeypatch.setitem(sys.modules, "coacd", None)  # not installed
     task = load_task(tmp_path / "block.yaml")
-    built = part_pieces(task.mesh)
+    built = part_pieces(task.object.mesh)
     assert built.description == "block.stl: convex, its own hull" and len(built.pieces) == 1
     assert len(built.pieces[0]) == 8
 
@@ -110,9 +110,9 @@ def test_a_decomposition_is_the_same_every_time(tmp_path):
     from stablepush.execution import part_geometry
 
     task = fidelity.notched_pivoting(shipped("pivoting"), tmp_path)
-    first = part_pieces(task.mesh)
+    first = part_pieces(task.object.mesh)
     part_geometry._pieces.cache_clear()
-    again = part_pieces(task.mesh)
+    again = part_pieces(task.object.mesh)
     assert first is not again and first.description == again.description
     assert all(np.array_equal(a, b) for a, b in zip(first.pieces, again.pieces))
 

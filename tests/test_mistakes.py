@@ -103,7 +103,7 @@ def test_show_draws_an_unsolved_plan_marked_as_such_and_point_pushers(tmp_path):
     first, last = snapshots[0], snapshots[-1]
     assert any(line.get_marker() == "o" for line in first.get_lines())
     # The orientation arrow runs along O's x axis: from the pose's (x, z), turned by its theta.
-    size = 0.3 * max(max(abs(v) for v in p) for p in pegs.vertices)
+    size = 0.3 * max(max(abs(v) for v in p) for p in pegs.object.vertices)
     for ax, (x, z, theta) in ((first, (0, 0, 0)), (last, end)):
         arrows = [t for t in ax.texts if isinstance(t, Annotation) and t.arrow_patch is not None]
         assert len(arrows) == 1

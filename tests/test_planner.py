@@ -54,10 +54,10 @@ def pads_inside(task, pose_mm_deg, slack_mm=1e-9):
     """Every pad disc inside the cross-section (mm), by point-in-polygon and edge distances."""
     x, z, th = pose_mm_deg
     c, s = math.cos(math.radians(th)), math.sin(math.radians(th))
-    for center, radius in task.pads:
+    for center, radius in task.gripper.pads:
         d = np.array(center) - np.array([x, z])
         p_o = np.array([c * d[0] - s * d[1], s * d[0] + c * d[1]])  # R^T (p - c)
-        if not _point_in_polygon(p_o, task.vertices) or _distance_to_boundary(p_o, task.vertices) < radius - slack_mm:
+        if not _point_in_polygon(p_o, task.object.vertices) or _distance_to_boundary(p_o, task.object.vertices) < radius - slack_mm:
             return False
     return True
 
@@ -104,7 +104,7 @@ def unit_steps(task, plan):
 
 def test_low_mu_straight_push_is_not_stable_but_lift_then_drag_is():
     task = shipped("horizontal-offset-low-mu")
-    model = task.build_model()
+    model = task.model
     for pusher in range(len(task.pushers)):
         assert not model.check(task.start, pose_to_si((1, 0, 0)), pusher).feasible
     for seed in SEEDS:
@@ -228,7 +228,7 @@ def test_planner_parameters_reach_the_ompl_planner():
 
 def test_a_step_that_cuts_a_concave_corner_loses_the_grasp():
     task = shipped("t-shaped")
-    model = task.build_model()
+    model = task.model
     a, b = (4.0, 4.0, 0.0), (12.0, 17.0, 0.0)  # pads at (-4, -4) in the web, (-12, -17) in the flange
     assert model.grasp_maintained(pose_to_si(a)) and model.grasp_maintained(pose_to_si(b))
     assert pads_inside(task, a) and pads_inside(task, b)
@@ -241,7 +241,7 @@ def test_a_step_that_cuts_a_concave_corner_loses_the_grasp():
 
 
 def test_capsule_reduces_to_disc_and_matches_sampling():
-    section = shipped("t-shaped").section()
+    section = shipped("t-shaped").object.section()
     rng = np.random.default_rng(7)
     for _ in range(300):
         a = rng.uniform(-40, 40, 2) * MM

@@ -23,7 +23,7 @@ def cube_pegs():
 
 
 def test_random_motions_are_never_stable_for_a_peg(cube_pegs):
-    model = cube_pegs.build_model()
+    model = cube_pegs.model
     assert [c.dimension for c in model.pusher_cones] == [2, 2]
     rng = np.random.default_rng(7)
     for _ in range(2000):
@@ -35,7 +35,7 @@ def test_random_motions_are_never_stable_for_a_peg(cube_pegs):
 def test_a_root_of_the_wedge_equation_found_here_is_stable_and_a_turn_off_it_is_not(cube_pegs):
     """The surface found independently of the planner's root finder: bisection on e . w_motion in
     Python, then the core and the independent LP agree the push is stable on it, not off it."""
-    model, reference = cube_pegs.build_model(), IndependentModel(cube_pegs)
+    model, reference = cube_pegs.model, IndependentModel(cube_pegs)
     e = np.array(model.pusher_cones[0].equality_rows[0])
     heading = math.radians(340)
 

@@ -41,7 +41,7 @@ def test_unreachable_verdicts_are_sound_and_reached_plans_check(monkeypatch):
     off (else they would only repeat themselves) and not reached."""
     task = shipped("t-shaped")
     result = reach_map(task, **GRID, seed=1, time_limit=0.3)
-    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None, deadline=None: None)
+    monkeypatch.setattr(search, "why_unreachable", lambda task, deadline=None: None)
     for cell in result.cells:
         cell_task = dataclasses.replace(task, goal=tuple(cell["goal"]))
         if cell["verdict"] == "unreachable":

@@ -89,7 +89,7 @@ def test_the_release_hold_is_the_static_one_less_the_arms_acceleration():
     loose = min(parse_task(heavy_part(0, 10.0)).goal_hold_ratios().values())
     held = parse_task(heavy_part(0, round(10.0 * 1.1 / loose, 1)))  # held 1.1 times its weight
     need = needed_hold_ratio(held, ["left"])
-    model = held.build_model()
+    model = held.model
     assert need > 1.0 and min(held.goal_hold_ratios().values()) >= 1.0
     for pose in goal_poses(held):
         if model.hold_ratio(pose_to_si(pose), 0) >= need:

@@ -95,7 +95,7 @@ def test_an_alias_bomb_is_refused_before_it_grows(tmp_path):
 def test_yaml_1_2_numbers_are_numbers():
     text = task_text("horizontal-offset-low-mu").replace("mass: 202", "mass: 2.02e2").replace("mu: 0.2}", "mu: 2e-1}")
     task = parse_task(text)
-    assert task.mass == 202.0 and task.pushers[0].mu == 0.2
+    assert task.object.mass == 202.0 and task.pushers[0].mu == 0.2
 
 
 @pytest.mark.parametrize("move, says", [
@@ -126,9 +126,11 @@ def test_the_core_refuses_what_python_would_never_pass_instead_of_trapping():
         import copy
         from stablepush.task import load_task
         task = load_task({str(LOW_MU)!r})
-        heavy = copy.copy(task)  # 1e302 kg: past Task's own range (refused there), the core's guard behind it
-        object.__setattr__(heavy, "mass", 1e305)
-        model, heavy = task.build_model(), heavy.build_model()
+        part = copy.copy(task.object)  # 1e302 kg: past PartSpec's own range (refused there), the core's guard behind it
+        object.__setattr__(part, "mass", 1e305)
+        heavy = copy.copy(task)
+        object.__setattr__(heavy, "object", part)
+        model, heavy = task.model, heavy.model
         for m, q, dq in ((model, (0, 0, 0), (float("nan"), 0, 0)), (model, (float("inf"), 0, 0), (1e-3, 0, 0)),
                          (model, (0, 0, 0), (1e-163, 0, 0)), (heavy, (0, 0, 0), (1e300, 0, 0))):
             try:
@@ -147,7 +149,7 @@ def test_the_core_refuses_what_python_would_never_pass_instead_of_trapping():
 
 def test_planner_parameters_are_refused_out_of_their_declared_range():
     task = shipped("horizontal-offset-high-mu")
-    model = task.build_model()
+    model = task.model
     def settings(time_limit=1.0, **parameters):
         return _core.PlannerSettings(start=pose_to_si(task.start), goal=pose_to_si(task.goal), step=(1e-3, 0.0175),
                                      tolerance=(1e-3, 0.0175), time_limit=time_limit, parameters=parameters)
@@ -710,8 +712,6 @@ def _plan_then_edit(tmp_path, edit):
 def test_every_command_and_the_api_refuse_a_plan_whose_task_changed_and_name_what(tmp_path, edit, changed):
     """A user edited the task after planning: the library's check_plan refuses the plan (the rule
     is not the CLI's), so execute, show, trajectory, evaluate and the API all do, naming the field."""
-    import dataclasses
-
     import stablepush as sp
     from stablepush.evaluation import Batch, Spreads
 
@@ -732,7 +732,7 @@ def test_every_command_and_the_api_refuse_a_plan_whose_task_changed_and_name_wha
             call()
     # The pad mu edited in code, as the user study did: the same refusal.
     with pytest.raises(PlanError, match=r"changed since the plan was made \(gripper.mu\)"):
-        sp.check_plan(dataclasses.replace(load_task(str(TASKS / "horizontal-offset-high-mu.yaml")), mu=0.5),
+        sp.check_plan(load_task(str(TASKS / "horizontal-offset-high-mu.yaml")).with_values({"gripper.mu": 0.5}),
                       sp.plan_task(load_task(str(TASKS / "horizontal-offset-high-mu.yaml"))))
 
 

@@ -38,16 +38,15 @@ def box_samples(task, rng, interior=2):
     corners = sorted(itertools.product(*span.values()), key=lambda c: (c[0] * c[1], -c[2], c[3]))
     points = corners + [tuple(rng.uniform(lo, hi) for lo, hi in span.values()) for _ in range(interior)]
     for pad_mu, grip, mass, pusher_mu in points:
-        yield IndependentModel(dataclasses.replace(
-            task, mu=task.mu * pad_mu, grip_force=task.grip_force * grip, mass=task.mass * mass,
-            inertia=None if task.inertia is None else task.inertia * mass, uncertainty={},
-            pushers=tuple(dataclasses.replace(p, mu=p.mu * pusher_mu) for p in task.pushers)))
+        yield IndependentModel(dataclasses.replace(task, uncertainty={}).with_values({
+            "gripper.mu": task.gripper.mu * pad_mu, "gripper.grip_force": task.gripper.grip_force * grip,
+            "object.mass": task.object.mass * mass, **{f"pushers.{p.name}.mu": p.mu * pusher_mu for p in task.pushers}}))
 
 
 @pytest.mark.parametrize("name, n", [("horizontal-offset-low-mu", 1000), ("pivoting", 1000)])
 def test_corners_agree_with_the_independent_lp_over_the_whole_box(name, n):
     task = uncertain(name)
-    corners = task.corner_models()
+    corners = task.corner_models
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     references = list(box_samples(task, rng))
     compared = robust = 0
@@ -70,11 +69,11 @@ def test_the_corners_are_the_box_extremes_by_hand():
     """hold_ratio = 2 mu N / (m g) for the prism held at its centre (docs/model.md section 2): at
     the corners it scales by (1 +- 0.1)^2 / (1 -+ 0.05)."""
     task = uncertain("horizontal-offset-low-mu")
-    nominal = task.build_model().hold_ratio(pose_to_si(task.start), -1)
-    ratios = sorted(m.hold_ratio(pose_to_si(task.start), -1) / nominal for m in task.corner_models())
+    nominal = task.model.hold_ratio(pose_to_si(task.start), -1)
+    ratios = sorted(m.hold_ratio(pose_to_si(task.start), -1) / nominal for m in task.corner_models)
     expected = sorted(f / m for f in (0.9 * 0.9, 1.1 * 1.1) for m in (0.95, 1.05))
     assert ratios == pytest.approx(expected, rel=1e-9)
-    assert [p.mu for p in task.corner_models()[0].pushers] == pytest.approx([0.2 * 0.85] * 3)
+    assert [p.mu for p in task.corner_models[0].pushers] == pytest.approx([0.2 * 0.85] * 3)
 
 
 @pytest.mark.parametrize("name", ["horizontal-offset-low-mu", "pivoting", "t-shaped"])
@@ -83,7 +82,7 @@ def test_every_push_of_a_robust_plan_is_stable_everywhere_in_the_box(name):
     plan = plan_task(task, seed=1)
     assert plan.solved, plan.message
     references = list(box_samples(task, np.random.default_rng(7)))
-    nominal = task.build_model()
+    nominal = task.model
     for a, b in zip(plan.waypoints, plan.waypoints[1:]):
         q0, q1 = pose_to_si((a.x, a.z, a.theta)), pose_to_si((b.x, b.z, b.theta))
         dq = tuple(y - x for x, y in zip(q0, q1))
@@ -99,8 +98,8 @@ def test_uncertainty_is_validated():
         uncertain("pivoting", {"pad_mu": 1.5})
     with pytest.raises(TaskError, match="uncertainty.friction: unknown key"):
         uncertain("pivoting", {"friction": 0.1})
-    assert len(uncertain("pivoting", {}).corner_models()) == 1
-    assert math.isclose(uncertain("pivoting", {"mass": 0.2}).corner_models()[1].body.mass, 1.2 * 0.202)
+    assert len(uncertain("pivoting", {}).corner_models) == 1
+    assert math.isclose(uncertain("pivoting", {"mass": 0.2}).corner_models[1].body.mass, 1.2 * 0.202)
 
 
 def test_a_point_pusher_is_robust_to_its_own_mu_only_and_the_loader_says_so():

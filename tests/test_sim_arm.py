@@ -54,7 +54,7 @@ def test_ledge_force_to_slide_the_held_object_is_coulombs(grip_force, mu, engine
 
     task = task_with("horizontal-offset-low-mu", edit)
     force, slid = _ledge_force(task, engine=engine)
-    expected = 2 * mu * grip_force + task.mass * 1e-3 * G0
+    expected = 2 * mu * grip_force + task.object.mass * 1e-3 * G0
     assert force == pytest.approx(expected, rel=0.05), (force, expected)
     assert slid > 5.0  # mm: the object really slid up between the pads while the force was measured
 
@@ -182,10 +182,10 @@ def test_features_from_the_task_environment():
 
 def test_convex_pieces_of_the_t_cover_its_area():
     t = shipped("t-shaped")
-    pieces = convex_pieces(t.vertices)
+    pieces = convex_pieces(t.object.vertices)
     area = lambda p: 0.5 * sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(p, p[1:] + p[:1]))  # noqa: E731
     assert len(pieces) <= 3
-    assert sum(area(p) for p in pieces) == pytest.approx(area(list(t.vertices)))
+    assert sum(area(p) for p in pieces) == pytest.approx(area(list(t.object.vertices)))
     for p in pieces:
         n = len(p)
         assert all((p[i][0] - p[i - 1][0]) * (p[(i + 1) % n][1] - p[i - 1][1])
@@ -228,9 +228,9 @@ def test_a_deviated_world_scales_every_pad_and_feature_mu():
     steps = [Waypoint(*task.start), Waypoint(*task.start, pusher="left")]
     scene = scene_description(task, place_features(task, steps), task.start)
     nominal, scaled = SimArm(scene), SimArm(scene, WorldDeviation(mu_scale=0.85))
-    assert scene.gripper.mu == task.mu  # the scene itself is left as the executor sent it
+    assert scene.gripper.mu == task.gripper.mu  # the scene itself is left as the executor sent it
     np.testing.assert_allclose(scaled.model.pair_friction, 0.85 * nominal.model.pair_friction)
-    assert sorted(set(np.round(nominal.model.pair_friction[:, 0], 9))) == sorted({task.mu, 0.2})
+    assert sorted(set(np.round(nominal.model.pair_friction[:, 0], 9))) == sorted({task.gripper.mu, 0.2})
 
 
 def test_the_tracker_reports_the_pose_in_the_grasp_with_the_noise_asked_for():

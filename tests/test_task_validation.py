@@ -197,7 +197,7 @@ def test_every_shipped_task_loads(tasks_dir):
     assert names == ["horizontal-offset-high-mu", "horizontal-offset-low-mu", "large-manipulation", "pivoting", "t-shaped"]
     for name in names:
         task = load_task(tasks_dir / f"{name}.yaml")
-        assert task.build_model().grasp_maintained((0, 0, 0))
+        assert task.model.grasp_maintained((0, 0, 0))
 
 
 def test_too_many_pushers_is_refused():
@@ -231,12 +231,12 @@ def test_a_polygons_straight_vertices_are_no_corners():
     segment pusher across one and point pushers at them were refused as off the boundary or 'on a
     vertex, where its normal is ambiguous'."""
     from stablepush.task import parse_task
-    from stablepush.task.model import outline_corners
+    from stablepush.task.parts import outline_corners
 
     task = parse_task(STRAIGHT_VERTICES)
-    assert len(task.vertices) == 7  # as written: plans of the task keep its identity
-    assert outline_corners(task.vertices) == ((-30, -10), (30, -10), (30, 10), (0, 25), (-30, 10))
-    normals = [tuple(round(c, 12) for c in p.inward_normal) for p in task.build_model().pushers]
+    assert len(task.object.vertices) == 7  # as written: plans of the task keep its identity
+    assert outline_corners(task.object.vertices) == ((-30, -10), (30, -10), (30, 10), (0, 25), (-30, 10))
+    normals = [tuple(round(c, 12) for c in p.inward_normal) for p in task.model.pushers]
     assert normals == [(0.0, 1.0), (0.0, 1.0), (1.0, 0.0)]
     corner = STRAIGHT_VERTICES.replace("{name: side, at: [-30, 0], mu: 0.5}", "{name: side, at: [30, 10], mu: 0.5}")
     with pytest.raises(TaskError, match="sits on a vertex of the object"):
@@ -247,7 +247,7 @@ def test_straight_vertices_are_dropped_only_within_the_tolerance_of_the_edge_the
     """Each vertex of the run must lie within 1e-6 mm of the segment between the run's corners, not
     only of its neighbours': a bottom edge bowed by 4.5e-4 mm over 946 vertices 0.1 mm apart is no
     straight edge, though each vertex is straight between its neighbours; nor is a fold back."""
-    from stablepush.task.model import ON_BOUNDARY, outline_corners
+    from stablepush.task.parts import ON_BOUNDARY, outline_corners
 
     bowed = [(0.1 * i, -2e-7 * (0.1 * i) ** 2) for i in range(946)] + [(94.5, 10.0), (0.0, 10.0)]
     kept = outline_corners(bowed)

@@ -12,7 +12,7 @@ LOW_MU = shipped("horizontal-offset-low-mu")  # bottom -> left: one switch-over,
 
 
 def _switch_holds(task, plan):
-    model, holds = task.build_model(), []
+    model, holds = task.model, []
     for before, after in zip(plan.waypoints[1:], plan.waypoints[2:]):
         if after.pusher != before.pusher:
             holds.append(model.hold_ratio(pose_to_si(before.pose), task.pusher_index(before.pusher)))
@@ -53,7 +53,7 @@ def test_with_start_keeps_the_features_orientation():
     assert moved.start == (14.6, -13.7, 44.0)
     assert [moved.feature_angle(p) for p in moved.pusher_names] == [task.start[2]] * len(task.pushers)
     q = pose_to_si(moved.start)
-    assert moved.build_model().hold_ratio(q, 0) == pytest.approx(task.build_model().hold_ratio(q, 0))
+    assert moved.model.hold_ratio(q, 0) == pytest.approx(task.model.hold_ratio(q, 0))
 
 
 def test_a_correction_switches_where_the_pads_hold_1_4_times_when_nothing_holding_1_5_is_found():
@@ -79,5 +79,5 @@ def test_a_correction_switches_where_the_pads_hold_1_4_times_when_nothing_holdin
     assert "hold 1.4 times" in record.attempt
     assert _transits_held(task, steps, "left", TRANSIT_HOLD_RATIO_LEAST)
     assert not _transits_held(task, steps, "left", TRANSIT_HOLD_RATIO)
-    hold = task.build_model().hold_ratio(pose_to_si(measured), task.pusher_index("left"))
+    hold = task.model.hold_ratio(pose_to_si(measured), task.pusher_index("left"))
     assert TRANSIT_HOLD_RATIO_LEAST <= hold < TRANSIT_HOLD_RATIO

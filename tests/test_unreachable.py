@@ -60,7 +60,7 @@ planner: {time_limit: 5}
 
 def test_a_goal_no_push_can_end_at_is_unreachable_and_one_beside_the_ledge_is_planned():
     task = parse_task(LEDGE)
-    assert task.build_model().hold_ratio(pose_to_si(task.goal), 0) < 1.0  # the pads alone do not hold it there
+    assert task.model.hold_ratio(pose_to_si(task.goal), 0) < 1.0  # the pads alone do not hold it there
     plan = plan_task(task)
     assert plan.outcome == "unreachable" and len(plan.waypoints) == 1, plan.message
     assert "no pusher has a stable push that ends within planner.tolerance of the goal (ledge)" in plan.message
@@ -121,7 +121,7 @@ def test_a_goal_the_pads_cannot_slide_to_without_leaving_the_object_is_unreachab
     same_square = (*(p - direction_in_gripper(-20.0, (-25.0, 0.0))).tolist(), -20.0)
     assert U.why_unreachable(dataclasses.replace(turned, goal=same_square)) is None
     # With the verdict off, the search does not cross the 9.9 mm neck either.
-    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None, deadline=None: None)
+    monkeypatch.setattr(search, "why_unreachable", lambda task, deadline=None: None)
     for t in (task, turned):
         for seed in (1, 2):
             assert not plan_task(t, seed=seed, time_limit=1.5).solved
@@ -157,8 +157,8 @@ def test_a_pad_called_off_near_a_goal_is_off_at_every_pose_within_its_tolerance(
     task = parse_task(dumbbell(9.9)) if name == "dumbbell" else shipped(name)
     task = dataclasses.replace(task, planner=task.planner.replace(tolerance=[2.0, 5.0]))
     rng = np.random.default_rng(zlib.crc32(name.encode()))
-    section = task.section()
-    model = task.corner_models()[0]
+    section = task.object.section()
+    model = task.corner_models[0]
     called, spared = 0, 0
     scale = np.array([2.0, 2.0, 5.0])  # the tolerance box's half-widths
     corners = np.array(list(itertools.product((-1.0, 1.0), repeat=3)))
@@ -166,7 +166,7 @@ def test_a_pad_called_off_near_a_goal_is_off_at_every_pose_within_its_tolerance(
         goal = tuple(rng.uniform(-40.0, 40.0, 2)) + (float(rng.uniform(-30.0, 30.0)),)
         off = U.pads_off_near(task, goal, section)
         called += bool(off)
-        spared += len(off) < len(task.pads)
+        spared += len(off) < len(task.gripper.pads)
         if not off:
             continue
         for q in [*(corners * scale), *rng.uniform(-1.0, 1.0, (40, 3)) * scale]:
@@ -182,14 +182,14 @@ def test_a_start_and_goal_a_chain_of_grasps_joins_are_never_called_cut_off(name)
     chain of grasps 0.25 mm apart (pad centres in O on a grid, the core's grasp_maintained at each)
     joins them, verdict 5 says nothing; on the dumbbell's 9.9 mm neck some pairs are cut off."""
     task = parse_task(dumbbell(9.9)) if name == "dumbbell" else shipped(name)
-    model = task.build_model()
-    xs = np.array([v[0] for v in task.vertices])
-    zs = np.array([v[1] for v in task.vertices])
+    model = task.model
+    xs = np.array([v[0] for v in task.object.vertices])
+    zs = np.array([v[1] for v in task.object.vertices])
     step = 0.25
     gx = np.arange(xs.min(), xs.max() + step, step)
     gz = np.arange(zs.min(), zs.max() + step, step)
     # A pad centre c in O at theta 0 is the pose (-c) for a pad at G's origin (the default pads).
-    assert all(tuple(p[0]) == (0.0, 0.0) for p in task.pads)
+    assert all(tuple(p[0]) == (0.0, 0.0) for p in task.gripper.pads)
     ok = np.array([[model.grasp_maintained(pose_to_si((-x, -z, 0.0))) for z in gz] for x in gx])
     label = np.zeros(ok.shape, int)
     n = 0
@@ -271,7 +271,7 @@ def test_the_hold_bound_is_never_below_the_cores_hold_ratio_in_the_box(name):
         tol = (float(rng.uniform(0.1, 3.0)), float(rng.uniform(0.1, 5.0)))
         goal = tuple(np.array(task.goal) + rng.normal(0.0, [2.0, 2.0, 10.0]))
         t = dataclasses.replace(task, goal=goal, planner=task.planner.replace(tolerance=list(tol)))
-        for model in t.corner_models():
+        for model in t.corner_models:
             for pusher in range(len(t.pushers)):
                 bound = U._hold_bound(t, model, pusher)
                 worst = max(model.hold_ratio(pose_to_si(q), pusher) for q in _random_in_box(rng, goal, tol, 40))
@@ -279,7 +279,7 @@ def test_the_hold_bound_is_never_below_the_cores_hold_ratio_in_the_box(name):
         # And above the independent LP's (tests/independent_lp.py, HiGHS on polygon vertices).
         independent = IndependentModel(t)
         for pusher in range(len(t.pushers)):
-            bound = U._hold_bound(t, t.build_model(), pusher)
+            bound = U._hold_bound(t, t.model, pusher)
             for q in _random_in_box(rng, goal, tol, 5):
                 assert bound >= independent.hold_ratio(pose_to_si(q), pusher) - 1e-9, (name, trial, pusher, q)
 
@@ -292,7 +292,7 @@ def test_a_start_with_a_stable_push_is_never_called_stuck(name):
     says the pusher may push."""
     rng = np.random.default_rng(7 + len(name))
     task = shipped(name)
-    model = task.build_model()
+    model = task.model
     step = task.planner.step
     sampled = 0  # random poses and directions where the core found a stable push
     for _ in range(30):
@@ -334,7 +334,7 @@ def test_a_box_with_a_stable_push_anywhere_in_it_is_never_called_stuck(name):
     the LP over the box says the pusher may push."""
     rng = np.random.default_rng(11 + len(name))
     task = parse_task({"ledge": LEDGE, "centred ledge": CENTRED_LEDGE}[name]) if "ledge" in name else shipped(name)
-    model, independent = task.build_model(), IndependentModel(task)
+    model, independent = task.model, IndependentModel(task)
     step = task.planner.step
     found = 0
     for _ in range(12):
@@ -412,7 +412,7 @@ def test_no_goal_the_ledge_cannot_end_at_is_reached_by_a_long_search(monkeypatch
     unreachable = [goal for goal, why in verdicts.items() if why is not None]
     assert unreachable and len(unreachable) < len(verdicts), verdicts
     assert plan_task(dataclasses.replace(task, goal=(30.0, -4.0, 0.0))).solved
-    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None, deadline=None: None)
+    monkeypatch.setattr(search, "why_unreachable", lambda task, deadline=None: None)
     for goal in unreachable:
         for seed in (1, 2):
             plan = plan_task(dataclasses.replace(task, goal=goal), seed=seed, time_limit=1.5)
@@ -437,7 +437,7 @@ def test_no_goal_called_unreachable_on_a_grid_is_reached_by_a_long_search(name, 
             verdicts[goal] = U.why_unreachable(t)
     unreachable = [goal for goal, why in verdicts.items() if why is not None]
     assert unreachable and len(unreachable) < len(verdicts), verdicts
-    monkeypatch.setattr(search, "why_unreachable", lambda task, models=None, deadline=None: None)
+    monkeypatch.setattr(search, "why_unreachable", lambda task, deadline=None: None)
     for goal in unreachable:
         t = dataclasses.replace(task, goal=goal)
         for seed in (1, 2):

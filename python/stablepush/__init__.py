@@ -21,12 +21,24 @@ from stablepush._core import ContactCase, PushResult
 from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, SettingError, StablepushError, TaskError
 from stablepush.plan import Plan, PlanOutcome, PusherContact, Waypoint, check_plan, load_plan, plan_task
 from stablepush.plan import write_plan as save_plan
-from stablepush.task import Cell, PlannerSettings, PusherSpec, Robot, Task, load_task, parse_task
+from stablepush.task import (
+    Cell,
+    DynamicsSpec,
+    GripperSpec,
+    PartSpec,
+    PlannerSettings,
+    PusherSpec,
+    Robot,
+    Task,
+    load_task,
+    parse_task,
+)
 from stablepush.task import check_push as check
 
 __version__ = "0.1.0"
 __all__ = ["load_task", "parse_task", "plan_task", "check", "check_plan", "save_plan", "load_plan", "trajectory",
-           "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PlannerSettings", "PusherSpec", "Cell", "Robot",
+           "plan_figure", "Plan", "Waypoint", "PusherContact", "Task", "PartSpec", "GripperSpec", "DynamicsSpec",
+           "PlannerSettings", "PusherSpec", "Cell", "Robot",
            "Trajectory", "StablepushError", "TaskError", "PlanError", "OutputError", "ArmFault", "RunnerError",
            "SettingError", "ContactCase", "PlanOutcome", "PushResult", "joint_path"]
 

@@ -444,8 +444,8 @@ def design_task(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], d: D
     environment["features"] = {name: [round(v, 6) for v in pose] for name, pose in d.features.items()}
     out = {**task, "pushers": [dict(by_name[name]) for name in d.pushers], "environment": environment}
     read = d.task if d.task is not None else layout_task(task, [by_name[name] for name in d.pushers], source)
-    if read.mesh is not None and isinstance(out.get("object"), dict):
-        out["object"] = {**out["object"], "file": read.mesh.file}
+    if read.object.mesh is not None and isinstance(out.get("object"), dict):
+        out["object"] = {**out["object"], "file": read.object.mesh.file}
     robot = environment.get("robot")
     if isinstance(robot, dict) and read.environment.robot.model is not None:
         environment["robot"] = {**robot, "model": read.environment.robot.model}

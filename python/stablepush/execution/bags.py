@@ -353,8 +353,8 @@ def _scene_markers(T, stamp, task: Task, features: Iterable[Feature]) -> list:
     """The object's outline extruded to its thickness (LINE_LIST in object), the pads (CYLINDER
     in gripper, axis along y) and each feature's contact segment (LINE_LIST in world)."""
     Marker = T["visualization_msgs/msg/Marker"]
-    half = task.thickness * MM / 2
-    outline = [(x * MM, z * MM) for x, z in task.vertices]
+    half = task.object.thickness * MM / 2
+    outline = [(x * MM, z * MM) for x, z in task.object.vertices]
     edges = []
     for (x0, z0), (x1, z1) in zip(outline, outline[1:] + outline[:1]):
         for y in (-half, half):
@@ -362,7 +362,7 @@ def _scene_markers(T, stamp, task: Task, features: Iterable[Feature]) -> list:
         edges += [(x0, -half, z0), (x0, half, z0)]
     markers = [_marker(T, stamp, 0, OBJECT, Marker.LINE_LIST, edges, (0.0005, 0, 0), (0.85, 0.55, 0.25))]
     along_y = (np.sqrt(0.5), np.sqrt(0.5), 0.0, 0.0)  # the cylinder's z axis turned onto y
-    for k, ((cx, cz), r) in enumerate(task.pads):  # pad k on the finger at +y when k is even
+    for k, ((cx, cz), r) in enumerate(task.gripper.pads):  # pad k on the finger at +y when k is even
         y = half if k % 2 == 0 else -half
         markers.append(_marker(T, stamp, 1 + k, GRIPPER, Marker.CYLINDER, [], (2 * r * MM, 2 * r * MM, 0.002),
                                (0.2, 0.2, 0.2), pose=_pose(T, (cx * MM, y, cz * MM), along_y)))

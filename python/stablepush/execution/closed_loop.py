@@ -161,7 +161,7 @@ def _transits_held(task: Task, steps: Sequence[Waypoint], pusher: str, ratio: fl
     pusher changes (the object travels between features there), `pusher` being the one in contact
     at steps[0]. With the task's uncertainty the pads must also hold at least the weight at every
     corner of its box: the box then says what the ratio stands in for."""
-    nominal, corners = task.build_model(), task.corner_models()
+    nominal, corners = task.model, task.corner_models
     previous = pusher
     for before, step in zip(steps, steps[1:]):
         if step.pusher != previous:  # leaving `previous`'s feature: gravity in G as on that feature
@@ -178,21 +178,25 @@ def switch_held(task: Task, pose: Sequence[float], pusher: str) -> bool:
     the task's model and at every corner of the box the first corrections are planned robust to
     (CORRECTION_MU_SPREAD, or the task's own uncertainty box), as those corrections ask."""
     q, index = pose_to_si(pose), task.pusher_index(pusher)
-    return all(m.hold_ratio(q, index) >= TRANSIT_HOLD_RATIO for m in _correction_models(task))
+    box = _correction_box(task)  # its nominal model is the task's: a box changes no model
+    return all(m.hold_ratio(q, index) >= TRANSIT_HOLD_RATIO for m in (box.model, *box.corner_models))
 
 
-_CORRECTION_MODELS: "OrderedDict[str, list]" = OrderedDict()  # by task: the models switch_held asks
+# By task: the task with the box switch_held asks at the corners of, kept with the models it has
+# built, for the tasks of other runs of the same task in this process (evaluate's trials).
+_CORRECTION_BOXES: "OrderedDict[str, Task]" = OrderedDict()
 
 
-def _correction_models(task: Task) -> list:
+def _correction_box(task: Task) -> Task:
+    """The task with the box the first corrections are planned robust to: its own, else
+    CORRECTION_MU_SPREAD in pusher and pad mu."""
     key = repr((task.identity(), sorted(task.feature_orientations.items())))
-    if key not in _CORRECTION_MODELS:
-        box = task if task.uncertainty else dataclasses.replace(
+    if key not in _CORRECTION_BOXES:
+        _CORRECTION_BOXES[key] = task if task.uncertainty else dataclasses.replace(
             task, uncertainty={"pusher_mu": CORRECTION_MU_SPREAD, "pad_mu": CORRECTION_MU_SPREAD})
-        _CORRECTION_MODELS[key] = [task.build_model(), *box.corner_models()]
-        while len(_CORRECTION_MODELS) > _AIMED_KEPT:
-            _CORRECTION_MODELS.popitem(last=False)
-    return _CORRECTION_MODELS[key]
+        while len(_CORRECTION_BOXES) > _AIMED_KEPT:
+            _CORRECTION_BOXES.popitem(last=False)
+    return _CORRECTION_BOXES[key]
 
 
 # The aims made in this process, by task, plan and tolerance: `evaluate` runs one plan in many worlds,

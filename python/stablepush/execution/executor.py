@@ -48,7 +48,7 @@ RIDE_FRACTION = 0.25
 def execution_warnings(task: Task) -> List[str]:
     """What makes a run of this task on the executor's cell differ from its model (legal, but
     probably not meant): one line each."""
-    if task.pushes == "by_moving_pusher":
+    if task.dynamics.pushes == "by_moving_pusher":
         return ["the task's pushes are by_moving_pusher (gravity fixed in G), but the executor pushes against "
                 "fixed features, where gravity turns in G with theta: the plan was made for another cell"]
     return []

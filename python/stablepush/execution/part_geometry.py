@@ -113,10 +113,11 @@ def scene_object_geometry(task: Task) -> Tuple[str, Optional[MeshSolid]]:
     """What a scene's object adds to the section for a simulator: what the simulated solid is, in
     words, and for a mesh part its convex pieces, the solid's inertia tensor and the y of its
     centre of mass (scene.MeshSolid, SI units)."""
-    if task.mesh is None:
-        return f"prism of the section, {task.thickness:g} mm thick", None
-    built = part_pieces(task.mesh)
-    inertia, com = solid_inertia(task.mesh, task.mass)
+    part = task.object
+    if part.mesh is None:
+        return f"prism of the section, {part.thickness:g} mm thick", None
+    built = part_pieces(part.mesh)
+    inertia, com = solid_inertia(part.mesh, part.mass)
     return built.description, MeshSolid(
         pieces=tuple(tuple((x, y, z) for x, y, z in (piece * 1e-3).tolist()) for piece in built.pieces),
         inertia=tuple((a, b, c) for a, b, c in inertia.tolist()), com_y=float(com[1]) * 1e-3)

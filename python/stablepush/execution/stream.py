@@ -149,7 +149,7 @@ def arm_trajectory(
     retract = env.retract * MM
     home = np.asarray(env.home, float) * MM
     lane_of = {name: f.object_pose[1, 3] + env.lane_offset * MM for name, f in features.items()}
-    reach = max(math.hypot(x, z) for x, z in task.vertices) * MM
+    reach = max(math.hypot(x, z) for x, z in task.object.vertices) * MM
     top = max(max(f.start[2], f.end[2]) for f in features.values())
 
     stream = _Stream(rate_hz, pose_to_matrix(start_pose), resume_from, [s.pose for s in steps])
@@ -187,7 +187,7 @@ def arm_trajectory(
             stream.move(guarded_from, "approach")
             stream.move(touching, "approach", guarded_speed=GUARD_SPEED)
         for i in range(first + 1, contact.last + 1):
-            stream.push(feature.object_pose, steps[i - 1].pose, steps[i].pose, task.step_time, i,
+            stream.push(feature.object_pose, steps[i - 1].pose, steps[i].pose, task.dynamics.step_time, i,
                         come_to_rest=i == contact.last)
         current = feature
     stream.hold(SETTLE_TIME, "settle")

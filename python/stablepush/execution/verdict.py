@@ -103,7 +103,7 @@ def judge(task: Task, report, tolerance: "Tolerance | Sequence[float] | None" = 
         return miss("moved_on_release", f"on its last feature it was within the tolerance "
                                         f"({_offsets(final, task.goal)}); when the feature let go it moved in the "
                                         f"grasp by {moved}: the pads alone do not hold it there against gravity")
-    if not task.build_model().grasp_maintained(Pose.of(landed).si()):
+    if not task.model.grasp_maintained(Pose.of(landed).si()):
         return miss("grasp_lost", "a pad is no longer on the object where it came to rest")
     failed = [r for r in report.replans if not r.solved and r.trigger != "plan_short"]
     if failed:

@@ -88,7 +88,7 @@ def place_features(task: Task, steps: Sequence[Waypoint], every_pusher: bool = F
     model assumes for this feature (`Task.feature_angle`: the start's unless environment.features
     says otherwise). Gravity in the world is the task's gravity (G's axes are W's at home)."""
     env = task.environment
-    section = task.section()
+    section = task.object.section()
     home = np.asarray(env.home, float) * MM
     features: Dict[str, Feature] = {}
     contacts = contacts_of(steps)
@@ -137,7 +137,7 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: PoseLi
     (part_geometry.scene_object_geometry: a mesh part's convex pieces, which needs CoACD for a
     non-convex one); without, a simulator builds the prism of the section (for callers that read
     only the poses)."""
-    body = task.rigid_body()
+    body = task.object.rigid_body()
     q = Pose.of(in_grasp)
     T_GO = grasp_transform(tuple(q))
     start = translation(np.asarray(task.environment.home, float) * MM)
@@ -148,13 +148,14 @@ def scene_description(task: Task, features: Dict[str, Feature], in_grasp: PoseLi
     geometry, mesh = scene_object_geometry(task) if solid else (None, None)
     com_x, com_z = body.com
     gravity_x, gravity_z = task.gravity
+    part, grip = task.object, task.gripper
     return Scene(
         task=task.name,
         gravity=(gravity_x, gravity_z),
-        object=SceneObject(polygon=tuple((x * MM, z * MM) for x, z in task.vertices), thickness=task.thickness * MM,
+        object=SceneObject(polygon=tuple((x * MM, z * MM) for x, z in part.vertices), thickness=part.thickness * MM,
                            mass=body.mass, com=(com_x, com_z), inertia=body.inertia, geometry=geometry, mesh=mesh),
-        gripper=SceneGripper(grip_force=task.grip_force, mu=task.mu, pad_rings=task.pad_rings,
-                             pads=tuple(Pad(center=(c[0] * MM, c[1] * MM), radius=r * MM) for c, r in task.pads)),
+        gripper=SceneGripper(grip_force=grip.grip_force, mu=grip.mu, pad_rings=grip.pad_rings,
+                             pads=tuple(Pad(center=(c[0] * MM, c[1] * MM), radius=r * MM) for c, r in grip.pads)),
         features=tuple(f.in_scene() for f in features.values()),
         gripper_pose=tuple(matrix_to_pose(start)),
         object_pose=tuple(matrix_to_pose(start @ T_GO)),

@@ -49,7 +49,7 @@ def _queries(task: Task, rng: np.random.Generator, n: int, sticking: bool):
     if sticking:
         # Rotation about the first pad's centre: that centre sticks, every other pad point slides.
         w = np.radians(rng.uniform(0.2, 1.5, n)) * rng.choice([-1.0, 1.0], n)
-        pad = np.array(task.pads[0][0]) * MM
+        pad = np.array(task.gripper.pads[0][0]) * MM
         arm = pad[None, :] - q[:, :2]
         dq = np.column_stack([-w * arm[:, 1], w * arm[:, 0], w])
     else:
@@ -71,7 +71,7 @@ def bench_checks(
     for name, value in (("checks", checks), ("batch", batch)):
         if not is_integer(value) or value < 1:
             raise ValueError(f"{name}: must be a whole number of at least 1, got {value!r}")
-    model = task.build_model()
+    model = task.model
     rng = np.random.default_rng(seed)
     out = {}
     batches = -(-checks // batch)
@@ -122,11 +122,11 @@ class PlanningTrial:
     first_min_margin: Optional[float] = None
 
 
-def planning_trial(task: Task, seed: int, time_limit: Optional[float] = None, improve_for: Optional[float] = None,
-                   models=None) -> PlanningTrial:
-    """One planning run of `task` with `seed` (`models`: the task's corner models, built once by the
-    caller when it runs many)."""
-    plan = plan_task(task, seed=seed, time_limit=time_limit, models=models, improve_for=improve_for)
+def planning_trial(task: Task, seed: int, time_limit: Optional[float] = None,
+                   improve_for: Optional[float] = None) -> PlanningTrial:
+    """One planning run of `task` with `seed` (the task's models are built on its first run and
+    kept with it)."""
+    plan = plan_task(task, seed=seed, time_limit=time_limit, improve_for=improve_for)
     s = plan.stats
     first = s.get("first") or {}
     return PlanningTrial(
@@ -149,10 +149,9 @@ def bench_planning(task: Task, trials: int, seed: int = 1, time_limit: Optional[
     lost). `progress(1)` after each trial."""
     if runner is not None:
         return _bench_on_runner(PlanningJob(task, seed, time_limit, improve_for), trials, runner, progress)
-    models = task.corner_models()
     out = []
     for k in range(trials):
-        out.append(planning_trial(task, seed + k, time_limit, improve_for, models))
+        out.append(planning_trial(task, seed + k, time_limit, improve_for))
         if progress is not None:
             progress(1)
     return out

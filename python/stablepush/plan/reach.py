@@ -120,11 +120,11 @@ def at_start_verdict(task: Task) -> dict:
     (why_unreachable), and otherwise not found (a plan that pushes away and back is not searched)."""
     need = task.planner.min_hold_ratio
     # The models only where a hold is asked for: without one every such goal is reached.
-    models = task.corner_models() if need > 0.0 else []
+    models = task.corner_models if need > 0.0 else ()
     held = min((m.hold_ratio(pose_to_si(task.start), -1) for m in models), default=float("inf"))
     if held >= need:
         return {"solved": True, "switches": 0, "pushes": 0, "outcome": "at_start", "verdict": "reached"}
-    reason = why_unreachable(task, models)
+    reason = why_unreachable(task)
     if reason is not None:
         return {"outcome": "unreachable", "verdict": "unreachable", "reason": reason}
     return {"outcome": "at_start", "verdict": "not found",
@@ -153,8 +153,8 @@ def reach_cell(job: ReachJob, i: int) -> dict:
     try:
         plan = plan_task(task, seed=job.seed, time_limit=job.time_limit, check_limit=job.check_limit or None)
     except PadFaceError as exc:  # a path that takes a mesh part's pads off its faces: the goal's grasp if there
-        assert task.mesh is not None, "PadFaceError is a mesh part's"
-        off_at_goal = first_pad_off_faces(task.mesh, task.pads, [goal]) is not None
+        assert task.object.mesh is not None, "PadFaceError is a mesh part's"
+        off_at_goal = first_pad_off_faces(task.object.mesh, task.gripper.pads, [goal]) is not None
         return {**cell, "verdict": "unreachable" if off_at_goal else "not found", "reason": exc.reason}
     s = plan.stats
     cell.update(solved=plan.solved, planning_time_s=s["planning_time_s"], switches=s["switches"],

@@ -52,16 +52,16 @@ def plan_task(
     max_switches: Optional[int] = None,
     improve_for: Optional[float] = None,
     check_limit: Optional[int] = None,
-    models: "Optional[List[_core.StablePushModel]]" = None,
     min_transit_hold: float = 0.0,
     start_pusher: Optional[str] = None,
     explain: bool = True,
     deepen: bool = True,
 ) -> Plan:
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
-    task's planner section (which has defaults for every key). `models` are the task's
-    corner_models() (built here unless given, e.g. once for many seeds): with an `uncertainty`
-    section every push must be stable at every corner, and each waypoint's margin is the least.
+    task's planner section (which has defaults for every key). The search runs in the task's
+    corner_models (built on first use and kept with the task, so that many seeds build them once):
+    with an `uncertainty` section every push must be stable at every corner, and each waypoint's
+    margin is the least.
     `min_transit_hold` > 0: switch pushers only where the pads alone hold the object with that
     factor of its weight in every model; `start_pusher`, the pusher in contact at the start (a
     re-plan from a feature), makes a plan that begins with another pusher a transit at the start.
@@ -85,14 +85,12 @@ def plan_task(
         check_limit=None if check_limit is None else planner_parameter("check_limit", "check_limit", check_limit))
     # A hold factor, as planner.min_hold_ratio is (docs/model.md section 3).
     min_transit_hold = number_field("min_transit_hold", min_transit_hold, LIMITS["min_hold_ratio"])
-    if models:  # the caller's: they must be this task's
-        task.check_models(models)
     _check_push_cap(task, settings)
-    models = models or task.corner_models()
+    models = task.corner_models
     model = models[0]
     began = time.perf_counter()
     # The verdicts are bounded by the search's own limit: past it they stop, undecided.
-    reason = why_unreachable(task, models, deadline=began + settings.time_limit)
+    reason = why_unreachable(task, deadline=began + settings.time_limit)
     if reason is not None:
         return _unreachable(task, models, settings, reason, time.perf_counter() - began)
     pusher_at_start = -1 if start_pusher is None else task.pusher_index(start_pusher, "start_pusher")
@@ -120,7 +118,7 @@ def plan_task(
                                       margin_per_normal=_margin_per_normal(models, raw_waypoints[k - 1].pose, w.pose,
                                                                            w.pusher)))
 
-    if task.mesh is not None:
+    if task.object.mesh is not None:
         _check_pad_faces(task, waypoints)
     outcome = raw.outcome.name
     s = raw.stats
@@ -225,9 +223,9 @@ def _check_pad_faces(task: Task, waypoints: Sequence[Waypoint]) -> None:
     """A mesh part's pads rest on its slab's two faces all along the path (the model's grasp is the
     slab's; a step, a curve or an edge under a pad is a grasp the model does not describe):
     PadFaceError naming the pad, the pose and what lies under it."""
-    mesh = task.mesh
+    mesh = task.object.mesh
     assert mesh is not None, "only a mesh part's pads are checked against its faces"
-    found = first_pad_off_faces(mesh, task.pads, [w.pose for w in waypoints])
+    found = first_pad_off_faces(mesh, task.gripper.pads, [w.pose for w in waypoints])
     if found is not None:
         k, i, (x, z), problem = found
         pose = [round(v, 3) for v in waypoints[k].pose]

@@ -60,7 +60,8 @@ from typing import List, Optional, Sequence
 import numpy as np
 
 from stablepush.frames import direction_in_gripper
-from stablepush.task.model import Task, outline_corners
+from stablepush.task.model import Task
+from stablepush.task.parts import outline_corners
 from stablepush.units import MM, pose_to_si
 
 POLYGON_SIDES = 16  # of the polygon circumscribed about each pad point's friction disc
@@ -74,9 +75,9 @@ class _OutOfTime(Exception):
     """The verdicts' time ran out before they decided."""
 
 
-def why_unreachable(task: Task, models=None, deadline: Optional[float] = None) -> Optional[str]:
+def why_unreachable(task: Task, deadline: Optional[float] = None) -> Optional[str]:
     """The reason no plan of `task` can reach its goal, or None when none is found (module
-    docstring). `models`: task.corner_models(), built here unless given. `deadline`: a
+    docstring), in the task's corner_models. `deadline`: a
     time.perf_counter() value after which the verdicts stop, undecided (None), between one pusher's
     or pad's test and the next: on a task of many pushers and pad points each costs seconds, and
     a verdict is never needed for soundness."""
@@ -85,7 +86,7 @@ def why_unreachable(task: Task, models=None, deadline: Optional[float] = None) -
             raise _OutOfTime
 
     try:
-        return _decide(task, models or task.corner_models(), on_time)
+        return _decide(task, task.corner_models, on_time)
     except _OutOfTime:
         return None
 
@@ -150,8 +151,8 @@ def _pad_cut_off(task: Task, model, on_time=lambda: None) -> Optional[str]:
         return None
     from shapely.geometry import Point, Polygon  # here: only outlines with reflex corners need it
 
-    outline = Polygon(outline_corners(task.vertices))
-    for k, (centre, radius) in enumerate(task.pads):
+    outline = Polygon(outline_corners(task.object.vertices))
+    for k, (centre, radius) in enumerate(task.gripper.pads):
         on_time()
         eroded = outline.buffer(-(radius * math.cos(math.pi / (4 * QUAD_SEGS)) - ERODE_MARGIN), quad_segs=QUAD_SEGS)
         parts = list(getattr(eroded, "geoms", [eroded]))
@@ -182,9 +183,9 @@ def pads_off_near(task: Task, pose: Sequence[float], section=None) -> List[int]:
     """Verdict 6 (module docstring): the indices of the pads that are off the object at every pose
     within planner.tolerance of `pose` (mm, mm, deg). `section`: the task's cross-section, built
     here unless given."""
-    section = section if section is not None else task.section()
+    section = section if section is not None else task.object.section()
     off = []
-    for k, (centre, radius) in enumerate(task.pads):
+    for k, (centre, radius) in enumerate(task.gripper.pads):
         c = direction_in_gripper(-pose[2], (centre[0] - pose[0], centre[1] - pose[1]))  # the centre in O [mm]
         at = np.array(c) * MM
         depth = section.distance_to_boundary(at) / MM * (1.0 if section.contains_disc(at, 0.0) else -1.0)
@@ -238,7 +239,7 @@ def _may_push(task: Task, model, q: Sequence[float], pusher: int, box=(0.0, 0.0)
     w_g = np.array([*_in_gripper(-q[2], -weight), _cross_y(r_cm, -weight)])
     # M xi / dt for a push of at most one unit step (|dx|, |dz| <= L, |dtheta| <= A): a box in O.
     L, A = task.planner.step[0] * MM, math.radians(task.planner.step[1])
-    dt2 = task.step_time ** 2
+    dt2 = task.dynamics.step_time ** 2
     arm = float(np.linalg.norm(r_cm))
     force = body.mass * (math.sqrt(2.0) * L + A * arm) / dt2
     momentum = np.array([force, force, arm * force + body.inertia * A / dt2])

@@ -4,7 +4,7 @@ file, or edited by hand, is refused (PlanError naming the waypoint)."""
 from __future__ import annotations
 
 import math
-from typing import List, Optional
+from typing import List, Optional, Sequence
 
 from stablepush.compiled import _core
 from stablepush.errors import PlanError
@@ -38,9 +38,9 @@ def check_plan(task: Task, plan: Plan, source: Optional[str] = None, require_sol
     fault = (_record_fault(task, plan, require_solved) or _waypoints_fault(task, plan.waypoints, require_solved)
              or _switches_fault(plan) or _ends_fault(task, plan, require_solved))
     if fault is None:
-        model = task.build_model()
+        model = task.model
         # With an uncertainty box every push must be stable at each corner, as the planner made it.
-        corners = task.corner_models() if task.uncertainty else None
+        corners = task.corner_models if task.uncertainty else None
         fault = (_pushes_fault(task, plan.waypoints, model, corners)
                  or _hold_fault(task, plan.waypoints, corners or [model], require_solved))
     if fault is not None:
@@ -112,7 +112,7 @@ def _ends_fault(task: Task, plan: Plan, require_solved: bool) -> FieldFault:
     return None
 
 
-def _pushes_fault(task: Task, waypoints: List[Waypoint], model, corners: Optional[list]) -> FieldFault:
+def _pushes_fault(task: Task, waypoints: List[Waypoint], model, corners: Optional[Sequence]) -> FieldFault:
     """Every push at most one unit step, moving the object, stable (for `model`, the task's, or at
     each of the `corners` of its uncertainty box) with at least the task's min_margin, and ending
     with the pads on the object."""
@@ -142,7 +142,7 @@ def _step_fault(task: Task, q0, q1, unit) -> Optional[str]:
     return None
 
 
-def _stability_fault(pusher: str, index: int, q0, q1, model, corners: Optional[list],
+def _stability_fault(pusher: str, index: int, q0, q1, model, corners: Optional[Sequence],
                      min_margin: float) -> Optional[str]:
     """Why the push q0 -> q1 (SI) by `pusher` is not a stable push with min_margin (N) to spare."""
     dq = tuple(b - a for a, b in zip(q0, q1))
@@ -160,8 +160,8 @@ def plan_margin(task: Task, plan: Plan) -> float:
     """The least margin [N] of any push of the plan in the stable-push test (docs/model.md section
     3): over every corner of the task's uncertainty box when it has one. How much friction, force
     or weight may change before some push of the plan stops sticking; inf for a plan of no push."""
-    model = task.build_model()
-    corners = task.corner_models() if task.uncertainty else None
+    model = task.model
+    corners = task.corner_models if task.uncertainty else None
     least = math.inf
     for w0, w1 in zip(plan.waypoints, plan.waypoints[1:]):
         q0, q1 = pose_to_si(w0.pose), pose_to_si(w1.pose)
@@ -172,7 +172,7 @@ def plan_margin(task: Task, plan: Plan) -> float:
     return least
 
 
-def _hold_fault(task: Task, waypoints: List[Waypoint], models: list, require_solved: bool) -> FieldFault:
+def _hold_fault(task: Task, waypoints: List[Waypoint], models: Sequence, require_solved: bool) -> FieldFault:
     """A solved plan's end, where the pads alone hold min_hold_ratio times the weight (in each of `models`)."""
     min_hold = task.planner.min_hold_ratio
     if not (require_solved and min_hold > 0 and len(waypoints) > 1):

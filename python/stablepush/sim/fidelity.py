@@ -47,6 +47,7 @@ from stablepush.sim.engines import DEFAULT_ENGINE, make_grasp
 from stablepush.sim.scene import triangulated
 from stablepush.task.mesh import load_mesh_object
 from stablepush.task.model import Task
+from stablepush.task.parts import PartSpec
 from stablepush.task.schema import parse_task
 
 G0 = 9.81  # m/s^2
@@ -110,11 +111,12 @@ def as_mesh_part(task: Task, directory: Path, outline: Optional[Sequence[Sequenc
     default the task's section) extruded to the task's thickness, of the task's mass. Its pushers
     and poses are the task's, so `outline` must keep them on its boundary."""
     name = f"{task.name}-mesh"
-    path = write_extrusion(outline if outline is not None else task.vertices, task.thickness,
+    path = write_extrusion(outline if outline is not None else task.object.vertices, task.object.thickness,
                            Path(directory) / f"{name}.stl")
-    part = load_mesh_object(path, "object", mass=task.mass)
-    return dataclasses.replace(task, name=name, vertices=part.vertices, thickness=part.thickness, com=part.com,
-                               inertia=part.inertia, mesh=part.part)
+    part = load_mesh_object(path, "object", mass=task.object.mass)
+    solid = PartSpec(vertices=part.vertices, thickness=part.thickness, mass=task.object.mass, com=part.com,
+                     inertia=part.inertia, mesh=part.part)
+    return dataclasses.replace(task, name=name, object=solid)
 
 
 def notched_pivoting(task: Task, directory: Path) -> Task:
@@ -125,10 +127,7 @@ def notched_pivoting(task: Task, directory: Path) -> Task:
 
 def with_pusher_mu(task: Task, pusher: str, mu: float) -> Task:
     """`task` with pusher `pusher`'s friction coefficient set to `mu` (mu >= 0)."""
-    index = task.pusher_index(pusher)
-    pushers = list(task.pushers)
-    pushers[index] = dataclasses.replace(pushers[index], mu=float(mu))
-    return dataclasses.replace(task, pushers=tuple(pushers))
+    return task.with_values({f"pushers.{pusher}.mu": float(mu)})
 
 
 class KinematicGrasp:
@@ -211,7 +210,8 @@ def wall_creep(load: float, pad_speed: float, travel: Optional[float] = None,
     mu_wall = task.pushers[0].mu
     return CreepResult(load=load, pad_speed_mm_s=pad_speed * 1e3,
                        creep_um_per_mm=abs(z1 - z0) * 1e6 / ((s1 - s0) * 1e3),
-                       pad_friction_ratio=fn / (2 * task.mu * task.grip_force), wall_cone_use=ft / (mu_wall * fn),
+                       pad_friction_ratio=fn / (2 * task.gripper.mu * task.gripper.grip_force),
+                       wall_cone_use=ft / (mu_wall * fn),
                        pad_dropout_steps=drops, steps_per_s=rig.world.steps_per_second)
 
 

@@ -44,9 +44,9 @@ def check_push(
 ) -> Dict[str, dict]:
     """Is the unit motion `move` (dx mm, dz mm, dtheta deg) from pose `at` (x mm, z mm, theta deg)
     a stable push? One entry per pusher (or only `pusher`), keyed by pusher name. With the task's
-    `uncertainty`, robustly: the verdict of the least stable corner of the box. Each call builds
-    the task's models (about a millisecond); a loop of many checks may build
-    `task.build_model()` once and call its `check` (SI units: stablepush.units.pose_to_si)."""
+    `uncertainty`, robustly: the verdict of the least stable corner of the box. The task's models
+    are built on its first check (about a millisecond) and kept with it; a loop of many checks
+    may call `task.model.check` itself (SI units: stablepush.units.pose_to_si)."""
     require_task(task)
     at = pose_field("at", list(at))
     move = pose_field("move", list(move))
@@ -55,10 +55,10 @@ def check_push(
                                 f"give a unit motion (dx, dz, dtheta)")
     q, dq = pose_to_si(at), pose_to_si(move)
     names = [pusher] if pusher is not None else task.pusher_names
-    model = task.build_model()
+    model = task.model
     _require_grasp(model, q, at)
     if any(task.uncertainty.values()):  # the least stable corner of the box decides
-        corners = task.corner_models()
+        corners = task.corner_models
         return {name: result_to_dict(_core.worst_case(corners, q, dq, task.pusher_index(name))) for name in names}
     if pusher is not None:
         return {pusher: result_to_dict(model.check(q, dq, task.pusher_index(pusher)))}
@@ -91,10 +91,10 @@ def stable_directions(task: Task, at: Sequence[float], pusher: Optional[str] = N
     heading_step = number_field("heading_step", heading_step, HEADING_STEP_DEG)
     names = [pusher] if pusher is not None else task.pusher_names
     indices = [task.pusher_index(name) for name in names]
-    model = task.build_model()
+    model = task.model
     q = np.array(pose_to_si(at))
     _require_grasp(model, q.tolist(), at)
-    corners = task.corner_models() if task.uncertainty else [model]
+    corners = task.corner_models
     step_mm, step_deg = task.planner.step
     scale = np.array(pose_to_si((step_mm, step_mm, step_deg)))
     headings = [heading_step * i for i in range(math.ceil(360.0 / heading_step - 1e-9))]  # deg

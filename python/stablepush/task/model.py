@@ -6,43 +6,43 @@ core's stable-push model built from it in SI (docs/model.md sections 1-4 and 7).
 from __future__ import annotations
 
 import dataclasses
-import json
+import functools
 import math
 import os
-import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from stablepush.compiled import _core
-from stablepush.errors import SettingError, TaskError
+from stablepush.errors import TaskError
 from stablepush.pose import Tolerance
-from stablepush.task.mesh import PartMesh
-from stablepush.task.robot_files import model_source
-from stablepush.units import MM, G, as_triple, is_integer, is_real, mm2_to_si, pose_to_si
+from stablepush.task.parts import (
+    ANGLE,
+    COORDINATE,
+    LENGTH,
+    MU,
+    PHYSICS_LIMITS,
+    DynamicsSpec,
+    GripperSpec,
+    PartSpec,
+    check_each,
+    check_finite,
+    check_integer,
+    check_vector,
+    check_within,
+)
 
-# Plausible-physics bounds on world numbers, in file units: the task file's (schema.py) and the
-# cell's and robot's values made in code alike. Past them the model's arithmetic (doubles and the
-# exact re-check) is no longer meaningful. Far wider than any real cell.
-MAX_COORDINATE = 1e4  # mm: vertices, com, pusher ends, pad centres, poses, world positions
-MAX_ANGLE = 3600.0  # deg: poses and feature orientations
-COORDINATE = (-MAX_COORDINATE, MAX_COORDINATE)
-ANGLE = (-MAX_ANGLE, MAX_ANGLE)
-LENGTH = (1e-2, MAX_COORDINATE)  # mm: sizes, radii, distances
+# Re-exported: modules that bound world numbers take them from here.
+from stablepush.task.parts import MAX_ANGLE as MAX_ANGLE
+from stablepush.task.parts import MAX_COORDINATE as MAX_COORDINATE
+from stablepush.task.robot_files import model_source
+from stablepush.units import as_triple, is_integer, mm2_to_si, pose_to_si
+
 JOINT_SPEED = (1e-3, 1e3)  # rad/s or m/s: environment.robot.max_joint_speed
 # A robot model file is named by one of these endings (MuJoCo compiles both; Drake parses both).
 ROBOT_MODEL_SUFFIXES = (".urdf", ".xml", ".mjcf")
 MAX_NAME = 100  # characters of a name (a pusher's, the flange's)
-MU = (0.0, 100.0)  # a friction coefficient
-# The part's, the gripper's and the world's numbers (file units), checked by Task whoever makes
-# one: the task file (schema.py) and code alike.
-PHYSICS_LIMITS: Dict[str, Tuple[float, float]] = {
-    "mass": (1e-3, 1e7),  # g
-    "inertia": (1e-15, 1e6),  # kg m^2
-    "force": (1e-6, 1e5),  # N
-    "gravity": (-1e3, 1e3),  # m/s^2 per component
-    "step_time": (1e-4, 1e3),  # s
-}
+
 MAX_PUSHER_POINTS = 20  # a line pusher's contact points
 # The planner section's numbers (file units), checked by PlannerSettings whoever makes one: the
 # task file (schema.py) and code alike.
@@ -56,44 +56,14 @@ PLANNER_LIMITS: Dict[str, Tuple[float, float]] = {
     "end_within": (0.01, 1.0),  # a share of the tolerance; 1: the tolerance's edge will do
 }
 
-# How pushes are made (dynamics.pushes), which decides how gravity turns in G during a push
-# (docs/planner.md, "Gravity during a push"): against features fixed in the world, the object keeps its
-# world orientation on each feature and the gripper turns; by a moving pusher, the gripper stays.
-PUSHES = ("against_fixed_features", "by_moving_pusher")
-
-
-def _finite(field: str, value) -> None:
-    if not is_real(value):
-        raise TypeError(f"{field} must be a number, got {type(value).__name__}")
-    try:
-        ok = math.isfinite(float(value))
-    except OverflowError:
-        ok = False
-    if not ok:
-        raise TaskError(field, f"must be finite, got {value!r:.40}")
-
-
-def _within(field: str, value, within: Tuple[float, float]) -> None:
-    """A finite number (TypeError, ValueError as _finite) from within[0] to within[1]: TaskError
-    naming `field`, as the task file's own check words it."""
-    _finite(field, value)
-    if not within[0] <= float(value) <= within[1]:
-        raise TaskError(field, f"must be between {within[0]:g} and {within[1]:g}, got {float(value):g}")
-
-
-def _within_each(field: str, value, size: int, bounds: Sequence[Tuple[float, float]]) -> None:
-    """`size` finite numbers (TypeError otherwise), the i-th within bounds[i] (the last bound for
-    the rest): TaskError naming field[i]."""
-    _finite_vector(field, value, size)
-    for i, v in enumerate(value):
-        _within(f"{field}[{i}]", v, bounds[min(i, len(bounds) - 1)])
 
 
 def _world_pose(field: str, value, size: int) -> None:
     """x, y, z mm (COORDINATE) then angles deg (ANGLE), each named field[i]."""
-    _finite_vector(field, value, size)
+    check_vector(field, value, size)
     for i, v in enumerate(value):
-        _within(f"{field}[{i}]", v, COORDINATE if i < 3 else ANGLE)
+        check_within(f"{field}[{i}]", v, COORDINATE if i < 3 else ANGLE)
+
 
 
 def _robot_model(value: str) -> str:
@@ -115,9 +85,6 @@ def _robot_model(value: str) -> str:
     return str(path)
 
 
-def _integer(field: str, value) -> None:
-    if isinstance(value, bool) or not is_integer(value):
-        raise TypeError(f"{field} must be an integer, got {value!r:.40}")
 
 
 def _string_mapping_of_numbers(field: str, value, keys=None) -> Dict[str, float]:
@@ -130,16 +97,10 @@ def _string_mapping_of_numbers(field: str, value, keys=None) -> Dict[str, float]
         if not isinstance(key, str) or (keys is not None and key not in keys):
             allowed = f" (one of {', '.join(keys)})" if keys is not None else ""
             raise TaskError(field, f"{key!r:.40} is not a name it takes{allowed}")
-        _finite(f"{field}.{key}", v)
+        check_finite(f"{field}.{key}", v)
         out[key] = float(v)
     return out
 
-
-def _finite_vector(field: str, value, size: int) -> None:
-    if not isinstance(value, (tuple, list)) or len(value) != size:
-        raise TypeError(f"{field} must be {size} numbers, got {value!r:.60}")
-    for v in value:
-        _finite(field, v)
 
 
 @dataclass(frozen=True)
@@ -169,17 +130,17 @@ class PlannerSettings:
         """Each field's type (TypeError) and range (TaskError naming planner.KEY), as the task
         file's planner section is checked: PLANNER_LIMITS and the core's declared parameters."""
         for name in ("time_limit", "min_margin", "sampling_margin", "min_hold_ratio", "end_within"):
-            _within(f"planner.{name}", getattr(self, name), PLANNER_LIMITS[name])
+            check_within(f"planner.{name}", getattr(self, name), PLANNER_LIMITS[name])
             object.__setattr__(self, name, float(getattr(self, name)))
         for name in ("seed", "max_switches"):
             if isinstance(getattr(self, name), bool) or not is_integer(getattr(self, name)):
                 raise TypeError(f"planner.{name} must be an integer, got {getattr(self, name)!r:.40}")
-            _within(f"planner.{name}", getattr(self, name), _core.TRRT_STAR_PARAMETER_RANGES[name][1:])
+            check_within(f"planner.{name}", getattr(self, name), _core.TRRT_STAR_PARAMETER_RANGES[name][1:])
             object.__setattr__(self, name, int(getattr(self, name)))
         for name in ("step", "tolerance"):
-            _finite_vector(f"planner.{name}", getattr(self, name), 2)
+            check_vector(f"planner.{name}", getattr(self, name), 2)
             for i, v in enumerate(getattr(self, name)):
-                _within(f"planner.{name}[{i}]", v, PLANNER_LIMITS[name])
+                check_within(f"planner.{name}[{i}]", v, PLANNER_LIMITS[name])
             object.__setattr__(self, name, tuple(float(v) for v in getattr(self, name)))
         if not isinstance(self.tuning, dict):
             raise TypeError(f"planner.tuning must be a mapping, got {type(self.tuning).__name__}")
@@ -187,7 +148,7 @@ class PlannerSettings:
         for key, value in self.tuning.items():
             if key not in _core.TRRT_STAR_PARAMETER_RANGES or key in ("seed", "max_switches"):
                 raise TaskError(f"planner.{key!s:.40}", "not a planner setting")
-            _within(f"planner.{key}", value, _core.TRRT_STAR_PARAMETER_RANGES[key][1:])
+            check_within(f"planner.{key}", value, _core.TRRT_STAR_PARAMETER_RANGES[key][1:])
 
     @classmethod
     def from_mapping(cls, values: Dict[str, Any]) -> "PlannerSettings":
@@ -221,49 +182,15 @@ class PlannerSettings:
                 **{key: repr(value) for key, value in self.tuning.items()}}
 
 
-# uncertainty: key -> the task value it widens (+- this fraction of it); a push must be stable for
-# every value in the box (Task.corner_models).
-UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers[].mu", "grip_force": "gripper.grip_force",
+# uncertainty (and evaluate's --vary): key -> the path (Task.value) of the quantity it widens, +- this
+# fraction of it; `*` stands for each pusher's name. A push must be stable for every value in the
+# box (Task.corner_models).
+UNCERTAIN = {"pad_mu": "gripper.mu", "pusher_mu": "pushers.*.mu", "grip_force": "gripper.grip_force",
              "mass": "object.mass"}
-
-
-ON_BOUNDARY = 1e-6  # mm: closer than this, a point is on an edge (the core's tolerance, 1e-9 m)
-
-
-def outline_corners(vertices: Sequence[Tuple[float, float]]) -> Tuple[Tuple[float, float], ...]:
-    """The outline's vertices less its straight ones, as the core takes them (mm, in order).
-
-    A vertex is straight when it lies within ON_BOUNDARY of the segment between its neighbours and
-    between them; CAD outlines have them. The core takes each edge as one face, so a pusher across
-    a straight vertex would be off every edge and one at it on a corner. A run of straight vertices
-    between two corners is dropped only when every one of them lies within ON_BOUNDARY of the
-    segment joining those corners, in order along it, so the shape stays the same to ON_BOUNDARY.
-    An outline with fewer than three corners is returned as it is (CrossSection.defect names it)."""
-    n = len(vertices)
-
-    def straight(a, v, b) -> bool:
-        chord = (b[0] - a[0], b[1] - a[1])
-        length = math.hypot(*chord)
-        if length == 0.0:
-            return False
-        along = ((v[0] - a[0]) * chord[0] + (v[1] - a[1]) * chord[1]) / length
-        off = abs(chord[0] * (v[1] - a[1]) - chord[1] * (v[0] - a[0])) / length
-        return off <= ON_BOUNDARY and 0.0 < along < length
-
-    corners = [i for i in range(n) if not straight(vertices[i - 1], vertices[i], vertices[(i + 1) % n])]
-    if len(corners) < 3:
-        return tuple(vertices)
-    kept = []
-    for k, a in enumerate(corners):
-        b = corners[(k + 1) % len(corners)]
-        run = [(a + j) % n for j in range(1, (b - a) % n)]
-        kept.append(a)
-        line = [vertices[a]] + [vertices[i] for i in run] + [vertices[b]]
-        on_one_edge = all(straight(vertices[a], vertices[i], vertices[b]) for i in run) and all(
-            straight(p, q, vertices[b]) for p, q in zip(line, line[1:-1]))  # in order along the edge
-        if not on_one_edge:
-            kept.extend(run)
-    return tuple(vertices[i] for i in kept)
+# The quantities a world or a calibration changes (Task.value, Task.with_values), by their path in
+# the task file -> (the Task's group, its field); pushers.NAME.mu is pusher NAME's friction.
+VALUE_PATHS = {"gripper.mu": ("gripper", "mu"), "gripper.grip_force": ("gripper", "grip_force"),
+               "object.mass": ("object", "mass")}
 
 
 # The planner section's keys every task has, in the task file's form; a task file (or a Task
@@ -299,7 +226,7 @@ class Robot:
                                                         f"spaces, got {self.flange!r:.60}")
         _world_pose("environment.robot.tcp", self.tcp, 6)
         _world_pose("environment.robot.base", self.base, 4)
-        _within("environment.robot.max_joint_speed", self.max_joint_speed, JOINT_SPEED)
+        check_within("environment.robot.max_joint_speed", self.max_joint_speed, JOINT_SPEED)
         if self.model is not None:
             object.__setattr__(self, "model", _robot_model(self.model))
         object.__setattr__(self, "tcp", tuple(float(v) for v in self.tcp))
@@ -365,7 +292,7 @@ class Cell:
             raise TypeError(f"environment.robot must be a Robot or a mapping, got {type(self.robot).__name__}")
         object.__setattr__(self, "home", tuple(float(v) for v in self.home))
         for name in ("retract", "station_spacing", "lane_offset"):
-            _within(f"environment.{name}", getattr(self, name), LENGTH)
+            check_within(f"environment.{name}", getattr(self, name), LENGTH)
             object.__setattr__(self, name, float(getattr(self, name)))
         if not isinstance(self.end_on_feature, bool):
             raise TypeError(f"environment.end_on_feature must be true or false, got {self.end_on_feature!r:.40}")
@@ -412,11 +339,11 @@ class PusherSpec:
         if not self.name.strip() or len(self.name) > MAX_NAME:
             raise TaskError("pushers[].name", f"must be a name of 1 to {MAX_NAME} characters, got {self.name!r:.40}")
         for end in ("a", "b"):
-            _within_each(f"pushers.{self.name:.40}.{end}", getattr(self, end), 2, [COORDINATE])
+            check_each(f"pushers.{self.name:.40}.{end}", getattr(self, end), 2, [COORDINATE])
             object.__setattr__(self, end, tuple(float(v) for v in getattr(self, end)))
-        _within(f"pushers.{self.name:.40}.mu", self.mu, MU)
-        _integer(f"pushers.{self.name:.40}.points", self.points)
-        _within(f"pushers.{self.name:.40}.points", self.points, (1, MAX_PUSHER_POINTS))
+        check_within(f"pushers.{self.name:.40}.mu", self.mu, MU)
+        check_integer(f"pushers.{self.name:.40}.points", self.points)
+        check_within(f"pushers.{self.name:.40}.points", self.points, (1, MAX_PUSHER_POINTS))
 
     @property
     def is_point(self) -> bool:
@@ -425,21 +352,15 @@ class PusherSpec:
 
 @dataclass(frozen=True)
 class Task:
-    """A validated task, in file units (mm, deg, g, N); `build_model` converts to SI."""
+    """A validated task, in file units (mm, deg, g, N), its groups the task file's sections (a
+    quantity's path on a Task is its path in the file: task.gripper.mu is gripper.mu); `model` and
+    `corner_models` are the core's, in SI, built from it on first use."""
 
     name: str
-    vertices: Tuple[Tuple[float, float], ...]  # cross-section in O, mm, counterclockwise
-    thickness: float  # mm along y
-    mass: float  # g
-    com: Optional[Tuple[float, float]]  # mm in O; None: the centroid
-    inertia: Optional[float]  # kg m^2 about the com; None: uniform body
-    grip_force: float  # N per pad
-    mu: float  # pad-object friction
-    pad_rings: int
-    pads: Tuple[Tuple[Tuple[float, float], float], ...]  # (centre mm in G, radius mm)
+    object: PartSpec  # the part: its section, thickness, mass, com, inertia, mesh
+    gripper: GripperSpec  # the grip force, the pads' mu, their rings and the pads
     gravity: Tuple[float, float]  # m/s^2 in G while G's axes are the world's (at the home pose)
-    step_time: float  # s
-    friction_polygon_sides: int
+    dynamics: DynamicsSpec  # a unit push's time, the sticking polygons' sides, how pushes are made
     pushers: Tuple[PusherSpec, ...]
     start: Tuple[float, float, float]  # mm, mm, deg
     goal: Tuple[float, float, float]
@@ -447,10 +368,6 @@ class Task:
     planner: PlannerSettings = field(default_factory=PlannerSettings)
     environment: Cell = field(default_factory=Cell)  # a mapping in the file's form is taken as Cell.from_mapping
     source: Optional[str] = None
-    pushes: str = PUSHES[0]  # see PUSHES
-    # shape: mesh: the solid the section was cut from (the pads' faces are checked on it, the
-    # simulators run it); None for a box or a polygon, which are the slab itself.
-    mesh: Optional[PartMesh] = None
     uncertainty: Dict[str, float] = field(default_factory=dict)  # key -> +- fraction of nominal (UNCERTAIN)
     # What the file says that is legal but probably not meant (each names the field); the CLI
     # prints them as "warning:" lines.
@@ -462,7 +379,7 @@ class Task:
     def __post_init__(self) -> None:
         """The shape of the fields (TypeError or ValueError naming the field): a Task made by
         `load_task`/`parse_task` always has it; one edited in code (dataclasses.replace) must too,
-        before anything reaches the core."""
+        before anything reaches the core. The groups check their own fields."""
         if not isinstance(self.name, str):
             raise TypeError(f"Task.name must be a string, got {type(self.name).__name__}")
         if isinstance(self.planner, dict):
@@ -473,24 +390,12 @@ class Task:
             object.__setattr__(self, "environment", Cell.from_mapping(self.environment))
         if not isinstance(self.environment, Cell):
             raise TypeError(f"Task.environment must be a Cell or a mapping, got {type(self.environment).__name__}")
-        for name, bounds in (("thickness", LENGTH), ("mass", PHYSICS_LIMITS["mass"]),
-                             ("grip_force", PHYSICS_LIMITS["force"]), ("mu", MU),
-                             ("step_time", PHYSICS_LIMITS["step_time"])):
-            _within(f"Task.{name}", getattr(self, name), bounds)
-        _within_each("Task.gravity", self.gravity, 2, [PHYSICS_LIMITS["gravity"]])
-        _within_each("Task.start", self.start, 3, [COORDINATE, COORDINATE, ANGLE])
-        _within_each("Task.goal", self.goal, 3, [COORDINATE, COORDINATE, ANGLE])
-        if not isinstance(self.vertices, (tuple, list)) or len(self.vertices) < 3:
-            raise TypeError("Task.vertices must be a sequence of at least 3 (x, z) pairs")
-        for i, v in enumerate(self.vertices):
-            _within_each(f"Task.vertices[{i}]", v, 2, [COORDINATE])
-        if not isinstance(self.pads, (tuple, list)) or not self.pads:
-            raise TypeError("Task.pads must be a sequence of ((x, z), radius)")
-        for i, pad in enumerate(self.pads):
-            if not isinstance(pad, (tuple, list)) or len(pad) != 2:
-                raise TypeError(f"Task.pads[{i}] must be ((x, z), radius)")
-            _within_each(f"Task.pads[{i}].center", pad[0], 2, [COORDINATE])
-            _within(f"Task.pads[{i}] radius", pad[1], LENGTH)
+        for name, kind in (("object", PartSpec), ("gripper", GripperSpec), ("dynamics", DynamicsSpec)):
+            if not isinstance(getattr(self, name), kind):
+                raise TypeError(f"Task.{name} must be a {kind.__name__}, got {type(getattr(self, name)).__name__}")
+        check_each("Task.gravity", self.gravity, 2, [PHYSICS_LIMITS["gravity"]])
+        check_each("Task.start", self.start, 3, [COORDINATE, COORDINATE, ANGLE])
+        check_each("Task.goal", self.goal, 3, [COORDINATE, COORDINATE, ANGLE])
         if not isinstance(self.pushers, (tuple, list)) or not all(isinstance(p, PusherSpec) for p in self.pushers):
             raise TypeError("Task.pushers must be a sequence of PusherSpec")
         self._check_the_other_fields()
@@ -498,21 +403,8 @@ class Task:
     def _check_the_other_fields(self) -> None:
         """The fields __post_init__ has not checked: each one's type, named (an edited Task with
         uncertainty=None, say, escaped from sp.check and sp.plan_task as an AttributeError)."""
-        if self.com is not None:  # a numpy array too, taken as the pair it holds
-            com: Any = self.com  # typed a pair; an array is taken too
-            com = com.tolist() if getattr(com, "ndim", None) == 1 else com
-            _finite_vector("Task.com", com, 2)
-            object.__setattr__(self, "com", tuple(float(v) for v in com))
-        if self.inertia is not None:
-            _within("Task.inertia", self.inertia, PHYSICS_LIMITS["inertia"])
-        _integer("Task.pad_rings", self.pad_rings)
-        _integer("Task.friction_polygon_sides", self.friction_polygon_sides)
         if self.source is not None and not isinstance(self.source, str):
             raise TypeError(f"Task.source must be a string or None, got {type(self.source).__name__}")
-        if self.mesh is not None and not isinstance(self.mesh, PartMesh):
-            raise TypeError(f"Task.mesh must be a PartMesh or None, got {type(self.mesh).__name__}")
-        if not isinstance(self.pushes, str) or self.pushes not in PUSHES:
-            raise TaskError("dynamics.pushes", f"must be one of {', '.join(PUSHES)}, got {self.pushes!r:.40}")
         object.__setattr__(self, "uncertainty", _string_mapping_of_numbers("Task.uncertainty", self.uncertainty,
                                                                            tuple(UNCERTAIN)))
         object.__setattr__(self, "feature_orientations",
@@ -520,6 +412,11 @@ class Task:
         if not isinstance(self.warnings, (tuple, list)) or not all(isinstance(w, str) for w in self.warnings):
             raise TypeError(f"Task.warnings must be a sequence of strings, got {self.warnings!r:.40}")
         object.__setattr__(self, "warnings", tuple(self.warnings))
+
+    def __getstate__(self) -> Dict[str, Any]:
+        """The fields without the built models (MODEL_CACHE): a pickled or copied Task (Ray sends
+        Tasks to its workers) builds its own where it is used; the core's models do not pickle."""
+        return {k: v for k, v in self.__dict__.items() if k not in MODEL_CACHE}
 
     def feature_angle(self, pusher: str) -> float:
         """The object's world orientation (deg about the world's y) while it rests on `pusher`'s
@@ -545,13 +442,14 @@ class Task:
         changed since can say what changed (`stablepush.plan.verify.changes_since_planned`)."""
         planner = {k: self.planner.as_dict()[k] for k in ("step", "tolerance", "max_switches", "min_margin",
                                                           "min_hold_ratio")}
+        part, grip = self.object, self.gripper
         return json_values({
             "name": self.name,
-            "object": {"vertices": self.vertices, "thickness": self.thickness, "mass": self.mass, "com": self.com,
-                       "inertia": self.inertia},
-            "gripper": {"grip_force": self.grip_force, "mu": self.mu, "pad_rings": self.pad_rings, "pads": self.pads},
-            "gravity": self.gravity, "step_time": self.step_time, "pushes": self.pushes,
-            "friction_polygon_sides": self.friction_polygon_sides,
+            "object": {"vertices": part.vertices, "thickness": part.thickness, "mass": part.mass, "com": part.com,
+                       "inertia": part.inertia},
+            "gripper": {"grip_force": grip.grip_force, "mu": grip.mu, "pad_rings": grip.pad_rings, "pads": grip.pads},
+            "gravity": self.gravity, "step_time": self.dynamics.step_time, "pushes": self.dynamics.pushes,
+            "friction_polygon_sides": self.dynamics.friction_polygon_sides,
             "pushers": {p.name: {"from": p.a, "to": p.b, "mu": p.mu} for p in self.pushers},
             "start": self.start, "goal": self.goal, "planner": planner, "uncertainty": self.uncertainty,
             "features": {name: self.feature_angle(name) for name in self.pusher_names},
@@ -580,42 +478,87 @@ class Task:
             names = ", ".join(self.pusher_names)
             raise TaskError(field, f"no pusher named {name!r:.60} (the task has {names})") from None
 
-    def section(self) -> "_core.CrossSection":
-        """The core's cross-section: the outline's corners (outline_corners), in m."""
-        return _core.CrossSection([mm2_to_si(v) for v in outline_corners(self.vertices)])
+    def value(self, path: str) -> float:
+        """The quantity at `path`, named as in the task file: gripper.mu, gripper.grip_force,
+        object.mass or pushers.NAME.mu (VALUE_PATHS); TaskError naming an unknown path or pusher."""
+        group, key = self._value_at(path)
+        if group == "pushers":
+            return self.pushers[key].mu
+        return getattr(getattr(self, group), key)
 
-    def rigid_body(self, section: "Optional[_core.CrossSection]" = None) -> "_core.RigidBody":
-        """The object's mass [kg], com [m, in O] and moment of inertia about y at the com [kg m^2]."""
-        uniform = _core.RigidBody.uniform(section or self.section(), self.mass * G)
-        com = mm2_to_si(self.com) if self.com is not None else tuple(uniform.com)
-        if self.inertia is not None:
-            inertia = self.inertia
-        else:  # the uniform body's inertia about the given com (parallel axes)
-            offset2 = (com[0] - uniform.com[0]) ** 2 + (com[1] - uniform.com[1]) ** 2
-            inertia = uniform.inertia + self.mass * G * offset2
-        return _core.RigidBody(self.mass * G, com, inertia)
+    def with_values(self, values: Mapping[str, float]) -> "Task":
+        """A new Task with the quantities at these paths (value's) changed, each refused by its
+        group's own check when out of range (TaskError naming it). A new object.mass scales a
+        given object.inertia with it (the same part, denser or lighter)."""
+        if not isinstance(values, Mapping):
+            raise TypeError(f"with_values takes a mapping of paths to numbers, got {type(values).__name__}")
+        changes: Dict[str, Dict[str, Any]] = {}
+        pushers = list(self.pushers)
+        for path, new in values.items():
+            group, key = self._value_at(path)
+            if group == "pushers":
+                pushers[key] = dataclasses.replace(pushers[key], mu=new)
+            else:
+                changes.setdefault(group, {})[key] = new
+        groups = {group: dataclasses.replace(getattr(self, group), **fields) for group, fields in changes.items()}
+        part = groups.get("object")
+        if part is not None and part.inertia is not None:
+            groups["object"] = dataclasses.replace(part, inertia=part.inertia * (part.mass / self.object.mass))
+        return dataclasses.replace(self, pushers=tuple(pushers), **groups)
 
-    def corner_models(self) -> List["_core.StablePushModel"]:
-        """The models every push must be stable in (docs/model.md section 7): the nominal model
-        alone, or with `uncertainty`, the 4 corners of (pad mu x grip force, mass) at the smallest
-        pusher mu. The required pusher wrench is affine in mu N and in m, the sticking polygons
-        scale with mu N and a pusher's cone shrinks with its mu, so a push stable at these corners
-        is stable for every value in the box (a convex combination of the corners' witnesses is a
-        witness). mu and N enter only as their product, so the corners scale mu alone."""
-        return [corner.build_model() for corner in self._corner_tasks()]
+    def _value_at(self, path: str) -> Tuple[str, Any]:
+        """Where `path` (value's) lies: (group, field), or ("pushers", the pusher's index)."""
+        if not isinstance(path, str):
+            raise TypeError(f"a value's path is a string (gripper.mu), got {type(path).__name__}")
+        if path in VALUE_PATHS:
+            return VALUE_PATHS[path]
+        if path.startswith("pushers.") and path.endswith(".mu") and len(path) > len("pushers..mu"):
+            return "pushers", self.pusher_index(path[len("pushers."):-len(".mu")], path)
+        raise TaskError(f"{path:.60}", f"not a value of a task ({', '.join(VALUE_PATHS)} or pushers.NAME.mu)")
 
-    def _corner_tasks(self) -> List["Task"]:
-        """This task at each corner of its uncertainty box (corner_models), or itself alone."""
+    @functools.cached_property
+    def model(self) -> "_core.StablePushModel":
+        """The core's stable-push model of this task, in SI units, built on first use and kept with
+        this Task (a Task made from it, by dataclasses.replace or with_values, builds its own)."""
+        section = self.object.section()
+        pushers = [_core.Pusher.on_boundary(section, p.name, mm2_to_si(p.a), mm2_to_si(p.b), p.mu, p.points)
+                   for p in self.pushers]
+        fixed = self.dynamics.pushes == "against_fixed_features"
+        return _core.StablePushModel(
+            section=section, body=self.object.rigid_body(section), gripper=self.gripper.core(), pushers=pushers,
+            gravity=self.gravity, step_time=self.dynamics.step_time,
+            friction_polygon_sides=self.dynamics.friction_polygon_sides,
+            gravity_frame=_core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
+            feature_angles=[math.radians(self.feature_angle(p.name)) for p in self.pushers],
+        )
+
+    @functools.cached_property
+    def corner_models(self) -> Tuple["_core.StablePushModel", ...]:
+        """The models every push must be stable in (docs/model.md section 7), each corner task's
+        `model`: the nominal model alone, or with `uncertainty`, the 4 corners of (pad mu x grip
+        force, mass) at the smallest pusher mu. The required pusher wrench is affine in mu N and in
+        m, the sticking polygons scale with mu N and a pusher's cone shrinks with its mu, so a push
+        stable at these corners is stable for every value in the box (a convex combination of the
+        corners' witnesses is a witness). mu and N enter only as their product, so the corners
+        scale mu alone."""
+        return tuple(corner.model for corner in self.corner_tasks)
+
+    @functools.cached_property
+    def corner_tasks(self) -> Tuple["Task", ...]:
+        """This task at each corner of its uncertainty box (corner_models), each without a box of
+        its own; this task alone when it has none."""
         u = self.uncertainty
         if not any(u.values()):
-            return [self]
-        low_pushers = tuple(dataclasses.replace(p, mu=p.mu * (1.0 - u.get("pusher_mu", 0.0))) for p in self.pushers)
+            return (self,)
+        pad_mu, mass = UNCERTAIN["pad_mu"], UNCERTAIN["mass"]
+        low_pushers = {UNCERTAIN["pusher_mu"].replace("*", p.name): p.mu * (1.0 - u.get("pusher_mu", 0.0))
+                       for p in self.pushers}
         friction = [(1.0 - u.get("pad_mu", 0.0)) * (1.0 - u.get("grip_force", 0.0)),
                     (1.0 + u.get("pad_mu", 0.0)) * (1.0 + u.get("grip_force", 0.0))]
         masses = [1.0 - u.get("mass", 0.0), 1.0 + u.get("mass", 0.0)]
-        return [dataclasses.replace(self, mu=self.mu * f, mass=self.mass * m, pushers=low_pushers,
-                                    inertia=None if self.inertia is None else self.inertia * m, uncertainty={})
-                for f in friction for m in masses]
+        point = dataclasses.replace(self, uncertainty={})
+        return tuple(point.with_values({pad_mu: self.value(pad_mu) * f, mass: self.value(mass) * m, **low_pushers})
+                     for f in friction for m in masses)
 
     def goal_hold_ratios(self) -> Dict[str, float]:
         """Per pusher, `hold_ratio` at the goal with gravity as while that pusher's feature holds
@@ -623,68 +566,12 @@ class Task:
         box's corners: below 1 the pads alone do not hold the object there against gravity
         (docs/model.md section 2, "Holding without a pusher"); +inf without gravity."""
         q = pose_to_si(self.goal)
-        models = self.corner_models()
-        return {p.name: min(m.hold_ratio(q, i) for m in models) for i, p in enumerate(self.pushers)}
-
-    def check_models(self, models: Sequence["_core.StablePushModel"], field: str = "models") -> None:
-        """TypeError or ValueError (naming `field[k]`) unless `models` are this task's corner_models(),
-        every corner present, in any order: each model must have been built by build_model from what
-        one corner's model is built from (model_inputs), which is recorded beside each model built.
-        A model of another task, or the nominal model of a task with an uncertainty box, would give
-        answers that are not this task's."""
-        expected = {corner.model_inputs() for corner in self._corner_tasks()}
-        found = set()
-        for k, model in enumerate(models):
-            name = f"{field}[{k}]"
-            if not isinstance(model, _core.StablePushModel):
-                raise TypeError(f"{name}: expected a StablePushModel (task.corner_models()), "
-                                f"got {type(model).__name__}")
-            made_from = _MODEL_INPUTS.get(model)
-            if made_from not in expected:
-                box = " (the task has an uncertainty box: its corner models)" if any(self.uncertainty.values()) else ""
-                raise SettingError(name, f"not one of the corner_models() of task {self.name!r}{box}: a model of "
-                                         f"another task, or not made by Task.build_model")
-            found.add(made_from)
-        if found != expected:
-            raise SettingError(field, f"{len(models)} model(s), not the {len(expected)} of task.corner_models()")
-
-    def model_inputs(self) -> str:
-        """What build_model builds from, as canonical JSON (numbers as floats, so 62 and 62.0 are
-        one mass): the object, the pads, gravity and how pushes are made, the pushers and, against
-        fixed features, the object's orientation on each (the start's where environment.features
-        does not give it); not the goal or planner, which a model does not depend on."""
-        fixed = self.pushes == "against_fixed_features"
-        return json.dumps(_floats(json_values({
-            "object": [self.vertices, self.thickness, self.mass, self.com, self.inertia],
-            "gripper": [self.grip_force, self.mu, self.pad_rings, self.pads],
-            "dynamics": [self.gravity, self.step_time, self.friction_polygon_sides, self.pushes],
-            "pushers": [[p.name, p.a, p.b, p.mu, p.points, self.feature_angle(p.name) if fixed else None]
-                        for p in self.pushers],
-        })), sort_keys=True)
-
-    def build_model(self) -> "_core.StablePushModel":
-        """The core's stable-push model of this task, in SI units."""
-        section = self.section()
-        body = self.rigid_body(section)
-        gripper = make_gripper(self.pads, self.grip_force, self.mu, self.pad_rings)
-        pushers = [
-            _core.Pusher.on_boundary(section, p.name, mm2_to_si(p.a), mm2_to_si(p.b), p.mu, p.points)
-            for p in self.pushers
-        ]
-        fixed = self.pushes == "against_fixed_features"
-        model = _core.StablePushModel(
-            section=section, body=body, gripper=gripper, pushers=pushers, gravity=self.gravity,
-            step_time=self.step_time, friction_polygon_sides=self.friction_polygon_sides,
-            gravity_frame=_core.GravityFrame.object if fixed else _core.GravityFrame.gripper,
-            feature_angles=[math.radians(self.feature_angle(p.name)) for p in self.pushers],
-        )
-        _MODEL_INPUTS[model] = self.model_inputs()
-        return model
+        return {p.name: min(m.hold_ratio(q, i) for m in self.corner_models) for i, p in enumerate(self.pushers)}
 
 
-# Each model build_model made -> its task's model_inputs(), for check_models; weak, so a model
-# outlives no reference of its own.
-_MODEL_INPUTS: "weakref.WeakKeyDictionary[_core.StablePushModel, str]" = weakref.WeakKeyDictionary()
+# The Task's attributes that hold what it built (functools.cached_property), which its pickled or
+# copied state leaves out (Task.__getstate__).
+MODEL_CACHE = ("model", "corner_models", "corner_tasks")
 
 
 def require_task(value: Any, field: str = "task") -> Task:
@@ -711,15 +598,3 @@ def json_values(value):
         return int(value)
     return float(value)
 
-
-def _floats(value):
-    """json_values' output with every int a float."""
-    if isinstance(value, list):
-        return [_floats(v) for v in value]
-    if isinstance(value, dict):
-        return {k: _floats(v) for k, v in value.items()}
-    return float(value) if isinstance(value, int) and not isinstance(value, bool) else value
-
-
-def make_gripper(pads, grip_force: float, mu: float, pad_rings: int) -> "_core.Gripper":
-    return _core.Gripper([_core.Pad(mm2_to_si(c), r * MM) for c, r in pads], grip_force, mu, pad_rings)

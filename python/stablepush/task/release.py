@@ -54,13 +54,13 @@ def release_hold_ratio(task: Task, pose: Sequence[float], pusher: int) -> float:
              for k in range(DIRECTIONS)]
     least = math.inf
     # Each corner of the uncertainty box as a task (Task.corner_models' own), its gravity replaced.
-    for corner in task._corner_tasks():
-        g = np.asarray(corner.build_model().gravity_in_gripper(q, pusher), float)
+    for corner in task.corner_tasks:
+        g = np.asarray(corner.model.gravity_in_gripper(q, pusher), float)
         if not g.any():
             continue  # no weight: the arm's acceleration alone is not a release the model speaks of
         for c, s in turns:
             loaded = dataclasses.replace(corner, gravity=tuple(g - accel * np.array([c, s])), uncertainty={})
-            least = min(least, loaded.build_model().hold_ratio(q, -1))
+            least = min(least, loaded.model.hold_ratio(q, -1))
     return least
 
 
@@ -83,7 +83,7 @@ def needed_hold_ratio(task: Task, pushers: Sequence[str]) -> float:
     plan that ends with one of `pushers` end where the pads also hold the release's load: above
     the static ratio of every goal pose (goal_poses) where they do not, rounded up to 0.01; 1 when
     they hold it wherever the static ratio is 1."""
-    models = task.corner_models()
+    models = task.corner_models
     need = 1.0
     for i, p in enumerate(task.pushers):
         if p.name not in pushers:

@@ -24,17 +24,10 @@ from stablepush.inputs import read_capped
 from stablepush.outputs import protect_input
 from stablepush.task.mesh import PartMesh, first_pad_off_faces, load_mesh_object, slab_text
 from stablepush.task.model import (
-    ANGLE,
-    COORDINATE,
     JOINT_SPEED,
-    LENGTH,
     MAX_PUSHER_POINTS,
-    MU,
-    ON_BOUNDARY,
-    PHYSICS_LIMITS,
     PLANNER_DEFAULTS,
     PLANNER_LIMITS,
-    PUSHES,
     ROBOT_MODEL_SUFFIXES,
     UNCERTAIN,
     Cell,
@@ -42,7 +35,18 @@ from stablepush.task.model import (
     PusherSpec,
     Robot,
     Task,
-    make_gripper,
+)
+from stablepush.task.parts import (
+    ANGLE,
+    COORDINATE,
+    LENGTH,
+    MU,
+    ON_BOUNDARY,
+    PHYSICS_LIMITS,
+    PUSHES,
+    DynamicsSpec,
+    GripperSpec,
+    PartSpec,
     outline_corners,
 )
 from stablepush.task.release import goal_release_holds, needed_hold_ratio
@@ -512,10 +516,11 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
     pushers = _validate_pushers(top["pushers"], section, notes, units)
     start = pose_field("start", top["start"])
     goal = pose_field("goal", top["goal"])
-    gripper = make_gripper(pads, grip_force, mu, pad_rings)
+    gripper = GripperSpec(grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads)
+    core_gripper = gripper.core()
     grasped = [("start", start), ("goal", goal)] if goal_in_grasp else [("start", start)]
     for label, q in grasped:
-        inside = gripper.pads_inside(section, pose_to_si(q))
+        inside = core_gripper.pads_inside(section, pose_to_si(q))
         for i, ok in enumerate(inside):
             if not ok:
                 where = f"gripper.pads[{i}]" if "pads" in grip else "gripper (default pads)"
@@ -542,10 +547,12 @@ def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> T
     notes.extend(_sub_millimetre(pads if "pads" in grip and not units else (), environment))
     notes.extend(_in_radians([("start", start), ("goal", goal)], planner.tolerance[1]))
     task = Task(
-        name=name, vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
-        grip_force=grip_force, mu=mu, pad_rings=pad_rings, pads=pads, gravity=gravity, step_time=step_time,
-        friction_polygon_sides=sides, pushers=pushers, start=start, goal=goal, planner=planner,
-        environment=environment, source=source, pushes=pushes, uncertainty=uncertainty, mesh=mesh,
+        name=name, object=PartSpec(vertices=vertices, thickness=thickness, mass=mass, com=com, inertia=inertia,
+                                   mesh=mesh),
+        gripper=gripper, gravity=gravity,
+        dynamics=DynamicsSpec(step_time=step_time, friction_polygon_sides=sides, pushes=pushes),
+        pushers=pushers, start=start, goal=goal, planner=planner, environment=environment, source=source,
+        uncertainty=uncertainty,
         warnings=tuple(notes + _implausible(vertices, thickness, mass, grip_force, mu, pushers, gravity)),
     )
     if goal_in_grasp and not environment.end_on_feature:
@@ -569,7 +576,8 @@ def goal_hold_warnings(task: Task) -> List[str]:
         # The release's hold is linear in pad mu x grip force (the friction that balances the load
         # scales with it): the force with which every pusher's end holds, rounded up to 0.1 N.
         least = min(goal_release_holds(task).values())
-        grip = (f"gripper.grip_force {math.ceil(task.grip_force / least * 10.0) / 10.0:g} N or more" if least > 0.0
+        force = math.ceil(task.gripper.grip_force / least * 10.0) / 10.0 if least > 0.0 else 0.0
+        grip = (f"gripper.grip_force {force:g} N or more" if least > 0.0
                 else "no grip force does: the pads hold nothing with gripper.mu 0")
         return [f"goal: the pads alone hold only {best:.2f} times the object's weight at the goal{box}: when the "
                 f"last feature lets go the object moves in the grasp and the run misses (moved_on_release). "

@@ -42,10 +42,10 @@ def _colour(task: Task, pusher: str) -> str:
 
 
 def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits) -> None:
-    outline = in_gripper(pose, list(task.vertices) + [task.vertices[0]])
+    outline = in_gripper(pose, list(task.object.vertices) + [task.object.vertices[0]])
     ax.fill(outline[:, 0], outline[:, 1], color="0.85", zorder=1)
     ax.plot(outline[:, 0], outline[:, 1], color="0.25", lw=1.2, zorder=2)
-    for (cx, cz), r in task.pads:
+    for (cx, cz), r in task.gripper.pads:
         ax.add_patch(Circle((cx, cz), r, fill=False, ec="0.1", lw=1.0, ls="--", zorder=3))
     ax.plot([0], [0], "+", color="0.1", ms=6, zorder=3)
     for spec in task.pushers:
@@ -58,7 +58,7 @@ def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits)
             ax.plot(seg[:, 0], seg[:, 1], color=colour, lw=5 if active else 1.5, solid_capstyle="butt",
                     zorder=4 if active else 2)
     # O's x axis from its origin: the object's orientation (a symmetric outline looks alike turned).
-    size = 0.3 * max(max(abs(v) for v in p) for p in task.vertices)
+    size = 0.3 * max(max(abs(v) for v in p) for p in task.object.vertices)
     axis = in_gripper(pose, [(0.0, 0.0), (size, 0.0)])
     ax.annotate("", xy=axis[1], xytext=axis[0], zorder=5,
                 arrowprops={"arrowstyle": "->", "color": "0.15", "lw": 1.2})
@@ -70,7 +70,7 @@ def _draw_grasp(ax, task: Task, pose, pusher: Optional[str], title: str, limits)
 
 
 def _limits(task: Task, steps: Sequence[Waypoint]):
-    pts = np.vstack([in_gripper(s.pose, task.vertices) for s in steps])
+    pts = np.vstack([in_gripper(s.pose, task.object.vertices) for s in steps])
     pad = 5.0
     return ((pts[:, 0].min() - pad, pts[:, 0].max() + pad), (pts[:, 1].min() - pad, pts[:, 1].max() + pad))
 
@@ -171,7 +171,7 @@ def plan_figure(task: Task, plan: Plan, title: Optional[str] = None) -> Figure:
 
 def _draw_goal_outline(ax, task: Task) -> None:
     """The object's outline at the goal pose, dashed red: where a plan that stops short should have ended."""
-    goal = in_gripper(task.goal, list(task.vertices) + [task.vertices[0]])
+    goal = in_gripper(task.goal, list(task.object.vertices) + [task.object.vertices[0]])
     ax.plot(goal[:, 0], goal[:, 1], color="tab:red", lw=1.2, ls="--", zorder=6)
 
 
@@ -210,7 +210,7 @@ def save_figure(fig, path: str, dpi: int = 110) -> None:
 def cone_figure(task: Task, pusher: str):
     """The generalized friction cone of `pusher` in O: the edges n +- mu t of every contact point's
     cone as wrenches (f_x, f_z, tau_y / l), unit length, and the cone's surface."""
-    model = task.build_model()
+    model = task.model
     index = task.pusher_index(pusher)
     cone = model.pusher_cones[index]
     length = cone.torque_length
@@ -367,7 +367,7 @@ def layouts_figure(layouts: Sequence[dict], title: str = "") -> Figure:
     for k, layout in enumerate(layouts):
         ax = fig.add_subplot(1, max(1, len(layouts)), k + 1)
         task = layout["task"]
-        outline = np.array(list(task.vertices) + [task.vertices[0]], float)
+        outline = np.array(list(task.object.vertices) + [task.object.vertices[0]], float)
         ax.fill(outline[:, 0], outline[:, 1], color="0.85", edgecolor="0.3")
         for pusher in task.pushers:
             colour = _colour(task, pusher.name)
