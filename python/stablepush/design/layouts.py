@@ -31,7 +31,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
-from stablepush.design.commented import commented_task
 from stablepush.design.folder import DESIGN_HEADER, DESIGN_NAME
 from stablepush.errors import PadFaceError, SettingError, TaskError
 from stablepush.execution.world import place_features
@@ -45,6 +44,7 @@ from stablepush.runners import Runner, WorkerLost, run_all
 from stablepush.task.mechanics import stable_directions
 from stablepush.task.model import Robot, Task
 from stablepush.task.schema import parse_task, planner_integer, planner_limit
+from stablepush.task.task_text import commented_task, with_files_named_absolutely
 from stablepush.units import is_integer
 
 # What a layout is ranked by, each best first: the key, and +1 where less is better, -1 more.
@@ -444,12 +444,7 @@ def design_task(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], d: D
     environment["features"] = {name: [round(v, 6) for v in pose] for name, pose in d.features.items()}
     out = {**task, "pushers": [dict(by_name[name]) for name in d.pushers], "environment": environment}
     read = d.task if d.task is not None else layout_task(task, [by_name[name] for name in d.pushers], source)
-    if read.object.mesh is not None and isinstance(out.get("object"), dict):
-        out["object"] = {**out["object"], "file": read.object.mesh.file}
-    robot = environment.get("robot")
-    if isinstance(robot, dict) and read.environment.robot.model is not None:
-        environment["robot"] = {**robot, "model": read.environment.robot.model}
-    return out
+    return with_files_named_absolutely(out, read)
 
 
 def designs_folder(design_file: str) -> Path:
@@ -462,7 +457,7 @@ def designs_folder(design_file: str) -> Path:
 def design_files(study: DesignStudy, task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], folder: Path,
                  source: Optional[str] = None) -> Dict[Union[str, Path], str]:
     """Each design as a task file, `folder`/design-<rank>.yaml (its `task_file` set): path -> YAML,
-    with the design file `source`'s comments where they apply (commented.commented_task)."""
+    with the design file `source`'s comments where they apply (task.task_text.commented_task)."""
     try:
         text = Path(source).read_text(encoding="utf-8") if source is not None else None
     except (OSError, UnicodeError):  # read once already (schema.load_design); without it, no comments

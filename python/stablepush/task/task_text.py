@@ -1,5 +1,6 @@
-"""A design's task file written with the design file's comments (`stablepush design`'s
-design-<rank>.yaml).
+"""A task file written from its mapping with the comments of the file it came from: a design's
+(`stablepush design`'s design-<rank>.yaml, from the design file) and a calibrated task
+(`stablepush calibrate -o`, from the task file); and the files such a mapping names, named absolutely.
 
 A design's task (layouts.design_task) is the design file's mapping with `candidates` replaced by
 the layout's `pushers`, `environment.features` set, and files named relative to the design file
@@ -24,6 +25,8 @@ import re
 from typing import Any, Dict, List, Optional, Tuple
 
 import yaml
+
+from stablepush.task.model import Task
 
 # A section's first line: a key at column 0 (not a comment, list item, flow collection, directive or
 # document marker) followed by a colon.
@@ -147,3 +150,17 @@ def _fresh(value):
 
 def _dump(mapping: Dict[str, Any]) -> str:
     return yaml.safe_dump(mapping, sort_keys=False, default_flow_style=None, width=4096)
+
+
+def with_files_named_absolutely(mapping: Dict[str, Any], task: Task) -> Dict[str, Any]:
+    """A task file's mapping with the files its `task` read (a mesh, a robot model) named by the
+    absolute paths it read them from, so that the file reads the same files from any folder (a
+    model `~/arm.urdf` is the home folder's, as the first file read it)."""
+    out = dict(mapping)
+    if task.object.mesh is not None and isinstance(out.get("object"), dict):
+        out["object"] = {**out["object"], "file": task.object.mesh.file}
+    environment = out.get("environment")
+    if isinstance(environment, dict) and isinstance(environment.get("robot"), dict) \
+            and task.environment.robot.model is not None:
+        out["environment"] = {**environment, "robot": {**environment["robot"], "model": task.environment.robot.model}}
+    return out
