@@ -37,6 +37,15 @@ def fail(message: str) -> None:
     sys.exit(EXIT_BAD_INPUT)
 
 
+def help_with(**values):
+    """Fill the command's docstring's {name} fields before click reads it as the help: what the
+    library defines (the causes of a miss, a probe's bounds) is then written once."""
+    def fill(command):
+        command.__doc__ = command.__doc__.format(**values)
+        return command
+    return fill
+
+
 def given(name: str) -> bool:
     """Whether the running command's option `name` was given on the command line (not defaulted)."""
     return click.get_current_context().get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE

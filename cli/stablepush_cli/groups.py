@@ -94,16 +94,67 @@ class ArmChoice:
 
 @dataclass(frozen=True)
 class SimWorld:
-    """--sim-mu-scale, --tracker-noise: how a simulated world departs from the task."""
+    """--sim-mu-scale, --tracker-noise, --world: how a simulated world departs from the task."""
 
     mu_scale: float
     tracker_noise: Tuple[float, float]
+    world: Tuple[Tuple[str, float], ...] = ()
 
     def deviation(self):
         from stablepush.sim import WorldDeviation
 
         return WorldDeviation(mu_scale=self.mu_scale, tracker_noise_mm=self.tracker_noise[0],
-                              tracker_noise_deg=self.tracker_noise[1])
+                              tracker_noise_deg=self.tracker_noise[1], world=self.world)
+
+
+def world_option(scope: str) -> Callable:
+    """--world FIELD=VALUE, repeatable: a task field's value in the simulated world whatever the
+    task says; `scope` says which worlds ("With --sim: the", "The")."""
+    from stablepush_cli.options import parse_world
+
+    return click.option(
+        "--world", "world", multiple=True, callback=parse_world, metavar="FIELD=VALUE",
+        help=f"{scope} simulated world's value of a task field, whatever the task says (the real world does not "
+             f"read the task file either): gripper.mu, gripper.grip_force (N), object.mass (g) or "
+             f"pushers.NAME.mu. Repeatable; before --sim-mu-scale. A world to calibrate against "
+             f"(`stablepush calibrate --sim --world ...`).")
+
+
+def arm_connection(sim_help: str) -> Callable:
+    """--arm, --sim, --engine, --ack-timeout as `connection` (ArmChoice); `sim_help`: what --sim does."""
+    from stablepush.execution import ACK_TIMEOUT_RANGE, DEFAULT_ACK_TIMEOUT, DEFAULT_PORT
+    from stablepush.sim import DEFAULT_ENGINE, ENGINES
+    from stablepush_cli.options import Finite, parse_host_port
+
+    return option_group(
+        "connection", ArmChoice,
+        click.option("--arm", "arm", default=None, metavar="HOST:PORT", callback=parse_host_port,
+                     help=f"The arm server (stablepush.arm/2 protocol, see docs/execution.md). Default: with --sim a "
+                          f"simulated arm started in this process, else 127.0.0.1:{DEFAULT_PORT}."),
+        click.option("--sim", is_flag=True, help=sim_help),
+        click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+                     help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with stablepush's "
+                          "own Coulomb friction; drake: Drake's contact solver alone decides stick and slip."),
+        click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True, type=Finite(*ACK_TIMEOUT_RANGE),
+                     metavar="S", help="Give up when the arm server does not reply within S seconds (not with --sim: "
+                                       "the simulated arm runs in this process, and a waypoint takes as long as it "
+                                       "takes)."))
+
+
+def sim_world(tracker_noise_help: str = "") -> Callable:
+    """--sim-mu-scale, --tracker-noise and --world as `world` (SimWorld)."""
+    from stablepush_cli.options import Finite
+
+    return option_group(
+        "world", SimWorld,
+        click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True, type=Finite(min=0.1, max=10),
+                     metavar="S", help="With --sim: the simulated pads' and features' mu are S times the task's, to "
+                                       "test the plan against a world whose friction differs from its model."),
+        click.option("--tracker-noise", "tracker_noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0),
+                     metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise on the "
+                                            "object's pose in the grasp (x and z in mm, theta in deg)."
+                                            + tracker_noise_help),
+        world_option("With --sim: the"))
 
 
 @dataclass(frozen=True)

@@ -205,6 +205,21 @@ def parse_vary(_ctx, _param, values):
     return out
 
 
+def parse_world(_ctx, _param, values):
+    """--world FIELD=VALUE, repeated, as (field, value) pairs in order (the fields and ranges are
+    checked by the library's WorldDeviation, and against the task where there is one)."""
+    out = []
+    for value in values:
+        name, sep, number = value.partition("=")
+        try:
+            if not sep or not ascii_number(number):
+                raise ValueError(number)
+            out.append((name.strip(), float(number)))
+        except ValueError:
+            raise click.BadParameter(f"expected FIELD=VALUE (e.g. gripper.mu=0.3), got {value!r:.80}") from None
+    return tuple(out)
+
+
 def parse_axis(_ctx, param, value):
     """A grid axis A:B:N (N values from A to B; A:A:1 for A alone), within the task file's pose bounds;
     the library's own check (grid_axis) refuses a count of 1 with B other than A, and equal ends

@@ -7,14 +7,15 @@ import sys
 import click
 
 from stablepush.errors import SettingError
-from stablepush.execution import ACK_TIMEOUT_RANGE, CAUSES, DEFAULT_ACK_TIMEOUT, DEFAULT_PORT
-from stablepush.sim import DEFAULT_ENGINE, ENGINES, VIDEO_VIEWS
+from stablepush.execution import CAUSES, DEFAULT_PORT
+from stablepush.sim import DEFAULT_ENGINE, VIDEO_VIEWS
 from stablepush_cli.common import (
     EXIT_ARM_FAULT,
     EXIT_MISSED,
     check_named_outputs,
     fail,
     given,
+    help_with,
     progressbar,
     say_beside,
 )
@@ -26,46 +27,25 @@ from stablepush_cli.groups import (
     SimWorld,
     StreamChoice,
     VideoRequest,
+    arm_connection,
     option_group,
     plan_and_task,
     robot_choice,
+    sim_world,
     video_request,
 )
 from stablepush_cli.options import (
     Finite,
     Whole,
-    parse_host_port,
     stamp_option,
     video_output,
     video_settings_need,
 )
 
 
-def _help_with(**values):
-    """Fill the command's docstring's {name} fields before click reads it as the help: lists the
-    library defines (the causes of a miss) are then written once."""
-    def fill(command):
-        command.__doc__ = command.__doc__.format(**values)
-        return command
-    return fill
-
-
 @click.command()
 @plan_and_task("The task the plan was made for (checked against the plan before anything moves).")
-@option_group("connection", ArmChoice,
-              click.option("--arm", "arm", default=None, metavar="HOST:PORT", callback=parse_host_port,
-                           help=f"The arm server (stablepush.arm/2 protocol, see docs/execution.md). Default: with "
-                                f"--sim a simulated arm started in this process, else 127.0.0.1:{DEFAULT_PORT}."),
-              click.option("--sim", is_flag=True,
-                           help="Start a simulated arm here and run the plan on it (see --engine)."),
-              click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
-                           help="With --sim: the physics engine of the simulated arm. mujoco: pads slide with "
-                                "stablepush's own Coulomb friction; drake: Drake's contact solver alone decides "
-                                "stick and slip."),
-              click.option("--ack-timeout", default=DEFAULT_ACK_TIMEOUT, show_default=True,
-                           type=Finite(*ACK_TIMEOUT_RANGE), metavar="S",
-                           help="Give up when the arm server does not reply within S seconds (not with --sim: the "
-                                "simulated arm runs in this process, and a waypoint takes as long as it takes)."))
+@arm_connection("Start a simulated arm here and run the plan on it (see --engine).")
 @option_group("stream", StreamChoice,
               click.option("--rate", "rate_hz", default=100.0, show_default=True, type=Finite(min=1, max=1000),
                            metavar="HZ", help="Waypoints per second of motion. Each push takes the fewest whole "
@@ -110,14 +90,7 @@ def _help_with(**values):
 @click.option("-v", "--verbose", is_flag=True,
               help="A line per correction of the closed loop and per contact (slip, carry, where the guard found "
                    "its feature); without, one line sums each up.")
-@option_group("world", SimWorld,
-              click.option("--sim-mu-scale", "mu_scale", default=1.0, show_default=True,
-                           type=Finite(min=0.1, max=10), metavar="S",
-                           help="With --sim: the simulated pads' and features' mu are S times the task's, to test "
-                                "the plan against a world whose friction differs from its model."),
-              click.option("--tracker-noise", "tracker_noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0),
-                           metavar="MM DEG", help="With --sim: standard deviations of the simulated tracker's noise "
-                                                  "on the object's pose in the grasp (x and z in mm, theta in deg)."))
+@sim_world()
 @option_group("loop", LoopChoice,
               click.option("--closed-loop", "closed_loop", is_flag=True,
                            help="As the object comes onto each feature and after each push compare the arm's "
@@ -141,7 +114,7 @@ def _help_with(**values):
                                                   "feature past it (default: a fifth of the task's goal "
                                                   "tolerance)."))
 @robot_choice
-@_help_with(causes=", ".join(CAUSES))
+@help_with(causes=", ".join(CAUSES))
 def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, json_path, success_tolerance, record_path,
             stamp_ns, video: VideoRequest, quiet: bool, verbose: bool, world: SimWorld, loop: LoopChoice,
             robot: RobotChoice) -> None:
@@ -202,7 +175,8 @@ def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, json_
         fail("--sim and --arm: choose one (a simulated arm started here, or the arm server at HOST:PORT)")
     _only_with("--sim (a simulated arm started here)", connection.sim,
                ("--engine", connection.engine != DEFAULT_ENGINE), ("--sim-mu-scale", world.mu_scale != 1.0),
-               ("--tracker-noise", any(world.tracker_noise)))
+               ("--tracker-noise", any(world.tracker_noise)), ("--world", bool(world.world)))
+    world.deviation().world_task(task)  # each field one the task has (TaskError naming it)
     _only_with("an arm server (--arm, or no --sim)", not connection.sim, ("--ack-timeout", given("ack_timeout")))
     # The video is made first: the renderer needs MUJOCO_GL=osmesa before the simulated arm loads MuJoCo.
     videos = ([video_output("--video", video.path, video.fps, video.size, quiet, video.view)] if video.path
@@ -309,7 +283,7 @@ def _report_fault(fault, plan_file: str, last_step: int, sim: bool) -> None:
 # The options of `execute` that say how a run runs, so a resume keeps them (outputs are left out:
 # a resumed run writes its own).
 RUN_OPTIONS = ("arm", "sim", "engine", "rate_hz", "pace", "ack_timeout", "success_tolerance", "mu_scale",
-               "tracker_noise", "closed_loop", "replan_threshold", "final_tolerance", "guarded")
+               "tracker_noise", "world", "closed_loop", "replan_threshold", "final_tolerance", "guarded")
 
 
 def _resume_command(ctx: click.Context, step: int) -> str:
@@ -324,6 +298,8 @@ def _resume_command(ctx: click.Context, step: int) -> str:
             continue
         if param.name == "arm":
             words += ["--arm", f"{value[0]}:{value[1]}"]
+        elif param.name == "world":
+            words += [word for name, number in value for word in ("--world", f"{name}={number!r}")]
         elif isinstance(param, click.Option) and param.is_flag and param.secondary_opts:  # --x/--no-x
             words.append(param.opts[0] if value else param.secondary_opts[0])
         elif isinstance(param, click.Option) and param.is_flag:

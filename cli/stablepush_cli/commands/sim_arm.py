@@ -6,6 +6,7 @@ import click
 from stablepush.execution import DEFAULT_PORT
 from stablepush.sim import DEFAULT_ENGINE, ENGINES
 from stablepush.task import Robot, robot_with
+from stablepush_cli.groups import world_option
 from stablepush_cli.options import (
     Finite,
     Whole,
@@ -37,9 +38,10 @@ from stablepush_cli.options import (
 @click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
               help="The physics engine. mujoco: pads slide with stablepush's own Coulomb friction; drake: Drake's "
                    "contact solver alone decides stick and slip (about half MuJoCo's speed).")
+@world_option("The")
 @robot_options
 def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, seed: int, idle_timeout: float,
-            engine: str, robot_model, flange, tcp, base) -> None:
+            engine: str, world, robot_model, flange, tcp, base) -> None:
     """Serve a simulated arm (MuJoCo or Drake) over the arm protocol, until interrupted.
 
     A 7-joint arm of simple shapes (shipped MJCF), or yours (--robot, --flange, --tcp, --base), with
@@ -51,11 +53,19 @@ def sim_arm(host: str, port: int, exit_after, mu_scale: float, tracker_noise, se
     Joint servos track the streamed waypoints by IK; the simulation steps in lock-step with the stream
     (one waypoint period per waypoint), headless, and reports its steps/s. Each acknowledgement carries
     the object's pose in the grasp as a tracker would (`object_in_grasp`), with --tracker-noise.
+    With --world the world keeps its own friction, grip or mass whatever a client's task says: a
+    world to calibrate against, as a real cell is (a pusher's mu applies where a run places its
+    feature).
+
+    \b
+    Examples:
+      stablepush sim-arm --port 47100
+      stablepush sim-arm --port 47100 --world gripper.mu=0.3 --world pushers.left.mu=0.25
     """
     from stablepush.sim import SimArmServer, WorldDeviation
 
     deviation = WorldDeviation(mu_scale=mu_scale, tracker_noise_mm=tracker_noise[0], tracker_noise_deg=tracker_noise[1],
-                               seed=seed)
+                               seed=seed, world=world)
     robot = robot_with(Robot(), robot_model, flange, tcp, base)
     server = SimArmServer(host, port, exit_after=exit_after, deviation=deviation, idle_timeout=idle_timeout,
                           engine=engine, robot=robot)

@@ -5,17 +5,22 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Tuple
+from typing import Dict, Tuple
 
 import numpy as np
 
 from stablepush.errors import SettingError
-from stablepush.execution.scene import Scene, SceneFeature
+from stablepush.execution.scene import Scene, SceneFeature, SceneObject
 from stablepush.frames import matrix_to_pose, pose_to_matrix, rot_y
-from stablepush.task.model import MAX_ANGLE, MAX_COORDINATE
+from stablepush.task.model import MAX_ANGLE, MAX_COORDINATE, VALUE_PATHS, Task
+from stablepush.task.parts import MU, PHYSICS_LIMITS
 from stablepush.units import is_finite_real, is_integer
 
 SCALE_RANGE = (1e-3, 1e3)  # a world's multiplier of a task's mu, grip force or mass
+# The task fields a world may set whatever the task says (Task.value's paths, file units) -> their
+# range; pushers.NAME.mu is MU's too.
+WORLD_FIELDS = {"gripper.mu": MU, "gripper.grip_force": PHYSICS_LIMITS["force"], "object.mass": PHYSICS_LIMITS["mass"]}
+assert set(WORLD_FIELDS) == set(VALUE_PATHS), "a world sets the quantities Task.with_values does"
 MAX_SEED = 2**32 - 1  # the tracker's noise seed (numpy's legacy bound, as a study's seed)
 
 
@@ -34,7 +39,10 @@ class WorldDeviation:
     object's mass (and inertia) times `mass_scale`, each feature `feature_offsets` off where the
     plan puts it ((pusher, dx mm, dz mm, dtheta deg) in the world's x, z and about y through the
     middle of its segment), and a tracker whose `object_in_grasp` carries Gaussian noise (standard
-    deviations in mm and deg, drawn from `seed`)."""
+    deviations in mm and deg, drawn from `seed`). `world`: (task field, value) pairs the world has
+    whatever the task it is given says (`gripper.mu`, `gripper.grip_force` N, `object.mass` g,
+    `pushers.NAME.mu`, as Task.with_values names them), before the scales: a world that hides its
+    friction from the client, as a real one does."""
 
     mu_scale: float = 1.0
     tracker_noise_mm: float = 0.0
@@ -45,6 +53,7 @@ class WorldDeviation:
     grip_scale: float = 1.0
     mass_scale: float = 1.0
     feature_offsets: Tuple[Tuple[str, float, float, float], ...] = ()
+    world: Tuple[Tuple[str, float], ...] = ()
 
     def __post_init__(self):
         """Each field within what a world can be (SettingError naming it; TypeError for a wrong
@@ -65,18 +74,36 @@ class WorldDeviation:
             for name, value, bound in zip(("dx", "dz", "dtheta"), offset[1:], (MAX_COORDINATE, MAX_COORDINATE,
                                                                                 MAX_ANGLE)):
                 _number(f"feature_offsets[{k}].{name}", value, (-bound, bound))
+        if not isinstance(self.world, (tuple, list)):
+            raise TypeError(f"world must be a sequence of (field, value), got {type(self.world).__name__}")
+        for k, pair in enumerate(self.world):
+            if not isinstance(pair, (tuple, list)) or len(pair) != 2 or not isinstance(pair[0], str):
+                raise TypeError(f"world[{k}] must be (task field, value), got {pair!r:.60}")
+            _number(pair[0], pair[1], _world_range(pair[0]))
+        object.__setattr__(self, "world", tuple((name, float(value)) for name, value in self.world))
+
+    def world_task(self, task: Task) -> Task:
+        """`task` with this world's own values (`world`): the model of the world it simulates, which
+        the friction-fidelity contract holds it to. TaskError naming a field the task has not (a
+        pusher it lacks)."""
+        return task.with_values(dict(self.world))
+
+    def fixed_to(self, task: Task) -> "WorldDeviation":
+        """This world with every mu of `task` (the pads', each pusher's) set in `world` where it
+        does not set it itself: a world whose friction stays the task's whatever a run's plan was
+        made for (a calibration's probes are plans of other worlds than the task's)."""
+        own = dict(self.world)
+        fields = ["gripper.mu"] + [f"pushers.{p.name}.mu" for p in task.pushers]
+        return dataclasses.replace(self, world=tuple((name, own.pop(name, task.value(name))) for name in fields)
+                                   + tuple(own.items()))
 
     def apply(self, scene: Scene) -> Scene:
-        """`scene` as this world has it: a new Scene."""
+        """`scene` as this world has it: a new Scene. A pusher's mu in `world` applies to its
+        feature where the scene has one (a run places the features its plan uses)."""
+        scene = _with_world(scene, dict(self.world))
         gripper = dataclasses.replace(scene.gripper, mu=scene.gripper.mu * (self.mu_scale * self.pad_mu_scale),
                                       grip_force=scene.gripper.grip_force * self.grip_scale)
-        obj = scene.object
-        mesh = obj.mesh
-        if mesh is not None:  # a mesh part's solid's tensor (scene.object_inertia)
-            scaled = (np.asarray(mesh.inertia, float) * self.mass_scale).tolist()
-            mesh = dataclasses.replace(mesh, inertia=tuple((a, b, c) for a, b, c in scaled))
-        obj = dataclasses.replace(obj, mass=obj.mass * self.mass_scale, inertia=obj.inertia * self.mass_scale,
-                                  mesh=mesh)
+        obj = _scaled_mass(scene.object, self.mass_scale)
         offsets = {name: (dx, dz, dth) for name, dx, dz, dth in self.feature_offsets}
         features = []
         for feature in scene.features:
@@ -85,6 +112,39 @@ class WorldDeviation:
                 feature = _moved(feature, *offsets[feature.pusher])
             features.append(feature)
         return dataclasses.replace(scene, gripper=gripper, object=obj, features=tuple(features))
+
+
+def _world_range(name: str) -> Tuple[float, float]:
+    """The range of a world's field (SettingError naming one a world cannot set)."""
+    parts = name.split(".")
+    if name in WORLD_FIELDS:
+        return WORLD_FIELDS[name]
+    if len(parts) >= 3 and parts[0] == "pushers" and parts[-1] == "mu":
+        return MU
+    raise SettingError("world", f"{name!r:.60} is not a field a world sets (one of {', '.join(WORLD_FIELDS)}, "
+                                f"pushers.NAME.mu)")
+
+
+def _with_world(scene: Scene, values: Dict[str, float]) -> Scene:
+    """`scene` with the world's own values of task fields (WorldDeviation.world)."""
+    if not values:
+        return scene
+    gripper = dataclasses.replace(scene.gripper, mu=values.get("gripper.mu", scene.gripper.mu),
+                                  grip_force=values.get("gripper.grip_force", scene.gripper.grip_force))
+    obj = scene.object
+    if "object.mass" in values:
+        obj = _scaled_mass(obj, values["object.mass"] * 1e-3 / obj.mass)
+    features = tuple(dataclasses.replace(f, mu=values.get(f"pushers.{f.pusher}.mu", f.mu)) for f in scene.features)
+    return dataclasses.replace(scene, gripper=gripper, object=obj, features=features)
+
+
+def _scaled_mass(obj: SceneObject, scale: float) -> SceneObject:
+    """The object `scale` times as heavy: its mass and inertia, and a mesh solid's tensor."""
+    mesh = obj.mesh
+    if mesh is not None:  # a mesh part's solid's tensor (scene.object_inertia)
+        scaled = (np.asarray(mesh.inertia, float) * scale).tolist()
+        mesh = dataclasses.replace(mesh, inertia=tuple((a, b, c) for a, b, c in scaled))
+    return dataclasses.replace(obj, mass=obj.mass * scale, inertia=obj.inertia * scale, mesh=mesh)
 
 
 def _moved(feature: SceneFeature, dx_mm: float, dz_mm: float, dtheta_deg: float) -> SceneFeature:
