@@ -312,6 +312,7 @@ class _Run:
             replans=self.replans, warnings=execution_warnings(task), engine=self.ready.engine,
             simulated_geometry=self.ready.geometry,
             ends_on_feature=task.environment.end_on_feature,
+            steps=[[*w.pose, w.pusher] for w in steps],
         )
         loop = self.options.closed_loop
         report.verdict = judge(task, report, self.options.success_tolerance, loop.max_replans if loop else None)

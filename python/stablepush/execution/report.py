@@ -69,6 +69,9 @@ class ExecutionReport:
     simulated_geometry: Optional[str] = None  # the solid the simulator made of the object, as it says
     verdict: Optional[Verdict] = None  # whether it landed, and why not (stablepush.execution.verdict)
     ends_on_feature: bool = False  # the task's environment.end_on_feature: no release at the end
+    # The run's steps as run (the plan's, or as the guard and the closed loop spliced them): each
+    # [x mm, z mm, theta deg, pusher], the start's pusher None; the contacts' steps index them.
+    steps: List[list] = field(default_factory=list)
 
     @property
     def success(self) -> Optional[bool]:
@@ -192,6 +195,7 @@ class ExecutionReport:
             "contacts": [c.__dict__ for c in self.contacts], "features": self.features,
             "wall_time_s": self.wall_time_s, "sim_steps_per_s": self.sim_steps_per_s,
             "closed_loop": self.closed_loop, "guard": self.guard, "replans": [r.as_dict() for r in self.replans],
+            "steps": [list(step) for step in self.steps],
         }
 
 
