@@ -15,7 +15,8 @@ from stablepush.task import load_task, parse_task  # noqa: E402
 # xdist workers. A search with a time limit takes as long on any machine: one that plans goal
 # after goal for 1.5 s each (the ledge's, 27 s) is slow like its grid siblings.
 SLOW_MODULES = {"test_fuzz", "test_execute", "test_sim_arm", "test_friction_fidelity", "test_reliability",
-                "test_robust", "test_point_pushers", "test_cross_check", "test_evaluate", "test_reach", "test_readme", "test_bags"}
+                "test_robust", "test_point_pushers", "test_cross_check", "test_evaluate", "test_reach", "test_readme", "test_bags",
+                "test_calibrate_sim"}
 SLOW_TESTS = {
     "test_h_representation_matches_generators",
     "test_large_manipulation_reaches_a_zero_switch_plan_for_nine_of_ten_seeds",

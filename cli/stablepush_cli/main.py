@@ -12,6 +12,7 @@ import click
 from stablepush.errors import OutputError, StablepushError
 from stablepush_cli.commands import (
     bench,
+    calibrate,
     check,
     check_cell,
     cone,
@@ -83,8 +84,9 @@ def cli() -> None:
     """
 
 
-for command in (bench.bench, check.check, check_cell.check_cell, cone.cone, design.design, evaluate.evaluate,
-                execute.execute, plan.plan, reach.reach, show.show, sim_arm.sim_arm, trajectory.trajectory):
+for command in (bench.bench, calibrate.calibrate, check.check, check_cell.check_cell, cone.cone, design.design,
+                evaluate.evaluate, execute.execute, plan.plan, reach.reach, show.show, sim_arm.sim_arm,
+                trajectory.trajectory):
     cli.add_command(command)
 
 
