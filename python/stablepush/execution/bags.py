@@ -35,6 +35,7 @@ import re
 import tempfile
 import time
 from contextlib import contextmanager
+from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
 from typing import Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
@@ -334,12 +335,22 @@ def _static_transforms(T, stamp, features: Iterable[Feature], robot: Optional[Ro
     return T["tf2_msgs/msg/TFMessage"](transforms=transforms)
 
 
-def _marker(T, stamp, ident: int, frame: str, kind: int, points, scale, colour, pose=None):
+@dataclass(frozen=True)
+class _Look:
+    """How a marker is drawn: its Marker type (LINE_LIST, CYLINDER, ...), its scale (m; a line's
+    width in x) and its colour (r, g, b)."""
+
+    kind: int
+    scale: Tuple[float, float, float]
+    colour: Tuple[float, float, float]
+
+
+def _marker(T, stamp, ident: int, frame: str, look: _Look, points, pose=None):
     Marker = T["visualization_msgs/msg/Marker"]
     return Marker(
-        header=_header(T, stamp, frame), ns="stablepush", id=ident, type=kind, action=Marker.ADD,
-        pose=pose or _pose(T, (0, 0, 0), (1, 0, 0, 0)), scale=_vector3(T, scale),
-        color=T["std_msgs/msg/ColorRGBA"](r=colour[0], g=colour[1], b=colour[2], a=1.0),
+        header=_header(T, stamp, frame), ns="stablepush", id=ident, type=look.kind, action=Marker.ADD,
+        pose=pose or _pose(T, (0, 0, 0), (1, 0, 0, 0)), scale=_vector3(T, look.scale),
+        color=T["std_msgs/msg/ColorRGBA"](r=look.colour[0], g=look.colour[1], b=look.colour[2], a=1.0),
         lifetime=T["builtin_interfaces/msg/Duration"](sec=0, nanosec=0), frame_locked=True,
         points=[T["geometry_msgs/msg/Point"](x=float(x), y=float(y), z=float(z)) for x, y, z in points],
         colors=[], texture_resource="", texture=T["sensor_msgs/msg/CompressedImage"](
@@ -360,19 +371,21 @@ def _scene_markers(T, stamp, task: Task, features: Iterable[Feature]) -> list:
         for y in (-half, half):
             edges += [(x0, y, z0), (x1, y, z1)]
         edges += [(x0, -half, z0), (x0, half, z0)]
-    markers = [_marker(T, stamp, 0, OBJECT, Marker.LINE_LIST, edges, (0.0005, 0, 0), (0.85, 0.55, 0.25))]
+    markers = [_marker(T, stamp, 0, OBJECT, _Look(Marker.LINE_LIST, (0.0005, 0, 0), (0.85, 0.55, 0.25)), edges)]
     along_y = (np.sqrt(0.5), np.sqrt(0.5), 0.0, 0.0)  # the cylinder's z axis turned onto y
     for k, ((cx, cz), r) in enumerate(task.gripper.pads):  # pad k on the finger at +y when k is even
         y = half if k % 2 == 0 else -half
-        markers.append(_marker(T, stamp, 1 + k, GRIPPER, Marker.CYLINDER, [], (2 * r * MM, 2 * r * MM, 0.002),
-                               (0.2, 0.2, 0.2), pose=_pose(T, (cx * MM, y, cz * MM), along_y)))
+        markers.append(_marker(T, stamp, 1 + k, GRIPPER,
+                               _Look(Marker.CYLINDER, (2 * r * MM, 2 * r * MM, 0.002), (0.2, 0.2, 0.2)), [],
+                               pose=_pose(T, (cx * MM, y, cz * MM), along_y)))
+    blue = (0.3, 0.5, 0.8)
     for k, feature in enumerate(features):
         if np.allclose(feature.start, feature.end):  # a point pusher: a peg
-            markers.append(_marker(T, stamp, 100 + k, WORLD, Marker.SPHERE, [], (0.004, 0.004, 0.004), (0.3, 0.5, 0.8),
+            markers.append(_marker(T, stamp, 100 + k, WORLD, _Look(Marker.SPHERE, (0.004, 0.004, 0.004), blue), [],
                                    pose=_pose(T, feature.start, (1, 0, 0, 0))))
         else:
-            markers.append(_marker(T, stamp, 100 + k, WORLD, Marker.LINE_LIST, [feature.start, feature.end],
-                                   (0.003, 0, 0), (0.3, 0.5, 0.8)))
+            markers.append(_marker(T, stamp, 100 + k, WORLD, _Look(Marker.LINE_LIST, (0.003, 0, 0), blue),
+                                   [feature.start, feature.end]))
     return markers
 
 
