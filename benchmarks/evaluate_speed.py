@@ -6,7 +6,7 @@ of the worlds of docs/evaluate.md's tables (evaluate_tasks.SPREADS), closed loop
 open`, judged at 0.5 mm / 0.5 deg, on MuJoCo, in this process (one core). Trial k runs under each
 setting in turn (the order alternates with k, so that a machine's drift falls on both), each
 timed whole: world built, home found, run, judged. The settings are simulator time steps
-(`--timestep-ms A B`; the contract's step is sim.scene.TIMESTEP). Per task and setting:
+(`--timestep-ms A B`; the contract's step is kinematics.cell_model.TIMESTEP). Per task and setting:
 
 - trials per core-minute (60 s / the mean wall time of a trial) and x real time;
 - the time a `--target 0.99` decision takes at best on 2 workers: it needs 296 landings in a row
@@ -30,8 +30,8 @@ from shipped import TASKS
 
 from stablepush.evaluation import Batch, robust_task
 from stablepush.evaluation.batch import run_trial
+from stablepush.kinematics import cell_model
 from stablepush.plan import check_plan, plan_task
-from stablepush.sim import scene
 from stablepush.task import load_task
 
 DECISION_TRIALS = 296  # the fewest trials in which --target 0.99 --confidence 0.95 can say `above`
@@ -43,7 +43,7 @@ def timed_trials(batch: Batch, trials: int, steps_s) -> dict:
     out = {step: [] for step in steps_s}
     for k in range(trials):
         for step in (steps_s if k % 2 == 0 else tuple(reversed(steps_s))):
-            scene.TIMESTEP = step
+            cell_model.TIMESTEP = step
             started = time.perf_counter()
             record = run_trial(batch, k)
             out[step].append({**record, "wall_s": time.perf_counter() - started})
@@ -76,7 +76,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("tasks", nargs="*", type=Path, help="task files (default: the pivot and the T)")
     parser.add_argument("--trials", type=int, default=8)
-    parser.add_argument("--timestep-ms", nargs=2, type=float, default=(scene.TIMESTEP * 1e3, 0.5),
+    parser.add_argument("--timestep-ms", nargs=2, type=float, default=(cell_model.TIMESTEP * 1e3, 0.5),
                         metavar=("A", "B"), help="the two time steps compared, ms (default: the contract's, 0.5)")
     parser.add_argument("--plans", choices=("robust", "nominal"), default="robust")
     parser.add_argument("--loop", choices=("open", "closed"), default="closed")
@@ -108,7 +108,7 @@ def main() -> None:
               f"goal error gap at most {a['max_goal_error_gap_mm'] or 0:.3f} mm, "
               f"{a['max_goal_error_gap_deg'] or 0:.3f} deg | | | |", flush=True)
         results.append(row)
-    scene.TIMESTEP = steps[0]
+    cell_model.TIMESTEP = steps[0]
     if args.json:
         args.json.write_text(json.dumps(results, indent=1, default=str) + "\n")
 

@@ -13,7 +13,8 @@ import time
 
 from shipped import TASKS
 
-from stablepush.sim import fidelity, friction, scene
+from stablepush.kinematics import cell_model
+from stablepush.sim import fidelity, friction
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
 from stablepush.task import check_push, load_task, with_robot
 
@@ -23,7 +24,7 @@ def main() -> None:
     parser.add_argument("--stiff", action="store_true", help="measure the solver's stiff pad friction alone (no pad point ever slides with explicit friction)")
     parser.add_argument("--engine", choices=ENGINES, default=DEFAULT_ENGINE, help="the physics engine (default mujoco)")
     parser.add_argument("--timestep-ms", type=float, default=None, metavar="MS",
-                        help="MuJoCo's time step for this run (default: sim.scene.TIMESTEP, the contract's)")
+                        help="MuJoCo's time step for this run (default: kinematics.cell_model.TIMESTEP, the contract's)")
     parser.add_argument("--robot", metavar="FILE", help="the arm of the pivot on the arm: a URDF or MJCF file")
     parser.add_argument("--flange", metavar="LINK", help="with --robot: the link the jaws mount on")
     parser.add_argument("--tcp", nargs=6, type=float, metavar=("X", "Y", "Z", "RX", "RY", "RZ"),
@@ -38,9 +39,9 @@ def main() -> None:
     if args.timestep_ms is not None:
         if engine != "mujoco":
             parser.error("--timestep-ms is MuJoCo's step (Drake's is drake_arm.DRAKE_TIMESTEP)")
-        scene.TIMESTEP = args.timestep_ms / 1e3
+        cell_model.TIMESTEP = args.timestep_ms / 1e3
     started = time.perf_counter()
-    print(f"engine: {engine}" + (f", {scene.TIMESTEP * 1e3:g} ms step" if engine == "mujoco" else "") + "\n")
+    print(f"engine: {engine}" + (f", {cell_model.TIMESTEP * 1e3:g} ms step" if engine == "mujoco" else "") + "\n")
     print("| wall load | pad speed mm/s | creep um per mm (limit) | pad friction / mu N | pad drop-out steps | steps/s |")
     print("|---:|---:|---:|---:|---:|---:|")
     for load in (0.5, 0.9):

@@ -938,7 +938,7 @@ class _NoWorld:
         return None
 
     def robot_description(self):
-        from stablepush.sim.robot import robot_description
+        from stablepush.kinematics.robot import robot_description
 
         return robot_description(self.robot)
 
@@ -1222,7 +1222,7 @@ def run_robots(count: int, seed: int, scratch: Path) -> None:
 
     import stablepush as sp
     from stablepush.errors import StablepushError
-    from stablepush.sim.robot import arm_model
+    from stablepush.kinematics.robot import arm_model
     from stablepush_cli.main import cli
 
     from generated_arms import TCP, mjcf_arm, urdf_arm

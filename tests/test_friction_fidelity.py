@@ -129,7 +129,7 @@ NOTCHED_BOX = ((-25, -25), (25, -25), (25, 15), (15, 15), (15, 25), (-25, 25))
 def test_a_wall_holds_a_mesh_part_under_sliding_pads_on_mujoco(outline, pad_speed, tmp_path):
     """One MuJoCo pair of convex solids gives all its contact points one depth: a wall of one box
     bears the friction's moment only by turning the part (19.6 um/mm on the box at 1 mm/s); the
-    wall's tiles (scene.FEATURE_TILES) bear it by their own depths."""
+    wall's tiles (cell_model.FEATURE_TILES) bear it by their own depths."""
     result = fidelity.wall_creep(0.9, pad_speed, engine="mujoco", mesh_dir=tmp_path, outline=outline)
     assert result.wall_cone_use == pytest.approx(0.9, abs=0.06)
     assert result.creep_um_per_mm <= fidelity.CREEP_LIMIT_UM_PER_MM[0.9], result

@@ -47,7 +47,7 @@ def test_a_joint_range_with_its_lower_end_above_its_upper_is_refused_by_name(tmp
     low < 0", from the IK's draws of a starting posture."""
     import stablepush as sp
     from stablepush.errors import TaskError
-    from stablepush.sim.robot import arm_model
+    from stablepush.kinematics.robot import arm_model
 
     arm = _mjcf(tmp_path, [('range="-2.9 2.9"', 'range="1e308 2.9"')])
     with pytest.raises(TaskError) as refused:
@@ -61,7 +61,7 @@ def test_a_joint_whose_range_lies_past_a_half_turn_is_drawn_within_it(tmp_path):
     import numpy as np
 
     import stablepush as sp
-    from stablepush.sim.robot import arm_model
+    from stablepush.kinematics.robot import arm_model
 
     arm = _mjcf(tmp_path, [('range="-2.6 2.6"', 'range="4 5"'), ('range="-2.9 2.9"', 'range="-5 -4"')])
     model = arm_model(sp.Robot(model=arm["model"], flange=arm["flange"], tcp=arm["tcp"]))

@@ -22,13 +22,13 @@ mujoco = pytest.importorskip("mujoco")
 def _forward(task, plan, path):
     """G's world pose [4x4] at each sample, through MuJoCo's own kinematics of a fresh model."""
     from stablepush.execution.world import place_features, scene_description
-    from stablepush.sim import scene as scene_mod
+    from stablepush.kinematics import cell_model
 
     scene = scene_description(task, place_features(task, list(plan.waypoints)), plan.waypoints[0].pose)
-    model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene))
+    model = mujoco.MjModel.from_xml_string(cell_model.build_mjcf(scene))
     data = mujoco.MjData(model)
     adr = [model.jnt_qposadr[model.joint(j).id] for j in path.joints]
-    site = model.site(scene_mod.GRIPPER_SITE).id
+    site = model.site(cell_model.GRIPPER_SITE).id
     for q in path.q:
         data.qpos[adr] = q
         mujoco.mj_kinematics(model, data)
@@ -40,7 +40,7 @@ def _forward(task, plan, path):
 @pytest.mark.parametrize("name", ["horizontal-offset-low-mu", "horizontal-offset-high-mu", "t-shaped",
                                   "large-manipulation"])
 def test_the_joint_trajectory_reproduces_the_cartesian_one_and_moves_continuously(name):
-    from stablepush.sim.joint_path import joint_path
+    from stablepush.kinematics.cell_path import joint_path
     from stablepush.task.model import Robot
 
     task = shipped(name)
@@ -61,7 +61,7 @@ def test_a_feature_out_of_the_arms_reach_is_refused_before_any_motion():
     """A feature 1.5 m away, past the shipped arm's 870 mm from its shoulder: the straight move
     out to it leaves the reach, and the check says by how much before any joint's speed or limit
     is named (the elbow straightening toward its singularity would have turned j1 too fast first)."""
-    from stablepush.sim.joint_path import CellError, joint_path
+    from stablepush.kinematics.cell_path import CellError, joint_path
 
     task = shipped("horizontal-offset-high-mu")
     far = dataclasses.replace(task, environment={**task.environment.as_dict(), "features": {"left": [1500, 0, 300, 0]}})
@@ -160,7 +160,7 @@ def test_the_bags_joint_trajectory_carries_velocities_and_accelerations_of_its_t
 
     from rosbags.highlevel import AnyReader
 
-    from stablepush.sim.joint_path import joint_path
+    from stablepush.kinematics.cell_path import joint_path
 
     task_file = TASKS / "horizontal-offset-low-mu.yaml"
     plan_file, bag, table = tmp_path / "p.json", tmp_path / "p.mcap", tmp_path / "p.csv"
@@ -200,7 +200,7 @@ def test_an_arm_whose_base_stands_too_far_is_out_of_reach_by_how_much_not_at_a_j
     posture gets G there, and the refusal says so with the numbers, before IK names a joint that
     stopped at its limit. The reach is the chain's length from its shoulder (joint_2, which joint_1
     turns in place): the links on to the flange and the TCP's 110 mm, measured on the model."""
-    from stablepush.sim.joint_path import CellError, joint_path
+    from stablepush.kinematics.cell_path import CellError, joint_path
     from stablepush.task import with_robot
 
     from generated_arms import link_lengths, urdf_arm

@@ -20,9 +20,9 @@ from stablepush.execution.run import run_plan
 from stablepush.execution.scene import Scene
 from stablepush.execution.world import place_features, scene_description
 from stablepush.extras import MissingExtra
+from stablepush.kinematics.cell_model import FEATURE_TILES, build_mjcf
 from stablepush.plan import Waypoint, check_plan, plan_task
 from stablepush.sim import fidelity
-from stablepush.sim.scene import FEATURE_TILES, build_mjcf
 from stablepush.task import load_task
 
 from conftest import ROOT, shipped

@@ -14,8 +14,8 @@ import pytest
 
 from stablepush.execution.stream import arm_trajectory
 from stablepush.execution.world import place_features, scene_description
+from stablepush.kinematics import cell_model
 from stablepush.plan import plan_task
-from stablepush.sim import scene as scene_mod
 from stablepush.sim.arm import SimArm
 from stablepush.sim.friction import CoulombPadFriction
 
@@ -33,7 +33,7 @@ def _object_path(friction_class):
     features = place_features(task, steps)
     scene = scene_description(task, features, steps[0].pose)
     arm = SimArm(scene)
-    arm.pad_friction = friction_class(arm.model, scene_mod.pad_geoms(arm.model))
+    arm.pad_friction = friction_class(arm.model, cell_model.pad_geoms(arm.model))
     q = arm._object_qpos
     path = []
     for point in arm_trajectory(task, steps, features, 100.0, scene.gripper_pose)[:WAYPOINTS]:
@@ -90,7 +90,7 @@ def test_a_time_step_copied_from_the_scratch_is_the_step_mj_step_takes():
     _, copied = _object_path(CoulombPadFriction)
     _, stepped = _object_path(_SteppedAgain)
     # the pivot's ring points slide: most of the time steps came from the scratch
-    time_steps = round(WAYPOINTS * 0.01 / scene_mod.TIMESTEP)
+    time_steps = round(WAYPOINTS * 0.01 / cell_model.TIMESTEP)
     assert copied.pad_friction.copied_steps > 0.5 * time_steps
     assert stepped.pad_friction.copied_steps == 0
     assert copied.pad_friction.trial_steps == stepped.pad_friction.trial_steps

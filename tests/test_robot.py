@@ -130,7 +130,7 @@ def test_a_generated_arm_passes_the_friction_contracts_pivot_on_the_arm(arms, na
 
 @pytest.mark.parametrize("name", list(ARMS))
 def test_the_joint_trajectory_through_the_labs_own_model_reproduces_the_cartesian_one(arms, name):
-    from stablepush.sim.joint_path import joint_path
+    from stablepush.kinematics.cell_path import joint_path
 
     task = _on(arms[name])
     plan = plan_task(task, seed=1)
@@ -332,8 +332,8 @@ def test_a_run_on_an_mjcf_arm_records_its_joints_and_no_urdf(arms, tmp_path):
     in /tf_static), and no /robot_description."""
     pytest.importorskip("rosbags")
     from stablepush.execution.run import BagRecording, RunOptions, run_plan
+    from stablepush.kinematics.robot import arm_model
     from stablepush.sim.local_arm import SimulatedArm
-    from stablepush.sim.robot import arm_model
 
     task = _on(arms["7-joint MJCF"])
     plan = plan_task(task, seed=1)
@@ -375,8 +375,8 @@ def test_the_shipped_arm_is_the_default_and_moves_with_its_base():
     """No robot: arm.xml as it is. The shipped arm on a raised, turned base is built by the same
     path as a lab's and still lands (its IK finds the posture from the base's frame)."""
     from stablepush.execution.run import RunOptions, run_plan
+    from stablepush.kinematics.robot import ARM_XML, arm_model
     from stablepush.sim.local_arm import SimulatedArm
-    from stablepush.sim.robot import ARM_XML, arm_model
 
     assert ET.tostring(arm_model(None).tree) == ET.tostring(ET.parse(ARM_XML).getroot())
     task = with_robot(shipped(TASK), base=[-30.0, 20.0, 10.0, 8.0])
@@ -428,8 +428,8 @@ def test_a_bad_robot_section_is_refused_naming_the_field(tmp_path, section, fiel
      "MuJoCo cannot compile"),
 ])
 def test_a_model_that_cannot_carry_the_jaws_is_refused_naming_why(tmp_path, model, flange, match):
+    from stablepush.kinematics.robot import RobotError
     from stablepush.sim.local_arm import SimulatedArm
-    from stablepush.sim.robot import RobotError
 
     path = tmp_path / "arm.xml"
     path.write_text(model)
@@ -443,7 +443,7 @@ def test_the_sim_arm_server_serves_a_labs_arm_and_a_run_over_tcp_lands(arms):
     same model first (ModelledArm), lands."""
     from stablepush.execution import TcpArm
     from stablepush.execution.run import RunOptions, run_plan
-    from stablepush.sim.joint_path import ModelledArm, modelled
+    from stablepush.kinematics.cell_path import ModelledArm, modelled
     from stablepush.sim.server import running_sim_arm
 
     task = _on(arms["7-joint MJCF"])

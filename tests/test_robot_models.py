@@ -13,7 +13,7 @@ from stablepush.task.model import Robot as RobotValue
 from generated_arms import mjcf_arm, urdf_arm
 
 mujoco = pytest.importorskip("mujoco")
-from stablepush.sim.robot import RobotError, arm_model, robot_description  # noqa: E402
+from stablepush.kinematics.robot import RobotError, arm_model, robot_description  # noqa: E402
 
 AXES6 = ("z", "y", "y", "z", "y", "z")
 AXES7 = ("z", "x", "z", "-x", "z", "x", "z")
@@ -129,8 +129,8 @@ def test_q_a_flange_whose_name_holds_a_quote_is_found(tmp_path):
 def _scene_model(robot):
     """The MuJoCo model of a shipped task's scene on `robot` (compiled: a repeated name fails here)."""
     from stablepush.execution.world import place_features, scene_description
+    from stablepush.kinematics.cell_model import build_mjcf
     from stablepush.plan import plan_task
-    from stablepush.sim.scene import build_mjcf
 
     from conftest import shipped
 
@@ -143,7 +143,7 @@ def _scene_model(robot):
 
 def test_c_the_shipped_arm_given_as_a_labs_model_keeps_its_names_apart_from_the_jaws(tmp_path):
     """arm.xml as --robot: exit 4 "repeated name" (its own finger_pos, finger_neg, G, floor)."""
-    from stablepush.sim.robot import ARM_XML
+    from stablepush.kinematics.robot import ARM_XML
 
     robot = Robot(model=str(ARM_XML), flange="hand", tcp=(0.0, 0.0, 110.0, 0.0, 180.0, 0.0))
     model = _scene_model(robot)
@@ -174,9 +174,9 @@ def test_c_an_arm_joint_named_as_the_jaws_is_refused_by_name(tmp_path):
 
 
 def test_c_every_name_a_scene_adds_is_one_a_labs_model_is_kept_apart_from():
-    """PROJECT_NAMES and PROJECT_PREFIXES cover every name scene.py and the jaws add (so a lab's
+    """PROJECT_NAMES and PROJECT_PREFIXES cover every name cell_model.py and the jaws add (so a lab's
     model is renamed wherever it could clash)."""
-    from stablepush.sim.robot import ARM_XML, is_project_name
+    from stablepush.kinematics.robot import ARM_XML, is_project_name
 
     model = _scene_model(None)
     arm = mujoco.MjModel.from_xml_path(str(ARM_XML))

@@ -12,10 +12,10 @@ import pytest
 from stablepush.execution.stream import arm_trajectory
 from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
+from stablepush.kinematics.cell_model import convex_pieces
 from stablepush.plan import Waypoint
 from stablepush.sim.arm import SimArm
 from stablepush.sim.engines import ENGINES, make_arm
-from stablepush.sim.scene import convex_pieces
 
 from conftest import shipped, task_with
 
@@ -197,8 +197,8 @@ def test_a_feature_stops_short_of_a_reflex_corner_of_the_object_wherever_it_is_p
     """The T's web feature runs down the web to its corner with the flange: its solid, at home and
     placed off by up to 0.5 mm / 0.5 deg, ends FEATURE_CORNER_GAP short of that corner and nowhere
     else, so the flange passes under it on the approach. The other features keep their segments."""
+    from stablepush.kinematics.cell_model import FEATURE_CORNER_GAP, FEATURE_DEPTH, feature_solid
     from stablepush.sim.deviation import WorldDeviation
-    from stablepush.sim.scene import FEATURE_CORNER_GAP, FEATURE_DEPTH, feature_solid
 
     task = shipped("t-shaped")
     scene = scene_description(task, place_features(task, [Waypoint(*task.start)], every_pusher=True), task.start)

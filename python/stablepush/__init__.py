@@ -49,7 +49,7 @@ _LAZY = {
     "plan_figure": ("stablepush.viz.figures", "plan_figure"),
     "trajectory": ("stablepush.execution.trajectory", "plan_trajectory"),
     "Trajectory": ("stablepush.execution.trajectory", "Trajectory"),
-    "joint_path": ("stablepush.sim.joint_path", "joint_path"),
+    "joint_path": ("stablepush.kinematics", "joint_path"),
 }
 
 

@@ -44,8 +44,7 @@ def check_cell(files: PlanFiles, rate_hz: float, json_path, robot: RobotChoice) 
     from stablepush.outputs import write_atomically
 
     require("mujoco", "check-cell (the arm's kinematics)")
-    from stablepush.sim import CellError
-    from stablepush.sim.joint_path import joint_path
+    from stablepush.kinematics import CellError, joint_path
 
     check_named_outputs({"--json": json_path}, files.inputs())
     task, plan = files.load()

@@ -80,7 +80,7 @@ def trajectory(files: PlanFiles, out_path: str, rate_hz: float, quat: str, joint
     traj = timed_trajectory(task, plan, rate_hz)
     path = None
     if joints:
-        from stablepush.sim.joint_path import joint_path
+        from stablepush.kinematics import joint_path
 
         path = joint_path(task, plan, rate_hz, traj)
         if not out_path.lower().endswith(".mcap"):

@@ -22,12 +22,11 @@ from stablepush.execution.scene import Scene
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.extras import require
 from stablepush.frames import matrix_to_pose
+from stablepush.kinematics import cell_model, ik
+from stablepush.kinematics.arm_kinematics import ArmKinematics
+from stablepush.kinematics.cell_path import checked_path
+from stablepush.kinematics.robot import arm_model, robot_description
 from stablepush.plan.plan import Plan
-from stablepush.sim import ik
-from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import ArmKinematics
-from stablepush.sim.joint_path import checked_path
-from stablepush.sim.robot import arm_model, robot_description
 from stablepush.task.model import Robot, Task
 
 
@@ -95,7 +94,7 @@ class JointTrajectoryArm(Arm):
         state where it stands (the executor's stream starts from there); the posture IK's null
         space pulls toward is the one at the scene's start pose nearest the measured joints."""
         mujoco = require("mujoco", "the arm's kinematics (a joint-level arm)")  # as a kinematics library
-        model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, robot=self.robot))
+        model = mujoco.MjModel.from_xml_string(cell_model.build_mjcf(scene, robot=self.robot))
         self._kinematics = ArmKinematics(model, self.arm.joints)
         self._period = 1.0 / float(rate_hz)
         q = self._read()

@@ -412,8 +412,8 @@ def measure_layout(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], sour
 
 
 def _arm_follows(task: Task, plan) -> Dict[str, Any]:
-    """The cell check of the task's arm on the plan (sim.joint_path), as its JSON verdict."""
-    from stablepush.sim.joint_path import CellError, joint_path
+    """The cell check of the task's arm on the plan (kinematics.cell_path), as its JSON verdict."""
+    from stablepush.kinematics.cell_path import CellError, joint_path
 
     try:
         return joint_path(task, plan).verdict()

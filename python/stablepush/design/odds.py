@@ -38,7 +38,7 @@ def evaluate_designs(study: DesignStudy, trials: int, spreads: Spreads, top: int
     the top designs ran (layout -> trials). SettingError naming an argument out of its range,
     before any trial."""
     _check_arguments(study, trials, spreads, top, seed, closed_loop, engine)
-    from stablepush.sim.joint_path import CellError  # loads MuJoCo: not before the odds are asked for
+    from stablepush.kinematics.cell_path import CellError  # loads MuJoCo: not before the odds are asked for
 
     runner = runner or Runner()
     ran: Dict[str, int] = {" + ".join(d.pushers): 0 for d in study.designs[:top]}

@@ -1,5 +1,6 @@
-"""The simulated arm on two physics engines (engines.py): MuJoCo (scene.py, arm.py, friction.py)
-and Drake (drake_arm.py); what both share (tracking.py: IK on ik.py, the servo ramp, the state;
+"""The simulated arm on two physics engines (engines.py): MuJoCo (arm.py, friction.py) and Drake
+(drake_arm.py), both building the cell that stablepush.kinematics describes; what both share
+(tracking.py: IK on kinematics.ik, the servo ramp, the state;
 deviation.py: a world that departs from the task), the arm behind the arm port in this process
 (local_arm.py) and served over TCP (server.py, `stablepush sim-arm`), the friction-fidelity
 contract both must pass (fidelity.py), and videos of recorded runs (video.py)."""
@@ -16,8 +17,9 @@ _EXPORTS = {
     "WorldDeviation": "stablepush.sim.deviation",
     "SimulatedArm": "stablepush.sim.local_arm",
     "SimArmServer": "stablepush.sim.server",
-    "CellError": "stablepush.sim.joint_path",
-    "modelled": "stablepush.sim.joint_path",
+    # the cell check's, for the command lines that build an arm (a simulated or a served one)
+    "CellError": "stablepush.kinematics.cell_path",
+    "modelled": "stablepush.kinematics.cell_path",
     "RunVideo": "stablepush.sim.video",
     "check_fps": "stablepush.sim.video",
     "check_size": "stablepush.sim.video",

@@ -1,4 +1,4 @@
-"""The simulated arm: a MuJoCo scene (scene.py) whose joint servos track end-effector poses by
+"""The simulated arm: a MuJoCo model of the cell (kinematics.cell_model) whose joint servos track end-effector poses by
 damped least-squares IK (tracking.py). It knows nothing of runs: `local_arm.SimulatedArm` puts it
 behind the arm port, and `server.py` serves that over TCP.
 
@@ -13,29 +13,30 @@ from typing import Callable, Dict, Optional, Sequence
 import numpy as np
 
 from stablepush.execution.scene import Scene
-from stablepush.sim import scene as scene_mod
+from stablepush.kinematics import cell_model
+from stablepush.kinematics.arm_kinematics import ArmKinematics
+from stablepush.kinematics.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.friction import CoulombPadFriction, mujoco
-from stablepush.sim.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.sim.tracking import SETTLE_TIME, TrackingArm, in_grasp
 from stablepush.task.model import Robot
 
 
 class SimulatedGrasp:
     """A scene's grasp in MuJoCo, shared by the arm and the friction-fidelity rig (`fidelity.py`):
-    the model (`scene.build_mjcf`, with the arm of `robot`), the jaws closed on the object with the
+    the model (`cell_model.build_mjcf`, with the arm of `robot`), the jaws closed on the object with the
     grip force, the pad friction (friction.py) stepped with the physics, and the read-outs of the
     grasp."""
 
     def __init__(self, scene: Scene, kinematic_hand: bool = False, robot: Optional[Robot] = None):
         self.arm = arm_model(robot)
-        self.model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, kinematic_hand, robot))
+        self.model = mujoco.MjModel.from_xml_string(cell_model.build_mjcf(scene, kinematic_hand, robot))
         self.data = mujoco.MjData(self.model)
         m = self.model
         self._site = m.site(GRIPPER_SITE).id
-        self._object = m.body(scene_mod.OBJECT_BODY).id
-        self._object_qpos = m.jnt_qposadr[m.joint(scene_mod.OBJECT_BODY).id]
-        self.pad_friction = CoulombPadFriction(m, scene_mod.pad_geoms(m))
+        self._object = m.body(cell_model.OBJECT_BODY).id
+        self._object_qpos = m.jnt_qposadr[m.joint(cell_model.OBJECT_BODY).id]
+        self.pad_friction = CoulombPadFriction(m, cell_model.pad_geoms(m))
         self.steps = 0
         self.step_wall_time = 0.0
         fingers = [m.jnt_qposadr[m.joint(j).id] for j in FINGER_JOINTS]
@@ -43,10 +44,10 @@ class SimulatedGrasp:
         self.data.qpos[self._object_qpos:self._object_qpos + 7] = scene.object_pose
         # close: the servos saturate at the grip force
         self.data.ctrl[[m.actuator(j).id for j in FINGER_JOINTS]] = 0.0
-        self._pad_geoms = set(scene_mod.pad_geoms(m))
+        self._pad_geoms = set(cell_model.pad_geoms(m))
         if kinematic_hand:
-            self._hand_qpos = [m.jnt_qposadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
-            self._hand_dof = [m.jnt_dofadr[m.joint(j).id] for j in scene_mod.HAND_JOINTS]
+            self._hand_qpos = [m.jnt_qposadr[m.joint(j).id] for j in cell_model.HAND_JOINTS]
+            self._hand_dof = [m.jnt_dofadr[m.joint(j).id] for j in cell_model.HAND_JOINTS]
             mujoco.mj_forward(m, self.data)
         # the arm sets its own drives, then calls mj_forward once
 
@@ -104,7 +105,7 @@ class SimulatedGrasp:
 
     def contact_force_on_object(self, pusher: str) -> np.ndarray:
         """Total force [N, world frame] that pusher `pusher`'s feature exerts on the object now."""
-        geoms = set(scene_mod.feature_geoms(self.model, pusher))
+        geoms = set(cell_model.feature_geoms(self.model, pusher))
         total = np.zeros(3)
         f6 = np.zeros(6)
         for i in range(self.data.ncon):
@@ -119,35 +120,6 @@ class SimulatedGrasp:
     @property
     def steps_per_second(self) -> float:
         return self.steps / self.step_wall_time if self.step_wall_time > 0 else 0.0
-
-
-class ArmKinematics:
-    """The arm's forward kinematics on a MuJoCo model of its scene, for IK (ik.Kinematics): q [rad]
-    of the arm's `joints` (base to flange) -> G's rotation and position in the world [m] and its
-    Jacobian (linear rows over angular), computed on scratch data so the simulation's state is not
-    touched. `lower` and `upper` are the joints' limits [rad] (infinite for an unlimited joint)."""
-
-    def __init__(self, model, joints: Sequence[str]):
-        m = self.model = model
-        ids = [m.joint(j).id for j in joints]
-        self.qpos_adr = np.array([m.jnt_qposadr[j] for j in ids])
-        self.dof_adr = np.array([m.jnt_dofadr[j] for j in ids])
-        limited = m.jnt_limited[ids].astype(bool)
-        self.lower = np.where(limited, m.jnt_range[ids, 0], -np.inf)
-        self.upper = np.where(limited, m.jnt_range[ids, 1], np.inf)
-        self.site = m.site(GRIPPER_SITE).id
-        self.data = mujoco.MjData(m)
-        self._jacp = np.zeros((3, m.nv))
-        self._jacr = np.zeros((3, m.nv))
-
-    def __call__(self, q: np.ndarray):
-        d = self.data
-        d.qpos[self.qpos_adr] = q
-        mujoco.mj_kinematics(self.model, d)
-        mujoco.mj_comPos(self.model, d)
-        mujoco.mj_jacSite(self.model, d, self._jacp, self._jacr, self.site)
-        J = np.vstack([self._jacp, self._jacr])[:, self.dof_adr]
-        return d.site_xmat[self.site].reshape(3, 3), d.site_xpos[self.site].copy(), J
 
 
 class SimArm(TrackingArm, SimulatedGrasp):

@@ -141,7 +141,7 @@ def _with_world(scene: Scene, values: Dict[str, float]) -> Scene:
 def _scaled_mass(obj: SceneObject, scale: float) -> SceneObject:
     """The object `scale` times as heavy: its mass and inertia, and a mesh solid's tensor."""
     mesh = obj.mesh
-    if mesh is not None:  # a mesh part's solid's tensor (scene.object_inertia)
+    if mesh is not None:  # a mesh part's solid's tensor (cell_model.object_inertia)
         scaled = (np.asarray(mesh.inertia, float) * scale).tolist()
         mesh = dataclasses.replace(mesh, inertia=tuple((a, b, c) for a, b, c in scaled))
     return dataclasses.replace(obj, mass=obj.mass * scale, inertia=obj.inertia * scale, mesh=mesh)

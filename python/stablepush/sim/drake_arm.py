@@ -2,7 +2,7 @@
 one (`arm.py`), with Drake's own contact solver deciding stick and slip. Nothing here writes a
 friction force.
 
-The arm is the shipped arm.xml read by Drake's MJCF parser (`scene.arm_tree`); what that parser
+The arm is the shipped arm.xml read by Drake's MJCF parser (`cell_model.arm_tree`); what that parser
 leaves out is added with Drake's own API from the same tree: the position servos' damping `kv`
 (as PD gains), the jaw coupling (a coupler constraint), gravity compensation (`gravcomp`: a
 feed-forward torque) and the site G (a fixed frame). The pads' point spheres, the object's convex
@@ -38,9 +38,9 @@ import numpy as np
 from stablepush.execution.scene import Scene, SceneObject
 from stablepush.extras import require
 from stablepush.frames import pose_to_matrix
-from stablepush.sim import scene as scene_mod
+from stablepush.kinematics import cell_model
+from stablepush.kinematics.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.sim.deviation import WorldDeviation
-from stablepush.sim.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.sim.tracking import SETTLE_TIME, TrackingArm, in_grasp
 from stablepush.task.model import Robot
 
@@ -87,11 +87,12 @@ class DrakeGrasp:
         self.timestep = time_step = DRAKE_TIMESTEP
         approximation = DRAKE_APPROXIMATION
         self.arm = arm_model(robot)
-        tree = scene_mod.arm_tree(scene, kinematic_hand, robot)
+        tree = cell_model.arm_tree(scene, kinematic_hand, robot)
         if kinematic_hand:
             # Drake keeps a joint's armature only on an actuated joint: a heavy hand stands in for
             # the hand joints' (the pads' forces must not move it within a step).
-            scene_mod.found(tree, f".//body[@name='{KINEMATIC_HAND_BODY}']/geom").set("mass", repr(KINEMATIC_HAND_MASS))
+            hand_geom = cell_model.found(tree, f".//body[@name='{KINEMATIC_HAND_BODY}']/geom")
+            hand_geom.set("mass", repr(KINEMATIC_HAND_MASS))
         builder = d.DiagramBuilder()
         plant, scene_graph = d.AddMultibodyPlantSceneGraph(builder, time_step=time_step)
         plant.set_discrete_contact_approximation(getattr(d.DiscreteContactApproximation, "k" + approximation.title()))
@@ -107,7 +108,7 @@ class DrakeGrasp:
         self.plant = plant
 
         # What the MJCF parser leaves out, from the same tree.
-        for position in scene_mod.found(tree, "actuator"):
+        for position in cell_model.found(tree, "actuator"):
             actuator = plant.GetJointActuatorByName(position.get("name"), self._arm)
             actuator.set_controller_gains(d.PdControllerGains(p=float(position.attrib["kp"]),
                                                               d=float(position.get("kv", "0"))))
@@ -115,7 +116,7 @@ class DrakeGrasp:
         plant.AddCouplerConstraint(joint0=neg_joint, joint1=pos_joint, gear_ratio=1.0)
         self._gravcomp_bodies = [plant.GetBodyByName(b.get("name"), self._arm).index()
                                  for b in tree.iter("body") if b.get("gravcomp") == "1"]
-        site = scene_mod.found(tree, f".//site[@name='{GRIPPER_SITE}']")
+        site = cell_model.found(tree, f".//site[@name='{GRIPPER_SITE}']")
         parent = next(b for b in tree.iter("body") if site in list(b))
         X_BG = d.RigidTransform(d.Quaternion(_vector(site.get("quat", "1 0 0 0"))), _vector(site.get("pos", "0 0 0")))
         hand = plant.GetBodyByName(parent.get("name"), self._arm)
@@ -125,7 +126,7 @@ class DrakeGrasp:
                         for g in plant.GetCollisionGeometriesForBody(plant.get_body(b))]
         arm_geometry += plant.GetCollisionGeometriesForBody(plant.world_body())  # the floor
         self._pads = self._add_pads(scene)
-        solid = scene_mod.object_solid(scene.object)
+        solid = cell_model.object_solid(scene.object)
         self._object_body, self._pieces = self._add_object(scene.object, solid)
         pad_faces = self._add_pad_faces(scene.object)
         self._features = self._add_features(scene)
@@ -133,7 +134,7 @@ class DrakeGrasp:
 
         # Only pads and features touch the object; a pad touches a box piece, or the deep prism of a
         # section piece on its own side (_add_pad_faces).
-        sides = [side for _, _, side, _ in scene_mod.pad_layout(scene)]
+        sides = [side for _, _, side, _ in cell_model.pad_layout(scene)]
         pads_on = {s: d.GeometrySet([g for g, side in zip(self._pads, sides) if side == s]) for s in (1.0, -1.0)}
         deep = [g for faces in pad_faces.values() for g in faces]
         boxes = [g for g, piece in zip(self._pieces, solid) if piece.box]
@@ -164,7 +165,7 @@ class DrakeGrasp:
             joint.set_translation(self.plant_context, scene.object.thickness / 2)
         self._finger_servos = [self._servo_index(j) for j in FINGER_JOINTS]
         if kinematic_hand:
-            self._hand = [plant.GetJointByName(j, self._arm) for j in scene_mod.HAND_JOINTS]
+            self._hand = [plant.GetJointByName(j, self._arm) for j in cell_model.HAND_JOINTS]
             self.simulator.Initialize()
 
     def step_hand(self, motion: Sequence[float], velocity: Sequence[float]) -> None:
@@ -198,23 +199,23 @@ class DrakeGrasp:
         d, plant = self._d, self.plant
         props = self._properties(partner_mu(scene.gripper.mu))
         pads = []
-        for name, finger, side, (px, pz) in scene_mod.pad_layout(scene):
+        for name, finger, side, (px, pz) in cell_model.pad_layout(scene):
             body = plant.GetBodyByName(finger, self._arm)
-            X = d.RigidTransform([px, side * scene_mod.PAD_POINT_RADIUS, pz])
-            pads.append(plant.RegisterCollisionGeometry(body, X, d.Sphere(scene_mod.PAD_POINT_RADIUS), name, props))
+            X = d.RigidTransform([px, side * cell_model.PAD_POINT_RADIUS, pz])
+            pads.append(plant.RegisterCollisionGeometry(body, X, d.Sphere(cell_model.PAD_POINT_RADIUS), name, props))
         return pads
 
     def _add_object(self, obj: SceneObject, solid: list):
         """The object's body (its solid's mass properties, scene.object_inertia) and the convex
-        `solid` pieces (scene.object_solid) as its geometry: a box piece as a Box, any other as
+        `solid` pieces (cell_model.object_solid) as its geometry: a box piece as a Box, any other as
         a Convex of its corners."""
         d, plant = self._d, self.plant
-        instance = plant.AddModelInstance(scene_mod.OBJECT_BODY)
-        J = scene_mod.object_inertia(obj)
+        instance = plant.AddModelInstance(cell_model.OBJECT_BODY)
+        J = cell_model.object_inertia(obj)
         inertia = d.SpatialInertia.MakeFromCentralInertia(
-            obj.mass, list(scene_mod.object_com(obj)),
+            obj.mass, list(cell_model.object_com(obj)),
             d.RotationalInertia(J[0, 0], J[1, 1], J[2, 2], J[0, 1], J[0, 2], J[1, 2]))
-        body = plant.AddRigidBody(scene_mod.OBJECT_BODY, instance, inertia)
+        body = plant.AddRigidBody(cell_model.OBJECT_BODY, instance, inertia)
         props = self._properties(OBJECT_MU, "compliant")
         geometries = []
         for piece in solid:
@@ -230,7 +231,7 @@ class DrakeGrasp:
 
     def _add_pad_faces(self, obj: SceneObject) -> Dict[float, list]:
         """What the pads on each side (+1, -1: the object's +y and -y faces) touch: every piece of the
-        section (scene.object_pieces) that is not built as a box, as a prism from that face
+        section (cell_model.object_pieces) that is not built as a box, as a prism from that face
         PAD_FACE_DEPTH deep into the object, without mass. Drake's sphere-vs-convex query answers a
         pad point within about 5.5 times its penetration of a prism's side face through that side,
         along the direction from the prism's centre (the wedge's pad point 0.3 mm inside its heel
@@ -243,7 +244,7 @@ class DrakeGrasp:
         props = self._properties(OBJECT_MU)  # point contact, as the pads': no hydroelastic mesh
         half = obj.thickness / 2
         faces: Dict[float, list] = {1.0: [], -1.0: []}
-        for name, piece, rectangle in scene_mod.object_pieces(obj):
+        for name, piece, rectangle in cell_model.object_pieces(obj):
             if rectangle and obj.mesh is None:
                 continue  # the pads touch the box piece itself: the sphere-vs-box query is exact
             for side in faces:
@@ -258,14 +259,14 @@ class DrakeGrasp:
         d, plant = self._d, self.plant
         out = {}
         for feature in scene.features:
-            solid = scene_mod.feature_solid(feature, scene.object)
+            solid = cell_model.feature_solid(feature, scene.object)
             if solid["kind"] == "box":
                 R = d.RotationMatrix.MakeYRotation(solid["angle"])
                 shape = d.Box(*(2 * np.asarray(solid["half_size"])))
             else:  # a rod along y
                 R = d.RotationMatrix.MakeXRotation(math.pi / 2)
                 shape = d.Capsule(solid["radius"], 2 * solid["half_length"])
-            name = scene_mod.feature_geom(feature.pusher)
+            name = cell_model.feature_geom(feature.pusher)
             out[feature.pusher] = plant.RegisterCollisionGeometry(
                 plant.world_body(), d.RigidTransform(R, solid["center"]), shape, name,
                 self._properties(partner_mu(feature.mu), "rigid"))

@@ -2,7 +2,7 @@
 that runs plans must reproduce before its results mean anything.
 
 Every experiment uses the arm's own grasp (fingers, force-capped jaw servos, pad points, contact
-pairs, solver options and the pad friction of `scene.py` and `friction.py`) on a hand that
+pairs, solver options and the pad friction of `kinematics/cell_model.py` and `friction.py`) on a hand that
 moves as prescribed in G's plane (`build_mjcf(..., kinematic_hand=True)`), so what is measured is
 friction, not the arm's tracking:
 
@@ -40,11 +40,11 @@ import yaml
 
 from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import angle_about_y
+from stablepush.kinematics.cell_model import triangulated
 from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
 from stablepush.plan.verify import check_plan
 from stablepush.sim.engines import DEFAULT_ENGINE, make_grasp
-from stablepush.sim.scene import triangulated
 from stablepush.task.mesh import load_mesh_object
 from stablepush.task.model import Task
 from stablepush.task.parts import PartSpec

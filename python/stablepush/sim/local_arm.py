@@ -10,11 +10,11 @@ from stablepush.execution.arm import Arm, ArmError, ArmReady, RobotDescription
 from stablepush.execution.scene import Scene
 from stablepush.execution.stream import ArmWaypoint
 from stablepush.extras import MissingExtra, require
+from stablepush.kinematics.cell_model import simulated_geometry, simulated_outline
+from stablepush.kinematics.robot import arm_model, robot_description
 from stablepush.plan.plan import Plan
 from stablepush.sim.deviation import WorldDeviation
 from stablepush.sim.engines import DEFAULT_ENGINE, load_engine, make_arm
-from stablepush.sim.robot import arm_model, robot_description
-from stablepush.sim.scene import simulated_geometry, simulated_outline
 from stablepush.task.model import Robot, Task
 
 
@@ -54,7 +54,7 @@ class SimulatedArm(Arm):
         except MissingExtra:
             self.log("the cell is not checked: the check runs on MuJoCo, which is not installed ([sim])")
             return
-        from stablepush.sim.joint_path import checked_path
+        from stablepush.kinematics.cell_path import checked_path
 
         path = checked_path(task, plan, rate_hz, self.robot)
         self.log(f"cell checked: {path.describe()}")

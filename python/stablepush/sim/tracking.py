@@ -14,11 +14,11 @@ import numpy as np
 
 from stablepush.execution.scene import Scene
 from stablepush.frames import angle_about_y, matrix_to_pose
-from stablepush.sim import ik
+from stablepush.kinematics import ik
 from stablepush.sim.deviation import WorldDeviation
 
 if TYPE_CHECKING:
-    from stablepush.sim.robot import ArmModel
+    from stablepush.kinematics.robot import ArmModel
 
 SETTLE_TIME = 0.3  # s of simulation after the grasp closes, before the first waypoint
 

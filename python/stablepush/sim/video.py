@@ -28,7 +28,7 @@ Frames are taken from the samples every 1/fps s of the stream's time (100 Hz at 
 rate) and played at fps, so the video runs at the robot's speed.
 
 That is the `schematic` view (the default). The `3d` view draws the run's whole MuJoCo model instead
-(scene.build_mjcf: the arm of the task's robot with its jaws, the object and the features, the
+(cell_model.build_mjcf: the arm of the task's robot with its jaws, the object and the features, the
 floor), posed from the recorded states (the arm's reported joints, the object's pose, the jaws at
 the object's faces; nothing simulated), seen by a fixed camera from the front and above that frames
 the arm and the features over the whole run; `both` puts the 3-D view left of the schematic, each
@@ -62,10 +62,7 @@ from stablepush.execution.scene import Scene
 from stablepush.execution.world import place_features, scene_description
 from stablepush.extras import require
 from stablepush.frames import grasp_transform, matrix_to_pose, pose_to_matrix, quat_about_y
-from stablepush.plan.plan import Plan
-from stablepush.sim import VIDEO_VIEWS
-from stablepush.sim.robot import FINGER_JOINTS, arm_model
-from stablepush.sim.scene import (
+from stablepush.kinematics.cell_model import (
     OBJECT_BODY,
     add_object_geoms,
     build_mjcf,
@@ -74,6 +71,9 @@ from stablepush.sim.scene import (
     mjcf_numbers,
     simulated_outline,
 )
+from stablepush.kinematics.robot import FINGER_JOINTS, arm_model
+from stablepush.plan.plan import Plan
+from stablepush.sim import VIDEO_VIEWS
 from stablepush.task.model import Robot, Task
 
 SUFFIX = ".mp4"  # H.264 in MP4: plays in browsers, on GitHub and in every player
@@ -356,7 +356,7 @@ def render_model_xml(scene: Scene, box: Tuple[float, float, float, float], size:
                       fromto=mjcf_numbers((a[0], front, a[1], b[0], front, b[1])), rgba=mjcf_numbers(_GHOST_EDGE_RGBA))
 
     hand = ET.SubElement(world, "body", name="gripper", mocap="true")
-    for k, pad in enumerate(scene.gripper.pads):  # pad k on the finger at +y when k is even (scene.pad_layout)
+    for k, pad in enumerate(scene.gripper.pads):  # pad k on the finger at +y when k is even (cell_model.pad_layout)
         side = 1.0 if k % 2 == 0 else -1.0
         (cx, cz), r = pad.center, pad.radius
         ET.SubElement(hand, "geom", name=f"pad{k}", type="cylinder", size=mjcf_numbers((r, 0.0005)),
@@ -510,7 +510,7 @@ class _Schematic:
 
 
 class _ArmView:
-    """The run's MuJoCo model (scene.build_mjcf with the task's robot) posed from the recorded
+    """The run's MuJoCo model (cell_model.build_mjcf with the task's robot) posed from the recorded
     joints and object pose, the jaws at the object's faces as the simulated arm starts them, seen
     by a fixed camera that frames the arm and the features at `samples` (the drawn ones)."""
 

@@ -1,7 +1,7 @@
-"""Inverse kinematics of the simulated arm, the same for every engine: damped least squares on
-G's pose, with a null-space pull toward the home posture (the arm has one joint more than the
-pose needs). The engine supplies the forward kinematics; this is the arm's controller, not
-physics, so both engines track a waypoint with the same joint set-points.
+"""Inverse kinematics of the arm, the same for both engines, the cell check and a joint-level arm:
+damped least squares on G's pose, with a null-space pull toward the home posture (the arm has one
+joint more than the pose needs). The caller supplies the forward kinematics; this is the arm's
+controller, not physics, so both engines track a waypoint with the same joint set-points.
 
 Poses are (x, y, z, qw, qx, qy, qz) in the world [m]; joint angles in rad.
 """

@@ -4,7 +4,7 @@ joint_trajectory_controller, MoveIt's execution).
 
 Every sample of the timed trajectory (execution.trajectory: the executor's stream) is solved for
 the arm's joint positions (ik.solve_ik, each from the sample before, so the path stays on one
-branch) on the MuJoCo model of the run's scene (scene.build_mjcf: the shipped arm, arm.xml, its
+branch) on the MuJoCo model of the run's scene (cell_model.build_mjcf: the shipped arm, arm.xml, its
 jaws, the object and the features where the executor places them). The cell check refuses a plan
 (CellError, a PlanError: exit 2) first where a sample lies farther from the arm's first joint
 than the chain's length (out of reach: by how much, from where), then at the first sample where
@@ -37,12 +37,11 @@ from stablepush.execution.trajectory import Trajectory, timed_trajectory
 from stablepush.execution.world import place_features, scene_description
 from stablepush.extras import require
 from stablepush.frames import pose_to_matrix
+from stablepush.kinematics import cell_model, ik
+from stablepush.kinematics.arm_kinematics import ArmKinematics
+from stablepush.kinematics.robot import arm_model, model_stamp, robot_description
 from stablepush.plan.plan import Plan
 from stablepush.plan.verify import check_plan
-from stablepush.sim import ik
-from stablepush.sim import scene as scene_mod
-from stablepush.sim.arm import ArmKinematics
-from stablepush.sim.robot import arm_model, model_stamp, robot_description
 from stablepush.task.model import Robot, Task
 
 mujoco = require("mujoco", "the arm's kinematics and the cell check")  # a kinematics library here, not a simulator
@@ -203,7 +202,7 @@ class _Solver:
     def __init__(self, scene: Scene, robot: Robot):
         self.arm = arm_model(robot)
         self.robot = robot_description(robot)
-        model = mujoco.MjModel.from_xml_string(scene_mod.build_mjcf(scene, robot=robot))
+        model = mujoco.MjModel.from_xml_string(cell_model.build_mjcf(scene, robot=robot))
         self.kin = ArmKinematics(model, self.arm.joints)
         self.model, self.data = model, self.kin.data
         # out of reach, the first sample says so (CellError) from the nearest posture found
@@ -211,7 +210,7 @@ class _Solver:
                                     self.kin.upper)
         links = _link_bodies(model, self.arm.joints)
         self.link_geoms = [g for g in range(model.ngeom) if model.geom_bodyid[g] in links]
-        self.obstacles = [model.geom(scene_mod.feature_geom(f.pusher)).id for f in scene.features]
+        self.obstacles = [model.geom(cell_model.feature_geom(f.pusher)).id for f in scene.features]
         self.obstacles.append(model.geom("floor").id)
         self.base = robot.base
         self._arm_reach()
@@ -346,7 +345,7 @@ def _link_bodies(model, joints: Sequence[str]) -> set:
         if parent in moved:
             moved.add(b)
     jaws = {model.body(name).id for name in _JAW_BODIES}
-    return {b for b in moved if b not in jaws and model.body(b).name != scene_mod.OBJECT_BODY}
+    return {b for b in moved if b not in jaws and model.body(b).name != cell_model.OBJECT_BODY}
 
 
 def modelled(arm: Arm, robot: Robot) -> Arm:

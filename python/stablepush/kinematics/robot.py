@@ -11,7 +11,7 @@ both engines read one tree: MuJoCo whole, Drake through its MJCF parser. In that
 - every joint from the base to the flange gets a position servo named after it, stiff as the
   shipped arm's, and every body is carried by gravity compensation (gravcomp), as the shipped
   arm's are; the model's own actuators, sensors and keyframes are dropped;
-- no geom of the arm collides in the simulation (contype 0): the cell check (joint_path.py)
+- no geom of the arm collides in the simulation (contype 0): the cell check (cell_path.py)
   measures the links' clearance from the fixtures and the floor before any motion instead.
 Lengths in m, angles in rad in the tree; the Robot's fields are mm and deg.
 """
@@ -50,7 +50,7 @@ JOINT_ARMATURE = 0.2  # kg m^2
 HOME_STARTS = 24  # seeded joint vectors IK starts from to find a lab's arm's home posture
 # What of a lab's model the run has no use for, or replaces by its own.
 _DROPPED = ("actuator", "sensor", "keyframe", "contact", "option")
-# The names the project gives what it adds to a scene (here, scene.py and video.py: the base, G,
+# The names the project gives what it adds to a scene (here, cell_model.py and the 3D video: the base, G,
 # the jaws and their servos, the floor, the kinematic hand, the object, the features, the pads, a
 # mesh part's slabs). A lab's model that uses one has it renamed LAB_PREFIX + name, with every
 # reference to it, so that neither is taken for the other (test_robot_models checks the list).

@@ -1,6 +1,7 @@
-"""The MuJoCo scene of the simulated arm: the shipped arm (arm.xml) plus the held object, the
-multi-point finger pads and the fixed features, built from a scene (`stablepush.execution.scene.Scene`,
-SI units: what the executor sends in its `hello`). The object is a union of convex pieces
+"""The cell as one MJCF tree, which both simulator engines and the cell check read: the arm
+(robot.py; the shipped arm, arm.xml) plus the held object, the multi-point finger pads and the
+fixed features, built from a scene (`stablepush.execution.scene.Scene`, SI units: what the
+executor sends in its `hello`). The object is a union of convex pieces
 (`object_solid`): a mesh part's own, which the scene carries (`stablepush.execution.part_geometry`),
 or for a box or polygon part the prism of its section.
 
@@ -9,7 +10,7 @@ Contact settings that keep friction honest (the simulation's results rest on the
 - elliptic friction cones with impratio 100, so sticking contacts do not creep;
 - noslip iterations, which remove the residual slip of MuJoCo's soft constraints;
 - a small solref time constant (stiff contacts, 2.5 time steps);
-- pad friction chosen per pad point by its own slip (`friction.py`): the solver's stiff friction
+- pad friction chosen per pad point by its own slip (the MuJoCo engine's `friction.py`): the solver's stiff friction
   while it sticks, explicit Coulomb friction (mu N opposite its slip) while it slides, which
   removes the pads' drop-outs while they slide;
 - each pad is a disc of point contacts laid out as the task's `pad_rings` says, so the simulated
@@ -33,7 +34,7 @@ import numpy as np
 
 from stablepush.execution.scene import Scene, SceneFeature, SceneObject
 from stablepush.frames import pose_to_matrix, quat_about_y, turn
-from stablepush.sim.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
+from stablepush.kinematics.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.task.model import Robot
 
 OBJECT_BODY = "object"
@@ -223,7 +224,7 @@ def arm_tree(scene: Scene, kinematic_hand: bool = False, robot: Optional[Robot] 
     finger servos capped at the scene's grip force; with `kinematic_hand` the shipped arm is
     replaced by a hand at the scene's gripper pose that moves in G's plane through three joints
     (HAND_JOINTS) whose motion the caller prescribes: the same fingers, pads and contacts without
-    the arm, for measuring friction alone (`fidelity.py`). Both engines read the arm from this tree
+    the arm, for measuring friction alone (`stablepush.sim.fidelity`). Both engines read the arm from this tree
     (MuJoCo whole, Drake through its MJCF parser)."""
     root = arm_model(None if kinematic_hand else robot).arm_tree()
     if kinematic_hand:
