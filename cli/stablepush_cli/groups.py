@@ -3,8 +3,9 @@ world a simulated run departs into, the closed loop, a video. Each group is decl
 taken by every command that has it, so a command's function takes a few values, not every option.
 
 `option_group(target, build, *decorators)` adds the options of `decorators` to a command and hands
-it `target` = build(**their values). The options keep their names in click's context (`ctx.params`),
-where `--help`, `given()` and a resume command read them.
+it `target` = build(**their values); a group among `decorators` hands `build` its value as its own
+target. The options keep their names in click's context (`ctx.params`), where `--help`, `given()`
+and a resume command read them.
 """
 from __future__ import annotations
 
@@ -19,8 +20,7 @@ from stablepush_cli.options import robot_options as _robot_options
 
 def option_group(target: str, build: Callable[..., Any], *decorators: Callable) -> Callable:
     """A decorator: the options `decorators` add, handed to the command as `target` = build(**values)."""
-    probe = click.command()(functools.reduce(lambda f, d: d(f), reversed(decorators), lambda **_: None))
-    names = [param.name for param in probe.params]
+    names = [name for decorator in decorators for name in _handed(decorator)]
 
     def decorate(command: Callable) -> Callable:
         @functools.wraps(command)
@@ -32,7 +32,15 @@ def option_group(target: str, build: Callable[..., Any], *decorators: Callable) 
             grouped = decorator(grouped)
         return grouped
 
+    decorate.group_target = target  # type: ignore[attr-defined]  # what an enclosing group's build is handed
     return decorate
+
+
+def _handed(decorator: Callable) -> list:
+    """The names of the values `decorator` hands a command: a group's target, else its options'."""
+    if hasattr(decorator, "group_target"):
+        return [decorator.group_target]
+    return [param.name for param in click.command()(decorator(lambda **_: None)).params]
 
 
 @dataclass(frozen=True)
@@ -77,6 +85,12 @@ class RobotChoice:
 
         return with_robot(task, self.robot_model, self.flange, self.tcp, self.base)
 
+    def arm(self):
+        """This arm over the shipped one, for a command that takes no task (stablepush.task.robot_with)."""
+        from stablepush.task import Robot, robot_with
+
+        return robot_with(Robot(), self.robot_model, self.flange, self.tcp, self.base)
+
 
 robot_choice = option_group("robot", RobotChoice, _robot_options)
 
@@ -94,17 +108,19 @@ class ArmChoice:
 
 @dataclass(frozen=True)
 class SimWorld:
-    """--sim-mu-scale, --tracker-noise, --world: how a simulated world departs from the task."""
+    """--sim-mu-scale, --tracker-noise, --world: how a simulated world departs from the task
+    (`seed`: of the tracker's noise)."""
 
     mu_scale: float
     tracker_noise: Tuple[float, float]
     world: Tuple[Tuple[str, float], ...] = ()
+    seed: int = 0
 
     def deviation(self):
         from stablepush.sim import WorldDeviation
 
         return WorldDeviation(mu_scale=self.mu_scale, tracker_noise_mm=self.tracker_noise[0],
-                              tracker_noise_deg=self.tracker_noise[1], world=self.world)
+                              tracker_noise_deg=self.tracker_noise[1], seed=self.seed, world=self.world)
 
 
 def world_option(scope: str) -> Callable:
