@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
+from typing import Optional
 
 import click
 
@@ -10,7 +12,7 @@ from stablepush_cli.common import (
     load_task_file,
     say_beside,
 )
-from stablepush_cli.groups import RunnerChoice, runner_choice
+from stablepush_cli.groups import RunnerChoice, option_group, runner_choice
 from stablepush_cli.options import (
     SEED,
     TIME_LIMIT,
@@ -19,19 +21,25 @@ from stablepush_cli.options import (
 )
 
 
+@dataclass(frozen=True)
+class BenchTrials:
+    """--trials, --seed, --time-limit: the planning runs of each task, seeds seed, seed+1, ..."""
+
+    trials: int
+    seed: int
+    time_limit: Optional[float]
+
+
 @click.command()
 @click.argument("task_files", metavar="TASK.yaml...", nargs=-1, required=True, type=click.Path(dir_okay=False))
 @click.option("--checks", "checks_only", is_flag=True, help="Benchmark the stable-push test instead of planning.")
-@click.option(
-    "--trials",
-    default=10,
-    show_default=True,
-    type=Whole(min=1),
-    help="Planning runs per task (seeds seed, seed+1, ...).",
-)
-@click.option("--seed", default=1, show_default=True, type=SEED, help="First seed.")
-@click.option("--time-limit", type=TIME_LIMIT, default=None, metavar="S",
-              help="Per-trial time limit (default: each task's planner.time_limit).")
+@option_group(
+    "runs", BenchTrials,
+    click.option("--trials", default=10, show_default=True, type=Whole(min=1),
+                 help="Planning runs per task (seeds seed, seed+1, ...)."),
+    click.option("--seed", default=1, show_default=True, type=SEED, help="First seed."),
+    click.option("--time-limit", type=TIME_LIMIT, default=None, metavar="S",
+                 help="Per-trial time limit (default: each task's planner.time_limit)."))
 @click.option("--out", "out_path", type=click.Path(dir_okay=False), default=None,
               help="Also write every trial to this file: .csv (one row per trial) or .json (trials and summary).")
 @click.option(
@@ -43,8 +51,8 @@ from stablepush_cli.options import (
                    "and report the first and the improved plans.")
 @runner_choice("the planning trials", "one after the other, here",
                " Times are each search's own, so they compare across runners; parallel runs share the CPUs.")
-def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out_path, count: int,
-          improve_for, where: RunnerChoice) -> None:
+def bench(task_files, checks_only: bool, runs: BenchTrials, out_path, count: int, improve_for,
+          where: RunnerChoice) -> None:
     """Benchmark planning over seeds, in the shape of the paper's Table II.
 
     For each task: success rate, median / p95 / min / max planning time, median switch-overs and path
@@ -69,7 +77,7 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
 
     tasks = [load_task_file(path) for path in task_files]
     if checks_only:
-        _bench_checks(tasks, count, seed)
+        _bench_checks(tasks, count, runs.seed)
         return
     from stablepush.outputs import require_suffix
 
@@ -79,12 +87,12 @@ def bench(task_files, checks_only: bool, trials: int, seed: int, time_limit, out
 
     runner = None if where.workers is None and where.ray_address is None else where.runner(default=1)
     every, rows = [], []
-    with click.progressbar(length=trials * len(tasks), label="planning", file=sys.stderr) as bar:
+    with click.progressbar(length=runs.trials * len(tasks), label="planning", file=sys.stderr) as bar:
         for task in tasks:
-            runs = bench_planning(task, trials, seed=seed, time_limit=time_limit, progress=bar.update,
-                                            improve_for=improve_for, runner=runner)
-            every.extend(runs)
-            rows.append(summarize_planning(runs))
+            trials = bench_planning(task, runs.trials, seed=runs.seed, time_limit=runs.time_limit,
+                                    progress=bar.update, improve_for=improve_for, runner=runner)
+            every.extend(trials)
+            rows.append(summarize_planning(trials))
 
     def num(v, fmt):
         return "-" if v is None else format(v, fmt)
