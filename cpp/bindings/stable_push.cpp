@@ -83,6 +83,10 @@ void expose_stable_push(py::module_& m) {
            "The largest multiple of the weight the pads alone hold at rest at q, gravity as during a push by\n"
            "`pusher` (-1: G's axes the world's); >= 1: held; inf: no gravity.")
       .def("grasp_maintained", &StablePushModel::grasp_maintained, py::arg("q"))
+      .def("in_world", &StablePushModel::in_world, py::arg("pad_mu_scale"), py::arg("grip_force_scale"),
+           py::arg("mass_scale"),
+           "This model with the pads' mu, the grip force and the object's mass and inertia scaled (the pushers'\n"
+           "cones shared): a world of the same part, grasp and pushers.")
       .def(
           "check_batch",
           [](const StablePushModel& m, py::array_t<double, py::array::c_style | py::array::forcecast> q,

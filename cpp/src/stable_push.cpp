@@ -89,6 +89,17 @@ StablePushModel::StablePushModel(CrossSection section, RigidBody body, Gripper g
   polygon_inradius_ = std::cos(M_PI / polygon_sides_);
 }
 
+StablePushModel StablePushModel::in_world(double pad_mu_scale, double grip_force_scale, double mass_scale) const {
+  for (double scale : {pad_mu_scale, grip_force_scale, mass_scale})
+    if (!(std::isfinite(scale) && scale > 0.0)) throw std::invalid_argument("a world's scales must be finite and > 0");
+  StablePushModel world = *this;
+  world.gripper_ = Gripper(gripper_.pads(), gripper_.grip_force() * grip_force_scale, gripper_.mu() * pad_mu_scale,
+                           gripper_.pad_rings());
+  world.body_.mass *= mass_scale;
+  world.body_.inertia *= mass_scale;
+  return world;
+}
+
 Vec2 StablePushModel::gravity_in_gripper(const Pose& q, int pusher) const {
   return gravity_in_gripper(Rotation2(q.theta), pusher);
 }

@@ -425,6 +425,11 @@ class StablePushModel:
         The largest multiple of the weight the pads alone hold at rest at q, gravity as during a push by
         `pusher` (-1: G's axes the world's); >= 1: held; inf: no gravity.
         """
+    def in_world(self, pad_mu_scale: typing.SupportsFloat | typing.SupportsIndex, grip_force_scale: typing.SupportsFloat | typing.SupportsIndex, mass_scale: typing.SupportsFloat | typing.SupportsIndex) -> StablePushModel:
+        """
+        This model with the pads' mu, the grip force and the object's mass and inertia scaled (the pushers'
+        cones shared): a world of the same part, grasp and pushers.
+        """
     def motion_wrench(self, q: Pose | collections.abc.Sequence[typing.SupportsFloat] | numpy.typing.NDArray[numpy.float64], dq: Motion | collections.abc.Sequence[typing.SupportsFloat] | numpy.typing.NDArray[numpy.float64], pusher: typing.SupportsInt | typing.SupportsIndex = -1) -> MotionWrench:
         ...
     @property

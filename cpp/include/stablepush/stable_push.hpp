@@ -135,6 +135,13 @@ class StablePushModel {
   /// Every pad disc inside the cross-section at q.
   bool grasp_maintained(const Pose& q) const { return gripper_.grasp_maintained(section_, q); }
 
+  /// This model in another world of the same part, grasp and pushers: the pads' mu and grip force
+  /// times `pad_mu_scale` and `grip_force_scale`, the object's mass and inertia times `mass_scale`
+  /// (its centre of mass where it was). The pushers' cones are shared, not rebuilt: their exact
+  /// facets are most of what a model costs to make, and a world that changes a pusher's mu needs a
+  /// model of its own. std::invalid_argument when a scale is not finite and positive.
+  StablePushModel in_world(double pad_mu_scale, double grip_force_scale, double mass_scale) const;
+
  private:
   /// Walks the terms of the motion wrench in G: loads.force(f, arm) for a force f [N] at arm [m]
   /// from O's origin, loads.torque(t) for a pure torque [N m], loads.sticking(arm, limit, n) for a

@@ -1,8 +1,10 @@
 """A plan's measured success rate over many perturbed worlds (`stablepush evaluate`): the worlds
 (worlds.py), the batch that runs one trial per world (batch.py) where `stablepush.runners`
-says: here, on local processes or on Ray, and the sequential decision that may stop it early
-(sequential.py)."""
+says: here, on local processes or on Ray, the sequential decision that may stop it early
+(sequential.py), and the model's verdict on a world (prediction.py) that joins many model-only
+worlds to the trials (ppi.py)."""
 from stablepush.evaluation.batch import (
+    MAX_PREDICTIONS,
     Batch,
     Evaluation,
     decision_state,
@@ -10,10 +12,15 @@ from stablepush.evaluation.batch import (
     run_trial,
     study_trials,
     wilson_interval,
+    with_predictions,
     write_evaluation,
 )
+from stablepush.evaluation.ppi import PredictedRate, prediction_powered_rate
+from stablepush.evaluation.prediction import PlanInWorlds, Prediction, predicted_multipliers
 from stablepush.evaluation.sequential import SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world, robust_task
 
-__all__ = ["Batch", "Evaluation", "SequentialTest", "Spreads", "TrialWorld", "VARY_KEYS", "decision_state",
-           "draw_world", "evaluate", "robust_task", "run_trial", "study_trials", "wilson_interval", "write_evaluation"]
+__all__ = ["Batch", "Evaluation", "MAX_PREDICTIONS", "PlanInWorlds", "PredictedRate", "Prediction", "SequentialTest",
+           "Spreads", "TrialWorld", "VARY_KEYS", "decision_state", "draw_world", "evaluate", "predicted_multipliers",
+           "prediction_powered_rate", "robust_task", "run_trial", "study_trials", "wilson_interval",
+           "with_predictions", "write_evaluation"]

@@ -6,13 +6,14 @@ records where the object ended against the goal. Trials are independent: they ru
 other, on local worker processes, or on Ray (`stablepush.runners`), and a trial's outcome depends on
 (seed, i) alone, so all three give the same trials. With `Batch.video_dir`, a failed trial's run,
 kept in memory while it runs, is drawn into a video in the worker after its verdict
-(`stablepush.sim.video`), which changes no outcome.
+(`stablepush.sim.mujoco.video`), which changes no outcome.
 
 The summary's `ci95` is the Wilson score interval of the success rate (scipy's `binomtest`).
 Units: mm and deg as in plan files; times in s.
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 import traceback
@@ -22,6 +23,8 @@ from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 import numpy as np
 
 from stablepush.errors import SettingError
+from stablepush.evaluation.ppi import PredictedRate, prediction_powered_rate
+from stablepush.evaluation.prediction import PlanInWorlds, predicted_multipliers
 from stablepush.evaluation.sequential import SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.bags import RunRecording
@@ -36,7 +39,7 @@ from stablepush.pose import Pose, Tolerance
 from stablepush.runners import Runner, WorkerLost, run_all, this_node
 from stablepush.sim.deviation import MAX_SEED, WorldDeviation
 from stablepush.sim.local_arm import SimulatedArm
-from stablepush.sim.video import check_fps, check_size
+from stablepush.sim.mujoco.video import check_fps, check_size
 from stablepush.task.model import Task
 from stablepush.units import is_integer
 
@@ -45,6 +48,7 @@ PERCENTILES = (50, 90, 95, 99)
 EDGE = 0.9  # of the success tolerance: an open-loop plan ending this far out is warned of
 DEFAULT_TRIALS = 100  # a study's trials when none are named and no sequential test sets the cap
 MAX_TRIALS = 1_000_000  # a study's, as `evaluate --trials` takes
+MAX_PREDICTIONS = 10_000_000  # model-only worlds, as `evaluate --predict` takes (about 100 us each)
 
 
 @dataclass(frozen=True)
@@ -62,7 +66,7 @@ class Batch:
     engine: str = "mujoco"
     tolerance: Optional[Tuple[float, float]] = None
     # Where each failed trial's video goes (`trial-<i>.mp4`; None: no videos), and how it is drawn
-    # (stablepush.sim.video). Drawn after the trial's verdict, so the outcomes do not depend on them.
+    # (stablepush.sim.mujoco.video). Drawn after the trial's verdict, so the outcomes do not depend on them.
     video_dir: Optional[str] = None
     video_fps: float = 25.0
     video_size: Tuple[int, int] = (640, 480)
@@ -182,7 +186,7 @@ def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: 
     """Draw a failed trial's recorded run in its own world (features where this trial put them)
     into video_dir/trial-<i>.mp4 and return the path; None, with `video_error` in the record, when
     it cannot be drawn (no waypoint was acknowledged, say). Never raises: the trial's record stands."""
-    from stablepush.sim.video import render_run, run_scene
+    from stablepush.sim.mujoco.video import render_run, run_scene
 
     assert batch.video_dir is not None, "asked only of a batch with a video_dir"
     path = os.path.join(batch.video_dir, f"trial-{trial}.mp4")
@@ -266,6 +270,24 @@ def evaluate(batch: Batch, trials: Optional[int] = None, runner: Runner = Runner
                       requested=trials, interrupted=interrupted, decision=decision.as_dict())
 
 
+def with_predictions(evaluation: "Evaluation", predictions: int) -> "Evaluation":
+    """`evaluation` with the model's verdict on each trial's world (each record's `predicted`) and
+    its success rate from `predictions` model-only worlds of the same spreads joined with the
+    trials by prediction-powered inference (ppi.prediction_powered_rate; the crashed trials left
+    out, as from the rate). SettingError for a count of predictions that is not a whole number
+    from 1 to MAX_PREDICTIONS."""
+    if isinstance(predictions, bool) or not is_integer(predictions) or not 1 <= predictions <= MAX_PREDICTIONS:
+        raise SettingError("predict", f"must be a whole number from 1 to {MAX_PREDICTIONS:,}, got {predictions!r:.40}")
+    batch = evaluation.batch
+    judge = PlanInWorlds(batch.task, batch.plan, batch.success_tolerance, batch.closed_loop)
+    trials = [{**t, "predicted": judge.predict(batch.world(t["trial"])).as_dict()} for t in evaluation.trials]
+    judged = [t for t in trials if not crashed(t)]
+    rate = prediction_powered_rate(
+        [bool(t["success"]) for t in judged], [t["predicted"]["lands"] for t in judged],
+        judge.predict_multipliers(predicted_multipliers(batch.seed, predictions, batch.spreads)))
+    return dataclasses.replace(evaluation, trials=trials, prediction=rate)
+
+
 def decision_state(test: SequentialTest, done: Sequence[dict]) -> str:
     """Where `test` stands on the trial records `done` (finished in any order), as evaluate() feeds
     it: the trials in the order of their numbers up to the first not yet finished, in words
@@ -317,6 +339,7 @@ class Evaluation:
     requested: int
     interrupted: bool = False
     decision: Optional[dict] = None  # the sequential test's: its settings, decision, and the trials it took
+    prediction: Optional[PredictedRate] = None  # the rate with the model's verdicts (with_predictions)
 
     def summary(self) -> dict:
         """Counts, the success rate with its Wilson 95% interval, goal-error percentiles (mm and
@@ -358,6 +381,7 @@ class Evaluation:
             "wall_s": self.wall_s, "runner": self.runner, "nodes": dict(sorted(nodes.items())),
             "robot_time_s": robot_time, "real_time_factor": robot_time / self.wall_s if self.wall_s > 0 else None,
             "decision": self.decision,
+            "prediction": self.prediction.as_dict() if self.prediction is not None else None,
             # trials a correction's search was stopped by its wall-time guard in, not by its count of
             # tests: their outcome may depend on the machine's load (docs/evaluate.md)
             "wall_guard_trials": [t["trial"] for t in self.trials if t.get("wall_guard")],
@@ -389,6 +413,8 @@ class Evaluation:
             mm, deg = s["goal_error_mm"], s["goal_error_deg"]
             lines.append(f"goal error: median {mm['p50']:.3f} mm / {deg['p50']:.3f} deg, "
                          f"p95 {mm['p95']:.3f} mm / {deg['p95']:.3f} deg")
+        if self.prediction is not None:
+            lines.append(self.prediction.describe())
         if s["decision"] is not None:
             d = s["decision"]
             said = {"above": "it lands at least", "below": "it lands less than",
