@@ -316,6 +316,7 @@ def _pool(kind: str, ctx: dict):
                                                         (), 3]),
         "axis": ([(-1.0, 1.0, 2), (0.0, 0.0, 1)], [(NAN, 1, 2), (0, 1, 0), (0, 1, 10 ** 6), "0:1:2", (0, 1),
                                                    (0, INF, 2), (0, 1, 1.5)]),
+        "grid": ([ctx["grid"]], [None, 3, ((-1.0, 1.0, 2), (0.0, 0.0, 1), (0.0, 0.0, 1)), ctx["task"]]),
         "task": ([ctx["task"]], [None, ctx["task_path"], {"name": "x"}, ctx["plan"], 3]),
         "plan": ([ctx["plan"]], [None, ctx["plan_path"], ctx["task"], {"waypoints": []}, 3]),
         "runner": ([None], ["ray", 3, "local", ctx["task"]]),
@@ -346,7 +347,7 @@ def _api_table(sp, ctx):
     from stablepush.design import design, evaluate_designs
     from stablepush.evaluation import Batch, SequentialTest, Spreads, evaluate
     from stablepush.execution.executor import RunOptions
-    from stablepush.plan.reach import reach_map
+    from stablepush.plan.reach import ReachGrid, reach_map
     from stablepush.runners import Runner
     from stablepush.sim.deviation import WorldDeviation
     from stablepush.sim.local_arm import SimulatedArm
@@ -383,8 +384,9 @@ def _api_table(sp, ctx):
         "evaluate_designs": (evaluate_designs, {"study": "study", "trials": "count", "spreads": "spreads",
                                                 "top": "count", "seed": "seed", "closed_loop": "bool",
                                                 "engine": "engine", "runner": "runner"}),
-        "reach_map": (reach_map, {"task": "task", "x": "axis", "z": "axis", "theta": "axis", "seed": "seed",
-                                  "time_limit": "time", "check_limit": "whole0"}),
+        "ReachGrid": (ReachGrid, {"x": "axis", "z": "axis", "theta": "axis"}),
+        "reach_map": (reach_map, {"task": "task", "grid": "grid", "seed": "seed", "time_limit": "time",
+                                  "check_limit": "whole0"}),
         "SimulatedArm": (SimulatedArm, {"engine": "engine", "deviation": "deviation", "robot": "robot"}),
         "WorldDeviation": (WorldDeviation, {"mu_scale": "mu", "tracker_noise_mm": "noise", "seed": "seed"}),
         "RunOptions": (RunOptions, {"rate_hz": "rate", "resume_from": "whole0", "pace": "bool",
@@ -394,7 +396,7 @@ def _api_table(sp, ctx):
 
 # Arguments the table must keep cheap when good: the fixed ones each call gets unless drawn.
 API_FIXED = {"plan_task": {"time_limit": 0.02}, "design": {"time_limit": 0.05, "reach_top": 0},
-             "reach_map": {"time_limit": 0.01, "x": (-1.0, 1.0, 2), "z": (0.0, 0.0, 1), "theta": (0.0, 0.0, 1)},
+             "reach_map": {"time_limit": 0.01},
              "evaluate": {"trials": 1}, "evaluate_designs": {"trials": 1, "top": 1}, "WorldDeviation": {},
              "Runner": {"workers": 1}}
 # Good values that the kind's pool would not give for this function.
@@ -409,6 +411,7 @@ API_GOOD = {("Cell", "retract"): [20.0], ("Cell", "lane_offset"): [75.0], ("Worl
 def _api_context(sp, scratch: Path) -> dict:
     from stablepush.design import design
     from stablepush.evaluation import Batch, SequentialTest, Spreads
+    from stablepush.plan.reach import ReachGrid
     from stablepush.sim.deviation import WorldDeviation
     from stablepush.task.schema import load_design
 
@@ -442,7 +445,7 @@ def _api_context(sp, scratch: Path) -> dict:
             "model": arm["model"], "robot": sp.Robot(model=arm["model"], flange="tool0", tcp=arm["tcp"]),
             "spreads": spreads, "study": study, "batch": Batch(task=task, plan=plan, spreads=spreads),
             "test": SequentialTest(target=0.5), "design_task": design_task, "candidates": candidates,
-            "deviation": WorldDeviation()}
+            "deviation": WorldDeviation(), "grid": ReachGrid((-1.0, 1.0, 2), (0.0, 0.0, 1), (0.0, 0.0, 1))}
 
 
 class _Work:

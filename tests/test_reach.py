@@ -12,13 +12,13 @@ from click.testing import CliRunner
 
 from stablepush.errors import TaskError
 from stablepush.plan import check_plan, plan_task, search
-from stablepush.plan.reach import ReachJob, axis_values, reach_cell, reach_map
+from stablepush.plan.reach import ReachGrid, ReachJob, axis_values, reach_cell, reach_map
 from stablepush.runners import Runner
 from stablepush_cli.main import cli
 
 from conftest import TASKS, shipped, task_with
 
-GRID = dict(x=(-30.0, 30.0, 5), z=(-15.0, 15.0, 3), theta=(-20.0, 20.0, 2))
+GRID = ReachGrid(x=(-30.0, 30.0, 5), z=(-15.0, 15.0, 3), theta=(-20.0, 20.0, 2))
 
 
 def _verdicts(result):
@@ -30,8 +30,8 @@ def _verdicts(result):
 
 def test_the_same_seed_gives_the_same_map_here_and_on_workers():
     task = shipped("t-shaped")
-    here = reach_map(task, **GRID, seed=3, time_limit=0.3)
-    workers = reach_map(task, **GRID, seed=3, time_limit=0.3, runner=Runner(workers=2))
+    here = reach_map(task, GRID, seed=3, time_limit=0.3)
+    workers = reach_map(task, GRID, seed=3, time_limit=0.3, runner=Runner(workers=2))
     assert _verdicts(here) == _verdicts(workers)
     assert len(here.cells) == 30 and {c["verdict"] for c in here.cells} >= {"reached", "unreachable"}
 
@@ -40,7 +40,7 @@ def test_unreachable_verdicts_are_sound_and_reached_plans_check(monkeypatch):
     """Each cell called unreachable is planned again for 1 s with the planner's verdicts switched
     off (else they would only repeat themselves) and not reached."""
     task = shipped("t-shaped")
-    result = reach_map(task, **GRID, seed=1, time_limit=0.3)
+    result = reach_map(task, GRID, seed=1, time_limit=0.3)
     monkeypatch.setattr(search, "why_unreachable", lambda task, deadline=None: None)
     for cell in result.cells:
         cell_task = dataclasses.replace(task, goal=tuple(cell["goal"]))
@@ -169,10 +169,10 @@ def test_show_draws_a_plan_that_found_no_push_and_marks_the_goal(tmp_path):
 
 
 def test_the_library_refuses_a_bad_grid_naming_the_axis_before_any_cell():
-    """reach_map checks its axes, seed and time limit as the CLI does: a count that is not a whole
-    number, a bound past the task file's pose bounds, a seed or time limit out of the planner's
-    ranges, a count of 1 with two ends or equal ends with a larger count are refused with the
-    argument named, and the map records the axes it planned."""
+    """ReachGrid checks its axes and reach_map its seed and time limit as the CLI does: a count that
+    is not a whole number, a bound past the task file's pose bounds, a seed or time limit out of the
+    planner's ranges, a count of 1 with two ends or equal ends with a larger count are refused with
+    the argument named, and the map records the axes it planned."""
     task = shipped("pivoting")
     x, z = (0.0, 0.0, 1), (0.0, 0.0, 1)
     bad = {r"x\[1\]": dict(x=(0.0, math.nan, 2)), "x: must be \\(from, to, count\\)": dict(x=(0.0, 10.0)),
@@ -184,8 +184,12 @@ def test_the_library_refuses_a_bad_grid_naming_the_axis_before_any_cell():
     for field, change in bad.items():
         arguments = {"x": x, "z": z, "theta": (0.0, 0.0, 1), "seed": 1, "time_limit": 0.1, **change}
         with pytest.raises(TaskError, match=field):
-            reach_map(task, **arguments)
-    result = reach_map(task, x=np.array([0.0, 0.0, 1.0]), z=z, theta=(0.0, 90.0, np.int64(2)), time_limit=0.1)
+            grid = ReachGrid(arguments.pop("x"), arguments.pop("z"), arguments.pop("theta"))
+            reach_map(task, grid, **arguments)
+    with pytest.raises(TypeError, match="grid must be a ReachGrid"):
+        reach_map(task, (x, z, (0.0, 0.0, 1)))
+    result = reach_map(task, ReachGrid(x=np.array([0.0, 0.0, 1.0]), z=z, theta=(0.0, 90.0, np.int64(2))),
+                       time_limit=0.1)
     assert result.axes["theta"] == [0.0, 90.0, 2] and type(result.axes["theta"][2]) is int
     assert result.axes["x"] == [0.0, 0.0, 1] and len(result.cells) == 2
 

@@ -11,7 +11,7 @@ import pytest
 
 from stablepush.evaluation import Batch, Spreads, evaluate
 from stablepush.plan import check_plan, plan_task
-from stablepush.plan.reach import reach_map
+from stablepush.plan.reach import ReachGrid, reach_map
 from stablepush.runners import Runner
 
 from conftest import shipped
@@ -48,10 +48,10 @@ def _cells(result):
 def test_a_reach_map_bounded_by_tests_is_the_same_under_load():
     """Not-found cells included: their partial paths end where the count stopped the search."""
     task = shipped("large-manipulation")
-    grid = dict(x=(5.0, 15.0, 3), z=(-13.0, -3.0, 3), theta=(45.0, 45.0, 1))
-    quiet = reach_map(task, **grid, seed=1, time_limit=1000.0, check_limit=2_000)
+    grid = ReachGrid(x=(5.0, 15.0, 3), z=(-13.0, -3.0, 3), theta=(45.0, 45.0, 1))
+    quiet = reach_map(task, grid, seed=1, time_limit=1000.0, check_limit=2_000)
     with cpu_hog():
-        loaded = reach_map(task, **grid, seed=1, time_limit=1000.0, check_limit=2_000)
+        loaded = reach_map(task, grid, seed=1, time_limit=1000.0, check_limit=2_000)
     assert _cells(quiet) == _cells(loaded)
     assert any(c["verdict"] == "not found" for c in quiet.cells) and not quiet.guard_fired()
 

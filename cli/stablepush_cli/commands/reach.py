@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
+from typing import Optional, Sequence, Tuple
 
 import click
 
@@ -11,7 +13,7 @@ from stablepush_cli.common import (
     progressbar,
     say_beside,
 )
-from stablepush_cli.groups import RunnerChoice, runner_choice
+from stablepush_cli.groups import RunnerChoice, option_group, runner_choice
 from stablepush_cli.options import (
     SEED,
     TIME_LIMIT,
@@ -19,21 +21,53 @@ from stablepush_cli.options import (
     parse_axis,
 )
 
+Axis = Tuple[float, float, int]
+
+
+@dataclass(frozen=True)
+class GoalAxes:
+    """--x, --z, --theta: the grid's axes (from, to, count), each None for the task's goal alone."""
+
+    x_axis: Optional[Axis]
+    z_axis: Optional[Axis]
+    theta_axis: Optional[Axis]
+
+    def grid(self, goal: Sequence[float]):
+        """The grid (stablepush.plan.ReachGrid), an axis not given the goal's value alone."""
+        from stablepush.plan import ReachGrid
+
+        axes = (self.x_axis, self.z_axis, self.theta_axis)
+        return ReachGrid(*(a if a is not None else (g, g, 1) for a, g in zip(axes, goal)))
+
+
+@dataclass(frozen=True)
+class CellSearch:
+    """--checks, --time-limit, --seed: each cell's search, bounded by a count of tests, then a time."""
+
+    check_limit: int
+    time_limit: float
+    seed: Optional[int]
+
 
 @click.command()
 @click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
-@click.option("--x", "x_axis", callback=parse_axis, default=None, metavar="A:B:N",
-              help="Goal x values, mm: N from A to B (default: the task's goal x alone).")
-@click.option("--z", "z_axis", callback=parse_axis, default=None, metavar="A:B:N", help="Goal z values, mm (likewise).")
-@click.option("--theta", "theta_axis", callback=parse_axis, default=None, metavar="A:B:N",
-              help="Goal theta values, deg (likewise).")
-@click.option("--checks", "check_limit", default=1_000_000, show_default=True, type=Whole(min=0, max=10**15),
-              metavar="N", help="Stable-push tests each cell's search may make: a count, so the map is the same on "
-                                "any machine under any load (0: --time-limit alone bounds it).")
-@click.option("--time-limit", default=10.0, show_default=True, type=TIME_LIMIT,
-              metavar="S", help="Each cell's search time, a guard past --checks: a cell it stops is counted in the "
-                                "summary (its verdict may differ on a less loaded machine).")
-@click.option("--seed", default=None, type=SEED, help="Planner seed (default: the task's).")
+@option_group(
+    "axes", GoalAxes,
+    click.option("--x", "x_axis", callback=parse_axis, default=None, metavar="A:B:N",
+                 help="Goal x values, mm: N from A to B (default: the task's goal x alone)."),
+    click.option("--z", "z_axis", callback=parse_axis, default=None, metavar="A:B:N",
+                 help="Goal z values, mm (likewise)."),
+    click.option("--theta", "theta_axis", callback=parse_axis, default=None, metavar="A:B:N",
+                 help="Goal theta values, deg (likewise)."))
+@option_group(
+    "search", CellSearch,
+    click.option("--checks", "check_limit", default=1_000_000, show_default=True, type=Whole(min=0, max=10**15),
+                 metavar="N", help="Stable-push tests each cell's search may make: a count, so the map is the same "
+                                   "on any machine under any load (0: --time-limit alone bounds it)."),
+    click.option("--time-limit", default=10.0, show_default=True, type=TIME_LIMIT,
+                 metavar="S", help="Each cell's search time, a guard past --checks: a cell it stops is counted in the "
+                                   "summary (its verdict may differ on a less loaded machine)."),
+    click.option("--seed", default=None, type=SEED, help="Planner seed (default: the task's)."))
 @runner_choice("the cells' plans")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
               help="Write the map: its cells (goal, verdict, reason, solved, seed, planning time, switch-overs).")
@@ -42,8 +76,8 @@ from stablepush_cli.options import (
                    "ends); at most six slices, evenly chosen, the one nearest the start's theta among them (the "
                    "title says how many of how many).")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_limit: float, seed,
-          where: RunnerChoice, json_path, png_path, quiet: bool) -> None:
+def reach(task_file: str, axes: GoalAxes, search: CellSearch, where: RunnerChoice, json_path, png_path,
+          quiet: bool) -> None:
     """Map where the pushers can take the object: plan from the task's start to every goal of a grid.
 
     Each cell is the task with its goal replaced, planned on its own. Its verdict: `reached`,
@@ -69,13 +103,12 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_lim
     runner = where.runner(default=default_workers())
     # The grid replaces the goal; its cells say where there is no grasp.
     task = load_task_file(task_file, goal_in_grasp=False)
-    gx, gz, gth = task.goal
-    axes = [a if a is not None else (g, g, 1) for a, g in ((x_axis, gx), (z_axis, gz), (theta_axis, gth))]
-    count = axes[0][2] * axes[1][2] * axes[2][2]  # reach_map refuses more than plan.reach.MAX_CELLS
+    grid = axes.grid(task.goal)
+    count = grid.cells
     bar = progressbar(quiet, length=count, label=f"{count} cells", show_pos=True)
     try:
-        result = reach_map(task, *axes, seed=task.planner.seed if seed is None else seed, time_limit=time_limit,
-                           check_limit=check_limit, runner=runner,
+        result = reach_map(task, grid, seed=task.planner.seed if search.seed is None else search.seed,
+                           time_limit=search.time_limit, check_limit=search.check_limit, runner=runner,
                            progress=(lambda cell: bar.update(1)) if bar else None)
     finally:
         if bar is not None:
@@ -88,6 +121,7 @@ def reach(task_file: str, x_axis, z_axis, theta_axis, check_limit: int, time_lim
 
         save_figure(reach_figure(task, data), png_path)
     c = data["counts"]
+    check_limit, time_limit = search.check_limit, search.time_limit
     bound = f"{check_limit:,} tests" if check_limit else f"{time_limit:g} s"
     say(f"{task.name}: {c['reached']} of {count} goals reached, {c['not found']} not found in {bound}, "
         f"{c['unreachable']} unreachable ({result.wall_s:.1f} s on {result.runner})")

@@ -37,7 +37,7 @@ from stablepush.execution.world import place_features
 from stablepush.frames import angle_about_y
 from stablepush.plan import check_plan, plan_task
 from stablepush.plan.plan import Plan
-from stablepush.plan.reach import reach_map
+from stablepush.plan.reach import ReachGrid, reach_map
 from stablepush.plan.search import require_goal_apart
 from stablepush.plan.verify import plan_margin
 from stablepush.runners import Runner, WorkerLost, run_all
@@ -426,8 +426,8 @@ def _reach_near_goal(task: Task, runner: Runner) -> float:
     tolerances either side in x and z, the goal's theta) that the layout also reaches."""
     tol = task.planner.tolerance[0] * REACH_SPAN
     gx, gz, gt = task.goal
-    cells = reach_map(task, (gx - tol, gx + tol, REACH_CELLS), (gz - tol, gz + tol, REACH_CELLS), (gt, gt, 1),
-                      seed=task.planner.seed, time_limit=REACH_TIME_LIMIT, check_limit=REACH_CHECKS,
+    grid = ReachGrid((gx - tol, gx + tol, REACH_CELLS), (gz - tol, gz + tol, REACH_CELLS), (gt, gt, 1))
+    cells = reach_map(task, grid, seed=task.planner.seed, time_limit=REACH_TIME_LIMIT, check_limit=REACH_CHECKS,
                       runner=runner).cells
     return sum(1 for c in cells if c["solved"]) / len(cells)
 

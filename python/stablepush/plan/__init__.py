@@ -10,8 +10,8 @@ __all__ = ["Plan", "PlanOutcome", "Waypoint", "PusherContact", "plan_task", "end
            "read_plan", "write_plan", "release_note"]
 # Loaded when first used: the reach map and the benchmark bring in the batch runners.
 _EXPORTS = {"MAX_AXIS": "stablepush.plan.reach", "grid_axis": "stablepush.plan.reach",
-            "reach_map": "stablepush.plan.reach", "bench_checks": "stablepush.plan.benchmark",
-            "bench_planning": "stablepush.plan.benchmark", "summarize_planning": "stablepush.plan.benchmark",
-            "write_planning_trials": "stablepush.plan.benchmark"}
+            "ReachGrid": "stablepush.plan.reach", "reach_map": "stablepush.plan.reach",
+            "bench_checks": "stablepush.plan.benchmark", "bench_planning": "stablepush.plan.benchmark",
+            "summarize_planning": "stablepush.plan.benchmark", "write_planning_trials": "stablepush.plan.benchmark"}
 __all__ += list(_EXPORTS)
 __getattr__ = lazy_exports(__name__, _EXPORTS)

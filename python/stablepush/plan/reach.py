@@ -64,9 +64,39 @@ REACH_CHECKS = 1_000_000
 
 
 @dataclass(frozen=True)
+class ReachGrid:
+    """The goals a reach map plans to: x by z by theta (mm, mm, deg), each axis (from, to, count).
+    Made with an axis out of its range it raises TaskError naming it (the task file's pose bounds,
+    at most MAX_AXIS values an axis and MAX_CELLS cells); each axis is kept as grid_axis gives it."""
+
+    x: Axis
+    z: Axis
+    theta: Axis
+
+    def __post_init__(self) -> None:
+        for name, bound in (("x", COORDINATE), ("z", COORDINATE), ("theta", ANGLE)):
+            object.__setattr__(self, name, grid_axis(name, getattr(self, name), bound))
+        if self.cells > MAX_CELLS:
+            raise TaskError("x, z, theta", f"{self.cells} cells; at most {MAX_CELLS}")
+
+    @property
+    def axes(self) -> Tuple[Axis, Axis, Axis]:
+        return self.x, self.z, self.theta
+
+    @property
+    def cells(self) -> int:
+        return self.x[2] * self.z[2] * self.theta[2]
+
+    def goals(self) -> Tuple[Tuple[float, float, float], ...]:
+        """Every goal of the grid, x fastest, then z, then theta."""
+        return tuple((gx, gz, gth) for gth in axis_values(self.theta) for gz in axis_values(self.z)
+                     for gx in axis_values(self.x))
+
+
+@dataclass(frozen=True)
 class ReachJob:
     """A reach map's shared part: the task, the goals of the grid (x fastest, then z, then
-    theta), the seed and each cell's time limit [s]; `grid` makes it from the grid's axes."""
+    theta), the seed and each cell's time limit [s]; `grid` makes it from a ReachGrid."""
 
     task: Task
     goals: Tuple[Tuple[float, float, float], ...]
@@ -78,18 +108,14 @@ class ReachJob:
     check_limit: int = REACH_CHECKS
 
     @classmethod
-    def grid(cls, task: Task, x: Axis, z: Axis, theta: Axis, seed: int, time_limit: float,
+    def grid(cls, task: Task, grid: "ReachGrid", seed: int, time_limit: float,
              check_limit: int = REACH_CHECKS) -> "ReachJob":
-        """The job of the grid x by z by theta; TaskError naming the axis, `seed` or `time_limit` when
-        one is out of its range (the task file's pose bounds; at most MAX_AXIS values an axis and
-        MAX_CELLS cells)."""
-        x, z, theta = (grid_axis(name, axis, bound) for name, axis, bound in
-                       (("x", x, COORDINATE), ("z", z, COORDINATE), ("theta", theta, ANGLE)))
-        if x[2] * z[2] * theta[2] > MAX_CELLS:
-            raise TaskError("x, z, theta", f"{x[2] * z[2] * theta[2]} cells; at most {MAX_CELLS}")
-        goals = tuple((gx, gz, gth) for gth in axis_values(theta) for gz in axis_values(z) for gx in axis_values(x))
-        return cls(task=task, goals=goals, seed=planner_integer("seed", "seed", seed),
-                   time_limit=planner_limit("time_limit", time_limit), axes=(x, z, theta),
+        """The job of the grid; TaskError naming `seed`, `time_limit` or `check_limit` when one is
+        out of its range (TypeError for a grid that is not a ReachGrid)."""
+        if not isinstance(grid, ReachGrid):
+            raise TypeError(f"grid must be a ReachGrid(x, z, theta), got {type(grid).__name__}")
+        return cls(task=task, goals=grid.goals(), seed=planner_integer("seed", "seed", seed),
+                   time_limit=planner_limit("time_limit", time_limit), axes=grid.axes,
                    check_limit=planner_integer("check_limit", "check_limit", check_limit))
 
 
@@ -204,18 +230,17 @@ class ReachMap:
         return sum(1 for c in self.cells if c.get("guard_fired"))
 
 
-def reach_map(task: Task, x: Axis, z: Axis, theta: Axis, seed: int = 1, time_limit: float = 10.0,
-              runner=None, progress=None, check_limit: int = REACH_CHECKS) -> ReachMap:
-    """The reach map of `task` over the grid x by z by theta (each (from, to, count)), each cell's
-    search bounded by `check_limit` stable-push tests (0: by `time_limit` [s] alone, which then
-    decides what a machine's load may change); `runner` a `stablepush.runners.Runner` (None: here);
-    `progress(cell)` after each cell."""
+def reach_map(task: Task, grid: ReachGrid, seed: int = 1, time_limit: float = 10.0, runner=None, progress=None,
+              check_limit: int = REACH_CHECKS) -> ReachMap:
+    """The reach map of `task` over `grid`, each cell's search bounded by `check_limit`
+    stable-push tests (0: by `time_limit` [s] alone, which then decides what a machine's load may
+    change); `runner` a `stablepush.runners.Runner` (None: here); `progress(cell)` after each cell."""
     import time
 
     from stablepush.runners import Runner, WorkerLost, run_all
 
     require_task(task)
-    job = ReachJob.grid(task, x, z, theta, seed, time_limit, check_limit)
+    job = ReachJob.grid(task, grid, seed, time_limit, check_limit)
     runner = runner or Runner()
     started = time.perf_counter()
     cells: Dict[int, dict] = {}  # by index: run_all yields each once, as it finishes
