@@ -14,8 +14,9 @@ import time
 from shipped import TASKS
 
 from stablepush.kinematics import cell_model
-from stablepush.sim import fidelity, friction
+from stablepush.sim import fidelity
 from stablepush.sim.engines import DEFAULT_ENGINE, ENGINES
+from stablepush.sim.mujoco import friction
 from stablepush.task import check_push, load_task, with_robot
 
 
@@ -38,7 +39,7 @@ def main() -> None:
         friction.SLIDE_SPEED = float("inf")
     if args.timestep_ms is not None:
         if engine != "mujoco":
-            parser.error("--timestep-ms is MuJoCo's step (Drake's is drake_arm.DRAKE_TIMESTEP)")
+            parser.error("--timestep-ms is MuJoCo's step (Drake's is sim.drake.arm.DRAKE_TIMESTEP)")
         cell_model.TIMESTEP = args.timestep_ms / 1e3
     started = time.perf_counter()
     print(f"engine: {engine}" + (f", {cell_model.TIMESTEP * 1e3:g} ms step" if engine == "mujoco" else "") + "\n")

@@ -13,7 +13,7 @@ import yaml
 
 from stablepush.execution.world import place_features, scene_description
 from stablepush.plan import Waypoint, plan_task
-from stablepush.sim.arm import SimArm
+from stablepush.sim.mujoco.arm import SimArm
 from stablepush.task import parse_task
 from stablepush.task.schema import MAX_PUSHER_POINTS, MAX_PUSHERS, MAX_VERTICES
 

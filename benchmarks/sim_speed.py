@@ -1,7 +1,7 @@
 """How fast the simulated arm runs a plan, one worker (docs/evaluate.md, "Speed"): each task's seed-1
 plan streamed straight into the MuJoCo arm in this process (no socket, no executor), open loop, in
 the task's own world. Per task: the robot time, the wall and CPU seconds, robot seconds per wall
-second (x real time), the pads' scratch steps (stablepush.sim.friction), the mj_step calls per time
+second (x real time), the pads' scratch steps (stablepush.sim.mujoco.friction), the mj_step calls per time
 step (a scratch step taken as the time step counts once), and a fingerprint of the final state, so
 that a change meant to make the simulation cheaper can show it left every state as it was.
 
@@ -28,7 +28,7 @@ from shipped import TASKS
 from stablepush.execution.stream import arm_trajectory
 from stablepush.execution.world import place_features, scene_description
 from stablepush.plan import plan_task
-from stablepush.sim.arm import SimArm
+from stablepush.sim.mujoco.arm import SimArm
 from stablepush.task import load_task
 
 
@@ -101,7 +101,7 @@ def _timer(data, name: str):
 def _timers_cells(data, before: dict, load: list) -> str:
     """The mean microseconds of the real steps and of their constraint solves since `before`, and the
     mean contacts, constraint rows and solver iterations at the waypoints. A step the pads' friction
-    took from its scratch copy (stablepush.sim.friction) ran on that copy and is not among them."""
+    took from its scratch copy (stablepush.sim.mujoco.friction) ran on that copy and is not among them."""
     cells = []
     for name, (seconds, count) in before.items():
         now_seconds, now_count = _timer(data, name)

@@ -1,6 +1,6 @@
-"""Generate the type stubs of the compiled modules (stablepush._core, stablepush.sim._pad_friction).
+"""Generate the type stubs of the compiled modules (stablepush._core, stablepush.sim.mujoco._pad_friction).
 
-    python scripts/stubs.py --write     # python/stablepush/_core.pyi and sim/_pad_friction.pyi
+    python scripts/stubs.py --write     # python/stablepush/_core.pyi and sim/mujoco/_pad_friction.pyi
     python scripts/stubs.py --check     # exit 1 when a stub is not current (tests/test_stubs.py)
     python scripts/stubs.py --out DIR   # written under DIR instead (DIR/stablepush/_core.pyi, ...)
 
@@ -23,7 +23,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE_ROOT = ROOT / "python"
-MODULES = ("stablepush._core", "stablepush.sim._pad_friction")
+MODULES = ("stablepush._core", "stablepush.sim.mujoco._pad_friction")
 REGENERATE = "python scripts/stubs.py --write"
 
 # A parameter (not a return value) annotated with one of the value classes that a sequence

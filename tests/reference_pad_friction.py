@@ -1,7 +1,7 @@
 """The pad friction's first implementation, in numpy: the reference the compiled one
-(`stablepush.sim._pad_friction`, cpp/sim/coulomb_pad_friction.cpp) is checked against in
+(`stablepush.sim.mujoco._pad_friction`, cpp/sim/coulomb_pad_friction.cpp) is checked against in
 tests/test_pad_friction.py, bit for bit. The algorithm and its thresholds are
-stablepush/sim/friction.py's."""
+stablepush/sim/mujoco/friction.py's."""
 from __future__ import annotations
 
 from typing import Sequence
@@ -9,7 +9,7 @@ from typing import Sequence
 import mujoco
 import numpy as np
 
-from stablepush.sim.friction import (
+from stablepush.sim.mujoco.friction import (
     DIRECTION_TOLERANCE_DEG,
     FRICTIONLESS_MU,
     MAX_TRIALS,
@@ -23,7 +23,7 @@ _DIRECTIONS_AGREE = np.cos(np.radians(DIRECTION_TOLERANCE_DEG))
 
 
 class ReferencePadFriction:
-    """stablepush.sim.friction.CoulombPadFriction's interface and behaviour, in numpy."""
+    """stablepush.sim.mujoco.friction.CoulombPadFriction's interface and behaviour, in numpy."""
 
     def __init__(self, model, pad_geoms: Sequence[int]):
         self.model = model

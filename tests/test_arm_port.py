@@ -214,7 +214,7 @@ def test_the_engine_neutral_parts_and_the_drake_arm_load_no_mujoco():
         "except ImportError:\n"
         "    print('no drake')\n"
         "else:\n"
-        "    import stablepush.sim.drake_arm\n"
+        "    import stablepush.sim.drake.arm\n"
         "    assert load_engine('drake') == 'drake'\n"
         "print('mujoco' in sys.modules)\n"
     )

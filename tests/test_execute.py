@@ -556,7 +556,7 @@ def test_closed_loop_lands_the_wedge_in_a_low_friction_world_and_says_so(tmp_pat
     with 15% less mu than its task, closed loop, the run lands within 0.2 mm and 0.2 deg of the goal,
     the report says success and lists the corrections with what triggered them. On Drake its goal
     puts a pad point 0.15 mm inside the heel face, where Drake's sphere-vs-convex query answered
-    through that face and pushed the wedge 0.4 mm out of the grasp (drake_arm._add_pad_faces)."""
+    through that face and pushed the wedge 0.4 mm out of the grasp (sim.drake.arm._add_pad_faces)."""
     _, report = _closed_loop_within_0_2_at_0_85(tmp_path, "more/wedge-heel.yaml", "--engine", engine)
     assert report["success"] is True and report["tolerance"] == [0.2, 0.2] and report["engine"] == engine
     assert report["replans"] and all(r["trigger"] in ("plan_short", "off_plan", "off_goal") for r in report["replans"])

@@ -6,7 +6,8 @@ friction.py, Drake with its own contact solver). `python3 benchmarks/friction_fi
 """
 import pytest
 
-from stablepush.sim import fidelity, friction
+from stablepush.sim import fidelity
+from stablepush.sim.mujoco import friction
 from stablepush.task import check_push
 
 from conftest import shipped
@@ -77,7 +78,7 @@ def test_drakes_coarser_step_fails_the_contract(monkeypatch):
     """Drake's convex friction is regularized: a sticking contact slips at a rate proportional to
     the time step. At 0.4 ms (not the arm's 0.125 ms) the stable pivot turns about 0.2 deg in the
     world, past the contract's 0.1 deg, so the contract decides the step."""
-    from stablepush.sim import drake_arm
+    from stablepush.sim.drake import arm as drake_arm
 
     monkeypatch.setattr(drake_arm, "DRAKE_TIMESTEP", 0.0004)
     result = fidelity.pivot(shipped("pivoting"), "left", turn_deg=30, engine="drake")
@@ -87,7 +88,7 @@ def test_drakes_coarser_step_fails_the_contract(monkeypatch):
 def test_each_drake_contact_pair_has_the_tasks_mu():
     """Drake combines two surfaces' mu as 2 a b / (a + b); each pad and feature carries the partner
     value that gives its pair with the object the task's (or the deviated world's) mu."""
-    from stablepush.sim import drake_arm
+    from stablepush.sim.drake import arm as drake_arm
 
     for mu in (0.0, 1e-6, 0.1, 0.35, 0.6, 1.0, 3.0, 100.0):
         b = drake_arm.partner_mu(mu)

@@ -141,7 +141,7 @@ def test_the_mjcf_of_a_mesh_task_holds_its_pieces_as_mesh_geoms(tmp_path):
 
 def test_the_drake_world_of_a_mesh_task_holds_its_pieces_as_convex_shapes(tmp_path):
     pytest.importorskip("pydrake")
-    from stablepush.sim.drake_arm import DrakeGrasp
+    from stablepush.sim.drake.arm import DrakeGrasp
 
     task = _flanged(tmp_path)
     scene = _scene(task)

@@ -16,8 +16,8 @@ from stablepush.execution.stream import arm_trajectory
 from stablepush.execution.world import place_features, scene_description
 from stablepush.kinematics import cell_model
 from stablepush.plan import plan_task
-from stablepush.sim.arm import SimArm
-from stablepush.sim.friction import CoulombPadFriction
+from stablepush.sim.mujoco.arm import SimArm
+from stablepush.sim.mujoco.friction import CoulombPadFriction
 
 from conftest import shipped
 from reference_pad_friction import ReferencePadFriction

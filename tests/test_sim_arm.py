@@ -14,8 +14,8 @@ from stablepush.execution.world import place_features, scene_description
 from stablepush.frames import grasp_transform, pose_to_matrix
 from stablepush.kinematics.cell_model import convex_pieces
 from stablepush.plan import Waypoint
-from stablepush.sim.arm import SimArm
 from stablepush.sim.engines import ENGINES, make_arm
+from stablepush.sim.mujoco.arm import SimArm
 
 from conftest import shipped, task_with
 
@@ -45,7 +45,7 @@ def _ledge_force(task, speed=0.01, duration=1.0, engine="mujoco"):
 @pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("grip_force, mu", [
     (10.0, 0.425), (10.0, 0.6), (5.0, 0.3),
-    (20.0, 0.8),  # chattered (16% high) before sliding pad points got Coulomb friction (sim/friction.py)
+    (20.0, 0.8),  # chattered (16% high) before sliding pad points got Coulomb friction (sim/mujoco/friction.py)
 ])
 def test_ledge_force_to_slide_the_held_object_is_coulombs(grip_force, mu, engine):
     def edit(data):

@@ -1,4 +1,4 @@
-"""The compiled modules' type stubs (python/stablepush/_core.pyi, sim/_pad_friction.pyi) are what
+"""The compiled modules' type stubs (python/stablepush/_core.pyi, sim/mujoco/_pad_friction.pyi) are what
 scripts/stubs.py generates from the built modules now, and ship with the package with py.typed."""
 import importlib.util
 

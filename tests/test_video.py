@@ -1,4 +1,4 @@
-"""Videos of runs (`execute --video`, `evaluate --video-failed`; stablepush.sim.video): drawn
+"""Videos of runs (`execute --video`, `evaluate --video-failed`; stablepush.sim.mujoco.video): drawn
 headless from the recorded states, decoded back with imageio-ffmpeg's reader. The fast tests check
 the options and what each waypoint carries; the slow ones (marked) run the simulated arm."""
 import json
@@ -12,7 +12,7 @@ from stablepush.execution.bags import RunRecording, RunSample
 from stablepush.execution.stream import arm_trajectory
 from stablepush.execution.world import place_features
 from stablepush.plan import check_plan, plan_task
-from stablepush.sim import video
+from stablepush.sim.mujoco import video
 from stablepush_cli.main import cli
 
 from conftest import TASKS, shipped

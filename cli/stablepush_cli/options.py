@@ -165,7 +165,7 @@ class VideoBar:
 
 
 def video_output(option: str, path: str, fps: float, size, quiet: bool, view: str = "schematic"):
-    """The run's video in `view` as an output (stablepush.sim.video.RunVideo), with a VideoBar
+    """The run's video in `view` as an output (stablepush.sim.mujoco.video.RunVideo), with a VideoBar
     unless `quiet`; exit 2 naming `option` for one that could not be written. Loads MuJoCo for
     headless rendering (MUJOCO_GL=osmesa), so call it before the simulated arm starts."""
     check_video(option, path, fps, size)

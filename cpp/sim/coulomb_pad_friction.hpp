@@ -1,5 +1,5 @@
 // Pad friction in MuJoCo that sticks and slides as Coulomb's law says: the simulated arm's one
-// compiled part (python/stablepush/sim/friction.py explains the physics, its thresholds and why).
+// compiled part (python/stablepush/sim/mujoco/friction.py explains the physics, its thresholds and why).
 //
 // A pad point whose own slip says it slides gets its contact made frictionless for the step and
 // Coulomb's friction applied as a generalized force,

@@ -1,4 +1,4 @@
-// PYBIND11_MODULE(_pad_friction): coulomb_pad_friction.hpp for python/stablepush/sim/friction.py,
+// PYBIND11_MODULE(_pad_friction): coulomb_pad_friction.hpp for python/stablepush/sim/mujoco/friction.py,
 // which owns the MuJoCo model and data and hands their addresses over (MjModel._address).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -25,7 +25,7 @@ py::array_t<bool> as_array(const std::vector<char>& flags) {
 }  // namespace
 
 PYBIND11_MODULE(_pad_friction, m) {
-  m.doc() = "The simulated arm's pad friction in C++ (stablepush.sim.friction explains it; SI units)";
+  m.doc() = "The simulated arm's pad friction in C++ (stablepush.sim.mujoco.friction explains it; SI units)";
   m.attr("MUJOCO_VERSION") = mjVERSION_HEADER;  // the headers built against: must equal mujoco.mj_version()
 
   py::class_<PadFrictionParameters>(m, "PadFrictionParameters", "The pad friction's thresholds (friction.py).")

@@ -1,6 +1,6 @@
 """A run of a plan on an arm, with what it writes: `run_plan` streams the plan (executor.py) to
 any arm behind the port (arm.py), records the run when an output needs it, and writes each output
-(the JSON report, an MCAP bag, a video: `stablepush.sim.video.RunVideo`) whether the run landed,
+(the JSON report, an MCAP bag, a video: `stablepush.sim.mujoco.video.RunVideo`) whether the run landed,
 missed or ended in a fault. `stablepush execute`, evaluate's trials, the fidelity contract and the
 benchmarks all run plans through it.
 """

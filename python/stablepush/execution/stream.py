@@ -52,7 +52,7 @@ class ArmWaypoint:
     (during a push) or the last one reached (otherwise); when `completes` is set, the arm's
     acknowledgement of this waypoint confirms that plan step. `planned` is that step's pose in the
     grasp (x mm, z mm, theta deg) in the plan being streamed, a re-planned one after a correction
-    (so a recording can show the plan the arm was following, `stablepush.sim.video`)."""
+    (so a recording can show the plan the arm was following, `stablepush.sim.mujoco.video`)."""
 
     seq: int
     t: float  # s from the start of the stream

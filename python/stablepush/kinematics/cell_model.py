@@ -10,7 +10,7 @@ Contact settings that keep friction honest (the simulation's results rest on the
 - elliptic friction cones with impratio 100, so sticking contacts do not creep;
 - noslip iterations, which remove the residual slip of MuJoCo's soft constraints;
 - a small solref time constant (stiff contacts, 2.5 time steps);
-- pad friction chosen per pad point by its own slip (the MuJoCo engine's `friction.py`): the solver's stiff friction
+- pad friction chosen per pad point by its own slip (`stablepush.sim.mujoco.friction`): the solver's stiff friction
   while it sticks, explicit Coulomb friction (mu N opposite its slip) while it slides, which
   removes the pads' drop-outs while they slide;
 - each pad is a disc of point contacts laid out as the task's `pad_rings` says, so the simulated
@@ -281,7 +281,7 @@ def object_com(obj: SceneObject) -> Tuple[float, float, float]:
 def object_pieces(obj: SceneObject) -> List[Tuple[str, list, bool]]:
     """The section's convex pieces: (name, convex ccw outline in O's xz [m], whether the piece is
     an axis-aligned rectangle). The prism of these is what a box or polygon part is simulated as
-    (object_solid); Drake's pads touch deep prisms of them on any part (drake_arm._add_pad_faces)."""
+    (object_solid); Drake's pads touch deep prisms of them on any part (sim.drake.arm._add_pad_faces)."""
     pieces = convex_pieces(simulated_outline(obj.polygon)[0])
     return [(f"object_piece{i}", piece, _axis_aligned_rectangle(piece)) for i, piece in enumerate(pieces)]
 

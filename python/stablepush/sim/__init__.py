@@ -1,11 +1,11 @@
-"""The simulated arm on two physics engines (engines.py): MuJoCo (arm.py, friction.py) and Drake
-(drake_arm.py), both building the cell that stablepush.kinematics describes; what both share
-(tracking.py: IK on kinematics.ik, the servo ramp, the state;
-deviation.py: a world that departs from the task), the arm behind the arm port in this process
-(local_arm.py) and served over TCP (server.py, `stablepush sim-arm`), the friction-fidelity
-contract both must pass (fidelity.py), and videos of recorded runs (video.py)."""
+"""The simulated arm on two physics engines, each a sub-package: MuJoCo (mujoco/: the arm, the pads'
+friction, videos of recorded runs) and Drake (drake/), both building the cell that
+stablepush.kinematics describes, named in one registry (engines.py). What both share stays here:
+tracking.py (IK on kinematics.ik, the servo ramp, the state), deviation.py (a world that departs
+from the task), the arm behind the arm port in this process (local_arm.py) and served over TCP
+(server.py, `stablepush sim-arm`), and the friction-fidelity contract both must pass (fidelity.py)."""
 
-# How a run's video draws it (video.py): here, so that a command line can offer the choice without
+# How a run's video draws it (mujoco/video.py): here, so that a command line can offer the choice without
 # loading the renderer's module.
 VIDEO_VIEWS = ("schematic", "3d", "both")
 
@@ -20,11 +20,11 @@ _EXPORTS = {
     # the cell check's, for the command lines that build an arm (a simulated or a served one)
     "CellError": "stablepush.kinematics.cell_path",
     "modelled": "stablepush.kinematics.cell_path",
-    "RunVideo": "stablepush.sim.video",
-    "check_fps": "stablepush.sim.video",
-    "check_size": "stablepush.sim.video",
-    "check_video_path": "stablepush.sim.video",
-    "video_directory": "stablepush.sim.video",
+    "RunVideo": "stablepush.sim.mujoco.video",
+    "check_fps": "stablepush.sim.mujoco.video",
+    "check_size": "stablepush.sim.mujoco.video",
+    "check_video_path": "stablepush.sim.mujoco.video",
+    "video_directory": "stablepush.sim.mujoco.video",
 }
 __all__ = ["VIDEO_VIEWS", *_EXPORTS]
 __getattr__ = lazy_exports(__name__, _EXPORTS)

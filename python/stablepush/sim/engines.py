@@ -1,6 +1,6 @@
-"""The physics engines a simulated arm can run on, by name, in one registry: MuJoCo (`arm.py`,
-whose sliding pad friction is stablepush's own Coulomb law, `friction.py`) and Drake
-(`drake_arm.py`, whose contact solver alone decides stick and slip). Both build the same arm,
+"""The physics engines a simulated arm can run on, by name, in one registry: MuJoCo (`mujoco/arm.py`,
+whose sliding pad friction is stablepush's own Coulomb law, `mujoco/friction.py`) and Drake
+(`drake/arm.py`, whose contact solver alone decides stick and slip). Both build the same arm,
 grasp and world from a scene (execution.scene.Scene) and answer to the same calls, `EngineArm`
 and `EngineGrasp` below, so the in-process arm (local_arm.py), the executor and the fidelity
 contract never ask which one they have. Importing this module loads neither engine.
@@ -58,8 +58,8 @@ class Engine:
 
 # The one place an engine is named. Drake reads the arm's MJCF with its own parser: no MuJoCo needed.
 REGISTRY: Dict[str, Engine] = {
-    "mujoco": Engine("mujoco", "stablepush.sim.arm", "SimArm", "SimulatedGrasp"),
-    "drake": Engine("pydrake.all", "stablepush.sim.drake_arm", "DrakeArm", "DrakeGrasp"),
+    "mujoco": Engine("mujoco", "stablepush.sim.mujoco.arm", "SimArm", "SimulatedGrasp"),
+    "drake": Engine("pydrake.all", "stablepush.sim.drake.arm", "DrakeArm", "DrakeGrasp"),
 }
 ENGINES = tuple(REGISTRY)
 DEFAULT_ENGINE = "mujoco"

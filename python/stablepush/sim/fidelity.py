@@ -2,8 +2,8 @@
 that runs plans must reproduce before its results mean anything.
 
 Every experiment uses the arm's own grasp (fingers, force-capped jaw servos, pad points, contact
-pairs, solver options and the pad friction of `kinematics/cell_model.py` and `friction.py`) on a hand that
-moves as prescribed in G's plane (`build_mjcf(..., kinematic_hand=True)`), so what is measured is
+pairs, solver options and the pad friction of `kinematics/cell_model.py` and `mujoco/friction.py`) on a
+hand that moves as prescribed in G's plane (`build_mjcf(..., kinematic_hand=True)`), so what is measured is
 friction, not the arm's tracking:
 
 - `wall_creep`: a box held by two pads that slide over it at a given speed while a fixed wall

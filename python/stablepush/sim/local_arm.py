@@ -34,7 +34,7 @@ class SimulatedArm(Arm):
         arm_model(self.robot)  # a model that cannot carry the jaws is the caller's error now (RobotError)
         self.deviation = deviation
         self.log = log or (lambda text: None)
-        self.sim: Any = None  # the engine's arm (arm.SimArm or drake_arm.DrakeArm) of the current world
+        self.sim: Any = None  # the engine's arm (mujoco.arm.SimArm or drake.arm.DrakeArm) of the current world
         self._scene: Optional[Scene] = None
         self._period = 0.01
 

@@ -1,4 +1,4 @@
-"""What a simulated arm does the same on every engine (MuJoCo's `arm.py`, Drake's `drake_arm.py`):
+"""What a simulated arm does the same on every engine (MuJoCo's `mujoco/arm.py`, Drake's `drake/arm.py`):
 the pose in the grasp it reports, the IK that turns a streamed pose of G into joint set-points,
 the servo ramp between waypoints, and the state message with the tracker's noise. Imports no engine.
 
@@ -40,7 +40,7 @@ class TrackingArm:
     next's over the waypoint period (`_set_servos`, `_run`), and the report with the tracker's
     noise. Mixed in before the engine's grasp class, whose constructor takes the altered scene."""
 
-    if TYPE_CHECKING:  # what the engine's grasp and arm class give (arm.SimArm, drake_arm.DrakeArm)
+    if TYPE_CHECKING:  # what the engine's grasp and arm class give (mujoco.arm.SimArm, drake.arm.DrakeArm)
         arm: ArmModel
         timestep: float
         steps_per_second: float

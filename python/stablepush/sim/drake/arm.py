@@ -1,5 +1,5 @@
 """The simulated arm in Drake, the second engine: the same arm, grasp and world as the MuJoCo
-one (`arm.py`), with Drake's own contact solver deciding stick and slip. Nothing here writes a
+one (`sim/mujoco/arm.py`), with Drake's own contact solver deciding stick and slip. Nothing here writes a
 friction force.
 
 The arm is the shipped arm.xml read by Drake's MJCF parser (`cell_model.arm_tree`); what that parser
@@ -7,9 +7,9 @@ leaves out is added with Drake's own API from the same tree: the position servos
 (as PD gains), the jaw coupling (a coupler constraint), gravity compensation (`gravcomp`: a
 feed-forward torque) and the site G (a fixed frame). The pads' point spheres, the object's convex
 pieces (a mesh part's own, or the prism of the section) and the features come from the same scene
-parts as MuJoCo's (`scene.pad_layout`, `scene.object_solid`, `scene.feature_solid`).
+parts as MuJoCo's (`cell_model.pad_layout`, `cell_model.object_solid`, `cell_model.feature_solid`).
 
-Contact (chosen by the friction-fidelity contract, `fidelity.py`; docs/engines.md says how):
+Contact (chosen by the friction-fidelity contract, `sim/fidelity.py`; docs/engines.md says how):
 - Drake's DRAKE_APPROXIMATION discrete model (a convex approximation solved by SAP; the PD servos,
   their effort limits and the coupler are implicit in it), at DRAKE_TIMESTEP: its friction is
   regularized, and a sticking contact slips at about 1e-3 w f h (w the contact's inverse mass, f

@@ -48,7 +48,7 @@ from stablepush.extras import require
 # Before _pad_friction, which links against MuJoCo's library: without the package, the extra to install.
 mujoco = require("mujoco", "the simulated arm (execute --sim, evaluate, sim-arm)")
 
-from stablepush.sim import _pad_friction  # noqa: E402
+from stablepush.sim.mujoco import _pad_friction  # noqa: E402
 
 SLIDE_SPEED = 5e-4  # m/s: a pad point slipping faster than this (SLIDE_STEPS steps running) may slide
 STICK_SPEED = 1e-4  # m/s: a sliding pad point whose slip falls below this sticks again

@@ -17,7 +17,7 @@ from stablepush.kinematics import cell_model
 from stablepush.kinematics.arm_kinematics import ArmKinematics
 from stablepush.kinematics.robot import FINGER_JOINTS, GRIPPER_SITE, arm_model
 from stablepush.sim.deviation import WorldDeviation
-from stablepush.sim.friction import CoulombPadFriction, mujoco
+from stablepush.sim.mujoco.friction import CoulombPadFriction, mujoco
 from stablepush.sim.tracking import SETTLE_TIME, TrackingArm, in_grasp
 from stablepush.task.model import Robot
 

@@ -1,5 +1,5 @@
 """
-The simulated arm's pad friction in C++ (stablepush.sim.friction explains it; SI units)
+The simulated arm's pad friction in C++ (stablepush.sim.mujoco.friction explains it; SI units)
 """
 from __future__ import annotations
 import collections.abc
