@@ -28,7 +28,7 @@ from generated_task_odds import generate_task, goal_for
 from shipped import TASKS
 
 from stablepush.design import DEFAULT_RANK, design, evaluate_designs, measure_layout
-from stablepush.task.schema import candidate_pushers
+from stablepush.task.design_file import candidate_pushers
 
 NO_END_OR_POINTS = tuple(k for k in DEFAULT_RANK if k not in ("end", "points"))
 

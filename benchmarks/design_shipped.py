@@ -15,7 +15,7 @@ from evaluate_tasks import add_runner_options, runner_of
 from shipped import TASKS
 
 from stablepush.design import DEFAULT_RANK, design, measure_layout
-from stablepush.task.schema import candidate_pushers
+from stablepush.task.design_file import candidate_pushers
 
 DEFAULT_TASKS = ("horizontal-offset-low-mu", "horizontal-offset-high-mu", "pivoting", "t-shaped", "large-manipulation")
 

@@ -413,7 +413,7 @@ def _api_context(sp, scratch: Path) -> dict:
     from stablepush.evaluation import Batch, SequentialTest, Spreads
     from stablepush.plan.reach import ReachGrid
     from stablepush.sim.deviation import WorldDeviation
-    from stablepush.task.schema import load_design
+    from stablepush.task.design_file import load_design
 
     from generated_arms import urdf_arm
 

@@ -26,7 +26,7 @@ from stablepush.design import (
 from stablepush.errors import TaskError
 from stablepush.evaluation import Batch, Spreads, evaluate
 from stablepush.runners import Runner
-from stablepush.task.schema import load_design
+from stablepush.task.design_file import load_design
 from stablepush.units import pose_to_si
 from stablepush_cli.main import cli
 

@@ -14,7 +14,7 @@ from stablepush import design as design_package
 from stablepush.design import layouts, odds
 from stablepush.errors import SettingError, StablepushError, TaskError
 from stablepush.evaluation import SequentialTest, Spreads, study_trials
-from stablepush.task.schema import load_design
+from stablepush.task.design_file import load_design
 from stablepush_cli.main import cli
 
 from conftest import ROOT

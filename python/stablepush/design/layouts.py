@@ -1,7 +1,7 @@
 """Where should the fixtures go: from a part, a grasp, a start and a goal to a ranked set of
 fixture layouts, each a complete task with a verified plan (`stablepush design`).
 
-A design file is a task file whose `candidates` stand in for its `pushers` (schema.load_design):
+A design file is a task file whose `candidates` stand in for its `pushers` (design_file.load_design):
 every edge and convex corner of the part's section, or pushers listed. A layout is a set of at
 most `max_fixtures` candidates. The search
 1. prunes every candidate whose cone holds no stable push, from the start, that brings the object
@@ -41,9 +41,10 @@ from stablepush.plan.reach import ReachGrid, reach_map
 from stablepush.plan.search import require_goal_apart
 from stablepush.plan.verify import plan_margin
 from stablepush.runners import Runner, WorkerLost, run_all
+from stablepush.task.fields import planner_integer, planner_limit
 from stablepush.task.mechanics import stable_directions
 from stablepush.task.model import Robot, Task
-from stablepush.task.schema import parse_task, planner_integer, planner_limit
+from stablepush.task.schema import parse_task
 from stablepush.task.task_text import commented_task, with_files_named_absolutely
 from stablepush.units import is_integer
 
@@ -282,16 +283,18 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
            max_fixtures: int = 2, rank: Sequence[str] = DEFAULT_RANK, reach_top: int = 3,
            time_limit: Optional[float] = None, runner: Optional[Runner] = None,
            progress: Optional[Callable[[Design], None]] = None, check_limit: int = LAYOUT_CHECKS) -> DesignStudy:
-    """Search the layouts of at most `max_fixtures` of `candidates` (schema.load_design), each
+    """Search the layouts of at most `max_fixtures` of `candidates` (design_file.load_design), each
     planned within `check_limit` stable-push tests (0: no count; then `time_limit` s, None: the
     task's planner.time_limit, which is otherwise only a guard), and rank the solved ones
     by `rank` (keys of RANK_KEYS); the best `reach_top` get a reach map around the goal.
     `progress(design)` after each layout is planned."""
     rank, check_limit = _checked_arguments(max_fixtures, rank, reach_top, time_limit, runner, progress, check_limit)
     if not isinstance(task, dict):
-        raise TypeError(f"task must be a design file's task mapping (schema.load_design), got {type(task).__name__}")
+        raise TypeError(f"task must be a design file's task mapping (design_file.load_design), got "
+                        f"{type(task).__name__}")
     if not isinstance(candidates, (list, tuple)) or not all(isinstance(c, dict) for c in candidates):
-        raise TypeError(f"candidates must be a list of pusher entries (schema.load_design), got {candidates!r:.60}")
+        raise TypeError(f"candidates must be a list of pusher entries (design_file.load_design), got "
+                        f"{candidates!r:.60}")
     max_fixtures = min(max_fixtures, len(candidates))
     everything = layout_task(task, candidates, source)  # every candidate checked once, on the part
     require_goal_apart(everything)  # else every candidate would be pruned as making no push toward the goal
@@ -460,7 +463,7 @@ def design_files(study: DesignStudy, task: Dict[str, Any], candidates: Sequence[
     with the design file `source`'s comments where they apply (task.task_text.commented_task)."""
     try:
         text = Path(source).read_text(encoding="utf-8") if source is not None else None
-    except (OSError, UnicodeError):  # read once already (schema.load_design); without it, no comments
+    except (OSError, UnicodeError):  # read once already (design_file.load_design); without it, no comments
         text = None
     files: Dict[Union[str, Path], str] = {}  # as write_designs takes them (each key a str)
     for k, d in enumerate(study.designs, start=1):

@@ -57,9 +57,9 @@ from stablepush.errors import PadFaceError
 from stablepush.plan.plan import Waypoint
 from stablepush.plan.search import plan_task
 from stablepush.pose import Pose, PoseLike, Tolerance
+from stablepush.task.fields import PLANNER_PARAMETER_RANGES
 from stablepush.task.mechanics import blocked_senses
 from stablepush.task.model import Task
-from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import as_triple, pose_to_si
 
 THRESHOLD_FRACTION = 0.5  # default threshold: this fraction of the task's goal tolerance

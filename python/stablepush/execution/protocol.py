@@ -60,17 +60,9 @@ from stablepush import strict_json
 from stablepush.execution.part_geometry import MAX_PIECE_VERTICES, MAX_PIECES
 from stablepush.execution.scene import Scene
 from stablepush.strict_json import is_finite_number
-from stablepush.task.schema import (
-    ANGLE,
-    COORDINATE,
-    LIMITS,
-    MAX_PAD_POINTS,
-    MAX_PAD_RINGS,
-    MAX_PADS,
-    MAX_PUSHERS,
-    MAX_VERTICES,
-    MIN_POSITIVE_MU,
-)
+from stablepush.task.fields import LIMITS, MIN_POSITIVE_MU
+from stablepush.task.parts import ANGLE, COORDINATE
+from stablepush.task.schema import MAX_PAD_POINTS, MAX_PAD_RINGS, MAX_PADS, MAX_PUSHERS, MAX_VERTICES
 from stablepush.units import MM, G
 
 PROTOCOL = "stablepush.arm/2"
@@ -179,7 +171,7 @@ def _check_placed(pose: list, what: str) -> None:
         raise ProtocolError(f"{what}: the quaternion is not of unit length")
 
 
-# A hello's scene (scene.Scene.as_dict, SI units) within the task file's own ranges (schema.LIMITS,
+# A hello's scene (scene.Scene.as_dict, SI units) within the task file's own ranges (fields.LIMITS,
 # in mm, g and N there): kind -> (lowest, highest), converted once.
 _SCENE_RANGES = {
     "position": (COORDINATE[0] * MM, COORDINATE[1] * MM),  # m: polygon, com, pad centres, feature ends
@@ -203,7 +195,7 @@ def read_scene(scene: Any) -> Scene:
 
 def check_scene(scene: Any) -> None:
     """A hello's `scene` (scene.Scene.as_dict) as a world can be built from: every number finite
-    and within the task file's own range for it (schema.LIMITS, in SI), the counts within the task
+    and within the task file's own range for it (fields.LIMITS, in SI), the counts within the task
     file's caps (vertices, pads, pad rings and their points, features), each feature's normal a
     unit vector and its object pose a pose; ProtocolError naming the field otherwise. A simulator
     built worlds from a gripper mu of -1, a normal [0, 0, 0], a mu of 1e300 or no pads."""
@@ -313,7 +305,7 @@ def _numbers(path: str, value: Any, n: int, kind: Optional[str]) -> None:
 
 
 def _friction(path: str, value: Any) -> None:
-    """A friction coefficient as a task file takes one (schema._friction): 0, or MIN_POSITIVE_MU up."""
+    """A friction coefficient as a task file takes one (fields._friction): 0, or MIN_POSITIVE_MU up."""
     _number(path, value, "mu")
     if 0.0 < value < MIN_POSITIVE_MU:
         raise ProtocolError(f"hello: {path} must be 0 (frictionless) or at least {MIN_POSITIVE_MU:g}, got {value:g}")

@@ -35,9 +35,10 @@ import numpy as np
 from stablepush.errors import PadFaceError, TaskError
 from stablepush.plan.search import plan_task
 from stablepush.plan.unreachable import pads_off_near, why_unreachable
+from stablepush.task.fields import number_field, planner_integer, planner_limit
 from stablepush.task.mesh import first_pad_off_faces
 from stablepush.task.model import Task, require_task
-from stablepush.task.schema import ANGLE, COORDINATE, number_field, planner_integer, planner_limit
+from stablepush.task.parts import ANGLE, COORDINATE
 from stablepush.units import as_triple, is_finite_real, pose_to_si
 
 Axis = Tuple[float, float, int]  # from, to, count (count 1: `from` alone)

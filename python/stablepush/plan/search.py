@@ -18,10 +18,10 @@ from stablepush.plan.files import MAX_WAYPOINTS
 from stablepush.plan.plan import Plan, PusherContact, Waypoint
 from stablepush.plan.unreachable import why_unreachable
 from stablepush.pose import Tolerance
+from stablepush.task.fields import LIMITS, number_field, planner_limit, planner_parameter
 from stablepush.task.mechanics import blocked_senses
 from stablepush.task.mesh import first_pad_off_faces, slab_text
 from stablepush.task.model import PlannerSettings, Task, require_task
-from stablepush.task.schema import LIMITS, number_field, planner_limit, planner_parameter
 from stablepush.units import MM, pose_from_si, pose_to_si
 
 

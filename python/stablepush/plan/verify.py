@@ -9,9 +9,9 @@ from typing import List, Optional, Sequence
 from stablepush.compiled import _core
 from stablepush.errors import PlanError
 from stablepush.plan.plan import FieldFault, Plan, Waypoint, require_plan
+from stablepush.task.fields import PLANNER_PARAMETER_RANGES
 from stablepush.task.model import Task, require_task
 from stablepush.task.release import needed_hold_ratio
-from stablepush.task.schema import PLANNER_PARAMETER_RANGES
 from stablepush.units import MM, pose_to_si
 
 STEP_SLACK = 1e-6  # unit steps: rounding in a plan file's decimal poses

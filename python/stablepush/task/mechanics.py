@@ -9,8 +9,8 @@ import numpy as np
 from stablepush.compiled import _core
 from stablepush.errors import TaskError
 from stablepush.pose import Tolerance
+from stablepush.task.fields import number_field, pose_field
 from stablepush.task.model import Task, require_task
-from stablepush.task.schema import number_field, pose_field
 from stablepush.units import pose_to_si
 
 SMALLEST_MOVE = 1e-6  # mm or deg: below, the motion's velocity terms are rounding noise

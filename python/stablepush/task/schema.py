@@ -1,4 +1,6 @@
-"""Task files (docs/model.md section 4): read the YAML, validate every field, make a `Task`.
+"""Task files (docs/model.md section 4): read the YAML, validate every field, make a `Task`. The
+checks of single fields and the YAML reader are fields.py's, the environment.robot section
+robot_section.py's; a design file (design_file.py) is read with this file's object and pusher checks.
 
 Files use mm, degrees, grams and newtons. Every bad input is refused with a `TaskError` that
 names the field and the reason, before anything reaches the C++ core.
@@ -7,10 +9,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import datetime
 import math
-import re
-import reprlib
 from pathlib import Path
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
@@ -19,30 +18,43 @@ import yaml
 
 from stablepush.compiled import _core
 from stablepush.errors import TaskError
-from stablepush.frames import turn
 from stablepush.inputs import read_capped
 from stablepush.outputs import protect_input
+from stablepush.task.fields import (
+    LIMITS,
+    MAX_TASK_BYTES,
+    PLANNER_PARAMETER_RANGES,
+    SUB_MM,
+    _friction,
+    _in_metres,
+    _integer,
+    _load_yaml,
+    _mapping,
+    _name,
+    _number,
+    _pair,
+    _reads_as_radians,
+    _shown,
+    _vector,
+    _yaml_problem,
+    planner_limit,
+    planner_parameter,
+    pose_field,
+)
 from stablepush.task.mesh import PartMesh, first_pad_off_faces, load_mesh_object, slab_text
 from stablepush.task.model import (
-    JOINT_SPEED,
     MAX_PUSHER_POINTS,
     PLANNER_DEFAULTS,
-    PLANNER_LIMITS,
-    ROBOT_MODEL_SUFFIXES,
     UNCERTAIN,
     Cell,
     PlannerSettings,
     PusherSpec,
-    Robot,
     Task,
 )
 from stablepush.task.parts import (
     ANGLE,
     COORDINATE,
-    LENGTH,
-    MU,
     ON_BOUNDARY,
-    PHYSICS_LIMITS,
     PUSHES,
     DynamicsSpec,
     GripperSpec,
@@ -50,8 +62,8 @@ from stablepush.task.parts import (
     outline_corners,
 )
 from stablepush.task.release import goal_release_holds, needed_hold_ratio
-from stablepush.task.robot_files import model_source
-from stablepush.units import MM, is_integer, is_real, mm2_to_si, pose_to_si
+from stablepush.task.robot_section import robot_section
+from stablepush.units import MM, mm2_to_si, pose_to_si
 
 DEFAULT_PAD_RADIUS_MM = 5.0
 DEFAULT_GRAVITY = (0.0, -9.81)
@@ -60,270 +72,17 @@ DEFAULT_POLYGON_SIDES = 16
 DEFAULT_PUSHER_POINTS = 3
 MAX_PUSHERS = 32  # the planner holds sets of pushers as 32-bit masks
 SNAP_TO_EDGE = 0.05  # mm: a pusher this close to an edge is put on it (a warning says so)
-# mm: a pad radius, retract or spacing under this, or a pusher or world position this near 0 in
-# every coordinate, reads as a length written in metres (the warnings and refusals say so).
-SUB_MM = 1.0
 # Resource caps: each bounds the model's size (and so the time and memory to build it and to
 # test a push) before anything reaches the core. docs/limits.md, "Limits".
-MAX_TASK_BYTES = 1_000_000
 MAX_VERTICES = 1000  # of the cross-section
 MAX_PAD_RINGS = 6  # 1 + 3 r (r + 1) points per pad: 127 at the cap
 MAX_PAD_POINTS = 128  # over all pads: the hold ratio's LP grows with the cube of the points (about 2 s at the cap)
 MAX_PADS = 8
 # A segment's cone is its end points' anyway, and building it grows fast with more (0.1 s a pusher at 50).
 MAX_POLYGON_SIDES = 64
-MAX_YAML_ALIASES = 1000  # aliases (*name) a task file may use (PyYAML writes one per shared value)
-MAX_YAML_NODES = 100_000  # values in the file, aliases expanded
-# Plausible-physics bounds on each number, in file units (the world's, COORDINATE, ANGLE and
-# LENGTH, are model.py's: the cell and robot values check them too).
-LIMITS: Dict[str, Tuple[float, float]] = {  # kind -> (lowest, highest); both inclusive
-    "length": LENGTH,  # mm: sizes, radii, distances
-    "mu": MU,
-    **PHYSICS_LIMITS,
-    **PLANNER_LIMITS,
-}
 # Where the arm works (stablepush.execution): the environment section's keys but `features`, and
 # their defaults (Cell says what each is).
 ENVIRONMENT_DEFAULTS: Dict[str, Any] = {k: v for k, v in Cell().as_dict().items() if k not in ("features", "robot")}
-
-# TRRTstar's declared parameters and their ranges live in the C++ planner (declared once there;
-# its setters refuse values outside them): key -> (kind, lowest, highest). seed and max_switches
-# are among them; the rest are tuning keys, written to the plan only when the task gives them.
-PLANNER_PARAMETER_RANGES: Dict[str, Tuple[str, float, float]] = dict(_core.TRRT_STAR_PARAMETER_RANGES)
-
-
-# ---------------------------------------------------------------------------------------------
-# YAML: duplicate keys refused (PyYAML silently keeps the last one), YAML 1.2 numbers (1e-3 is a
-# number, not a string), and a budget on aliases and on the values they expand to (a few hundred
-# bytes of nested aliases otherwise expand to gigabytes).
-
-
-class _StrictLoader(yaml.SafeLoader):
-    def __init__(self, stream):
-        super().__init__(stream)
-        self.aliases = 0
-
-    def compose_node(self, parent, index):
-        if self.check_event(yaml.AliasEvent):
-            self.aliases += 1
-            if self.aliases > MAX_YAML_ALIASES:
-                line = self.peek_event().start_mark.line + 1
-                raise TaskError("", f"line {line}: more than {MAX_YAML_ALIASES} YAML aliases (*name); "
-                                    f"write the values out")
-        return super().compose_node(parent, index)
-
-
-def _construct_mapping(loader: _StrictLoader, node: yaml.MappingNode, deep: bool = False) -> dict:
-    seen = set()
-    for key_node, _ in node.value:
-        key = loader.construct_object(key_node, deep=deep)
-        line = key_node.start_mark.line + 1
-        if not isinstance(key, (str, int, float, bool, type(None))):
-            raise TaskError("", f"line {line}: a mapping key must be a name, got a {type(key).__name__}")
-        if key in seen:
-            raise TaskError(str(key), f"duplicate key (line {line})")
-        seen.add(key)
-    return loader.construct_mapping(node, deep=deep)
-
-
-_StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
-_StrictLoader.add_implicit_resolver(  # YAML 1.2 exponents, which 1.1 reads as strings: 1e-3, 2.02e2, 1.5E+2
-    "tag:yaml.org,2002:float", re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
-    list("-+0123456789."))
-
-
-def _expanded_size(node: yaml.Node) -> int:
-    """How many values `node` stands for with its aliases expanded (TaskError past the budget or
-    on a value that contains itself)."""
-    sizes: Dict[int, int] = {}
-    open_nodes = set()
-
-    def size(n: yaml.Node) -> int:
-        if id(n) in sizes:
-            return sizes[id(n)]
-        if id(n) in open_nodes:
-            raise TaskError("", f"line {n.start_mark.line + 1}: a YAML value contains itself (through an alias)")
-        open_nodes.add(id(n))
-        children = [c for pair in n.value for c in pair] if isinstance(n, yaml.MappingNode) else (
-            n.value if isinstance(n, yaml.SequenceNode) else [])
-        total = 1
-        for child in children:
-            total += size(child)
-            if total > MAX_YAML_NODES:
-                raise TaskError("", f"the file stands for more than {MAX_YAML_NODES} values (aliases expanded)")
-        open_nodes.discard(id(n))
-        sizes[id(n)] = total
-        return total
-
-    return size(node)
-
-
-def _refuse_duplicate_keys(node: yaml.Node, path: str) -> None:
-    """TaskError naming the dotted path of a key written twice in one mapping (`object.mass`), before
-    anything is constructed; _construct_mapping still refuses keys equal only once read (1 and 1.0)."""
-    if isinstance(node, yaml.MappingNode):
-        seen = set()
-        for key_node, value_node in node.value:
-            key = key_node.value if isinstance(key_node, yaml.ScalarNode) else None
-            if key is not None and (key_node.tag, key) in seen:
-                raise TaskError(_join(path, key), f"duplicate key (line {key_node.start_mark.line + 1})")
-            seen.add((key_node.tag, key))
-            _refuse_duplicate_keys(value_node, _join(path, key) if key is not None else path)
-    elif isinstance(node, yaml.SequenceNode):
-        for i, item in enumerate(node.value):
-            _refuse_duplicate_keys(item, f"{path}[{i}]")
-
-
-def _load_yaml(text: str) -> Any:
-    if len(text) > MAX_TASK_BYTES:
-        raise TaskError("", f"the file has {len(text)} characters; a task file has at most {MAX_TASK_BYTES}")
-    loader = _StrictLoader(text)
-    try:
-        node = loader.get_single_node()
-        if node is None:
-            return None
-        _expanded_size(node)
-        _refuse_duplicate_keys(node, "")
-        return loader.construct_document(node)
-    except RecursionError:
-        raise TaskError("", "values nested too deeply") from None
-    finally:
-        loader.dispose()
-
-
-# ---------------------------------------------------------------------------------------------
-# Field checkers: each takes the dotted path for its message.
-
-
-def _mapping(path: str, value: Any, required: Sequence[str], optional: Sequence[str]) -> dict:
-    if not isinstance(value, dict):
-        raise TaskError(path, f"must be a mapping, got {_yaml_kind(value)}")
-    if len(value) > 64:
-        raise TaskError(path, f"has {len(value)} keys; at most 64")
-    for key in value:
-        if key not in required and key not in optional:
-            allowed = ", ".join(dict.fromkeys([*required, *optional]))
-            raise TaskError(_join(path, _shown(key, 40) if not isinstance(key, str) else _shown(key, 40).strip("'")),
-                            f"unknown key (allowed here: {allowed})")
-    for key in required:
-        if key not in value:
-            raise TaskError(_join(path, key), "missing")
-    return value
-
-
-def _join(path: str, key: str) -> str:
-    return f"{path}.{key}" if path else key
-
-
-def _number(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> float:
-    """A finite number (numpy's scalars too, but not a bool), inside `within` (lowest, highest;
-    both inclusive) when given."""
-    if not is_real(value):
-        raise TaskError(path, f"must be a number, got {_shown(value)}")
-    try:
-        x = float(value)
-    except OverflowError:  # an int past the double range
-        raise TaskError(path, f"must be finite, got {_shown(value)}") from None
-    if not math.isfinite(x):
-        raise TaskError(path, f"must be finite, got {_shown(value)}")
-    if within is not None and not within[0] <= x <= within[1]:
-        # A positive length under the least one is a length in metres (every length field takes LIMITS["length"]).
-        slip = _in_metres(x) if tuple(within) == LIMITS["length"] and 0.0 < x < within[0] else ""
-        raise TaskError(path, f"must be between {within[0]:g} and {within[1]:g}, got {x:g}{slip}")
-    return x
-
-
-def _in_metres(value: Any) -> str:
-    """The hint for a length, a point or points in mm that read as metres: "(0.006 m is 6 mm)"."""
-    def shown(v: Any, k: float) -> str:
-        return f"{v * k:g}" if isinstance(v, (int, float)) else "[" + ", ".join(shown(c, k) for c in v) + "]"
-
-    return f"; written in metres? task files use mm ({shown(value, 1.0)} m is {shown(value, 1e3)} mm)"
-
-
-# The least positive friction coefficient: below it the cones' rows underflow (a mu of 1e-170
-# reached the exact re-check as infinity), and no material is that slippery without being 0.
-MIN_POSITIVE_MU = 1e-6
-
-
-def _friction(path: str, value: Any) -> float:
-    """A friction coefficient: 0 (frictionless) or MIN_POSITIVE_MU to LIMITS["mu"]'s top."""
-    mu = _number(path, value, LIMITS["mu"])
-    if 0.0 < mu < MIN_POSITIVE_MU:
-        raise TaskError(path, f"must be 0 (frictionless) or at least {MIN_POSITIVE_MU:g}, got {mu:g}")
-    return mu
-
-
-def _integer(path: str, value: Any, lowest: int, highest: int) -> int:
-    """An integer (numpy's too, but not a bool) from `lowest` to `highest`, as a Python int."""
-    if not is_integer(value):
-        raise TaskError(path, f"must be an integer, got {_shown(value)}")
-    if not lowest <= int(value) <= highest:
-        raise TaskError(path, f"must be an integer from {lowest} to {highest}, got {_shown(value)}")
-    return int(value)
-
-
-def _vector(path: str, value: Any, n: int, within: Optional[Tuple[float, float]] = None) -> Tuple[float, ...]:
-    if not isinstance(value, (list, tuple)) or len(value) != n:
-        raise TaskError(path, f"must be a list of {n} numbers, got {_shown(value)}")
-    return tuple(_number(f"{path}[{i}]", v, within) for i, v in enumerate(value))
-
-
-def _pair(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> Tuple[float, float]:
-    """_vector of two numbers, typed as the pair it is (an (x, z) point, gravity)."""
-    x, z = _vector(path, value, 2, within)
-    return x, z
-
-
-def number_field(path: str, value: Any, within: Optional[Tuple[float, float]] = None) -> float:
-    """An argument that must be a finite number (within `within`, inclusive): TaskError naming `path`."""
-    return _number(path, value, within)
-
-
-def pose_field(path: str, value: Any) -> Tuple[float, float, float]:
-    """[x mm, z mm, theta deg] within the coordinate and angle bounds."""
-    _vector(path, value, 3)
-    return (_number(f"{path}[0]", value[0], COORDINATE), _number(f"{path}[1]", value[1], COORDINATE),
-            _number(f"{path}[2]", value[2], ANGLE))
-
-
-def _name(path: str, value: Any) -> str:
-    if isinstance(value, (bool, int, float, datetime.date)):  # YAML 1.1: no/off/yes/on, 007, 2024-01-01
-        kind = "boolean" if isinstance(value, bool) else "date" if isinstance(value, datetime.date) else "number"
-        raise TaskError(path, f"must be a non-empty string, got {_shown(value)}: YAML read it as a {kind}; put "
-                              f"the name in quotes")
-    if not isinstance(value, str) or not value.strip():
-        raise TaskError(path, f"must be a non-empty string, got {_shown(value)}")
-    if len(value) > 100 or any(not ch.isprintable() for ch in value):
-        raise TaskError(path, f"must be at most 100 printable characters, got {_shown(value)}")
-    return value
-
-
-def _yaml_kind(value: Any) -> str:
-    """What a YAML value is, in YAML's words (an empty value is null)."""
-    if value is None:
-        return "null (an empty value)"
-    if isinstance(value, bool):
-        return "a boolean"
-    if isinstance(value, (int, float)):
-        return "a number"
-    kinds: Dict[type, str] = {str: "a string", list: "a list", dict: "a mapping"}
-    return kinds.get(type(value), f"a {type(value).__name__}")
-
-
-def _shown(value: Any, limit: int = 60) -> str:
-    """A value for a message: its repr, cut to one short line."""
-    text = reprlib.Repr()
-    text.maxstring = text.maxother = limit
-    text.maxlevel = 2
-    shown = text.repr(value).replace("\n", " ")
-    return shown if len(shown) <= limit else shown[: limit - 3] + "..."
-
-
-# ---------------------------------------------------------------------------------------------
-
-
-# ---------------------------------------------------------------------------------------------
 
 
 def load_task(path: "str | Path", goal_in_grasp: bool = True) -> Task:
@@ -346,89 +105,6 @@ def load_task(path: "str | Path", goal_in_grasp: bool = True) -> Task:
         raise
 
 
-def load_design(path: "str | Path") -> Tuple[Dict[str, Any], List[Dict[str, Any]]]:
-    """A design task file (`stablepush design`): a task whose `candidates` stand in for its
-    `pushers`. Returns the task's mapping without them and the candidate pushers as pusher entries
-    of the task file's form (`candidate_pushers`); every layout of them is then a task of its own
-    (parse_task of the mapping with `pushers` set). TaskError naming the field; `environment.features`
-    is refused: the design places the fixtures."""
-    source = str(path)
-    try:
-        data = _load_yaml(read_capped(path, MAX_TASK_BYTES).decode("utf-8"))
-        protect_input(path, "a design file")
-    except ValueError as exc:
-        raise TaskError("", f"cannot read the design file: {exc}", source) from None
-    except OSError as exc:
-        raise TaskError("", f"cannot read the design file ({exc.strerror or exc})", source) from None
-    except yaml.YAMLError as exc:
-        raise TaskError("", f"not valid YAML ({_yaml_problem(exc)})", source) from None
-    if not isinstance(data, dict):
-        raise TaskError("", "a design file is a mapping, as a task file is", source)
-    if "pushers" in data:
-        raise TaskError("pushers", "a design file gives candidates instead of pushers (candidates: {mu: 0.5}, or a "
-                                   "list of pusher entries)", source)
-    if "candidates" not in data:
-        raise TaskError("candidates", "missing: {mu: M} (every edge and convex corner of the section), or a list of "
-                                      "pusher entries", source)
-    environment = data.get("environment")
-    if isinstance(environment, dict) and "features" in environment:  # else every layout without one is refused
-        raise TaskError("environment.features", "a design places its fixtures itself (each design's "
-                                                "environment.features is where its plan puts them): remove it from "
-                                                "the design file", source)
-    task = {k: v for k, v in data.items() if k != "candidates"}
-    try:
-        return task, candidate_pushers(data["candidates"], task, source)
-    except TaskError as exc:
-        raise TaskError(exc.field, exc.reason, source) from None
-
-
-def candidate_pushers(value: Any, task: Mapping[str, Any], source: Optional[str] = None) -> List[Dict[str, Any]]:
-    """The candidates of a design file as pusher entries: `{mu: M}` (optional `points`) makes every
-    edge of the object's section a segment pusher (`edge<k>`, from corner k to corner k+1, in the
-    section's counterclockwise order) and every convex corner two point pushers, CORNER_INSET
-    along each of its edges (`corner<k>a` toward corner k-1, `corner<k>b` toward k+1: at the corner
-    itself a point contact's normal is not defined, docs/model.md section 2), each of friction M; a
-    list is taken as pusher entries as they are (checked as `pushers` is)."""
-    if isinstance(value, list):
-        if not value:
-            raise TaskError("candidates", "an empty list: give at least one pusher entry")
-        _validate_pushers(value, _core.CrossSection([mm2_to_si(v) for v in _corners_of(task, source)]), [])
-        return [dict(entry) for entry in value]
-    spec = _mapping("candidates", value, ["mu"], ["points"])
-    mu = _friction("candidates.mu", spec["mu"])
-    points = _integer("candidates.points", spec.get("points", DEFAULT_PUSHER_POINTS), 2, MAX_PUSHER_POINTS)
-    corners = _corners_of(task, source)
-    n = len(corners)
-    edges = [{"name": f"edge{k}", "from": list(corners[k]), "to": list(corners[(k + 1) % n]), "mu": mu,
-              "points": points} for k in range(n)]
-    convex = []
-    for k in range(n):  # at a corner itself a point contact's normal is not defined: just beside it
-        if turn(corners[k - 1], corners[k], corners[(k + 1) % n]) > 0:
-            for side, neighbour in (("a", corners[k - 1]), ("b", corners[(k + 1) % n])):
-                convex.append({"name": f"corner{k}{side}", "at": _toward(corners[k], neighbour), "mu": mu})
-    candidates = edges + convex
-    if len(candidates) > MAX_PUSHERS:
-        raise TaskError("candidates", f"the section's {n} corners make {len(candidates)} candidates, more than "
-                                      f"{MAX_PUSHERS}: list the candidates instead")
-    return candidates
-
-
-# mm along an edge from a corner where its point-pusher candidates sit (at most a quarter of the edge)
-CORNER_INSET = 1.0
-
-
-def _toward(corner, neighbour) -> List[float]:
-    """The point CORNER_INSET from `corner` along the edge toward `neighbour` (mm)."""
-    dx, dz = neighbour[0] - corner[0], neighbour[1] - corner[1]
-    length = math.hypot(dx, dz)
-    inset = min(CORNER_INSET, length / 4)
-    return [corner[0] + dx / length * inset, corner[1] + dz / length * inset]
-
-
-def _corners_of(task: Mapping[str, Any], source: Optional[str]) -> Tuple[Tuple[float, float], ...]:
-    """The corners of a task mapping's object section (mm, counterclockwise), its object checked."""
-    vertices, *_ = _validate_object(_mapping("", task, ["object"], list(task))["object"], source, [])
-    return outline_corners(vertices)
 
 
 def parse_task(text: "str | Mapping[str, Any]", source: Optional[str] = None, goal_in_grasp: bool = True) -> Task:
@@ -459,12 +135,6 @@ def parse_task(text: "str | Mapping[str, Any]", source: Optional[str] = None, go
     return _validate(data, source, goal_in_grasp)
 
 
-def _yaml_problem(exc: "yaml.YAMLError") -> str:
-    """PyYAML's problem and where, in one line (its own text spans lines, with a caret drawing)."""
-    mark = getattr(exc, "problem_mark", None)
-    problem = getattr(exc, "problem", None) or " ".join(str(exc).split())
-    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-    return f"{problem}{where}"
 
 
 def _validate(data: Any, source: Optional[str], goal_in_grasp: bool = True) -> Task:
@@ -673,16 +343,6 @@ def _sub_millimetre(pads, environment: Cell) -> List[str]:
     return out
 
 
-# An angle written in radians (task files use degrees) is warned about only where no one writes the
-# value in degrees, so that a deliberate small turn is not. It is nonzero, at most 2 pi (a radian
-# value) and not a whole number of degrees (a turn written in degrees nearly always is), and either
-# - in radians it is a round angle: within RADIAN_ROUNDING of a multiple of 5 deg (0.26 is 14.9 deg,
-#   0.785 is 45.0, 1.57 is 90.0, 3.14 is 179.9). RADIAN_ROUNDING covers radians rounded to two
-#   decimals (off by at most 0.005 rad, 0.29 deg); of the values of one decimal, written in degrees,
-#   only 0.7, 1.4, 3.4, 4.1, 4.8, 5.5 and 6.2 lie that near one; or
-# - it lies within planner.tolerance's angle of 0: in degrees, a turn the planner cannot tell from
-#   none, a fraction nobody writes on purpose.
-RADIAN_ROUNDING = 0.3  # deg
 
 
 def _in_radians(poses, tolerance: float) -> List[str]:
@@ -697,12 +357,6 @@ def _in_radians(poses, tolerance: float) -> List[str]:
     return out
 
 
-def _reads_as_radians(angle: float) -> bool:
-    """An angle in degrees that reads as written in radians: nonzero, at most 2 pi, not a whole
-    number of degrees, and a round angle in radians (RADIAN_ROUNDING above)."""
-    degrees = math.degrees(angle)
-    round_angle = abs(degrees - 5.0 * round(degrees / 5.0)) <= RADIAN_ROUNDING and abs(degrees) >= 2.5
-    return 0.0 < abs(angle) <= 2.0 * math.pi and angle != round(angle) and round_angle
 
 
 MESH_KEYS = ["file", "scale", "plane_y", "tolerance", "density"]
@@ -882,113 +536,6 @@ def _validate_environment(value: Any, pusher_names: Sequence[str], source: Optio
     return Cell.from_mapping(out)
 
 
-def robot_section(value: Any, source: Optional[str] = None, names: Optional[Dict[str, str]] = None) -> Robot:
-    """The environment.robot section as a Robot: `model` a URDF or MJCF file (relative to the task
-    file's folder), with the `flange` it mounts the jaws on and the `tcp` (both required with a
-    model: no default fits another arm), `base` and `max_joint_speed` [rad/s] optional. A tcp or
-    base that reads as metres and radians is refused, named as `names` says (a command line's
-    --tcp, --base; default: the task file's field)."""
-    robot = _mapping("environment.robot", value, [], ["model", "flange", "tcp", "base", "max_joint_speed"])
-    out: Dict[str, Any] = {}
-    if "model" in robot:
-        out["model"] = robot_model_file("environment.robot.model", robot["model"], source)
-        for key in ("flange", "tcp"):
-            if key not in robot:
-                raise TaskError(f"environment.robot.{key}", "is required with a robot model (the shipped arm's "
-                                                            "does not fit another arm)")
-    if "flange" in robot:
-        out["flange"] = _name("environment.robot.flange", robot["flange"])
-    if "tcp" in robot:
-        tcp = _vector("environment.robot.tcp", robot["tcp"], 6)
-        out["tcp"] = [_number(f"environment.robot.tcp[{i}]", v, COORDINATE if i < 3 else ANGLE)
-                      for i, v in enumerate(tcp)]
-    if "base" in robot:
-        base = _vector("environment.robot.base", robot["base"], 4)
-        out["base"] = [_number(f"environment.robot.base[{i}]", v, COORDINATE if i < 3 else ANGLE)
-                       for i, v in enumerate(base)]
-    for key in ("tcp", "base"):
-        slip = _robot_unit_slip(out[key]) if key in out else ""
-        if slip:
-            name = (names or {}).get(key, f"environment.robot.{key}")
-            raise TaskError(name, f"{' '.join(f'{v:g}' for v in out[key])}: {slip}; {name} takes mm and deg")
-    if "max_joint_speed" in robot:
-        out["max_joint_speed"] = _number("environment.robot.max_joint_speed", robot["max_joint_speed"], JOINT_SPEED)
-    return Robot.from_mapping(out)
-
-
-def _robot_unit_slip(pose: Sequence[float]) -> str:
-    """Why a tcp or base (x, y, z mm, then angles deg) reads as written in metres and radians, as the
-    task's own lengths and angles do (_sub_millimetre, _in_radians): a position off the origin by
-    under SUB_MM, an angle that is a round one in radians; '' when neither."""
-    position, angles = list(pose[:3]), [a for a in pose[3:] if _reads_as_radians(a)]
-    slips = []
-    if any(position) and max(map(abs, position)) < SUB_MM:
-        slips.append("written in metres? (" + ", ".join(f"{v:g} m is {v * 1e3:g} mm" for v in position if v) + ")")
-    if angles:
-        slips.append("written in radians? (" + ", ".join(f"{a:g} rad is {math.degrees(a):.4g} deg" for a in angles)
-                     + ")")
-    return "; ".join(slips)
-
-
-def with_robot(task: Task, model: Optional[str] = None, flange: Optional[str] = None,
-               tcp: Optional[Sequence[float]] = None, base: Optional[Sequence[float]] = None) -> Task:
-    """`task` on another arm: its environment.robot changed as `robot_with` changes it (a command
-    line's --robot, --flange, --tcp and --base)."""
-    if model is None and flange is None and tcp is None and base is None:
-        return task
-    cell = dataclasses.replace(task.environment, robot=robot_with(task.environment.robot, model, flange, tcp, base))
-    return dataclasses.replace(task, environment=cell)
-
-
-def robot_with(robot: Robot, model: Optional[str] = None, flange: Optional[str] = None,
-               tcp: Optional[Sequence[float]] = None, base: Optional[Sequence[float]] = None) -> Robot:
-    """`robot` with the fields given changed, checked as the task file's are: another model must
-    come with its flange and tcp; a relative model file is taken from the working folder."""
-    section = {k: v for k, v in robot.as_dict().items() if v is not None}
-    if model is not None:
-        section = {k: v for k, v in section.items() if k not in ("flange", "tcp")}
-        section["model"] = model
-    changes = {"flange": flange, "tcp": None if tcp is None else list(tcp),
-               "base": None if base is None else list(base)}
-    section.update({k: v for k, v in changes.items() if v is not None})
-    return robot_section(section, names={k: f"--{k}" for k in ("tcp", "base") if changes[k] is not None})
-
-
-def robot_model_file(field: str, value: Any, source: Optional[str] = None) -> str:
-    """A robot model's file name, relative to the folder of `source` (a task file) when not
-    absolute: an existing .urdf, .xml or .mjcf file."""
-    if not isinstance(value, str) or not value.strip():
-        raise TaskError(field, f"must name a URDF or MJCF file, got {_shown(value)}")
-    path = Path(value).expanduser()
-    if not path.is_absolute() and source:
-        path = Path(source).parent / path
-    if path.suffix.lower() not in ROBOT_MODEL_SUFFIXES:
-        raise TaskError(field, f"{value!r:.80} is not a URDF or MJCF file (it ends {', '.join(ROBOT_MODEL_SUFFIXES)})")
-    if not path.is_file():
-        raise TaskError(field, f"no file {str(path)!r:.120}")
-    model_source(path)  # read now, every file it names protected as an input: refused before any work
-    return str(path.resolve())
-
-
-def planner_parameter(path: str, key: str, value: Any) -> "int | float":
-    """`value` for TRRTstar's declared parameter `key`, checked against the core's range for it
-    (the CLI's --seed and --max-switches go through here too)."""
-    kind, lowest, highest = PLANNER_PARAMETER_RANGES[key]
-    if kind == "integer":
-        return planner_integer(path, key, value)
-    return _number(path, value, (lowest, highest))
-
-
-def planner_integer(path: str, key: str, value: Any) -> int:
-    """planner_parameter of an integer parameter (seed, max_switches, check_limit), typed int."""
-    kind, lowest, highest = PLANNER_PARAMETER_RANGES[key]
-    assert kind == "integer", f"the planner's {key} is a {kind} parameter"
-    return _integer(path, value, int(lowest), int(highest))
-
-
-def planner_limit(path: str, value: Any) -> float:
-    """A time limit [s]: finite, positive, at most the core's MAX_TIME_LIMIT."""
-    return _number(path, value, LIMITS["time_limit"])
 
 
 def _validate_planner(value: Any) -> PlannerSettings:
