@@ -273,6 +273,8 @@ BAD, MAYBE = "bad", "maybe"  # a value the task file would refuse; one that may 
 def _pool(kind: str, ctx: dict):
     """(good values, bad values) of an argument kind: the good ones are what the task file or the
     command line takes, the bad ones what either would refuse."""
+    from stablepush.plan import SearchRules
+
     pools = {
         "count": ([1, 2], [0, -1, 1.5, NAN, "2", 10 ** 30, [1]]),
         "whole0": ([0, 1], [-1, 1.5, "1", NAN, 2 ** 70]),
@@ -317,6 +319,10 @@ def _pool(kind: str, ctx: dict):
         "axis": ([(-1.0, 1.0, 2), (0.0, 0.0, 1)], [(NAN, 1, 2), (0, 1, 0), (0, 1, 10 ** 6), "0:1:2", (0, 1),
                                                    (0, INF, 2), (0, 1, 1.5)]),
         "grid": ([ctx["grid"]], [None, 3, ((-1.0, 1.0, 2), (0.0, 0.0, 1), (0.0, 0.0, 1)), ctx["task"]]),
+        "rules": ([None, SearchRules(), SearchRules(start_pusher="left", min_transit_hold=1.0)],
+                  [3, "left", SearchRules(start_pusher="nobody"), SearchRules(start_pusher=3),
+                   SearchRules(min_transit_hold=NAN), SearchRules(min_transit_hold=-1.0),
+                   SearchRules(min_transit_hold="1")]),
         "task": ([ctx["task"]], [None, ctx["task_path"], {"name": "x"}, ctx["plan"], 3]),
         "plan": ([ctx["plan"]], [None, ctx["plan_path"], ctx["task"], {"waypoints": []}, 3]),
         "runner": ([None], ["ray", 3, "local", ctx["task"]]),
@@ -358,7 +364,7 @@ def _api_table(sp, ctx):
         "load_plan": (sp.load_plan, {"path": "plan_path"}),
         "save_plan": (sp.save_plan, {"plan": "plan", "json_path": "path_out", "csv_path": "csv_out"}),
         "plan_task": (sp.plan_task, {"task": "task", "seed": "seed", "time_limit": "time", "max_switches": "whole0",
-                                     "improve_for": "seconds0", "check_limit": "whole0", "start_pusher": "pusher"}),
+                                     "improve_for": "seconds0", "check_limit": "whole0", "rules": "rules"}),
         "check": (sp.check, {"task": "task", "at": "pose", "move": "pose", "pusher": "pusher"}),
         "check_plan": (sp.check_plan, {"task": "task", "plan": "plan", "source": "label",
                                        "require_solved": "flag"}),
@@ -525,6 +531,7 @@ def run_api(count: int, seed: int, scratch: Path) -> None:
 
     import stablepush as sp
     from stablepush.errors import StablepushError
+    from stablepush.plan import SearchRules
 
     rng = random.Random(seed)
     tasks = [sp.load_task(path) for path in TASKS[:5]]
@@ -540,7 +547,9 @@ def run_api(count: int, seed: int, scratch: Path) -> None:
         what = rng.choice(["plan", "check", "check_plan", "trajectory", "save_plan", "plan-edited"])
         if what == "plan":
             key = rng.choice(["seed", "time_limit", "max_switches", "improve_for", "min_transit_hold", "start_pusher"])
-            call = lambda: sp.plan_task(task, **{key: hostile()}, **({} if key == "time_limit" else {"time_limit": 0.02}))  # noqa: E731
+            given = {"rules": SearchRules(**{key: hostile()})} if key in ("min_transit_hold", "start_pusher") else {
+                key: hostile()}
+            call = lambda: sp.plan_task(task, **given, **({} if key == "time_limit" else {"time_limit": 0.02}))  # noqa: E731
         elif what == "plan-edited":  # a Task edited past its loader's checks: a quantity by its path, or a field
             field = rng.choice(["gripper.mu", "gripper.grip_force", "object.mass", "pushers.left.mu", "start", "goal",
                                 "gripper.pads", "object", "pushers", "gravity"])

@@ -16,6 +16,7 @@ from click.testing import CliRunner
 import stablepush as sp
 from stablepush.execution.world import place_features
 from stablepush.frames import grasp_transform, pose_to_matrix
+from stablepush.plan import SearchRules
 from stablepush.task.model import PLANNER_DEFAULTS, PlannerSettings
 from stablepush_cli.main import cli
 
@@ -334,9 +335,9 @@ def test_a_path_where_a_task_or_plan_goes_is_named():
         with pytest.raises(TypeError, match=re.escape(words)):
             call()
     with pytest.raises(sp.TaskError, match="min_transit_hold"):
-        sp.plan_task(task, min_transit_hold=math.nan)
+        sp.plan_task(task, rules=SearchRules(min_transit_hold=math.nan))
     with pytest.raises(sp.TaskError, match="start_pusher: no pusher named 'nope'"):
-        sp.plan_task(task, start_pusher="nope")
+        sp.plan_task(task, rules=SearchRules(start_pusher="nope"))
 
 
 def test_the_gripper_quaternion_stream_is_continuous_past_half_a_turn():

@@ -246,7 +246,7 @@ def test_a_robots_tcp_or_base_in_metres_and_radians_is_refused_naming_the_option
 def test_a_goal_no_push_from_the_start_moves_the_object_toward_is_named_when_the_search_fails():
     """The only pusher presses on the left end (+x); the goal lies 20 mm to -x. The search spends its
     time and used to blame the time limit alone."""
-    from stablepush.plan import plan_task
+    from stablepush.plan import SearchRules, plan_task
 
     from conftest import task_with
 
@@ -258,4 +258,4 @@ def test_a_goal_no_push_from_the_start_moves_the_object_toward_is_named_when_the
         "; the goal lies at dx -20 mm, dz 0 mm, dtheta 0 deg from the start, and no stable push from there moves "
         "the object along -x (none): a plan must go around, if any can (each pusher's stable pushes from the "
         "start: stable_directions)"), plan.message
-    assert "the goal lies" not in plan_task(task, time_limit=0.3, explain=False).message
+    assert "the goal lies" not in plan_task(task, time_limit=0.3, rules=SearchRules(explain=False)).message

@@ -19,6 +19,7 @@ from stablepush.evaluation import batch as batch_mod
 from stablepush.execution.guard import GuardedApproach
 from stablepush.execution.protocol import PROTOCOL, ProtocolError, decode, encode
 from stablepush.plan.files import MAX_WAYPOINTS
+from stablepush.plan.search import SearchRules
 from stablepush.runners import Runner, run_all
 from stablepush_cli.main import cli
 
@@ -273,7 +274,7 @@ def test_every_task_field_edited_to_any_type_is_refused_by_name_or_taken(field, 
         assert field in str(exc), (field, value, exc)
         return
     for call in (lambda: sp.check(task, at=task.start, move=(0.1, 0.0, 0.0)),
-                 lambda: sp.plan_task(task, time_limit=0.01, explain=False)):
+                 lambda: sp.plan_task(task, time_limit=0.01, rules=SearchRules(explain=False))):
         try:
             call()
         except (StablepushError, TypeError, ValueError):

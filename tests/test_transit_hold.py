@@ -1,9 +1,9 @@
-"""Switch-overs only where the pads hold (`plan_task(min_transit_hold=...)`): between two features
+"""Switch-overs only where the pads hold (`plan_task(rules=SearchRules(min_transit_hold=...))`): between two features
 the object is carried by the pads alone, so the search may change pusher only at a pose where
 `hold_ratio` (with the gravity of the feature being left) reaches the given factor."""
 import pytest
 
-from stablepush.plan.search import plan_task
+from stablepush.plan.search import SearchRules, plan_task
 from stablepush.units import pose_to_si
 
 from conftest import shipped
@@ -27,7 +27,7 @@ def test_without_the_rule_the_low_mu_offset_switches_where_the_pads_hold_4_26_ti
 
 @pytest.mark.parametrize("factor", [1.5, 3.0, 4.0, 4.2, 4.3, 5.0, 20.0])
 def test_every_switch_over_of_a_plan_is_where_the_pads_hold_the_factor(factor):
-    plan = plan_task(LOW_MU, seed=1, min_transit_hold=factor, time_limit=0.3)
+    plan = plan_task(LOW_MU, seed=1, rules=SearchRules(min_transit_hold=factor), time_limit=0.3)
     assert all(h >= factor for h in _switch_holds(LOW_MU, plan)), (factor, _switch_holds(LOW_MU, plan))
     # The offset needs the bottom pusher's lift and then the left one: no switch-over, no plan.
     assert plan.solved == (factor <= 4.2), (factor, plan.outcome, plan.pusher_sequence)
@@ -39,12 +39,12 @@ def test_a_replan_from_a_feature_makes_a_transit_at_its_start():
     plan = plan_task(LOW_MU, seed=1)
     k = next(i for i, w in enumerate(plan.waypoints) if w.pusher == "left") - 1
     on_bottom = LOW_MU.with_start(plan.waypoints[k].pose)
-    assert plan_task(on_bottom, seed=1, min_transit_hold=4.0, start_pusher="bottom", time_limit=0.3).solved
-    refused = plan_task(on_bottom, seed=1, min_transit_hold=4.5, start_pusher="bottom", time_limit=0.3)
+    assert plan_task(on_bottom, seed=1, rules=SearchRules(4.0, start_pusher="bottom"), time_limit=0.3).solved
+    refused = plan_task(on_bottom, seed=1, rules=SearchRules(4.5, start_pusher="bottom"), time_limit=0.3)
     assert not refused.solved and refused.pusher_sequence[:1] in ([], ["bottom"]), refused.pusher_sequence
     # Not started on a feature, the same search leaves with the left pusher at once: what refused
     # it above was the transit at the start, not the search.
-    assert plan_task(on_bottom, seed=1, min_transit_hold=4.5, time_limit=0.3).pusher_sequence == ["left"]
+    assert plan_task(on_bottom, seed=1, rules=SearchRules(4.5), time_limit=0.3).pusher_sequence == ["left"]
 
 
 def test_with_start_keeps_the_features_orientation():

@@ -55,7 +55,7 @@ from typing import List, Optional, Sequence, Tuple
 
 from stablepush.errors import PadFaceError
 from stablepush.plan.plan import Waypoint
-from stablepush.plan.search import plan_task
+from stablepush.plan.search import SearchRules, plan_task
 from stablepush.pose import Pose, PoseLike, Tolerance
 from stablepush.task.fields import PLANNER_PARAMETER_RANGES
 from stablepush.task.mechanics import blocked_senses
@@ -235,7 +235,7 @@ def _aim(task: Task, steps: Sequence[Waypoint], loop: ClosedLoop) -> Optional[Tu
         planner = counted(task.planner, AIM_CHECKS).replace(tolerance=loop.final_tolerance.as_list(),
                                                             max_switches=budget)
         result = _search(dataclasses.replace(task.with_start(start), planner=planner),
-                         min_transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO)
+                         transit_hold=1.0 if task.uncertainty else TRANSIT_HOLD_RATIO)
         if isinstance(result, PadFaceError):
             tried.append(f"{budget} switch-over(s): {result.reason}")
             ended.append("off_faces")
@@ -277,12 +277,13 @@ _ENDED = {"time_limit": "out of tests", "guard": "stopped by the wall-time guard
           "transit": "a transit the pads do not hold", "off_faces": "a path off the part's faces"}
 
 
-def _search(task: Task, **kwargs):
-    """A correction's search (plan_task, without its explanation or deeper end), or the
-    PadFaceError of a path that takes a mesh part's pads off its faces: that correction is not
-    taken, and the others are tried."""
+def _search(task: Task, transit_hold: float, start_pusher: Optional[str] = None):
+    """A correction's search (plan_task, without its explanation or deeper end), switching pushers
+    where the pads hold `transit_hold` times the weight, or the PadFaceError of a path that takes a
+    mesh part's pads off its faces: that correction is not taken, and the others are tried."""
+    rules = SearchRules(min_transit_hold=transit_hold, start_pusher=start_pusher, explain=False, deepen=False)
     try:
-        return plan_task(task, explain=False, deepen=False, **kwargs)
+        return plan_task(task, rules=rules)
     except PadFaceError as exc:
         return exc
 
@@ -376,7 +377,7 @@ def replan(task: Task, measured: Sequence[float], pusher: str, loop: ClosedLoop,
         # robust attempts' box too (its pads' mu is 15% lower at two of them: the stricter rule, as
         # measured).
         transit_hold = (1.0 if task.uncertainty else attempt.transit_hold) if attempt.every_pusher else 0.0
-        result = _search(candidate, min_transit_hold=transit_hold, start_pusher=pusher)
+        result = _search(candidate, transit_hold, start_pusher=pusher)
         if isinstance(result, PadFaceError):
             tried.append(f"{attempt.describe(pusher)}: {result.reason}")
             ended.append("off_faces")

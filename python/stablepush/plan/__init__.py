@@ -3,11 +3,11 @@ belongs to a task. Builds on `stablepush.task`; knows nothing of arms or figures
 from stablepush.lazy import lazy_exports
 from stablepush.plan.files import load_plan, read_plan, write_plan
 from stablepush.plan.plan import Plan, PlanOutcome, PusherContact, Waypoint
-from stablepush.plan.search import end_text, plan_task
+from stablepush.plan.search import SearchRules, end_text, plan_task
 from stablepush.plan.verify import check_plan, release_note
 
-__all__ = ["Plan", "PlanOutcome", "Waypoint", "PusherContact", "plan_task", "end_text", "check_plan", "load_plan",
-           "read_plan", "write_plan", "release_note"]
+__all__ = ["Plan", "PlanOutcome", "Waypoint", "PusherContact", "plan_task", "SearchRules", "end_text", "check_plan",
+           "load_plan", "read_plan", "write_plan", "release_note"]
 # Loaded when first used: the reach map and the benchmark bring in the batch runners.
 _EXPORTS = {"MAX_AXIS": "stablepush.plan.reach", "grid_axis": "stablepush.plan.reach",
             "ReachGrid": "stablepush.plan.reach", "reach_map": "stablepush.plan.reach",

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+from dataclasses import dataclass
 from typing import List, Optional, Sequence
 
 from stablepush.compiled import _core
@@ -44,6 +45,24 @@ def require_goal_apart(task: Task) -> None:
                                 f"files use mm)", task.source)
 
 
+@dataclass(frozen=True)
+class SearchRules:
+    """What a search is asked beyond the task's planner section. `min_transit_hold` > 0: switch
+    pushers only where the pads alone hold the object with that factor of its weight in every
+    model; `start_pusher`, the pusher in contact at the start (a re-plan from a feature), makes a
+    plan that begins with another pusher a transit at the start. After a search that ran out of
+    time, `explain` names in the message the senses toward the goal in which no stable push from
+    the start moves the object (_toward_goal: some 0.05 s). A solved plan whose end uses more than
+    planner.end_within of the tolerance in some coordinate (Tolerance.used) is planned again
+    (`deepen`; _deeper). The closed loop's re-plans, which read the outcome alone and plan to the
+    loop's own tolerance, neither explain nor deepen. plan_task checks the fields."""
+
+    min_transit_hold: float = 0.0
+    start_pusher: Optional[str] = None
+    explain: bool = True
+    deepen: bool = True
+
+
 def plan_task(
     task: Task,
     *,
@@ -52,30 +71,26 @@ def plan_task(
     max_switches: Optional[int] = None,
     improve_for: Optional[float] = None,
     check_limit: Optional[int] = None,
-    min_transit_hold: float = 0.0,
-    start_pusher: Optional[str] = None,
-    explain: bool = True,
-    deepen: bool = True,
+    rules: Optional[SearchRules] = None,
 ) -> Plan:
     """Plan stable pushes from the task's start to its goal. Arguments left as None take the
-    task's planner section (which has defaults for every key). The search runs in the task's
-    corner_models (built on first use and kept with the task, so that many seeds build them once):
-    with an `uncertainty` section every push must be stable at every corner, and each waypoint's
-    margin is the least.
-    `min_transit_hold` > 0: switch pushers only where the pads alone hold the object with that
-    factor of its weight in every model; `start_pusher`, the pusher in contact at the start (a
-    re-plan from a feature), makes a plan that begins with another pusher a transit at the start.
+    task's planner section (which has defaults for every key); `rules` (SearchRules) what the
+    search is asked beyond it (None: SearchRules()). The search runs in the task's corner_models
+    (built on first use and kept with the task, so that many seeds build them once): with an
+    `uncertainty` section every push must be stable at every corner, and each waypoint's margin
+    is the least.
     A goal that no plan can reach for a reason decided before the search (plan.unreachable) returns
-    at once: outcome `unreachable`, the start alone, the reason in the message. After a search that
-    ran out of time, `explain` names in the message the senses toward the goal in which no stable
-    push from the start moves the object (_toward_goal: some 0.05 s; the closed loop's re-plans,
-    which read the outcome alone, leave it out).
+    at once: outcome `unreachable`, the start alone, the reason in the message.
     A solved plan whose end uses more than planner.end_within of the tolerance in some coordinate
     (Tolerance.used) is planned again, with finish steps and then to that share of the
-    tolerance (`deepen`; _deeper), within DEEPER_CHECKS stable-push tests: a plan that ends at the
-    tolerance's edge leaves an open-loop run no room for a real push's drift. Where neither finds
-    one, the first plan stands and its stats say how deep it got (`end_used`, `deeper`).
-    TaskError (field `goal`) when the start is already within the tolerance of the goal."""
+    tolerance (rules.deepen; _deeper), within DEEPER_CHECKS stable-push tests: a plan that ends at
+    the tolerance's edge leaves an open-loop run no room for a real push's drift. Where neither
+    finds one, the first plan stands and its stats say how deep it got (`end_used`, `deeper`).
+    TaskError (field `goal`) when the start is already within the tolerance of the goal; TypeError
+    for rules that are not a SearchRules."""
+    rules = SearchRules() if rules is None else rules
+    if not isinstance(rules, SearchRules):
+        raise TypeError(f"rules must be a SearchRules, got {type(rules).__name__}")
     require_goal_apart(task)
     settings = task.planner.replace(
         seed=None if seed is None else planner_parameter("seed", "seed", seed),
@@ -84,7 +99,7 @@ def plan_task(
         improve_for=None if improve_for is None else planner_parameter("improve_for", "improve_for", improve_for),
         check_limit=None if check_limit is None else planner_parameter("check_limit", "check_limit", check_limit))
     # A hold factor, as planner.min_hold_ratio is (docs/model.md section 3).
-    min_transit_hold = number_field("min_transit_hold", min_transit_hold, LIMITS["min_hold_ratio"])
+    min_transit_hold = number_field("min_transit_hold", rules.min_transit_hold, LIMITS["min_hold_ratio"])
     _check_push_cap(task, settings)
     models = task.corner_models
     model = models[0]
@@ -93,10 +108,10 @@ def plan_task(
     reason = why_unreachable(task, deadline=began + settings.time_limit)
     if reason is not None:
         return _unreachable(task, models, settings, reason, time.perf_counter() - began)
-    pusher_at_start = -1 if start_pusher is None else task.pusher_index(start_pusher, "start_pusher")
+    pusher_at_start = -1 if rules.start_pusher is None else task.pusher_index(rules.start_pusher, "start_pusher")
     raw = _search(task, models, settings, Tolerance.of(settings.tolerance), min_transit_hold, pusher_at_start)
     first_checks, deep = int(raw.stats.feasibility_checks), None
-    if deepen and raw.outcome.name == "goal_reached" and settings.end_within < 1.0:
+    if rules.deepen and raw.outcome.name == "goal_reached" and settings.end_within < 1.0:
         deep = _deeper(task, models, settings, raw, min_transit_hold, pusher_at_start)
         if deep is not None:
             raw = deep.pop("raw") or raw
@@ -163,7 +178,7 @@ def plan_task(
     last = waypoints[-1]
     last_q, last_pusher = pose_to_si((last.x, last.z, last.theta)), names.index(last.pusher) if last.pusher else -1
     message = _message(outcome, stats, bool(raw.ends_at_goal), settings)
-    if outcome == "time_limit" and explain:
+    if outcome == "time_limit" and rules.explain:
         message += _toward_goal(task)
     return Plan(task=task.name, solved=outcome == "goal_reached", outcome=outcome,
                 message=message, waypoints=waypoints, stats=stats,
