@@ -1226,7 +1226,7 @@ def _robot_mutation(kind: str, text: str, folder: Path, rng: random.Random, flan
 def run_robots(count: int, seed: int, scratch: Path) -> None:
     """`count` generated arms (tests/generated_arms.py: URDF or MJCF, 6 or 7 joints), each with
     one to two mutations (_robot_mutation), given to `check-cell` (now and then with `--json`
-    naming the model itself) or to stablepush.sim.robot.arm_model. check-cell must end 0, 1 or
+    naming the model itself) or to stablepush.kinematics.robot.arm_model. check-cell must end 0, 1 or
     2 in one `error:` line; arm_model must return or raise a StablepushError; no case may hang or
     write over the model."""
     import shlex

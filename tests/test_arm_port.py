@@ -198,6 +198,18 @@ def test_a_resume_on_the_same_simulated_arm_keeps_its_world_and_lands(low_mu):
     assert report.resumed_from == step and report.success is True, report.verdict
 
 
+def test_the_joint_level_bridge_and_the_kinematics_load_no_simulator():
+    """A lab's joint-level arm (stablepush.bridge) needs the arm's kinematics and the cell check, not
+    a simulator: importing it and the kinematics room loads no module of stablepush.sim and no Drake."""
+    code = (
+        "import sys\n"
+        "import stablepush.bridge, stablepush.kinematics.arm_kinematics, stablepush.kinematics.cell_path\n"
+        "print(sorted(m for m in sys.modules if m == 'stablepush.sim' or m.startswith(('stablepush.sim.', 'pydrake'))))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip().splitlines()[-1] == "[]", out
+
+
 def test_the_engine_neutral_parts_and_the_drake_arm_load_no_mujoco():
     """Drake reads the arm's MJCF with its own parser: `--engine drake` needs no MuJoCo."""
     code = (

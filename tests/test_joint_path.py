@@ -1,4 +1,4 @@
-"""The shipped arm's joints along a plan (stablepush.sim.joint_path): the joint trajectory
+"""The shipped arm's joints along a plan (stablepush.kinematics.cell_path): the joint trajectory
 reproduces the Cartesian one through forward kinematics computed apart from the solver, moves
 continuously, and a plan the arm cannot follow in its cell is refused before any motion, naming
 where and why."""

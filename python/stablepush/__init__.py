@@ -15,7 +15,7 @@ reach maps). Every error raised on purpose is a `StablepushError` (TaskError, Pl
 OutputError, ArmFault, RunnerError, SettingError).
 
 The package's layers, each importing only those below it (docs/architecture.md):
-`sim`, `viz` > `execution` > `plan` > `task` > `units`, `frames`, `errors`, `outputs`, `_core`.
+`sim`, `viz` > `kinematics` > `execution` > `plan` > `task` > `units`, `frames`, `errors`, `outputs`, `_core`.
 """
 from stablepush._core import ContactCase, PushResult
 from stablepush.errors import ArmFault, OutputError, PlanError, RunnerError, SettingError, StablepushError, TaskError

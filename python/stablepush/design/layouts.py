@@ -14,7 +14,7 @@ most `max_fixtures` candidates. The search
    goal its plan ends, planning time, the least margin of its pushes over the uncertainty box
    (verify.plan_margin), where each fixture stands in the world at the start
    (execution.world.place_features: the task's environment.features), and, where the task names
-   its arm (environment.robot), whether the arm can follow the plan (sim.joint_path);
+   its arm (environment.robot), whether the arm can follow the plan (kinematics.cell_path);
 4. ranks them (RANK_KEYS, `rank`), keeps the best of each set of fixtures its plan uses, then
    for the best `reach_top` a small reach map around the goal (REACH_CELLS cells, REACH_SPAN
    tolerances either side in x and z): the share of nearby goals the layout also reaches, and

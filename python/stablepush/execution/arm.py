@@ -72,7 +72,7 @@ class Arm(abc.ABC):
     def check_cell(self, task: "Task", plan: "Plan", rate_hz: float) -> None:
         """Refuse, before any motion, a plan this arm cannot follow in its cell: a PlanError naming
         the first sample of the timed trajectory it cannot reach, the joint past its limit or the
-        link in a fixture (stablepush.sim.joint_path.CellError). An arm that has a model of itself
+        link in a fixture (stablepush.kinematics.CellError). An arm that has a model of itself
         checks here (the simulated arm, the joint-trajectory bridge); this default knows none and
         lets every plan pass (`stablepush check-cell --robot` asks the same of a model)."""
 

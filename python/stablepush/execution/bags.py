@@ -138,7 +138,7 @@ ROBOT_DESCRIPTION = "/robot_description"
 
 
 class JointSamples(NamedTuple):
-    """The arm's joints at each sample of a trajectory (stablepush.sim.joint_path.JointPath.samples):
+    """The arm's joints at each sample of a trajectory (stablepush.kinematics.cell_path.JointPath.samples):
     their `names`, and one row per sample of `positions` [rad], `velocities` [rad/s] and
     `accelerations` [rad/s^2]; `robot`, the arm's model (its base link, its URDF)."""
 

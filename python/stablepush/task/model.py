@@ -201,7 +201,7 @@ PLANNER_DEFAULTS: Dict[str, Any] = PlannerSettings().as_dict()
 @dataclass(frozen=True)
 class Robot:
     """The arm a plan runs on, as the task's `environment.robot` section gives it: `model`, a URDF
-    or MJCF file of the arm (None: the shipped arm, stablepush/sim/arm.xml), `flange`, the link
+    or MJCF file of the arm (None: the shipped arm, stablepush/kinematics/arm.xml), `flange`, the link
     (body) the project's jaws mount on, `tcp`, the grasp frame G in the flange's frame (x, y, z mm
     and the fixed-axis roll, pitch, yaw deg of a URDF `rpy`), `base`, the arm's base in the world
     (x, y, z mm and yaw deg about the world's z), and `max_joint_speed` [rad/s, or m/s for a

@@ -1,6 +1,6 @@
 """The files of a lab's robot model as they are read (URDF or MJCF): the XML decoded as it
 declares, an MJCF's includes put in place, and every file it names checked and protected as an
-input, before MuJoCo (stablepush.sim.robot) compiles it. The task loads a model through here, so
+input, before MuJoCo (stablepush.kinematics.robot) compiles it. The task loads a model through here, so
 a model that cannot be read is refused as the task file is, before any work.
 """
 from __future__ import annotations
