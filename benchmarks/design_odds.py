@@ -27,7 +27,7 @@ from evaluate_tasks import SPREADS, add_runner_options, runner_of
 from generated_task_odds import generate_task, goal_for
 from shipped import TASKS
 
-from stablepush.design import DEFAULT_RANK, design, evaluate_designs, measure_layout
+from stablepush.design import DEFAULT_RANK, DesignOdds, LayoutSearch, design, evaluate_designs, measure_layout
 from stablepush.task.design_file import candidate_pushers
 
 NO_END_OR_POINTS = tuple(k for k in DEFAULT_RANK if k not in ("end", "points"))
@@ -74,8 +74,9 @@ def main() -> None:
     print("|---|---|---:|---:|---:|---:|---:|---:|---|")
     firsts = {"the rule's first": 0, "the first without end, points": 0, "the best measured": 0}
     for name, task, candidates, own_pushers, source in tasks:
-        study = design(task, candidates, source=source, max_fixtures=args.max_fixtures,
-                       time_limit=args.time_limit, reach_top=0, runner=runner)
+        study = design(task, candidates, source=source,
+                       search=LayoutSearch(max_fixtures=args.max_fixtures, time_limit=args.time_limit, reach_top=0),
+                       runner=runner)
         if not study.designs:
             print(f"<!-- {name}: {study.verdict} -->", flush=True)
             continue
@@ -84,7 +85,7 @@ def main() -> None:
         chosen = list(dict.fromkeys(ranked[:args.top] + without[:args.top]))
         own = measure_layout(task, own_pushers, source, time_limit=args.time_limit)
         study.designs = chosen + ([own] if own.solved else [])
-        evaluate_designs(study, args.trials, SPREADS, top=len(study.designs), seed=args.seed, runner=runner)
+        evaluate_designs(study, DesignOdds(args.trials, SPREADS, top=len(study.designs), seed=args.seed), runner=runner)
 
         def place(d, order):
             return "own" if d is own else order.index(d) + 1

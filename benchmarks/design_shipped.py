@@ -14,7 +14,7 @@ import yaml
 from evaluate_tasks import add_runner_options, runner_of
 from shipped import TASKS
 
-from stablepush.design import DEFAULT_RANK, design, measure_layout
+from stablepush.design import DEFAULT_RANK, LayoutSearch, design, measure_layout
 from stablepush.task.design_file import candidate_pushers
 
 DEFAULT_TASKS = ("horizontal-offset-low-mu", "horizontal-offset-high-mu", "pivoting", "t-shaped", "large-manipulation")
@@ -53,8 +53,9 @@ def main() -> None:
             if d.solved and not first:
                 first.append(time.perf_counter() - started)
 
-        study = design(task, candidates, source=str(path), max_fixtures=args.max_fixtures,
-                       time_limit=args.time_limit, reach_top=0, runner=runner, progress=seen)
+        study = design(task, candidates, source=str(path),
+                       search=LayoutSearch(max_fixtures=args.max_fixtures, time_limit=args.time_limit, reach_top=0),
+                       runner=runner, progress=seen)
         wall = time.perf_counter() - started
         own = measure_layout(task, own_pushers, str(path), time_limit=args.time_limit)
         if not own.solved:

@@ -319,6 +319,8 @@ def _pool(kind: str, ctx: dict):
         "axis": ([(-1.0, 1.0, 2), (0.0, 0.0, 1)], [(NAN, 1, 2), (0, 1, 0), (0, 1, 10 ** 6), "0:1:2", (0, 1),
                                                    (0, INF, 2), (0, 1, 1.5)]),
         "grid": ([ctx["grid"]], [None, 3, ((-1.0, 1.0, 2), (0.0, 0.0, 1), (0.0, 0.0, 1)), ctx["task"]]),
+        "layout_search": ([ctx["layout_search"]], [None, 3, {"time_limit": 0.05}, ctx["odds"]]),
+        "odds": ([ctx["odds"]], [None, 3, ctx["spreads"], ctx["layout_search"]]),
         "rules": ([None, SearchRules(), SearchRules(start_pusher="left", min_transit_hold=1.0)],
                   [3, "left", SearchRules(start_pusher="nobody"), SearchRules(start_pusher=3),
                    SearchRules(min_transit_hold=NAN), SearchRules(min_transit_hold=-1.0),
@@ -350,7 +352,7 @@ def _api_table(sp, ctx):
     """function -> (callable, {parameter: kind}): every name of stablepush.__all__ that is a function
     or a value type, and the documented functions of the subpackages (design, evaluation, runners,
     reach, the simulated arm, the run's options)."""
-    from stablepush.design import design, evaluate_designs
+    from stablepush.design import DesignOdds, LayoutSearch, design, evaluate_designs
     from stablepush.evaluation import Batch, SequentialTest, Spreads, evaluate
     from stablepush.execution.executor import RunOptions
     from stablepush.plan.reach import ReachGrid, reach_map
@@ -384,12 +386,13 @@ def _api_table(sp, ctx):
                           "guarded": "bool", "engine": "engine", "tolerance": "pair", "video_fps": "rate",
                           "video_size": "size"}),
         "evaluate": (evaluate, {"batch": "batch", "trials": "count", "runner": "runner", "test": "test"}),
+        "LayoutSearch": (LayoutSearch, {"max_fixtures": "count", "rank": "rank", "reach_top": "whole0",
+                                        "time_limit": "time", "check_limit": "whole0"}),
         "design": (design, {"task": "design_task", "candidates": "candidates", "source": "source",
-                            "max_fixtures": "count", "rank": "rank", "reach_top": "whole0", "time_limit": "time",
-                            "runner": "runner", "check_limit": "whole0"}),
-        "evaluate_designs": (evaluate_designs, {"study": "study", "trials": "count", "spreads": "spreads",
-                                                "top": "count", "seed": "seed", "closed_loop": "bool",
-                                                "engine": "engine", "runner": "runner"}),
+                            "search": "layout_search", "runner": "runner"}),
+        "DesignOdds": (DesignOdds, {"trials": "count", "spreads": "spreads", "top": "count", "seed": "seed",
+                                    "closed_loop": "bool", "engine": "engine"}),
+        "evaluate_designs": (evaluate_designs, {"study": "study", "odds": "odds", "runner": "runner"}),
         "ReachGrid": (ReachGrid, {"x": "axis", "z": "axis", "theta": "axis"}),
         "reach_map": (reach_map, {"task": "task", "grid": "grid", "seed": "seed", "time_limit": "time",
                                   "check_limit": "whole0"}),
@@ -401,21 +404,17 @@ def _api_table(sp, ctx):
 
 
 # Arguments the table must keep cheap when good: the fixed ones each call gets unless drawn.
-API_FIXED = {"plan_task": {"time_limit": 0.02}, "design": {"time_limit": 0.05, "reach_top": 0},
-             "reach_map": {"time_limit": 0.01},
-             "evaluate": {"trials": 1}, "evaluate_designs": {"trials": 1, "top": 1}, "WorldDeviation": {},
-             "Runner": {"workers": 1}}
+API_FIXED = {"plan_task": {"time_limit": 0.02}, "reach_map": {"time_limit": 0.01}, "evaluate": {"trials": 1},
+             "WorldDeviation": {}, "Runner": {"workers": 1}}
 # Good values that the kind's pool would not give for this function.
 API_GOOD = {("Cell", "retract"): [20.0], ("Cell", "lane_offset"): [75.0], ("WorldDeviation", "tracker_noise_mm"): [0.0],
             ("SimulatedArm", "robot"): [None], ("Runner", "workers"): [1], ("evaluate", "trials"): [1],
-            ("evaluate_designs", "trials"): [1], ("evaluate_designs", "top"): [1], ("design", "reach_top"): [0],
             ("plan_task", "improve_for"): [None], ("plan_task", "check_limit"): [None, 100000],
-            ("design", "check_limit"): [100000], ("reach_map", "check_limit"): [100000],
-            ("design", "max_fixtures"): [1, 2], ("PusherSpec", "points"): [2], ("Batch", "tolerance"): [None, (0.5, 0.5)]}
+            ("reach_map", "check_limit"): [100000], ("PusherSpec", "points"): [2], ("Batch", "tolerance"): [None, (0.5, 0.5)]}
 
 
 def _api_context(sp, scratch: Path) -> dict:
-    from stablepush.design import design
+    from stablepush.design import DesignOdds, LayoutSearch, design
     from stablepush.evaluation import Batch, SequentialTest, Spreads
     from stablepush.plan.reach import ReachGrid
     from stablepush.sim.deviation import WorldDeviation
@@ -443,7 +442,9 @@ def _api_context(sp, scratch: Path) -> dict:
     (scratch / "a-folder").mkdir(exist_ok=True)
     (folder / "binary.bin").write_bytes(bytes(range(256)))
     spreads = Spreads(vary={"pad_mu": 0.1})
-    study = design(design_task, candidates, source=str(design_path), time_limit=0.05, reach_top=0)
+    # cheap when good: layouts of one fixture, each searched within 100,000 tests, no reach map
+    layout_search = LayoutSearch(max_fixtures=1, time_limit=0.05, reach_top=0, check_limit=100000)
+    study = design(design_task, candidates, source=str(design_path), search=LayoutSearch(time_limit=0.05, reach_top=0))
     return {"task": task, "plan": plan, "task_path": str(task_path), "plan_path": str(plan_path),
             "task_text": LOW_MU.read_text(), "folder": str(scratch / "a-folder"), "fifo": str(fifo),
             "missing": str(scratch / "missing.yaml"), "binary": str(folder / "binary.bin"),
@@ -451,7 +452,8 @@ def _api_context(sp, scratch: Path) -> dict:
             "model": arm["model"], "robot": sp.Robot(model=arm["model"], flange="tool0", tcp=arm["tcp"]),
             "spreads": spreads, "study": study, "batch": Batch(task=task, plan=plan, spreads=spreads),
             "test": SequentialTest(target=0.5), "design_task": design_task, "candidates": candidates,
-            "deviation": WorldDeviation(), "grid": ReachGrid((-1.0, 1.0, 2), (0.0, 0.0, 1), (0.0, 0.0, 1))}
+            "deviation": WorldDeviation(), "grid": ReachGrid((-1.0, 1.0, 2), (0.0, 0.0, 1), (0.0, 0.0, 1)),
+            "layout_search": layout_search, "odds": DesignOdds(1, spreads, top=1)}
 
 
 class _Work:

@@ -15,6 +15,8 @@ import stablepush as sp
 from stablepush.design import (
     DEFAULT_RANK,
     Design,
+    DesignOdds,
+    LayoutSearch,
     design,
     design_task,
     evaluate_designs,
@@ -70,7 +72,8 @@ def test_candidates_are_the_sections_edges_and_points_beside_its_convex_corners(
 @pytest.mark.slow
 def test_the_offset_design_is_at_least_as_good_as_the_tasks_own_layout_and_verifies(tmp_path):
     task, candidates = load_design(DESIGN)
-    study = design(task, candidates, source=str(DESIGN), time_limit=2.0, reach_top=0, runner=Runner(workers=2))
+    study = design(task, candidates, source=str(DESIGN), search=LayoutSearch(time_limit=2.0, reach_top=0),
+                   runner=Runner(workers=2))
     assert study.designs, study.verdict
     own_task = yaml.safe_load((TASKS / "horizontal-offset-low-mu.yaml").read_text())
     own = measure_layout(task, own_task["pushers"], str(DESIGN), time_limit=2.0)
@@ -112,7 +115,7 @@ def test_every_design_of_a_generated_part_plans_and_verifies(tmp_path, seed):
     except TaskError as exc:  # a draw whose goal leaves the pads off the part: refused by name, as a task is
         assert exc.field.startswith(("goal", "object")), exc
         return
-    study = design(task, candidates, source=str(path), max_fixtures=1, time_limit=0.5, reach_top=0)
+    study = design(task, candidates, source=str(path), search=LayoutSearch(max_fixtures=1, time_limit=0.5, reach_top=0))
     if not study.designs:
         assert study.verdict.startswith("no layout of the candidates can do it: "), study.verdict
         return
@@ -245,10 +248,11 @@ def test_evaluate_ranks_the_best_designs_by_their_odds_in_the_same_worlds(tmp_pa
     path.write_text(yaml.safe_dump(data))
     task, candidates = load_design(path)
     runner = Runner(workers=2)
-    study = design(task, candidates, source=str(path), max_fixtures=1, time_limit=1.0, reach_top=0, runner=runner)
+    study = design(task, candidates, source=str(path), search=LayoutSearch(max_fixtures=1, time_limit=1.0, reach_top=0),
+                   runner=runner)
     assert len(study.designs) > 3, study.verdict
     spreads = Spreads.for_task(layout_task(task, candidates, str(path)), {"pad_mu": 0.3, "pusher_mu": 0.3})
-    evaluate_designs(study, 3, spreads, top=3, seed=5, runner=runner)
+    evaluate_designs(study, DesignOdds(3, spreads, top=3, seed=5), runner=runner)
     assert study.rank[0] == "success" and study.evaluated["trials"] == 3
     measured = [d for d in study.designs if d.success is not None]
     assert study.designs[:3] == measured and all(d.success["trials"] == 3 for d in measured)

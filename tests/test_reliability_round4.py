@@ -259,11 +259,12 @@ def one_study(tmp_path_factory):
     ({"max_fixtures": 1.5}, "max_fixtures"),
 ])
 def test_o_design_refuses_its_arguments_before_the_search(one_study, monkeypatch, arguments, field):
-    """design(rank=("bogus",)) searched every layout, then raised KeyError."""
+    """design(rank=("bogus",)) searched every layout, then raised KeyError: its search is refused
+    when made."""
     task, candidates, source = one_study
     _no_search(monkeypatch)
     with pytest.raises(StablepushError) as refused:
-        layouts.design(task, candidates, source=source, **arguments)
+        layouts.design(task, candidates, source=source, search=layouts.LayoutSearch(**arguments))
     assert refused.value.field == field, str(refused.value)
 
 
@@ -285,7 +286,7 @@ def test_o_evaluate_designs_refuses_its_arguments_before_any_trial(one_study, mo
     monkeypatch.setattr(odds, "Batch", lambda **kw: pytest.fail("a batch was made"))
     given = {"trials": 2, "spreads": Spreads(vary={"pad_mu": 0.1}), **arguments}
     with pytest.raises(SettingError) as refused:
-        odds.evaluate_designs(study, **given)
+        odds.evaluate_designs(study, odds.DesignOdds(**given))
     assert refused.value.field == field, str(refused.value)
     assert study.evaluated is None and study.designs[0].success is None
 

@@ -107,6 +107,8 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     """
     from stablepush.design import (
         DEFAULT_RANK,
+        DesignOdds,
+        LayoutSearch,
         check_designs_folder,
         design_files,
         designs_folder,
@@ -129,8 +131,9 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     runner = where.runner(default=default_workers())
     bar = progressbar(quiet, length=None, label="layouts planned", show_pos=True)
     try:
-        study = search(task, candidates, source=design_file, max_fixtures=max_fixtures, rank=rank,
-                       reach_top=reach_top, time_limit=time_limit, check_limit=check_limit, runner=runner,
+        layouts = LayoutSearch(max_fixtures=max_fixtures, rank=rank, reach_top=reach_top, time_limit=time_limit,
+                               check_limit=check_limit)
+        study = search(task, candidates, source=design_file, search=layouts, runner=runner,
                        progress=(lambda d: bar.update(1)) if bar else None)
     finally:
         if bar is not None:
@@ -138,8 +141,8 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     if spreads is not None and study.designs:
         with landings_bar(quiet, trials * min(evaluate_top, len(study.designs))) as landed:
             ranked = list(study.designs)
-            evaluate_designs(study, trials, spreads, top=evaluate_top, seed=seed, closed_loop=closed_loop,
-                             engine=engine, runner=runner,
+            odds = DesignOdds(trials, spreads, top=evaluate_top, seed=seed, closed_loop=closed_loop, engine=engine)
+            evaluate_designs(study, odds, runner=runner,
                              progress=(lambda d, record, done: landed(done, f"design {ranked.index(d) + 1}: "))
                              if landed else None)
     files = design_files(study, task, candidates, out, design_file)

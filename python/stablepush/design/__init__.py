@@ -7,6 +7,7 @@ from stablepush.design.layouts import (
     RANK_KEYS,
     Design,
     DesignStudy,
+    LayoutSearch,
     design,
     design_files,
     design_task,
@@ -15,8 +16,8 @@ from stablepush.design.layouts import (
     measure_layout,
     parse_rank,
 )
-from stablepush.design.odds import evaluate_designs
+from stablepush.design.odds import DesignOdds, evaluate_designs
 
-__all__ = ["design", "evaluate_designs", "design_files", "check_designs_folder", "write_designs", "designs_folder",
-           "design_task", "layout_task", "measure_layout", "parse_rank", "Design", "DesignStudy", "RANK_KEYS",
-           "DEFAULT_RANK"]
+__all__ = ["design", "LayoutSearch", "evaluate_designs", "DesignOdds", "design_files", "check_designs_folder",
+           "write_designs", "designs_folder", "design_task", "layout_task", "measure_layout", "parse_rank", "Design",
+           "DesignStudy", "RANK_KEYS", "DEFAULT_RANK"]

@@ -279,23 +279,56 @@ def layout_task(task: Dict[str, Any], pushers: Sequence[Dict[str, Any]], source:
     return parse_task({**task, "pushers": [dict(p) for p in pushers]}, source)
 
 
+@dataclass(frozen=True)
+class LayoutSearch:
+    """How design() searches: the layouts of at most `max_fixtures` candidates, each planned within
+    `check_limit` stable-push tests (0: no count; then `time_limit` s, None: the task's
+    planner.time_limit, which is otherwise only a guard), the solved ones ranked by `rank` (keys of
+    RANK_KEYS; `success` may be among them: evaluate_designs measures it), the best `reach_top`
+    given a reach map around the goal. Made with a field out of its range it raises TaskError or
+    SettingError naming it, as `stablepush design` takes them."""
+
+    max_fixtures: int = 2
+    rank: Tuple[str, ...] = DEFAULT_RANK
+    reach_top: int = 3
+    time_limit: Optional[float] = None
+    check_limit: int = LAYOUT_CHECKS
+
+    def __post_init__(self) -> None:
+        max_fixtures, reach_top, rank = self.max_fixtures, self.reach_top, self.rank
+        if isinstance(max_fixtures, bool) or not is_integer(max_fixtures) or max_fixtures < 1:
+            raise SettingError("max_fixtures", f"must be a whole number from 1 up, got {max_fixtures!r:.40}")
+        if isinstance(reach_top, bool) or not is_integer(reach_top) or not 0 <= reach_top <= MAX_REACH_TOP:
+            raise SettingError("reach_top", f"must be a whole number from 0 to {MAX_REACH_TOP}, got {reach_top!r:.40}")
+        if self.time_limit is not None:
+            planner_limit("time_limit", self.time_limit)
+        if isinstance(rank, str) or not isinstance(rank, (tuple, list)):
+            raise TaskError("rank", f"a sequence of keys from {', '.join(RANK_KEYS)}, got {rank!r:.80}")
+        object.__setattr__(self, "rank", _rank_keys(tuple(rank), repr(tuple(rank)), measured=True))
+        object.__setattr__(self, "check_limit", planner_integer("check_limit", "check_limit", self.check_limit))
+
+
 def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: Optional[str] = None,
-           max_fixtures: int = 2, rank: Sequence[str] = DEFAULT_RANK, reach_top: int = 3,
-           time_limit: Optional[float] = None, runner: Optional[Runner] = None,
-           progress: Optional[Callable[[Design], None]] = None, check_limit: int = LAYOUT_CHECKS) -> DesignStudy:
-    """Search the layouts of at most `max_fixtures` of `candidates` (design_file.load_design), each
-    planned within `check_limit` stable-push tests (0: no count; then `time_limit` s, None: the
-    task's planner.time_limit, which is otherwise only a guard), and rank the solved ones
-    by `rank` (keys of RANK_KEYS); the best `reach_top` get a reach map around the goal.
-    `progress(design)` after each layout is planned."""
-    rank, check_limit = _checked_arguments(max_fixtures, rank, reach_top, time_limit, runner, progress, check_limit)
+           search: Optional[LayoutSearch] = None, runner: Optional[Runner] = None,
+           progress: Optional[Callable[[Design], None]] = None) -> DesignStudy:
+    """Search the layouts of `candidates` (design_file.load_design) as `search` says (None:
+    LayoutSearch()), and rank the solved ones. `progress(design)` after each layout is planned.
+    TypeError for a search, runner or progress that is not one."""
+    search = LayoutSearch() if search is None else search
+    if not isinstance(search, LayoutSearch):
+        raise TypeError(f"search: expected a LayoutSearch, got {type(search).__name__}")
+    if runner is not None and not isinstance(runner, Runner):
+        raise TypeError(f"runner: expected a Runner, got {type(runner).__name__}")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress: expected a function, got {type(progress).__name__}")
+    rank, reach_top, check_limit = search.rank, search.reach_top, search.check_limit
     if not isinstance(task, dict):
         raise TypeError(f"task must be a design file's task mapping (design_file.load_design), got "
                         f"{type(task).__name__}")
     if not isinstance(candidates, (list, tuple)) or not all(isinstance(c, dict) for c in candidates):
         raise TypeError(f"candidates must be a list of pusher entries (design_file.load_design), got "
                         f"{candidates!r:.60}")
-    max_fixtures = min(max_fixtures, len(candidates))
+    max_fixtures = min(search.max_fixtures, len(candidates))
     everything = layout_task(task, candidates, source)  # every candidate checked once, on the part
     require_goal_apart(everything)  # else every candidate would be pruned as making no push toward the goal
     toward = _pushers_toward_goal(everything)
@@ -303,7 +336,7 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
     layouts = [combo for size in range(1, max_fixtures + 1)
                for combo in itertools.combinations(range(len(candidates)), size) if set(combo) & set(useful)]
     total = sum(math.comb(len(candidates), k) for k in range(1, max_fixtures + 1))
-    job = _Job(task, tuple(candidates), source, tuple(layouts), time_limit, check_limit)
+    job = _Job(task, tuple(candidates), source, tuple(layouts), search.time_limit, check_limit)
     runner = runner or Runner()
     results: List[Design] = []
     for i, result in run_all(_plan_layout, job, range(len(layouts)), runner):
@@ -323,28 +356,6 @@ def design(task: Dict[str, Any], candidates: Sequence[Dict[str, Any]], source: O
                        pruned_candidates=[c["name"] for i, c in enumerate(candidates) if i not in useful],
                        layouts_searched=len(layouts), layouts_pruned=total - len(layouts), rank=tuple(rank),
                        failed=[d for d in results if not d.solved])
-
-
-def _checked_arguments(max_fixtures: Any, rank: Any, reach_top: Any, time_limit: Any, runner: Any, progress: Any,
-                       check_limit: Any) -> Tuple[Tuple[str, ...], int]:
-    """design()'s arguments checked before any work, as `stablepush design` takes them (TaskError
-    or SettingError naming the one out of its range, TypeError for a runner or progress that is
-    not one): the rank as a tuple of keys (`success` may be among them: evaluate_designs measures
-    it) and the check limit."""
-    if isinstance(max_fixtures, bool) or not is_integer(max_fixtures) or max_fixtures < 1:
-        raise SettingError("max_fixtures", f"must be a whole number from 1 up, got {max_fixtures!r:.40}")
-    if isinstance(reach_top, bool) or not is_integer(reach_top) or not 0 <= reach_top <= MAX_REACH_TOP:
-        raise SettingError("reach_top", f"must be a whole number from 0 to {MAX_REACH_TOP}, got {reach_top!r:.40}")
-    if time_limit is not None:
-        planner_limit("time_limit", time_limit)
-    if runner is not None and not isinstance(runner, Runner):
-        raise TypeError(f"runner: expected a Runner, got {type(runner).__name__}")
-    if progress is not None and not callable(progress):
-        raise TypeError(f"progress: expected a function, got {type(progress).__name__}")
-    if isinstance(rank, str) or not isinstance(rank, (tuple, list)):
-        raise TaskError("rank", f"a sequence of keys from {', '.join(RANK_KEYS)}, got {rank!r:.80}")
-    keys = tuple(rank)
-    return _rank_keys(keys, repr(keys), measured=True), planner_integer("check_limit", "check_limit", check_limit)
 
 
 def _distinct(ranked: List[Design]) -> List[Design]:
