@@ -266,6 +266,17 @@ class StudyOutputs:
 
 
 @dataclass(frozen=True)
+class TrialRun:
+    """--closed-loop, --engine, and evaluate's --guard and --success-tolerance: how each trial of a
+    study runs and what counts as landing (None: the task's tolerance)."""
+
+    closed_loop: bool
+    engine: str
+    guarded: bool = True
+    success_tolerance: Optional[Tuple[float, float]] = None
+
+
+@dataclass(frozen=True)
 class WorldSpreads:
     """--vary, --feature-error, --tracker-noise: how a study's worlds differ from the task."""
 

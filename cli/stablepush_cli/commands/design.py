@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional
 
 import click
 
@@ -17,9 +19,8 @@ from stablepush_cli.common import (
     landings_bar,
     progressbar,
     say_beside,
-    study_spreads,
 )
-from stablepush_cli.groups import RunnerChoice, runner_choice
+from stablepush_cli.groups import RunnerChoice, TrialRun, WorldSpreads, option_group, runner_choice
 from stablepush_cli.options import (
     TIME_LIMIT,
     Finite,
@@ -30,41 +31,83 @@ from stablepush_cli.options import (
 ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine", "seed")
 
 
+@dataclass(frozen=True)
+class LayoutChoice:
+    """--max-fixtures, --rank, --checks, --time-limit, --reach-top: how the layouts are searched."""
+
+    max_fixtures: int
+    rank_text: Optional[str]
+    check_limit: int
+    time_limit: float
+    reach_top: int
+
+    def search(self, measured: bool):
+        """The search (stablepush.design.LayoutSearch); `measured`: the designs' odds are (--evaluate),
+        so the rule may rank by success."""
+        from stablepush.design import DEFAULT_RANK, LayoutSearch, parse_rank
+
+        rank = parse_rank(self.rank_text, measured=measured) if self.rank_text is not None else DEFAULT_RANK
+        return LayoutSearch(max_fixtures=self.max_fixtures, rank=rank, reach_top=self.reach_top,
+                            time_limit=self.time_limit, check_limit=self.check_limit)
+
+
+@dataclass(frozen=True)
+class OddsChoice:
+    """--evaluate, --evaluate-top, --vary, --feature-error, --closed-loop, --engine, --seed: the odds
+    of the best designs, measured in the same worlds (`trials` None: not measured)."""
+
+    trials: Optional[int]
+    evaluate_top: int
+    worlds: WorldSpreads
+    run: TrialRun
+    seed: int
+
+
 @click.command()
 @click.argument("design_file", metavar="DESIGN.yaml", type=click.Path(dir_okay=False))
-@click.option("--max-fixtures", default=2, show_default=True, type=Whole(min=1, max=4), metavar="K",
-              help="Layouts of 1 to K fixtures.")
-@click.option("--rank", "rank_text", default=None, metavar="KEYS",
-              help="The ranking rule: keys, most important first, from arm (the task's arm follows the plan "
-                   "first), fixtures, points (point pushers used), end (the plan's end's offset from the goal over "
-                   "the tolerance), switches, pushes (less first), margin, reach (more first), tests (the search's "
-                   "stable-push tests), time (planning time: depends on the machine's load) and success "
-                   "(with --evaluate). Default: arm,fixtures,points,end,switches,margin,pushes,reach,tests; with "
-                   "--evaluate, success first unless the rule places it.")
-@click.option("--checks", "check_limit", default=2_000_000, show_default=True, type=Whole(min=0, max=10**15),
-              metavar="N", help="Stable-push tests each layout's search may make: a count, so the same design file "
-                                "gives the same designs on any machine under any load (0: --time-limit alone).")
-@click.option("--time-limit", default=30.0, show_default=True, type=TIME_LIMIT, metavar="S",
-              help="Each layout's search time, a guard past --checks (the task's planner.time_limit is not used: "
-                   "there are many layouts).")
-@click.option("--reach-top", default=3, show_default=True, type=Whole(min=0, max=100), metavar="N",
-              help="The best N designs get a 3x3 reach map around the goal (2 tolerances either side in x and z), "
-                   "and are ranked again with it.")
-@click.option("--evaluate", "trials", default=None, type=Whole(min=1, max=100_000), metavar="N",
-              help="Run each of the best --evaluate-top designs' plans through `evaluate`, N trials each in the "
-                   "same worlds, and rank them by their measured success rate first.")
-@click.option("--evaluate-top", default=3, show_default=True, type=Whole(min=1, max=100), metavar="K",
-              help="With --evaluate: how many of the best designs to evaluate.")
-@click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
-              help="With --evaluate: the worlds' spreads, as `evaluate --vary` (default: the design file's "
-                   "uncertainty box, else a lab's).")
-@click.option("--feature-error", nargs=2, type=Finite(min=0), default=None, metavar="MM DEG",
-              help="With --evaluate: place each fixture off by up to MM and DEG, as `evaluate --feature-error`.")
-@click.option("--closed-loop", is_flag=True, help="With --evaluate: run the trials closed loop.")
-@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
-              help="With --evaluate: the simulated arm's physics engine.")
-@click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
-              help="With --evaluate: the worlds' seed (every design runs in the same worlds).")
+@option_group(
+    "layouts", LayoutChoice,
+    click.option("--max-fixtures", default=2, show_default=True, type=Whole(min=1, max=4), metavar="K",
+                 help="Layouts of 1 to K fixtures."),
+    click.option("--rank", "rank_text", default=None, metavar="KEYS",
+                 help="The ranking rule: keys, most important first, from arm (the task's arm follows the plan "
+                      "first), fixtures, points (point pushers used), end (the plan's end's offset from the goal "
+                      "over the tolerance), switches, pushes (less first), margin, reach (more first), tests (the "
+                      "search's stable-push tests), time (planning time: depends on the machine's load) and success "
+                      "(with --evaluate). Default: arm,fixtures,points,end,switches,margin,pushes,reach,tests; with "
+                      "--evaluate, success first unless the rule places it."),
+    click.option("--checks", "check_limit", default=2_000_000, show_default=True, type=Whole(min=0, max=10**15),
+                 metavar="N", help="Stable-push tests each layout's search may make: a count, so the same design "
+                                   "file gives the same designs on any machine under any load (0: --time-limit "
+                                   "alone)."),
+    click.option("--time-limit", default=30.0, show_default=True, type=TIME_LIMIT, metavar="S",
+                 help="Each layout's search time, a guard past --checks (the task's planner.time_limit is not used: "
+                      "there are many layouts)."),
+    click.option("--reach-top", default=3, show_default=True, type=Whole(min=0, max=100), metavar="N",
+                 help="The best N designs get a 3x3 reach map around the goal (2 tolerances either side in x and "
+                      "z), and are ranked again with it."))
+@option_group(
+    "odds", OddsChoice,
+    click.option("--evaluate", "trials", default=None, type=Whole(min=1, max=100_000), metavar="N",
+                 help="Run each of the best --evaluate-top designs' plans through `evaluate`, N trials each in the "
+                      "same worlds, and rank them by their measured success rate first."),
+    click.option("--evaluate-top", default=3, show_default=True, type=Whole(min=1, max=100), metavar="K",
+                 help="With --evaluate: how many of the best designs to evaluate."),
+    option_group(
+        "worlds", WorldSpreads,
+        click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
+                     help="With --evaluate: the worlds' spreads, as `evaluate --vary` (default: the design file's "
+                          "uncertainty box, else a lab's)."),
+        click.option("--feature-error", nargs=2, type=Finite(min=0), default=None, metavar="MM DEG",
+                     help="With --evaluate: place each fixture off by up to MM and DEG, as `evaluate "
+                          "--feature-error`.")),
+    option_group(
+        "run", TrialRun,
+        click.option("--closed-loop", is_flag=True, help="With --evaluate: run the trials closed loop."),
+        click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+                     help="With --evaluate: the simulated arm's physics engine.")),
+    click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
+                 help="With --evaluate: the worlds' seed (every design runs in the same worlds)."))
 @click.option("--out", "out_dir", default=None, type=click.Path(file_okay=False), metavar="DIR",
               help="Where each design's task file goes (design-1.yaml is the best). Default: NAME.designs/ beside "
                    "the design file NAME.design.yaml. The folder then holds this run's designs only: the designs an "
@@ -77,9 +120,8 @@ ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine"
               help="Draw the best three layouts side by side (PNG, PDF or SVG).")
 @runner_choice("the layouts' plans")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, time_limit: float, reach_top: int, trials,
-           evaluate_top: int, vary, feature_error, closed_loop: bool, engine: str, seed: int, out_dir, json_path,
-           png_path, where: RunnerChoice, quiet: bool) -> None:
+def design(design_file: str, layouts: LayoutChoice, odds: OddsChoice, out_dir, json_path, png_path,
+           where: RunnerChoice, quiet: bool) -> None:
     """Find where the fixtures should go: rank layouts of candidate pushers by their plans.
 
     DESIGN.yaml is a task file whose `candidates` stand in for its `pushers`: `candidates: {mu:
@@ -106,14 +148,11 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
       stablepush design data/designs/offset-low-mu.design.yaml --evaluate 20 --vary pad_mu=0.2
     """
     from stablepush.design import (
-        DEFAULT_RANK,
         DesignOdds,
-        LayoutSearch,
         check_designs_folder,
         design_files,
         designs_folder,
         evaluate_designs,
-        parse_rank,
         write_designs,
     )
     from stablepush.design import design as search
@@ -121,28 +160,27 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
     from stablepush.runners import default_workers
     from stablepush.task import load_design
 
-    rank = parse_rank(rank_text, measured=trials is not None) if rank_text is not None else DEFAULT_RANK
+    layout_search = layouts.search(measured=odds.trials is not None)
     out = Path(out_dir) if out_dir is not None else designs_folder(design_file)
     require_suffix("--plot", png_path, FIGURE_SUFFIXES)
     check_named_outputs({"--json": json_path, "--plot": png_path}, {"DESIGN.yaml": design_file})
     check_designs_folder(out, "--out")
     task, candidates = load_design(design_file)
-    spreads = _spreads(task, candidates, design_file, trials, vary, feature_error)
+    spreads = _spreads(task, candidates, design_file, odds)
     runner = where.runner(default=default_workers())
     bar = progressbar(quiet, length=None, label="layouts planned", show_pos=True)
     try:
-        layouts = LayoutSearch(max_fixtures=max_fixtures, rank=rank, reach_top=reach_top, time_limit=time_limit,
-                               check_limit=check_limit)
-        study = search(task, candidates, source=design_file, search=layouts, runner=runner,
+        study = search(task, candidates, source=design_file, search=layout_search, runner=runner,
                        progress=(lambda d: bar.update(1)) if bar else None)
     finally:
         if bar is not None:
             bar.render_finish()
-    if spreads is not None and study.designs:
-        with landings_bar(quiet, trials * min(evaluate_top, len(study.designs))) as landed:
+    if spreads is not None and odds.trials is not None and study.designs:
+        measure = DesignOdds(odds.trials, spreads, top=odds.evaluate_top, seed=odds.seed,
+                             closed_loop=odds.run.closed_loop, engine=odds.run.engine)
+        with landings_bar(quiet, odds.trials * min(odds.evaluate_top, len(study.designs))) as landed:
             ranked = list(study.designs)
-            odds = DesignOdds(trials, spreads, top=evaluate_top, seed=seed, closed_loop=closed_loop, engine=engine)
-            evaluate_designs(study, odds, runner=runner,
+            evaluate_designs(study, measure, runner=runner,
                              progress=(lambda d, record, done: landed(done, f"design {ranked.index(d) + 1}: "))
                              if landed else None)
     files = design_files(study, task, candidates, out, design_file)
@@ -180,16 +218,16 @@ def design(design_file: str, max_fixtures: int, rank_text, check_limit: int, tim
         sys.exit(130)
 
 
-def _spreads(task, candidates, design_file: str, trials, vary, feature_error):
+def _spreads(task, candidates, design_file: str, odds: OddsChoice):
     """The worlds --evaluate draws (None without it): the design's spreads, checked before the search."""
     from stablepush.design import layout_task
 
-    if trials is None:
+    if odds.trials is None:
         named = [name for name in ODDS_OPTIONS if given(name)]
         if named:
             fail(f"--{named[0].replace('_', '-')}: only with --evaluate N")
         return None
-    return study_spreads(layout_task(task, candidates, design_file), vary, feature_error)
+    return odds.worlds.spreads(layout_task(task, candidates, design_file))
 
 
 def _figures(d) -> str:
