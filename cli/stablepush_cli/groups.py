@@ -252,11 +252,13 @@ def runner_choice(what: str, default: str = "the number of CPUs", where_help: st
 
 @dataclass(frozen=True)
 class StudyOutputs:
-    """--json, --csv, --plot: where a study's records and figure go."""
+    """--json, --csv, --plot and the failed trials' videos: where a study's records, figure and
+    videos go."""
 
     json_path: Optional[str]
     csv_path: Optional[str]
     png_path: Optional[str]
+    video: VideoRequest
 
     def named(self) -> Dict[str, Optional[str]]:
         return {"--json": self.json_path, "--csv": self.csv_path, "--plot": self.png_path}

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import os
 import sys
+from dataclasses import dataclass
+from typing import Optional
 
 import click
 
@@ -23,7 +25,7 @@ from stablepush_cli.groups import (
     RobotChoice,
     RunnerChoice,
     StudyOutputs,
-    VideoRequest,
+    TrialRun,
     WorldSpreads,
     option_group,
     robot_choice,
@@ -39,30 +41,55 @@ from stablepush_cli.options import (
 )
 
 
+@dataclass(frozen=True)
+class EvaluatedPlan:
+    """TASK.yaml, --plan, --robust: the plan evaluated, the one given or one planned here (robust:
+    to the worlds)."""
+
+    task_file: str
+    plan_file: Optional[str]
+    robust: bool
+
+
+@dataclass(frozen=True)
+class StudyTrials:
+    """--trials, --target, --confidence, --seed: how many trials run (a count, or until the
+    sequential test of --target decides) and the seed their worlds are drawn from."""
+
+    trials: Optional[int]
+    target: Optional[float]
+    confidence: float
+    seed: int
+
+
 @click.command()
-@click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False))
-@click.option("--plan", "plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False), default=None,
-              help="The plan to evaluate (checked against the task). Default: plan once from the task.")
-@click.option("--robust", is_flag=True,
-              help="Plan robust to the worlds: the task's uncertainty box widened to the --vary spreads, so every "
-                   "push is stable for every multiplier they draw (docs/model.md section 7). Corrections keep "
-                   "the box. Not with --plan.")
-@click.option("--trials", default=None, type=Whole(min=1, max=1_000_000),
-              help="Number of trials (worlds)  [default: 100]. With --target, the most to run  [default: the most "
-                   "trials the test is expected to take at any success rate, a cap it decides within "
-                   "(docs/evaluate.md)].")
-@click.option("--target", "target", default=None, type=Finite(min=0, max=1, min_open=True, max_open=True),
-              metavar="RATE", help="Decide whether the plan lands at least RATE of the time (e.g. 0.99), and stop "
-                                   "as soon as the evidence does: a sequential probability ratio test, valid however "
-                                   "early it stops (docs/evaluate.md). A rate one point below RATE is called above "
-                                   "with probability at most 1 - --confidence, and one at RATE below likewise; so "
-                                   "RATE lies strictly between 0.01 and 1.")
-@click.option("--confidence", default=0.95, show_default=True, type=Finite(min=0.5, max=1, min_open=True,
-                                                                                 max_open=True),
-              metavar="C", help="With --target: the decision's confidence.")
-@click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
-              help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and outcomes, "
-                   "serially, on workers or on Ray.")
+@option_group(
+    "source", EvaluatedPlan,
+    click.argument("task_file", metavar="TASK.yaml", type=click.Path(dir_okay=False)),
+    click.option("--plan", "plan_file", metavar="PLAN.json", type=click.Path(dir_okay=False), default=None,
+                 help="The plan to evaluate (checked against the task). Default: plan once from the task."),
+    click.option("--robust", is_flag=True,
+                 help="Plan robust to the worlds: the task's uncertainty box widened to the --vary spreads, so "
+                      "every push is stable for every multiplier they draw (docs/model.md section 7). Corrections "
+                      "keep the box. Not with --plan."))
+@option_group(
+    "count", StudyTrials,
+    click.option("--trials", default=None, type=Whole(min=1, max=1_000_000),
+                 help="Number of trials (worlds)  [default: 100]. With --target, the most to run  [default: the "
+                      "most trials the test is expected to take at any success rate, a cap it decides within "
+                      "(docs/evaluate.md)]."),
+    click.option("--target", "target", default=None, type=Finite(min=0, max=1, min_open=True, max_open=True),
+                 metavar="RATE", help="Decide whether the plan lands at least RATE of the time (e.g. 0.99), and "
+                                      "stop as soon as the evidence does: a sequential probability ratio test, valid "
+                                      "however early it stops (docs/evaluate.md). A rate one point below RATE is "
+                                      "called above with probability at most 1 - --confidence, and one at RATE "
+                                      "below likewise; so RATE lies strictly between 0.01 and 1."),
+    click.option("--confidence", default=0.95, show_default=True,
+                 type=Finite(min=0.5, max=1, min_open=True, max_open=True),
+                 metavar="C", help="With --target: the decision's confidence."),
+    click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
+                 help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and "
+                      "outcomes, serially, on workers or on Ray."))
 @option_group(
     "worlds", WorldSpreads,
     click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
@@ -75,14 +102,16 @@ from stablepush_cli.options import (
                       "without --vary, else 0 0."),
     click.option("--tracker-noise", nargs=2, type=Finite(min=0), default=(0.0, 0.0), metavar="MM DEG",
                  help="Standard deviations of the tracker's noise on the pose in the grasp."))
-@click.option("--closed-loop", is_flag=True, help="Run each trial closed loop (re-plan from the tracked pose).")
-@click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
-              help="Find each feature by touch at the end of its approach (as `execute --guard`).")
-@click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
-              help="The simulated arm's physics engine.")
-@click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None, metavar="MM DEG",
-              help="A trial lands when the object comes to rest within MM (x and z) and DEG of the goal in the "
-                   "grasp, as `execute` judges a run (default: the task's planner.tolerance).")
+@option_group(
+    "run", TrialRun,
+    click.option("--closed-loop", is_flag=True, help="Run each trial closed loop (re-plan from the tracked pose)."),
+    click.option("--guard/--no-guard", "guarded", default=True, show_default=True,
+                 help="Find each feature by touch at the end of its approach (as `execute --guard`)."),
+    click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
+                 help="The simulated arm's physics engine."),
+    click.option("--success-tolerance", nargs=2, type=Finite(min=0, min_open=True), default=None, metavar="MM DEG",
+                 help="A trial lands when the object comes to rest within MM (x and z) and DEG of the goal in the "
+                      "grasp, as `execute` judges a run (default: the task's planner.tolerance)."))
 @runner_choice("the trials")
 @option_group(
     "outputs", StudyOutputs,
@@ -91,18 +120,17 @@ from stablepush_cli.options import (
     click.option("--csv", "csv_path", type=click.Path(dir_okay=False), default=None, help="Write one trial a row."),
     click.option("--plot", "png_path", type=click.Path(dir_okay=False), default=None,
                  help="Draw the goal error's CDF against the tolerance, and success over the varied parameters "
-                      "(PNG, PDF or SVG, as the name ends)."))
-@video_request(
-    "--video-failed",
-    click.option("--video-failed", "video_path", type=click.Path(file_okay=False), default=None, metavar="DIR",
-                 help="Draw each failed trial's run as a video, DIR/trial-<i>.mp4 (made if missing; as `execute "
-                      "--video` draws it, in the trial's own world), named in the trial's record (--json, --csv)."))
+                      "(PNG, PDF or SVG, as the name ends)."),
+    video_request(
+        "--video-failed",
+        click.option("--video-failed", "video_path", type=click.Path(file_okay=False), default=None, metavar="DIR",
+                     help="Draw each failed trial's run as a video, DIR/trial-<i>.mp4 (made if missing; as `execute "
+                          "--video` draws it, in the trial's own world), named in the trial's record (--json, "
+                          "--csv).")))
 @click.option("--quiet", is_flag=True, help="No progress bar.")
 @robot_choice
-def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confidence: float, seed: int,
-             worlds: WorldSpreads, closed_loop: bool, guarded: bool, engine: str, success_tolerance,
-             where: RunnerChoice, outputs: StudyOutputs, video: VideoRequest, quiet: bool,
-             robot: RobotChoice) -> None:
+def evaluate(source: EvaluatedPlan, count: StudyTrials, worlds: WorldSpreads, run: TrialRun, where: RunnerChoice,
+             outputs: StudyOutputs, quiet: bool, robot: RobotChoice) -> None:
     """Measure how often a plan lands: run it in TRIALS simulated worlds that differ from its model.
 
     Each trial's world multiplies the task's parameters named by --vary by factors drawn within the
@@ -130,7 +158,8 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
       stablepush evaluate data/tasks/t-shaped.yaml --trials 100 --robust --vary pad_mu=0.15 --vary pusher_mu=0.15
       stablepush evaluate data/tasks/t-shaped.yaml --trials 20 --vary pad_mu=0.3 --video-failed t-failed
     """
-    test = _test(target, confidence)
+    test = _test(count.target, count.confidence)
+    video = outputs.video
     video_dir = video.path
     if video_dir:  # before the trials load MuJoCo: the renderer needs MUJOCO_GL=osmesa from the start
         check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video.fps, video.size)
@@ -142,18 +171,18 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
     from stablepush.runners import default_workers
 
     require_suffix("--plot", outputs.png_path, FIGURE_SUFFIXES)
-    check_named_outputs(outputs.named(), {"TASK.yaml": task_file, "--plan": plan_file})
+    check_named_outputs(outputs.named(), {"TASK.yaml": source.task_file, "--plan": source.plan_file})
     say = say_beside(*outputs.given())
 
     runner = where.runner(default=default_workers())
-    if guarded:  # before a plan is searched for; Batch refuses it as well
+    if run.guarded:  # before a plan is searched for; Batch refuses it as well
         from stablepush.execution import GuardedApproach
 
         try:
             GuardedApproach.for_tracker_noise(*worlds.tracker_noise)
         except SettingError as exc:
             fail(f"--tracker-noise: {exc.reason}")
-    task, plan, spreads = _study(task_file, plan_file, robust, worlds)
+    task, plan, spreads = _study(source, worlds)
     task = robot.on(task)
     if video_dir:
         from stablepush.sim import video_directory
@@ -163,21 +192,23 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         except OutputError as exc:
             fail(f"--video-failed {exc}")
     try:
-        batch = Batch(task=task, plan=plan, spreads=spreads, seed=seed, closed_loop=closed_loop, guarded=guarded,
-                      engine=engine, tolerance=success_tolerance, video_dir=video_dir, video_fps=video.fps,
-                      video_size=video.size)
+        batch = Batch(task=task, plan=plan, spreads=spreads, seed=count.seed, closed_loop=run.closed_loop,
+                      guarded=run.guarded, engine=run.engine, tolerance=run.success_tolerance, video_dir=video_dir,
+                      video_fps=video.fps, video_size=video.size)
     except SettingError as exc:  # the tracker's noise, past what the guard can tell a touch from
         fail(f"--{exc.field.replace('_', '-')}: {exc.reason}")
     for warning in batch.warnings():
         click.echo(f"warning: {warning}", err=True)
+    trials = count.trials
     if test is not None and trials is not None and test.cap_warning(trials):
         click.echo(f"warning: --trials {trials}: {test.cap_warning(trials)}", err=True)
     trials = study_trials(spreads, trials, test)  # as evaluate() runs them: the bar and the header say so too
     if not quiet:
         box = ", ".join(f"{key} +-{fraction:.0%}" for key, fraction in task.uncertainty.items())
         click.echo(f"{task.name}: {spreads.describe()}", err=True)
-        click.echo(f"{task.name}: {'up to ' if test else ''}{trials} trials, {'closed' if closed_loop else 'open'} loop"
-                   f"{'' if guarded else ', approaches not guarded'} on {engine}, "
+        click.echo(f"{task.name}: {'up to ' if test else ''}{trials} trials, "
+                   f"{'closed' if run.closed_loop else 'open'} loop"
+                   f"{'' if run.guarded else ', approaches not guarded'} on {run.engine}, "
                    f"on {runner.describe(trials)}" + (f"; the plan is robust to {box}" if box else ""), err=True)
     with landings_bar(quiet, trials) as landed:
         result = run_evaluation(batch, trials, runner, (lambda record, done: landed(
@@ -197,8 +228,9 @@ def evaluate(task_file: str, plan_file, robust: bool, trials: int, target, confi
         sys.exit(130)
 
 
-def _study(task_file: str, plan_file, robust: bool, worlds: WorldSpreads):
+def _study(source: EvaluatedPlan, worlds: WorldSpreads):
     """The task, the plan to evaluate (the one given, else planned here) and the worlds' spreads."""
+    task_file, plan_file, robust = source.task_file, source.plan_file, source.robust
     if robust and plan_file:
         fail("--robust plans from the task; a plan given with --plan is evaluated as it is")
     if plan_file:
