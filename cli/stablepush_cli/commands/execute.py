@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import contextlib
 import sys
+from dataclasses import dataclass
+from typing import Optional, Tuple
 
 import click
 
@@ -43,6 +45,26 @@ from stablepush_cli.options import (
 )
 
 
+@dataclass(frozen=True)
+class RunReport:
+    """--json, --success-tolerance, --record, --stamp, --video: the run's report and the tolerance
+    its verdict is judged by (None: the task's), and the bag and the video recorded of it."""
+
+    json_path: Optional[str]
+    success_tolerance: Optional[Tuple[float, float]]
+    record_path: Optional[str]
+    stamp_ns: Optional[int]
+    video: VideoRequest
+
+
+@dataclass(frozen=True)
+class Verbosity:
+    """--quiet, -v: no progress bar; a line per correction and per contact."""
+
+    quiet: bool
+    verbose: bool
+
+
 @click.command()
 @plan_and_task("The task the plan was made for (checked against the plan before anything moves).")
 @arm_connection("Start a simulated arm here and run the plan on it (see --engine).")
@@ -60,36 +82,42 @@ from stablepush_cli.options import (
               click.option("--pace/--no-pace", default=None,
                            help="Hold the stream to --rate in wall-clock time (default: on for a real arm, off "
                                 "with --sim)."))
-@click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
-              help="Write the run's report as JSON: success, tolerance, cause of a miss, engine, final pose in the "
-                   "grasp, slip per contact, corrections, features (on an arm fault: the verdict and where to resume).")
-@click.option("--success-tolerance", "success_tolerance", nargs=2, type=Finite(min=0, min_open=True),
-              default=None, metavar="MM DEG",
-              help="The run lands when the object ends within MM (x and z) and DEG of the goal in the grasp "
-                   "(default: the task's planner.tolerance).")
-@click.option("--record", "record_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mcap",
-              help="Record the run as a ROS 2 bag (one MCAP file): the commanded and measured gripper pose, the "
-                   "object in the world and in the grasp, /tf and /tf_static, the pusher in contact, each correction "
-                   "and the verdict; with the arm's model (--sim, --robot or environment.robot) its /joint_states "
-                   "and, for a URDF, /robot_description (docs/execution.md, 'ROS 2 bags'); written on a fault too.")
-@stamp_option("--record", "when the run starts")
-@video_request(
-    "--video",
-    click.option("--video", "video_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mp4",
-                 help="Draw the run as a video (H.264 MP4, headless): seen along the gripping axis as the plan "
-                      "figures are, the object, the pads, the features (the pusher in contact highlighted) and the "
-                      "plan's pose at each step as a green ghost (docs/execution.md, 'Video of a run'); needs the "
-                      "object's pose, which a simulated arm reports; drawn on a fault too."),
-    click.option("--video-view", "video_view", type=click.Choice(VIDEO_VIEWS), default="schematic",
-                 show_default=True,
-                 help="With --video: schematic, along the gripping axis as the plan figures are; 3d, the whole cell "
-                      "in perspective, the arm posed from the joints it reported (its model: --sim, --robot or the "
-                      "task's environment.robot), the part in its jaws and the features; both, the two side by "
-                      "side, the video twice as wide."))
-@click.option("--quiet", is_flag=True, help="No progress bar.")
-@click.option("-v", "--verbose", is_flag=True,
-              help="A line per correction of the closed loop and per contact (slip, carry, where the guard found "
-                   "its feature); without, one line sums each up.")
+@option_group(
+    "report", RunReport,
+    click.option("--json", "json_path", type=click.Path(dir_okay=False), default=None,
+                 help="Write the run's report as JSON: success, tolerance, cause of a miss, engine, final pose in the "
+                      "grasp, slip per contact, corrections, features (on an arm fault: the verdict and where to "
+                      "resume)."),
+    click.option("--success-tolerance", "success_tolerance", nargs=2, type=Finite(min=0, min_open=True),
+                 default=None, metavar="MM DEG",
+                 help="The run lands when the object ends within MM (x and z) and DEG of the goal in the grasp "
+                      "(default: the task's planner.tolerance)."),
+    click.option("--record", "record_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mcap",
+                 help="Record the run as a ROS 2 bag (one MCAP file): the commanded and measured gripper pose, the "
+                      "object in the world and in the grasp, /tf and /tf_static, the pusher in contact, each "
+                      "correction and the verdict; with the arm's model (--sim, --robot or environment.robot) its "
+                      "/joint_states and, for a URDF, /robot_description (docs/execution.md, 'ROS 2 bags'); written "
+                      "on a fault too."),
+    stamp_option("--record", "when the run starts"),
+    video_request(
+        "--video",
+        click.option("--video", "video_path", type=click.Path(dir_okay=False), default=None, metavar="RUN.mp4",
+                     help="Draw the run as a video (H.264 MP4, headless): seen along the gripping axis as the plan "
+                          "figures are, the object, the pads, the features (the pusher in contact highlighted) and "
+                          "the plan's pose at each step as a green ghost (docs/execution.md, 'Video of a run'); "
+                          "needs the object's pose, which a simulated arm reports; drawn on a fault too."),
+        click.option("--video-view", "video_view", type=click.Choice(VIDEO_VIEWS), default="schematic",
+                     show_default=True,
+                     help="With --video: schematic, along the gripping axis as the plan figures are; 3d, the whole "
+                          "cell in perspective, the arm posed from the joints it reported (its model: --sim, --robot "
+                          "or the task's environment.robot), the part in its jaws and the features; both, the two "
+                          "side by side, the video twice as wide.")))
+@option_group(
+    "talk", Verbosity,
+    click.option("--quiet", is_flag=True, help="No progress bar."),
+    click.option("-v", "--verbose", is_flag=True,
+                 help="A line per correction of the closed loop and per contact (slip, carry, where the guard found "
+                      "its feature); without, one line sums each up."))
 @sim_world()
 @option_group("loop", LoopChoice,
               click.option("--closed-loop", "closed_loop", is_flag=True,
@@ -115,9 +143,8 @@ from stablepush_cli.options import (
                                                   "tolerance)."))
 @robot_choice
 @help_with(causes=", ".join(CAUSES))
-def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, json_path, success_tolerance, record_path,
-            stamp_ns, video: VideoRequest, quiet: bool, verbose: bool, world: SimWorld, loop: LoopChoice,
-            robot: RobotChoice) -> None:
+def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, report: RunReport, talk: Verbosity,
+            world: SimWorld, loop: LoopChoice, robot: RobotChoice) -> None:
     """Run a plan on an arm: stream end-effector waypoints and report what the arm confirmed.
 
     Each pusher the plan uses is a fixed feature of the world (the task's `environment:` section
@@ -160,6 +187,8 @@ def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, json_
     )
     from stablepush.outputs import require_suffix
 
+    json_path, record_path, stamp_ns, video = report.json_path, report.record_path, report.stamp_ns, report.video
+    quiet = talk.quiet
     require_suffix("--record", record_path, (".mcap",))
     if stamp_ns is not None and not record_path:
         fail("--stamp: only with --record (it is the recording's start time)")
@@ -191,7 +220,7 @@ def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, json_
     except SettingError as exc:  # a noise the guard cannot tell a touch from
         fail(f"--tracker-noise: {exc.reason}")
     options = RunOptions(rate_hz=stream.rate_hz, resume_from=stream.resume_from, pace=stream.pace,
-                         closed_loop=loop.loop_for(task), guard=guard, success_tolerance=success_tolerance)
+                         closed_loop=loop.loop_for(task), guard=guard, success_tolerance=report.success_tolerance)
     target = _arm_for(connection, world, quiet, task.environment.robot)
     with _run_progress(task, plan, stream.resume_from, quiet) as progress:
         run = run_plan(task, plan, target, options, progress=progress,
@@ -203,7 +232,7 @@ def execute(files: PlanFiles, connection: ArmChoice, stream: StreamChoice, json_
             if output.progress is not None:
                 output.progress.close()
     say = say_beside(json_path, record_path, video.path)
-    lines = run.written if run.fault is not None else run.report.describe(verbose) + run.written
+    lines = run.written if run.fault is not None else run.report.describe(talk.verbose) + run.written
     for line in lines:
         say(line)
     for output, error in run.failed:  # as each would have been refused before the run, named by its option
