@@ -121,3 +121,35 @@ def test_a_good_model_narrows_the_interval_of_a_plan_that_misses_often():
     plain = clopper_pearson(int(y.sum()), y.size, 0.05)
     assert rate.high - rate.low < plain[1] - plain[0]
     assert rate.low <= plain[1] and plain[0] <= rate.high
+
+
+def test_evaluate_predict_joins_the_models_verdicts_to_the_same_trials(tmp_path):
+    import json
+
+    from click.testing import CliRunner
+
+    from stablepush_cli.main import cli
+
+    args = ["evaluate", str(TASKS / "horizontal-offset-low-mu.yaml"), "--trials", "2", "--vary", "pad_mu=0.35",
+            "--vary", "pusher_mu=0.35", "--workers", "1", "--quiet"]
+    plain = CliRunner().invoke(cli, [*args, "--json", str(tmp_path / "plain.json")])
+    predicted = CliRunner().invoke(cli, [*args, "--predict", "300", "--json", str(tmp_path / "predicted.json")])
+    assert plain.exit_code == predicted.exit_code == 0, predicted.output
+    assert "model-only worlds" in predicted.output and "the model agreed with" in predicted.output
+    without, joined = (json.loads((tmp_path / f"{name}.json").read_text()) for name in ("plain", "predicted"))
+    assert [t["success"] for t in without["trials"]] == [t["success"] for t in joined["trials"]]
+    assert all(isinstance(t["predicted"]["lands"], bool) for t in joined["trials"])
+    p = joined["summary"]["prediction"]
+    assert p["predictions"] == 300 and p["trials"] == 2 and sum(p["agreement"].values()) == 2
+    assert p["interval"][0] <= p["estimate"] <= p["interval"][1]
+    assert without["summary"]["prediction"] is None
+
+
+def test_evaluate_refuses_a_count_of_predictions_before_any_trial():
+    from click.testing import CliRunner
+
+    from stablepush_cli.main import cli
+
+    result = CliRunner().invoke(cli, ["evaluate", str(TASKS / "pivoting.yaml"), "--predict", "20000000"])
+    assert result.exit_code == 2 and "--predict: must be a whole number from 1 to 10,000,000" in result.output
+    assert "trials" not in result.output.split("--predict")[0]

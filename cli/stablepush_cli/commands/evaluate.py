@@ -53,13 +53,15 @@ class EvaluatedPlan:
 
 @dataclass(frozen=True)
 class StudyTrials:
-    """--trials, --target, --confidence, --seed: how many trials run (a count, or until the
-    sequential test of --target decides) and the seed their worlds are drawn from."""
+    """--trials, --target, --confidence, --seed, --predict: how many trials run (a count, or until
+    the sequential test of --target decides), the seed their worlds are drawn from, and how many
+    model-only worlds join them (None: none)."""
 
     trials: Optional[int]
     target: Optional[float]
     confidence: float
     seed: int
+    predict: Optional[int] = None
 
 
 @click.command()
@@ -89,7 +91,14 @@ class StudyTrials:
                  metavar="C", help="With --target: the decision's confidence."),
     click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
                  help="Trial i's world depends on (seed, i) alone: the same seed gives the same worlds and "
-                      "outcomes, serially, on workers or on Ray."))
+                      "outcomes, serially, on workers or on Ray."),
+    click.option("--predict", default=None, type=Whole(min=1), metavar="N",
+                 help="Also ask the plan's model for its verdict on N model-only worlds of the same spreads (each "
+                      "push stable, the release held, the end within the tolerance; about 0.1 ms a world) and on "
+                      "each trial's world, and join them to the trials by prediction-powered inference: the summary "
+                      "adds the model's agreement with the simulator and an interval that holds whatever that "
+                      "agreement (docs/evaluate.md, 'Odds from predictions'). The trials and --target's decision "
+                      "are the same with or without it. At most 10,000,000."))
 @option_group(
     "worlds", WorldSpreads,
     click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
@@ -175,13 +184,7 @@ def evaluate(source: EvaluatedPlan, count: StudyTrials, worlds: WorldSpreads, ru
     say = say_beside(*outputs.given())
 
     runner = where.runner(default=default_workers())
-    if run.guarded:  # before a plan is searched for; Batch refuses it as well
-        from stablepush.execution import GuardedApproach
-
-        try:
-            GuardedApproach.for_tracker_noise(*worlds.tracker_noise)
-        except SettingError as exc:
-            fail(f"--tracker-noise: {exc.reason}")
+    _check_before_trials(count, worlds, run)
     task, plan, spreads = _study(source, worlds)
     task = robot.on(task)
     if video_dir:
@@ -213,6 +216,8 @@ def evaluate(source: EvaluatedPlan, count: StudyTrials, worlds: WorldSpreads, ru
     with landings_bar(quiet, trials) as landed:
         result = run_evaluation(batch, trials, runner, (lambda record, done: landed(
             done, suffix=f"; {decision_state(test, done)}" if test else "")) if landed else None, test=test)
+    if count.predict is not None and result.trials:
+        result = _with_predictions(result, count.predict, quiet)
     write_evaluation(result, outputs.json_path, outputs.csv_path, outputs.png_path)
     s = result.summary()
     if not s["trials"]:
@@ -226,6 +231,24 @@ def evaluate(source: EvaluatedPlan, count: StudyTrials, worlds: WorldSpreads, ru
         sys.exit(EXIT_INTERNAL)
     if s["interrupted"]:
         sys.exit(130)
+
+
+def _check_before_trials(count: StudyTrials, worlds: WorldSpreads, run: TrialRun) -> None:
+    """Refuse, before a plan is searched for, a tracker noise the guard cannot tell a touch from
+    (Batch refuses it as well) and a count of predictions out of range."""
+    option = "--tracker-noise"
+    try:
+        if run.guarded:
+            from stablepush.execution import GuardedApproach
+
+            GuardedApproach.for_tracker_noise(*worlds.tracker_noise)
+        if count.predict is not None:
+            from stablepush.evaluation import check_predictions
+
+            option = "--predict"
+            check_predictions(count.predict)
+    except SettingError as exc:
+        fail(f"{option}: {exc.reason}")
 
 
 def _study(source: EvaluatedPlan, worlds: WorldSpreads):
@@ -259,6 +282,15 @@ def _plan_for(task, spreads, robust: bool):
         click.echo(f"{task.name}{' (robust)' if robust else ''}: {plan.message}", err=True)
         sys.exit(EXIT_NOT_SOLVED)
     return task, plan
+
+
+def _with_predictions(result, predict: int, quiet: bool):
+    """The evaluation with the model's verdicts on `predict` model-only worlds and on each trial's."""
+    from stablepush.evaluation import with_predictions
+
+    if not quiet:
+        click.echo(f"predicting {predict:,} model-only worlds", err=True)
+    return with_predictions(result, predict)  # its count was checked before the trials
 
 
 def _test(target, confidence: float):

@@ -7,6 +7,7 @@ from stablepush.evaluation.batch import (
     MAX_PREDICTIONS,
     Batch,
     Evaluation,
+    check_predictions,
     decision_state,
     evaluate,
     run_trial,
@@ -21,6 +22,6 @@ from stablepush.evaluation.sequential import SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world, robust_task
 
 __all__ = ["Batch", "Evaluation", "MAX_PREDICTIONS", "PlanInWorlds", "PredictedRate", "Prediction", "SequentialTest",
-           "Spreads", "TrialWorld", "VARY_KEYS", "decision_state", "draw_world", "evaluate", "predicted_multipliers",
-           "prediction_powered_rate", "robust_task", "run_trial", "study_trials", "wilson_interval",
-           "with_predictions", "write_evaluation"]
+           "Spreads", "TrialWorld", "VARY_KEYS", "check_predictions", "decision_state", "draw_world", "evaluate",
+           "predicted_multipliers", "prediction_powered_rate", "robust_task", "run_trial", "study_trials",
+           "wilson_interval", "with_predictions", "write_evaluation"]

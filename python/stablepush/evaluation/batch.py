@@ -270,14 +270,21 @@ def evaluate(batch: Batch, trials: Optional[int] = None, runner: Runner = Runner
                       requested=trials, interrupted=interrupted, decision=decision.as_dict())
 
 
+def check_predictions(predictions: int) -> int:
+    """`predictions`, a count of model-only worlds; SettingError unless a whole number from 1 to
+    MAX_PREDICTIONS (asked before the trials run, by whoever will join predictions to them)."""
+    if isinstance(predictions, bool) or not is_integer(predictions) or not 1 <= predictions <= MAX_PREDICTIONS:
+        raise SettingError("predict", f"must be a whole number from 1 to {MAX_PREDICTIONS:,}, got {predictions!r:.40}")
+    return predictions
+
+
 def with_predictions(evaluation: "Evaluation", predictions: int) -> "Evaluation":
     """`evaluation` with the model's verdict on each trial's world (each record's `predicted`) and
     its success rate from `predictions` model-only worlds of the same spreads joined with the
     trials by prediction-powered inference (ppi.prediction_powered_rate; the crashed trials left
     out, as from the rate). SettingError for a count of predictions that is not a whole number
     from 1 to MAX_PREDICTIONS."""
-    if isinstance(predictions, bool) or not is_integer(predictions) or not 1 <= predictions <= MAX_PREDICTIONS:
-        raise SettingError("predict", f"must be a whole number from 1 to {MAX_PREDICTIONS:,}, got {predictions!r:.40}")
+    check_predictions(predictions)
     batch = evaluation.batch
     judge = PlanInWorlds(batch.task, batch.plan, batch.success_tolerance, batch.closed_loop)
     trials = [{**t, "predicted": judge.predict(batch.world(t["trial"])).as_dict()} for t in evaluation.trials]
@@ -456,7 +463,8 @@ class Evaluation:
                   + [f"{name}_{c}" for name in offsets for c in ("dx_mm", "dz_mm", "dtheta_deg")]
                   + [f"{short}_{c}" for _, short in errors for c in ("x_mm", "z_mm", "theta_deg", "distance_mm")]
                   + ["replans", "sim_time_s", "wall_s", "verdict", "error", "node"]
-                  + (["video", "video_error"] if self.batch.video_dir else []))
+                  + (["video", "video_error"] if self.batch.video_dir else [])
+                  + (["predicted_lands", "predicted_least_margin_n"] if self.prediction is not None else []))
         rows = []
         for t in self.trials:
             w = t["world"]
@@ -465,7 +473,9 @@ class Evaluation:
                         + [(t[which] or {}).get(c, "") for which, _ in errors for c in ("x", "z", "theta", "distance")]
                         + [t["replans"], t["sim_time_s"], t["wall_s"], t["verdict"] or "", t["error"] or "",
                            t.get("node") or ""]
-                        + ([t.get("video") or "", t.get("video_error") or ""] if self.batch.video_dir else []))
+                        + ([t.get("video") or "", t.get("video_error") or ""] if self.batch.video_dir else [])
+                        + ([t["predicted"]["lands"], t["predicted"]["least_margin"]]
+                           if self.prediction is not None else []))
         return header, rows
 
 
