@@ -14,7 +14,14 @@ from stablepush import _core
 from stablepush.errors import PadFaceError, TaskError
 from stablepush.plan import plan_task
 from stablepush.task import load_task, parse_task
-from stablepush.task.mesh import PartMesh, _solid_in_o, first_pad_off_faces, load_mesh_object, pad_face_problem
+from stablepush.task.mesh import (
+    MeshSection,
+    PartMesh,
+    _solid_in_o,
+    first_pad_off_faces,
+    load_mesh_object,
+    pad_face_problem,
+)
 
 from conftest import ROOT
 
@@ -51,12 +58,12 @@ def _cylinder(tmp_path, sections=256):
 def test_a_fine_section_is_simplified_within_its_tolerance(tmp_path):
     path = _cylinder(tmp_path)
     for tolerance in (0.01, 0.1, 1.0):
-        obj = load_mesh_object(path, "object", mass=100.0, tolerance=tolerance)
+        obj = load_mesh_object(path, "object", MeshSection(tolerance=tolerance), mass=100.0)
         assert obj.section_vertices >= 256 and len(obj.vertices) <= obj.section_vertices
         exact = Polygon([(20 * math.cos(a), 20 * math.sin(a)) for a in np.linspace(0, 2 * math.pi, 2048)])
         # Simplified within the tolerance (plus the 256-gon's own sagitta, 0.003 mm).
         assert Polygon(obj.vertices).hausdorff_distance(exact) <= tolerance + 0.01
-    assert len(load_mesh_object(path, "object", mass=100.0, tolerance=1.0).vertices) < 40
+    assert len(load_mesh_object(path, "object", MeshSection(tolerance=1.0), mass=100.0).vertices) < 40
 
 
 @pytest.mark.parametrize("edit, field, says", [
@@ -180,7 +187,7 @@ def test_a_section_in_two_pieces_is_refused(tmp_path):
     solid = _extruded(u, cap, 40.0)
     solid.export(tmp_path / "u.stl")
     with pytest.raises(TaskError, match="2 separate pieces") as error:
-        load_mesh_object(tmp_path / "u.stl", "object", mass=10.0, plane_y=25.0)
+        load_mesh_object(tmp_path / "u.stl", "object", MeshSection(plane_y=25.0), mass=10.0)
     assert error.value.field == "object.plane_y"
 
 

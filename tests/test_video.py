@@ -179,7 +179,7 @@ def test_execute_video_draws_the_arm_and_the_part_in_3d(tmp_path):
     shipped_task = shipped("t-shaped")
     scene = video.run_scene(shipped_task, check_plan(shipped_task, plan_task(shipped_task, seed=1)))
     with pytest.raises(OutputError, match="no3d.mp4: the 3-D view draws the arm from its joints"):
-        video.render_run(tmp_path / "no3d.mp4", shipped_task, scene, [sample], view="3d")
+        video.render_run(tmp_path / "no3d.mp4", shipped_task, scene, [sample], look=video.VideoLook(view="3d"))
 
 
 @pytest.mark.slow

@@ -186,13 +186,13 @@ def _failed_trial_video(batch: Batch, trial: int, world: TrialWorld, recording: 
     """Draw a failed trial's recorded run in its own world (features where this trial put them)
     into video_dir/trial-<i>.mp4 and return the path; None, with `video_error` in the record, when
     it cannot be drawn (no waypoint was acknowledged, say). Never raises: the trial's record stands."""
-    from stablepush.sim.mujoco.video import render_run, run_scene
+    from stablepush.sim.mujoco.video import VideoLook, render_run, run_scene
 
     assert batch.video_dir is not None, "asked only of a batch with a video_dir"
     path = os.path.join(batch.video_dir, f"trial-{trial}.mp4")
     try:
         scene = deviation_of(batch, world).apply(run_scene(batch.task, batch.plan, batch.closed_loop))
-        render_run(path, batch.task, scene, recording.samples, fps=batch.video_fps, size=batch.video_size)
+        render_run(path, batch.task, scene, recording.samples, look=VideoLook(batch.video_fps, batch.video_size))
     except Exception as exc:  # noqa: BLE001 - a video that cannot be drawn does not change the trial
         record["video_error"] = f"{type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
         return None

@@ -179,13 +179,27 @@ class MeshObject:
     notes: Tuple[str, ...] = ()  # legal but probably not meant (each names its field)
 
 
-def load_mesh_object(path: Path, field: str, *, scale: float = 1.0, plane_y: Optional[float] = None,
-                     tolerance: float = 0.1, mass: Optional[float] = None, density: Optional[float] = None,
-                     max_vertices: int = 1000, thickness_range: Tuple[float, float] = (1e-2, 1e4)) -> MeshObject:
-    """The object of a mesh file. `mass` [g] or `density` [g/cm^3] (exactly one); `plane_y` [mm,
-    after scaling] defaults to the centre of mass's y; `tolerance` [mm] bounds how far the
-    simplified section departs from the true one; `thickness_range` [mm] bounds the solid's extent
-    along y. One body, cut into one outline without holes. TaskError naming `field` on any problem."""
+@dataclass(frozen=True)
+class MeshSection:
+    """How the task's section is taken from a mesh file: its units times `scale` into mm, cut by
+    the plane y = `plane_y` [mm, after scaling; None: the centre of mass's y], the outline
+    simplified within `tolerance` [mm] of the true one (the task file's object.scale, .plane_y and
+    .tolerance, which load_mesh_object checks against the mesh)."""
+
+    scale: float = 1.0
+    plane_y: Optional[float] = None
+    tolerance: float = 0.1
+
+
+def load_mesh_object(path: Path, field: str, section: Optional[MeshSection] = None, *, mass: Optional[float] = None,
+                     density: Optional[float] = None, max_vertices: int = 1000,
+                     thickness_range: Tuple[float, float] = (1e-2, 1e4)) -> MeshObject:
+    """The object of a mesh file, its section taken as `section` says (None: MeshSection()).
+    `mass` [g] or `density` [g/cm^3] (exactly one); `thickness_range` [mm] bounds the solid's
+    extent along y. One body, cut into one outline without holes. TaskError naming `field` on any
+    problem."""
+    section = MeshSection() if section is None else section
+    scale, plane_y, tolerance = section.scale, section.plane_y, section.tolerance
     try:
         import trimesh
         from shapely.geometry import Polygon

@@ -41,7 +41,7 @@ from stablepush.task.fields import (
     planner_parameter,
     pose_field,
 )
-from stablepush.task.mesh import PartMesh, first_pad_off_faces, load_mesh_object, slab_text
+from stablepush.task.mesh import MeshSection, PartMesh, first_pad_off_faces, load_mesh_object, slab_text
 from stablepush.task.model import (
     MAX_PUSHER_POINTS,
     PLANNER_DEFAULTS,
@@ -444,10 +444,11 @@ def _mesh_object(obj: dict, source: Optional[str], notes: List[str]):
     if not found:
         what = "not a regular file (a device, a FIFO or a directory)" if path.exists() else "no such file"
         raise TaskError("object.file", f"{what}: {path}")
+    section = MeshSection(scale=_number("object.scale", obj.get("scale", 1.0), (1e-6, 1e6)),
+                          plane_y=_number("object.plane_y", obj["plane_y"], COORDINATE) if "plane_y" in obj else None,
+                          tolerance=_number("object.tolerance", obj.get("tolerance", 0.1), (1e-4, 100.0)))
     mesh = load_mesh_object(
-        path, "object", scale=_number("object.scale", obj.get("scale", 1.0), (1e-6, 1e6)),
-        plane_y=_number("object.plane_y", obj["plane_y"], COORDINATE) if "plane_y" in obj else None,
-        tolerance=_number("object.tolerance", obj.get("tolerance", 0.1), (1e-4, 100.0)),
+        path, "object", section,
         mass=_number("object.mass", obj["mass"], LIMITS["mass"]) if "mass" in obj else None,
         density=_number("object.density", obj["density"], (1e-3, 100.0)) if "density" in obj else None,
         max_vertices=MAX_VERTICES, thickness_range=LIMITS["length"])

@@ -204,8 +204,9 @@ class RunVideo(RunOutput):
         closed_loop = run.options.closed_loop is not None
         scene = run_scene(run.task, run.plan, closed_loop, run.options.resume_from)
         robot = run.task.environment.robot if recording.robot is not None else None  # the arm's joints are its
-        info = self.info = render_run(self.path, run.task, scene, recording.samples, fps=self.fps,
-                                      size=self.size, progress=self.progress, view=self.view, robot=robot)
+        info = self.info = render_run(self.path, run.task, scene, recording.samples,
+                                      look=VideoLook(self.fps, self.size, self.view), progress=self.progress,
+                                      robot=robot)
         return (f"video written to {self.path}: {info.frames} frames, {info.width}x{info.height} at {info.fps:g} "
                 f"fps, drawn in {info.render_s:.1f} s ({info.ms_per_frame:.0f} ms a frame)")
 
@@ -379,19 +380,29 @@ def render_model_xml(scene: Scene, box: Tuple[float, float, float, float], size:
 # -- drawing and encoding ------------------------------------------------------------------------
 
 
+@dataclass(frozen=True)
+class VideoLook:
+    """How a video is drawn: `fps` frames per second of robot time, `size` (width, height) in
+    pixels, `view` (VIDEO_VIEWS). Checked where it is drawn (render_run)."""
+
+    fps: float = DEFAULT_FPS
+    size: Tuple[int, int] = DEFAULT_SIZE
+    view: str = DEFAULT_VIEW
+
+
 def render_run(path: Union[str, Path], task: Task, scene: Scene, samples: Sequence[RunSample], *,
-               fps: float = DEFAULT_FPS, size: Tuple[int, int] = DEFAULT_SIZE,
-               progress: Optional[Callable[[int, int], None]] = None, view: str = DEFAULT_VIEW,
+               look: VideoLook = VideoLook(), progress: Optional[Callable[[int, int], None]] = None,
                robot: Optional[Robot] = None) -> VideoInfo:
     """Draw the recorded run `samples` (RunRecording.samples) of `task` in the world `scene` (the
-    scene the run's arm built; the features are drawn where it has them) in `view`
-    (VIDEO_VIEWS; the 3-D view draws the arm of `robot` from the samples' joints) and write it to
-    `path` (.mp4) atomically. `progress(frames done, frames)` after each frame. OutputError (naming
+    scene the run's arm built; the features are drawn where it has them) as `look` says (the 3-D
+    view draws the arm of `robot` from the samples' joints) and write it to `path` (.mp4)
+    atomically. `progress(frames done, frames)` after each frame. OutputError (naming
     the path) for a bad file name or setting, a run without samples or without the object's pose (a
     real arm without a tracker), a 3-D view without the arm's model or joints, or a missing renderer
     or encoder."""
     from stablepush.outputs import write_files
 
+    fps, size, view = look.fps, look.size, look.view
     try:
         check_fps(fps)
         check_size(tuple(size))
