@@ -134,7 +134,7 @@ def _probe(task, connection: ArmChoice, world: SimWorld, settings, quiet: bool, 
 
             return SimulatedArm(connection.engine, world.deviation().fixed_to(task), robot=task.environment.robot)
         from stablepush.execution import TcpArm
-        from stablepush.sim import modelled
+        from stablepush.kinematics import modelled
 
         host, port = connection.arm or ("127.0.0.1", DEFAULT_PORT)
         return modelled(TcpArm(host, port, connection.ack_timeout), task.environment.robot)

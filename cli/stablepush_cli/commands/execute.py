@@ -259,7 +259,7 @@ def _arm_for(connection: ArmChoice, world: SimWorld, quiet: bool, robot):
         log = None if quiet else lambda text: click.echo(f"sim-arm: {text}", err=True)
         return SimulatedArm(connection.engine, world.deviation(), log=log, robot=robot)
     from stablepush.execution import TcpArm
-    from stablepush.sim import modelled
+    from stablepush.kinematics import modelled
 
     host, port = connection.arm or ("127.0.0.1", DEFAULT_PORT)
     return modelled(TcpArm(host, port, connection.ack_timeout), robot)

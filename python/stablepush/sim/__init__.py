@@ -17,9 +17,6 @@ _EXPORTS = {
     "WorldDeviation": "stablepush.sim.deviation",
     "SimulatedArm": "stablepush.sim.local_arm",
     "SimArmServer": "stablepush.sim.server",
-    # the cell check's, for the command lines that build an arm (a simulated or a served one)
-    "CellError": "stablepush.kinematics.cell_path",
-    "modelled": "stablepush.kinematics.cell_path",
     "RunVideo": "stablepush.sim.mujoco.video",
     "check_fps": "stablepush.sim.mujoco.video",
     "check_size": "stablepush.sim.mujoco.video",
