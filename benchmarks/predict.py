@@ -17,6 +17,7 @@ predictors of every quality: how often the 95% interval holds the rate, for ours
 `ppi-python` package is installed, for its CLT interval (`ppi_mean_ci`, PPI++).
 """
 import argparse
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -123,7 +124,8 @@ def main() -> None:
     lines = rows(args) if args.what == "rows" else validity(args)
     if args.md:
         command = " ".join(["python3", "benchmarks/predict.py", *sys.argv[1:]])
-        args.md.write_text(f"Measured with `{command}`\n\n" + "\n".join(lines) + "\n")
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+        args.md.write_text(f"Measured at commit {commit or '(unknown)'} with `{command}`\n\n" + "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":
