@@ -24,12 +24,12 @@ holds its level as n grows; with 100 trials of a plan that lands 99% of the time
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Dict, Sequence, Tuple, Union
+from typing import Dict, Tuple
 
 import numpy as np
 
 from stablepush.errors import SettingError
-from stablepush.evaluation.prediction import agreement
+from stablepush.evaluation.prediction import Verdicts, agreement
 
 # The share of the error rate pi's interval takes; a and b share the rest. The predictions are many
 # (pi's interval is narrow at any level), the trials few.
@@ -74,9 +74,6 @@ def clopper_pearson(successes: int, n: int, alpha: float) -> Tuple[float, float]
     low = 0.0 if successes == 0 else float(beta.ppf(alpha / 2, successes, n - successes + 1))
     high = 1.0 if successes == n else float(beta.ppf(1 - alpha / 2, successes + 1, n - successes))
     return low, high
-
-
-Verdicts = Union[Sequence[bool], np.ndarray]
 
 
 def prediction_powered_rate(landed: Verdicts, predicted: Verdicts, predicted_unlabelled: Verdicts,

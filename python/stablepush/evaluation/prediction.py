@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -60,7 +60,8 @@ class Prediction:
 
 class PlanInWorlds:
     """A plan of a task, ready to be re-checked in many worlds: its pushes as arrays by pusher and
-    the models of the pushers' scaled mu, made once each."""
+    the models of the pushers' scaled mu, made once each. A trial lands within `tolerance` of the
+    goal; `closed_loop`: the run corrects its end to it, so the plan's own end is not asked."""
 
     def __init__(self, task: Task, plan: Plan, tolerance: Tolerance, closed_loop: bool = False):
         self.task = task
@@ -125,10 +126,13 @@ def predicted_multipliers(seed: int, count: int, spreads: Spreads) -> np.ndarray
     return 1.0 + rng.uniform(-1.0, 1.0, size=(count, len(VARY_KEYS))) * spread
 
 
-def agreement(predicted: np.ndarray, landed: np.ndarray) -> Dict[str, int]:
+Verdicts = Union[Sequence[bool], np.ndarray]  # one land-or-miss a world
+
+
+def agreement(predicted: Verdicts, landed: Verdicts) -> Dict[str, int]:
     """The confusion table of the model's verdicts against the simulator's on the same worlds:
     counts of (predicted, landed) as `lands_landed`, `lands_missed`, `misses_landed`,
     `misses_missed`."""
-    predicted, landed = np.asarray(predicted, bool), np.asarray(landed, bool)
-    return {"lands_landed": int(np.sum(predicted & landed)), "lands_missed": int(np.sum(predicted & ~landed)),
-            "misses_landed": int(np.sum(~predicted & landed)), "misses_missed": int(np.sum(~predicted & ~landed))}
+    f, y = np.asarray(predicted, bool), np.asarray(landed, bool)
+    return {"lands_landed": int(np.sum(f & y)), "lands_missed": int(np.sum(f & ~y)),
+            "misses_landed": int(np.sum(~f & y)), "misses_missed": int(np.sum(~f & ~y))}
