@@ -25,7 +25,7 @@ from stablepush.design import (
     measure_layout,
     parse_rank,
 )
-from stablepush.errors import TaskError
+from stablepush.errors import SettingError, TaskError
 from stablepush.evaluation import Batch, Spreads, evaluate
 from stablepush.runners import Runner
 from stablepush.task.design_file import load_design
@@ -264,12 +264,35 @@ def test_evaluate_ranks_the_best_designs_by_their_odds_in_the_same_worlds(tmp_pa
     assert again["successes"] == best.success["successes"]
 
 
+def test_with_predictions_the_designs_rank_by_the_low_end_of_their_prediction_powered_interval(tmp_path):
+    data, source = _pivot_design()
+    path = tmp_path / "pivot.design.yaml"
+    path.write_text(yaml.safe_dump(data))
+    task, candidates = load_design(path)
+    runner = Runner(workers=2)
+    study = design(task, candidates, source=str(path), search=LayoutSearch(max_fixtures=1, time_limit=1.0, reach_top=0),
+                   runner=runner)
+    spreads = Spreads.for_task(layout_task(task, candidates, str(path)), {"pad_mu": 0.3, "pusher_mu": 0.3})
+    evaluate_designs(study, DesignOdds(2, spreads, top=2, seed=5, predict=500), runner=runner)
+    measured = study.designs[:2]
+    assert all(d.success["prediction"]["predictions"] == 500 and d.success["prediction"]["trials"] == 2
+               for d in measured)
+    lows = [d.success["prediction"]["interval"][0] for d in measured]
+    assert lows == sorted(lows, reverse=True)
+    assert "with 500 predictions" in measured[0].odds() and study.evaluated["predictions"] == 500
+    assert "model-only worlds" in study.describe_odds()
+    with pytest.raises(SettingError, match="predict"):
+        DesignOdds(2, spreads, predict=0)
+
+
 @pytest.mark.parametrize("args, says", [
     (["--vary", "pad_mu=0.2"], "--vary: only with --evaluate N"),
     (["--closed-loop"], "--closed-loop: only with --evaluate N"),
     (["--rank", "success,margin"], "rank"),
     (["--evaluate", "2", "--vary", "pad_mu=2"], "--vary"),
     (["--evaluate", "2", "--feature-error", "1e9", "0"], "--feature-error"),
+    (["--predict", "100"], "--predict: only with --evaluate N"),
+    (["--evaluate", "2", "--predict", "20000000"], "--predict: must be a whole number from 1 to 10,000,000"),
 ])
 def test_the_odds_options_are_refused_before_the_search(tmp_path, args, says):
     result = CliRunner().invoke(cli, ["design", str(DESIGN), "--quiet", "--out", str(tmp_path / "d"), *args])

@@ -28,7 +28,7 @@ from stablepush_cli.options import (
     parse_vary,
 )
 
-ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine", "seed")
+ODDS_OPTIONS = ("evaluate_top", "vary", "feature_error", "closed_loop", "engine", "seed", "predict")
 
 
 @dataclass(frozen=True)
@@ -53,14 +53,16 @@ class LayoutChoice:
 
 @dataclass(frozen=True)
 class OddsChoice:
-    """--evaluate, --evaluate-top, --vary, --feature-error, --closed-loop, --engine, --seed: the odds
-    of the best designs, measured in the same worlds (`trials` None: not measured)."""
+    """--evaluate, --evaluate-top, --vary, --feature-error, --closed-loop, --engine, --seed,
+    --predict: the odds of the best designs, measured in the same worlds (`trials` None: not
+    measured), with model-only worlds joined to their trials (`predict` None: none)."""
 
     trials: Optional[int]
     evaluate_top: int
     worlds: WorldSpreads
     run: TrialRun
     seed: int
+    predict: Optional[int] = None
 
 
 @click.command()
@@ -107,7 +109,11 @@ class OddsChoice:
         click.option("--engine", default=DEFAULT_ENGINE, show_default=True, type=click.Choice(ENGINES),
                      help="With --evaluate: the simulated arm's physics engine.")),
     click.option("--seed", default=1, show_default=True, type=Whole(min=0, max=2**32 - 1),
-                 help="With --evaluate: the worlds' seed (every design runs in the same worlds)."))
+                 help="With --evaluate: the worlds' seed (every design runs in the same worlds)."),
+    click.option("--predict", default=None, type=Whole(min=1), metavar="M",
+                 help="With --evaluate: join M model-only worlds to each design's trials, as `evaluate --predict`, "
+                      "and rank the designs by the low end of that interval instead of their trials' rate. At most "
+                      "10,000,000."))
 @click.option("--out", "out_dir", default=None, type=click.Path(file_okay=False), metavar="DIR",
               help="Where each design's task file goes (design-1.yaml is the best). Default: NAME.designs/ beside "
                    "the design file NAME.design.yaml. The folder then holds this run's designs only: the designs an "
@@ -146,6 +152,7 @@ def design(design_file: str, layouts: LayoutChoice, odds: OddsChoice, out_dir, j
       stablepush design data/designs/offset-low-mu.design.yaml --json offset.designs.json
       stablepush plan data/designs/offset-low-mu.designs/design-1.yaml -o best.plan.json
       stablepush design data/designs/offset-low-mu.design.yaml --evaluate 20 --vary pad_mu=0.2
+      stablepush design data/designs/offset-low-mu.design.yaml --evaluate 20 --predict 100000
     """
     from stablepush.design import (
         DesignOdds,
@@ -177,7 +184,7 @@ def design(design_file: str, layouts: LayoutChoice, odds: OddsChoice, out_dir, j
             bar.render_finish()
     if spreads is not None and odds.trials is not None and study.designs:
         measure = DesignOdds(odds.trials, spreads, top=odds.evaluate_top, seed=odds.seed,
-                             closed_loop=odds.run.closed_loop, engine=odds.run.engine)
+                             closed_loop=odds.run.closed_loop, engine=odds.run.engine, predict=odds.predict)
         with landings_bar(quiet, odds.trials * min(odds.evaluate_top, len(study.designs))) as landed:
             ranked = list(study.designs)
             evaluate_designs(study, measure, runner=runner,
@@ -227,6 +234,14 @@ def _spreads(task, candidates, design_file: str, odds: OddsChoice):
         if named:
             fail(f"--{named[0].replace('_', '-')}: only with --evaluate N")
         return None
+    if odds.predict is not None:
+        from stablepush.errors import SettingError
+        from stablepush.evaluation import check_predictions
+
+        try:
+            check_predictions(odds.predict)
+        except SettingError as exc:
+            fail(f"--predict: {exc.reason}")
     return odds.worlds.spreads(layout_task(task, candidates, design_file))
 
 

@@ -136,9 +136,16 @@ class Design:
         values = {"arm": None if self.arm is None else int(not self.arm["follows"]), "fixtures": self.fixtures,
                   "points": self.points, "end": self.end_used, "switches": self.switches, "margin": self.margin_n,
                   "pushes": self.pushes, "reach": self.reach, "tests": self.tests, "time": self.planning_time_s,
-                  "success": (self.success or {}).get("success_rate")}
+                  "success": self._success_value()}
         ranked = tuple(math.inf if (value := values[k]) is None else RANK_KEYS[k] * value for k in rank)
         return (not self.solved, *ranked)
+
+    def _success_value(self) -> Optional[float]:
+        """What `success` ranks by: the prediction-powered interval's low end where the odds were
+        measured with predictions, else the trials' success rate."""
+        measured = self.success or {}
+        predicted = measured.get("prediction")
+        return predicted["interval"][0] if predicted else measured.get("success_rate")
 
     def odds(self) -> str:
         """The measured odds in words (", landed 19 of 20 trials (76%-99%)"), or why none were
@@ -149,6 +156,10 @@ class Design:
             return f", not evaluated: {self.success['refused']}"
         s, ci = self.success, self.success["ci95"]
         interval = f" ({ci[0]:.0%}-{ci[1]:.0%})" if ci else ""
+        predicted = s.get("prediction")
+        if predicted:
+            low, high = predicted["interval"]
+            interval += f", {low:.0%}-{high:.0%} with {predicted['predictions']:,} predictions"
         return f", landed {s['successes']} of {s['judged']} trials{interval}"
 
     def as_dict(self) -> Dict[str, Any]:
@@ -246,6 +257,9 @@ class DesignStudy:
         which = "the best design" if e["top"] == 1 else f"the best {e['top']} designs"
         worlds = (f"in the same worlds ({e['spreads']}; seed {e['seed']}, {'closed' if e['closed_loop'] else 'open'} "
                   f"loop on {e['engine']})")
+        if e.get("predictions"):
+            worlds += (f", with {e['predictions']:,} model-only worlds each (ranked by the prediction-powered "
+                       f"interval's low end)")
         ran = e.get("ran", {})
         if not self.interrupted and all(n == e["trials"] for n in ran.values()):
             return f"odds: {which}, {e['trials']} trials each {worlds}"

@@ -16,7 +16,7 @@ from typing import Callable, Dict, Optional
 
 from stablepush.design.layouts import Design, DesignStudy
 from stablepush.errors import SettingError
-from stablepush.evaluation import Batch, Spreads, evaluate
+from stablepush.evaluation import Batch, Spreads, check_predictions, evaluate, with_predictions
 from stablepush.evaluation.batch import MAX_TRIALS
 from stablepush.runners import Runner
 from stablepush.sim.deviation import MAX_SEED
@@ -29,9 +29,9 @@ MAX_TOP = 100  # designs whose odds one study measures (design --evaluate-top)
 @dataclass(frozen=True)
 class DesignOdds:
     """How evaluate_designs measures the best `top` designs' odds: `trials` worlds of `spreads`
-    each (the same worlds for every design, from `seed`), open or `closed_loop`, on `engine`. Made
-    with a field out of its range it raises SettingError naming it, as `design --evaluate` takes
-    them."""
+    each (the same worlds for every design, from `seed`), open or `closed_loop`, on `engine`, with
+    `predict` model-only worlds each when given. Made with a field out of its range it raises
+    SettingError naming it, as `design --evaluate` takes them."""
 
     trials: int
     spreads: Spreads
@@ -39,6 +39,9 @@ class DesignOdds:
     seed: int = 1
     closed_loop: bool = False
     engine: str = DEFAULT_ENGINE
+    # model-only worlds joined to each design's trials (evaluation.with_predictions); None: none, and
+    # the designs rank by their trials' rate, else by the prediction-powered interval's low end
+    predict: Optional[int] = None
 
     def __post_init__(self) -> None:
         for name, value, low, high in (("trials", self.trials, 1, MAX_TRIALS), ("top", self.top, 1, MAX_TOP),
@@ -52,6 +55,8 @@ class DesignOdds:
             raise SettingError("closed_loop", f"must be true or false, got {self.closed_loop!r:.40}")
         if self.engine not in ENGINES:
             raise SettingError("engine", f"must be one of {', '.join(ENGINES)}, got {self.engine!r:.40}")
+        if self.predict is not None:
+            check_predictions(self.predict)
 
 
 def evaluate_designs(study: DesignStudy, odds: DesignOdds, runner: Optional[Runner] = None,
@@ -62,8 +67,10 @@ def evaluate_designs(study: DesignStudy, odds: DesignOdds, runner: Optional[Runn
     runs no trial (`success.refused` says why) and ranks below those measured.
     `progress(design, record, done)` after each trial. Ctrl-C stops the study with the designs
     measured so far (`study.interrupted`); `study.evaluated["ran"]` says how many trials each of
-    the top designs ran (layout -> trials). TypeError for a study or odds that is not one, before
-    any trial."""
+    the top designs ran (layout -> trials). With `odds.predict`, each design's trials are joined
+    with the model's verdicts on that many worlds (`success.prediction`), and `success` ranks by
+    the prediction-powered interval's low end. TypeError for a study or odds that is not one,
+    before any trial."""
     if not isinstance(study, DesignStudy):
         raise TypeError(f"study: expected a DesignStudy (design()'s result), got {type(study).__name__}")
     if not isinstance(odds, DesignOdds):
@@ -83,14 +90,17 @@ def evaluate_designs(study: DesignStudy, odds: DesignOdds, runner: Optional[Runn
             continue
         measured = evaluate(batch, odds.trials, runner,
                             progress=functools.partial(progress, d) if progress else None)  # progress(d, record, done)
+        if odds.predict is not None and measured.trials:
+            measured = with_predictions(measured, odds.predict)
         s = measured.summary()
         d.success = {key: s[key] for key in ("trials", "judged", "successes", "success_rate", "ci95", "causes",
-                                             "crashed", "wall_s")}
+                                             "crashed", "wall_s", "prediction")}
         ran[" + ".join(d.pushers)] = s["trials"]
         if measured.interrupted:
             study.interrupted = True
             break
-    study.evaluated = {"trials": odds.trials, "top": min(top, len(study.designs)), "seed": odds.seed,
+    study.evaluated = {"trials": odds.trials, "predictions": odds.predict, "top": min(top, len(study.designs)),
+                       "seed": odds.seed,
                        "spreads": odds.spreads.describe(), "closed_loop": odds.closed_loop, "engine": odds.engine,
                        "interrupted": study.interrupted, "ran": ran}
     if "success" not in study.rank:
