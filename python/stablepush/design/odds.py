@@ -94,7 +94,9 @@ def evaluate_designs(study: DesignStudy, odds: DesignOdds, runner: Optional[Runn
             measured = with_predictions(measured, odds.predict)
         s = measured.summary()
         d.success = {key: s[key] for key in ("trials", "judged", "successes", "success_rate", "ci95", "causes",
-                                             "crashed", "wall_s", "prediction")}
+                                             "crashed", "wall_s")}
+        if odds.predict is not None:
+            d.success["prediction"] = s["prediction"]
         ran[" + ".join(d.pushers)] = s["trials"]
         if measured.interrupted:
             study.interrupted = True
