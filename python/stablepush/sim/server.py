@@ -28,6 +28,7 @@ from stablepush.sim.local_arm import SimulatedArm
 
 DEFAULT_IDLE_TIMEOUT = 30.0  # s a client may stay silent within a session
 BUSY_WAIT = 2.0  # s a new client waits for a session to end before it is told the arm is busy
+ACCEPT_POLL = 0.5  # s
 
 
 class SimArmServer:
@@ -56,11 +57,17 @@ class SimArmServer:
         self._closed = threading.Event()
 
     def serve_forever(self) -> None:
+        # accept() wakes every ACCEPT_POLL s: a Ctrl-C the kernel hands to a session's thread is only
+        # seen when the main thread runs Python again, and a close() from another thread ends the loop.
+        self._socket.settimeout(ACCEPT_POLL)
         while not self._closed.is_set():
             try:
                 connection, _ = self._socket.accept()
+            except socket.timeout:
+                continue
             except OSError:
                 break
+            connection.settimeout(None)
             threading.Thread(target=self._connection, args=(connection,), name="sim-arm client", daemon=True).start()
 
     def start_in_thread(self) -> threading.Thread:
