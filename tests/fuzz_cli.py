@@ -984,7 +984,10 @@ def _sim_arm(args: List[str]):
     import subprocess
 
     child = subprocess.Popen([sys.executable, "-c", "from stablepush_cli.main import cli; cli(prog_name='stablepush')",
-                              *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                              *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             # a test worker may ignore SIGINT, and an ignored SIGINT survives exec: the child
+                             # would never see the Ctrl-C this harness sends
+                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         line, lines = "", []
         deadline = time.monotonic() + 30
