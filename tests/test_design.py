@@ -241,15 +241,22 @@ def _pivot_design():
     return data, path
 
 
-@pytest.mark.slow
-def test_evaluate_ranks_the_best_designs_by_their_odds_in_the_same_worlds(tmp_path):
-    data, source = _pivot_design()
+def _pivot_study(tmp_path):
+    """The pivot's design file written to tmp_path and its one-fixture layouts searched on 2 workers:
+    (path, task, candidates, runner, study)."""
+    data, _ = _pivot_design()
     path = tmp_path / "pivot.design.yaml"
     path.write_text(yaml.safe_dump(data))
     task, candidates = load_design(path)
     runner = Runner(workers=2)
     study = design(task, candidates, source=str(path), search=LayoutSearch(max_fixtures=1, time_limit=1.0, reach_top=0),
                    runner=runner)
+    return path, task, candidates, runner, study
+
+
+@pytest.mark.slow
+def test_evaluate_ranks_the_best_designs_by_their_odds_in_the_same_worlds(tmp_path):
+    path, task, candidates, runner, study = _pivot_study(tmp_path)
     assert len(study.designs) > 3, study.verdict
     spreads = Spreads.for_task(layout_task(task, candidates, str(path)), {"pad_mu": 0.3, "pusher_mu": 0.3})
     evaluate_designs(study, DesignOdds(3, spreads, top=3, seed=5), runner=runner)
@@ -265,13 +272,7 @@ def test_evaluate_ranks_the_best_designs_by_their_odds_in_the_same_worlds(tmp_pa
 
 
 def test_with_predictions_the_designs_rank_by_the_low_end_of_their_prediction_powered_interval(tmp_path):
-    data, source = _pivot_design()
-    path = tmp_path / "pivot.design.yaml"
-    path.write_text(yaml.safe_dump(data))
-    task, candidates = load_design(path)
-    runner = Runner(workers=2)
-    study = design(task, candidates, source=str(path), search=LayoutSearch(max_fixtures=1, time_limit=1.0, reach_top=0),
-                   runner=runner)
+    path, task, candidates, runner, study = _pivot_study(tmp_path)
     spreads = Spreads.for_task(layout_task(task, candidates, str(path)), {"pad_mu": 0.3, "pusher_mu": 0.3})
     evaluate_designs(study, DesignOdds(2, spreads, top=2, seed=5, predict=500), runner=runner)
     measured = study.designs[:2]
