@@ -7,6 +7,7 @@ task's plan, each run open loop in the same world.
 
     python3 benchmarks/calibrate.py [--tasks low-mu t-shaped ...] [--generated 3] [--worlds 4] [--seed 1]
                                     [--off 0.4] [--engine mujoco] [--workers 2 | --ray [ADDRESS]] [--md OUT.md]
+                                    [--estimate gripper.grip_force]
     python3 benchmarks/calibrate.py --agreement 200 [--seed 1]
     python3 benchmarks/calibrate.py --runs 20 [--tasks ...] [--worlds 2]
 
@@ -33,7 +34,7 @@ from evaluate_tasks import add_runner_options, runner_of
 from generated_task_odds import generate_task, goal_for
 from shipped import TASKS
 
-from stablepush.calibration import CalibrationSettings, calibrate, calibrate_from_runs
+from stablepush.calibration import PAD_PRODUCT, CalibrationSettings, calibrate, calibrate_from_runs
 from stablepush.calibration.belief import Belief
 from stablepush.calibration.probes import Unknowns, WorldGrid, candidates, probe_plan, probe_world, stuck
 from stablepush.execution import RunOptions, run_plan
@@ -46,10 +47,11 @@ from stablepush.units import pose_to_si
 SHIPPED = ("horizontal-offset-low-mu", "horizontal-offset-high-mu", "t-shaped", "pivoting")
 
 
-def hidden_world(task, seed: int, t: int, w: int, off: float) -> WorldDeviation:
-    """World w of task t: every mu of the task times its own factor from 1 -+ off."""
+def hidden_world(task, seed: int, t: int, w: int, off: float, pads: str = "gripper.mu") -> WorldDeviation:
+    """World w of task t: the pads' quantity `pads` and every pusher's mu, each the task's times
+    its own factor from 1 -+ off."""
     rng = np.random.default_rng([seed, t, w])
-    fields = ["gripper.mu"] + [f"pushers.{p.name}.mu" for p in task.pushers]
+    fields = [pads] + [f"pushers.{p.name}.mu" for p in task.pushers]
     return WorldDeviation(world=tuple((name, task.value(name) * float(rng.uniform(1 - off, 1 + off)))
                                       for name in fields))
 
@@ -64,15 +66,15 @@ def _lands(task, world: WorldDeviation, engine: str):
 
 
 def calibration_job(shared, i: int) -> dict:
-    specs, worlds, seed, off, engine = shared
+    specs, worlds, seed, off, engine, pads = shared
     t, w = divmod(i, worlds)
     name, text = specs[t]
     task = parse_task(text, source=name)
-    world = hidden_world(task, seed, t, w, off)
+    world = hidden_world(task, seed, t, w, off, pads)
     truth = world.world_task(task)
     started = time.perf_counter()
     calibration = calibrate(task, lambda: SimulatedArm(engine, world, robot=task.environment.robot),
-                            CalibrationSettings(return_to_start=False))
+                            CalibrationSettings(return_to_start=False, estimate=(pads,)))
     wall = time.perf_counter() - started
     rows = []
     for field, interval in calibration.estimates.items():
@@ -105,25 +107,44 @@ def runs_job(shared, i: int) -> dict:
         if run.fault is None:
             reports.append((f"run {k}", run.as_dict()))
     out = {"task": task.name, "world": w, "runs": len(reports), "contacts": sum(len(r["contacts"]) for _, r in reports)}
-    for label, used in (("one", reports[:1]), ("all", reports)):
+    out["unidentified"] = {}
+    for label, used in (("one", reports[:1]), ("five", reports[:5]), ("all", reports)):
         if not used:
             continue
         calibration = calibrate_from_runs(task, used, CalibrationSettings())
         out[label] = {field: {"truth": truth.value(field), "low": iv.low, "high": iv.high,
                               "covered": iv.low <= truth.value(field) <= iv.high,
                               "share": iv.half_width / iv.value} for field, iv in calibration.estimates.items()}
+        if label == "all":
+            out["unidentified"] = calibration.unidentified
     return out
 
 
 def _runs_summary(results: list) -> list:
-    lines = ["| task | world | runs | contacts | field | truth | interval from 1 run | from all runs | covered |",
-             "|---|---:|---:|---:|---|---:|---|---|---|"]
+    """Per task, world and field: the interval from the first run's report, the first 5 and all;
+    then, over every row, coverage and the median half-width after 1, 5 and all runs."""
+    def cell(row):
+        return f"{row['low']:.3f}-{row['high']:.3f} (+-{row['share']:.0%})" if row else ""
+
+    lines = ["| task | world | runs | contacts | field | truth | from 1 run | from 5 | from all | covered |",
+             "|---|---:|---:|---:|---|---:|---|---|---|---|"]
+    kinds: dict = {}
     for r in sorted(results, key=lambda r: (r["task"], r["world"])):
         for field, row in (r.get("all") or {}).items():
-            one = (r.get("one") or {}).get(field)
+            one, five = (r.get("one") or {}).get(field), (r.get("five") or {}).get(field)
             lines.append(f"| {r['task']} | {r['world']} | {r['runs']} | {r['contacts']} | {field} | {row['truth']:.3f} "
-                         f"| {one['low']:.3f}-{one['high']:.3f} (+-{one['share']:.0%}) | {row['low']:.3f}-{row['high']:.3f}"
-                         f" (+-{row['share']:.0%}) | {'yes' if row['covered'] else 'NO'} |" if one else "")
+                         f"| {cell(one)} | {cell(five)} | {cell(row)} | {'yes' if row['covered'] else 'NO'} |")
+            kinds.setdefault("pads" if field == "gripper.mu" else "features", []).append((one, five, row))
+        for field, why in (r.get("unidentified") or {}).items():
+            lines.append(f"| {r['task']} | {r['world']} | {r['runs']} | {r['contacts']} | {field} | | | | "
+                         f"not identified: {why} | |")
+    lines.append("")
+    for kind, rows in kinds.items():
+        medians = [float(np.median([row[k]["share"] for row in rows if row[k]])) for k in range(3)]
+        lines.append(f"- {kind}: interval from all runs holds the truth in {sum(r[2]['covered'] for r in rows)}/"
+                     f"{len(rows)}; median half-width +-{medians[0]:.0%} from 1 run, +-{medians[1]:.0%} from 5, "
+                     f"+-{medians[2]:.0%} from all")
+    lines.append(f"- fields not identified from all runs: {sum(len(r.get('unidentified') or {}) for r in results)}")
     return lines
 
 
@@ -144,7 +165,7 @@ def _summary(results: list, targets=(0.07, 0.10)) -> list:
     kinds = {"pads": [], "features": []}
     for r in sorted(results, key=lambda r: (r["task"], r["world"])):
         for row in r["rows"]:
-            kinds["pads" if row["field"] == "gripper.mu" else "features"].append(row)
+            kinds["features" if row["field"].startswith("pushers.") else "pads"].append(row)
             lines.append(f"| {r['task']} | {r['world']} | {r['probes']} | {r['wall_s']:.0f} | {row['field']} "
                          f"| {row['truth']:.3f} | {row['estimate']:.3f} | {row['low']:.3f}-{row['high']:.3f} "
                          f"| {'yes' if row['covered'] else 'NO'} | {row['error']:+.1%} |")
@@ -231,6 +252,9 @@ def main() -> None:
     parser.add_argument("--agreement", type=int, default=0, metavar="N", help="instead: N random probes' agreement")
     parser.add_argument("--runs", type=int, default=0, metavar="N",
                         help="instead: calibrate from N runs' reports of each task's nominal plan (calibrate --from)")
+    parser.add_argument("--estimate", default="gripper.mu", choices=PAD_PRODUCT,
+                        help="the pads' quantity the hidden worlds change and calibration estimates (the others "
+                             "as the task's)")
     parser.add_argument("--md", type=Path, default=None, help="also write the table here")
     parser.add_argument("--json", type=Path, default=None, help="also write every job's record here")
     add_runner_options(parser)
@@ -244,7 +268,7 @@ def main() -> None:
         job, shared, indices = runs_job, (specs, args.worlds, args.seed, args.off, args.engine, args.runs), \
             range(len(specs) * args.worlds)
     else:
-        job, shared, indices = calibration_job, (specs, args.worlds, args.seed, args.off, args.engine), \
+        job, shared, indices = calibration_job, (specs, args.worlds, args.seed, args.off, args.engine, args.estimate), \
             range(len(specs) * args.worlds)
     results = []
     lost = []

@@ -220,6 +220,63 @@ def test_runs_whose_pushes_slipped_bound_the_friction_from_their_reports():
     assert SLIP_MM < 0.3 and SLIP_DEG < 0.2
 
 
+def test_the_pads_product_is_read_as_the_grip_force_or_the_mass_that_is_named():
+    """mu, grip force and mass enter the stable-push test only as mu N / m (docs/model.md section
+    7). So the slipped drag of the test above puts the grip force where it put mu, as a share of
+    the task's (the margins over the grid are the same), and the mass above the task's; naming two
+    leaves both unidentified, with the product in the reason."""
+    task = load_task(TASKS / "horizontal-offset-low-mu.yaml")
+    steps = [[0.0, 0.0, 0.0, None]] + [[float(k), -0.1 * k, 0.0, "left"] for k in range(1, 5)]
+    slipped = [("a.json", _report(task, steps, [{"pusher": "left", "first_step": 1, "last_step": 4, "slip_mm": 0.3,
+                                                 "slip_deg": 0.2}]))]
+    mu = calibrate_from_runs(task, slipped, CalibrationSettings(grid=9)).estimates["gripper.mu"]
+    by_force = calibrate_from_runs(task, slipped, CalibrationSettings(grid=9, estimate=("gripper.grip_force",)))
+    force = by_force.estimates["gripper.grip_force"]
+    assert "gripper.mu" not in by_force.estimates and "gripper.mu" not in by_force.unidentified
+    for a, b in ((force.value, mu.value), (force.low, mu.low), (force.high, mu.high)):
+        assert a / task.gripper.grip_force == pytest.approx(b / task.gripper.mu, rel=1e-9)
+    mass = calibrate_from_runs(task, slipped, CalibrationSettings(grid=9, estimate=("object.mass",)))
+    assert mass.estimates["object.mass"].value > task.object.mass
+    both = calibrate_from_runs(task, slipped, CalibrationSettings(grid=9, estimate=("gripper.mu", "object.mass")))
+    assert set(both.unidentified) >= {"gripper.mu", "object.mass"} and "gripper.mu" not in both.estimates
+    assert "only through the product" in both.unidentified["gripper.mu"]
+    assert both.calibrated_task().gripper.mu == task.gripper.mu  # the task's values kept
+
+
+@pytest.mark.parametrize("name", ["t-shaped", "horizontal-offset-low-mu"])
+def test_a_pushs_verdict_depends_on_mu_times_grip_force_over_mass_alone(name):
+    """docs/model.md section 7: the pads' mu x 0.8, the grip force x 0.8 and the mass / 0.8 give
+    the same verdict for every push, over random poses and moves (the margin scales with the
+    product)."""
+    task = load_task(TASKS / f"{name}.yaml")
+    s = 0.8
+    worlds = [task.with_values({"gripper.mu": task.gripper.mu * s}).model,
+              task.with_values({"gripper.grip_force": task.gripper.grip_force * s}).model,
+              task.with_values({"object.mass": task.object.mass / s}).model]
+    rng = np.random.default_rng(3)
+    flips = []
+    for _ in range(150):
+        q = [rng.uniform(-5e-3, 5e-3), rng.uniform(-5e-3, 5e-3), math.radians(rng.uniform(-5, 5))]
+        dq = [rng.normal() * 1e-3, rng.normal() * 1e-3, math.radians(rng.normal())]
+        results = [model.check_all(q, dq) for model in worlds]
+        for by_mu, by_force, by_mass in zip(*results):
+            assert by_mu.feasible == by_force.feasible == by_mass.feasible
+            flips.append(by_mu.feasible)
+            assert by_force.margin == pytest.approx(by_mu.margin, rel=1e-6, abs=1e-9)
+    assert 0 < sum(flips) < len(flips)  # both verdicts occur
+
+
+def test_a_calibrated_grip_force_is_written_with_its_box():
+    task = load_task(TASKS / "horizontal-offset-low-mu.yaml")
+    calibration = Calibration(task, {"gripper.grip_force": Interval(12.0, 11.0, 13.5)}, {}, [], "test",
+                              CalibrationSettings(estimate=("gripper.grip_force",)))
+    again = parse_task(calibrated_task_text(calibration), source="calibrated.yaml")
+    assert again.gripper.grip_force == pytest.approx(12.0) and again.gripper.mu == task.gripper.mu
+    assert "pad_mu" not in again.uncertainty
+    assert again.gripper.grip_force * (1 - again.uncertainty["grip_force"]) <= 11.0
+    assert again.gripper.grip_force * (1 + again.uncertainty["grip_force"]) >= 13.5
+
+
 def test_a_report_without_its_steps_is_refused_naming_the_file(tmp_path):
     task = load_task(TASKS / "horizontal-offset-low-mu.yaml")
     with pytest.raises(SettingError, match="old.json.*no `steps`"):
@@ -256,3 +313,6 @@ def test_calibration_settings_refuse_what_they_cannot_be():
         CalibrationSettings(spread=1.0)
     with pytest.raises(SettingError, match="target"):
         CalibrationSettings(target=(0.0, 0.1))
+    for estimate in ((), ("gripper.pad_rings",), ("object.mass", "object.mass"), "gripper.mu"):
+        with pytest.raises(SettingError, match="estimate"):
+            CalibrationSettings(estimate=estimate)

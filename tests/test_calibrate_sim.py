@@ -77,3 +77,21 @@ def test_a_runs_report_holds_its_steps_and_calibrate_learns_from_it(tmp_path):
                                        str(tmp_path / "cal.json")])
     assert learned.exit_code == 0, learned.output
     assert "gripper.mu" in json.loads((tmp_path / "cal.json").read_text())["estimates"]
+
+
+def test_calibrate_estimates_a_hidden_grip_force_when_asked_and_writes_it(tmp_path):
+    """The world grips with 13 N where the task says 10, its pads' mu as the task's: with
+    --estimate gripper.grip_force the probes read the pads' product as the grip force, and its
+    interval holds the world's."""
+    out, report = tmp_path / "cal.yaml", tmp_path / "cal.json"
+    result = CliRunner().invoke(cli, ["calibrate", str(TASKS / "horizontal-offset-low-mu.yaml"), "--sim", "--world",
+                                      "gripper.grip_force=13", "--estimate", "gripper.grip_force", "--max-probes", "8",
+                                      "--no-return", "--quiet", "-o", str(out), "--json", str(report)])
+    assert result.exit_code == 0, result.output
+    data = json.loads(report.read_text())
+    force = data["estimates"]["gripper.grip_force"]
+    assert force["low"] <= 13.0 <= force["high"] and force["value"] > 10.0, force
+    assert "gripper.mu" not in data["estimates"] and "gripper.mu" not in data["unidentified"]
+    calibrated = load_task(out)
+    assert calibrated.gripper.grip_force == pytest.approx(force["value"], rel=1e-3)
+    assert calibrated.uncertainty["grip_force"] > 0.0

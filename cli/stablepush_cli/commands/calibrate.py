@@ -5,7 +5,7 @@ import json
 
 import click
 
-from stablepush.calibration import LIMITS, NEIGHBOURHOOD, CalibrationSettings
+from stablepush.calibration import LIMITS, NEIGHBOURHOOD, PAD_PRODUCT, CalibrationSettings
 from stablepush.execution import DEFAULT_PORT
 from stablepush_cli.common import check_named_outputs, fail, help_with, load_task_file, say_beside
 from stablepush_cli.groups import (
@@ -22,9 +22,10 @@ from stablepush_cli.options import Finite, Whole
 DEFAULTS = CalibrationSettings()
 
 
-def _settings(max_probes, spread, target, error_rate, rate_hz, return_to_start):
+def _settings(max_probes, spread, target, error_rate, rate_hz, return_to_start, estimate):
     return CalibrationSettings(max_probes=max_probes, spread=spread, target=target, error_rate=error_rate,
-                               rate_hz=rate_hz, return_to_start=return_to_start)
+                               rate_hz=rate_hz, return_to_start=return_to_start,
+                               estimate=tuple(estimate) or DEFAULTS.estimate)
 
 
 @click.command()
@@ -52,7 +53,12 @@ def _settings(max_probes, spread, target, error_rate, rate_hz, return_to_start):
     click.option("--rate", "rate_hz", default=DEFAULTS.rate_hz, show_default=True, metavar="HZ",
                  type=Finite(min=1, max=1000), help="Waypoints per second of the probes' runs (as `execute --rate`)."),
     click.option("--return/--no-return", "return_to_start", default=True, show_default=True,
-                 help="End by pushing the object back to the task's start, by a plan of the calibrated task."))
+                 help="End by pushing the object back to the task's start, by a plan of the calibrated task."),
+    click.option("--estimate", multiple=True, metavar="FIELD", type=click.Choice(PAD_PRODUCT),
+                 help="Which of the pads' quantities is unknown (default gripper.mu; the others are taken as the "
+                      "task gives them). They enter the model only as the product mu x grip force / mass, so the "
+                      "probes measure that product: one FIELD named is estimated from it; two or more, the product "
+                      "alone is reported. Repeatable."))
 @option_group(
     "outputs", lambda output, json_path: (output, json_path),
     click.option("-o", "--output", "output", default=None, metavar="CALIBRATED.yaml", type=click.Path(dir_okay=False),
@@ -67,7 +73,7 @@ def _settings(max_probes, spread, target, error_rate, rate_hz, return_to_start):
 @help_with(pushes=DEFAULTS.pushes, near_mm=NEIGHBOURHOOD[0], near_deg=NEIGHBOURHOOD[1])
 def calibrate(task_file: str, connection: ArmChoice, world: SimWorld, runs, settings, outputs, quiet: bool,
               robot: RobotChoice) -> None:
-    """Measure the friction the arm will push with: the pads' mu and each feature's.
+    """Measure the friction the arm will push with: the pads' mu (or grip force, or mass) and each feature's.
 
     The model chooses short probing pushes ({pushes} unit pushes by one feature) whose outcome, the part
     following its pusher or slipping, flips at a known value of the unknown mu: the stable-push
@@ -76,7 +82,7 @@ def calibrate(task_file: str, connection: ArmChoice, world: SimWorld, runs, sett
     (the pads stay on the part and hold it, within 10 mm and 10 deg of the start). Probes run on
     the arm as `execute` runs a plan (the same arm port and tracker: --sim, or --arm for a lab's
     bridge); the tracker's pose in the grasp says whether a probe stuck. Grip force and mass are
-    taken as the task gives them.
+    taken as the task gives them, unless --estimate names one (then the pads' mu is taken as given).
 
     It stops when every mu a probe can reach is within --target, or after --max-probes; Ctrl-C
     stops after the probe running and keeps what was measured. Then, unless --no-return, a plan of
@@ -88,6 +94,7 @@ def calibrate(task_file: str, connection: ArmChoice, world: SimWorld, runs, sett
       stablepush calibrate data/tasks/t-shaped.yaml --sim --world gripper.mu=0.2 -o t-cal.yaml
       stablepush calibrate data/tasks/t-shaped.yaml --arm 10.0.0.7:47100 --json cal.json
       stablepush calibrate data/tasks/t-shaped.yaml --from run1.json --from run2.json
+      stablepush calibrate data/tasks/t-shaped.yaml --sim --world gripper.grip_force=8 --estimate gripper.grip_force
     """
     from stablepush.outputs import write_atomically
 

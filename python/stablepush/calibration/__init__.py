@@ -9,6 +9,7 @@ _EXPORTS = {
     "CalibrationSettings": "stablepush.calibration.settings",
     "LIMITS": "stablepush.calibration.settings",
     "NEIGHBOURHOOD": "stablepush.calibration.settings",
+    "PAD_PRODUCT": "stablepush.calibration.settings",
     "Belief": "stablepush.calibration.belief",
     "Interval": "stablepush.calibration.belief",
     "Unknowns": "stablepush.calibration.probes",

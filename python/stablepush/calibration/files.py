@@ -9,18 +9,22 @@ from typing import Any, Dict, Optional
 import yaml
 
 from stablepush.calibration.session import Calibration
+from stablepush.calibration.settings import PAD_PRODUCT
+from stablepush.task.model import VALUE_PATHS
 from stablepush.task.task_text import commented_task, with_files_named_absolutely
 
 DIGITS = 4  # significant digits of an estimate written to the task file
 
 
 def calibrated_mapping(text: str, calibration: Calibration) -> Dict[str, Any]:
-    """The task file's mapping (`text`, its YAML) with each estimated mu replaced by its estimate
+    """The task file's mapping (`text`, its YAML) with each estimated quantity replaced by its estimate
     and `uncertainty` covering every interval (Calibration.calibrated_task, rounded outward)."""
     mapping = yaml.safe_load(text)
     calibrated = calibration.calibrated_task()
-    if "gripper.mu" in calibration.estimates:
-        mapping["gripper"] = {**mapping["gripper"], "mu": _rounded(calibrated.gripper.mu)}
+    for field_name in PAD_PRODUCT:
+        if field_name in calibration.estimates:
+            group, key = VALUE_PATHS[field_name]
+            mapping[group] = {**mapping[group], key: _rounded(calibrated.value(field_name))}
     pushers = []
     for entry, pusher in zip(mapping["pushers"], calibrated.pushers):
         estimated = f"pushers.{pusher.name}.mu" in calibration.estimates

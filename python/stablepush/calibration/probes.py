@@ -2,9 +2,10 @@
 friction the task does not know.
 
 The stable-push test (docs/model.md section 2) is the instrument. For a push of the object by
-pusher i, the test's verdict is a function of the pads' mu and pusher i's mu; the boundary where
-it flips runs across the (pad mu, pusher mu) plane at a slope set by the push's direction,
-because gravity's share of the required wrench does not scale with friction. A probe is a few
+pusher i, the test's verdict is a function of the pads' mu and pusher i's mu (the pads' mu times
+the grip force over the mass, in fact: settings.PAD_PRODUCT); the boundary where it flips runs
+across the (pad mu, pusher mu) plane at a slope set by the push's direction, because gravity's
+share of the required wrench does not scale with friction. A probe is a few
 unit pushes the same way from where the object is; `WorldGrid` holds the task's model at every
 cell of the unknowns' grid, so each candidate probe's verdict over the grid is a table of
 booleans, and the probe chosen is the one whose outcome the posterior (belief.py) is least sure
@@ -12,7 +13,7 @@ of (the most expected information).
 
 A probe is safe at every cell of the grid: each of its poses keeps the pads on the object, lies
 within `neighbourhood` of the task's start, and the pads alone hold the object there against
-gravity with the least pad mu of the grid (hold_ratio >= 1), so that a push that slips leaves the
+gravity where the grid's pads hold least (hold_ratio >= 1), so that a push that slips leaves the
 object in the grasp.
 """
 from __future__ import annotations
@@ -30,6 +31,7 @@ from stablepush.calibration.settings import (
     DEFAULT_GRID,
     DEFAULT_SPREAD,
     NEIGHBOURHOOD,
+    PAD_PRODUCT,
     PROBE_PUSHES,
 )
 from stablepush.plan.plan import Plan, Waypoint
@@ -51,34 +53,57 @@ SLIP_DEG = 0.1
 
 @dataclass(frozen=True)
 class Unknowns:
-    """What a calibration estimates, each as the task file names it (`gripper.mu`,
-    `pushers.NAME.mu`), with its grid of candidate values."""
+    """What a calibration estimates, each as the task file names it, with its grid of candidate
+    values: the pads' product (settings.PAD_PRODUCT) as the first of `pad_fields` (`pad_axis`, its
+    values; the task's is `pad_nominal`), the others of `pad_fields` at the task's values; each
+    pusher's mu (`pushers.NAME.mu`)."""
 
     pad_axis: Tuple[float, ...]
     pusher_names: Tuple[str, ...]
     pusher_axes: Tuple[Tuple[float, ...], ...]
+    pad_fields: Tuple[str, ...] = PAD_PRODUCT[:1]
+    pad_nominal: float = 1.0
 
     @classmethod
-    def of(cls, task: Task, spread: float = DEFAULT_SPREAD, size: int = DEFAULT_GRID) -> "Unknowns":
-        return cls(pad_axis=grid(task.gripper.mu, spread, size), pusher_names=tuple(task.pusher_names),
-                   pusher_axes=tuple(grid(p.mu, spread, size) for p in task.pushers))
+    def of(cls, task: Task, spread: float = DEFAULT_SPREAD, size: int = DEFAULT_GRID,
+           estimate: Sequence[str] = PAD_PRODUCT[:1]) -> "Unknowns":
+        nominal = task.value(estimate[0])
+        return cls(pad_axis=grid(nominal, spread, size), pusher_names=tuple(task.pusher_names),
+                   pusher_axes=tuple(grid(p.mu, spread, size) for p in task.pushers), pad_fields=tuple(estimate),
+                   pad_nominal=nominal)
+
+    @property
+    def pad_field(self) -> str:
+        """The task field the pads' axis spans."""
+        return self.pad_fields[0]
+
+    @property
+    def weakest_pad(self) -> int:
+        """The pads' axis index where the pads hold least: the least mu or grip force, the most mass."""
+        return len(self.pad_axis) - 1 if self.pad_field == "object.mass" else 0
+
+    def product_scale(self, value: float) -> float:
+        """The pads' product (gripper.mu x gripper.grip_force / object.mass) at pads' axis value
+        `value`, as a multiple of the task's."""
+        ratio = value / self.pad_nominal if self.pad_nominal > 0.0 else value
+        return 1.0 / ratio if self.pad_field == "object.mass" else ratio
 
     @property
     def fields(self) -> List[str]:
-        return ["gripper.mu"] + [f"pushers.{name}.mu" for name in self.pusher_names]
+        return list(self.pad_fields) + [f"pushers.{name}.mu" for name in self.pusher_names]
 
     def belief(self) -> Belief:
         return Belief(self.pad_axis, self.pusher_axes)
 
     def values_at(self, pad: int, pusher: int, index: int) -> Dict[str, float]:
         """The task's fields at grid cell (pad value `pad`, pusher `pusher`'s value `index`)."""
-        return {"gripper.mu": self.pad_axis[pad], f"pushers.{self.pusher_names[pusher]}.mu":
+        return {self.pad_field: self.pad_axis[pad], f"pushers.{self.pusher_names[pusher]}.mu":
                 self.pusher_axes[pusher][index]}
 
 
 class WorldGrid:
-    """The task's model at each cell (k, j) of the grid: the pads' mu pad_axis[k], every pusher i's
-    mu pusher_axes[i][j]. A push by pusher i at cell (k, j) is the test of (pads k, pusher i's j).
+    """The task's model at each cell (k, j) of the grid: the pads' quantity pad_axis[k], every
+    pusher i's mu pusher_axes[i][j]. A push by pusher i at cell (k, j) is the test of (pads k, pusher i's j).
     The object rests on each feature turned in the world as it is in the grasp at `at` (x mm, z
     mm, theta deg; None: the task's start), as a probe from there holds it (probe_world)."""
 
@@ -88,7 +113,7 @@ class WorldGrid:
         start = as_triple(float(v) for v in (task.start if at is None else at))
         self.at = start
         base = dataclasses.replace(task, uncertainty={}, start=start, feature_orientations={})
-        self.models = [[base.with_values({"gripper.mu": unknowns.pad_axis[k],
+        self.models = [[base.with_values({unknowns.pad_field: unknowns.pad_axis[k],
                                           **{f"pushers.{name}.mu": axis[j]
                                              for name, axis in zip(unknowns.pusher_names, unknowns.pusher_axes)}}).model
                         for j in range(n)] for k in range(n)]
@@ -157,7 +182,7 @@ def directions(count: int = DIRECTIONS) -> np.ndarray:
 def safe(task: Task, worlds: WorldGrid, poses: Sequence[Sequence[float]], pusher: int,
          neighbourhood: Tuple[float, float] = NEIGHBOURHOOD) -> bool:
     """Whether a probe through `poses` by `pusher` is safe at every cell (module docstring)."""
-    least_pads = worlds.models[0][0]  # the grid's least pad mu: holds least
+    least_pads = worlds.models[worlds.unknowns.weakest_pad][0]
     for pose in poses:
         off = Pose.of(pose).minus(task.start)
         if abs(off[0]) > neighbourhood[0] or abs(off[1]) > neighbourhood[0] or abs(off[2]) > neighbourhood[1]:

@@ -54,7 +54,7 @@ def calibrate_from_runs(task: Task, reports: Sequence[Tuple[str, Mapping[str, An
     grid, against its observed stick or slip."""
     require_task(task)
     started = time.perf_counter()
-    unknowns = Unknowns.of(task, settings.spread, settings.grid)
+    unknowns = Unknowns.of(task, settings.spread, settings.grid, settings.estimate)
     worlds = WorldGrid(task, unknowns)
     belief = unknowns.belief()
     instrument = instrument_of(task, settings)
@@ -80,6 +80,6 @@ def calibrate_from_runs(task: Task, reports: Sequence[Tuple[str, Mapping[str, An
                 belief.observe(pusher, instrument.chance(margins), outcome)
                 record.outcome = "stuck" if outcome else "slipped"
             records.append(record)
-    estimates, unidentified = estimates_of(belief, unknowns, seen, settings)
+    estimates, unidentified = estimates_of(belief, unknowns, seen, settings, pushes="push of the runs")
     return Calibration(task, estimates, unidentified, records, f"{len(reports)} run report(s) read", settings,
                        wall_time_s=time.perf_counter() - started)

@@ -6,7 +6,8 @@ the start by a plan of the calibrated task.
 Each probe runs as a plan (stablepush.execution.run.run_plan) on a fresh arm session from
 `arm_for()`: the same `Arm` and tracker as `stablepush execute`, so a lab's bridge works
 unchanged. The object's pose in the grasp that the tracker reports after a probe is where the next
-one starts. Grip force and mass are taken as the task gives them (the gripper's setting, a scale).
+one starts. Grip force and mass are taken as the task gives them (the gripper's setting, a scale)
+unless settings.estimate names one of them.
 """
 from __future__ import annotations
 
@@ -26,13 +27,13 @@ from stablepush.calibration.probes import (
     probe_world,
     stuck,
 )
-from stablepush.calibration.settings import CalibrationSettings
+from stablepush.calibration.settings import PAD_PRODUCT, CalibrationSettings
 from stablepush.errors import PlanError
 from stablepush.execution.arm import Arm
 from stablepush.execution.executor import RunOptions
 from stablepush.execution.run import run_plan
 from stablepush.plan.search import plan_task
-from stablepush.task.model import Task, require_task
+from stablepush.task.model import UNCERTAIN, Task, require_task
 
 LEAST_BITS = 0.02  # a probe expected to tell less is not worth running
 
@@ -64,7 +65,8 @@ class ProbeRecord:
 
 @dataclass
 class Calibration:
-    """What a calibration found: per task field (`gripper.mu`, `pushers.NAME.mu`) its estimate and
+    """What a calibration found: per task field (`gripper.mu`, or the grip force or mass estimated
+    instead; `pushers.NAME.mu`) its estimate and
     interval, the fields it could not identify and why, every probe, why it stopped, and the run
     back to the start (`returned`: whether it landed, where, or why not)."""
 
@@ -78,14 +80,15 @@ class Calibration:
     wall_time_s: float = 0.0
 
     def calibrated_task(self) -> Task:
-        """The task with each estimated mu replaced by its estimate and an uncertainty box that
-        covers every interval: `pad_mu` the pads' half-width, `pusher_mu` the widest pusher's (and
+        """The task with each estimated quantity replaced by its estimate and an uncertainty box
+        that covers every interval: `pad_mu` (`grip_force`, `mass`) the pads' half-width,
+        `pusher_mu` the widest pusher's (and
         the task's own where a pusher was not identified), each a share of its estimate."""
         values = {name: interval.value for name, interval in self.estimates.items()}
         box = dict(self.task.uncertainty)
-        if "gripper.mu" in self.estimates:
-            pad = self.estimates["gripper.mu"]
-            box["pad_mu"] = _share(pad)
+        for key, field_name in UNCERTAIN.items():
+            if field_name in PAD_PRODUCT and field_name in self.estimates:
+                box[key] = _share(self.estimates[field_name])
         pushers = [_share(i) for name, i in self.estimates.items() if name.startswith("pushers.")]
         if pushers:
             left = [box.get("pusher_mu", 0.0)] if any(n.startswith("pushers.") for n in self.unidentified) else []
@@ -123,20 +126,28 @@ def instrument_of(task: Task, settings: CalibrationSettings) -> Instrument:
                       settings.boundary * 2.0 * task.gripper.mu * task.gripper.grip_force)
 
 
-def estimates_of(belief: Belief, unknowns: Unknowns, probed: List[bool],
-                 settings: CalibrationSettings) -> Tuple[Dict[str, Interval], Dict[str, str]]:
-    """Each unknown's interval, or why it has none: `probed[i]`, whether any probe by pusher i could
-    tell anything (its outcome uncertain over the grid)."""
+def estimates_of(belief: Belief, unknowns: Unknowns, probed: List[bool], settings: CalibrationSettings,
+                 pushes: str = "safe push") -> Tuple[Dict[str, Interval], Dict[str, str]]:
+    """Each unknown's interval, or why it has none: `probed[i]`, whether any of the `pushes` by
+    pusher i could tell anything (its outcome uncertain over the grid)."""
     estimates: Dict[str, Interval] = {}
     unidentified: Dict[str, str] = {}
-    if belief.observations:
-        estimates["gripper.mu"] = belief.pad_interval(settings.level)
+    if not belief.observations:
+        unidentified.update({name: "no probe was observed" for name in unknowns.pad_fields})
+    elif len(unknowns.pad_fields) == 1:
+        estimates[unknowns.pad_field] = belief.pad_interval(settings.level)
     else:
-        unidentified["gripper.mu"] = "no probe was observed"
+        pad = belief.pad_interval(settings.level)
+        scales = sorted(unknowns.product_scale(v) for v in (pad.value, pad.low, pad.high))
+        why = (f"enters the stable-push test only through the product {' x '.join(PAD_PRODUCT[:2])} / "
+               f"{PAD_PRODUCT[2]} (docs/model.md section 7), which the probes put at {scales[1]:.3g} "
+               f"({scales[0]:.3g} to {scales[2]:.3g}) times the task's; name one of "
+               f"{', '.join(unknowns.pad_fields)} alone with --estimate to read the product as that one")
+        unidentified.update({name: why for name in unknowns.pad_fields})
     for i, name in enumerate(unknowns.pusher_names):
         field_name = f"pushers.{name}.mu"
         if not probed[i]:
-            unidentified[field_name] = (f"no safe push by {name} from where the object was flips within the grid "
+            unidentified[field_name] = (f"no {pushes} by {name} from where the object was flips within the grid "
                                         f"(its mu times {1 - settings.spread:g} to {1 + settings.spread:g})")
         elif not belief.informative(i):
             unidentified[field_name] = f"no push by {name} that could tell was observed"
@@ -156,7 +167,7 @@ class Session:
     def __init__(self, task: Task, arm_for: ArmFactory, settings: CalibrationSettings = CalibrationSettings()):
         self.task = require_task(task)
         self.arm_for, self.settings = arm_for, settings
-        self.unknowns = Unknowns.of(task, settings.spread, settings.grid)
+        self.unknowns = Unknowns.of(task, settings.spread, settings.grid, settings.estimate)
         self.worlds = WorldGrid(task, self.unknowns)
         self.belief: Belief = self.unknowns.belief()
         self.instrument = instrument_of(task, settings)
@@ -202,7 +213,7 @@ class Session:
 
     def _run(self, probe: Probe) -> Optional[ProbeRecord]:
         world = probe_world(self.task, self.unknowns, self.belief, probe)
-        planned_in = {name: world.value(name) for name in ("gripper.mu", f"pushers.{probe.pusher}.mu")}
+        planned_in = {name: world.value(name) for name in (self.unknowns.pad_field, f"pushers.{probe.pusher}.mu")}
         record = ProbeRecord(probe.pusher, probe.start, probe.move, probe.pushes, probe.p_stuck, probe.bits, planned_in)
         plan = probe_plan(world, probe)
         started = time.perf_counter()

@@ -24,6 +24,11 @@ DEFAULT_BOUNDARY = 0.02
 # What a calibration aims for: the interval's half-width, as a share of the estimate, for the pads'
 # mu and for a pusher's.
 DEFAULT_TARGET = (0.07, 0.10)
+# The pads' quantities, as the task file names them: they enter the stable-push test only as the
+# product gripper.mu x gripper.grip_force / object.mass (every force of the balance scales with it,
+# docs/model.md section 7), so probes measure that product. `estimate` names which of them it is
+# read as; the others are taken as the task gives them (the gripper's setting, a scale).
+PAD_PRODUCT = ("gripper.mu", "gripper.grip_force", "object.mass")
 # Each setting's range, checked by CalibrationSettings whoever makes one (the command line too).
 LIMITS = {"max_probes": (1, 200), "pushes": (1, 20), "grid": (5, 81), "spread": (0.05, 0.95),
           "error_rate": (1e-4, 0.45), "level": (0.5, 0.999),
@@ -37,7 +42,8 @@ class CalibrationSettings:
     with probability `error_rate`; the intervals hold the truth with `level` credibility; it stops
     once each interval's half-width is within `target` (pads, pushers: shares of the estimate);
     `rate_hz`, the runs' waypoints per second; `return_to_start`, push the object back to the
-    task's start at the end."""
+    task's start at the end; `estimate`, which of PAD_PRODUCT the probes' product is read as (one
+    named: it is estimated; several: the product alone is reported, each unidentified)."""
 
     max_probes: int = MAX_PROBES
     pushes: int = PROBE_PUSHES
@@ -49,6 +55,7 @@ class CalibrationSettings:
     target: Tuple[float, float] = DEFAULT_TARGET
     rate_hz: float = 100.0
     return_to_start: bool = True
+    estimate: Tuple[str, ...] = PAD_PRODUCT[:1]
 
     def __post_init__(self) -> None:
         for name in ("max_probes", "pushes", "grid"):
@@ -61,3 +68,7 @@ class CalibrationSettings:
                 raise SettingError(name, f"must be a number from {bounds[0]:g} to {bounds[1]:g}, got {value!r:.40}")
         if len(self.target) != 2 or not all(is_real(v) and 0.0 < float(v) < 1.0 for v in self.target):
             raise SettingError("target", f"must be two shares between 0 and 1 (pads, pushers), got {self.target!r:.60}")
+        estimate = tuple(self.estimate)
+        if not estimate or any(f not in PAD_PRODUCT for f in estimate) or len(set(estimate)) != len(estimate):
+            raise SettingError("estimate", f"must name one or more of {', '.join(PAD_PRODUCT)}, each once, "
+                                           f"got {self.estimate!r:.80}")
