@@ -220,6 +220,25 @@ def test_runs_whose_pushes_slipped_bound_the_friction_from_their_reports():
     assert SLIP_MM < 0.3 and SLIP_DEG < 0.2
 
 
+def test_the_same_pushes_run_again_are_one_observation_their_majority():
+    """Runs of one plan make the same pushes; where the model or the simulator errs on them it errs
+    every time, so 20 reports of a slipped drag narrow nothing beyond one, and one stuck report
+    among three slipped ones is outvoted."""
+    task = load_task(TASKS / "horizontal-offset-low-mu.yaml")
+    steps = [[0.0, 0.0, 0.0, None]] + [[float(k), -0.1 * k, 0.0, "left"] for k in range(1, 5)]
+
+    def report(slip_mm):
+        return _report(task, steps, [{"pusher": "left", "first_step": 1, "last_step": 4, "slip_mm": slip_mm,
+                                      "slip_deg": 0.001}])
+
+    settings = CalibrationSettings(grid=9)
+    once = calibrate_from_runs(task, [("a.json", report(0.3))], settings).estimates["gripper.mu"]
+    twenty = calibrate_from_runs(task, [(f"{k}.json", report(0.3)) for k in range(20)], settings)
+    assert twenty.estimates["gripper.mu"] == once and len(twenty.probes) == 20
+    outvoted = [("s.json", report(0.01))] + [(f"{k}.json", report(0.3)) for k in range(3)]
+    assert calibrate_from_runs(task, outvoted, settings).estimates["gripper.mu"] == once
+
+
 def test_the_pads_product_is_read_as_the_grip_force_or_the_mass_that_is_named():
     """mu, grip force and mass enter the stable-push test only as mu N / m (docs/model.md section
     7). So the slipped drag of the test above puts the grip force where it put mu, as a share of
