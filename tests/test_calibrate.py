@@ -235,7 +235,10 @@ def test_the_same_pushes_run_again_are_one_observation_their_majority():
     once = calibrate_from_runs(task, [("a.json", report(0.3))], settings).estimates["gripper.mu"]
     twenty = calibrate_from_runs(task, [(f"{k}.json", report(0.3)) for k in range(20)], settings)
     assert twenty.estimates["gripper.mu"] == once and len(twenty.probes) == 20
-    outvoted = [("s.json", report(0.01))] + [(f"{k}.json", report(0.3)) for k in range(3)]
+    shifted = [[v + 0.03 * (k < 3) for k, v in enumerate(step[:3])] + step[3:] for step in steps]  # tracker noise
+    outvoted = [("s.json", report(0.01))] + [(f"{k}.json", report(0.3)) for k in range(2)]
+    outvoted.append(("t.json", _report(task, shifted, [{"pusher": "left", "first_step": 1, "last_step": 4,
+                                                         "slip_mm": 0.3, "slip_deg": 0.001}])))
     assert calibrate_from_runs(task, outvoted, settings).estimates["gripper.mu"] == once
 
 

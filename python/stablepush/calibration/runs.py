@@ -8,11 +8,13 @@ The same pushes run again tell what they told the first time: where the simulato
 errs on a push, it errs on every run of it, so repeats are not fresh evidence. Counted as such, 20
 runs of one plan excluded the world's mu from the pads' interval in 3 of 12 hidden worlds
 (benchmarks/calibrate.py --runs 20). So the contacts that made the same pushes are one
-observation, their majority outcome (a tie: none)."""
+observation, their majority outcome (a tie: none); runs of one plan start where the tracker
+sees the object, so "the same" is within SAME_PUSH."""
 from __future__ import annotations
 
 import time
-from typing import Any, Dict, List, Mapping, Sequence, Tuple
+from dataclasses import dataclass
+from typing import Any, List, Mapping, Sequence, Tuple
 
 import numpy as np
 
@@ -24,6 +26,10 @@ from stablepush.inputs import read_capped
 from stablepush.outputs import protect_input
 from stablepush.task.model import Task, require_task
 
+# Two contacts make the same push when each of their steps is within this (mm, deg): a run starts
+# where the tracker sees the object, so runs of one plan shift its steps by the tracker's noise
+# (0.02-0.05 mm), which moves the push's margins by nothing the grid resolves.
+SAME_PUSH = (0.1, 0.1)
 MAX_REPORT_BYTES = 64 * 1024 * 1024  # a run report's JSON: a long closed-loop run's is a few MB
 
 
@@ -53,6 +59,22 @@ def _steps(report: Mapping[str, Any], source: str) -> List[Tuple[Tuple[float, fl
     return out
 
 
+@dataclass
+class _Push:
+    """The pushes of the runs' contacts that are one push (`same`): by `pusher` through `poses`
+    (x mm, z mm, theta deg per step), its least `margins` over the grid and every outcome seen."""
+
+    pusher: int
+    poses: np.ndarray
+    margins: np.ndarray
+    outcomes: List[bool]
+
+    def same(self, pusher: int, poses: np.ndarray) -> bool:
+        """Whether a contact by `pusher` through `poses` makes this push: each step within SAME_PUSH."""
+        return (pusher == self.pusher and poses.shape == self.poses.shape
+                and bool((np.abs(poses - self.poses) <= np.array([SAME_PUSH[0], SAME_PUSH[0], SAME_PUSH[1]])).all()))
+
+
 def calibrate_from_runs(task: Task, reports: Sequence[Tuple[str, Mapping[str, Any]]],
                         settings: CalibrationSettings = CalibrationSettings()) -> Calibration:
     """What the runs' `reports` ((source, report as JSON) pairs, written by `execute --json` or
@@ -66,7 +88,7 @@ def calibrate_from_runs(task: Task, reports: Sequence[Tuple[str, Mapping[str, An
     instrument = instrument_of(task, settings)
     records: List[ProbeRecord] = []
     seen = [False] * len(task.pushers)
-    pushes: Dict[tuple, Tuple[int, np.ndarray, List[bool]]] = {}  # the same pushes -> (pusher, margins, outcomes)
+    pushes: List[_Push] = []
     for source, report in reports:
         if report.get("task") != task.name:
             raise SettingError(source, f"a run of task {str(report.get('task'))[:80]!r}, not {task.name!r}")
@@ -75,24 +97,26 @@ def calibrate_from_runs(task: Task, reports: Sequence[Tuple[str, Mapping[str, An
             outcome = stuck(contact)
             first, last = int(contact["first_step"]), int(contact["last_step"])
             pusher = task.pusher_index(contact["pusher"], f"{source}: contacts[].pusher")
-            key = (pusher, tuple(tuple(round(v, 6) for v in pose) for pose, _ in steps[first - 1:last + 1]))
-            if key not in pushes:
+            poses = np.array([pose for pose, _ in steps[first - 1:last + 1]])
+            push = next((p for p in pushes if p.same(pusher, poses)), None)
+            if push is None:
                 margins = np.full((len(unknowns.pad_axis),) * 2, np.inf)
-                for (before, _), (after, _) in zip(steps[first - 1:last], steps[first:last + 1]):
-                    move = tuple(a - b for a, b in zip(after, before))
-                    margins = np.minimum(margins, worlds.margins([before], move)[:, :, pusher])
-                pushes[key] = (pusher, margins, [])
+                for before, after in zip(poses[:-1], poses[1:]):
+                    margins = np.minimum(margins, worlds.margins([tuple(before)], tuple(after - before))[:, :, pusher])
+                push = _Push(pusher, poses, margins, [])
+                pushes.append(push)
                 seen[pusher] |= bool((margins > 0.0).any() and not (margins > 0.0).all())
             record = ProbeRecord(contact["pusher"], steps[first - 1][0], (0.0, 0.0, 0.0), last - first + 1,
                                  p_stuck=float("nan"), bits=float("nan"), planned_in={},
                                  slip_mm=contact.get("slip_mm"), slip_deg=contact.get("slip_deg"))
             if outcome is not None:
-                pushes[key][2].append(outcome)
+                push.outcomes.append(outcome)
                 record.outcome = "stuck" if outcome else "slipped"
             records.append(record)
-    for pusher, margins, outcomes in pushes.values():
-        if 2 * sum(outcomes) != len(outcomes):  # a tie (or none observed) tells nothing
-            belief.observe(pusher, instrument.chance(margins), 2 * sum(outcomes) > len(outcomes))
+    for push in pushes:
+        stuck_count = sum(push.outcomes)
+        if 2 * stuck_count != len(push.outcomes):  # a tie (or none observed) tells nothing
+            belief.observe(push.pusher, instrument.chance(push.margins), 2 * stuck_count > len(push.outcomes))
     estimates, unidentified = estimates_of(belief, unknowns, seen, settings, pushes="push of the runs")
     return Calibration(task, estimates, unidentified, records, f"{len(reports)} run report(s) read", settings,
                        wall_time_s=time.perf_counter() - started)
