@@ -83,7 +83,8 @@ class StudyTrials:
     click.option("--target", "target", default=None, type=Finite(min=0, max=1, min_open=True, max_open=True),
                  metavar="RATE", help="Decide whether the plan lands at least RATE of the time (e.g. 0.99), and "
                                       "stop as soon as the evidence does: a sequential probability ratio test, valid "
-                                      "however early it stops (docs/evaluate.md). A rate one point below RATE is "
+                                      "however early it stops (docs/evaluate.md); with --predict, a "
+                                      "prediction-powered test by betting, as valid. A rate one point below RATE is "
                                       "called above with probability at most 1 - --confidence, and one at RATE "
                                       "below likewise; so RATE lies strictly between 0.01 and 1."),
     click.option("--confidence", default=0.95, show_default=True,
@@ -97,8 +98,9 @@ class StudyTrials:
                       "push stable, the release held, the end within the tolerance; about 0.1 ms a world) and on "
                       "each trial's world, and join them to the trials by prediction-powered inference: the summary "
                       "adds the model's agreement with the simulator and an interval that holds whatever that "
-                      "agreement (docs/evaluate.md, 'Odds from predictions'). The trials and --target's decision "
-                      "are the same with or without it. At most 10,000,000."))
+                      "agreement (docs/evaluate.md, 'Odds from predictions'). With --target, the decision uses "
+                      "them too (a prediction-powered test: the same error rates, often fewer trials). Without "
+                      "--target the trials are the same with or without it. At most 10,000,000."))
 @option_group(
     "worlds", WorldSpreads,
     click.option("--vary", "vary", multiple=True, callback=parse_vary, metavar="KEY=FRACTION",
@@ -174,7 +176,7 @@ def evaluate(source: EvaluatedPlan, count: StudyTrials, worlds: WorldSpreads, ru
         check_video("--video-failed", os.path.join(video_dir, "trial-0.mp4"), video.fps, video.size)
     else:
         video_settings_need("--video-failed")
-    from stablepush.evaluation import Batch, decision_state, study_trials, write_evaluation
+    from stablepush.evaluation import Batch, decision_state, decision_test, study_trials, write_evaluation
     from stablepush.evaluation import evaluate as run_evaluation
     from stablepush.outputs import FIGURE_SUFFIXES, require_suffix
     from stablepush.runners import default_workers
@@ -213,11 +215,12 @@ def evaluate(source: EvaluatedPlan, count: StudyTrials, worlds: WorldSpreads, ru
                    f"{'closed' if run.closed_loop else 'open'} loop"
                    f"{'' if run.guarded else ', approaches not guarded'} on {run.engine}, "
                    f"on {runner.describe(trials)}" + (f"; the plan is robust to {box}" if box else ""), err=True)
+    verdicts = _model_only(batch, count.predict, quiet)
+    decider = decision_test(test, verdicts)  # with --predict, the prediction-powered test evaluate() decides by
     with landings_bar(quiet, trials) as landed:
         result = run_evaluation(batch, trials, runner, (lambda record, done: landed(
-            done, suffix=f"; {decision_state(test, done)}" if test else "")) if landed else None, test=test)
-    if count.predict is not None and result.trials:
-        result = _with_predictions(result, count.predict, quiet)
+            done, suffix=f"; {decision_state(decider, done)}" if decider else "")) if landed else None, test=test,
+            predictions=verdicts)
     write_evaluation(result, outputs.json_path, outputs.csv_path, outputs.png_path)
     s = result.summary()
     if not s["trials"]:
@@ -284,13 +287,16 @@ def _plan_for(task, spreads, robust: bool):
     return task, plan
 
 
-def _with_predictions(result, predict: int, quiet: bool):
-    """The evaluation with the model's verdicts on `predict` model-only worlds and on each trial's."""
-    from stablepush.evaluation import with_predictions
+def _model_only(batch, predict: Optional[int], quiet: bool):
+    """The model's verdicts on `predict` model-only worlds (None without --predict), made before the
+    trials: evaluate() joins them to the trials, and a --target decision uses them."""
+    from stablepush.evaluation import model_only_verdicts
 
+    if predict is None:
+        return None
     if not quiet:
         click.echo(f"predicting {predict:,} model-only worlds", err=True)
-    return with_predictions(result, predict)  # its count was checked before the trials
+    return model_only_verdicts(batch, predict)  # its count was checked before the trials
 
 
 def _test(target, confidence: float):

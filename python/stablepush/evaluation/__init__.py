@@ -9,7 +9,9 @@ from stablepush.evaluation.batch import (
     Evaluation,
     check_predictions,
     decision_state,
+    decision_test,
     evaluate,
+    model_only_verdicts,
     run_trial,
     study_trials,
     wilson_interval,
@@ -18,10 +20,11 @@ from stablepush.evaluation.batch import (
 )
 from stablepush.evaluation.ppi import PredictedRate, prediction_powered_rate
 from stablepush.evaluation.prediction import PlanInWorlds, Prediction, predicted_multipliers
-from stablepush.evaluation.sequential import SequentialTest
+from stablepush.evaluation.sequential import PredictionPoweredTest, SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world, robust_task
 
-__all__ = ["Batch", "Evaluation", "MAX_PREDICTIONS", "PlanInWorlds", "PredictedRate", "Prediction", "SequentialTest",
-           "Spreads", "TrialWorld", "VARY_KEYS", "check_predictions", "decision_state", "draw_world", "evaluate",
-           "predicted_multipliers", "prediction_powered_rate", "robust_task", "run_trial", "study_trials",
-           "wilson_interval", "with_predictions", "write_evaluation"]
+__all__ = ["Batch", "Evaluation", "MAX_PREDICTIONS", "PlanInWorlds", "PredictedRate", "Prediction",
+           "PredictionPoweredTest", "SequentialTest", "Spreads", "TrialWorld", "VARY_KEYS", "check_predictions",
+           "decision_state", "decision_test", "draw_world", "evaluate", "model_only_verdicts", "predicted_multipliers",
+           "prediction_powered_rate", "robust_task", "run_trial", "study_trials", "wilson_interval", "with_predictions",
+           "write_evaluation"]

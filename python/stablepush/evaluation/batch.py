@@ -18,14 +18,14 @@ import os
 import time
 import traceback
 from dataclasses import dataclass
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from stablepush.errors import SettingError
 from stablepush.evaluation.ppi import PredictedRate, prediction_powered_rate
 from stablepush.evaluation.prediction import PlanInWorlds, predicted_multipliers
-from stablepush.evaluation.sequential import SequentialTest
+from stablepush.evaluation.sequential import PredictionPoweredTest, SequentialTest
 from stablepush.evaluation.worlds import VARY_KEYS, Spreads, TrialWorld, draw_world
 from stablepush.execution.bags import RunRecording
 from stablepush.execution.closed_loop import ClosedLoop
@@ -227,9 +227,14 @@ def study_trials(spreads: Spreads, trials: Optional[int] = None, test: Optional[
     return spreads.trials_to_run(trials)
 
 
+# A count of model-only worlds to predict, or the model's verdicts on them already (model_only_verdicts)
+ModelOnly = Union[int, np.ndarray]
+AnyTest = Union[SequentialTest, PredictionPoweredTest]
+
+
 def evaluate(batch: Batch, trials: Optional[int] = None, runner: Runner = Runner(),
              progress: Optional[Callable[[dict, List[dict]], None]] = None,
-             test: Optional[SequentialTest] = None) -> "Evaluation":
+             test: Optional[SequentialTest] = None, predictions: Optional[ModelOnly] = None) -> "Evaluation":
     """Run trials 0 .. trials-1 of `batch` on `runner` (None: study_trials' default);
     `progress(record, done)` after each. Ctrl-C (KeyboardInterrupt) stops the batch and keeps the
     trials done (`interrupted`). When every world is the model's own (Spreads.one_world) one trial
@@ -237,23 +242,33 @@ def evaluate(batch: Batch, trials: Optional[int] = None, runner: Runner = Runner
     (sequential.py), `trials` is a cap: the study stops once the test decides. It is asked after
     each trial in the order of the trials' numbers (a trial that finishes early on another worker
     waits for those before it), since a test asked in the order trials happen to finish could be
-    swayed by how long each kind takes; decision_state(test, done) is where it stands."""
+    swayed by how long each kind takes; decision_state(test, done) is where it stands.
+
+    With `predictions` (a count of model-only worlds, or the model's verdicts on them from
+    model_only_verdicts), the model predicts those worlds before the trials, each finished trial
+    gets its own world's verdict (`predicted`), and the evaluation is returned joined with them
+    (with_predictions); a `test` then decides by the prediction-powered test of its settings
+    (decision_test), whose decision the evaluation's `decision` names (`method`)."""
     if not isinstance(batch, Batch):
         raise TypeError(f"batch must be a Batch, got {type(batch).__name__}")
     if not isinstance(runner, Runner):
         raise TypeError(f"runner must be a Runner (stablepush.runners.Runner), got {type(runner).__name__}")
     if test is not None and not isinstance(test, SequentialTest):
         raise TypeError(f"test must be a SequentialTest or None, got {type(test).__name__}")
+    verdicts = None if predictions is None else model_only_verdicts(batch, predictions)
+    judge = None if verdicts is None else _judge(batch)
     trials = study_trials(batch.spreads, trials, test)
     source = run_all(run_trial, batch, range(trials), runner)
     started = time.perf_counter()
     done: List[dict] = []
     interrupted = False
-    decision = _Decision(test)
+    decision = _Decision(decision_test(test, verdicts))
     try:
         for i, record in source:
             if isinstance(record, WorkerLost):
                 record = _crashed(batch, i, record.why)
+            if judge is not None:  # microseconds: the model's verdict on the trial's own world
+                record = {**record, "predicted": judge.predict(batch.world(i)).as_dict()}
             done.append(record)
             if progress is not None:
                 progress(record, done)
@@ -266,8 +281,10 @@ def evaluate(batch: Batch, trials: Optional[int] = None, runner: Runner = Runner
         if close is not None:
             close()
     done.sort(key=lambda r: r["trial"])
-    return Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started, runner=runner.describe(trials),
-                      requested=trials, interrupted=interrupted, decision=decision.as_dict())
+    evaluation = Evaluation(batch=batch, trials=done, wall_s=time.perf_counter() - started,
+                            runner=runner.describe(trials), requested=trials, interrupted=interrupted,
+                            decision=decision.as_dict())
+    return evaluation if verdicts is None or not done else with_predictions(evaluation, verdicts)
 
 
 def check_predictions(predictions: int) -> int:
@@ -278,56 +295,95 @@ def check_predictions(predictions: int) -> int:
     return predictions
 
 
-def with_predictions(evaluation: "Evaluation", predictions: int) -> "Evaluation":
-    """`evaluation` with the model's verdict on each trial's world (each record's `predicted`) and
-    its success rate from `predictions` model-only worlds of the same spreads joined with the
-    trials by prediction-powered inference (ppi.prediction_powered_rate; the crashed trials left
-    out, as from the rate). SettingError for a count of predictions that is not a whole number
-    from 1 to MAX_PREDICTIONS."""
+def _judge(batch: Batch) -> PlanInWorlds:
+    return PlanInWorlds(batch.task, batch.plan, batch.success_tolerance, batch.closed_loop)
+
+
+def model_only_verdicts(batch: Batch, predictions: ModelOnly) -> np.ndarray:
+    """The model's verdicts (a bool array) on `predictions` model-only worlds of the batch's spreads
+    (prediction.predicted_multipliers); verdicts already made (an array) are returned as they are.
+    SettingError for a count that is not a whole number from 1 to MAX_PREDICTIONS."""
+    if isinstance(predictions, np.ndarray):
+        if predictions.ndim != 1 or predictions.size == 0:
+            raise ValueError(f"model-only verdicts must be a non-empty 1-d array, got shape {predictions.shape}")
+        return predictions.astype(bool)
     check_predictions(predictions)
+    return _judge(batch).predict_multipliers(predicted_multipliers(batch.seed, predictions, batch.spreads))
+
+
+def decision_test(test: Optional[SequentialTest], verdicts: Optional[np.ndarray] = None) -> Optional[AnyTest]:
+    """The test a study decides with: with the model's `verdicts` on model-only worlds, the
+    prediction-powered test of `test`'s settings (sequential.PredictionPoweredTest), else `test`."""
+    if test is None or verdicts is None:
+        return test
+    return PredictionPoweredTest.of(test, verdicts)
+
+
+def with_predictions(evaluation: "Evaluation", predictions: ModelOnly) -> "Evaluation":
+    """`evaluation` with the model's verdict on each trial's world (each record's `predicted`; one
+    it has is kept) and its success rate from `predictions` model-only worlds of the same spreads
+    (a count, or the verdicts model_only_verdicts made) joined with the trials by
+    prediction-powered inference (ppi.prediction_powered_rate; the crashed trials left out, as
+    from the rate). SettingError for a count of predictions that is not a whole number from 1 to
+    MAX_PREDICTIONS."""
     batch = evaluation.batch
-    judge = PlanInWorlds(batch.task, batch.plan, batch.success_tolerance, batch.closed_loop)
-    trials = [{**t, "predicted": judge.predict(batch.world(t["trial"])).as_dict()} for t in evaluation.trials]
+    verdicts = model_only_verdicts(batch, predictions)
+    judge = _judge(batch)
+    trials = [t if "predicted" in t else {**t, "predicted": judge.predict(batch.world(t["trial"])).as_dict()}
+              for t in evaluation.trials]
     judged = [t for t in trials if not crashed(t)]
-    rate = prediction_powered_rate(
-        [bool(t["success"]) for t in judged], [t["predicted"]["lands"] for t in judged],
-        judge.predict_multipliers(predicted_multipliers(batch.seed, predictions, batch.spreads)))
+    rate = prediction_powered_rate([bool(t["success"]) for t in judged], [t["predicted"]["lands"] for t in judged],
+                                   verdicts)
     return dataclasses.replace(evaluation, trials=trials, prediction=rate)
 
 
-def decision_state(test: SequentialTest, done: Sequence[dict]) -> str:
-    """Where `test` stands on the trial records `done` (finished in any order), as evaluate() feeds
+def decision_state(test: AnyTest, done: Sequence[dict]) -> str:
+    """Where `test` (as decision_test gives it: the prediction-powered test reads each record's
+    `predicted`) stands on the trial records `done` (finished in any order), as evaluate() feeds
     it: the trials in the order of their numbers up to the first not yet finished, in words
-    (SequentialTest.state), for a progress line."""
+    (the test's state), for a progress line."""
     decision = _Decision(test)
     for record in sorted(done, key=lambda r: r["trial"]):
         if decision.add(record):
             break
+    if isinstance(test, PredictionPoweredTest):
+        return test.state(decision.landed, decision.predicted)
     return test.state(decision.successes, decision.judged)
 
 
 class _Decision:
     """A sequential test fed the trials in the order of their numbers."""
 
-    def __init__(self, test: Optional[SequentialTest]):
+    def __init__(self, test: Optional[AnyTest]):
         self.test = test
-        self.waiting: Dict[int, Optional[bool]] = {}  # None: a crashed trial, passed over
+        # (landed, the model's verdict on its world; None without predictions); None: a crashed trial, passed over
+        self.waiting: Dict[int, Optional[Tuple[bool, Optional[bool]]]] = {}
         self.next = self.successes = self.judged = 0
+        self.landed: List[bool] = []
+        self.predicted: List[bool] = []
         self.verdict: Optional[str] = None
 
     def add(self, record: dict) -> bool:
         """Take a finished trial; whether the test has decided."""
         if self.test is None or self.verdict is not None:
             return self.verdict is not None
+        powered = isinstance(self.test, PredictionPoweredTest)
         # A crashed trial is no evidence either way (an internal error, not a miss): it is passed over.
-        self.waiting[record["trial"]] = None if crashed(record) else bool(record["success"])
+        self.waiting[record["trial"]] = None if crashed(record) else (
+            bool(record["success"]), bool(record["predicted"]["lands"]) if powered else None)
         while self.next in self.waiting and self.verdict is None:
-            landed = self.waiting.pop(self.next)
+            trial = self.waiting.pop(self.next)
             self.next += 1
-            if landed is not None:
+            if trial is not None:
+                landed, predicted = trial
                 self.judged += 1
                 self.successes += landed
-                self.verdict = self.test.decide(self.successes, self.judged)
+                self.landed.append(landed)
+                if isinstance(self.test, PredictionPoweredTest):
+                    self.predicted.append(bool(predicted))
+                    self.verdict = self.test.decide(self.landed, self.predicted)
+                else:
+                    self.verdict = self.test.decide(self.successes, self.judged)
         return self.verdict is not None
 
     def as_dict(self) -> Optional[dict]:
