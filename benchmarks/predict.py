@@ -5,6 +5,7 @@ prediction-powered interval gives against the trials' own.
     python3 benchmarks/predict.py rows [TASK.yaml ...] [--trials 100] [--predict 100000] [--plans nominal robust]
                                        [--loop open closed] [--workers 2] [--md OUT.md]
     python3 benchmarks/predict.py validity [--studies 2000] [--md OUT.md]
+    python3 benchmarks/predict.py decision [--studies 2000] [--md OUT.md]
 
 `rows`: each task's seed-1 plan (or its robust plan), in the tables' worlds (evaluate_tasks.SPREADS,
 judged within 0.5 mm and 0.5 deg): N simulated trials with the model's verdict on each, the
@@ -15,6 +16,12 @@ predictions took.
 `validity`: synthetic studies (100 trials, 100,000 model-only worlds; rates 0.99, 0.9, 0.6) with
 predictors of every quality: how often the 95% interval holds the rate, for ours and, when the
 `ppi-python` package is installed, for its CLT interval (`ppi_mean_ci`, PPI++).
+
+`decision`: synthetic studies of `--target 0.99` (95% confidence, capped at the Wald test's default
+cap, 1,276 trials; rates 0.999 to 0.95; 10,000 model-only worlds each, drawn with the same
+predictor) decided by Wald's SPRT (the trials alone) and by the prediction-powered test (with the
+model's verdicts): the share of studies decided each way, and the trials to decide (median, p90;
+an undecided study counts the cap).
 """
 import argparse
 import subprocess
@@ -28,6 +35,7 @@ from shipped import shipped_tasks
 
 from stablepush.evaluation import Batch, evaluate, robust_task, with_predictions
 from stablepush.evaluation.ppi import clopper_pearson, prediction_powered_rate
+from stablepush.evaluation.sequential import PredictionPoweredTest, SequentialTest
 from stablepush.plan import plan_task
 from stablepush.task import load_task
 
@@ -36,6 +44,8 @@ PREDICTORS = {
     "exact": lambda y, rng: y,
     "noisy (10% flipped)": lambda y, rng: y ^ (rng.random(y.size) < 0.1),
     "biased toward landing": lambda y, rng: y | (rng.random(y.size) < 0.5),
+    # as the tables' model (results/predict_rows.md): never says lands of a miss, calls some landings misses
+    "pessimistic (20% of landings called misses)": lambda y, rng: y & (rng.random(y.size) >= 0.2),
     "always wrong": lambda y, rng: ~y,
 }
 
@@ -106,9 +116,41 @@ def validity(args) -> list:
     return lines
 
 
+DECISION_RATES = (0.999, 0.995, 0.99, 0.98, 0.95)
+
+
+def decision(args) -> list:
+    wald = SequentialTest(0.99)
+    cap = wald.default_cap()
+    lines = ["| predictor | rate | studies | Wald: above / below / undecided | trials median / p90 "
+             "| with predictions: above / below / undecided | trials median / p90 |",
+             "|---|---:|---:|---|---:|---|---:|"]
+    for name, predictor in PREDICTORS.items():
+        for rate in DECISION_RATES:
+            rng = np.random.default_rng([args.seed, round(rate * 1000)])
+            ours, theirs = [], []
+            for _ in range(args.studies):
+                y = rng.random(cap) < rate
+                f = predictor(y, rng)
+                test = PredictionPoweredTest.of(wald, predictor(rng.random(args.predict) < rate, rng))
+                ours.append(test.first_decision(y, f))
+                theirs.append(wald.first_decision(y))
+            line = f"| {name} | {rate:g} | {args.studies} | {_decided(theirs)} | {_decided(ours)} |"
+            lines.append(line)
+            print(line, flush=True)
+    return lines
+
+
+def _decided(results) -> str:
+    verdicts = [v for v, _ in results]
+    shares = " / ".join(f"{verdicts.count(v) / len(results):.1%}" for v in ("above", "below", "undecided"))
+    n = np.array([k for _, k in results])
+    return f"{shares} | {np.median(n):.0f} / {np.percentile(n, 90):.0f}"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=("rows", "validity"))
+    parser.add_argument("what", choices=("rows", "validity", "decision"))
     parser.add_argument("tasks", nargs="*", type=Path)
     parser.add_argument("--trials", type=int, default=100)
     parser.add_argument("--predict", type=int, default=100_000)
@@ -119,9 +161,9 @@ def main() -> None:
     parser.add_argument("--md", type=Path, default=None, help="also write the table to this markdown file")
     add_runner_options(parser, workers=2)
     args = parser.parse_args()
-    if args.what == "validity":
+    if args.what in ("validity", "decision"):
         args.predict = min(args.predict, 10_000)  # the synthetic predictions cost nothing but memory
-    lines = rows(args) if args.what == "rows" else validity(args)
+    lines = {"rows": rows, "validity": validity, "decision": decision}[args.what](args)
     if args.md:
         command = " ".join(["python3", "benchmarks/predict.py", *sys.argv[1:]])
         commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
