@@ -173,6 +173,13 @@ PRIOR_TRIALS = 1.0
 # is trusted only as far as trials under both its verdicts show (the model of the tables' rows is
 # pessimistic: most worlds it calls misses land; benchmarks/results/predict_rows.md).
 VERDICT_PRIOR_TRIALS = 1.0
+# The share of the wealth held in Wald's likelihood ratio (SequentialTest's) rather than in the bets.
+# The bets are bold: they decide far above the target sooner than Wald, but near the indifference
+# zone, with a model that is not exact, they leave many studies undecided where Wald's ratio (the
+# most powerful between the two rates it weighs) decides; a mixture of the two is itself a wealth
+# (a nonnegative supermartingale of mean 1 under each hypothesis), and either decides it, each
+# paying log(1 / its share) for the other's place (benchmarks/results/predict_decision.md).
+WALD_WEIGHT = 0.5
 
 
 @dataclass(frozen=True)
@@ -217,6 +224,12 @@ class PredictionPoweredTest:
     (mu_hat - m)^2) and b' with m' - mu_hat, from the running mean and variance of the Z before t
     with a prior of PRIOR_TRIALS trials at the indifference zone's middle, truncated to the range.
 
+    The test holds WALD_WEIGHT of its wealth in Wald's likelihood ratio exp(L_t) (SequentialTest;
+    a nonnegative martingale of mean 1 under p0, its inverse under p1, whatever the model) and the
+    rest in the bets, and decides by the mixture: a mixture of wealths is a wealth, so the error
+    rates hold as above, and it decides about as soon as the better of the two, each paying
+    log(1 / its share) in log wealth.
+
     What it cannot beat: a trial that lands moves log K by at most log((Z - min Z) / (m - min Z)),
     about log(1 / p0), so near a target of 0.99 (p0 = 0.98) `above` takes at least about 150
     trials however good the model (the binomial floor: 0.98^n <= alpha); Wald's test needs 296.
@@ -260,6 +273,17 @@ class PredictionPoweredTest:
         return level, level
 
     def log_wealth(self, landed: Verdicts, predicted: Verdicts) -> Tuple[np.ndarray, np.ndarray]:
+        """The log wealths the test decides by after each trial (`above`'s, `below`'s): the bets'
+        (betting_log_wealth) mixed with Wald's likelihood ratio, WALD_WEIGHT of it,
+        log((1 - w) K_t + w exp(L_t)) and log((1 - w) K'_t + w exp(-L_t))."""
+        above, below = self.betting_log_wealth(landed, predicted)
+        wald = SequentialTest(self.target, self.confidence, self.indifference)
+        win, loss = wald.steps
+        ratio = np.cumsum(np.where(np.asarray(landed, bool), win, loss))
+        bet, lr = math.log(1.0 - WALD_WEIGHT), math.log(WALD_WEIGHT)
+        return np.logaddexp(bet + above, lr + ratio), np.logaddexp(bet + below, lr - ratio)
+
+    def betting_log_wealth(self, landed: Verdicts, predicted: Verdicts) -> Tuple[np.ndarray, np.ndarray]:
         """log K_t (`above`'s) and log K'_t (`below`'s) after each trial, with the trials' outcomes
         `landed` and the model's verdicts on their worlds `predicted`, in the order they were run.
         ValueError for sequences of different lengths."""
