@@ -49,6 +49,9 @@ def main() -> None:
                         help="decide whether each row lands at least RATE of the time and stop it when decided "
                              "(evaluate --target); --trials is then the cap")
     parser.add_argument("--confidence", type=float, default=0.95, help="with --target (default 0.95)")
+    parser.add_argument("--predict", type=int, default=None, metavar="N",
+                        help="N model-only worlds joined to the trials; with --target the decision uses them "
+                             "(evaluate --predict)")
     parser.add_argument("--json", type=Path, default=None,
                         help="every row's summary, with its missed trials' records under `missed` (trial, world, "
                              "verdict, replans: enough to run one again), as JSON")
@@ -75,14 +78,16 @@ def main() -> None:
                               guarded=approach == "guarded", engine=args.engine, tolerance=args.tolerance)
                 progress = progress_line(f"{task.name} {kind}", f"{loop} {approach}", args.trials)
                 test = SequentialTest(args.target, args.confidence) if args.target is not None else None
-                evaluation = evaluate(batch, args.trials, runner, progress=progress, test=test)
+                evaluation = evaluate(batch, args.trials, runner, progress=progress, test=test,
+                                      predictions=args.predict)
                 s = evaluation.summary()
                 missed = [t for t in evaluation.trials if not t["success"]]
                 summaries.append({**s, "plan": kind, "approach": approach, "missed": missed})
                 mm, deg = s["goal_error_mm"] or {}, s["goal_error_deg"] or {}
                 misses = ", ".join(f"{k} {v}" for k, v in sorted(s["causes"].items())) or "-"
                 if s["decision"] is not None:
-                    misses += f"; decision {s['decision']['decision']} after {s['decision']['trials']} trials"
+                    misses += (f"; decision {s['decision']['decision']} after {s['decision']['trials']} trials "
+                               f"({s['decision']['method']})")
                 tol = s["tolerance"]
                 print(f"| {task.name} | {kind} | {loop} | {approach} | {tol[0]:g} mm, {tol[1]:g} deg "
                       f"| {s['successes']}/{s['trials']} "
