@@ -189,12 +189,19 @@ def test_the_calibrated_task_file_holds_the_estimates_and_a_box_over_the_interva
     calibration = _calibration(task)
     text = calibrated_task_text(calibration)
     again = parse_task(text, source="calibrated.yaml")
-    assert again.gripper.mu == pytest.approx(0.4) and again.pushers[0].mu == pytest.approx(0.21)
+    assert again.gripper.mu == pytest.approx(0.4)
+    # left at its interval's low end: a plan stable there is stable over the whole interval
+    assert again.pushers[0].mu == pytest.approx(0.2)
     assert again.pushers[1].mu == task.pushers[1].mu  # right: not estimated, kept
-    # the box covers each interval about its estimate
+    # the pads' box covers their interval about the estimate
     assert again.gripper.mu * (1 - again.uncertainty["pad_mu"]) <= 0.38
     assert again.gripper.mu * (1 + again.uncertainty["pad_mu"]) >= 0.43
-    assert again.pushers[0].mu * (1 - again.uncertainty["pusher_mu"]) <= 0.2
+    assert again.uncertainty.get("pusher_mu", 0.0) == task.uncertainty.get("pusher_mu", 0.0)  # bottom: unidentified
+    every = Calibration(task, {"gripper.mu": Interval(0.4, 0.38, 0.43), **{
+        f"pushers.{p.name}.mu": Interval(0.2, 0.15, 0.3) for p in task.pushers}}, {}, [], "test",
+        CalibrationSettings())
+    assert "pusher_mu" not in every.calibrated_task().uncertainty
+    assert {p.mu for p in every.calibrated_task().pushers} == {0.15}
     assert "# Paper Table II" in text  # the task file's own comments kept
     assert "pushers.bottom.mu: not identified" in text
 

@@ -17,8 +17,8 @@ DIGITS = 4  # significant digits of an estimate written to the task file
 
 
 def calibrated_mapping(text: str, calibration: Calibration) -> Dict[str, Any]:
-    """The task file's mapping (`text`, its YAML) with each estimated quantity replaced by its estimate
-    and `uncertainty` covering every interval (Calibration.calibrated_task, rounded outward)."""
+    """The task file's mapping (`text`, its YAML) with the calibrated values and `uncertainty`
+    (Calibration.calibrated_task; the box rounded outward)."""
     mapping = yaml.safe_load(text)
     calibrated = calibration.calibrated_task()
     for field_name in PAD_PRODUCT:
@@ -51,6 +51,9 @@ def calibrated_task_text(calibration: Calibration, text: Optional[str] = None) -
                      f"the task said {task.value(name):.4g})")
     for name, why in calibration.unidentified.items():
         lines.append(f"#   {name}: not identified ({why}): the task's value is kept")
+    if any(name.startswith("pushers.") for name in calibration.estimates):
+        lines.append("# Each feature's mu is written at its interval's low end: a push stable there is stable at "
+                     "any higher mu.")
     return commented_task(text, calibrated_mapping(text, calibration), "\n".join(lines) + "\n")
 
 

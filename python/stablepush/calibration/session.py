@@ -80,19 +80,22 @@ class Calibration:
     wall_time_s: float = 0.0
 
     def calibrated_task(self) -> Task:
-        """The task with each estimated quantity replaced by its estimate and an uncertainty box
-        that covers every interval: `pad_mu` (`grip_force`, `mass`) the pads' half-width,
-        `pusher_mu` the widest pusher's (and
-        the task's own where a pusher was not identified), each a share of its estimate."""
-        values = {name: interval.value for name, interval in self.estimates.items()}
+        """The task as calibrated, for plans that hold wherever the world lies in the intervals:
+        the pads' quantity at its estimate with an uncertainty box (`pad_mu`, or `grip_force` or
+        `mass` when that was estimated) of its interval's half-width as a share of the estimate;
+        each identified pusher's mu at its interval's low end, with no box of its own: a push
+        stable there is stable at any higher mu (a pusher's cone only grows with its mu,
+        docs/model.md section 7), so one `pusher_mu` box over every pusher, as wide as the least
+        known one's interval, would ask more of the plan than the intervals do. The task's own
+        `pusher_mu` is kept where a pusher was not identified."""
+        values = {name: interval.low if name.startswith("pushers.") else interval.value
+                  for name, interval in self.estimates.items()}
         box = dict(self.task.uncertainty)
         for key, field_name in UNCERTAIN.items():
             if field_name in PAD_PRODUCT and field_name in self.estimates:
                 box[key] = _share(self.estimates[field_name])
-        pushers = [_share(i) for name, i in self.estimates.items() if name.startswith("pushers.")]
-        if pushers:
-            left = [box.get("pusher_mu", 0.0)] if any(n.startswith("pushers.") for n in self.unidentified) else []
-            box["pusher_mu"] = max(pushers + left)
+        if not any(name.startswith("pushers.") for name in self.unidentified):
+            box.pop("pusher_mu", None)
         return dataclasses.replace(self.task.with_values(values), uncertainty={k: v for k, v in box.items() if v > 0})
 
     def as_dict(self) -> dict:
