@@ -16,7 +16,7 @@ from typing import Callable, Dict, Optional
 
 from stablepush.design.layouts import Design, DesignStudy
 from stablepush.errors import SettingError
-from stablepush.evaluation import Batch, Spreads, check_predictions, evaluate, with_predictions
+from stablepush.evaluation import Batch, Spreads, check_predictions, evaluate
 from stablepush.evaluation.batch import MAX_TRIALS
 from stablepush.runners import Runner
 from stablepush.sim.deviation import MAX_SEED
@@ -89,9 +89,8 @@ def evaluate_designs(study: DesignStudy, odds: DesignOdds, runner: Optional[Runn
             d.success = {"refused": str(refusal)}
             continue
         measured = evaluate(batch, odds.trials, runner,
-                            progress=functools.partial(progress, d) if progress else None)  # progress(d, record, done)
-        if odds.predict is not None and measured.trials:
-            measured = with_predictions(measured, odds.predict)
+                            progress=functools.partial(progress, d) if progress else None,  # progress(d, record, done)
+                            predictions=odds.predict)
         s = measured.summary()
         d.success = {key: s[key] for key in ("trials", "judged", "successes", "success_rate", "ci95", "causes",
                                              "crashed", "wall_s")}

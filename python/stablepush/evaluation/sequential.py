@@ -140,11 +140,15 @@ class SequentialTest:
         return (f"the test cannot decide above within {cap} trials: a plan that lands every time needs {needed} "
                 f"(the default cap is {self.default_cap()})")
 
+    def log_ratios(self, outcomes: Verdicts) -> np.ndarray:
+        """The log likelihood ratio after each of `outcomes` (landed or not), in order."""
+        win, loss = self.steps
+        return np.cumsum(np.where(np.asarray(outcomes, bool), win, loss))
+
     def first_decision(self, outcomes: Sequence[bool]) -> Tuple[str, int]:
         """The test run over `outcomes` in order: its verdict and the trials it took (all of them,
         `undecided`, when neither bound was reached)."""
-        win, loss = self.steps
-        ratio = np.cumsum(np.where(np.asarray(outcomes, bool), win, loss))
+        ratio = self.log_ratios(outcomes)
         low, high = self.bounds
         crossed = np.flatnonzero((ratio >= high) | (ratio <= low))
         if crossed.size == 0:
@@ -277,9 +281,7 @@ class PredictionPoweredTest:
         (betting_log_wealth) mixed with Wald's likelihood ratio, WALD_WEIGHT of it,
         log((1 - w) K_t + w exp(L_t)) and log((1 - w) K'_t + w exp(-L_t))."""
         above, below = self.betting_log_wealth(landed, predicted)
-        wald = SequentialTest(self.target, self.confidence, self.indifference)
-        win, loss = wald.steps
-        ratio = np.cumsum(np.where(np.asarray(landed, bool), win, loss))
+        ratio = SequentialTest(self.target, self.confidence, self.indifference).log_ratios(landed)
         bet, lr = math.log(1.0 - WALD_WEIGHT), math.log(WALD_WEIGHT)
         return np.logaddexp(bet + above, lr + ratio), np.logaddexp(bet + below, lr - ratio)
 
