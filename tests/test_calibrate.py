@@ -295,6 +295,24 @@ def test_a_pushs_verdict_depends_on_mu_times_grip_force_over_mass_alone(name):
     assert 0 < sum(flips) < len(flips)  # both verdicts occur
 
 
+def test_an_interval_at_the_grids_end_is_said_to_be_there():
+    """The posterior knows the task's value times 1 -+ spread only: a mass of 300 g against the
+    task's 130 was estimated 186 (160 to 195 = 130 x 1.5) on the arm. Such an interval is flagged;
+    one inside the grid, or down at a frictionless grid's 0, is not."""
+    task = load_task(TASKS / "large-manipulation.yaml")
+    settings = CalibrationSettings(estimate=("object.mass",))
+    calibration = Calibration(task, {"object.mass": Interval(186.2, 159.8, 195.0),
+                                     "pushers.left.mu": Interval(0.6, 0.4, 0.8),
+                                     "pushers.right.mu": Interval(0.35, 0.3, 0.45)}, {}, [], "test", settings)
+    assert calibration.at_grid_edge() == {"object.mass": "high", "pushers.right.mu": "low"}
+    assert calibration.as_dict()["at_grid_edge"] == calibration.at_grid_edge()
+    assert "    at the grid's high end (the task's value x1.5): the world may lie beyond it" in "\n".join(
+        calibration.describe())
+    frictionless = Calibration(task.with_values({"pushers.left.mu": 0.0}), {"pushers.left.mu": Interval(0.1, 0.0, 0.3)},
+                               {}, [], "test", settings)
+    assert frictionless.at_grid_edge() == {}
+
+
 def test_a_calibrated_grip_force_is_written_with_its_box():
     task = load_task(TASKS / "horizontal-offset-low-mu.yaml")
     calibration = Calibration(task, {"gripper.grip_force": Interval(12.0, 11.0, 13.5)}, {}, [], "test",

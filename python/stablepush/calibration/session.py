@@ -16,7 +16,7 @@ import time
 from dataclasses import dataclass
 from typing import Callable, Dict, List, Optional, Tuple
 
-from stablepush.calibration.belief import Belief, Interval
+from stablepush.calibration.belief import Belief, Interval, grid
 from stablepush.calibration.probes import (
     Instrument,
     Probe,
@@ -103,15 +103,35 @@ class Calibration:
                 "estimates": {name: i.as_dict() for name, i in self.estimates.items()},
                 "unidentified": dict(self.unidentified), "probes": [p.as_dict() for p in self.probes],
                 "uncertainty": self.calibrated_task().uncertainty, "returned": self.returned,
-                "settings": dataclasses.asdict(self.settings), "wall_time_s": self.wall_time_s}
+                "at_grid_edge": self.at_grid_edge(), "settings": dataclasses.asdict(self.settings),
+                "wall_time_s": self.wall_time_s}
+
+    def at_grid_edge(self) -> Dict[str, str]:
+        """The estimates whose interval reaches an end of the grid (`low` or `high`): the posterior
+        knows only the task's value times 1 -+ settings.spread, so a world beyond it is reported at
+        that end, and the other estimates lean to make up for it. A grid that starts at 0 (no
+        lower value is possible) has no low end to reach."""
+        out = {}
+        for name, interval in self.estimates.items():
+            low, high = grid(self.task.value(name), self.settings.spread, 2)
+            if interval.high >= high * (1.0 - 1e-9):
+                out[name] = "high"
+            elif low > 0.0 and interval.low <= low * (1.0 + 1e-9):
+                out[name] = "low"
+        return out
 
     def describe(self) -> List[str]:
         """The lines `stablepush calibrate` prints."""
         lines = [f"{self.task.name}: {len(self.probes)} probe(s), stopped: {self.stopped} "
                  f"({self.wall_time_s:.1f} s)"]
+        edges = self.at_grid_edge()
         for name, i in self.estimates.items():
             lines.append(f"  {name}: {i.value:.4g} ({self.settings.level:.0%} interval {i.low:.4g} to {i.high:.4g}, "
                          f"+-{_share(i):.1%}; the task said {self.task.value(name):.4g})")
+            if name in edges:
+                factor = 1.0 + self.settings.spread if edges[name] == "high" else 1.0 - self.settings.spread
+                lines.append(f"    at the grid's {edges[name]} end (the task's value x{factor:g}): the world may lie "
+                             f"beyond it, and the other estimates then lean to make up for it")
         for name, why in self.unidentified.items():
             lines.append(f"  {name}: not identified: {why}")
         if self.returned is not None:
