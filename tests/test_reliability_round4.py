@@ -199,7 +199,7 @@ def test_n_an_evaluation_stopped_by_ctrl_c_says_how_many_trials_each_design_ran(
 
     monkeypatch.setattr(design_package, "design", search)
     monkeypatch.setattr(odds, "Batch", lambda **kw: kw)
-    monkeypatch.setattr(odds, "evaluate", lambda batch, trials, runner, progress=None: _Stopped(12))
+    monkeypatch.setattr(odds, "evaluate", lambda batch, trials, runner, progress=None, predictions=None: _Stopped(12))
     result = _design(path, *QUICK, "--out", tmp_path / "out", "--evaluate", "30", "--evaluate-top", "2",
                      "--json", tmp_path / "d.json")
     assert result.exit_code == 130, result.output
